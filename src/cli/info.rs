@@ -1,0 +1,100 @@
+//! `ctcal info`: what a recording is (format, sensor, events, time span, frames).
+
+use super::{Global, InputArgs, JsonTarget, emit_json, output, progress_bar, warn};
+use clap::Args;
+use ctcal::Recording;
+use serde::Serialize;
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Write the result as JSON to PATH (`-` for stdout).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+#[derive(Serialize)]
+struct Info {
+    format: ctcal::Format,
+    width: u16,
+    height: u16,
+    sensor_source: String,
+    events: u64,
+    on_events: u64,
+    t_first_us: i64,
+    t_last_us: i64,
+    /// Places where a timestamp is earlier than the one before.
+    timestamps_backwards: u64,
+    frames: usize,
+    file_bytes: u64,
+}
+
+pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
+    let recording = Recording::open(&args.input.input, &args.input.open_options())?;
+    for note in &recording.notes {
+        warn(global, note);
+    }
+    let mut stream = recording.events()?;
+    stream.allow_unsorted = true;
+    let bar = progress_bar(global, stream.progress().total, "reading");
+    let (mut first, mut last, mut on) = (i64::MAX, i64::MIN, 0u64);
+    while let Some(chunk) = stream.next_chunk()? {
+        first = first.min(*chunk.t.iter().min().expect("non-empty"));
+        last = last.max(*chunk.t.iter().max().expect("non-empty"));
+        on += chunk.on.iter().filter(|&&p| p).count() as u64;
+        bar.set_position(stream.progress().done);
+    }
+    bar.finish_and_clear();
+    let resolved = recording.resolve_sensor(stream.max_coordinates());
+    if let Some(w) = &resolved.warning {
+        warn(global, w);
+    }
+    let info = Info {
+        format: recording.format,
+        width: resolved.sensor.width,
+        height: resolved.sensor.height,
+        sensor_source: resolved.source.clone(),
+        events: stream.events_read(),
+        on_events: on,
+        t_first_us: first,
+        t_last_us: last,
+        timestamps_backwards: stream.unsorted_count(),
+        frames: recording.frame_times()?.len(),
+        file_bytes: std::fs::metadata(recording.event_file())
+            .map(|m| m.len())
+            .unwrap_or(0),
+    };
+    let target = args.json.as_deref().map(JsonTarget::parse);
+    if let Some(target) = &target {
+        emit_json(&info, target)?;
+    }
+    if !matches!(target, Some(JsonTarget::Stdout)) {
+        output::print_table(&[
+            ("format".into(), info.format.to_string()),
+            (
+                "sensor".into(),
+                format!("{}x{} ({})", info.width, info.height, info.sensor_source),
+            ),
+            (
+                "events".into(),
+                format!("{} ({} ON)", info.events, info.on_events),
+            ),
+            (
+                "time".into(),
+                format!("{} .. {} us", info.t_first_us, info.t_last_us),
+            ),
+            (
+                "duration".into(),
+                output::seconds((info.t_last_us - info.t_first_us) as f64 * 1e-6),
+            ),
+            (
+                "timestamps backwards".into(),
+                info.timestamps_backwards.to_string(),
+            ),
+            ("frames".into(), info.frames.to_string()),
+        ]);
+    }
+    Ok(())
+}

@@ -1,0 +1,138 @@
+//! Argument parsing and dispatch. Each subcommand lives in its own module; this one holds
+//! the shared flags, output helpers and the mapping from errors to exit codes.
+
+mod convert;
+mod info;
+mod output;
+mod stats;
+
+use clap::{Args, Parser, Subcommand};
+use ctcal::{Format, OpenOptions, Sensor};
+use std::path::PathBuf;
+
+/// ctcal: contrast thresholds, noise and statistics of event cameras and datasets.
+#[derive(Parser, Debug)]
+#[command(name = "ctcal", version, about, long_about = None, propagate_version = true)]
+pub struct Cli {
+    #[command(flatten)]
+    pub global: Global,
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// Flags every command takes.
+#[derive(Args, Debug, Clone)]
+pub struct Global {
+    /// Silence progress bars and warnings (errors still go to stderr).
+    #[arg(long, global = true)]
+    pub quiet: bool,
+    /// Bound the number of worker threads (default: all cores).
+    #[arg(long, global = true, value_name = "N")]
+    pub threads: Option<usize>,
+}
+
+/// How to open an input recording.
+#[derive(Args, Debug, Clone)]
+pub struct InputArgs {
+    /// Recording: an IJRR folder or events.txt, HDF5, AEDAT4, Prophesee RAW (EVT2/EVT3) or DAT.
+    pub input: PathBuf,
+    /// Read as this format instead of detecting it from the content.
+    #[arg(long, value_name = "ijrr|h5|aedat4|evt2|evt3|dat")]
+    pub format: Option<Format>,
+    /// Sensor size WxH, overriding the file's own metadata.
+    #[arg(long, value_name = "WxH", value_parser = parse_sensor)]
+    pub sensor: Option<Sensor>,
+}
+
+impl InputArgs {
+    pub fn open_options(&self) -> OpenOptions {
+        OpenOptions {
+            format: self.format,
+            sensor: self.sensor,
+        }
+    }
+}
+
+fn parse_sensor(text: &str) -> Result<Sensor, String> {
+    Sensor::parse(text).ok_or_else(|| format!("`{text}` is not WxH (e.g. 346x260)"))
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Format, sensor size, event count, time span and frame count of a recording.
+    Info(info::InfoArgs),
+    /// Rewrite a recording as an IJRR folder or an event_utils HDF5 file.
+    Convert(convert::ConvertArgs),
+    /// Event statistics: rates, timeline, hot pixels, background rate, intervals.
+    Stats(stats::StatsArgs),
+}
+
+/// A problem with the command line or the input that the user can fix (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct BadInput(pub String);
+
+/// Runs the command line; returns the process exit code.
+pub fn run() -> i32 {
+    let cli = Cli::parse();
+    if let Some(n) = cli.global.threads
+        && let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+    {
+        eprintln!("error: cannot start {n} threads: {e}");
+        return 1;
+    }
+    let result = match &cli.command {
+        Command::Info(args) => info::run(args, &cli.global),
+        Command::Convert(args) => convert::run(args, &cli.global),
+        Command::Stats(args) => stats::run(args, &cli.global),
+    };
+    match result {
+        Ok(()) => 0,
+        Err(error) => {
+            eprintln!("error: {error:#}");
+            exit_code(&error)
+        }
+    }
+}
+
+/// 2 for problems with the input or usage, 1 for everything else.
+fn exit_code(error: &anyhow::Error) -> i32 {
+    for cause in error.chain() {
+        if let Some(e) = cause.downcast_ref::<ctcal::InputError>() {
+            return if e.is_bad_input() { 2 } else { 1 };
+        }
+        if cause.is::<BadInput>() {
+            return 2;
+        }
+    }
+    1
+}
+
+/// Prints a warning to stderr unless quiet.
+pub fn warn(global: &Global, message: &str) {
+    if !global.quiet {
+        eprintln!("warning: {message}");
+    }
+}
+
+/// A progress bar over bytes (or rows) of input on stderr; hidden when quiet or not a TTY.
+pub fn progress_bar(global: &Global, total: u64, what: &str) -> indicatif::ProgressBar {
+    if global.quiet {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(total),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:30}] {percent}% {elapsed_precise}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(what.to_string());
+    bar
+}
+
+pub use output::{JsonTarget, emit_json};

@@ -1,0 +1,199 @@
+//! `ctcal stats`: event statistics of a recording (see `ctcal::stats`).
+
+use super::{BadInput, Global, InputArgs, JsonTarget, emit_json, output, progress_bar, warn};
+use clap::Args;
+use ctcal::Recording;
+use ctcal::stats::{SequenceStats, StatsAccumulator, StatsOptions};
+use std::path::PathBuf;
+
+#[derive(Args, Debug)]
+pub struct StatsArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Write the statistics as JSON to PATH (`-` for stdout).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+    /// Only events from S seconds after the first event.
+    #[arg(long, value_name = "S")]
+    pub start: Option<f64>,
+    /// Only events up to S seconds after the first event.
+    #[arg(long, value_name = "S")]
+    pub end: Option<f64>,
+    /// Rate-timeline window in seconds.
+    #[arg(long, value_name = "S", default_value_t = 0.01)]
+    pub window: f64,
+    /// Accept timestamps that go backwards and sort the events (in memory).
+    #[arg(long)]
+    pub sort: bool,
+}
+
+pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
+    if !(args.window.is_finite() && args.window > 0.0) {
+        return Err(BadInput(format!(
+            "--window {} must be a positive number of seconds",
+            args.window
+        ))
+        .into());
+    }
+    for (name, value) in [("--start", args.start), ("--end", args.end)] {
+        if value.is_some_and(|v| !v.is_finite() || v < 0.0) {
+            return Err(
+                BadInput(format!("{name} must be a non-negative number of seconds")).into(),
+            );
+        }
+    }
+    if let (Some(s), Some(e)) = (args.start, args.end)
+        && e < s
+    {
+        return Err(BadInput(format!("--end {e} is before --start {s}")).into());
+    }
+    let recording = Recording::open(&args.input.input, &args.input.open_options())?;
+    for note in &recording.notes {
+        warn(global, note);
+    }
+    let stats = compute(&recording, args, global)?;
+    let target = args.json.as_deref().map(JsonTarget::parse);
+    if let Some(target) = &target {
+        emit_json(&stats, target)?;
+    }
+    if !matches!(target, Some(JsonTarget::Stdout)) {
+        print_human(&stats);
+    }
+    Ok(())
+}
+
+fn compute(
+    recording: &Recording,
+    args: &StatsArgs,
+    global: &Global,
+) -> anyhow::Result<SequenceStats> {
+    let options = StatsOptions {
+        start_s: args.start,
+        end_s: args.end,
+        window_s: args.window,
+    };
+    let mut accumulator = StatsAccumulator::new(options, recording.sensor);
+    let max_coordinates = if args.sort {
+        let all = recording.read_all(true)?;
+        accumulator.add(&all);
+        all.max_coordinates()
+    } else {
+        let mut stream = recording.events()?;
+        let bar = progress_bar(global, stream.progress().total, "reading");
+        while let Some(chunk) = stream.next_chunk()? {
+            accumulator.add(chunk);
+            bar.set_position(stream.progress().done);
+        }
+        bar.finish_and_clear();
+        stream.max_coordinates()
+    };
+    let resolved = recording.resolve_sensor(max_coordinates);
+    if let Some(w) = &resolved.warning {
+        warn(global, w);
+    }
+    let frame_times = recording.frame_times()?;
+    accumulator.finish(&resolved, &frame_times).ok_or_else(|| {
+        ctcal::InputError::EmptyWindow {
+            path: recording.path.clone(),
+            detail: format!("--start {:?} --end {:?}", args.start, args.end),
+        }
+        .into()
+    })
+}
+
+fn print_human(s: &SequenceStats) {
+    let rate = |r: Option<f64>| {
+        r.map_or("undefined (zero duration)".to_string(), |r| {
+            format!("{r:.6}")
+        })
+    };
+    let mut rows = vec![
+        (
+            "sensor".to_string(),
+            format!("{}x{} ({})", s.width, s.height, s.sensor_source),
+        ),
+        (
+            "events".into(),
+            format!(
+                "{} ({} ON, {} OFF, ON fraction {:.4})",
+                s.events, s.on_events, s.off_events, s.on_fraction
+            ),
+        ),
+        (
+            "time".into(),
+            format!(
+                "{} .. {} us ({})",
+                s.t_first_us,
+                s.t_last_us,
+                output::seconds(s.duration_s)
+            ),
+        ),
+        ("events/pixel/s".into(), rate(s.events_per_pixel_per_second)),
+        (
+            "  ON / OFF".into(),
+            format!(
+                "{} / {}",
+                rate(s.on_per_pixel_per_second),
+                rate(s.off_per_pixel_per_second)
+            ),
+        ),
+        (
+            "active pixels".into(),
+            format!("{:.2} %", 100.0 * s.active_pixel_fraction),
+        ),
+        (
+            "background rate".into(),
+            format!(
+                "{:.4} Hz (median pixel, hot excluded)",
+                s.background_rate_hz
+            ),
+        ),
+        (
+            "same-pixel interval".into(),
+            match (s.inter_event_interval_s.p5, s.inter_event_interval_s.median) {
+                (Some(p5), Some(m)) => {
+                    format!("p5 {}, median {}", output::seconds(p5), output::seconds(m))
+                }
+                _ => "none (no pixel fired twice)".into(),
+            },
+        ),
+        ("hot pixels".into(), s.hot_pixels.len().to_string()),
+    ];
+    for h in s.hot_pixels.iter().take(10) {
+        rows.push((
+            format!("  ({}, {})", h.x, h.y),
+            format!("{} events, {:.1} Hz, z {:.1}", h.events, h.rate_hz, h.z),
+        ));
+    }
+    if s.hot_pixels.len() > 10 {
+        rows.push((
+            "  ...".into(),
+            format!("{} more (see --json)", s.hot_pixels.len() - 10),
+        ));
+    }
+    let peak = s
+        .rate_timeline
+        .iter()
+        .map(|w| w.events_per_pixel_per_second)
+        .fold(0.0, f64::max);
+    rows.push((
+        "rate timeline".into(),
+        format!(
+            "{} windows of {}, peak {peak:.3} e/pix/s",
+            s.rate_timeline.len(),
+            output::seconds(s.rate_timeline.first().map_or(0.0, |w| w.window_s))
+        ),
+    ));
+    rows.push((
+        "frames".into(),
+        match &s.frames {
+            Some(f) => format!(
+                "{} (median interval {})",
+                f.count,
+                f.median_interval_s.map_or("-".into(), output::seconds)
+            ),
+            None => "none".into(),
+        },
+    ));
+    output::print_table(&rows);
+}

@@ -1,0 +1,639 @@
+//! AEDAT 4.0 (iniVation DV): `#!AER-DAT4.0\r\n`, a u32 length and an `IOHeader` FlatBuffer
+//! (compression, position of the file data table, and an XML description naming each
+//! stream: `typeIdentifier` EVTS / FRME / IMUS / TRIG and `sizeX`/`sizeY`), then packets:
+//! i32 stream id, i32 byte size, and a (LZ4-frame or Zstandard compressed) size-prefixed
+//! FlatBuffer. Event packets hold a vector of 16-byte structs `{t: i64, x: i16, y: i16,
+//! on: bool}`; frame packets a `Frame` table. IMU and trigger packets are skipped unread.
+//!
+//! Schemas: iniVation dv-processing (`events.fbs`, `frame.fbs`, `io_header.fbs`). The tables
+//! are read with the maintained `flatbuffers` crate (every buffer verified before use); the
+//! three accessors below stand in for `flatc` output because ctcal reads only a few fields.
+
+use super::error::{FIX_TRUNCATED, InputError};
+use super::order::OrderCheck;
+use super::{EventDecoder, Progress};
+use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor};
+use flatbuffers::{Follow, ForwardsUOffset, Table, Vector, Verifiable, Verifier};
+use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::path::{Path, PathBuf};
+
+const MAGIC: &[u8] = b"#!AER-DAT4.0\r\n";
+
+/// Whether `head` starts like an AEDAT4 file.
+pub fn has_magic(head: &[u8]) -> bool {
+    head.starts_with(MAGIC)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Compression {
+    None,
+    Lz4,
+    Zstd,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum StreamKind {
+    Events,
+    Frames,
+    Other,
+}
+
+#[derive(Clone, Debug)]
+struct Stream {
+    id: i32,
+    kind: StreamKind,
+    size: Option<Sensor>,
+}
+
+/// What the header of an AEDAT4 file says.
+#[derive(Clone, Debug)]
+pub struct Aedat4Header {
+    compression: Compression,
+    data_start: u64,
+    data_end: Option<u64>,
+    streams: Vec<Stream>,
+    /// The camera named in the description (`source`), if any.
+    pub source: Option<String>,
+}
+
+impl Aedat4Header {
+    /// The event stream's sensor size.
+    pub fn event_sensor(&self) -> Option<Sensor> {
+        self.streams
+            .iter()
+            .find(|s| s.kind == StreamKind::Events)
+            .and_then(|s| s.size)
+    }
+
+    fn event_stream(&self) -> Option<i32> {
+        self.streams
+            .iter()
+            .find(|s| s.kind == StreamKind::Events)
+            .map(|s| s.id)
+    }
+
+    fn frame_stream(&self) -> Option<i32> {
+        self.streams
+            .iter()
+            .find(|s| s.kind == StreamKind::Frames)
+            .map(|s| s.id)
+    }
+
+    /// Reads and checks the header of `path`.
+    pub fn read(path: &Path) -> Result<Self, InputError> {
+        let mut file = std::fs::File::open(path).map_err(|e| InputError::io(path, e))?;
+        let mut magic = [0u8; 14];
+        read_exact(&mut file, &mut magic, path, 0, "the AEDAT4 magic line")?;
+        if magic != MAGIC {
+            return Err(InputError::corrupt(
+                path,
+                "byte offset 0",
+                "the file does not start with #!AER-DAT4.0",
+                "this is not an AEDAT 4.0 file; AEDAT 2/3 files must be converted with DV first",
+            ));
+        }
+        let mut length = [0u8; 4];
+        read_exact(&mut file, &mut length, path, 14, "the header length")?;
+        let length = u32::from_le_bytes(length) as usize;
+        let mut buffer = vec![0u8; length];
+        read_exact(&mut file, &mut buffer, path, 18, "the IOHeader")?;
+        let header = flatbuffers::root::<IoHeader>(&buffer).map_err(|e| {
+            InputError::corrupt(
+                path,
+                "byte offset 18 (IOHeader)",
+                format!("invalid header: {e}"),
+                FIX_TRUNCATED,
+            )
+        })?;
+        let compression = match header.compression() {
+            0 => Compression::None,
+            1 | 2 => Compression::Lz4,
+            3 | 4 => Compression::Zstd,
+            other => {
+                return Err(InputError::corrupt(
+                    path,
+                    "byte offset 18 (IOHeader)",
+                    format!("unknown compression code {other}"),
+                    "re-export the recording from DV with LZ4, Zstd or no compression",
+                ));
+            }
+        };
+        let description = header.description().unwrap_or_default();
+        let (streams, source) = parse_description(description).map_err(|problem| {
+            InputError::corrupt(
+                path,
+                "the XML stream description in the header",
+                problem,
+                FIX_TRUNCATED,
+            )
+        })?;
+        let data_end = u64::try_from(header.data_table_position()).ok();
+        Ok(Self {
+            compression,
+            data_start: 18 + length as u64,
+            data_end,
+            streams,
+            source,
+        })
+    }
+}
+
+fn read_exact(
+    file: &mut impl Read,
+    buffer: &mut [u8],
+    path: &Path,
+    offset: u64,
+    what: &str,
+) -> Result<(), InputError> {
+    file.read_exact(buffer).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::UnexpectedEof {
+            InputError::corrupt(
+                path,
+                format!("byte offset {offset}"),
+                format!("the file ends inside {what}"),
+                FIX_TRUNCATED,
+            )
+        } else {
+            InputError::io(path, e)
+        }
+    })
+}
+
+/// Streams (id, kind, size) and the camera name from the DV XML description.
+fn parse_description(xml: &str) -> Result<(Vec<Stream>, Option<String>), String> {
+    let document = roxmltree::Document::parse(xml).map_err(|e| format!("unreadable XML: {e}"))?;
+    let out_info = document
+        .descendants()
+        .find(|n| n.has_tag_name("node") && n.attribute("name") == Some("outInfo"))
+        .ok_or("no outInfo node")?;
+    let attr = |node: roxmltree::Node, key: &str| -> Option<String> {
+        node.children()
+            .find(|c| c.has_tag_name("attr") && c.attribute("key") == Some(key))
+            .and_then(|c| c.text())
+            .map(|t| t.trim().to_string())
+    };
+    let mut streams = Vec::new();
+    let mut source = None;
+    for node in out_info.children().filter(|n| n.has_tag_name("node")) {
+        let Some(id) = node.attribute("name").and_then(|n| n.parse::<i32>().ok()) else {
+            continue;
+        };
+        let kind = match attr(node, "typeIdentifier").as_deref() {
+            Some("EVTS") => StreamKind::Events,
+            Some("FRME") => StreamKind::Frames,
+            _ => StreamKind::Other,
+        };
+        let info = node
+            .children()
+            .find(|c| c.has_tag_name("node") && c.attribute("name") == Some("info"));
+        let size = info.and_then(|info| {
+            let w = attr(info, "sizeX")?.parse::<u16>().ok()?;
+            let h = attr(info, "sizeY")?.parse::<u16>().ok()?;
+            (w > 0 && h > 0).then(|| Sensor::new(w, h))
+        });
+        if source.is_none() {
+            source = info.and_then(|info| attr(info, "source"));
+        }
+        streams.push(Stream { id, kind, size });
+    }
+    if !streams.iter().any(|s| s.kind == StreamKind::Events) {
+        return Err("the description names no event (EVTS) stream".into());
+    }
+    Ok((streams, source))
+}
+
+/// Reads packets one at a time, decompressing those of one stream.
+struct PacketReader {
+    path: PathBuf,
+    file: BufReader<std::fs::File>,
+    position: u64,
+    end: u64,
+    compression: Compression,
+    raw: Vec<u8>,
+    decoded: Vec<u8>,
+}
+
+impl PacketReader {
+    fn open(path: &Path, header: &Aedat4Header) -> Result<Self, InputError> {
+        let mut file = std::fs::File::open(path).map_err(|e| InputError::io(path, e))?;
+        let length = file.metadata().map_err(|e| InputError::io(path, e))?.len();
+        file.seek(SeekFrom::Start(header.data_start))
+            .map_err(|e| InputError::io(path, e))?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file: BufReader::with_capacity(1 << 20, file),
+            position: header.data_start,
+            end: header.data_end.unwrap_or(length).min(length),
+            compression: header.compression,
+            raw: Vec::new(),
+            decoded: Vec::new(),
+        })
+    }
+
+    /// Advances to the next packet of stream `wanted`; returns its offset, its decoded bytes
+    /// are then in `self.decoded`. `None` at the end of the packets.
+    fn next(&mut self, wanted: i32) -> Result<Option<u64>, InputError> {
+        loop {
+            if self.position + 8 > self.end {
+                if self.position < self.end {
+                    return Err(InputError::corrupt(
+                        &self.path,
+                        format!("byte offset {}", self.position),
+                        "the file ends inside a packet header",
+                        FIX_TRUNCATED,
+                    ));
+                }
+                return Ok(None);
+            }
+            let offset = self.position;
+            let mut head = [0u8; 8];
+            read_exact(
+                &mut self.file,
+                &mut head,
+                &self.path,
+                offset,
+                "a packet header",
+            )?;
+            let stream = i32::from_le_bytes([head[0], head[1], head[2], head[3]]);
+            let size = i32::from_le_bytes([head[4], head[5], head[6], head[7]]);
+            if size < 0 || offset + 8 + size as u64 > self.end {
+                return Err(InputError::corrupt(
+                    &self.path,
+                    format!("byte offset {offset}"),
+                    format!(
+                        "packet of stream {stream} claims {size} bytes, more than the file holds"
+                    ),
+                    FIX_TRUNCATED,
+                ));
+            }
+            self.position = offset + 8 + size as u64;
+            if stream != wanted {
+                self.file
+                    .seek_relative(size as i64)
+                    .map_err(|e| InputError::io(&self.path, e))?;
+                continue;
+            }
+            self.raw.resize(size as usize, 0);
+            read_exact(
+                &mut self.file,
+                &mut self.raw,
+                &self.path,
+                offset + 8,
+                "a packet",
+            )?;
+            self.decoded.clear();
+            let result = match self.compression {
+                Compression::None => {
+                    self.decoded.extend_from_slice(&self.raw);
+                    Ok(())
+                }
+                Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(&self.raw[..])
+                    .read_to_end(&mut self.decoded)
+                    .map(|_| ()),
+                Compression::Zstd => zstd::stream::read::Decoder::new(&self.raw[..])
+                    .and_then(|mut d| d.read_to_end(&mut self.decoded))
+                    .map(|_| ()),
+            };
+            result.map_err(|e| {
+                InputError::corrupt(
+                    &self.path,
+                    format!("byte offset {offset} (packet of stream {stream})"),
+                    format!("cannot decompress the packet: {e}"),
+                    FIX_TRUNCATED,
+                )
+            })?;
+            return Ok(Some(offset));
+        }
+    }
+
+    fn invalid(&self, offset: u64, what: &str, error: impl std::fmt::Display) -> InputError {
+        InputError::corrupt(
+            &self.path,
+            format!("byte offset {offset} ({what} packet)"),
+            format!("invalid FlatBuffer: {error}"),
+            FIX_TRUNCATED,
+        )
+    }
+}
+
+/// Streaming decoder of the event stream.
+pub struct Aedat4Decoder {
+    packets: PacketReader,
+    stream: i32,
+    sensor: Option<Sensor>,
+    order: OrderCheck,
+    pending: Vec<u8>,
+    pending_at: usize,
+    packet_offset: u64,
+}
+
+impl Aedat4Decoder {
+    pub fn open(
+        path: &Path,
+        header: &Aedat4Header,
+        sensor: Option<Sensor>,
+    ) -> Result<Self, InputError> {
+        let stream = header
+            .event_stream()
+            .expect("checked by Aedat4Header::read");
+        Ok(Self {
+            packets: PacketReader::open(path, header)?,
+            stream,
+            sensor,
+            order: OrderCheck::default(),
+            pending: Vec::new(),
+            pending_at: 0,
+            packet_offset: 0,
+        })
+    }
+
+    /// Loads the next event packet's raw 16-byte structs into `pending`.
+    fn load_packet(&mut self) -> Result<bool, InputError> {
+        let Some(offset) = self.packets.next(self.stream)? else {
+            return Ok(false);
+        };
+        let packet = flatbuffers::size_prefixed_root::<EventPacket>(&self.packets.decoded)
+            .map_err(|e| self.packets.invalid(offset, "event", e))?;
+        self.pending.clear();
+        if let Some(elements) = packet.elements() {
+            self.pending.extend_from_slice(elements.bytes());
+        }
+        self.pending_at = 0;
+        self.packet_offset = offset;
+        Ok(true)
+    }
+}
+
+impl EventDecoder for Aedat4Decoder {
+    fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
+        while out.len() < CHUNK_EVENTS {
+            if self.pending_at >= self.pending.len() && !self.load_packet()? {
+                break;
+            }
+            let room = CHUNK_EVENTS - out.len();
+            let end = (self.pending_at + 16 * room).min(self.pending.len());
+            for (i, e) in self.pending[self.pending_at..end]
+                .chunks_exact(16)
+                .enumerate()
+            {
+                let t = i64::from_le_bytes(e[0..8].try_into().expect("8 bytes"));
+                let x = i16::from_le_bytes([e[8], e[9]]);
+                let y = i16::from_le_bytes([e[10], e[11]]);
+                let index = (self.pending_at / 16) + i;
+                let inside =
+                    x >= 0 && y >= 0 && self.sensor.is_none_or(|s| s.contains(x as u16, y as u16));
+                if !inside {
+                    return Err(super::outside_sensor(
+                        &self.packets.path,
+                        format!(
+                            "packet at byte offset {}, event {index}",
+                            self.packet_offset
+                        ),
+                        x as u32,
+                        y as u32,
+                        self.sensor,
+                    ));
+                }
+                let packet_offset = self.packet_offset;
+                self.order.check(t, || {
+                    format!("packet at byte offset {packet_offset}, event {index}")
+                });
+                out.push(t, x as u16, y as u16, e[12] != 0);
+            }
+            self.pending_at = end;
+        }
+        Ok(())
+    }
+
+    fn order(&self) -> &OrderCheck {
+        &self.order
+    }
+
+    fn progress(&self) -> Progress {
+        Progress {
+            done: self.packets.position,
+            total: self.packets.end,
+        }
+    }
+}
+
+/// Decodes every frame of the file's first frame stream (grey; colour is converted with
+/// ITU-R BT.601 weights). Frame time: the exposure midpoint where the packet gives the
+/// exposure, else the frame's own timestamp.
+pub fn read_frames(path: &Path, header: &Aedat4Header) -> Result<Vec<Frame>, InputError> {
+    let Some(stream) = header.frame_stream() else {
+        return Ok(Vec::new());
+    };
+    let mut packets = PacketReader::open(path, header)?;
+    let mut frames = Vec::new();
+    while let Some(offset) = packets.next(stream)? {
+        let frame = flatbuffers::size_prefixed_root::<FramePacket>(&packets.decoded)
+            .map_err(|e| packets.invalid(offset, "frame", e))?;
+        let (w, h) = (frame.width().max(0) as u32, frame.height().max(0) as u32);
+        let data = frame.pixels().map(|p| p.bytes()).unwrap_or_default();
+        let channels = match frame.format() {
+            0 => 1,
+            16 => 3,
+            24 => 4,
+            other => {
+                return Err(packets.invalid(
+                    offset,
+                    "frame",
+                    format!("unknown pixel format {other}"),
+                ));
+            }
+        };
+        if data.len() != (w * h) as usize * channels {
+            return Err(packets.invalid(
+                offset,
+                "frame",
+                format!(
+                    "{} pixel bytes for a {w}x{h} frame with {channels} channels",
+                    data.len()
+                ),
+            ));
+        }
+        let pixels = if channels == 1 {
+            data.to_vec()
+        } else {
+            data.chunks_exact(channels)
+                .map(|p| {
+                    let (b, g, r) = (p[0] as f32, p[1] as f32, p[2] as f32);
+                    (0.299 * r + 0.587 * g + 0.114 * b).round() as u8
+                })
+                .collect()
+        };
+        let (start, end) = (frame.exposure_start_t(), frame.exposure_end_t());
+        let (t, exposure_us) = if end > start && start > 0 {
+            (start + (end - start) / 2, Some(end - start))
+        } else {
+            (frame.t(), None)
+        };
+        frames.push(Frame {
+            t,
+            width: w,
+            height: h,
+            pixels,
+            exposure_us,
+        });
+    }
+    Ok(frames)
+}
+
+// --- FlatBuffer accessors (field slots from the dv-processing schemas) ---
+
+/// Little-endian scalars read without an alignment requirement: DV writes some tables whose
+/// 8-byte fields are not 8-aligned within the buffer, which the stock scalar verifier
+/// rejects; bounds are still checked.
+macro_rules! unaligned_scalar {
+    ($name:ident, $t:ty, $n:expr) => {
+        struct $name;
+        impl<'a> Follow<'a> for $name {
+            type Inner = $t;
+            unsafe fn follow(buf: &'a [u8], loc: usize) -> $t {
+                let mut bytes = [0u8; $n];
+                bytes.copy_from_slice(&buf[loc..loc + $n]);
+                <$t>::from_le_bytes(bytes)
+            }
+        }
+        impl Verifiable for $name {
+            fn run_verifier(
+                v: &mut Verifier,
+                pos: usize,
+            ) -> Result<(), flatbuffers::InvalidFlatbuffer> {
+                v.range_in_buffer(pos, $n)
+            }
+        }
+    };
+}
+unaligned_scalar!(LeI64, i64, 8);
+unaligned_scalar!(LeI32, i32, 4);
+unaligned_scalar!(LeI16, i16, 2);
+unaligned_scalar!(LeI8, i8, 1);
+
+struct IoHeader<'a>(Table<'a>);
+
+impl<'a> Follow<'a> for IoHeader<'a> {
+    type Inner = IoHeader<'a>;
+    unsafe fn follow(buf: &'a [u8], loc: usize) -> Self::Inner {
+        // SAFETY: forwarded from the caller's contract (a verified table at `loc`).
+        IoHeader(unsafe { Table::new(buf, loc) })
+    }
+}
+
+impl Verifiable for IoHeader<'_> {
+    fn run_verifier(v: &mut Verifier, pos: usize) -> Result<(), flatbuffers::InvalidFlatbuffer> {
+        v.visit_table(pos)?
+            .visit_field::<LeI32>("compression", 4, false)?
+            .visit_field::<LeI64>("dataTablePosition", 6, false)?
+            .visit_field::<ForwardsUOffset<&str>>("infoNode", 8, false)?
+            .finish();
+        Ok(())
+    }
+}
+
+impl<'a> IoHeader<'a> {
+    fn compression(&self) -> i32 {
+        // SAFETY: the buffer was verified (`flatbuffers::root`) before this accessor runs.
+        unsafe { self.0.get::<LeI32>(4, Some(0)) }.unwrap_or(0)
+    }
+    fn data_table_position(&self) -> i64 {
+        // SAFETY: as above.
+        unsafe { self.0.get::<LeI64>(6, Some(-1)) }.unwrap_or(-1)
+    }
+    fn description(&self) -> Option<&'a str> {
+        // SAFETY: as above.
+        unsafe { self.0.get::<ForwardsUOffset<&str>>(8, None) }
+    }
+}
+
+/// One 16-byte event struct `{t: i64, x: i16, y: i16, on: bool, 3 bytes padding}`.
+#[repr(transparent)]
+struct RawEvent([u8; 16]);
+
+impl flatbuffers::SimpleToVerifyInSlice for RawEvent {}
+
+impl<'a> Follow<'a> for RawEvent {
+    type Inner = &'a [u8];
+    unsafe fn follow(buf: &'a [u8], loc: usize) -> Self::Inner {
+        &buf[loc..loc + 16]
+    }
+}
+
+struct EventPacket<'a>(Table<'a>);
+
+impl<'a> Follow<'a> for EventPacket<'a> {
+    type Inner = EventPacket<'a>;
+    unsafe fn follow(buf: &'a [u8], loc: usize) -> Self::Inner {
+        // SAFETY: forwarded from the caller's contract (a verified table at `loc`).
+        EventPacket(unsafe { Table::new(buf, loc) })
+    }
+}
+
+impl Verifiable for EventPacket<'_> {
+    fn run_verifier(v: &mut Verifier, pos: usize) -> Result<(), flatbuffers::InvalidFlatbuffer> {
+        v.visit_table(pos)?
+            .visit_field::<ForwardsUOffset<Vector<'_, RawEvent>>>("elements", 4, false)?
+            .finish();
+        Ok(())
+    }
+}
+
+impl<'a> EventPacket<'a> {
+    fn elements(&self) -> Option<Vector<'a, RawEvent>> {
+        // SAFETY: the buffer was verified (`size_prefixed_root`) before this accessor runs.
+        unsafe { self.0.get::<ForwardsUOffset<Vector<'a, RawEvent>>>(4, None) }
+    }
+}
+
+struct FramePacket<'a>(Table<'a>);
+
+impl<'a> Follow<'a> for FramePacket<'a> {
+    type Inner = FramePacket<'a>;
+    unsafe fn follow(buf: &'a [u8], loc: usize) -> Self::Inner {
+        // SAFETY: forwarded from the caller's contract (a verified table at `loc`).
+        FramePacket(unsafe { Table::new(buf, loc) })
+    }
+}
+
+impl Verifiable for FramePacket<'_> {
+    fn run_verifier(v: &mut Verifier, pos: usize) -> Result<(), flatbuffers::InvalidFlatbuffer> {
+        v.visit_table(pos)?
+            .visit_field::<LeI64>("timestamp", 4, false)?
+            .visit_field::<LeI64>("timestampStartOfFrame", 6, false)?
+            .visit_field::<LeI64>("timestampEndOfFrame", 8, false)?
+            .visit_field::<LeI64>("timestampStartOfExposure", 10, false)?
+            .visit_field::<LeI64>("timestampEndOfExposure", 12, false)?
+            .visit_field::<LeI8>("format", 14, false)?
+            .visit_field::<LeI16>("sizeX", 16, false)?
+            .visit_field::<LeI16>("sizeY", 18, false)?
+            .visit_field::<ForwardsUOffset<Vector<'_, u8>>>("pixels", 24, false)?
+            .finish();
+        Ok(())
+    }
+}
+
+impl<'a> FramePacket<'a> {
+    // SAFETY (all accessors): the buffer was verified before any accessor runs.
+    fn t(&self) -> i64 {
+        unsafe { self.0.get::<LeI64>(4, Some(0)) }.unwrap_or(0)
+    }
+    fn exposure_start_t(&self) -> i64 {
+        unsafe { self.0.get::<LeI64>(10, Some(0)) }.unwrap_or(0)
+    }
+    fn exposure_end_t(&self) -> i64 {
+        unsafe { self.0.get::<LeI64>(12, Some(0)) }.unwrap_or(0)
+    }
+    fn format(&self) -> i8 {
+        unsafe { self.0.get::<LeI8>(14, Some(0)) }.unwrap_or(0)
+    }
+    fn width(&self) -> i16 {
+        unsafe { self.0.get::<LeI16>(16, Some(0)) }.unwrap_or(0)
+    }
+    fn height(&self) -> i16 {
+        unsafe { self.0.get::<LeI16>(18, Some(0)) }.unwrap_or(0)
+    }
+    fn pixels(&self) -> Option<Vector<'a, u8>> {
+        unsafe { self.0.get::<ForwardsUOffset<Vector<'a, u8>>>(24, None) }
+    }
+}

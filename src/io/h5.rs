@@ -1,0 +1,478 @@
+//! HDF5 event files in the two layouts researchers meet most:
+//!
+//! - event_utils / event_cnn_minimal (Stoffregen et al. 2020): `events/ts` (float64 seconds),
+//!   `events/xs`, `events/ys` (integers), `events/ps` (bool or 0/1 or -1/1), frames as
+//!   `images/image%09d` with a `timestamp` attribute in seconds, and a root attribute
+//!   `sensor_resolution` = (H, W). Writers disagree on that order, so the claim is checked
+//!   against the coordinates and swapped when only the swapped reading contains them;
+//! - v2e: `events` N x 4 unsigned `[t_us, x, y, p]`, frames in `frame` (N, H, W) with
+//!   `frame_ts` in microseconds.
+//!
+//! Read through `hdf5-metno` (libhdf5) in chunks of `CHUNK_EVENTS` rows.
+
+use super::error::InputError;
+use super::order::OrderCheck;
+use super::{EventDecoder, Progress};
+use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor, TimeUs};
+use hdf5::types::TypeDescriptor;
+use std::path::{Path, PathBuf};
+
+/// HDF5 signature at the start of a file.
+pub const SIGNATURE: &[u8] = b"\x89HDF\r\n\x1a\n";
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Layout {
+    EventUtils,
+    V2e,
+}
+
+/// What an HDF5 event file holds, checked against its data.
+#[derive(Clone, Debug)]
+pub struct H5Info {
+    pub layout: Layout,
+    pub events: usize,
+    /// The sensor after checking the file's claim against the coordinates.
+    pub sensor: Option<Sensor>,
+    /// How the sensor is known (or why the claim was changed).
+    pub sensor_note: Option<String>,
+    pub frame_count: usize,
+}
+
+fn h5_error(path: &Path, what: &str, e: hdf5::Error) -> InputError {
+    InputError::hdf5(
+        path,
+        format!("{what}: {e}"),
+        "check that the file is a complete event_utils or v2e HDF5 file (h5ls -r shows its layout)",
+    )
+}
+
+fn open_file(path: &Path) -> Result<hdf5::File, InputError> {
+    if !path.exists() {
+        return Err(InputError::NotFound {
+            path: path.to_path_buf(),
+        });
+    }
+    hdf5::File::open(path).map_err(|e| h5_error(path, "cannot open", e))
+}
+
+fn missing(path: &Path, what: &str) -> InputError {
+    InputError::hdf5(
+        path,
+        format!("no {what}"),
+        "ctcal reads the event_utils layout (events/ts, events/xs, events/ys, events/ps) and the v2e layout (events: N x 4 [t_us, x, y, p])",
+    )
+}
+
+fn layout_of(path: &Path, file: &hdf5::File) -> Result<Layout, InputError> {
+    if let Ok(group) = file.group("events") {
+        for name in ["ts", "xs", "ys", "ps"] {
+            if !group.link_exists(name) {
+                return Err(missing(path, &format!("dataset events/{name}")));
+            }
+        }
+        return Ok(Layout::EventUtils);
+    }
+    if let Ok(ds) = file.dataset("events") {
+        let shape = ds.shape();
+        if shape.len() == 2 && shape[1] == 4 {
+            return Ok(Layout::V2e);
+        }
+        return Err(InputError::hdf5(
+            path,
+            format!("dataset `events` has shape {shape:?}, expected N x 4"),
+            "v2e files store events as N rows of [t_us, x, y, p]",
+        ));
+    }
+    Err(missing(
+        path,
+        "group `events` (event_utils) or dataset `events` (v2e)",
+    ))
+}
+
+/// Reads a 1-D integer dataset slice as i64 whatever its stored integer type.
+fn read_ints(ds: &hdf5::Dataset, range: std::ops::Range<usize>) -> hdf5::Result<Vec<i64>> {
+    Ok(ds
+        .read_slice_1d::<i64, _>(range)?
+        .into_raw_vec_and_offset()
+        .0)
+}
+
+/// Reads a polarity slice: booleans, integers (>0 is ON) or floats (>0 is ON).
+fn read_polarities(ds: &hdf5::Dataset, range: std::ops::Range<usize>) -> hdf5::Result<Vec<bool>> {
+    Ok(match ds.dtype()?.to_descriptor()? {
+        TypeDescriptor::Boolean => {
+            ds.read_slice_1d::<bool, _>(range)?
+                .into_raw_vec_and_offset()
+                .0
+        }
+        TypeDescriptor::Float(_) => ds
+            .read_slice_1d::<f64, _>(range)?
+            .iter()
+            .map(|&p| p > 0.0)
+            .collect(),
+        _ => read_ints(ds, range)?.into_iter().map(|p| p > 0).collect(),
+    })
+}
+
+/// The claimed `sensor_resolution` (H, W), as an attribute or a dataset.
+fn claimed_resolution(file: &hdf5::File) -> Option<(u16, u16)> {
+    let values: Vec<i64> = file
+        .attr("sensor_resolution")
+        .ok()
+        .and_then(|a| a.read_raw::<i64>().ok())
+        .or_else(|| {
+            file.dataset("sensor_resolution")
+                .ok()
+                .and_then(|d| d.read_raw::<i64>().ok())
+        })?;
+    match values.as_slice() {
+        [h, w, ..] if *h > 0 && *w > 0 => Some((u16::try_from(*h).ok()?, u16::try_from(*w).ok()?)),
+        _ => None,
+    }
+}
+
+/// Largest x and y (and whether any coordinate is negative), over the whole file.
+fn coordinate_extent(
+    path: &Path,
+    file: &hdf5::File,
+    layout: Layout,
+    n: usize,
+) -> Result<(i64, i64), InputError> {
+    let mut max_x = -1i64;
+    let mut max_y = -1i64;
+    let mut start = 0;
+    while start < n {
+        let end = (start + CHUNK_EVENTS).min(n);
+        let (xs, ys) = read_coordinates(file, layout, start..end)
+            .map_err(|e| h5_error(path, "reading coordinates", e))?;
+        for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+            if x < 0 || y < 0 || x > u16::MAX as i64 || y > u16::MAX as i64 {
+                return Err(InputError::corrupt(
+                    path,
+                    format!("event index {}", start + i),
+                    format!("coordinate out of range (x={x}, y={y})"),
+                    "the file is damaged or uses another coordinate convention; rewrite it with x, y in 0..W-1, 0..H-1",
+                ));
+            }
+            max_x = max_x.max(x);
+            max_y = max_y.max(y);
+        }
+        start = end;
+    }
+    Ok((max_x, max_y))
+}
+
+fn read_coordinates(
+    file: &hdf5::File,
+    layout: Layout,
+    range: std::ops::Range<usize>,
+) -> hdf5::Result<(Vec<i64>, Vec<i64>)> {
+    match layout {
+        Layout::EventUtils => Ok((
+            read_ints(&file.dataset("events/xs")?, range.clone())?,
+            read_ints(&file.dataset("events/ys")?, range)?,
+        )),
+        Layout::V2e => {
+            let ds = file.dataset("events")?;
+            let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, 1..3])?;
+            Ok((rows.column(0).to_vec(), rows.column(1).to_vec()))
+        }
+    }
+}
+
+/// Inspects an HDF5 event file and checks its sensor claim against the coordinates.
+pub fn probe(path: &Path) -> Result<H5Info, InputError> {
+    let file = open_file(path)?;
+    let layout = layout_of(path, &file)?;
+    let events = match layout {
+        Layout::EventUtils => {
+            let n = file
+                .dataset("events/ts")
+                .map_err(|e| h5_error(path, "events/ts", e))?
+                .shape();
+            let n = n.first().copied().unwrap_or(0);
+            for name in ["xs", "ys", "ps"] {
+                let ds = file
+                    .dataset(&format!("events/{name}"))
+                    .map_err(|e| h5_error(path, name, e))?;
+                let len = ds.shape().first().copied().unwrap_or(0);
+                if len != n {
+                    return Err(InputError::hdf5(
+                        path,
+                        format!("events/{name} has {len} entries but events/ts has {n}"),
+                        "the file is damaged or was written incompletely; rewrite it",
+                    ));
+                }
+            }
+            n
+        }
+        Layout::V2e => file
+            .dataset("events")
+            .map_err(|e| h5_error(path, "events", e))?
+            .shape()[0],
+    };
+    let (sensor, sensor_note) = match claimed_resolution(&file) {
+        None => (None, None),
+        Some((h, w)) => {
+            let (max_x, max_y) = coordinate_extent(path, &file, layout, events)?;
+            let fits = |w: u16, h: u16| max_x < w as i64 && max_y < h as i64;
+            if fits(w, h) {
+                (
+                    Some(Sensor::new(w, h)),
+                    Some(format!("sensor_resolution ({h}, {w}) read as (H, W)")),
+                )
+            } else if fits(h, w) {
+                (
+                    Some(Sensor::new(h, w)),
+                    Some(format!(
+                        "sensor_resolution is stored as ({h}, {w}); the coordinates (x up to {max_x}, y up to {max_y}) only fit {h}x{w}, so it was read as (W, H)"
+                    )),
+                )
+            } else {
+                return Err(InputError::OutsideSensor {
+                    path: path.to_path_buf(),
+                    place: "root attribute sensor_resolution".into(),
+                    x: max_x as u32,
+                    y: max_y as u32,
+                    width: w,
+                    height: h,
+                    claimed: format!(
+                        " the file claims (sensor_resolution = ({h}, {w}), in either order)"
+                    ),
+                    fix: "pass --sensor WxH with the real sensor size".into(),
+                });
+            }
+        }
+    };
+    let frame_count = match layout {
+        Layout::EventUtils => image_names(&file).len(),
+        Layout::V2e => file.dataset("frame").map(|d| d.shape()[0]).unwrap_or(0),
+    };
+    Ok(H5Info {
+        layout,
+        events,
+        sensor,
+        sensor_note,
+        frame_count,
+    })
+}
+
+fn image_names(file: &hdf5::File) -> Vec<String> {
+    let mut names: Vec<String> = file
+        .group("images")
+        .and_then(|g| g.member_names())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|n| n.starts_with("image"))
+        .collect();
+    names.sort();
+    names
+}
+
+/// Reads every frame.
+pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError> {
+    let file = open_file(path)?;
+    let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
+    let mut frames = Vec::new();
+    match info.layout {
+        Layout::EventUtils => {
+            for name in image_names(&file) {
+                let ds = file
+                    .dataset(&format!("images/{name}"))
+                    .map_err(|e| err(&name, e))?;
+                let t: f64 = ds
+                    .attr("timestamp")
+                    .and_then(|a| a.read_scalar::<f64>())
+                    .map_err(|e| err(&format!("images/{name} attribute `timestamp`"), e))?;
+                let image = ds.read_dyn::<u8>().map_err(|e| err(&name, e))?;
+                let shape = image.shape().to_vec();
+                if shape.len() != 2 {
+                    return Err(InputError::hdf5(
+                        path,
+                        format!(
+                            "images/{name} has shape {shape:?}; ctcal reads grey (H, W) images"
+                        ),
+                        "store frames as 8-bit grey (H, W) datasets",
+                    ));
+                }
+                frames.push(Frame {
+                    t: crate::events::s_to_us(t),
+                    width: shape[1] as u32,
+                    height: shape[0] as u32,
+                    pixels: image.iter().copied().collect(),
+                    exposure_us: None,
+                });
+            }
+        }
+        Layout::V2e => {
+            let Ok(ds) = file.dataset("frame") else {
+                return Ok(frames);
+            };
+            let stack = ds.read_dyn::<u8>().map_err(|e| err("frame", e))?;
+            let ts: Vec<i64> = file
+                .dataset("frame_ts")
+                .and_then(|d| d.read_raw::<i64>())
+                .map_err(|e| err("frame_ts", e))?;
+            let shape = stack.shape().to_vec();
+            if shape.len() != 3 || ts.len() != shape[0] {
+                return Err(InputError::hdf5(
+                    path,
+                    format!(
+                        "frame has shape {shape:?} and frame_ts {} entries",
+                        ts.len()
+                    ),
+                    "v2e frames are (N, H, W) with N timestamps in frame_ts",
+                ));
+            }
+            let size = shape[1] * shape[2];
+            let flat: Vec<u8> = stack.iter().copied().collect();
+            for (i, &t) in ts.iter().enumerate() {
+                frames.push(Frame {
+                    t: t as TimeUs,
+                    width: shape[2] as u32,
+                    height: shape[1] as u32,
+                    pixels: flat[i * size..(i + 1) * size].to_vec(),
+                    exposure_us: None,
+                });
+            }
+        }
+    }
+    Ok(frames)
+}
+
+/// One slice of the event columns, before validation (coordinates may be out of range).
+struct Columns {
+    t: Vec<TimeUs>,
+    x: Vec<i64>,
+    y: Vec<i64>,
+    on: Vec<bool>,
+}
+
+/// Streaming HDF5 event reader.
+pub struct H5Decoder {
+    path: PathBuf,
+    file: hdf5::File,
+    layout: Layout,
+    position: usize,
+    events: usize,
+    sensor: Option<Sensor>,
+    order: OrderCheck,
+}
+
+impl H5Decoder {
+    pub fn open(path: &Path, info: &H5Info, sensor: Option<Sensor>) -> Result<Self, InputError> {
+        Ok(Self {
+            path: path.to_path_buf(),
+            file: open_file(path)?,
+            layout: info.layout,
+            position: 0,
+            events: info.events,
+            sensor,
+            order: OrderCheck::default(),
+        })
+    }
+
+    fn read_range(&self, range: std::ops::Range<usize>) -> hdf5::Result<Columns> {
+        match self.layout {
+            Layout::EventUtils => {
+                let ts = self
+                    .file
+                    .dataset("events/ts")?
+                    .read_slice_1d::<f64, _>(range.clone())?;
+                // a non-finite time becomes i64::MIN and is reported by read_chunk
+                let t = ts
+                    .iter()
+                    .map(|&s| {
+                        if s.is_finite() {
+                            crate::events::s_to_us(s)
+                        } else {
+                            TimeUs::MIN
+                        }
+                    })
+                    .collect();
+                let (xs, ys) = read_coordinates(&self.file, self.layout, range.clone())?;
+                let ps = read_polarities(&self.file.dataset("events/ps")?, range)?;
+                Ok(Columns {
+                    t,
+                    x: xs,
+                    y: ys,
+                    on: ps,
+                })
+            }
+            Layout::V2e => {
+                let rows = self
+                    .file
+                    .dataset("events")?
+                    .read_slice_2d::<i64, _>(ndarray::s![range, ..])?;
+                Ok(Columns {
+                    t: rows.column(0).to_vec(),
+                    x: rows.column(1).to_vec(),
+                    y: rows.column(2).to_vec(),
+                    on: rows.column(3).iter().map(|&p| p > 0).collect(),
+                })
+            }
+        }
+    }
+}
+
+impl EventDecoder for H5Decoder {
+    fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
+        if self.position >= self.events {
+            return Ok(());
+        }
+        let end = (self.position + CHUNK_EVENTS.saturating_sub(out.len())).min(self.events);
+        let Columns {
+            t,
+            x: xs,
+            y: ys,
+            on: ps,
+        } = self.read_range(self.position..end).map_err(|e| {
+            h5_error(
+                &self.path,
+                &format!("reading events {}..{end}", self.position),
+                e,
+            )
+        })?;
+        for i in 0..t.len() {
+            let (x, y) = (xs[i], ys[i]);
+            let index = self.position + i;
+            let inside = x >= 0
+                && y >= 0
+                && x <= u16::MAX as i64
+                && y <= u16::MAX as i64
+                && self.sensor.is_none_or(|s| s.contains(x as u16, y as u16));
+            if !inside {
+                return Err(super::outside_sensor(
+                    &self.path,
+                    format!("event index {index}"),
+                    x.max(0) as u32,
+                    y.max(0) as u32,
+                    self.sensor,
+                ));
+            }
+            if t[i] == TimeUs::MIN {
+                return Err(InputError::corrupt(
+                    &self.path,
+                    format!("event index {index}"),
+                    "the timestamp is not a finite number",
+                    "the file is damaged; rewrite it from the source recording",
+                ));
+            }
+            self.order.check(t[i], || format!("event index {index}"));
+            out.push(t[i], x as u16, y as u16, ps[i]);
+        }
+        self.position = end;
+        Ok(())
+    }
+
+    fn order(&self) -> &OrderCheck {
+        &self.order
+    }
+
+    fn progress(&self) -> Progress {
+        Progress {
+            done: self.position as u64,
+            total: self.events as u64,
+        }
+    }
+}
