@@ -1,0 +1,96 @@
+//! Helpers shared by the integration tests.
+
+use assert_cmd::Command;
+use ctcal::{EventChunk, OpenOptions, Recording};
+use std::path::{Path, PathBuf};
+
+/// `../shared/data` beside the project root.
+pub fn shared_data() -> PathBuf {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    assert!(
+        path.is_dir(),
+        "shared test data missing at {}",
+        path.display()
+    );
+    path
+}
+
+pub fn real(name: &str) -> PathBuf {
+    shared_data().join("real").join(name)
+}
+
+pub fn oracle(name: &str) -> PathBuf {
+    shared_data().join("oracle").join(name)
+}
+
+/// The `ctcal` binary.
+pub fn ctcal() -> Command {
+    let mut cmd = Command::cargo_bin("ctcal").expect("ctcal binary built");
+    cmd.arg("--quiet");
+    cmd
+}
+
+/// Runs `ctcal <args> --json -` and parses stdout.
+pub fn json(args: &[&str]) -> serde_json::Value {
+    let output = ctcal()
+        .args(args)
+        .args(["--json", "-"])
+        .output()
+        .expect("runs");
+    assert!(
+        output.status.success(),
+        "ctcal {args:?} failed: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("stdout is JSON")
+}
+
+/// Runs ctcal expecting exit code 2; returns stderr.
+pub fn bad_input(args: &[&str]) -> String {
+    let output = ctcal().args(args).output().expect("runs");
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    assert_eq!(
+        output.status.code(),
+        Some(2),
+        "ctcal {args:?}: expected exit 2, stderr: {stderr}"
+    );
+    assert!(output.stdout.is_empty(), "nothing on stdout for an error");
+    stderr
+}
+
+/// Every event of a recording, via the library.
+pub fn read_events(path: &Path) -> EventChunk {
+    Recording::open(path, &OpenOptions::default())
+        .and_then(|r| r.read_all(false))
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// FNV-1a over (t, x, y, on) of every event: a fingerprint of an exact decode.
+pub fn fingerprint(events: &EventChunk) -> u64 {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            hash ^= b as u64;
+            hash = hash.wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for e in events.iter() {
+        eat(&e.t.to_le_bytes());
+        eat(&e.x.to_le_bytes());
+        eat(&e.y.to_le_bytes());
+        eat(&[e.on as u8]);
+    }
+    hash
+}
+
+/// `real/truth.json`.
+pub fn truth() -> serde_json::Value {
+    let text = std::fs::read_to_string(shared_data().join("real/truth.json")).expect("truth.json");
+    serde_json::from_str(&text).expect("valid JSON")
+}
+
+/// An oracle case's `params.json`.
+pub fn oracle_params(case: &str) -> serde_json::Value {
+    let text = std::fs::read_to_string(oracle(case).join("params.json")).expect("params.json");
+    serde_json::from_str(&text).expect("valid JSON")
+}

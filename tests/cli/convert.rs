@@ -1,0 +1,105 @@
+//! `ctcal convert` round trips: every shared input to an IJRR folder and to event_utils HDF5
+//! and back, every event identical; frames survive too.
+
+use crate::common::*;
+use std::path::Path;
+
+fn convert(input: &Path, out: &Path, to: &str) {
+    ctcal()
+        .args([
+            "convert",
+            input.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--to",
+            to,
+        ])
+        .assert()
+        .success();
+}
+
+#[test]
+fn every_shared_input_round_trips_through_text_and_hdf5() {
+    let data = shared_data();
+    let inputs = [
+        data.join("real/ijrr_slider_depth_50k"),
+        data.join("real/ijrr_boxes_rotation_chunk"),
+        data.join("real/davis346_faery.aedat4"),
+        data.join("real/dvxplorer_tonic.aedat4"),
+        data.join("real/evk4_faery_evt3.raw"),
+        data.join("real/evk4_faery_gen4.dat"),
+        data.join("real/gen3_faery_evt2.raw"),
+        data.join("real/gen3_expelliarmus_evt2.raw"),
+        data.join("h5/e_ct060_event_utils.h5"),
+        data.join("h5/e_ct060_v2e_layout.h5"),
+        data.join("oracle/dev_davis_like"),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    for input in inputs {
+        let original = read_events(&input);
+        let text = dir.path().join("as_text");
+        let h5 = dir.path().join("as.h5");
+        let back_text = dir.path().join("back_text");
+        let back_h5 = dir.path().join("back.h5");
+        convert(&input, &text, "ijrr");
+        convert(&input, &h5, "h5");
+        convert(&h5, &back_text, "ijrr");
+        convert(&text, &back_h5, "h5");
+        for path in [&text, &h5, &back_text, &back_h5] {
+            let events = read_events(path);
+            assert!(
+                events == original,
+                "{} -> {}: events differ",
+                input.display(),
+                path.file_name().unwrap().to_string_lossy()
+            );
+        }
+    }
+}
+
+#[test]
+fn frames_and_sensor_survive_conversion() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("davis.h5");
+    convert(&real("davis346_faery.aedat4"), &out, "h5");
+    let s = json(&["stats", out.to_str().unwrap()]);
+    assert_eq!(
+        (s["width"].as_u64(), s["height"].as_u64()),
+        (Some(346), Some(260))
+    );
+    assert_eq!(s["frames"]["count"].as_u64(), Some(59));
+    let text = dir.path().join("davis_text");
+    convert(&out, &text, "ijrr");
+    let original = ctcal::Recording::open(&real("davis346_faery.aedat4"), &Default::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    let copied = ctcal::Recording::open(&text, &Default::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    assert_eq!(copied.len(), original.len());
+    for (a, b) in original.iter().zip(&copied) {
+        assert_eq!((a.t, &a.pixels), (b.t, &b.pixels));
+    }
+}
+
+#[test]
+fn a_failed_conversion_leaves_nothing_under_the_output_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("events.txt");
+    std::fs::write(&bad, "0.1 1 1 1\n0.2 2 2 1\nnot an event\n").unwrap();
+    let out = dir.path().join("out");
+    let stderr = bad_input(&[
+        "convert",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(stderr.contains("line 3"), "{stderr}");
+    let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "only the input remains: {leftovers:?}");
+}

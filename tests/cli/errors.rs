@@ -1,0 +1,208 @@
+//! Bad input: each case gets exit code 2 and a message naming the file, the place and a fix.
+
+use crate::common::*;
+use std::path::Path;
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+fn truncated_copy(dir: &Path, source: &Path, name: &str, keep: usize) -> String {
+    let bytes = std::fs::read(source).unwrap();
+    write(dir, name, &bytes[..keep])
+}
+
+#[test]
+fn missing_file() {
+    let e = bad_input(&["stats", "/no/such/recording.raw"]);
+    assert!(
+        e.contains("/no/such/recording.raw") && e.contains("no such file"),
+        "{e}"
+    );
+    assert!(e.contains("fix:"), "{e}");
+}
+
+#[test]
+fn unknown_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "mystery.bin",
+        &[0xde, 0xad, 0xbe, 0xef, 0, 1, 2, 3],
+    );
+    let e = bad_input(&["info", &path]);
+    assert!(
+        e.contains("mystery.bin") && e.contains("unknown format") && e.contains("--format"),
+        "{e}"
+    );
+}
+
+#[test]
+fn truncated_evt3_aedat4_and_dat() {
+    let dir = tempfile::tempdir().unwrap();
+    let evt3 = truncated_copy(
+        dir.path(),
+        &real("evk4_faery_evt3.raw"),
+        "cut.raw",
+        225 + 500_000 + 1,
+    );
+    let e = bad_input(&["stats", &evt3]);
+    assert!(
+        e.contains("cut.raw") && e.contains("byte offset 500225") && e.contains("ends inside"),
+        "{e}"
+    );
+
+    let aedat = truncated_copy(
+        dir.path(),
+        &real("davis346_faery.aedat4"),
+        "cut.aedat4",
+        3_000_000,
+    );
+    let e = bad_input(&["stats", &aedat]);
+    assert!(
+        e.contains("cut.aedat4") && e.contains("byte offset") && e.contains("cut short"),
+        "{e}"
+    );
+
+    let dat = truncated_copy(
+        dir.path(),
+        &real("evk4_faery_gen4.dat"),
+        "cut.dat",
+        65 + 2 + 8 * 1000 + 3,
+    );
+    let e = bad_input(&["stats", &dat]);
+    assert!(
+        e.contains("cut.dat") && e.contains("ends inside an event"),
+        "{e}"
+    );
+
+    let evt2 = truncated_copy(
+        dir.path(),
+        &real("gen3_faery_evt2.raw"),
+        "cut2.raw",
+        166 + 4 * 1000 + 2,
+    );
+    let e = bad_input(&["stats", &evt2]);
+    assert!(
+        e.contains("cut2.raw") && e.contains("4-byte EVT2 word"),
+        "{e}"
+    );
+}
+
+#[test]
+fn garbage_and_nan_lines_name_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let garbage = write(
+        dir.path(),
+        "garbage.txt",
+        b"0.1 1 2 1\n0.2 3 4 0\n0.3 hello 4 1\n",
+    );
+    let e = bad_input(&["stats", &garbage]);
+    assert!(
+        e.contains("garbage.txt") && e.contains("line 3") && e.contains("hello"),
+        "{e}"
+    );
+    let nan = write(dir.path(), "nan.txt", b"# comment\n0.1 1 2 1\nnan 3 4 0\n");
+    let e = bad_input(&["stats", &nan]);
+    assert!(e.contains("line 3") && e.contains("finite"), "{e}");
+    let polarity = write(dir.path(), "pol.txt", b"0.1 1 2 7\n");
+    let e = bad_input(&["stats", &polarity]);
+    assert!(e.contains("line 1") && e.contains("polarity"), "{e}");
+}
+
+#[test]
+fn coordinates_outside_the_sensor() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "events.txt",
+        b"240 180\n0.1 10 10 1\n0.2 300 10 1\n",
+    );
+    let e = bad_input(&["stats", &path]);
+    assert!(
+        e.contains("line 3")
+            && e.contains("x=300")
+            && e.contains("240x180")
+            && e.contains("--sensor"),
+        "{e}"
+    );
+    // the user's --sensor is enforced too
+    let e = bad_input(&[
+        "stats",
+        real("davis346_faery.aedat4").to_str().unwrap(),
+        "--sensor",
+        "240x180",
+    ]);
+    assert!(e.contains("outside the 240x180 sensor"), "{e}");
+}
+
+#[test]
+fn unsorted_timestamps_are_counted_and_accepted_with_sort() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = write(
+        dir.path(),
+        "events.txt",
+        b"0.3 1 1 1\n0.1 2 2 0\n0.2 3 3 1\n0.15 4 4 1\n",
+    );
+    let e = bad_input(&["stats", &path]);
+    assert!(
+        e.contains("2 timestamps go backwards") && e.contains("line 2") && e.contains("--sort"),
+        "{e}"
+    );
+    let s = json(&["stats", &path, "--sort", "--sensor", "8x8"]);
+    assert_eq!(s["events"], 4);
+    assert_eq!(s["t_first_us"], 100_000);
+    assert_eq!(s["t_last_us"], 300_000);
+}
+
+#[test]
+fn empty_inputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = write(dir.path(), "empty.raw", b"");
+    let e = bad_input(&["stats", &empty]);
+    assert!(e.contains("empty.raw") && e.contains("no events"), "{e}");
+    let comments_only = write(dir.path(), "events.txt", b"# nothing recorded\n");
+    let e = bad_input(&["stats", &comments_only, "--format", "ijrr"]);
+    assert!(e.contains("no events"), "{e}");
+    let header_only = write(dir.path(), "header.raw", b"% evt 3.0\n% geometry 640x480\n");
+    let e = bad_input(&["stats", &header_only]);
+    assert!(e.contains("no events"), "{e}");
+}
+
+#[test]
+fn hdf5_with_missing_datasets() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("partial.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let events = file.create_group("events").unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&[0.1f64, 0.2])
+            .create("ts")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&[1i16, 2])
+            .create("xs")
+            .unwrap();
+    }
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(e.contains("partial.h5") && e.contains("events/ys"), "{e}");
+}
+
+#[test]
+fn bad_options_are_usage_errors() {
+    let input = real("ijrr_slider_depth_50k");
+    let e = bad_input(&["stats", input.to_str().unwrap(), "--window", "0"]);
+    assert!(e.contains("--window"), "{e}");
+    let e = bad_input(&["stats", input.to_str().unwrap(), "--sensor", "big"]);
+    assert!(e.contains("WxH"), "{e}");
+    let e = bad_input(&["stats", input.to_str().unwrap(), "--start", "5"]);
+    assert!(
+        e.contains("no events lie in the selected time window"),
+        "{e}"
+    );
+}

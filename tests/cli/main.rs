@@ -1,0 +1,8 @@
+//! ctcal's integration tests: one binary (as ripgrep does), driving the `ctcal` command and
+//! the library over the shared real recordings and simulator-oracle cases.
+
+mod common;
+mod convert;
+mod errors;
+mod readers;
+mod stats;

@@ -1,0 +1,154 @@
+//! `ctcal stats` against known truth: the JSON contract of ../shared/CLI.md, injected hot
+//! pixels, definitions checked by hand on real data.
+
+use crate::common::*;
+
+const CONTRACT_KEYS: [&str; 20] = [
+    "width",
+    "height",
+    "events",
+    "on_events",
+    "off_events",
+    "on_fraction",
+    "t_first_us",
+    "t_last_us",
+    "duration_s",
+    "events_per_pixel_per_second",
+    "on_per_pixel_per_second",
+    "off_per_pixel_per_second",
+    "active_pixel_fraction",
+    "rate_timeline",
+    "hot_pixels",
+    "hot_pixel_method",
+    "background_rate_hz",
+    "inter_event_interval_s",
+    "frames",
+    "t_first_us",
+];
+
+#[test]
+fn json_carries_every_contract_key() {
+    let s = json(&["stats", real("ijrr_slider_depth_50k").to_str().unwrap()]);
+    for key in CONTRACT_KEYS {
+        assert!(s.get(key).is_some(), "missing {key}");
+    }
+    let duration = s["duration_s"].as_f64().unwrap();
+    assert!((duration - (174_156 - 3_811) as f64 / 1e6).abs() < 1e-12);
+    let expected = 50_000.0 / (240.0 * 180.0 * duration);
+    assert!((s["events_per_pixel_per_second"].as_f64().unwrap() - expected).abs() < 1e-9);
+    let timeline = s["rate_timeline"].as_array().unwrap();
+    // 0.170345 s in 0.01 s windows: 17 windows, the remainder in the last
+    assert_eq!(timeline.len(), 17);
+    let total: u64 = timeline.iter().map(|w| w["events"].as_u64().unwrap()).sum();
+    assert_eq!(total, 50_000);
+    assert_eq!(timeline[0]["t_s"], 0.0);
+    assert_eq!(s["frames"]["count"], 5);
+    assert!(s["inter_event_interval_s"]["p5"].as_f64().unwrap() > 0.0);
+}
+
+#[test]
+fn finds_the_injected_hot_pixels_of_the_oracle() {
+    let params = oracle_params("dev_hot_pixels");
+    let injected: Vec<(u64, u64)> = params["post_processing"]["injection"]["hot_pixels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+        .collect();
+    let s = json(&["stats", oracle("dev_hot_pixels").to_str().unwrap()]);
+    let found: Vec<(u64, u64)> = s["hot_pixels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+        .collect();
+    for pixel in &injected {
+        assert!(
+            found.contains(pixel),
+            "missed hot pixel {pixel:?}; found {found:?}"
+        );
+    }
+    let false_ones = found.iter().filter(|p| !injected.contains(p)).count();
+    assert!(false_ones <= 2, "{false_ones} false hot pixels: {found:?}");
+    assert!(s["hot_pixel_method"].as_str().unwrap().contains("z-score"));
+}
+
+#[test]
+fn a_clean_simulation_has_no_hot_pixels() {
+    for case in [
+        "a_ideal_texture",
+        "b_asym_texture",
+        "c_noisy_static",
+        "dev_davis_like",
+    ] {
+        let s = json(&["stats", oracle(case).to_str().unwrap()]);
+        assert_eq!(s["hot_pixels"].as_array().unwrap().len(), 0, "{case}");
+    }
+}
+
+#[test]
+fn refractory_oracle_has_no_interval_below_its_refractory_period() {
+    // dev_refractory: 5 ms refractory period, shortest same-pixel interval 5238 us
+    let s = json(&["stats", oracle("dev_refractory").to_str().unwrap()]);
+    let p5 = s["inter_event_interval_s"]["p5"].as_f64().unwrap();
+    assert!(p5 >= 0.005, "p5 {p5}");
+    let median = s["inter_event_interval_s"]["median"].as_f64().unwrap();
+    // the oracle's own median is 5715 us
+    assert!(
+        (median - 0.005715).abs() / 0.005715 < 0.01,
+        "median {median}"
+    );
+}
+
+#[test]
+fn static_noise_background_rate_matches_the_oracle() {
+    // c_noisy_static: every event is shot noise; median pixel count / duration
+    let s = json(&["stats", oracle("c_noisy_static").to_str().unwrap()]);
+    let rate = s["background_rate_hz"].as_f64().unwrap();
+    // 116663 events over 43200 pixels and ~4 s is 0.675 Hz on average; the median pixel
+    // fires 3 events
+    assert!((rate - 3.0 / 3.996).abs() < 1e-9, "{rate}");
+}
+
+#[test]
+fn window_selection_counts_the_events_inside() {
+    let path = oracle("e_ct030_texture");
+    let all = read_events(&path);
+    let t0 = all.t[0];
+    let inside = all
+        .t
+        .iter()
+        .filter(|&&t| t >= t0 + 500_000 && t <= t0 + 1_000_000)
+        .count();
+    let s = json(&[
+        "stats",
+        path.to_str().unwrap(),
+        "--start",
+        "0.5",
+        "--end",
+        "1.0",
+        "--window",
+        "0.1",
+    ]);
+    assert_eq!(s["events"].as_u64(), Some(inside as u64));
+    assert_eq!(s["rate_timeline"].as_array().unwrap().len(), 5);
+}
+
+#[test]
+fn human_output_is_a_table_and_json_to_stdout_is_pure() {
+    let input = real("gen3_faery_evt2.raw");
+    let out = ctcal()
+        .args(["stats", input.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("events/pixel/s") && text.contains("521252"),
+        "{text}"
+    );
+    let out = ctcal()
+        .args(["stats", input.to_str().unwrap(), "--json", "-"])
+        .output()
+        .unwrap();
+    let _: serde_json::Value = serde_json::from_slice(&out.stdout).expect("only JSON on stdout");
+}
