@@ -23,6 +23,6 @@ pub mod events;
 pub mod io;
 pub mod sensors;
 
-pub use events::{Event, EventChunk, Frame, Sensor, TimeUs};
+pub use events::{CHUNK_EVENTS, Event, EventChunk, Frame, Sensor, TimeUs};
 pub use io::{Format, InputError, OpenOptions, Recording};
 pub mod stats;

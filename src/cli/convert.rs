@@ -4,13 +4,15 @@
 use super::{BadInput, Global, InputArgs, progress_bar, warn};
 use clap::{Args, ValueEnum};
 use ctcal::Recording;
-use ctcal::io::write::{H5Writer, IjrrWriter};
+use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum OutputFormat {
     Ijrr,
     H5,
+    /// Prophesee RAW EVT 3.0 (events only).
+    Evt3,
 }
 
 #[derive(Args, Debug)]
@@ -20,7 +22,7 @@ pub struct ConvertArgs {
     /// Output folder (IJRR) or file (HDF5).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
-    /// Output layout (default: h5 when --out ends in .h5/.hdf5, else ijrr).
+    /// Output layout (default: h5 when --out ends in .h5/.hdf5, evt3 for .raw, else ijrr).
     #[arg(long, value_enum)]
     pub to: Option<OutputFormat>,
     /// Accept timestamps that go backwards and write the events sorted by time.
@@ -31,6 +33,7 @@ pub struct ConvertArgs {
 enum Writer {
     Ijrr(IjrrWriter),
     H5(H5Writer),
+    Evt3(Evt3Writer),
 }
 
 pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
@@ -78,11 +81,13 @@ pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
     let mut writer = match to {
         OutputFormat::Ijrr => Writer::Ijrr(IjrrWriter::create(&args.out, resolved.sensor)?),
         OutputFormat::H5 => Writer::H5(H5Writer::create(&args.out, resolved.sensor)?),
+        OutputFormat::Evt3 => Writer::Evt3(Evt3Writer::create(&args.out, resolved.sensor)?),
     };
     let mut write = |chunk: &ctcal::EventChunk| -> anyhow::Result<()> {
         match &mut writer {
             Writer::Ijrr(w) => w.write_events(chunk)?,
             Writer::H5(w) => w.write_events(chunk)?,
+            Writer::Evt3(w) => w.write_events(chunk)?,
         }
         Ok(())
     };
@@ -102,11 +107,19 @@ pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
         match &mut writer {
             Writer::Ijrr(w) => w.write_frame(&frame)?,
             Writer::H5(w) => w.write_frame(&frame)?,
+            Writer::Evt3(_) => {
+                warn(
+                    global,
+                    "EVT3 holds events only; the frames were not written",
+                );
+                break;
+            }
         }
     }
     match writer {
         Writer::Ijrr(w) => w.finish()?,
         Writer::H5(w) => w.finish()?,
+        Writer::Evt3(w) => w.finish()?,
     }
     Ok(())
 }

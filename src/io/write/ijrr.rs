@@ -1,0 +1,91 @@
+//! IJRR folders: `events.txt` with a `width height` first line (as rpg_e2vid writes), then
+//! `t x y p` with t in seconds to the microsecond and p 0/1; frames as `images.txt` +
+//! `images/frame_XXXXXXXX.png`.
+
+use super::{commit, format_seconds, save_png, temporary_sibling};
+use crate::events::{EventChunk, Frame, Sensor};
+use crate::io::error::InputError;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Writes an IJRR folder.
+pub struct IjrrWriter {
+    target: PathBuf,
+    partial: PathBuf,
+    events: std::io::BufWriter<std::fs::File>,
+    line: Vec<u8>,
+    frames: Vec<u8>,
+    frame_count: usize,
+}
+
+impl IjrrWriter {
+    /// Starts a folder at `target`; `sensor` becomes the `width height` first line.
+    pub fn create(target: &Path, sensor: Sensor) -> Result<Self, InputError> {
+        let partial = temporary_sibling(target);
+        if partial.exists() {
+            std::fs::remove_dir_all(&partial).map_err(|e| InputError::write(&partial, e))?;
+        }
+        std::fs::create_dir_all(&partial).map_err(|e| InputError::write(target, e))?;
+        let file = std::fs::File::create(partial.join("events.txt"))
+            .map_err(|e| InputError::write(target, e))?;
+        let mut events = std::io::BufWriter::with_capacity(1 << 20, file);
+        writeln!(events, "{} {}", sensor.width, sensor.height)
+            .map_err(|e| InputError::write(target, e))?;
+        Ok(Self {
+            target: target.to_path_buf(),
+            partial,
+            events,
+            line: Vec::with_capacity(64),
+            frames: Vec::new(),
+            frame_count: 0,
+        })
+    }
+
+    pub fn write_events(&mut self, chunk: &EventChunk) -> Result<(), InputError> {
+        let mut buffer = itoa::Buffer::new();
+        for i in 0..chunk.len() {
+            self.line.clear();
+            format_seconds(chunk.t[i], &mut self.line);
+            self.line.push(b' ');
+            self.line
+                .extend_from_slice(buffer.format(chunk.x[i]).as_bytes());
+            self.line.push(b' ');
+            self.line
+                .extend_from_slice(buffer.format(chunk.y[i]).as_bytes());
+            self.line
+                .extend_from_slice(if chunk.on[i] { b" 1\n" } else { b" 0\n" });
+            self.events
+                .write_all(&self.line)
+                .map_err(|e| InputError::write(&self.target, e))?;
+        }
+        Ok(())
+    }
+
+    /// Adds a frame (PNG in `images/`, a line in `images.txt`).
+    pub fn write_frame(&mut self, frame: &Frame) -> Result<(), InputError> {
+        let folder = self.partial.join("images");
+        if self.frame_count == 0 {
+            std::fs::create_dir_all(&folder).map_err(|e| InputError::write(&self.target, e))?;
+        }
+        let name = format!("images/frame_{:08}.png", self.frame_count);
+        save_png(&self.partial.join(&name), frame)
+            .map_err(|e| InputError::write(&self.target, e))?;
+        format_seconds(frame.t, &mut self.frames);
+        self.frames
+            .extend_from_slice(format!(" {name}\n").as_bytes());
+        self.frame_count += 1;
+        Ok(())
+    }
+
+    /// Flushes and moves the folder into place.
+    pub fn finish(mut self) -> Result<(), InputError> {
+        self.events
+            .flush()
+            .map_err(|e| InputError::write(&self.target, e))?;
+        if self.frame_count > 0 {
+            std::fs::write(self.partial.join("images.txt"), &self.frames)
+                .map_err(|e| InputError::write(&self.target, e))?;
+        }
+        commit(&self.partial, &self.target)
+    }
+}
