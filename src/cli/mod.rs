@@ -1,9 +1,11 @@
 //! Argument parsing and dispatch. Each subcommand lives in its own module; this one holds
 //! the shared flags, output helpers and the mapping from errors to exit codes.
 
+mod calib;
 mod convert;
 mod info;
 mod output;
+mod simulate;
 mod stats;
 
 use clap::{Args, Parser, Subcommand};
@@ -65,6 +67,11 @@ pub enum Command {
     Convert(convert::ConvertArgs),
     /// Event statistics: rates, timeline, hot pixels, background rate, intervals.
     Stats(stats::StatsArgs),
+    /// Simulate events from frames or a scene through the pixel model.
+    Simulate(simulate::SimulateArgs),
+    /// Calibration stimuli to play on a monitor.
+    #[command(subcommand)]
+    Calib(calib::CalibCommand),
 }
 
 /// A problem with the command line or the input that the user can fix (exit code 2).
@@ -87,6 +94,8 @@ pub fn run() -> i32 {
         Command::Info(args) => info::run(args, &cli.global),
         Command::Convert(args) => convert::run(args, &cli.global),
         Command::Stats(args) => stats::run(args, &cli.global),
+        Command::Simulate(args) => simulate::run(args, &cli.global),
+        Command::Calib(command) => calib::run(command, &cli.global),
     };
     match result {
         Ok(()) => 0,
@@ -104,6 +113,12 @@ fn exit_code(error: &anyhow::Error) -> i32 {
             return if e.is_bad_input() { 2 } else { 1 };
         }
         if cause.is::<BadInput>() {
+            return 2;
+        }
+        if let Some(e) = cause.downcast_ref::<ctcal::sim::SimError>() {
+            return if e.is_bad_input() { 2 } else { 1 };
+        }
+        if cause.is::<ctcal::sim::ParamsError>() {
             return 2;
         }
     }

@@ -77,6 +77,11 @@ impl IjrrWriter {
         Ok(())
     }
 
+    /// Adds another file to the folder (e.g. provenance), written with it.
+    pub fn add_file(&mut self, name: &str, bytes: &[u8]) -> Result<(), InputError> {
+        std::fs::write(self.partial.join(name), bytes).map_err(|e| InputError::write(&self.target, e))
+    }
+
     /// Flushes and moves the folder into place.
     pub fn finish(mut self) -> Result<(), InputError> {
         self.events

@@ -1,0 +1,100 @@
+//! `ctcal calib checkerboard`: writes an on-screen calibration stimulus (Stoffregen et al.
+//! 2020, method 3) as `stimulus.txt` + `stimulus/frame_XXXXXXXX.png`.
+
+use super::{BadInput, Global, warn};
+use clap::{Args, Subcommand};
+use ctcal::io::write::{commit, format_seconds, save_png, temporary_sibling};
+use ctcal::sim::scene::stimulus::StimulusSpec;
+use std::path::PathBuf;
+
+#[derive(Subcommand, Debug)]
+pub enum CalibCommand {
+    /// A moving checkerboard on grey, to play full-screen on a monitor.
+    Checkerboard(CheckerboardArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct CheckerboardArgs {
+    /// Output folder.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Monitor refresh rate (one stimulus frame per refresh).
+    #[arg(long, value_name = "N", default_value_t = 75.0)]
+    pub refresh_hz: f64,
+    /// Screen width in pixels.
+    #[arg(long, value_name = "W", default_value_t = 240)]
+    pub width: usize,
+    /// Screen height in pixels.
+    #[arg(long, value_name = "H", default_value_t = 180)]
+    pub height: usize,
+    /// Square size in screen pixels.
+    #[arg(long, value_name = "N", default_value_t = 15.0)]
+    pub square_px: f64,
+    /// Squares across x down (the board is centred on the screen).
+    #[arg(long, value_name = "NxM", default_value = "8x6")]
+    pub squares: String,
+    /// Board speed in screen pixels per second.
+    #[arg(long, value_name = "V", default_value_t = 40.0)]
+    pub speed_px_s: f64,
+    /// Length of the stimulus.
+    #[arg(long, value_name = "D", default_value_t = 1.0)]
+    pub duration_s: f64,
+}
+
+pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
+    let CalibCommand::Checkerboard(args) = command;
+    let squares = ctcal::Sensor::parse(&args.squares)
+        .ok_or_else(|| BadInput(format!("--squares `{}` is not NxM (e.g. 8x6)", args.squares)))?;
+    for (name, value) in [
+        ("--refresh-hz", args.refresh_hz),
+        ("--square-px", args.square_px),
+        ("--duration-s", args.duration_s),
+    ] {
+        if !(value.is_finite() && value > 0.0) {
+            return Err(BadInput(format!("{name} must be positive")).into());
+        }
+    }
+    if !(args.speed_px_s.is_finite() && args.speed_px_s >= 0.0) || args.width == 0 || args.height == 0 {
+        return Err(BadInput("--speed-px-s must be >= 0 and the screen size positive".into()).into());
+    }
+    let spec = StimulusSpec {
+        width: args.width,
+        height: args.height,
+        refresh_hz: args.refresh_hz,
+        duration_s: args.duration_s,
+        square_px: args.square_px,
+        squares: [squares.width as usize, squares.height as usize],
+        speed_px_s: args.speed_px_s,
+    };
+    let board = (squares.width as f64 * args.square_px, squares.height as f64 * args.square_px);
+    if board.0 > args.width as f64 || board.1 > args.height as f64 {
+        return Err(BadInput(format!(
+            "the {}x{} px board does not fit the {}x{} screen\n  fix: use fewer or smaller squares",
+            board.0, board.1, args.width, args.height
+        ))
+        .into());
+    }
+    if board.0 == args.width as f64 || board.1 == args.height as f64 {
+        warn(global, "the board fills the screen along one axis, so it cannot move along it");
+    }
+    let partial = temporary_sibling(&args.out);
+    if partial.exists() {
+        std::fs::remove_dir_all(&partial)?;
+    }
+    std::fs::create_dir_all(partial.join("stimulus"))?;
+    let mut index = Vec::new();
+    for k in 0..spec.frame_count() {
+        let frame = spec.render(k);
+        let name = format!("stimulus/frame_{k:08}.png");
+        save_png(&partial.join(&name), &frame)?;
+        format_seconds(frame.t, &mut index);
+        index.extend_from_slice(format!(" {name}\n").as_bytes());
+    }
+    std::fs::write(partial.join("stimulus.txt"), &index)?;
+    std::fs::write(partial.join("stimulus.json"), serde_json::to_string_pretty(&spec)?)?;
+    commit(&partial, &args.out)?;
+    if !global.quiet {
+        println!("wrote {} frames at {} Hz to {}", spec.frame_count(), args.refresh_hz, args.out.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,83 @@
+//! Timestamp jitter: readout arbitration and the finite clock blur event times. Each event
+//! time gets Gaussian noise of standard deviation `timestamp_jitter_s`; events are then
+//! re-sorted. Jittered events can move across frame intervals, so they wait in a buffer
+//! until no later-generated event can precede them (six standard deviations).
+
+use crate::events::{Event, EventChunk, TimeUs};
+use rand::Rng;
+use rand_distr::{Distribution, Normal};
+
+/// Holds jittered events until they can be released in time order.
+pub struct JitterBuffer {
+    normal: Normal<f64>,
+    margin_us: TimeUs,
+    pending: Vec<Event>,
+}
+
+impl JitterBuffer {
+    pub fn new(sigma_s: f64) -> Self {
+        let sigma_us = sigma_s * 1e6;
+        Self {
+            normal: Normal::new(0.0, sigma_us).expect("finite sigma"),
+            margin_us: (6.0 * sigma_us).ceil() as TimeUs + 1,
+            pending: Vec::new(),
+        }
+    }
+
+    /// Jitters `events` (generated up to `generated_until`) and moves every event that no
+    /// later event can precede into `out`, sorted.
+    pub fn push(&mut self, events: &EventChunk, generated_until: TimeUs, rng: &mut impl Rng, out: &mut EventChunk) {
+        for mut e in events.iter() {
+            e.t += self.normal.sample(rng).round() as TimeUs;
+            self.pending.push(e);
+        }
+        self.release(generated_until - self.margin_us, out);
+    }
+
+    /// Releases everything (end of simulation).
+    pub fn flush(&mut self, out: &mut EventChunk) {
+        self.release(TimeUs::MAX, out);
+    }
+
+    fn release(&mut self, before: TimeUs, out: &mut EventChunk) {
+        self.pending.sort_by_key(|e| (e.t, e.y, e.x));
+        let split = self.pending.partition_point(|e| e.t < before);
+        for e in self.pending.drain(..split) {
+            out.push_event(e);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    #[test]
+    fn jittered_events_come_out_sorted_with_the_requested_spread() {
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(9);
+        let mut buffer = JitterBuffer::new(100e-6);
+        let mut out = EventChunk::default();
+        let mut offsets = Vec::new();
+        for block in 0..100 {
+            let chunk: EventChunk = (0..100)
+                .map(|i| Event { t: block * 1000 + i * 10, x: i as u16, y: 0, on: true })
+                .collect();
+            buffer.push(&chunk, block * 1000 + 1000, &mut rng, &mut out);
+        }
+        buffer.flush(&mut out);
+        assert_eq!(out.len(), 10_000);
+        assert!(out.is_time_sorted());
+        for e in out.iter() {
+            let block = (0..100).find(|b| {
+                let nominal = b * 1000 + e.x as i64 * 10;
+                (e.t - nominal).abs() < 700
+            });
+            if let Some(b) = block {
+                offsets.push((e.t - (b * 1000 + e.x as i64 * 10)) as f64);
+            }
+        }
+        let sd = (offsets.iter().map(|o| o * o).sum::<f64>() / offsets.len() as f64).sqrt();
+        assert!((sd - 100.0).abs() < 10.0, "{sd}");
+    }
+}

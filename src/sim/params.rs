@@ -1,0 +1,325 @@
+//! `PixelParams`: the simulator's parameters, exactly the PARAMS.toml keys of the CLI
+//! contract. Thresholds are required; every other absent key means that effect is off.
+//! Contrast thresholds and all "log" quantities are natural-log units of intensity.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// How intensity (camera DN, 0..255) maps to the log domain the pixel compares.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LogResponse {
+    /// v2e's lin-log: `ln(DN)` above 20 DN, linear below (continuous at 20 DN).
+    #[default]
+    V2e,
+    /// `ln(DN / 255 + log_eps)`.
+    Eps,
+}
+
+/// A screen between the scene and the camera (on-screen calibration stimuli).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DisplayParams {
+    /// Refresh rate; each stimulus frame is held until the next refresh (sample and hold).
+    pub refresh_hz: f64,
+    /// Luminance = black_level + (1 - black_level) * (DN / 255)^gamma.
+    pub gamma: f64,
+    /// Luminance of DN 0 as a fraction of white.
+    pub black_level: f64,
+    /// Camera DN of full white.
+    pub white_dn: f64,
+    /// Gaussian optical blur, sigma in pixels (absent: none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub blur_px: Option<f64>,
+    /// Time from a refresh to the camera seeing it, seconds (absent: 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_offset_s: Option<f64>,
+}
+
+/// The pixel model's parameters (PARAMS.toml).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PixelParams {
+    /// ON contrast threshold (log units).
+    pub ct_on: f64,
+    /// OFF contrast threshold (log units, positive).
+    pub ct_off: f64,
+    /// Frozen per-pixel threshold mismatch: standard deviation (log units), both polarities.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ct_sigma: Option<f64>,
+    /// Threshold noise redrawn after every event: standard deviation (log units).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ct_sigma_temporal: Option<f64>,
+    /// Refractory period, seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub refractory_s: Option<f64>,
+    /// Photoreceptor cutoff at full white (255 DN), Hz; scales as (DN + 20) / 275.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cutoff_hz: Option<f64>,
+    /// Leak: the reference drifts down by `leak_rate_hz * ct_on` per second.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leak_rate_hz: Option<f64>,
+    /// Pixel-to-pixel spread of the leak rate, decades (log10 standard deviation; default
+    /// 0.1 as v2e's `noise_rate_cov_decades`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leak_spread_decades: Option<f64>,
+    /// Shot-noise events (ON + OFF) per pixel per second in the dark.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shot_noise_rate_hz: Option<f64>,
+    /// Shot-noise rate at full white as a fraction of the dark rate (default 0.25, as v2e).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shot_noise_bright_factor: Option<f64>,
+    /// Fraction of pixels that are hot.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hot_pixel_fraction: Option<f64>,
+    /// Event rate of a hot pixel, Hz.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hot_pixel_rate_hz: Option<f64>,
+    /// Gaussian timestamp jitter, standard deviation in seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub timestamp_jitter_s: Option<f64>,
+    /// Log response (default v2e).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_response: Option<LogResponse>,
+    /// Offset of the `eps` log response (default 0.001).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_eps: Option<f64>,
+    /// Seed of every random draw (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seed: Option<u64>,
+    /// A screen between scene and camera.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub display: Option<DisplayParams>,
+}
+
+/// A parameter problem: which key, what is wrong, how to fix it.
+#[derive(Debug, thiserror::Error)]
+#[error("{source_name}: `{key}` {problem}\n  fix: {fix}")]
+pub struct ParamsError {
+    pub source_name: String,
+    pub key: String,
+    pub problem: String,
+    pub fix: String,
+}
+
+impl PixelParams {
+    /// Ideal pixel with these thresholds (every effect off).
+    pub fn ideal(ct_on: f64, ct_off: f64) -> Self {
+        Self {
+            ct_on,
+            ct_off,
+            ct_sigma: None,
+            ct_sigma_temporal: None,
+            refractory_s: None,
+            cutoff_hz: None,
+            leak_rate_hz: None,
+            leak_spread_decades: None,
+            shot_noise_rate_hz: None,
+            shot_noise_bright_factor: None,
+            hot_pixel_fraction: None,
+            hot_pixel_rate_hz: None,
+            timestamp_jitter_s: None,
+            log_response: None,
+            log_eps: None,
+            seed: None,
+            display: None,
+        }
+    }
+
+    /// Parses PARAMS.toml text; `source_name` names it in errors.
+    pub fn from_toml(text: &str, source_name: &str) -> Result<Self, ParamsError> {
+        let params: PixelParams = toml::from_str(text).map_err(|e| ParamsError {
+            source_name: source_name.to_string(),
+            key: e
+                .span()
+                .map(|s| text[s].lines().next().unwrap_or("").trim().to_string())
+                .unwrap_or_default(),
+            problem: format!("cannot be read: {}", e.message()),
+            fix: "PARAMS.toml needs ct_on and ct_off; optional keys: ct_sigma, ct_sigma_temporal, refractory_s, cutoff_hz, leak_rate_hz, leak_spread_decades, shot_noise_rate_hz, shot_noise_bright_factor, hot_pixel_fraction, hot_pixel_rate_hz, timestamp_jitter_s, log_response (\"v2e\"|\"eps\"), log_eps, seed, [display]".into(),
+        })?;
+        params.validate(source_name)?;
+        Ok(params)
+    }
+
+    /// Reads and validates a PARAMS.toml file.
+    pub fn from_file(path: &Path) -> Result<Self, crate::sim::SimError> {
+        let text = std::fs::read_to_string(path).map_err(|e| crate::io::InputError::io(path, e))?;
+        Ok(Self::from_toml(&text, &path.display().to_string())?)
+    }
+
+    /// The TOML text of these parameters.
+    pub fn to_toml(&self) -> String {
+        toml::to_string(self).expect("parameters serialise")
+    }
+
+    /// Checks every value's range.
+    pub fn validate(&self, source_name: &str) -> Result<(), ParamsError> {
+        let fail = |key: &str, problem: String, fix: &str| ParamsError {
+            source_name: source_name.to_string(),
+            key: key.to_string(),
+            problem,
+            fix: fix.to_string(),
+        };
+        let positive = |key: &str, v: f64| -> Result<(), ParamsError> {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(fail(key, format!("is {v}; it must be a positive number"), "give a value > 0"))
+            }
+        };
+        let non_negative = |key: &str, v: Option<f64>| -> Result<(), ParamsError> {
+            match v {
+                Some(v) if !(v.is_finite() && v >= 0.0) => Err(fail(
+                    key,
+                    format!("is {v}; it must be zero or positive"),
+                    "give a value >= 0, or remove the key to switch the effect off",
+                )),
+                _ => Ok(()),
+            }
+        };
+        positive("ct_on", self.ct_on)?;
+        positive("ct_off", self.ct_off)?;
+        for (key, v) in [
+            ("ct_sigma", self.ct_sigma),
+            ("ct_sigma_temporal", self.ct_sigma_temporal),
+            ("refractory_s", self.refractory_s),
+            ("cutoff_hz", self.cutoff_hz),
+            ("leak_rate_hz", self.leak_rate_hz),
+            ("leak_spread_decades", self.leak_spread_decades),
+            ("shot_noise_rate_hz", self.shot_noise_rate_hz),
+            ("shot_noise_bright_factor", self.shot_noise_bright_factor),
+            ("hot_pixel_rate_hz", self.hot_pixel_rate_hz),
+            ("timestamp_jitter_s", self.timestamp_jitter_s),
+        ] {
+            non_negative(key, v)?;
+        }
+        if let Some(f) = self.hot_pixel_fraction
+            && !(0.0..=1.0).contains(&f)
+        {
+            return Err(fail("hot_pixel_fraction", format!("is {f}"), "give a fraction between 0 and 1"));
+        }
+        if let Some(eps) = self.log_eps {
+            positive("log_eps", eps)?;
+        }
+        if let Some(d) = &self.display {
+            positive("display.refresh_hz", d.refresh_hz)?;
+            positive("display.gamma", d.gamma)?;
+            positive("display.white_dn", d.white_dn)?;
+            if !(d.black_level.is_finite() && (0.0..1.0).contains(&d.black_level)) {
+                return Err(fail(
+                    "display.black_level",
+                    format!("is {}", d.black_level),
+                    "give the luminance of black as a fraction of white, in [0, 1)",
+                ));
+            }
+            non_negative("display.blur_px", d.blur_px)?;
+            if d.time_offset_s.is_some_and(|t| !t.is_finite()) {
+                return Err(fail("display.time_offset_s", "is not finite".into(), "give seconds"));
+            }
+        }
+        Ok(())
+    }
+
+    pub fn seed(&self) -> u64 {
+        self.seed.unwrap_or(0)
+    }
+
+    pub fn log_response(&self) -> LogResponse {
+        self.log_response.unwrap_or_default()
+    }
+
+    pub fn log_eps(&self) -> f64 {
+        self.log_eps.unwrap_or(0.001)
+    }
+
+    /// An effect is on when its key is present and non-zero.
+    pub fn refractory_s(&self) -> f64 {
+        self.refractory_s.unwrap_or(0.0)
+    }
+
+    pub fn cutoff_hz(&self) -> Option<f64> {
+        self.cutoff_hz.filter(|&c| c > 0.0)
+    }
+
+    pub fn leak_rate_hz(&self) -> f64 {
+        self.leak_rate_hz.unwrap_or(0.0)
+    }
+
+    pub fn leak_spread_decades(&self) -> f64 {
+        self.leak_spread_decades.unwrap_or(0.1)
+    }
+
+    pub fn shot_noise_rate_hz(&self) -> f64 {
+        self.shot_noise_rate_hz.unwrap_or(0.0)
+    }
+
+    pub fn shot_noise_bright_factor(&self) -> f64 {
+        self.shot_noise_bright_factor.unwrap_or(0.25)
+    }
+
+    /// Hot pixels are on when both their fraction and rate are positive.
+    pub fn hot_pixels(&self) -> Option<(f64, f64)> {
+        match (self.hot_pixel_fraction, self.hot_pixel_rate_hz) {
+            (Some(f), Some(r)) if f > 0.0 && r > 0.0 => Some((f, r)),
+            _ => None,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thresholds_alone_make_an_ideal_pixel() {
+        let p = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.4\n", "t").unwrap();
+        assert_eq!(p, PixelParams::ideal(0.3, 0.4));
+        assert_eq!(p.refractory_s(), 0.0);
+        assert_eq!(p.cutoff_hz(), None);
+        assert_eq!(p.log_response(), LogResponse::V2e);
+    }
+
+    #[test]
+    fn every_key_round_trips_through_toml() {
+        let text = r#"
+ct_on = 0.35
+ct_off = 0.45
+ct_sigma = 0.03
+ct_sigma_temporal = 0.01
+refractory_s = 0.0005
+cutoff_hz = 300.0
+leak_rate_hz = 0.1
+shot_noise_rate_hz = 1.0
+shot_noise_bright_factor = 0.25
+hot_pixel_fraction = 0.001
+hot_pixel_rate_hz = 50.0
+timestamp_jitter_s = 0.0001
+log_response = "eps"
+log_eps = 0.01
+seed = 7
+
+[display]
+refresh_hz = 75.0
+gamma = 2.0
+black_level = 0.005
+white_dn = 200.0
+blur_px = 0.8
+"#;
+        let p = PixelParams::from_toml(text, "t").unwrap();
+        assert_eq!(p.display.as_ref().unwrap().gamma, 2.0);
+        let again = PixelParams::from_toml(&p.to_toml(), "t").unwrap();
+        assert_eq!(p, again);
+    }
+
+    #[test]
+    fn mistakes_name_the_key() {
+        let e = PixelParams::from_toml("ct_on = 0.3\n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("ct_off"), "{e}");
+        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.3\ncutof_hz = 3\n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("cutof_hz"), "{e}");
+        let e = PixelParams::from_toml("ct_on = -0.3\nct_off = 0.3\n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("`ct_on`"), "{e}");
+        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.3\nhot_pixel_fraction = 2\n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("hot_pixel_fraction"), "{e}");
+    }
+}

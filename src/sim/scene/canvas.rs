@@ -1,0 +1,196 @@
+//! Procedural textures: periodic log-normal canvases with a power-law spectrum, the texture
+//! model of the oracle scenes (and of natural images, whose amplitude spectra fall roughly
+//! as 1/f: Field, JOSA A 1987). White Gaussian noise is filtered in the Fourier domain by
+//! `A(f) = f^-beta * exp(-2 (pi * blur * f)^2)` (`A(0) = 0`), normalised to zero mean and unit
+//! standard deviation, and mapped to intensity `exp(clip(ln(mean) + log_std * z, ln(min),
+//! ln(max)))`. The canvas tiles seamlessly, so it can be sampled anywhere with wrap-around.
+
+use rand::Rng;
+use rand_distr::{Distribution, StandardNormal};
+use rustfft::FftPlanner;
+use rustfft::num_complex::Complex;
+use serde::{Deserialize, Serialize};
+
+/// A square, periodic intensity image (camera DN).
+#[derive(Clone, Debug)]
+pub struct Canvas {
+    pub size: usize,
+    pub pixels: Vec<f32>,
+}
+
+/// How to make a texture.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureParams {
+    #[serde(default = "default_canvas_px")]
+    pub canvas_px: usize,
+    #[serde(default = "default_mean")]
+    pub mean_dn: f64,
+    #[serde(default = "default_log_std")]
+    pub log_std: f64,
+    #[serde(default = "default_min")]
+    pub min_dn: f64,
+    #[serde(default = "default_max")]
+    pub max_dn: f64,
+    #[serde(default = "default_beta")]
+    pub spectrum_beta: f64,
+    #[serde(default = "default_blur")]
+    pub blur_px: f64,
+}
+
+fn default_canvas_px() -> usize {
+    512
+}
+fn default_mean() -> f64 {
+    90.0
+}
+fn default_log_std() -> f64 {
+    0.45
+}
+fn default_min() -> f64 {
+    25.0
+}
+fn default_max() -> f64 {
+    235.0
+}
+fn default_beta() -> f64 {
+    1.0
+}
+fn default_blur() -> f64 {
+    1.5
+}
+
+impl Default for TextureParams {
+    fn default() -> Self {
+        Self {
+            canvas_px: default_canvas_px(),
+            mean_dn: default_mean(),
+            log_std: default_log_std(),
+            min_dn: default_min(),
+            max_dn: default_max(),
+            spectrum_beta: default_beta(),
+            blur_px: default_blur(),
+        }
+    }
+}
+
+/// 2-D FFT in place (rows, then columns).
+fn fft2(data: &mut [Complex<f64>], n: usize, inverse: bool) {
+    let mut planner = FftPlanner::<f64>::new();
+    let fft = if inverse { planner.plan_fft_inverse(n) } else { planner.plan_fft_forward(n) };
+    for row in data.chunks_exact_mut(n) {
+        fft.process(row);
+    }
+    let mut column = vec![Complex::new(0.0, 0.0); n];
+    for x in 0..n {
+        for y in 0..n {
+            column[y] = data[y * n + x];
+        }
+        fft.process(&mut column);
+        for y in 0..n {
+            data[y * n + x] = column[y];
+        }
+    }
+}
+
+/// Signed FFT frequency of index `k` of `n` (cycles per pixel), as numpy's `fftfreq`.
+fn frequency(k: usize, n: usize) -> f64 {
+    let k = if k < n.div_ceil(2) { k as f64 } else { k as f64 - n as f64 };
+    k / n as f64
+}
+
+impl Canvas {
+    /// Synthesises a texture.
+    pub fn generate(params: &TextureParams, rng: &mut impl Rng) -> Self {
+        let n = params.canvas_px.max(8);
+        let mut data: Vec<Complex<f64>> = (0..n * n)
+            .map(|_| Complex::new(StandardNormal.sample(rng), 0.0))
+            .collect();
+        fft2(&mut data, n, false);
+        for y in 0..n {
+            for x in 0..n {
+                let f = frequency(x, n).hypot(frequency(y, n));
+                let amplitude = if f == 0.0 {
+                    0.0
+                } else {
+                    f.powf(-params.spectrum_beta)
+                        * (-2.0 * (std::f64::consts::PI * params.blur_px * f).powi(2)).exp()
+                };
+                data[y * n + x] *= amplitude;
+            }
+        }
+        fft2(&mut data, n, true);
+        let real: Vec<f64> = data.iter().map(|c| c.re).collect();
+        let mean = real.iter().sum::<f64>() / real.len() as f64;
+        let sd = (real.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / real.len() as f64).sqrt().max(1e-300);
+        let (lo, hi) = (params.min_dn.ln(), params.max_dn.ln());
+        let pixels = real
+            .iter()
+            .map(|v| {
+                let z = (v - mean) / sd;
+                (params.mean_dn.ln() + params.log_std * z).clamp(lo, hi).exp() as f32
+            })
+            .collect();
+        Self { size: n, pixels }
+    }
+
+    /// A canvas from a grey image (tiled periodically when sampled).
+    pub fn from_image(width: usize, height: usize, pixels: &[u8]) -> Self {
+        // resample to a square by nearest neighbour so wrap-around stays simple
+        let size = width.max(height);
+        let mut out = vec![0f32; size * size];
+        for y in 0..size {
+            for x in 0..size {
+                let sx = x * width / size;
+                let sy = y * height / size;
+                out[y * size + x] = pixels[sy * width + sx] as f32;
+            }
+        }
+        Self { size, pixels: out }
+    }
+
+    /// Bilinear sample at (column `x`, row `y`) with periodic wrap.
+    #[inline]
+    pub fn sample(&self, x: f64, y: f64) -> f32 {
+        let n = self.size as f64;
+        let (x, y) = (x.rem_euclid(n), y.rem_euclid(n));
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
+        let (i0, j0) = (x0 as usize % self.size, y0 as usize % self.size);
+        let (i1, j1) = ((i0 + 1) % self.size, (j0 + 1) % self.size);
+        let p = |i: usize, j: usize| self.pixels[j * self.size + i];
+        let top = p(i0, j0) + (p(i1, j0) - p(i0, j0)) * fx;
+        let bottom = p(i0, j1) + (p(i1, j1) - p(i0, j1)) * fx;
+        top + (bottom - top) * fy
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+
+    #[test]
+    fn texture_has_the_requested_log_statistics_and_range() {
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(1);
+        let params = TextureParams { canvas_px: 128, ..Default::default() };
+        let c = Canvas::generate(&params, &mut rng);
+        let logs: Vec<f64> = c.pixels.iter().map(|&p| (p as f64).ln()).collect();
+        let mean = logs.iter().sum::<f64>() / logs.len() as f64;
+        let sd = (logs.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / logs.len() as f64).sqrt();
+        assert!((mean - 90f64.ln()).abs() < 0.05, "{mean}");
+        assert!((sd - 0.45).abs() < 0.05, "{sd}");
+        assert!(c.pixels.iter().all(|&p| (24.99..=235.01).contains(&p)));
+    }
+
+    #[test]
+    fn sampling_wraps_and_interpolates() {
+        let c = Canvas { size: 2, pixels: vec![0.0, 10.0, 20.0, 30.0] };
+        assert_eq!(c.sample(0.0, 0.0), 0.0);
+        assert_eq!(c.sample(0.5, 0.0), 5.0);
+        assert_eq!(c.sample(0.5, 0.5), 15.0);
+        assert_eq!(c.sample(2.0, 2.0), 0.0);
+        assert_eq!(c.sample(-1.0, 0.0), 10.0);
+        assert_eq!(c.sample(1.5, 0.0), 5.0);
+    }
+}

@@ -1,0 +1,54 @@
+//! A textured plane translating and rotating in front of the camera (the oracle's
+//! "texture" scenes): frame pixel (x, y) at time t samples the canvas at
+//! `X = c0 + offset_x + vx t + cos(th) u - sin(th) v`, `Y = c0 + offset_y + vy t + sin(th) u +
+//! cos(th) v`, with `u = x - (W-1)/2`, `v = y - (H-1)/2`, `th = omega t` and `c0` the canvas
+//! centre; brightness may be modulated globally by `exp(mod_amp_ln * sin(2 pi mod_hz t))`.
+
+use super::canvas::{Canvas, TextureParams};
+use serde::{Deserialize, Serialize};
+
+/// Parameters of the texture scene.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureScene {
+    #[serde(flatten)]
+    pub texture: TextureParams,
+    #[serde(default)]
+    pub vx_px_s: f64,
+    #[serde(default)]
+    pub vy_px_s: f64,
+    #[serde(default)]
+    pub omega_deg_s: f64,
+    #[serde(default)]
+    pub offset_px: [f64; 2],
+    /// Global brightness modulation amplitude (log units) and frequency.
+    #[serde(default)]
+    pub mod_amp_ln: f64,
+    #[serde(default)]
+    pub mod_hz: f64,
+}
+
+impl TextureScene {
+    /// Fastest image motion, px/s (for choosing a render rate).
+    pub fn max_speed_px_s(&self, width: usize, height: usize) -> f64 {
+        let radius = (width as f64).hypot(height as f64) / 2.0;
+        self.vx_px_s.hypot(self.vy_px_s) + self.omega_deg_s.abs().to_radians() * radius
+    }
+
+    pub fn render(&self, canvas: &Canvas, width: usize, height: usize, t: f64, out: &mut [f32]) {
+        let th = self.omega_deg_s.to_radians() * t;
+        let (s, c) = th.sin_cos();
+        let c0 = canvas.size as f64 / 2.0;
+        let (ox, oy) = (c0 + self.offset_px[0] + self.vx_px_s * t, c0 + self.offset_px[1] + self.vy_px_s * t);
+        let gain = (self.mod_amp_ln * (std::f64::consts::TAU * self.mod_hz * t).sin()).exp() as f32;
+        let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
+        for y in 0..height {
+            let v = y as f64 - cy;
+            for x in 0..width {
+                let u = x as f64 - cx;
+                let value = canvas.sample(ox + c * u - s * v, oy + s * u + c * v);
+                out[y * width + x] = (value * gain).clamp(0.0, 255.0);
+            }
+        }
+    }
+}
