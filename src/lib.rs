@@ -25,5 +25,5 @@ pub mod sensors;
 
 pub use events::{CHUNK_EVENTS, Event, EventChunk, Frame, Sensor, TimeUs};
 pub use io::{Format, InputError, OpenOptions, Recording};
-pub mod stats;
 pub mod sim;
+pub mod stats;

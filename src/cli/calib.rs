@@ -43,8 +43,12 @@ pub struct CheckerboardArgs {
 
 pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
     let CalibCommand::Checkerboard(args) = command;
-    let squares = ctcal::Sensor::parse(&args.squares)
-        .ok_or_else(|| BadInput(format!("--squares `{}` is not NxM (e.g. 8x6)", args.squares)))?;
+    let squares = ctcal::Sensor::parse(&args.squares).ok_or_else(|| {
+        BadInput(format!(
+            "--squares `{}` is not NxM (e.g. 8x6)",
+            args.squares
+        ))
+    })?;
     for (name, value) in [
         ("--refresh-hz", args.refresh_hz),
         ("--square-px", args.square_px),
@@ -54,8 +58,13 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
             return Err(BadInput(format!("{name} must be positive")).into());
         }
     }
-    if !(args.speed_px_s.is_finite() && args.speed_px_s >= 0.0) || args.width == 0 || args.height == 0 {
-        return Err(BadInput("--speed-px-s must be >= 0 and the screen size positive".into()).into());
+    if !(args.speed_px_s.is_finite() && args.speed_px_s >= 0.0)
+        || args.width == 0
+        || args.height == 0
+    {
+        return Err(
+            BadInput("--speed-px-s must be >= 0 and the screen size positive".into()).into(),
+        );
     }
     let spec = StimulusSpec {
         width: args.width,
@@ -66,7 +75,10 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
         squares: [squares.width as usize, squares.height as usize],
         speed_px_s: args.speed_px_s,
     };
-    let board = (squares.width as f64 * args.square_px, squares.height as f64 * args.square_px);
+    let board = (
+        squares.width as f64 * args.square_px,
+        squares.height as f64 * args.square_px,
+    );
     if board.0 > args.width as f64 || board.1 > args.height as f64 {
         return Err(BadInput(format!(
             "the {}x{} px board does not fit the {}x{} screen\n  fix: use fewer or smaller squares",
@@ -75,7 +87,10 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
         .into());
     }
     if board.0 == args.width as f64 || board.1 == args.height as f64 {
-        warn(global, "the board fills the screen along one axis, so it cannot move along it");
+        warn(
+            global,
+            "the board fills the screen along one axis, so it cannot move along it",
+        );
     }
     let partial = temporary_sibling(&args.out);
     if partial.exists() {
@@ -91,10 +106,18 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
         index.extend_from_slice(format!(" {name}\n").as_bytes());
     }
     std::fs::write(partial.join("stimulus.txt"), &index)?;
-    std::fs::write(partial.join("stimulus.json"), serde_json::to_string_pretty(&spec)?)?;
+    std::fs::write(
+        partial.join("stimulus.json"),
+        serde_json::to_string_pretty(&spec)?,
+    )?;
     commit(&partial, &args.out)?;
     if !global.quiet {
-        println!("wrote {} frames at {} Hz to {}", spec.frame_count(), args.refresh_hz, args.out.display());
+        println!(
+            "wrote {} frames at {} Hz to {}",
+            spec.frame_count(),
+            args.refresh_hz,
+            args.out.display()
+        );
     }
     Ok(())
 }

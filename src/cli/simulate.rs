@@ -114,7 +114,11 @@ fn frame_index(dir: &Path) -> Result<PathBuf, BadInput> {
 }
 
 fn load_maps(args: &SimulateArgs, sensor: Sensor) -> Result<PixelMaps, SimError> {
-    let read = |path: &Option<PathBuf>| path.as_deref().map(|p| npy::read_pixel_map(p, sensor)).transpose();
+    let read = |path: &Option<PathBuf>| {
+        path.as_deref()
+            .map(|p| npy::read_pixel_map(p, sensor))
+            .transpose()
+    };
     Ok(PixelMaps {
         ct_on: read(&args.ct_on_map)?,
         ct_off: read(&args.ct_off_map)?,
@@ -125,45 +129,65 @@ fn load_maps(args: &SimulateArgs, sensor: Sensor) -> Result<PixelMaps, SimError>
 pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     let params = PixelParams::from_file(&args.params)?;
     let started = std::time::Instant::now();
-    let (mut source, scene_spec, render_hz, aps_frames): (Box<dyn FrameSource>, Option<SceneSpec>, Option<f64>, Vec<Frame>) =
-        match (&args.frames, &args.scene) {
-            (Some(dir), _) => {
-                let list = FrameList::read(&frame_index(dir)?)?;
-                if list.len() < 2 {
-                    return Err(BadInput(format!("{}: needs at least two frames to simulate events", list.index_path.display())).into());
-                }
-                (Box::new(FolderSource::new(list)?), None, None, Vec::new())
+    let (mut source, scene_spec, render_hz, aps_frames): (
+        Box<dyn FrameSource>,
+        Option<SceneSpec>,
+        Option<f64>,
+        Vec<Frame>,
+    ) = match (&args.frames, &args.scene) {
+        (Some(dir), _) => {
+            let list = FrameList::read(&frame_index(dir)?)?;
+            if list.len() < 2 {
+                return Err(BadInput(format!(
+                    "{}: needs at least two frames to simulate events",
+                    list.index_path.display()
+                ))
+                .into());
             }
-            (None, Some(path)) => {
-                let spec = SceneSpec::from_file(path)?;
-                let scene = spec.realise()?;
-                let source = SceneSource::new(&spec, scene.clone());
-                let hz = source.render_hz();
-                let frames = match &spec.aps {
-                    Some(a) => aps::render(&scene, spec.width, spec.height, spec.duration_s, hz, a),
-                    None => Vec::new(),
-                };
-                (Box::new(source), Some(spec), Some(hz), frames)
-            }
-            (None, None) => unreachable!("clap requires --frames or --scene"),
-        };
+            (Box::new(FolderSource::new(list)?), None, None, Vec::new())
+        }
+        (None, Some(path)) => {
+            let spec = SceneSpec::from_file(path)?;
+            let scene = spec.realise()?;
+            let source = SceneSource::new(&spec, scene.clone());
+            let hz = source.render_hz();
+            let frames = match &spec.aps {
+                Some(a) => aps::render(&scene, spec.width, spec.height, spec.duration_s, hz, a),
+                None => Vec::new(),
+            };
+            (Box::new(source), Some(spec), Some(hz), frames)
+        }
+        (None, None) => unreachable!("clap requires --frames or --scene"),
+    };
     if let Some(display) = &params.display {
         source = Box::new(DisplaySource::new(source, DisplayModel::new(display)));
     }
     let (width, height) = source.size();
     let sensor = Sensor::new(width as u16, height as u16);
     let maps = load_maps(args, sensor)?;
-    let to = args.to.unwrap_or(if args.out.extension().is_some_and(|e| e == "h5" || e == "hdf5") {
-        SimOutput::H5
-    } else {
-        SimOutput::Ijrr
-    });
+    let to = args.to.unwrap_or(
+        if args
+            .out
+            .extension()
+            .is_some_and(|e| e == "h5" || e == "hdf5")
+        {
+            SimOutput::H5
+        } else {
+            SimOutput::Ijrr
+        },
+    );
     let mut writer = match to {
         SimOutput::Ijrr => Writer::Ijrr(IjrrWriter::create(&args.out, sensor)?),
         SimOutput::H5 => Writer::H5(H5Writer::create(&args.out, sensor)?),
     };
     let bar = progress_bar(global, source.len_hint().unwrap_or(0), "simulating");
-    let summary = ctcal::sim::run(source.as_mut(), &params, maps, |events| writer.events(events), |n| bar.set_position(n))?;
+    let summary = ctcal::sim::run(
+        source.as_mut(),
+        &params,
+        maps,
+        |events| writer.events(events),
+        |n| bar.set_position(n),
+    )?;
     bar.finish_and_clear();
     for frame in &aps_frames {
         writer.frame(frame)?;
@@ -180,7 +204,11 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         t_first_sample_us: summary.t_first_sample_us,
         t_last_sample_us: summary.t_last_sample_us,
         duration_s,
-        events_per_pixel_per_second: if duration_s > 0.0 { summary.events as f64 / ((width * height) as f64 * duration_s) } else { 0.0 },
+        events_per_pixel_per_second: if duration_s > 0.0 {
+            summary.events as f64 / ((width * height) as f64 * duration_s)
+        } else {
+            0.0
+        },
         aps_frames: aps_frames.len(),
         render_hz,
         wall_s,
@@ -191,7 +219,10 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     };
     match writer {
         Writer::Ijrr(mut w) => {
-            w.add_file("simulation.json", serde_json::to_string_pretty(&result)?.as_bytes())?;
+            w.add_file(
+                "simulation.json",
+                serde_json::to_string_pretty(&result)?.as_bytes(),
+            )?;
             w.finish()?
         }
         Writer::H5(w) => w.finish()?,
@@ -204,11 +235,24 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         output::print_table(&[
             ("sensor".into(), format!("{width}x{height}")),
             ("input samples".into(), result.input_samples.to_string()),
-            ("events".into(), format!("{} ({} ON)", result.events, result.on_events)),
+            (
+                "events".into(),
+                format!("{} ({} ON)", result.events, result.on_events),
+            ),
             ("duration".into(), output::seconds(duration_s)),
-            ("events/pixel/s".into(), format!("{:.4}", result.events_per_pixel_per_second)),
+            (
+                "events/pixel/s".into(),
+                format!("{:.4}", result.events_per_pixel_per_second),
+            ),
             ("APS frames".into(), result.aps_frames.to_string()),
-            ("wall time".into(), format!("{} ({:.0} samples/s)", output::seconds(wall_s), result.samples_per_second)),
+            (
+                "wall time".into(),
+                format!(
+                    "{} ({:.0} samples/s)",
+                    output::seconds(wall_s),
+                    result.samples_per_second
+                ),
+            ),
             ("written".into(), args.out.display().to_string()),
         ]);
     }

@@ -49,7 +49,8 @@ impl DisplayModel {
         };
         let lut = (0..256)
             .map(|dn| {
-                let l = params.black_level + (1.0 - params.black_level) * (dn as f64 / 255.0).powf(params.gamma);
+                let l = params.black_level
+                    + (1.0 - params.black_level) * (dn as f64 / 255.0).powf(params.gamma);
                 (params.white_dn * l) as f32
             })
             .collect();
@@ -67,7 +68,8 @@ impl DisplayModel {
     /// Camera DN of one screen DN value (before blur).
     pub fn luminance_dn(&self, screen_dn: f32) -> f32 {
         let p = &self.params;
-        let l = p.black_level + (1.0 - p.black_level) * (screen_dn.clamp(0.0, 255.0) as f64 / 255.0).powf(p.gamma);
+        let l = p.black_level
+            + (1.0 - p.black_level) * (screen_dn.clamp(0.0, 255.0) as f64 / 255.0).powf(p.gamma);
         (p.white_dn * l) as f32
     }
 
@@ -151,7 +153,7 @@ mod tests {
     #[test]
     fn blur_preserves_a_flat_field_and_reflects_at_borders() {
         let d = DisplayModel::new(&params());
-        let out = d.camera_dn(&vec![255.0; 12], 4, 3);
+        let out = d.camera_dn(&[255.0; 12], 4, 3);
         assert!(out.iter().all(|&v| (v - 200.0).abs() < 1e-3));
         assert_eq!(reflect_101(-1, 5), 1);
         assert_eq!(reflect_101(5, 5), 3);

@@ -19,7 +19,10 @@ pub struct LogMap {
 
 impl LogMap {
     pub fn new(kind: LogResponse, eps: f64) -> Self {
-        Self { kind, eps: eps as f32 }
+        Self {
+            kind,
+            eps: eps as f32,
+        }
     }
 
     /// The log-domain value of intensity `dn` (camera DN).

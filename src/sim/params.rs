@@ -164,7 +164,11 @@ impl PixelParams {
             if v.is_finite() && v > 0.0 {
                 Ok(())
             } else {
-                Err(fail(key, format!("is {v}; it must be a positive number"), "give a value > 0"))
+                Err(fail(
+                    key,
+                    format!("is {v}; it must be a positive number"),
+                    "give a value > 0",
+                ))
             }
         };
         let non_negative = |key: &str, v: Option<f64>| -> Result<(), ParamsError> {
@@ -196,7 +200,11 @@ impl PixelParams {
         if let Some(f) = self.hot_pixel_fraction
             && !(0.0..=1.0).contains(&f)
         {
-            return Err(fail("hot_pixel_fraction", format!("is {f}"), "give a fraction between 0 and 1"));
+            return Err(fail(
+                "hot_pixel_fraction",
+                format!("is {f}"),
+                "give a fraction between 0 and 1",
+            ));
         }
         if let Some(eps) = self.log_eps {
             positive("log_eps", eps)?;
@@ -214,7 +222,11 @@ impl PixelParams {
             }
             non_negative("display.blur_px", d.blur_px)?;
             if d.time_offset_s.is_some_and(|t| !t.is_finite()) {
-                return Err(fail("display.time_offset_s", "is not finite".into(), "give seconds"));
+                return Err(fail(
+                    "display.time_offset_s",
+                    "is not finite".into(),
+                    "give seconds",
+                ));
             }
         }
         Ok(())
@@ -315,11 +327,16 @@ blur_px = 0.8
     fn mistakes_name_the_key() {
         let e = PixelParams::from_toml("ct_on = 0.3\n", "p.toml").unwrap_err();
         assert!(e.to_string().contains("ct_off"), "{e}");
-        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.3\ncutof_hz = 3\n", "p.toml").unwrap_err();
+        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.3\ncutof_hz = 3\n", "p.toml")
+            .unwrap_err();
         assert!(e.to_string().contains("cutof_hz"), "{e}");
         let e = PixelParams::from_toml("ct_on = -0.3\nct_off = 0.3\n", "p.toml").unwrap_err();
         assert!(e.to_string().contains("`ct_on`"), "{e}");
-        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.3\nhot_pixel_fraction = 2\n", "p.toml").unwrap_err();
+        let e = PixelParams::from_toml(
+            "ct_on = 0.3\nct_off = 0.3\nhot_pixel_fraction = 2\n",
+            "p.toml",
+        )
+        .unwrap_err();
         assert!(e.to_string().contains("hot_pixel_fraction"), "{e}");
     }
 }

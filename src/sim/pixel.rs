@@ -149,7 +149,11 @@ impl PixelState {
             let drift = self.leak_per_us * (t1 - t0) as f32;
             let d0 = u0 - self.reference;
             let d1 = u1 - (self.reference - drift);
-            if d0 < self.theta_on && d0 > -self.theta_off && d1 < self.theta_on && d1 > -self.theta_off {
+            if d0 < self.theta_on
+                && d0 > -self.theta_off
+                && d1 < self.theta_on
+                && d1 > -self.theta_off
+            {
                 self.reference -= drift;
                 self.filtered = u1;
                 return;
@@ -208,11 +212,21 @@ impl PixelState {
             } else {
                 f64::INFINITY
             };
-            let next = if sb - s <= allowed.max(min_step) { sb } else { s + allowed.max(min_step) };
+            let next = if sb - s <= allowed.max(min_step) {
+                sb
+            } else {
+                s + allowed.max(min_step)
+            };
             let f_next = ((next - sa) / h) as f32;
             let dn_next = lerp(dna, dnb, f_next);
             let tau_mid = bandwidth::tau_us(0.5 * (dn_s + dn_next), cutoff);
-            let y_next = bandwidth::advance(y, lerp(ua, ub, f_s), lerp(ua, ub, f_next), (next - s) as f32, tau_mid);
+            let y_next = bandwidth::advance(
+                y,
+                lerp(ua, ub, f_s),
+                lerp(ua, ub, f_next),
+                (next - s) as f32,
+                tau_mid,
+            );
             self.segment(model, s, next, y, y_next, dn_s, dn_next, rng, sink);
             y = y_next;
             s = next;
@@ -257,7 +271,8 @@ impl PixelState {
                 self.next_hot_us = ti + exponential_us(model.hot_rate_per_us, rng);
             } else {
                 self.next_noise_us = ti + exponential_us(self.noise_rate_per_us, rng);
-                let keep = shot_noise::brightness_factor(at(ti, dna, dnb), model.noise_bright_factor);
+                let keep =
+                    shot_noise::brightness_factor(at(ti, dna, dnb), model.noise_bright_factor);
                 if rng.random::<f32>() < keep {
                     let on = rng.random::<f32>() < self.noise_on_share;
                     sink.emit(ti, on);
@@ -289,11 +304,16 @@ impl PixelState {
         let mut db = yb - (self.reference - drift);
         let mut now = ta;
         loop {
-            let allowed = refractory::earliest_event_us(self.last_event_us, model.refractory_us).max(now);
+            let allowed =
+                refractory::earliest_event_us(self.last_event_us, model.refractory_us).max(now);
             if allowed > tb {
                 break;
             }
-            let d_allowed = if h > 0.0 { lerp(da, db, ((allowed - ta) / h) as f32) } else { db };
+            let d_allowed = if h > 0.0 {
+                lerp(da, db, ((allowed - ta) / h) as f32)
+            } else {
+                db
+            };
             let (on, t_fire) = if d_allowed >= self.theta_on {
                 (true, allowed)
             } else if d_allowed <= -self.theta_off {
@@ -345,13 +365,32 @@ mod tests {
         }
     }
 
-    fn run(model: &PixelModel, pixel: &mut PixelState, samples: &[(f64, f32)], transition: Transition) -> Vec<Event> {
+    fn run(
+        model: &PixelModel,
+        pixel: &mut PixelState,
+        samples: &[(f64, f32)],
+        transition: Transition,
+    ) -> Vec<Event> {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
         let mut events = Vec::new();
         let mut t_prev = samples[0].0;
         for &(t, u) in &samples[1..] {
-            let mut sink = EventSink { events: &mut events, origin_us: 0, x: 0, y: 0 };
-            pixel.advance(model, t_prev, t, u, u.exp(), transition, &mut rng, &mut sink);
+            let mut sink = EventSink {
+                events: &mut events,
+                origin_us: 0,
+                x: 0,
+                y: 0,
+            };
+            pixel.advance(
+                model,
+                t_prev,
+                t,
+                u,
+                u.exp(),
+                transition,
+                &mut rng,
+                &mut sink,
+            );
             t_prev = t;
         }
         events
@@ -361,13 +400,23 @@ mod tests {
     fn events_sit_at_interpolated_crossing_times_and_keep_the_remainder() {
         // log rises 0 -> 1 over 1000 us with theta 0.3: crossings at 300, 600, 900 us
         let mut p = PixelState::new(0.0, 1.0, 0.3, 0.3);
-        let events = run(&ideal(), &mut p, &[(0.0, 0.0), (1000.0, 1.0)], Transition::Linear);
+        let events = run(
+            &ideal(),
+            &mut p,
+            &[(0.0, 0.0), (1000.0, 1.0)],
+            Transition::Linear,
+        );
         let times: Vec<i64> = events.iter().map(|e| e.t).collect();
         assert_eq!(times, vec![300, 600, 900]);
         assert!(events.iter().all(|e| e.on));
         assert!((p.reference - 0.9).abs() < 1e-6);
         // back down to 0.05: OFF crossings at 0.6, 0.3 (levels), i.e. 0.95 -> ... times
-        let events = run(&ideal(), &mut p, &[(1000.0, 1.0), (2000.0, 0.05)], Transition::Linear);
+        let events = run(
+            &ideal(),
+            &mut p,
+            &[(1000.0, 1.0), (2000.0, 0.05)],
+            Transition::Linear,
+        );
         assert_eq!(events.len(), 2);
         assert!(events.iter().all(|e| !e.on));
         // d = 0.9 - 0.3 = 0.6 reached when u = 0.6: (1 - 0.6) / 0.95 * 1000 us after 1000
@@ -376,9 +425,17 @@ mod tests {
 
     #[test]
     fn refractory_delays_a_pending_change_instead_of_losing_it() {
-        let model = PixelModel { refractory_us: 500.0, ..ideal() };
+        let model = PixelModel {
+            refractory_us: 500.0,
+            ..ideal()
+        };
         let mut p = PixelState::new(0.0, 1.0, 0.3, 0.3);
-        let events = run(&model, &mut p, &[(0.0, 0.0), (1000.0, 1.0), (2000.0, 1.0)], Transition::Linear);
+        let events = run(
+            &model,
+            &mut p,
+            &[(0.0, 0.0), (1000.0, 1.0), (2000.0, 1.0)],
+            Transition::Linear,
+        );
         let times: Vec<i64> = events.iter().map(|e| e.t).collect();
         // first crossing at 300 us, then blocked until 800 and 1300 (still beyond threshold)
         assert_eq!(times, vec![300, 800, 1300]);
@@ -387,8 +444,16 @@ mod tests {
     #[test]
     fn a_display_step_fires_every_crossing_at_the_refresh() {
         let mut p = PixelState::new(0.0, 1.0, 0.3, 0.3);
-        let events = run(&ideal(), &mut p, &[(0.0, 0.0), (1000.0, 1.0)], Transition::Hold);
-        assert_eq!(events.iter().map(|e| e.t).collect::<Vec<_>>(), vec![1000, 1000, 1000]);
+        let events = run(
+            &ideal(),
+            &mut p,
+            &[(0.0, 0.0), (1000.0, 1.0)],
+            Transition::Hold,
+        );
+        assert_eq!(
+            events.iter().map(|e| e.t).collect::<Vec<_>>(),
+            vec![1000, 1000, 1000]
+        );
     }
 
     #[test]
@@ -407,20 +472,50 @@ mod tests {
     #[test]
     fn low_pass_delays_and_smooths_a_step() {
         // a step of 1.0 through the filter: crossings at -tau * ln(1 - k * 0.3)
-        let model = PixelModel { cutoff_hz: Some(1.0), ..ideal() };
+        let model = PixelModel {
+            cutoff_hz: Some(1.0),
+            ..ideal()
+        };
         let dn = 255.0; // cutoff 1 Hz * 275/275: tau = 1/(2 pi) s
         let tau = bandwidth::tau_us(dn, 1.0) as f64;
         let mut p = PixelState::new(0.0, dn, 0.3, 0.3);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
         let mut events = Vec::new();
-        let mut sink = EventSink { events: &mut events, origin_us: 0, x: 0, y: 0 };
+        let mut sink = EventSink {
+            events: &mut events,
+            origin_us: 0,
+            x: 0,
+            y: 0,
+        };
         p.dn = dn;
-        p.advance(&model, 0.0, 0.0, 1.0, dn, Transition::Hold, &mut rng, &mut sink);
-        p.advance(&model, 0.0, 10.0 * tau, 1.0, dn, Transition::Linear, &mut rng, &mut sink);
+        p.advance(
+            &model,
+            0.0,
+            0.0,
+            1.0,
+            dn,
+            Transition::Hold,
+            &mut rng,
+            &mut sink,
+        );
+        p.advance(
+            &model,
+            0.0,
+            10.0 * tau,
+            1.0,
+            dn,
+            Transition::Linear,
+            &mut rng,
+            &mut sink,
+        );
         assert_eq!(events.len(), 3);
         for (k, e) in events.iter().enumerate() {
             let expected = -tau * (1.0 - 0.3 * (k + 1) as f64).ln();
-            assert!((e.t as f64 - expected).abs() / expected < 0.01, "{} vs {expected}", e.t);
+            assert!(
+                (e.t as f64 - expected).abs() / expected < 0.01,
+                "{} vs {expected}",
+                e.t
+            );
         }
     }
 
@@ -433,12 +528,30 @@ mod tests {
         let mut events = Vec::new();
         let u = 90f32.ln();
         for k in 0..1000 {
-            let mut sink = EventSink { events: &mut events, origin_us: 0, x: 0, y: 0 };
+            let mut sink = EventSink {
+                events: &mut events,
+                origin_us: 0,
+                x: 0,
+                y: 0,
+            };
             let (t0, t1) = (k as f64 * 10_000.0, (k + 1) as f64 * 10_000.0);
-            p.advance(&ideal(), t0, t1, u, 90.0, Transition::Linear, &mut rng, &mut sink);
+            p.advance(
+                &ideal(),
+                t0,
+                t1,
+                u,
+                90.0,
+                Transition::Linear,
+                &mut rng,
+                &mut sink,
+            );
         }
         // 10 s at 100 Hz * brightness factor 0.7 = 700 events, Poisson sd 26
-        assert!((events.len() as f64 - 700.0).abs() < 4.0 * 26.5, "{}", events.len());
+        assert!(
+            (events.len() as f64 - 700.0).abs() < 4.0 * 26.5,
+            "{}",
+            events.len()
+        );
         let on = events.iter().filter(|e| e.on).count() as f64 / events.len() as f64;
         assert!((on - 0.5).abs() < 0.06);
         assert!((p.reference - u).abs() < 1e-6);

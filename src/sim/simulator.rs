@@ -56,7 +56,10 @@ impl Simulator {
         let model = PixelModel {
             refractory_us: params.refractory_s() * 1e6,
             cutoff_hz: params.cutoff_hz().map(|c| c as f32),
-            sigma_temporal: params.ct_sigma_temporal.filter(|&s| s > 0.0).map(|s| s as f32),
+            sigma_temporal: params
+                .ct_sigma_temporal
+                .filter(|&s| s > 0.0)
+                .map(|s| s as f32),
             noise_bright_factor: params.shot_noise_bright_factor() as f32,
             hot_rate_per_us: params.hot_pixels().map_or(0.0, |(_, r)| r * 1e-6),
             substep_tolerance: 0.002,
@@ -117,8 +120,13 @@ impl Simulator {
         let sigma = params.ct_sigma.unwrap_or(0.0);
         let mut draw_map = |given: &Option<Vec<f32>>, nominal: f64| -> Vec<f32> {
             match given {
-                Some(map) => map.iter().map(|&v| v.max(mismatch::MIN_THRESHOLD)).collect(),
-                None => (0..n).map(|_| mismatch::draw_threshold(nominal, sigma, &mut threshold_rng)).collect(),
+                Some(map) => map
+                    .iter()
+                    .map(|&v| v.max(mismatch::MIN_THRESHOLD))
+                    .collect(),
+                None => (0..n)
+                    .map(|_| mismatch::draw_threshold(nominal, sigma, &mut threshold_rng))
+                    .collect(),
             }
         };
         let theta_on = draw_map(&self.maps.ct_on, params.ct_on);
@@ -128,7 +136,9 @@ impl Simulator {
             (Some(map), _) => map.clone(),
             (None, true) => {
                 let mut rng = generator(self.seed, Stream::Leak, 0);
-                (0..n).map(|_| leak::draw_factor(params.leak_spread_decades(), &mut rng)).collect()
+                (0..n)
+                    .map(|_| leak::draw_factor(params.leak_spread_decades(), &mut rng))
+                    .collect()
             }
             (None, false) => vec![1.0; n],
         };
@@ -140,8 +150,13 @@ impl Simulator {
                 let mut p = PixelState::new(u, dn[i], theta_on[i], theta_off[i]);
                 p.leak_per_us = leak::drift_per_us(leak_rate, leak_factors[i], theta_on[i]);
                 if noise_rate > 0.0 {
-                    let (rate, on_share) =
-                        shot_noise::pixel_rates(noise_rate, params.ct_on, params.ct_off, theta_on[i], theta_off[i]);
+                    let (rate, on_share) = shot_noise::pixel_rates(
+                        noise_rate,
+                        params.ct_on,
+                        params.ct_off,
+                        theta_on[i],
+                        theta_off[i],
+                    );
                     p.noise_rate_per_us = rate;
                     p.noise_on_share = on_share;
                     p.next_noise_us = exponential_us(rate, &mut noise_rng);
@@ -152,7 +167,8 @@ impl Simulator {
         if let Some((fraction, _)) = params.hot_pixels() {
             let mut rng = generator(self.seed, Stream::HotPixels, 0);
             for index in hot_pixels::choose(n, fraction, &mut rng) {
-                self.pixels[index].next_hot_us = exponential_us(self.model.hot_rate_per_us, &mut rng);
+                self.pixels[index].next_hot_us =
+                    exponential_us(self.model.hot_rate_per_us, &mut rng);
             }
         }
     }
@@ -167,9 +183,12 @@ impl Simulator {
         let width = self.width;
         let model = &self.model;
         let log_map = self.log_map;
-        self.log_frame.par_chunks_mut(width).zip(dn.par_chunks(width)).for_each(|(out, dn)| {
-            log_map.apply_frame(dn, out);
-        });
+        self.log_frame
+            .par_chunks_mut(width)
+            .zip(dn.par_chunks(width))
+            .for_each(|(out, dn)| {
+                log_map.apply_frame(dn, out);
+            });
         let log_frame = &self.log_frame;
         self.pixels
             .par_chunks_mut(width)
@@ -186,7 +205,16 @@ impl Simulator {
                         x: x as u16,
                         y: y as u16,
                     };
-                    pixel.advance(model, t0, t1, log_frame[base + x], dn[base + x], transition, &mut row.rng, &mut sink);
+                    pixel.advance(
+                        model,
+                        t0,
+                        t1,
+                        log_frame[base + x],
+                        dn[base + x],
+                        transition,
+                        &mut row.rng,
+                        &mut sink,
+                    );
                 }
             });
         self.previous_us = t1;

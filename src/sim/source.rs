@@ -115,7 +115,8 @@ impl<S: FrameSource> DisplaySource<S> {
     }
 
     fn refresh_time(&self, k: u64) -> TimeUs {
-        self.first_t.unwrap_or(0) + (k as f64 * 1e6 / self.model.params().refresh_hz).round() as TimeUs
+        self.first_t.unwrap_or(0)
+            + (k as f64 * 1e6 / self.model.params().refresh_hz).round() as TimeUs
     }
 }
 

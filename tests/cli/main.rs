@@ -5,4 +5,5 @@ mod common;
 mod convert;
 mod errors;
 mod readers;
+mod simulate;
 mod stats;

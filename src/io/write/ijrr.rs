@@ -79,7 +79,8 @@ impl IjrrWriter {
 
     /// Adds another file to the folder (e.g. provenance), written with it.
     pub fn add_file(&mut self, name: &str, bytes: &[u8]) -> Result<(), InputError> {
-        std::fs::write(self.partial.join(name), bytes).map_err(|e| InputError::write(&self.target, e))
+        std::fs::write(self.partial.join(name), bytes)
+            .map_err(|e| InputError::write(&self.target, e))
     }
 
     /// Flushes and moves the folder into place.

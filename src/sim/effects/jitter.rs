@@ -26,7 +26,13 @@ impl JitterBuffer {
 
     /// Jitters `events` (generated up to `generated_until`) and moves every event that no
     /// later event can precede into `out`, sorted.
-    pub fn push(&mut self, events: &EventChunk, generated_until: TimeUs, rng: &mut impl Rng, out: &mut EventChunk) {
+    pub fn push(
+        &mut self,
+        events: &EventChunk,
+        generated_until: TimeUs,
+        rng: &mut impl Rng,
+        out: &mut EventChunk,
+    ) {
         for mut e in events.iter() {
             e.t += self.normal.sample(rng).round() as TimeUs;
             self.pending.push(e);
@@ -61,7 +67,12 @@ mod tests {
         let mut offsets = Vec::new();
         for block in 0..100 {
             let chunk: EventChunk = (0..100)
-                .map(|i| Event { t: block * 1000 + i * 10, x: i as u16, y: 0, on: true })
+                .map(|i| Event {
+                    t: block * 1000 + i * 10,
+                    x: i as u16,
+                    y: 0,
+                    on: true,
+                })
                 .collect();
             buffer.push(&chunk, block * 1000 + 1000, &mut rng, &mut out);
         }

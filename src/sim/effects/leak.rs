@@ -35,9 +35,14 @@ mod tests {
     #[test]
     fn factor_is_lognormal_with_the_given_spread() {
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(3);
-        let logs: Vec<f64> = (0..50_000).map(|_| (draw_factor(0.1, &mut rng) as f64).log10()).collect();
+        let logs: Vec<f64> = (0..50_000)
+            .map(|_| (draw_factor(0.1, &mut rng) as f64).log10())
+            .collect();
         let mean = logs.iter().sum::<f64>() / logs.len() as f64;
         let sd = (logs.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / logs.len() as f64).sqrt();
-        assert!(mean.abs() < 0.002 && (sd - 0.1).abs() < 0.002, "{mean} {sd}");
+        assert!(
+            mean.abs() < 0.002 && (sd - 0.1).abs() < 0.002,
+            "{mean} {sd}"
+        );
     }
 }

@@ -24,6 +24,9 @@ mod tests {
     #[test]
     fn a_pixel_may_fire_once_the_period_has_passed() {
         assert_eq!(earliest_event_us(1000.0, 5000.0), 6000.0);
-        assert_eq!(earliest_event_us(f64::NEG_INFINITY, 5000.0), f64::NEG_INFINITY);
+        assert_eq!(
+            earliest_event_us(f64::NEG_INFINITY, 5000.0),
+            f64::NEG_INFINITY
+        );
     }
 }

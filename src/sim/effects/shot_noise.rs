@@ -23,7 +23,10 @@ pub fn pixel_rates(
 ) -> (f64, f32) {
     let on = nominal_on / theta_on as f64;
     let off = nominal_off / theta_off as f64;
-    ((rate_hz / 2.0) * (on + off) * 1e-6, (on / (on + off)) as f32)
+    (
+        (rate_hz / 2.0) * (on + off) * 1e-6,
+        (on / (on + off)) as f32,
+    )
 }
 
 #[cfg(test)]

@@ -7,8 +7,18 @@ use super::{ApsSpec, Scene};
 use crate::events::Frame;
 
 /// Renders every APS frame whose exposure ends within `duration_s`.
-pub fn render(scene: &Scene, width: usize, height: usize, duration_s: f64, render_hz: f64, aps: &ApsSpec) -> Vec<Frame> {
-    let count = ((duration_s - aps.exposure_s) * aps.rate_hz + 1e-9).floor().max(0.0) as usize + 1;
+pub fn render(
+    scene: &Scene,
+    width: usize,
+    height: usize,
+    duration_s: f64,
+    render_hz: f64,
+    aps: &ApsSpec,
+) -> Vec<Frame> {
+    let count = ((duration_s - aps.exposure_s) * aps.rate_hz + 1e-9)
+        .floor()
+        .max(0.0) as usize
+        + 1;
     let samples = ((aps.exposure_s * render_hz).ceil() as usize).max(1) + 1;
     let mut sum = vec![0f64; width * height];
     let mut buffer = vec![0f32; width * height];
@@ -18,8 +28,16 @@ pub fn render(scene: &Scene, width: usize, height: usize, duration_s: f64, rende
             sum.iter_mut().for_each(|s| *s = 0.0);
             let n = if aps.exposure_s > 0.0 { samples } else { 1 };
             for k in 0..n {
-                let t = if n == 1 { start } else { start + aps.exposure_s * k as f64 / (n - 1) as f64 };
-                let weight = if n == 1 || (k > 0 && k + 1 < n) { 1.0 } else { 0.5 };
+                let t = if n == 1 {
+                    start
+                } else {
+                    start + aps.exposure_s * k as f64 / (n - 1) as f64
+                };
+                let weight = if n == 1 || (k > 0 && k + 1 < n) {
+                    1.0
+                } else {
+                    0.5
+                };
                 scene.render(width, height, t, &mut buffer);
                 for (s, &b) in sum.iter_mut().zip(&buffer) {
                     *s += weight * b as f64;
@@ -30,7 +48,10 @@ pub fn render(scene: &Scene, width: usize, height: usize, duration_s: f64, rende
                 t: ((start + aps.exposure_s / 2.0) * 1e6).round() as i64,
                 width: width as u32,
                 height: height as u32,
-                pixels: sum.iter().map(|s| (s / total_weight).round().clamp(0.0, 255.0) as u8).collect(),
+                pixels: sum
+                    .iter()
+                    .map(|s| (s / total_weight).round().clamp(0.0, 255.0) as u8)
+                    .collect(),
                 exposure_us: Some((aps.exposure_s * 1e6).round() as i64),
             }
         })
@@ -53,7 +74,10 @@ mod tests {
             vy_px_s: 0.0,
             origin_px: [0.0, 0.0],
         });
-        let aps = ApsSpec { rate_hz: 10.0, exposure_s: 0.02 };
+        let aps = ApsSpec {
+            rate_hz: 10.0,
+            exposure_s: 0.02,
+        };
         let frames = render(&scene, 40, 4, 0.5, 1000.0, &aps);
         assert_eq!(frames.len(), 5);
         assert_eq!(frames[0].t, 10_000);

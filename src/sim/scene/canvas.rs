@@ -77,7 +77,11 @@ impl Default for TextureParams {
 /// 2-D FFT in place (rows, then columns).
 fn fft2(data: &mut [Complex<f64>], n: usize, inverse: bool) {
     let mut planner = FftPlanner::<f64>::new();
-    let fft = if inverse { planner.plan_fft_inverse(n) } else { planner.plan_fft_forward(n) };
+    let fft = if inverse {
+        planner.plan_fft_inverse(n)
+    } else {
+        planner.plan_fft_forward(n)
+    };
     for row in data.chunks_exact_mut(n) {
         fft.process(row);
     }
@@ -95,7 +99,11 @@ fn fft2(data: &mut [Complex<f64>], n: usize, inverse: bool) {
 
 /// Signed FFT frequency of index `k` of `n` (cycles per pixel), as numpy's `fftfreq`.
 fn frequency(k: usize, n: usize) -> f64 {
-    let k = if k < n.div_ceil(2) { k as f64 } else { k as f64 - n as f64 };
+    let k = if k < n.div_ceil(2) {
+        k as f64
+    } else {
+        k as f64 - n as f64
+    };
     k / n as f64
 }
 
@@ -122,13 +130,17 @@ impl Canvas {
         fft2(&mut data, n, true);
         let real: Vec<f64> = data.iter().map(|c| c.re).collect();
         let mean = real.iter().sum::<f64>() / real.len() as f64;
-        let sd = (real.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / real.len() as f64).sqrt().max(1e-300);
+        let sd = (real.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / real.len() as f64)
+            .sqrt()
+            .max(1e-300);
         let (lo, hi) = (params.min_dn.ln(), params.max_dn.ln());
         let pixels = real
             .iter()
             .map(|v| {
                 let z = (v - mean) / sd;
-                (params.mean_dn.ln() + params.log_std * z).clamp(lo, hi).exp() as f32
+                (params.mean_dn.ln() + params.log_std * z)
+                    .clamp(lo, hi)
+                    .exp() as f32
             })
             .collect();
         Self { size: n, pixels }
@@ -173,7 +185,10 @@ mod tests {
     #[test]
     fn texture_has_the_requested_log_statistics_and_range() {
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(1);
-        let params = TextureParams { canvas_px: 128, ..Default::default() };
+        let params = TextureParams {
+            canvas_px: 128,
+            ..Default::default()
+        };
         let c = Canvas::generate(&params, &mut rng);
         let logs: Vec<f64> = c.pixels.iter().map(|&p| (p as f64).ln()).collect();
         let mean = logs.iter().sum::<f64>() / logs.len() as f64;
@@ -185,7 +200,10 @@ mod tests {
 
     #[test]
     fn sampling_wraps_and_interpolates() {
-        let c = Canvas { size: 2, pixels: vec![0.0, 10.0, 20.0, 30.0] };
+        let c = Canvas {
+            size: 2,
+            pixels: vec![0.0, 10.0, 20.0, 30.0],
+        };
         assert_eq!(c.sample(0.0, 0.0), 0.0);
         assert_eq!(c.sample(0.5, 0.0), 5.0);
         assert_eq!(c.sample(0.5, 0.5), 15.0);

@@ -24,9 +24,9 @@ pub mod stimulus;
 pub mod texture;
 
 use super::SimError;
+use super::pixel::Transition;
 use super::rng::{Stream, generator};
 use super::source::{FrameSource, Sample};
-use super::pixel::Transition;
 use crate::events::TimeUs;
 use canvas::Canvas;
 use serde::{Deserialize, Serialize};
@@ -106,19 +106,39 @@ impl SceneSpec {
     }
 
     fn validate(&self, path: &Path) -> Result<(), SimError> {
-        if self.width == 0 || self.height == 0 || self.width > u16::MAX as usize || self.height > u16::MAX as usize {
-            return Err(scene_error(path, format!("size {}x{} is not a sensor size", self.width, self.height), "give width and height in pixels"));
+        if self.width == 0
+            || self.height == 0
+            || self.width > u16::MAX as usize
+            || self.height > u16::MAX as usize
+        {
+            return Err(scene_error(
+                path,
+                format!("size {}x{} is not a sensor size", self.width, self.height),
+                "give width and height in pixels",
+            ));
         }
         if !(self.duration_s.is_finite() && self.duration_s > 0.0) {
-            return Err(scene_error(path, "duration_s must be positive", "give the scene length in seconds"));
+            return Err(scene_error(
+                path,
+                "duration_s must be positive",
+                "give the scene length in seconds",
+            ));
         }
         if self.render_hz.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
-            return Err(scene_error(path, "render_hz must be positive", "remove it to let ctcal choose"));
+            return Err(scene_error(
+                path,
+                "render_hz must be positive",
+                "remove it to let ctcal choose",
+            ));
         }
         if let Some(aps) = &self.aps
             && !(aps.rate_hz > 0.0 && aps.exposure_s >= 0.0 && aps.exposure_s <= 1.0 / aps.rate_hz)
         {
-            return Err(scene_error(path, "aps needs rate_hz > 0 and 0 <= exposure_s <= 1/rate_hz", "fix the [aps] table"));
+            return Err(scene_error(
+                path,
+                "aps needs rate_hz > 0 and 0 <= exposure_s <= 1/rate_hz",
+                "fix the [aps] table",
+            ));
         }
         let table = match self.kind {
             SceneKind::Texture => self.texture.is_some(),
@@ -126,8 +146,15 @@ impl SceneSpec {
             SceneKind::MultiObject => self.multi_object.is_some(),
         };
         if !table {
-            let name = serde_json::to_value(self.kind).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default();
-            return Err(scene_error(path, format!("kind = \"{name}\" needs a [{name}] table"), "add the table (see calib/scenes/)"));
+            let name = serde_json::to_value(self.kind)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default();
+            return Err(scene_error(
+                path,
+                format!("kind = \"{name}\" needs a [{name}] table"),
+                "add the table (see calib/scenes/)",
+            ));
         }
         Ok(())
     }
@@ -141,14 +168,22 @@ impl SceneSpec {
                 let canvas = Canvas::generate(&t.texture, &mut rng);
                 Scene::Texture(t, canvas)
             }
-            SceneKind::Checkerboard => Scene::Checkerboard(self.checkerboard.clone().expect("validated")),
+            SceneKind::Checkerboard => {
+                Scene::Checkerboard(self.checkerboard.clone().expect("validated"))
+            }
             SceneKind::MultiObject => {
                 let m = self.multi_object.as_ref().expect("validated");
                 let images = match &m.textures_dir {
                     Some(dir) => load_textures(dir)?,
                     None => Vec::new(),
                 };
-                Scene::MultiObject(m.realise(self.width, self.height, self.duration_s, images, &mut rng))
+                Scene::MultiObject(m.realise(
+                    self.width,
+                    self.height,
+                    self.duration_s,
+                    images,
+                    &mut rng,
+                ))
             }
         })
     }
@@ -156,7 +191,9 @@ impl SceneSpec {
     /// The render rate: as given, else fast enough that nothing moves more than half a
     /// pixel between frames (at least 100 Hz, at most 20 kHz).
     pub fn render_hz(&self, scene: &Scene) -> f64 {
-        self.render_hz.unwrap_or_else(|| (2.0 * scene.max_speed_px_s(self.width, self.height)).clamp(100.0, 20_000.0))
+        self.render_hz.unwrap_or_else(|| {
+            (2.0 * scene.max_speed_px_s(self.width, self.height)).clamp(100.0, 20_000.0)
+        })
     }
 }
 
@@ -169,13 +206,23 @@ fn load_textures(dir: &Path) -> Result<Vec<Canvas>, SimError> {
         .collect();
     paths.sort();
     if paths.is_empty() {
-        return Err(scene_error(dir, "textures_dir holds no .png images", "put grey PNG textures there or remove textures_dir"));
+        return Err(scene_error(
+            dir,
+            "textures_dir holds no .png images",
+            "put grey PNG textures there or remove textures_dir",
+        ));
     }
     paths
         .iter()
         .map(|p| {
             let image = image::open(p)
-                .map_err(|e| scene_error(p, format!("cannot decode: {e}"), "replace it with an intact PNG"))?
+                .map_err(|e| {
+                    scene_error(
+                        p,
+                        format!("cannot decode: {e}"),
+                        "replace it with an intact PNG",
+                    )
+                })?
                 .into_luma8();
             let (w, h) = image.dimensions();
             Ok(Canvas::from_image(w as usize, h as usize, image.as_raw()))
@@ -192,13 +239,38 @@ impl Scene {
         }
     }
 
-    /// Renders the intensity (camera DN) at time `t` seconds into `out` (W x H).
-    pub fn render(&self, width: usize, height: usize, t: f64, out: &mut [f32]) {
+    /// Renders rows `rows` of the intensity (camera DN) at time `t` seconds into `out`
+    /// (those rows of a W x H frame).
+    pub fn render_rows(
+        &self,
+        width: usize,
+        height: usize,
+        rows: std::ops::Range<usize>,
+        t: f64,
+        out: &mut [f32],
+    ) {
         match self {
-            Scene::Texture(t_scene, canvas) => t_scene.render(canvas, width, height, t, out),
-            Scene::Checkerboard(c) => c.render(width, height, t, out),
-            Scene::MultiObject(m) => m.render(width, height, t, out),
+            Scene::Texture(t_scene, canvas) => t_scene.render(canvas, width, height, rows, t, out),
+            Scene::Checkerboard(c) => c.render(width, rows, t, out),
+            Scene::MultiObject(m) => m.render(width, height, rows, t, out),
         }
+    }
+
+    /// Renders the whole frame at time `t` seconds into `out` (W x H).
+    pub fn render(&self, width: usize, height: usize, t: f64, out: &mut [f32]) {
+        self.render_rows(width, height, 0..height, t, out);
+    }
+
+    /// Renders the whole frame, bands of rows in parallel.
+    pub fn render_parallel(&self, width: usize, height: usize, t: f64, out: &mut [f32]) {
+        use rayon::prelude::*;
+        const BAND: usize = 8;
+        out.par_chunks_mut(width * BAND)
+            .enumerate()
+            .for_each(|(band, chunk)| {
+                let start = band * BAND;
+                self.render_rows(width, height, start..(start + BAND).min(height), t, chunk);
+            });
     }
 }
 
@@ -245,7 +317,8 @@ impl FrameSource for SceneSource {
         }
         let t = self.next as f64 / self.render_hz;
         let mut dn = vec![0f32; self.width * self.height];
-        self.scene.render(self.width, self.height, t, &mut dn);
+        self.scene
+            .render_parallel(self.width, self.height, t, &mut dn);
         self.next += 1;
         Ok(Some(Sample {
             t: (t * 1e6).round() as TimeUs,

@@ -70,7 +70,9 @@ impl Shape {
         match *self {
             Shape::Ellipse { rx, ry } => rx.max(ry),
             Shape::Rectangle { hx, hy } => hx.hypot(hy),
-            Shape::Polygon { sides, apothem } => apothem / (std::f64::consts::PI / sides as f64).cos(),
+            Shape::Polygon { sides, apothem } => {
+                apothem / (std::f64::consts::PI / sides as f64).cos()
+            }
         }
     }
 }
@@ -106,7 +108,8 @@ impl Trajectory {
         ];
         let speed = uniform(&mut r, speed);
         let direction = std::f64::consts::TAU * r();
-        let angular_velocity = uniform(&mut r, angular).to_radians() * if r() < 0.5 { -1.0 } else { 1.0 };
+        let angular_velocity =
+            uniform(&mut r, angular).to_radians() * if r() < 0.5 { -1.0 } else { 1.0 };
         Self {
             point,
             velocity: [speed * direction.cos(), speed * direction.sin()],
@@ -122,16 +125,24 @@ impl Trajectory {
     /// Centre, angle and scale at time t.
     fn pose(&self, t: f64) -> ([f64; 2], f64, f64) {
         let dt = t - self.pass_time;
-        let f = if self.duration > 0.0 { (t / self.duration).clamp(0.0, 1.0) } else { 0.0 };
+        let f = if self.duration > 0.0 {
+            (t / self.duration).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         (
-            [self.point[0] + self.velocity[0] * dt, self.point[1] + self.velocity[1] * dt],
+            [
+                self.point[0] + self.velocity[0] * dt,
+                self.point[1] + self.velocity[1] * dt,
+            ],
             self.angle0 + self.angular_velocity * t,
             self.scale0 + (self.scale1 - self.scale0) * f,
         )
     }
 
     fn max_speed(&self, radius: f64) -> f64 {
-        self.velocity[0].hypot(self.velocity[1]) + self.angular_velocity.abs() * radius * self.scale0.max(self.scale1)
+        self.velocity[0].hypot(self.velocity[1])
+            + self.angular_velocity.abs() * radius * self.scale0.max(self.scale1)
     }
 }
 
@@ -179,12 +190,22 @@ impl MultiObjectScene {
         );
         let mut objects = Vec::new();
         for _ in 0..count {
-            let size = self.object_size_px[0] + (self.object_size_px[1] - self.object_size_px[0]) * rng.random::<f64>();
+            let size = self.object_size_px[0]
+                + (self.object_size_px[1] - self.object_size_px[0]) * rng.random::<f64>();
             let aspect = 0.5 + rng.random::<f64>() * 0.5;
             let shape = match rng.random_range(0..3u32) {
-                0 => Shape::Ellipse { rx: size, ry: size * aspect },
-                1 => Shape::Rectangle { hx: size, hy: size * aspect },
-                _ => Shape::Polygon { sides: rng.random_range(3..=8), apothem: size },
+                0 => Shape::Ellipse {
+                    rx: size,
+                    ry: size * aspect,
+                },
+                1 => Shape::Rectangle {
+                    hx: size,
+                    hy: size * aspect,
+                },
+                _ => Shape::Polygon {
+                    sides: rng.random_range(3..=8),
+                    apothem: size,
+                },
             };
             let texture = if images.is_empty() {
                 let params = TextureParams {
@@ -211,9 +232,17 @@ impl MultiObjectScene {
                 self.object_angular_velocity_deg_s,
                 self.object_scale,
             );
-            objects.push(Object { shape, texture, trajectory });
+            objects.push(Object {
+                shape,
+                texture,
+                trajectory,
+            });
         }
-        MultiObjectWorld { textures, background, objects }
+        MultiObjectWorld {
+            textures,
+            background,
+            objects,
+        }
     }
 }
 
@@ -231,24 +260,39 @@ impl MultiObjectWorld {
         self.objects.len()
     }
 
-    pub fn render(&self, width: usize, height: usize, t: f64, out: &mut [f32]) {
+    /// Renders rows `rows` into `out` (those rows only).
+    pub fn render(
+        &self,
+        width: usize,
+        height: usize,
+        rows: std::ops::Range<usize>,
+        t: f64,
+        out: &mut [f32],
+    ) {
         // background: the image is the texture seen through the inverse of its motion
         let (centre, angle, scale) = self.background.pose(t);
         let (s, c) = angle.sin_cos();
         let texture = &self.textures[0];
-        let (cx, cy) = (width as f64 / 2.0, height as f64 / 2.0);
-        for y in 0..height {
+        let first = rows.start;
+        for y in rows.clone() {
             for x in 0..width {
-                let (dx, dy) = (x as f64 - cx - (centre[0] - cx), y as f64 - cy - (centre[1] - cy));
+                let (dx, dy) = (x as f64 - centre[0], y as f64 - centre[1]);
                 let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                out[y * width + x] = texture.sample(qx, qy);
+                out[(y - first) * width + x] = texture.sample(qx, qy);
             }
         }
+        let _ = height;
         for object in &self.objects {
             let (centre, angle, scale) = object.trajectory.pose(t);
             let reach = object.shape.radius() * scale + 1.0;
-            let (x_lo, x_hi) = ((centre[0] - reach).floor().max(0.0), (centre[0] + reach).ceil().min(width as f64 - 1.0));
-            let (y_lo, y_hi) = ((centre[1] - reach).floor().max(0.0), (centre[1] + reach).ceil().min(height as f64 - 1.0));
+            let (x_lo, x_hi) = (
+                (centre[0] - reach).floor().max(0.0),
+                (centre[0] + reach).ceil().min(width as f64 - 1.0),
+            );
+            let (y_lo, y_hi) = (
+                (centre[1] - reach).floor().max(rows.start as f64),
+                (centre[1] + reach).ceil().min(rows.end as f64 - 1.0),
+            );
             if x_lo > x_hi || y_lo > y_hi {
                 continue;
             }
@@ -258,10 +302,11 @@ impl MultiObjectWorld {
                 for x in x_lo as usize..=x_hi as usize {
                     let (dx, dy) = (x as f64 - centre[0], y as f64 - centre[1]);
                     let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                    let coverage = (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
+                    let coverage =
+                        (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
                     if coverage > 0.0 {
                         let value = texture.sample(qx + 64.0, qy + 64.0);
-                        let pixel = &mut out[y * width + x];
+                        let pixel = &mut out[(y - first) * width + x];
                         *pixel += (value - *pixel) * coverage;
                     }
                 }
@@ -282,7 +327,10 @@ mod tests {
         let r = Shape::Rectangle { hx: 4.0, hy: 2.0 };
         assert_eq!(r.distance(4.0, 0.0), 0.0);
         assert_eq!(r.distance(6.0, 0.0), 2.0);
-        let square = Shape::Polygon { sides: 4, apothem: 3.0 };
+        let square = Shape::Polygon {
+            sides: 4,
+            apothem: 3.0,
+        };
         assert!((square.distance(3.0, 0.0)).abs() < 1e-9);
         assert!((square.radius() - 3.0 * 2f64.sqrt()).abs() < 1e-9);
     }

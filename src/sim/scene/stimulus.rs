@@ -55,13 +55,25 @@ impl StimulusSpec {
     /// Board top-left corner at time t: amplitudes fill a quarter of the free space on each
     /// axis; the x axis sweeps 4x slower than y, the speed split equally between the axes.
     pub fn board_corner(&self, t: f64) -> (f64, f64) {
-        let (bw, bh) = (self.squares[0] as f64 * self.square_px, self.squares[1] as f64 * self.square_px);
-        let (x0, y0) = ((self.width as f64 - bw) / 2.0, (self.height as f64 - bh) / 2.0);
+        let (bw, bh) = (
+            self.squares[0] as f64 * self.square_px,
+            self.squares[1] as f64 * self.square_px,
+        );
+        let (x0, y0) = (
+            (self.width as f64 - bw) / 2.0,
+            (self.height as f64 - bh) / 2.0,
+        );
         let axis_speed = self.speed_px_s / 2f64.sqrt();
         let (ax, ay) = (x0 * 0.95, y0 * 0.95);
         // triangle slope is 4 amplitudes per period: period = 4 A / speed
         let (px, py) = (4.0 * ax / axis_speed, 4.0 * ay / axis_speed);
-        let tri = |t: f64, period: f64, amplitude: f64| if period > 0.0 { amplitude * triangle(t / period) } else { 0.0 };
+        let tri = |t: f64, period: f64, amplitude: f64| {
+            if period > 0.0 {
+                amplitude * triangle(t / period)
+            } else {
+                0.0
+            }
+        };
         (x0 + tri(t, px, ax), y0 + tri(t, py, ay))
     }
 
@@ -83,7 +95,8 @@ impl StimulusSpec {
                         continue;
                     }
                     for i in 0..nx {
-                        let ox = overlap(px, px + 1.0, bx + i as f64 * sq, bx + (i + 1) as f64 * sq);
+                        let ox =
+                            overlap(px, px + 1.0, bx + i as f64 * sq, bx + (i + 1) as f64 * sq);
                         let area = ox * oy;
                         board += area;
                         if (i + j) % 2 == 0 {

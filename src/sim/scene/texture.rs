@@ -35,19 +35,32 @@ impl TextureScene {
         self.vx_px_s.hypot(self.vy_px_s) + self.omega_deg_s.abs().to_radians() * radius
     }
 
-    pub fn render(&self, canvas: &Canvas, width: usize, height: usize, t: f64, out: &mut [f32]) {
+    /// Renders rows `rows` into `out` (those rows only).
+    pub fn render(
+        &self,
+        canvas: &Canvas,
+        width: usize,
+        height: usize,
+        rows: std::ops::Range<usize>,
+        t: f64,
+        out: &mut [f32],
+    ) {
         let th = self.omega_deg_s.to_radians() * t;
         let (s, c) = th.sin_cos();
         let c0 = canvas.size as f64 / 2.0;
-        let (ox, oy) = (c0 + self.offset_px[0] + self.vx_px_s * t, c0 + self.offset_px[1] + self.vy_px_s * t);
+        let (ox, oy) = (
+            c0 + self.offset_px[0] + self.vx_px_s * t,
+            c0 + self.offset_px[1] + self.vy_px_s * t,
+        );
         let gain = (self.mod_amp_ln * (std::f64::consts::TAU * self.mod_hz * t).sin()).exp() as f32;
         let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
-        for y in 0..height {
+        let first = rows.start;
+        for y in rows {
             let v = y as f64 - cy;
             for x in 0..width {
                 let u = x as f64 - cx;
                 let value = canvas.sample(ox + c * u - s * v, oy + s * u + c * v);
-                out[y * width + x] = (value * gain).clamp(0.0, 255.0);
+                out[(y - first) * width + x] = (value * gain).clamp(0.0, 255.0);
             }
         }
     }
