@@ -51,8 +51,9 @@ pub struct SimulateArgs {
     pub json: Option<PathBuf>,
 }
 
+/// What was simulated and what came out (`simulation.json` in an IJRR output folder).
 #[derive(Serialize)]
-struct Summary {
+struct Provenance {
     ctcal_version: &'static str,
     width: usize,
     height: usize,
@@ -65,13 +66,20 @@ struct Summary {
     events_per_pixel_per_second: f64,
     aps_frames: usize,
     render_hz: Option<f64>,
-    wall_s: f64,
-    samples_per_second: f64,
     params: PixelParams,
     #[serde(skip_serializing_if = "Option::is_none")]
     scene: Option<SceneSpec>,
     #[serde(skip_serializing_if = "Option::is_none")]
     frames: Option<PathBuf>,
+}
+
+/// The `--json` summary: the provenance plus timing.
+#[derive(Serialize)]
+struct Summary<'a> {
+    #[serde(flatten)]
+    provenance: &'a Provenance,
+    wall_s: f64,
+    samples_per_second: f64,
 }
 
 enum Writer {
@@ -194,7 +202,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     }
     let wall_s = started.elapsed().as_secs_f64();
     let duration_s = (summary.t_last_sample_us - summary.t_first_sample_us) as f64 * 1e-6;
-    let result = Summary {
+    let result = Provenance {
         ctcal_version: env!("CARGO_PKG_VERSION"),
         width,
         height,
@@ -211,8 +219,6 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         },
         aps_frames: aps_frames.len(),
         render_hz,
-        wall_s,
-        samples_per_second: summary.samples as f64 / wall_s,
         params,
         scene: scene_spec,
         frames: args.frames.clone(),
@@ -227,9 +233,10 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         }
         Writer::H5(w) => w.finish()?,
     }
+    let samples_per_second = summary.samples as f64 / wall_s;
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(&result, target)?;
+        emit_json(&Summary { provenance: &result, wall_s, samples_per_second }, target)?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) && !global.quiet {
         output::print_table(&[
@@ -250,7 +257,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
                 format!(
                     "{} ({:.0} samples/s)",
                     output::seconds(wall_s),
-                    result.samples_per_second
+                    samples_per_second
                 ),
             ),
             ("written".into(), args.out.display().to_string()),

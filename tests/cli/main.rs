@@ -5,5 +5,6 @@ mod common;
 mod convert;
 mod errors;
 mod readers;
+mod samples;
 mod simulate;
 mod stats;

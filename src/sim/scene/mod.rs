@@ -189,10 +189,13 @@ impl SceneSpec {
     }
 
     /// The render rate: as given, else fast enough that nothing moves more than half a
-    /// pixel between frames (at least 100 Hz, at most 20 kHz).
+    /// pixel between frames (at least 100 Hz, at most 20 kHz), rounded up so that a whole
+    /// number of frames spans the duration.
     pub fn render_hz(&self, scene: &Scene) -> f64 {
         self.render_hz.unwrap_or_else(|| {
-            (2.0 * scene.max_speed_px_s(self.width, self.height)).clamp(100.0, 20_000.0)
+            let needed =
+                (2.0 * scene.max_speed_px_s(self.width, self.height)).clamp(100.0, 20_000.0);
+            (self.duration_s * needed).ceil() / self.duration_s
         })
     }
 }
