@@ -236,7 +236,14 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     let samples_per_second = summary.samples as f64 / wall_s;
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(&Summary { provenance: &result, wall_s, samples_per_second }, target)?;
+        emit_json(
+            &Summary {
+                provenance: &result,
+                wall_s,
+                samples_per_second,
+            },
+            target,
+        )?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) && !global.quiet {
         output::print_table(&[

@@ -5,6 +5,7 @@
 //!   the photoreceptor's dark floor and keeps `L` finite at 0 DN.
 //! - eps: `L = ln(DN / 255 + eps)` (the common `log(I + eps)` of ESIM-style simulators).
 
+use super::fast_math;
 use super::params::LogResponse;
 
 /// `ln(20) / 20`: slope of the v2e response's linear part.
@@ -30,17 +31,31 @@ impl LogMap {
     pub fn apply(&self, dn: f32) -> f32 {
         match self.kind {
             LogResponse::V2e => {
-                if dn > 20.0 {
-                    dn.ln()
+                // both branches computed, then selected: keeps the frame loop vectorised
+                let log = fast_math::ln(if dn > 20.0 { dn } else { 20.0 });
+                if dn > 20.0 { log } else { dn * LINEAR_SLOPE }
+            }
+            LogResponse::Eps => fast_math::ln(dn * (1.0 / 255.0) + self.eps),
+        }
+    }
+
+    /// The intensity (camera DN) whose log-domain value is `value` (the inverse of
+    /// [`Self::apply`]).
+    pub fn inverse(&self, value: f32) -> f32 {
+        match self.kind {
+            LogResponse::V2e => {
+                if value > 20f32.ln() {
+                    value.exp()
                 } else {
-                    dn * LINEAR_SLOPE
+                    value / LINEAR_SLOPE
                 }
             }
-            LogResponse::Eps => (dn * (1.0 / 255.0) + self.eps).ln(),
+            LogResponse::Eps => 255.0 * (value.exp() - self.eps),
         }
     }
 
     /// Maps a frame of DN values into `out`.
+    #[inline(always)]
     pub fn apply_frame(&self, dn: &[f32], out: &mut [f32]) {
         for (o, &d) in out.iter_mut().zip(dn) {
             *o = self.apply(d);
@@ -61,6 +76,20 @@ mod tests {
         assert!((m.apply(100.0) - 100f32.ln()).abs() < 1e-6);
         // the screen black of dev_screen_checker (1 DN) sits at 0.1498
         assert!((m.apply(1.0) - 0.1498).abs() < 1e-4);
+    }
+
+    #[test]
+    fn inverse_undoes_the_response() {
+        for kind in [LogResponse::V2e, LogResponse::Eps] {
+            let m = LogMap::new(kind, 0.001);
+            for dn in [0.5f32, 5.0, 19.9, 20.0, 21.0, 90.0, 255.0, 400.0] {
+                let back = m.inverse(m.apply(dn));
+                assert!(
+                    (back - dn).abs() <= 1e-4 * dn.max(1.0),
+                    "{kind:?} {dn} -> {back}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -7,10 +7,12 @@
 
 pub mod display;
 pub mod effects;
+pub mod fast_math;
 pub mod log_response;
 pub mod params;
 pub mod pixel;
 pub mod rng;
+mod row;
 pub mod scene;
 pub mod simulator;
 pub mod source;

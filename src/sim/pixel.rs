@@ -41,6 +41,15 @@ pub struct PixelModel {
     /// sub-step, as a fraction of the threshold.
     pub substep_tolerance: f32,
     pub max_substeps: u32,
+    /// Leak, shot noise or hot pixels are on (the fast path then tracks drift, due
+    /// interruptions and intensity).
+    pub fast_path_effects: bool,
+    /// Some effect needs per-pixel history beyond the levels (refractory timing, temporal
+    /// threshold noise, noise and hot-pixel clocks).
+    pub per_pixel_history: bool,
+    /// No filter, leak, noise or hot pixels: quiet pixels are found by an intensity window
+    /// (see [`super::row`]).
+    pub intensity_window: bool,
 }
 
 /// One pixel's state. Times are microseconds since the simulation's first sample.
@@ -143,22 +152,6 @@ impl PixelState {
         let (u0, dn0) = (self.input, self.dn);
         self.input = u1;
         self.dn = dn1;
-        // Fast path: nothing can happen when no interruption is due and the level stays
-        // inside both thresholds at both ends of a straight segment.
-        if model.cutoff_hz.is_none() && self.next_noise_us >= t1 && self.next_hot_us >= t1 {
-            let drift = self.leak_per_us * (t1 - t0) as f32;
-            let d0 = u0 - self.reference;
-            let d1 = u1 - (self.reference - drift);
-            if d0 < self.theta_on
-                && d0 > -self.theta_off
-                && d1 < self.theta_on
-                && d1 > -self.theta_off
-            {
-                self.reference -= drift;
-                self.filtered = u1;
-                return;
-            }
-        }
         match transition {
             Transition::Linear => self.piece(model, t0, t1, u0, u1, dn0, dn1, rng, sink),
             Transition::Hold => {
@@ -362,6 +355,9 @@ mod tests {
             hot_rate_per_us: 0.0,
             substep_tolerance: 0.002,
             max_substeps: 64,
+            fast_path_effects: true,
+            per_pixel_history: true,
+            intensity_window: false,
         }
     }
 

@@ -1,15 +1,17 @@
-//! The simulator: a sensor of [`PixelState`]s driven by a sequence of intensity frames.
+//! The simulator: a sensor of pixels driven by a sequence of intensity frames.
 //!
-//! Pixel state lives in one flat array updated row-parallel with rayon; each row has its own
-//! random generator (see [`super::rng`]), so the output is identical whatever the thread
-//! count. Events of an interval are gathered per row into reused buffers (no allocation per
-//! event) and merged in time order.
+//! Pixel state is kept per row ([`super::row`]), rows updated in parallel with rayon in
+//! groups: the vectorised phase of every row of a group, then the full updates of its busy
+//! pixels. Each row owns its random generator (see [`super::rng`]), so output is identical
+//! whatever the thread count; events go to reused per-row buffers and are merged in time
+//! order.
 
 use super::effects::{hot_pixels, jitter::JitterBuffer, leak, mismatch, shot_noise};
 use super::log_response::LogMap;
 use super::params::PixelParams;
-use super::pixel::{EventSink, PixelModel, PixelState, Transition, exponential_us};
+use super::pixel::{PixelModel, PixelState, Transition, exponential_us};
 use super::rng::{Stream, generator};
+use super::row::{Cold, Row, Step};
 use crate::events::{Event, EventChunk, TimeUs};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
@@ -25,18 +27,12 @@ pub struct PixelMaps {
     pub leak_factor: Option<Vec<f32>>,
 }
 
-struct Row {
-    rng: Xoshiro256PlusPlus,
-    events: Vec<Event>,
-}
-
 /// A running simulation.
 pub struct Simulator {
     width: usize,
     height: usize,
     model: PixelModel,
     log_map: LogMap,
-    pixels: Vec<PixelState>,
     rows: Vec<Row>,
     origin: Option<TimeUs>,
     previous_us: f64,
@@ -64,25 +60,30 @@ impl Simulator {
             hot_rate_per_us: params.hot_pixels().map_or(0.0, |(_, r)| r * 1e-6),
             substep_tolerance: 0.002,
             max_substeps: 256,
+            fast_path_effects: params.leak_rate_hz() > 0.0
+                || params.shot_noise_rate_hz() > 0.0
+                || params.hot_pixels().is_some(),
+            intensity_window: params.cutoff_hz().is_none()
+                && params.leak_rate_hz() <= 0.0
+                && params.shot_noise_rate_hz() <= 0.0
+                && params.hot_pixels().is_none(),
+            per_pixel_history: params.refractory_s() > 0.0
+                || params.ct_sigma_temporal.is_some_and(|s| s > 0.0)
+                || params.shot_noise_rate_hz() > 0.0
+                || params.hot_pixels().is_some(),
         };
-        let seed = params.seed();
-        let rows = (0..height)
-            .map(|y| Row {
-                rng: generator(seed, Stream::Rows, y as u64),
-                events: Vec::new(),
-            })
-            .collect();
-        let jitter = params
-            .timestamp_jitter_s
-            .filter(|&s| s > 0.0)
-            .map(|s| (JitterBuffer::new(s), generator(seed, Stream::Jitter, 0)));
+        let jitter = params.timestamp_jitter_s.filter(|&s| s > 0.0).map(|s| {
+            (
+                JitterBuffer::new(s),
+                generator(params.seed(), Stream::Jitter, 0),
+            )
+        });
         Self {
             width,
             height,
             model,
             log_map: LogMap::new(params.log_response(), params.log_eps()),
-            pixels: Vec::new(),
-            rows,
+            rows: Vec::new(),
             origin: None,
             previous_us: 0.0,
             jitter,
@@ -90,7 +91,7 @@ impl Simulator {
             staged: EventChunk::default(),
             out: EventChunk::default(),
             log_frame: vec![0.0; width * height],
-            seed,
+            seed: params.seed(),
             params: params.clone(),
             maps,
         }
@@ -104,9 +105,20 @@ impl Simulator {
         self.height
     }
 
-    /// The pixels' current state (for inspection and tests).
-    pub fn pixels(&self) -> &[PixelState] {
-        &self.pixels
+    /// The state of pixel (x, y) (for inspection and tests).
+    pub fn pixel(&self, x: usize, y: usize) -> PixelState {
+        let row = &self.rows[y];
+        let mut p = PixelState::new(row.input[x], row.dn[x], row.theta_on[x], row.theta_off[x]);
+        if self.model.intensity_window {
+            p.input = self.log_map.apply(row.dn[x]);
+        }
+        p.reference = row.reference[x];
+        p.filtered = if self.model.cutoff_hz.is_some() {
+            row.filtered[x]
+        } else {
+            p.input
+        };
+        p
     }
 
     /// The first sample: sets every pixel's reference and filter to this frame (no events).
@@ -115,7 +127,7 @@ impl Simulator {
         self.origin = Some(t);
         self.previous_us = 0.0;
         let params = &self.params;
-        let n = self.width * self.height;
+        let (width, n) = (self.width, self.width * self.height);
         let mut threshold_rng = generator(self.seed, Stream::Thresholds, 0);
         let sigma = params.ct_sigma.unwrap_or(0.0);
         let mut draw_map = |given: &Option<Vec<f32>>, nominal: f64| -> Vec<f32> {
@@ -144,31 +156,77 @@ impl Simulator {
         };
         let mut noise_rng = generator(self.seed, Stream::Rows, u64::MAX);
         let noise_rate = params.shot_noise_rate_hz();
-        self.pixels = (0..n)
-            .map(|i| {
-                let u = self.log_map.apply(dn[i]);
-                let mut p = PixelState::new(u, dn[i], theta_on[i], theta_off[i]);
-                p.leak_per_us = leak::drift_per_us(leak_rate, leak_factors[i], theta_on[i]);
-                if noise_rate > 0.0 {
-                    let (rate, on_share) = shot_noise::pixel_rates(
-                        noise_rate,
-                        params.ct_on,
-                        params.ct_off,
-                        theta_on[i],
-                        theta_off[i],
-                    );
-                    p.noise_rate_per_us = rate;
-                    p.noise_on_share = on_share;
-                    p.next_noise_us = exponential_us(rate, &mut noise_rng);
-                }
-                p
-            })
-            .collect();
+        let mut hot_next = vec![f64::INFINITY; n];
         if let Some((fraction, _)) = params.hot_pixels() {
             let mut rng = generator(self.seed, Stream::HotPixels, 0);
             for index in hot_pixels::choose(n, fraction, &mut rng) {
-                self.pixels[index].next_hot_us =
-                    exponential_us(self.model.hot_rate_per_us, &mut rng);
+                hot_next[index] = exponential_us(self.model.hot_rate_per_us, &mut rng);
+            }
+        }
+        let log_map = self.log_map;
+        self.rows = (0..self.height)
+            .map(|y| {
+                let range = y * width..(y + 1) * width;
+                let input: Vec<f32> = dn[range.clone()]
+                    .iter()
+                    .map(|&d| log_map.apply(d))
+                    .collect();
+                let cold: Vec<Cold> = range
+                    .clone()
+                    .map(|i| {
+                        let (rate, on_share) = if noise_rate > 0.0 {
+                            shot_noise::pixel_rates(
+                                noise_rate,
+                                params.ct_on,
+                                params.ct_off,
+                                theta_on[i],
+                                theta_off[i],
+                            )
+                        } else {
+                            (0.0, 0.5)
+                        };
+                        Cold {
+                            frozen_on: theta_on[i],
+                            frozen_off: theta_off[i],
+                            noise_rate_per_us: rate,
+                            noise_on_share: on_share,
+                            last_event_us: f64::NEG_INFINITY,
+                            next_noise_us: exponential_us(rate, &mut noise_rng),
+                            next_hot_us: hot_next[i],
+                        }
+                    })
+                    .collect();
+                Row {
+                    y: y as u16,
+                    reference: input.clone(),
+                    filtered: input.clone(),
+                    input,
+                    dn: dn[range.clone()].to_vec(),
+                    theta_on: theta_on[range.clone()].to_vec(),
+                    theta_off: theta_off[range.clone()].to_vec(),
+                    leak: range
+                        .clone()
+                        .map(|i| leak::drift_per_us(leak_rate, leak_factors[i], theta_on[i]))
+                        .collect(),
+                    next_interrupt: cold
+                        .iter()
+                        .map(|c| c.next_noise_us.min(c.next_hot_us))
+                        .collect(),
+                    window_low: vec![0.0; width],
+                    window_high: vec![0.0; width],
+                    busy: vec![0; width],
+                    filter_end: vec![0.0; width],
+                    cold,
+                    rng: generator(self.seed, Stream::Rows, y as u64),
+                    events: Vec::new(),
+                }
+            })
+            .collect();
+        if self.model.intensity_window {
+            for row in &mut self.rows {
+                for x in 0..width {
+                    row.update_window(x, &log_map);
+                }
             }
         }
     }
@@ -178,44 +236,30 @@ impl Simulator {
     pub fn step(&mut self, t: TimeUs, dn: &[f32], transition: Transition) -> &EventChunk {
         let origin = self.origin.expect("start() before step()");
         assert_eq!(dn.len(), self.width * self.height, "frame size");
-        let (t0, t1) = (self.previous_us, (t - origin) as f64);
-        let t1 = t1.max(t0);
+        let (t0, t1) = (
+            self.previous_us,
+            ((t - origin) as f64).max(self.previous_us),
+        );
         let width = self.width;
         let model = &self.model;
         let log_map = self.log_map;
-        self.log_frame
-            .par_chunks_mut(width)
+        let log_frame = &mut self.log_frame;
+        self.rows
+            .par_iter_mut()
+            .zip(log_frame.par_chunks_mut(width))
             .zip(dn.par_chunks(width))
-            .for_each(|(out, dn)| {
-                log_map.apply_frame(dn, out);
-            });
-        let log_frame = &self.log_frame;
-        self.pixels
-            .par_chunks_mut(width)
-            .zip(self.rows.par_iter_mut())
-            .enumerate()
             .with_min_len(4)
-            .for_each(|(y, (pixels, row))| {
-                row.events.clear();
-                let base = y * width;
-                for (x, pixel) in pixels.iter_mut().enumerate() {
-                    let mut sink = EventSink {
-                        events: &mut row.events,
-                        origin_us: origin,
-                        x: x as u16,
-                        y: y as u16,
-                    };
-                    pixel.advance(
-                        model,
-                        t0,
-                        t1,
-                        log_frame[base + x],
-                        dn[base + x],
-                        transition,
-                        &mut row.rng,
-                        &mut sink,
-                    );
-                }
+            .for_each(|((row, log_row), dn_row)| {
+                let step = Step {
+                    model,
+                    log_map,
+                    origin,
+                    t0,
+                    t1,
+                    transition,
+                };
+                row.vector_phase(&step, dn_row, log_row);
+                row.busy_phase(&step, dn_row, log_row);
             });
         self.previous_us = t1;
         self.merged.clear();
@@ -249,10 +293,5 @@ impl Simulator {
             buffer.flush(&mut self.out);
         }
         &self.out
-    }
-
-    /// Number of pixel rows (for progress reporting).
-    pub fn rows(&self) -> usize {
-        self.height
     }
 }
