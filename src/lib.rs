@@ -27,3 +27,4 @@ pub use events::{CHUNK_EVENTS, Event, EventChunk, Frame, Sensor, TimeUs};
 pub use io::{Format, InputError, OpenOptions, Recording};
 pub mod sim;
 pub mod stats;
+pub mod synthetic;

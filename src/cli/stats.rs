@@ -80,10 +80,11 @@ fn compute(
     } else {
         let mut stream = recording.events()?;
         let bar = progress_bar(global, stream.progress().total, "reading");
-        while let Some(chunk) = stream.next_chunk()? {
+        let read_ahead = rayon::current_num_threads() > 1;
+        ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, progress| {
             accumulator.add(chunk);
-            bar.set_position(stream.progress().done);
-        }
+            bar.set_position(progress.done);
+        })?;
         bar.finish_and_clear();
         stream.max_coordinates()
     };

@@ -19,6 +19,7 @@ pub mod ijrr;
 pub mod npy;
 pub mod order;
 pub mod prophesee;
+pub mod read_ahead;
 pub mod text;
 pub mod write;
 
@@ -436,6 +437,25 @@ impl EventStream {
             self.max_y = self.max_y.max(y);
         }
         Ok(Some(&self.chunk))
+    }
+
+    /// The chunk the last [`Self::next_chunk`] returned.
+    pub fn current_chunk(&self) -> &EventChunk {
+        &self.chunk
+    }
+
+    /// Like [`Self::next_chunk`] but hands over the filled chunk, keeping `spare` as the
+    /// buffer for the next one (for passing chunks to another thread without copying).
+    pub fn next_chunk_swapped(
+        &mut self,
+        spare: EventChunk,
+    ) -> Result<Option<EventChunk>, InputError> {
+        if self.next_chunk()?.is_none() {
+            return Ok(None);
+        }
+        let mut spare = spare;
+        spare.clear();
+        Ok(Some(std::mem::replace(&mut self.chunk, spare)))
     }
 
     /// Events delivered so far.

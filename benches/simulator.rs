@@ -1,0 +1,86 @@
+//! Simulator throughput (input frames per second) at DAVIS240 and DAVIS346 sizes, ideal and
+//! with every effect, on one thread and on all threads. `examples/simulator_throughput.rs`
+//! prints the same matrix with events per second as a table.
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use ctcal::sim::scene::{SceneKind, SceneSpec, texture::TextureScene};
+use ctcal::sim::{PixelMaps, PixelParams, Simulator, Transition};
+
+fn frames(width: usize, height: usize, count: usize) -> Vec<(i64, Vec<f32>)> {
+    let spec = SceneSpec {
+        kind: SceneKind::Texture,
+        width,
+        height,
+        duration_s: count as f64 / 1000.0,
+        seed: 1,
+        render_hz: Some(1000.0),
+        aps: None,
+        texture: Some(TextureScene {
+            texture: Default::default(),
+            vx_px_s: 60.0,
+            vy_px_s: 25.0,
+            omega_deg_s: 0.0,
+            offset_px: [0.0, 0.0],
+            mod_amp_ln: 0.0,
+            mod_hz: 0.0,
+        }),
+        checkerboard: None,
+        multi_object: None,
+    };
+    let scene = spec.realise().unwrap();
+    (0..=count)
+        .map(|k| {
+            let mut dn = vec![0f32; width * height];
+            scene.render(width, height, k as f64 / 1000.0, &mut dn);
+            (k as i64 * 1000, dn)
+        })
+        .collect()
+}
+
+fn all_effects() -> PixelParams {
+    PixelParams::from_toml(
+        "ct_on = 0.35\nct_off = 0.45\nct_sigma = 0.03\nct_sigma_temporal = 0.01\nrefractory_s = 0.0005\ncutoff_hz = 300.0\nleak_rate_hz = 0.1\nshot_noise_rate_hz = 1.0\nhot_pixel_fraction = 0.0005\nhot_pixel_rate_hz = 50.0\ntimestamp_jitter_s = 0.0001\nseed = 3\n",
+        "bench",
+    )
+    .unwrap()
+}
+
+fn simulator(c: &mut Criterion) {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let mut group = c.benchmark_group("simulate");
+    group.sample_size(10);
+    for (width, height) in [(240, 180), (346, 260)] {
+        let input = frames(width, height, 200);
+        group.throughput(Throughput::Elements((input.len() - 1) as u64));
+        for (model, params) in [
+            ("ideal", PixelParams::ideal(0.3, 0.3)),
+            ("all_effects", all_effects()),
+        ] {
+            for threads in [1, cores] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let name = format!("{width}x{height}/{model}/{threads}_threads");
+                group.bench_function(name, |b| {
+                    b.iter(|| {
+                        pool.install(|| {
+                            let mut sim =
+                                Simulator::new(&params, width, height, PixelMaps::default());
+                            sim.start(input[0].0, &input[0].1);
+                            let mut events = 0;
+                            for (t, dn) in &input[1..] {
+                                events += sim.step(*t, dn, Transition::Linear).len();
+                            }
+                            events
+                        })
+                    })
+                });
+            }
+        }
+    }
+    group.finish();
+}
+
+criterion_group!(benches, simulator);
+criterion_main!(benches);
