@@ -3,7 +3,7 @@
 
 use super::{BadInput, Global, warn};
 use clap::{Args, Subcommand};
-use ctcal::io::write::{commit, format_seconds, save_png, temporary_sibling};
+use ctcal::io::write::{Staged, format_seconds, save_png};
 use ctcal::sim::scene::stimulus::StimulusSpec;
 use std::path::PathBuf;
 
@@ -92,10 +92,8 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
             "the board fills the screen along one axis, so it cannot move along it",
         );
     }
-    let partial = temporary_sibling(&args.out);
-    if partial.exists() {
-        std::fs::remove_dir_all(&partial)?;
-    }
+    let staged = Staged::new(&args.out)?;
+    let partial = staged.partial.clone();
     std::fs::create_dir_all(partial.join("stimulus"))?;
     let mut index = Vec::new();
     for k in 0..spec.frame_count() {
@@ -110,7 +108,7 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
         partial.join("stimulus.json"),
         serde_json::to_string_pretty(&spec)?,
     )?;
-    commit(&partial, &args.out)?;
+    staged.commit()?;
     if !global.quiet {
         println!(
             "wrote {} frames at {} Hz to {}",

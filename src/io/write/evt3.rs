@@ -4,16 +4,15 @@
 //! across long gaps the high word is repeated every 1024 steps so that a decoder can count
 //! the 24-bit clock's loops. Used to write large test recordings and for `convert --to evt3`.
 
-use super::{commit, temporary_sibling};
+use super::Staged;
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::io::error::InputError;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Writes an EVT3 file.
 pub struct Evt3Writer {
-    target: PathBuf,
-    partial: PathBuf,
+    staged: Staged,
     out: std::io::BufWriter<std::fs::File>,
     words: Vec<u8>,
     /// Time in units of 4096 us (the high word including loops) last written.
@@ -32,8 +31,9 @@ impl Evt3Writer {
                 "write HDF5 or IJRR instead",
             ));
         }
-        let partial = temporary_sibling(target);
-        let file = std::fs::File::create(&partial).map_err(|e| InputError::write(target, e))?;
+        let staged = Staged::new(target)?;
+        let file =
+            std::fs::File::create(&staged.partial).map_err(|e| InputError::write(target, e))?;
         let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
         write!(
             out,
@@ -43,8 +43,7 @@ impl Evt3Writer {
         )
         .map_err(|e| InputError::write(target, e))?;
         Ok(Self {
-            target: target.to_path_buf(),
-            partial,
+            staged,
             out,
             words: Vec::with_capacity(1 << 16),
             high: None,
@@ -66,7 +65,7 @@ impl Evt3Writer {
             let t = chunk.t[i];
             if t < 0 || t < self.last_t {
                 return Err(InputError::invalid(
-                    &self.target,
+                    &self.staged.target,
                     format!("EVT3 needs non-negative, time-sorted events (event {i} at {t} us)"),
                     "sort the events first (--sort)",
                 ));
@@ -96,7 +95,7 @@ impl Evt3Writer {
         }
         self.out
             .write_all(&self.words)
-            .map_err(|e| InputError::write(&self.target, e))?;
+            .map_err(|e| InputError::write(&self.staged.target, e))?;
         self.words.clear();
         Ok(())
     }
@@ -104,9 +103,9 @@ impl Evt3Writer {
     pub fn finish(mut self) -> Result<(), InputError> {
         self.out
             .flush()
-            .map_err(|e| InputError::write(&self.target, e))?;
+            .map_err(|e| InputError::write(&self.staged.target, e))?;
         drop(self.out);
-        commit(&self.partial, &self.target)
+        self.staged.commit()
     }
 }
 

@@ -1,17 +1,16 @@
 //! event_utils HDF5 files (Stoffregen et al. 2020's layout): `events/ts` (float64 seconds),
 //! `events/xs`, `events/ys` (int16), `events/ps` (bool), frames as `images/image%09d`.
 
-use super::{commit, temporary_sibling};
+use super::Staged;
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::io::error::InputError;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Writes an event_utils HDF5 file: `events/ts|xs|ys|ps`, `images/image%09d` with a
 /// `timestamp` attribute, and the root attributes event_utils writes (`sensor_resolution`
 /// as (H, W), `num_events`, `num_pos`, `num_neg`, `t0`, `tk`, `duration`, `num_imgs`).
 pub struct H5Writer {
-    target: PathBuf,
-    partial: PathBuf,
+    staged: Staged,
     file: hdf5::File,
     sensor: Sensor,
     written: usize,
@@ -25,9 +24,9 @@ const H5_CHUNK: usize = 1 << 16;
 
 impl H5Writer {
     pub fn create(target: &Path, sensor: Sensor) -> Result<Self, InputError> {
-        let partial = temporary_sibling(target);
+        let staged = Staged::new(target)?;
         let err = |e: hdf5::Error| InputError::write(target, std::io::Error::other(e.to_string()));
-        let file = hdf5::File::create(&partial).map_err(err)?;
+        let file = hdf5::File::create(&staged.partial).map_err(err)?;
         let events = file.create_group("events").map_err(err)?;
         macro_rules! column {
             ($t:ty, $name:expr) => {
@@ -45,8 +44,7 @@ impl H5Writer {
         column!(i16, "ys");
         column!(bool, "ps");
         Ok(Self {
-            target: target.to_path_buf(),
-            partial,
+            staged,
             file,
             sensor,
             written: 0,
@@ -58,7 +56,7 @@ impl H5Writer {
     }
 
     fn err(&self, e: hdf5::Error) -> InputError {
-        InputError::write(&self.target, std::io::Error::other(e.to_string()))
+        InputError::write(&self.staged.target, std::io::Error::other(e.to_string()))
     }
 
     pub fn write_events(&mut self, chunk: &EventChunk) -> Result<(), InputError> {
@@ -67,7 +65,7 @@ impl H5Writer {
         }
         if self.sensor.width > i16::MAX as u16 || self.sensor.height > i16::MAX as u16 {
             return Err(InputError::invalid(
-                &self.target,
+                &self.staged.target,
                 format!(
                     "the {} sensor does not fit event_utils' int16 coordinates",
                     self.sensor
@@ -151,8 +149,7 @@ impl H5Writer {
             Ok(())
         })();
         result.map_err(|e| self.err(e))?;
-        let (partial, target) = (self.partial.clone(), self.target.clone());
         drop(self.file);
-        commit(&partial, &target)
+        self.staged.commit()
     }
 }

@@ -2,16 +2,15 @@
 //! `t x y p` with t in seconds to the microsecond and p 0/1; frames as `images.txt` +
 //! `images/frame_XXXXXXXX.png`.
 
-use super::{commit, format_seconds, save_png, temporary_sibling};
+use super::{Staged, format_seconds, save_png};
 use crate::events::{EventChunk, Frame, Sensor};
 use crate::io::error::InputError;
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// Writes an IJRR folder.
 pub struct IjrrWriter {
-    target: PathBuf,
-    partial: PathBuf,
+    staged: Staged,
     events: std::io::BufWriter<std::fs::File>,
     line: Vec<u8>,
     frames: Vec<u8>,
@@ -21,10 +20,8 @@ pub struct IjrrWriter {
 impl IjrrWriter {
     /// Starts a folder at `target`; `sensor` becomes the `width height` first line.
     pub fn create(target: &Path, sensor: Sensor) -> Result<Self, InputError> {
-        let partial = temporary_sibling(target);
-        if partial.exists() {
-            std::fs::remove_dir_all(&partial).map_err(|e| InputError::write(&partial, e))?;
-        }
+        let staged = Staged::new(target)?;
+        let partial = staged.partial.clone();
         std::fs::create_dir_all(&partial).map_err(|e| InputError::write(target, e))?;
         let file = std::fs::File::create(partial.join("events.txt"))
             .map_err(|e| InputError::write(target, e))?;
@@ -32,8 +29,7 @@ impl IjrrWriter {
         writeln!(events, "{} {}", sensor.width, sensor.height)
             .map_err(|e| InputError::write(target, e))?;
         Ok(Self {
-            target: target.to_path_buf(),
-            partial,
+            staged,
             events,
             line: Vec::with_capacity(64),
             frames: Vec::new(),
@@ -56,20 +52,21 @@ impl IjrrWriter {
                 .extend_from_slice(if chunk.on[i] { b" 1\n" } else { b" 0\n" });
             self.events
                 .write_all(&self.line)
-                .map_err(|e| InputError::write(&self.target, e))?;
+                .map_err(|e| InputError::write(&self.staged.target, e))?;
         }
         Ok(())
     }
 
     /// Adds a frame (PNG in `images/`, a line in `images.txt`).
     pub fn write_frame(&mut self, frame: &Frame) -> Result<(), InputError> {
-        let folder = self.partial.join("images");
+        let folder = self.staged.partial.join("images");
         if self.frame_count == 0 {
-            std::fs::create_dir_all(&folder).map_err(|e| InputError::write(&self.target, e))?;
+            std::fs::create_dir_all(&folder)
+                .map_err(|e| InputError::write(&self.staged.target, e))?;
         }
         let name = format!("images/frame_{:08}.png", self.frame_count);
-        save_png(&self.partial.join(&name), frame)
-            .map_err(|e| InputError::write(&self.target, e))?;
+        save_png(&self.staged.partial.join(&name), frame)
+            .map_err(|e| InputError::write(&self.staged.target, e))?;
         format_seconds(frame.t, &mut self.frames);
         self.frames
             .extend_from_slice(format!(" {name}\n").as_bytes());
@@ -79,19 +76,20 @@ impl IjrrWriter {
 
     /// Adds another file to the folder (e.g. provenance), written with it.
     pub fn add_file(&mut self, name: &str, bytes: &[u8]) -> Result<(), InputError> {
-        std::fs::write(self.partial.join(name), bytes)
-            .map_err(|e| InputError::write(&self.target, e))
+        std::fs::write(self.staged.partial.join(name), bytes)
+            .map_err(|e| InputError::write(&self.staged.target, e))
     }
 
     /// Flushes and moves the folder into place.
     pub fn finish(mut self) -> Result<(), InputError> {
         self.events
             .flush()
-            .map_err(|e| InputError::write(&self.target, e))?;
+            .map_err(|e| InputError::write(&self.staged.target, e))?;
         if self.frame_count > 0 {
-            std::fs::write(self.partial.join("images.txt"), &self.frames)
-                .map_err(|e| InputError::write(&self.target, e))?;
+            std::fs::write(self.staged.partial.join("images.txt"), &self.frames)
+                .map_err(|e| InputError::write(&self.staged.target, e))?;
         }
-        commit(&self.partial, &self.target)
+        drop(self.events);
+        self.staged.commit()
     }
 }

@@ -40,11 +40,58 @@ pub fn commit(partial: &Path, target: &Path) -> Result<(), InputError> {
     Ok(())
 }
 
+/// An output being written under a temporary sibling name: moved into place by
+/// [`Staged::commit`], deleted when dropped uncommitted (an error or a panic midway).
+#[derive(Debug)]
+pub struct Staged {
+    pub target: PathBuf,
+    pub partial: PathBuf,
+    committed: bool,
+}
+
+impl Staged {
+    /// Stages an output for `target` (a stale partial copy of an earlier run is removed).
+    pub fn new(target: &Path) -> Result<Self, InputError> {
+        let partial = temporary_sibling(target);
+        remove_any(&partial).map_err(|e| InputError::write(&partial, e))?;
+        Ok(Self {
+            target: target.to_path_buf(),
+            partial,
+            committed: false,
+        })
+    }
+
+    /// Moves the finished output into place.
+    pub fn commit(mut self) -> Result<(), InputError> {
+        commit(&self.partial, &self.target)?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Staged {
+    fn drop(&mut self) {
+        if !self.committed {
+            // best effort: the error that stopped the writer is the one to report
+            let _ = remove_any(&self.partial);
+        }
+    }
+}
+
+fn remove_any(path: &Path) -> std::io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Ok(m) if m.is_dir() => std::fs::remove_dir_all(path),
+        Ok(_) => std::fs::remove_file(path),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+    }
+}
+
 /// Writes `bytes` to `path` atomically (temporary sibling, then rename).
 pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<(), InputError> {
-    let partial = temporary_sibling(path);
-    std::fs::write(&partial, bytes).map_err(|e| InputError::write(path, e))?;
-    commit(&partial, path)
+    let staged = Staged::new(path)?;
+    std::fs::write(&staged.partial, bytes).map_err(|e| InputError::write(path, e))?;
+    staged.commit()
 }
 
 /// Formats microseconds as seconds with six decimals (`-0.000001`, `12.345678`).
