@@ -3,30 +3,11 @@
 //! prints the same matrix with events per second as a table.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use ctcal::sim::scene::{SceneKind, SceneSpec, texture::TextureScene};
+use ctcal::sim::scene::SceneSpec;
 use ctcal::sim::{PixelMaps, PixelParams, Simulator, Transition};
 
 fn frames(width: usize, height: usize, count: usize) -> Vec<(i64, Vec<f32>)> {
-    let spec = SceneSpec {
-        kind: SceneKind::Texture,
-        width,
-        height,
-        duration_s: count as f64 / 1000.0,
-        seed: 1,
-        render_hz: Some(1000.0),
-        aps: None,
-        texture: Some(TextureScene {
-            texture: Default::default(),
-            vx_px_s: 60.0,
-            vy_px_s: 25.0,
-            omega_deg_s: 0.0,
-            offset_px: [0.0, 0.0],
-            mod_amp_ln: 0.0,
-            mod_hz: 0.0,
-        }),
-        checkerboard: None,
-        multi_object: None,
-    };
+    let spec = SceneSpec::moving_texture(width, height, count as f64 / 1000.0, 1000.0);
     let scene = spec.realise().unwrap();
     (0..=count)
         .map(|k| {
@@ -39,8 +20,8 @@ fn frames(width: usize, height: usize, count: usize) -> Vec<(i64, Vec<f32>)> {
 
 fn all_effects() -> PixelParams {
     PixelParams::from_toml(
-        "ct_on = 0.35\nct_off = 0.45\nct_sigma = 0.03\nct_sigma_temporal = 0.01\nrefractory_s = 0.0005\ncutoff_hz = 300.0\nleak_rate_hz = 0.1\nshot_noise_rate_hz = 1.0\nhot_pixel_fraction = 0.0005\nhot_pixel_rate_hz = 50.0\ntimestamp_jitter_s = 0.0001\nseed = 3\n",
-        "bench",
+        include_str!("../calib/params/all_effects.toml"),
+        "all_effects.toml",
     )
     .unwrap()
 }

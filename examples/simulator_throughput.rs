@@ -4,32 +4,14 @@
 //!
 //! cargo run --release --example simulator_throughput [SECONDS]
 
-use ctcal::sim::scene::{SceneKind, SceneSpec, texture::TextureScene};
+use ctcal::sim::scene::SceneSpec;
 use ctcal::sim::{PixelMaps, PixelParams, Simulator, Transition};
 use std::time::Instant;
 
 fn frames(width: usize, height: usize, seconds: f64, rate: f64) -> Vec<(i64, Vec<f32>)> {
-    let spec = SceneSpec {
-        kind: SceneKind::Texture,
-        width,
-        height,
-        duration_s: seconds,
-        seed: 1,
-        render_hz: Some(rate),
-        aps: None,
-        texture: Some(TextureScene {
-            texture: Default::default(),
-            vx_px_s: 60.0,
-            vy_px_s: 25.0,
-            omega_deg_s: 0.0,
-            offset_px: [0.0, 0.0],
-            mod_amp_ln: 0.0,
-            mod_hz: 0.0,
-        }),
-        checkerboard: None,
-        multi_object: None,
-    };
-    let scene = spec.realise().expect("scene");
+    let scene = SceneSpec::moving_texture(width, height, seconds, rate)
+        .realise()
+        .expect("scene");
     let n = (seconds * rate).round() as usize;
     (0..=n)
         .map(|k| {
@@ -43,8 +25,8 @@ fn frames(width: usize, height: usize, seconds: f64, rate: f64) -> Vec<(i64, Vec
 
 fn all_effects() -> PixelParams {
     PixelParams::from_toml(
-        "ct_on = 0.35\nct_off = 0.45\nct_sigma = 0.03\nct_sigma_temporal = 0.01\nrefractory_s = 0.0005\ncutoff_hz = 300.0\nleak_rate_hz = 0.1\nshot_noise_rate_hz = 1.0\nhot_pixel_fraction = 0.0005\nhot_pixel_rate_hz = 50.0\ntimestamp_jitter_s = 0.0001\nseed = 3\n",
-        "all effects",
+        include_str!("../calib/params/all_effects.toml"),
+        "all_effects.toml",
     )
     .expect("valid")
 }

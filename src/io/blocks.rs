@@ -2,7 +2,8 @@
 //! when a read ends in the middle of one, and memory stays at one block whatever the file
 //! size (a memory map would count the whole file as resident).
 
-use super::error::InputError;
+use super::Progress;
+use super::error::{FIX_TRUNCATED, InputError};
 use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
@@ -93,8 +94,39 @@ impl BlockReader {
         self.buffer_offset + self.start as u64
     }
 
-    /// File size in bytes.
-    pub fn total(&self) -> u64 {
-        self.total
+    /// Bytes consumed of the file.
+    pub fn progress(&self) -> Progress {
+        Progress {
+            done: self.offset(),
+            total: self.total,
+        }
+    }
+
+    /// The whole records of `unit` bytes in memory, at most `max` of them, and the file
+    /// offset of the first.
+    #[inline]
+    pub fn records(&self, unit: usize, max: usize) -> (&[u8], u64) {
+        let available = self.available();
+        let count = (available.len() / unit).min(max);
+        (&available[..count * unit], self.offset())
+    }
+
+    /// For fixed-size binary records: reads more when fewer than `unit` bytes are left.
+    /// `Ok(true)`: read on; `Ok(false)`: the file ended cleanly; an error when it ends inside
+    /// a record (`what` names the record, e.g. "a 4-byte EVT2 word").
+    pub fn refill_units(&mut self, unit: usize, what: &str) -> Result<bool, InputError> {
+        if self.available().len() >= unit || self.refill()? {
+            return Ok(true);
+        }
+        let left = self.available().len();
+        if left > 0 {
+            return Err(InputError::corrupt(
+                &self.path,
+                format!("byte offset {}", self.offset()),
+                format!("the file ends inside {what} ({left} of {unit} bytes)"),
+                FIX_TRUNCATED,
+            ));
+        }
+        Ok(false)
     }
 }

@@ -61,11 +61,11 @@ impl DatDecoder {
 impl EventDecoder for DatDecoder {
     fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
         loop {
-            let available = self.reader.available();
-            let base = self.reader.offset();
             let size = self.event_size;
-            let take = (available.len() / size).min(CHUNK_EVENTS.saturating_sub(out.len()));
-            for (i, bytes) in available[..take * size].chunks_exact(size).enumerate() {
+            let (records, base) = self
+                .reader
+                .records(size, CHUNK_EVENTS.saturating_sub(out.len()));
+            for (i, bytes) in records.chunks_exact(size).enumerate() {
                 let raw_t = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as u64;
                 let data = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
                 if raw_t < self.last_raw_t && self.last_raw_t - raw_t > 1 << 31 {
@@ -90,23 +90,12 @@ impl EventDecoder for DatDecoder {
                 self.order.check(t, || format!("byte offset {offset}"));
                 out.push(t, x, y, (data >> 28) & 0xf != 0);
             }
-            self.reader.consume(take * size);
+            let consumed = records.len();
+            self.reader.consume(consumed);
             if out.len() >= CHUNK_EVENTS {
                 return Ok(());
             }
-            if self.reader.available().len() >= size {
-                continue;
-            }
-            if !self.reader.refill()? {
-                let left = self.reader.available().len();
-                if left > 0 {
-                    return Err(InputError::corrupt(
-                        &self.path,
-                        format!("byte offset {}", self.reader.offset()),
-                        format!("the file ends inside an event ({left} of {size} bytes)"),
-                        FIX_TRUNCATED,
-                    ));
-                }
+            if !self.reader.refill_units(size, "an event")? {
                 return Ok(());
             }
         }
@@ -117,9 +106,6 @@ impl EventDecoder for DatDecoder {
     }
 
     fn progress(&self) -> Progress {
-        Progress {
-            done: self.reader.offset(),
-            total: self.reader.total(),
-        }
+        self.reader.progress()
     }
 }

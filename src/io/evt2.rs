@@ -8,7 +8,7 @@
 //! documentation); the decoder is written here because no maintained Rust crate decodes EVT2.
 
 use super::blocks::BlockReader;
-use super::error::{FIX_TRUNCATED, InputError};
+use super::error::InputError;
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Sensor};
@@ -93,32 +93,20 @@ impl State {
 impl EventDecoder for Evt2Decoder {
     fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
         loop {
-            let available = self.reader.available();
-            let base = self.reader.offset();
-            let words = available.len() / 4;
-            let room = CHUNK_EVENTS.saturating_sub(out.len());
-            let take = words.min(room);
-            for (i, bytes) in available[..take * 4].chunks_exact(4).enumerate() {
+            // a word emits at most one event
+            let (words, base) = self
+                .reader
+                .records(4, CHUNK_EVENTS.saturating_sub(out.len()));
+            for (i, bytes) in words.chunks_exact(4).enumerate() {
                 let word = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
                 self.state.decode(word, base + 4 * i as u64, out)?;
             }
-            self.reader.consume(take * 4);
+            let consumed = words.len();
+            self.reader.consume(consumed);
             if out.len() >= CHUNK_EVENTS {
                 return Ok(());
             }
-            if take < words {
-                continue;
-            }
-            if !self.reader.refill()? {
-                let left = self.reader.available().len();
-                if left > 0 {
-                    return Err(InputError::corrupt(
-                        &self.state.path,
-                        format!("byte offset {}", self.reader.offset()),
-                        format!("the file ends inside a 4-byte EVT2 word ({left} bytes left over)"),
-                        FIX_TRUNCATED,
-                    ));
-                }
+            if !self.reader.refill_units(4, "a 4-byte EVT2 word")? {
                 return Ok(());
             }
         }
@@ -129,9 +117,6 @@ impl EventDecoder for Evt2Decoder {
     }
 
     fn progress(&self) -> Progress {
-        Progress {
-            done: self.reader.offset(),
-            total: self.reader.total(),
-        }
+        self.reader.progress()
     }
 }

@@ -11,7 +11,7 @@
 //! one format and ctcal needs the same streaming and error conventions for all of them.
 
 use super::blocks::BlockReader;
-use super::error::{FIX_TRUNCATED, InputError};
+use super::error::InputError;
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Sensor};
@@ -128,33 +128,19 @@ impl State {
 impl EventDecoder for Evt3Decoder {
     fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
         loop {
-            let available = self.reader.available();
-            let base = self.reader.offset();
-            let words = available.len() / 2;
             // a vector word emits at most 12 events
-            let room = CHUNK_EVENTS.saturating_sub(out.len()) / 12;
-            let take = words.min(room.max(1));
-            for (i, bytes) in available[..take * 2].chunks_exact(2).enumerate() {
+            let room = (CHUNK_EVENTS.saturating_sub(out.len()) / 12).max(1);
+            let (words, base) = self.reader.records(2, room);
+            for (i, bytes) in words.chunks_exact(2).enumerate() {
                 let word = u16::from_le_bytes([bytes[0], bytes[1]]);
                 self.state.decode(word, base + 2 * i as u64, out)?;
             }
-            self.reader.consume(take * 2);
+            let consumed = words.len();
+            self.reader.consume(consumed);
             if out.len() + 12 > CHUNK_EVENTS {
                 return Ok(());
             }
-            if take < words {
-                continue;
-            }
-            if !self.reader.refill()? {
-                let left = self.reader.available().len();
-                if left > 0 {
-                    return Err(InputError::corrupt(
-                        &self.state.path,
-                        format!("byte offset {}", self.reader.offset()),
-                        "the file ends inside a 2-byte EVT3 word",
-                        FIX_TRUNCATED,
-                    ));
-                }
+            if !self.reader.refill_units(2, "a 2-byte EVT3 word")? {
                 return Ok(());
             }
         }
@@ -165,9 +151,6 @@ impl EventDecoder for Evt3Decoder {
     }
 
     fn progress(&self) -> Progress {
-        Progress {
-            done: self.reader.offset(),
-            total: self.reader.total(),
-        }
+        self.reader.progress()
     }
 }

@@ -215,10 +215,7 @@ impl EventDecoder for IjrrDecoder {
     }
 
     fn progress(&self) -> Progress {
-        Progress {
-            done: self.reader.offset(),
-            total: self.reader.total(),
-        }
+        self.reader.progress()
     }
 }
 

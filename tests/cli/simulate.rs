@@ -11,17 +11,23 @@ struct Simulated {
 
 /// Runs `ctcal simulate` with PARAMS text on a frame folder; extra args (maps) appended.
 fn simulate(params: &str, frames: &Path, extra: &[&str]) -> Simulated {
+    simulate_input(params, "--frames", frames, "out", extra)
+}
+
+/// Runs `ctcal simulate` with PARAMS text on `--frames DIR` or `--scene FILE`, writing `out`
+/// (a folder, or an HDF5 file when it ends in .h5) in a fresh temporary folder.
+fn simulate_input(params: &str, flag: &str, input: &Path, out: &str, extra: &[&str]) -> Simulated {
     let dir = tempfile::tempdir().unwrap();
     let params_path = dir.path().join("params.toml");
     std::fs::write(&params_path, params).unwrap();
-    let out = dir.path().join("out");
+    let out = dir.path().join(out);
     ctcal()
         .args([
             "simulate",
             "--params",
             params_path.to_str().unwrap(),
-            "--frames",
-            frames.to_str().unwrap(),
+            flag,
+            input.to_str().unwrap(),
         ])
         .args(["--out", out.to_str().unwrap()])
         .args(extra)
@@ -365,25 +371,9 @@ fn calibration_checkerboard_stimulus() {
     let frame = list.load(0).unwrap();
     assert_eq!((frame.width, frame.height), (240, 180));
     // simulating the stimulus on a display makes events only where the board moves
-    let params = dir.path().join("p.toml");
-    std::fs::write(
-        &params,
-        "ct_on = 0.3\nct_off = 0.3\n[display]\nrefresh_hz = 60.0\ngamma = 2.2\nblack_level = 0.01\nwhite_dn = 220.0\n",
-    )
-    .unwrap();
-    let sim = dir.path().join("sim");
-    ctcal()
-        .args([
-            "simulate",
-            "--params",
-            params.to_str().unwrap(),
-            "--frames",
-            out.to_str().unwrap(),
-        ])
-        .args(["--out", sim.to_str().unwrap()])
-        .assert()
-        .success();
-    let s = json(&["stats", sim.to_str().unwrap()]);
+    let params = "ct_on = 0.3\nct_off = 0.3\n[display]\nrefresh_hz = 60.0\ngamma = 2.2\nblack_level = 0.01\nwhite_dn = 220.0\n";
+    let sim = simulate(params, &out, &[]);
+    let s = json(&["stats", sim.out.to_str().unwrap()]);
     let active = s["active_pixel_fraction"].as_f64().unwrap();
     assert!(active > 0.05 && active < 0.6, "{active}");
 }
@@ -456,21 +446,14 @@ fn multi_object_scene_with_user_textures_and_hdf5_output() {
         "kind = \"multi_object\"\nwidth = 96\nheight = 72\nduration_s = 0.2\nseed = 5\n[multi_object]\nobjects = [3, 3]\nbackground_velocity_px_s = [5.0, 10.0]\nbackground_angular_velocity_deg_s = [0.0, 5.0]\nbackground_scale = [1.0, 1.2]\nobject_velocity_px_s = [40.0, 80.0]\nobject_angular_velocity_deg_s = [0.0, 20.0]\nobject_scale = [0.5, 1.0]\ntextures_dir = \"textures\"\n",
     )
     .unwrap();
-    let params = dir.path().join("p.toml");
-    std::fs::write(&params, "ct_on = 0.3\nct_off = 0.3\n").unwrap();
-    let out = dir.path().join("out.h5");
-    ctcal()
-        .args([
-            "simulate",
-            "--params",
-            params.to_str().unwrap(),
-            "--scene",
-            scene.to_str().unwrap(),
-        ])
-        .args(["--out", out.to_str().unwrap()])
-        .assert()
-        .success();
-    let s = json(&["stats", out.to_str().unwrap()]);
+    let first = simulate_input(
+        "ct_on = 0.3\nct_off = 0.3\n",
+        "--scene",
+        &scene,
+        "out.h5",
+        &[],
+    );
+    let s = json(&["stats", first.out.to_str().unwrap()]);
     assert_eq!(
         (s["width"].as_u64(), s["height"].as_u64()),
         (Some(96), Some(72))
@@ -478,17 +461,12 @@ fn multi_object_scene_with_user_textures_and_hdf5_output() {
     // two-level textures: high contrast edges everywhere something moves
     assert!(s["events"].as_u64().unwrap() > 5_000, "{s}");
     // and it is deterministic
-    let again = dir.path().join("again.h5");
-    ctcal()
-        .args([
-            "simulate",
-            "--params",
-            params.to_str().unwrap(),
-            "--scene",
-            scene.to_str().unwrap(),
-        ])
-        .args(["--out", again.to_str().unwrap()])
-        .assert()
-        .success();
-    assert!(read_events(&out) == read_events(&again));
+    let again = simulate_input(
+        "ct_on = 0.3\nct_off = 0.3\n",
+        "--scene",
+        &scene,
+        "out.h5",
+        &[],
+    );
+    assert!(read_events(&first.out) == read_events(&again.out));
 }

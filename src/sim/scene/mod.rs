@@ -85,6 +85,31 @@ fn scene_error(path: &Path, problem: impl Into<String>, fix: impl Into<String>) 
 }
 
 impl SceneSpec {
+    /// The default texture (`calib/scenes/texture_translation.toml` without APS frames)
+    /// translating at (60, 25) px/s for `duration_s`, rendered at `render_hz`.
+    pub fn moving_texture(width: usize, height: usize, duration_s: f64, render_hz: f64) -> Self {
+        Self {
+            kind: SceneKind::Texture,
+            width,
+            height,
+            duration_s,
+            seed: 1,
+            render_hz: Some(render_hz),
+            aps: None,
+            texture: Some(texture::TextureScene {
+                texture: Default::default(),
+                vx_px_s: 60.0,
+                vy_px_s: 25.0,
+                omega_deg_s: 0.0,
+                offset_px: [0.0, 0.0],
+                mod_amp_ln: 0.0,
+                mod_hz: 0.0,
+            }),
+            checkerboard: None,
+            multi_object: None,
+        }
+    }
+
     /// Reads and checks a scene file.
     pub fn from_file(path: &Path) -> Result<Self, SimError> {
         let text = std::fs::read_to_string(path).map_err(|e| crate::io::InputError::io(path, e))?;
