@@ -21,19 +21,20 @@ fn convert(input: &Path, out: &Path, to: &str) {
 #[test]
 fn every_shared_input_round_trips_through_text_and_hdf5() {
     let data = shared_data();
-    let inputs = [
-        data.join("real/ijrr_slider_depth_50k"),
-        data.join("real/ijrr_boxes_rotation_chunk"),
-        data.join("real/davis346_faery.aedat4"),
-        data.join("real/dvxplorer_tonic.aedat4"),
-        data.join("real/evk4_faery_evt3.raw"),
-        data.join("real/evk4_faery_gen4.dat"),
-        data.join("real/gen3_faery_evt2.raw"),
-        data.join("real/gen3_expelliarmus_evt2.raw"),
-        data.join("h5/e_ct060_event_utils.h5"),
-        data.join("h5/e_ct060_v2e_layout.h5"),
-        data.join("oracle/dev_davis_like"),
-    ];
+    // every recording of the shared data: real/, h5/ and every oracle case
+    let mut inputs = Vec::new();
+    for folder in ["real", "h5", "oracle"] {
+        for entry in std::fs::read_dir(data.join(folder)).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if name == "licences" || name.ends_with(".json") {
+                continue;
+            }
+            inputs.push(path);
+        }
+    }
+    inputs.sort();
+    assert!(inputs.len() >= 26, "{} inputs", inputs.len());
     let dir = tempfile::tempdir().unwrap();
     for input in inputs {
         let original = read_events(&input);
