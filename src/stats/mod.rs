@@ -9,6 +9,7 @@
 pub mod hot_pixels;
 pub mod intervals;
 pub mod pixel_grid;
+pub mod timeline;
 
 use crate::events::{EventChunk, Sensor, TimeUs, us_to_s};
 use crate::io::ResolvedSensor;
@@ -16,6 +17,7 @@ use hot_pixels::HotPixel;
 use intervals::IntervalHistogram;
 use pixel_grid::PixelGrid;
 use serde::Serialize;
+pub use timeline::{FrameSummary, RateWindow};
 
 /// Hints the cache to load `value` (no effect on results; a no-op off x86-64).
 #[inline(always)]
@@ -53,18 +55,6 @@ impl Default for StatsOptions {
     }
 }
 
-/// One window of the rate timeline.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct RateWindow {
-    /// Window start, seconds after the first event.
-    pub t_s: f64,
-    /// Window length in seconds (the last window absorbs the remainder: between half and
-    /// one and a half windows).
-    pub window_s: f64,
-    pub events: u64,
-    pub events_per_pixel_per_second: f64,
-}
-
 /// Quantiles of same-pixel intervals between consecutive events (either polarity).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct IntervalSummary {
@@ -73,13 +63,6 @@ pub struct IntervalSummary {
     pub count: u64,
     /// How the quantiles were computed.
     pub resolution: &'static str,
-}
-
-/// Frame timing.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct FrameSummary {
-    pub count: usize,
-    pub median_interval_s: Option<f64>,
 }
 
 /// Statistics of one event sequence (the `ctcal stats` JSON).
@@ -268,7 +251,7 @@ impl StatsAccumulator {
             on_per_pixel_per_second: per_pixel_per_second(self.on),
             off_per_pixel_per_second: per_pixel_per_second(off),
             active_pixel_fraction: active as f64 / pixels,
-            rate_timeline: timeline(
+            rate_timeline: timeline::rate_timeline(
                 &self.timeline,
                 self.window_us,
                 self.last - first,
@@ -284,7 +267,7 @@ impl StatsAccumulator {
                 count: self.intervals.total(),
                 resolution: "histogram quantiles: exact below 128 us, above that within 1/128 (0.8 %) of the value",
             },
-            frames: frame_summary(frame_times),
+            frames: timeline::frame_summary(frame_times),
         })
     }
 }
@@ -319,66 +302,6 @@ fn background_rate(counts: &[u32], width: usize, hot: &[HotPixel], duration_s: f
         (*kept[..mid].iter().max().expect("len >= 2") as f64 + upper) / 2.0
     };
     median / duration_s
-}
-
-/// Window rates over the selected span `span_us`; the remainder joins the last window.
-fn timeline(
-    counts: &[u64],
-    window_us: TimeUs,
-    span_us: TimeUs,
-    offset_s: f64,
-    pixels: f64,
-) -> Vec<RateWindow> {
-    let windows = ((span_us as f64 / window_us as f64).round() as usize).max(1);
-    let mut merged: Vec<u64> = counts.iter().take(windows).copied().collect();
-    let tail: u64 = counts.iter().skip(windows).sum();
-    if let Some(last) = merged.last_mut() {
-        *last += tail;
-    }
-    let n = merged.len();
-    merged
-        .iter()
-        .enumerate()
-        .map(|(k, &events)| {
-            let length_us = if k + 1 < n {
-                window_us
-            } else {
-                (span_us - (n as TimeUs - 1) * window_us).max(0)
-            };
-            let window_s = us_to_s(length_us);
-            RateWindow {
-                t_s: offset_s + us_to_s(k as TimeUs * window_us),
-                window_s,
-                events,
-                events_per_pixel_per_second: if window_s > 0.0 {
-                    events as f64 / (pixels * window_s)
-                } else {
-                    0.0
-                },
-            }
-        })
-        .collect()
-}
-
-fn frame_summary(times: &[TimeUs]) -> Option<FrameSummary> {
-    if times.is_empty() {
-        return None;
-    }
-    let mut gaps: Vec<TimeUs> = times.windows(2).map(|w| w[1] - w[0]).collect();
-    let median_interval_s = (!gaps.is_empty()).then(|| {
-        gaps.sort_unstable();
-        let n = gaps.len();
-        let median = if n % 2 == 1 {
-            gaps[n / 2] as f64
-        } else {
-            (gaps[n / 2 - 1] + gaps[n / 2]) as f64 / 2.0
-        };
-        median * 1e-6
-    });
-    Some(FrameSummary {
-        count: times.len(),
-        median_interval_s,
-    })
 }
 
 #[cfg(test)]

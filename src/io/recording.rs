@@ -1,0 +1,364 @@
+//! An opened recording: format detection, the sensor size (user, file metadata, frames, or
+//! inferred from the coordinates), as many streaming passes over its events as needed,
+//! its frames and its stimulus.
+
+use super::Format;
+use super::{
+    EventDecoder, FrameList, InputError, Progress, aedat4, dat, detect, evt2, evt3, h5, ijrr,
+    prophesee,
+};
+use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor, TimeUs};
+use crate::sensors;
+use std::path::{Path, PathBuf};
+
+/// Options for opening a recording.
+#[derive(Clone, Debug, Default)]
+pub struct OpenOptions {
+    /// Skip content detection and read as this format.
+    pub format: Option<Format>,
+    /// The sensor size, overriding what the file says.
+    pub sensor: Option<Sensor>,
+}
+
+#[derive(Clone, Debug)]
+enum Source {
+    Ijrr(ijrr::IjrrFiles),
+    H5(h5::H5Info),
+    Aedat4(aedat4::Aedat4Header),
+    Evt2 { data_offset: u64 },
+    Evt3 { data_offset: u64 },
+    Dat { data_offset: u64 },
+}
+
+/// An opened recording: its format, what it says about the sensor, and access to its events
+/// (as many streaming passes as needed), frames and stimulus.
+#[derive(Clone, Debug)]
+pub struct Recording {
+    pub path: PathBuf,
+    pub format: Format,
+    /// The sensor size known before reading events (from `--sensor`, the file's metadata or
+    /// its frames); `None` when it must be inferred from the coordinates.
+    pub sensor: Option<Sensor>,
+    /// Where [`Self::sensor`] comes from.
+    pub sensor_source: Option<String>,
+    /// Remarks for the user (e.g. a resolution claim that was corrected).
+    pub notes: Vec<String>,
+    source: Source,
+}
+
+/// The sensor used for a recording after its events were read.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ResolvedSensor {
+    pub sensor: Sensor,
+    pub source: String,
+    /// Set when the size was guessed from the coordinates.
+    pub warning: Option<String>,
+}
+
+impl Recording {
+    /// Opens `path`, detecting its format from content unless `options.format` is set.
+    pub fn open(path: &Path, options: &OpenOptions) -> Result<Self, InputError> {
+        if !path.exists() {
+            return Err(InputError::NotFound {
+                path: path.to_path_buf(),
+            });
+        }
+        let format = match options.format {
+            Some(f) => f,
+            None => detect(path)?,
+        };
+        let mut notes = Vec::new();
+        let (source, file_sensor): (Source, Option<(Sensor, String)>) = match format {
+            Format::Ijrr => {
+                let files = ijrr::IjrrFiles::locate(path)?;
+                let header = ijrr::read_header(&files.events)?;
+                let mut sensor = header
+                    .sensor
+                    .map(|s| (s, "the `width height` first line of events.txt".to_string()));
+                if sensor.is_none()
+                    && let Some(images) = &files.images
+                    && let Some((w, h)) = FrameList::read(images)?.image_size()?
+                {
+                    let (w, h) = (
+                        u16::try_from(w).unwrap_or(u16::MAX),
+                        u16::try_from(h).unwrap_or(u16::MAX),
+                    );
+                    sensor = Some((
+                        Sensor::new(w, h),
+                        "the size of the images in images.txt".to_string(),
+                    ));
+                }
+                (Source::Ijrr(files), sensor)
+            }
+            Format::H5 => {
+                let info = h5::probe(path)?;
+                let sensor = info.sensor.map(|s| {
+                    (
+                        s,
+                        info.sensor_note
+                            .clone()
+                            .unwrap_or_else(|| "sensor_resolution".into()),
+                    )
+                });
+                if let Some(note) = &info.sensor_note
+                    && note.contains("(W, H)")
+                {
+                    notes.push(note.clone());
+                }
+                (Source::H5(info), sensor)
+            }
+            Format::Aedat4 => {
+                let header = aedat4::Aedat4Header::read(path)?;
+                let sensor = header.event_sensor().map(|s| {
+                    (
+                        s,
+                        "sizeX/sizeY of the event stream in the AEDAT4 header".to_string(),
+                    )
+                });
+                (Source::Aedat4(header), sensor)
+            }
+            Format::Evt2 | Format::Evt3 | Format::Dat => {
+                let header = prophesee::PropheseeHeader::read(path)?;
+                let sensor = header.sensor();
+                let data_offset = header.length;
+                let source = match format {
+                    Format::Evt2 => Source::Evt2 { data_offset },
+                    Format::Evt3 => Source::Evt3 { data_offset },
+                    _ => Source::Dat { data_offset },
+                };
+                (source, sensor)
+            }
+        };
+        let (sensor, sensor_source) = match (options.sensor, file_sensor) {
+            (Some(s), Some((claimed, _))) if s != claimed => {
+                notes.push(format!("--sensor {s} overrides the file's {claimed}"));
+                (Some(s), Some("--sensor".to_string()))
+            }
+            (Some(s), _) => (Some(s), Some("--sensor".to_string())),
+            (None, Some((s, origin))) => (Some(s), Some(origin)),
+            (None, None) => (None, None),
+        };
+        Ok(Self {
+            path: path.to_path_buf(),
+            format,
+            sensor,
+            sensor_source,
+            notes,
+            source,
+        })
+    }
+
+    /// A fresh stream over the events (each call starts at the beginning).
+    pub fn events(&self) -> Result<EventStream, InputError> {
+        let decoder: Box<dyn EventDecoder> = match &self.source {
+            Source::Ijrr(files) => Box::new(ijrr::IjrrDecoder::open(&files.events, self.sensor)?),
+            Source::H5(info) => Box::new(h5::H5Decoder::open(&self.path, info, self.sensor)?),
+            Source::Aedat4(header) => Box::new(aedat4::Aedat4Decoder::open(
+                &self.path,
+                header,
+                self.sensor,
+            )?),
+            Source::Evt2 { data_offset } => Box::new(evt2::Evt2Decoder::open(
+                &self.path,
+                *data_offset,
+                self.sensor,
+            )?),
+            Source::Evt3 { data_offset } => Box::new(evt3::Evt3Decoder::open(
+                &self.path,
+                *data_offset,
+                self.sensor,
+            )?),
+            Source::Dat { data_offset } => Box::new(dat::DatDecoder::open(
+                &self.path,
+                *data_offset,
+                self.sensor,
+            )?),
+        };
+        Ok(EventStream {
+            decoder,
+            path: self.event_file().to_path_buf(),
+            chunk: EventChunk::with_capacity(CHUNK_EVENTS),
+            events: 0,
+            max_x: None,
+            max_y: 0,
+            allow_unsorted: false,
+        })
+    }
+
+    /// The file holding the events (`events.txt` for IJRR folders).
+    pub fn event_file(&self) -> &Path {
+        match &self.source {
+            Source::Ijrr(files) => &files.events,
+            _ => &self.path,
+        }
+    }
+
+    /// Every event in memory, sorted by time when `sort` (stable); an unsorted file is an
+    /// error unless `sort`.
+    pub fn read_all(&self, sort: bool) -> Result<EventChunk, InputError> {
+        let mut stream = self.events()?;
+        stream.allow_unsorted = sort;
+        let mut all = EventChunk::default();
+        while let Some(chunk) = stream.next_chunk()? {
+            all.extend_from(chunk);
+        }
+        if sort {
+            all.sort_by_time();
+        }
+        Ok(all)
+    }
+
+    /// The sensor for this recording once its largest coordinates are known: the known
+    /// sensor, else the smallest preset that contains every event (with a warning).
+    pub fn resolve_sensor(&self, max_coordinates: Option<(u16, u16)>) -> ResolvedSensor {
+        if let Some(sensor) = self.sensor {
+            return ResolvedSensor {
+                sensor,
+                source: self.sensor_source.clone().unwrap_or_default(),
+                warning: None,
+            };
+        }
+        let (max_x, max_y) = max_coordinates.unwrap_or((0, 0));
+        match sensors::smallest_containing(max_x, max_y) {
+            Some(preset) => ResolvedSensor {
+                sensor: preset.sensor(),
+                source: format!("inferred: {} ({})", preset.name, preset.sensor()),
+                warning: Some(format!(
+                    "{}: the file does not state the sensor size; using {} ({}), the smallest known sensor containing every event (x up to {max_x}, y up to {max_y}); pass --sensor WxH if that is wrong",
+                    self.path.display(),
+                    preset.name,
+                    preset.sensor()
+                )),
+            },
+            None => {
+                let sensor = Sensor::new(max_x.saturating_add(1), max_y.saturating_add(1));
+                ResolvedSensor {
+                    sensor,
+                    source: format!("inferred: {sensor} from the coordinates"),
+                    warning: Some(format!(
+                        "{}: the file does not state the sensor size and no known sensor contains x up to {max_x}, y up to {max_y}; using {sensor}; pass --sensor WxH",
+                        self.path.display()
+                    )),
+                }
+            }
+        }
+    }
+
+    /// Decodes every frame (APS images) of the recording.
+    pub fn frames(&self) -> Result<Vec<Frame>, InputError> {
+        match &self.source {
+            Source::Ijrr(files) => match &files.images {
+                Some(images) => FrameList::read(images)?.load_all(),
+                None => Ok(Vec::new()),
+            },
+            Source::H5(info) => h5::read_frames(&self.path, info),
+            Source::Aedat4(header) => aedat4::read_frames(&self.path, header),
+            _ => Ok(Vec::new()),
+        }
+    }
+
+    /// Frame timestamps (without decoding images where the format allows).
+    pub fn frame_times(&self) -> Result<Vec<TimeUs>, InputError> {
+        match &self.source {
+            Source::Ijrr(files) => match &files.images {
+                Some(images) => Ok(FrameList::read(images)?.times()),
+                None => Ok(Vec::new()),
+            },
+            _ => Ok(self.frames()?.iter().map(|f| f.t).collect()),
+        }
+    }
+
+    /// The on-screen stimulus of an IJRR folder (`stimulus.txt`), if it has one.
+    pub fn stimulus(&self) -> Result<Option<FrameList>, InputError> {
+        match &self.source {
+            Source::Ijrr(files) => files.stimulus.as_deref().map(FrameList::read).transpose(),
+            _ => Ok(None),
+        }
+    }
+}
+
+/// A pass over a recording's events, chunk by chunk, that checks at the end that the file
+/// was not empty and (unless allowed) that time never went backwards.
+pub struct EventStream {
+    decoder: Box<dyn EventDecoder>,
+    path: PathBuf,
+    chunk: EventChunk,
+    events: u64,
+    max_x: Option<u16>,
+    max_y: u16,
+    /// Accept decreasing timestamps (the caller sorts).
+    pub allow_unsorted: bool,
+}
+
+impl EventStream {
+    /// The next chunk of events; `None` after the last.
+    pub fn next_chunk(&mut self) -> Result<Option<&EventChunk>, InputError> {
+        self.chunk.clear();
+        self.decoder.read_chunk(&mut self.chunk)?;
+        if self.chunk.is_empty() {
+            if self.events == 0 {
+                return Err(InputError::Empty {
+                    path: self.path.clone(),
+                });
+            }
+            let order = self.decoder.order();
+            if order.backwards > 0
+                && !self.allow_unsorted
+                && let Some((place, previous_us, t_us)) = order.first.clone()
+            {
+                return Err(InputError::Unsorted {
+                    path: self.path.clone(),
+                    count: order.backwards,
+                    place,
+                    previous_us,
+                    t_us,
+                });
+            }
+            return Ok(None);
+        }
+        self.events += self.chunk.len() as u64;
+        if let Some((x, y)) = self.chunk.max_coordinates() {
+            self.max_x = Some(self.max_x.map_or(x, |m| m.max(x)));
+            self.max_y = self.max_y.max(y);
+        }
+        Ok(Some(&self.chunk))
+    }
+
+    /// The chunk the last [`Self::next_chunk`] returned.
+    pub fn current_chunk(&self) -> &EventChunk {
+        &self.chunk
+    }
+
+    /// Like [`Self::next_chunk`] but hands over the filled chunk, keeping `spare` as the
+    /// buffer for the next one (for passing chunks to another thread without copying).
+    pub fn next_chunk_swapped(
+        &mut self,
+        spare: EventChunk,
+    ) -> Result<Option<EventChunk>, InputError> {
+        if self.next_chunk()?.is_none() {
+            return Ok(None);
+        }
+        let mut spare = spare;
+        spare.clear();
+        Ok(Some(std::mem::replace(&mut self.chunk, spare)))
+    }
+
+    /// Events delivered so far.
+    pub fn events_read(&self) -> u64 {
+        self.events
+    }
+
+    /// Largest x and y delivered so far.
+    pub fn max_coordinates(&self) -> Option<(u16, u16)> {
+        self.max_x.map(|x| (x, self.max_y))
+    }
+
+    /// Timestamps that went backwards so far.
+    pub fn unsorted_count(&self) -> u64 {
+        self.decoder.order().backwards
+    }
+
+    pub fn progress(&self) -> Progress {
+        self.decoder.progress()
+    }
+}
