@@ -11,6 +11,7 @@
 //! Read through `hdf5-metno` (libhdf5) in chunks of `CHUNK_EVENTS` rows.
 
 use super::error::InputError;
+use super::h5_direct::{DirectColumn, ElementKind};
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor, TimeUs};
@@ -89,29 +90,180 @@ fn layout_of(path: &Path, file: &hdf5::File) -> Result<Layout, InputError> {
     ))
 }
 
-/// Reads a 1-D integer dataset slice as i64 whatever its stored integer type.
-fn read_ints(ds: &hdf5::Dataset, range: std::ops::Range<usize>) -> hdf5::Result<Vec<i64>> {
-    Ok(ds
-        .read_slice_1d::<i64, _>(range)?
-        .into_raw_vec_and_offset()
-        .0)
+/// One 1-D column of an event_utils file: read by direct chunk access and parallel
+/// inflation where the layout allows ([`super::h5_direct`]), through libhdf5 otherwise.
+/// Results go into caller buffers, which are reused from chunk to chunk.
+struct Column {
+    dataset: hdf5::Dataset,
+    direct: Option<(DirectColumn, ElementKind)>,
 }
 
-/// Reads a polarity slice: booleans, integers (>0 is ON) or floats (>0 is ON).
-fn read_polarities(ds: &hdf5::Dataset, range: std::ops::Range<usize>) -> hdf5::Result<Vec<bool>> {
-    Ok(match ds.dtype()?.to_descriptor()? {
-        TypeDescriptor::Boolean => {
-            ds.read_slice_1d::<bool, _>(range)?
-                .into_raw_vec_and_offset()
-                .0
+impl Column {
+    fn open(path: &Path, file: &hdf5::File, name: &str) -> hdf5::Result<Self> {
+        let dataset = file.dataset(name)?;
+        let kind = dataset.dtype().ok().and_then(|d| ElementKind::of(&d));
+        let direct = DirectColumn::new(path, &dataset).zip(kind);
+        Ok(Self { dataset, direct })
+    }
+
+    /// The raw bytes of `range` into `bytes`, when the direct path can read it.
+    fn raw(&self, range: &std::ops::Range<usize>, bytes: &mut Vec<u8>) -> Option<ElementKind> {
+        let (column, kind) = self.direct.as_ref()?;
+        column.read_into(range.clone(), bytes).map(|_| *kind)
+    }
+
+    /// Appends the values of `range` as i64, whatever the stored integer type.
+    fn ints(
+        &self,
+        range: std::ops::Range<usize>,
+        bytes: &mut Vec<u8>,
+        out: &mut Vec<i64>,
+    ) -> hdf5::Result<()> {
+        match self.raw(&range, bytes) {
+            Some(kind) => kind.extend_i64(bytes, out),
+            None => out.extend(self.dataset.read_slice_1d::<i64, _>(range)?.iter()),
         }
-        TypeDescriptor::Float(_) => ds
-            .read_slice_1d::<f64, _>(range)?
-            .iter()
-            .map(|&p| p > 0.0)
-            .collect(),
-        _ => read_ints(ds, range)?.into_iter().map(|p| p > 0).collect(),
-    })
+        Ok(())
+    }
+
+    /// Appends the values of `range` as f64.
+    fn floats(
+        &self,
+        range: std::ops::Range<usize>,
+        bytes: &mut Vec<u8>,
+        out: &mut Vec<f64>,
+    ) -> hdf5::Result<()> {
+        match self.raw(&range, bytes) {
+            Some(kind) => kind.extend_f64(bytes, out),
+            None => out.extend(self.dataset.read_slice_1d::<f64, _>(range)?.iter()),
+        }
+        Ok(())
+    }
+
+    /// Appends polarities (booleans, integers or floats; > 0 is ON).
+    fn flags(
+        &self,
+        range: std::ops::Range<usize>,
+        bytes: &mut Vec<u8>,
+        out: &mut Vec<bool>,
+    ) -> hdf5::Result<()> {
+        if let Some(kind) = self.raw(&range, bytes) {
+            let mut values = Vec::with_capacity(range.len());
+            kind.extend_f64(bytes, &mut values);
+            out.extend(values.iter().map(|&p| p > 0.0));
+            return Ok(());
+        }
+        match self.dataset.dtype()?.to_descriptor()? {
+            TypeDescriptor::Boolean => {
+                out.extend(self.dataset.read_slice_1d::<bool, _>(range)?.iter())
+            }
+            TypeDescriptor::Float(_) => out.extend(
+                self.dataset
+                    .read_slice_1d::<f64, _>(range)?
+                    .iter()
+                    .map(|&p| p > 0.0),
+            ),
+            _ => out.extend(
+                self.dataset
+                    .read_slice_1d::<i64, _>(range)?
+                    .iter()
+                    .map(|&p| p > 0),
+            ),
+        }
+        Ok(())
+    }
+}
+
+/// Reused buffers of the HDF5 reader.
+#[derive(Default)]
+struct Buffers {
+    bytes: Vec<u8>,
+    seconds: Vec<f64>,
+}
+
+/// The four event columns of an event_utils file, or the N x 4 table of a v2e file.
+enum EventTable {
+    EventUtils {
+        ts: Column,
+        xs: Column,
+        ys: Column,
+        ps: Column,
+    },
+    V2e(hdf5::Dataset),
+}
+
+impl EventTable {
+    fn open(path: &Path, file: &hdf5::File, layout: Layout) -> hdf5::Result<Self> {
+        Ok(match layout {
+            Layout::EventUtils => EventTable::EventUtils {
+                ts: Column::open(path, file, "events/ts")?,
+                xs: Column::open(path, file, "events/xs")?,
+                ys: Column::open(path, file, "events/ys")?,
+                ps: Column::open(path, file, "events/ps")?,
+            },
+            Layout::V2e => EventTable::V2e(file.dataset("events")?),
+        })
+    }
+
+    /// Replaces `columns.x` and `columns.y` with the coordinates of `range`.
+    fn coordinates(
+        &self,
+        range: std::ops::Range<usize>,
+        buffers: &mut Buffers,
+        columns: &mut Columns,
+    ) -> hdf5::Result<()> {
+        columns.x.clear();
+        columns.y.clear();
+        match self {
+            EventTable::EventUtils { xs, ys, .. } => {
+                xs.ints(range.clone(), &mut buffers.bytes, &mut columns.x)?;
+                ys.ints(range, &mut buffers.bytes, &mut columns.y)?;
+            }
+            EventTable::V2e(ds) => {
+                let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, 1..3])?;
+                columns.x.extend(rows.column(0).iter());
+                columns.y.extend(rows.column(1).iter());
+            }
+        }
+        Ok(())
+    }
+
+    /// Replaces `columns` with the events of `range`.
+    fn read(
+        &self,
+        range: std::ops::Range<usize>,
+        buffers: &mut Buffers,
+        columns: &mut Columns,
+    ) -> hdf5::Result<()> {
+        columns.t.clear();
+        columns.on.clear();
+        match self {
+            EventTable::EventUtils { ts, ps, .. } => {
+                buffers.seconds.clear();
+                ts.floats(range.clone(), &mut buffers.bytes, &mut buffers.seconds)?;
+                // a non-finite time becomes i64::MIN and is reported by read_chunk
+                columns.t.extend(buffers.seconds.iter().map(|&s| {
+                    if s.is_finite() {
+                        crate::events::s_to_us(s)
+                    } else {
+                        TimeUs::MIN
+                    }
+                }));
+                ps.flags(range.clone(), &mut buffers.bytes, &mut columns.on)?;
+                self.coordinates(range, buffers, columns)
+            }
+            EventTable::V2e(ds) => {
+                let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, ..])?;
+                columns.t.extend(rows.column(0).iter());
+                columns.x.clear();
+                columns.y.clear();
+                columns.x.extend(rows.column(1).iter());
+                columns.y.extend(rows.column(2).iter());
+                columns.on.extend(rows.column(3).iter().map(|&p| p > 0));
+                Ok(())
+            }
+        }
+    }
 }
 
 /// The claimed `sensor_resolution` (H, W), as an attribute or a dataset.
@@ -138,14 +290,19 @@ fn coordinate_extent(
     layout: Layout,
     n: usize,
 ) -> Result<(i64, i64), InputError> {
+    let table = EventTable::open(path, file, layout)
+        .map_err(|e| h5_error(path, "opening the event datasets", e))?;
+    let (mut buffers, mut columns) = (Buffers::default(), Columns::default());
     let mut max_x = -1i64;
     let mut max_y = -1i64;
     let mut start = 0;
     while start < n {
         let end = (start + CHUNK_EVENTS).min(n);
-        let (xs, ys) = read_coordinates(file, layout, start..end)
+        table
+            .coordinates(start..end, &mut buffers, &mut columns)
             .map_err(|e| h5_error(path, "reading coordinates", e))?;
-        for (i, (&x, &y)) in xs.iter().zip(&ys).enumerate() {
+        let (xs, ys) = (&columns.x, &columns.y);
+        for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
             if x < 0 || y < 0 || x > u16::MAX as i64 || y > u16::MAX as i64 {
                 return Err(InputError::corrupt(
                     path,
@@ -160,24 +317,6 @@ fn coordinate_extent(
         start = end;
     }
     Ok((max_x, max_y))
-}
-
-fn read_coordinates(
-    file: &hdf5::File,
-    layout: Layout,
-    range: std::ops::Range<usize>,
-) -> hdf5::Result<(Vec<i64>, Vec<i64>)> {
-    match layout {
-        Layout::EventUtils => Ok((
-            read_ints(&file.dataset("events/xs")?, range.clone())?,
-            read_ints(&file.dataset("events/ys")?, range)?,
-        )),
-        Layout::V2e => {
-            let ds = file.dataset("events")?;
-            let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, 1..3])?;
-            Ok((rows.column(0).to_vec(), rows.column(1).to_vec()))
-        }
-    }
 }
 
 /// Inspects an HDF5 event file and checks its sensor claim against the coordinates.
@@ -341,6 +480,7 @@ pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError>
 }
 
 /// One slice of the event columns, before validation (coordinates may be out of range).
+#[derive(Default)]
 struct Columns {
     t: Vec<TimeUs>,
     x: Vec<i64>,
@@ -351,8 +491,11 @@ struct Columns {
 /// Streaming HDF5 event reader.
 pub struct H5Decoder {
     path: PathBuf,
-    file: hdf5::File,
-    layout: Layout,
+    /// Keeps the file open for the datasets of `table`.
+    _file: hdf5::File,
+    table: EventTable,
+    buffers: Buffers,
+    columns: Columns,
     position: usize,
     events: usize,
     sensor: Option<Sensor>,
@@ -361,57 +504,20 @@ pub struct H5Decoder {
 
 impl H5Decoder {
     pub fn open(path: &Path, info: &H5Info, sensor: Option<Sensor>) -> Result<Self, InputError> {
+        let file = open_file(path)?;
+        let table = EventTable::open(path, &file, info.layout)
+            .map_err(|e| h5_error(path, "opening the event datasets", e))?;
         Ok(Self {
             path: path.to_path_buf(),
-            file: open_file(path)?,
-            layout: info.layout,
+            _file: file,
+            table,
+            buffers: Buffers::default(),
+            columns: Columns::default(),
             position: 0,
             events: info.events,
             sensor,
             order: OrderCheck::default(),
         })
-    }
-
-    fn read_range(&self, range: std::ops::Range<usize>) -> hdf5::Result<Columns> {
-        match self.layout {
-            Layout::EventUtils => {
-                let ts = self
-                    .file
-                    .dataset("events/ts")?
-                    .read_slice_1d::<f64, _>(range.clone())?;
-                // a non-finite time becomes i64::MIN and is reported by read_chunk
-                let t = ts
-                    .iter()
-                    .map(|&s| {
-                        if s.is_finite() {
-                            crate::events::s_to_us(s)
-                        } else {
-                            TimeUs::MIN
-                        }
-                    })
-                    .collect();
-                let (xs, ys) = read_coordinates(&self.file, self.layout, range.clone())?;
-                let ps = read_polarities(&self.file.dataset("events/ps")?, range)?;
-                Ok(Columns {
-                    t,
-                    x: xs,
-                    y: ys,
-                    on: ps,
-                })
-            }
-            Layout::V2e => {
-                let rows = self
-                    .file
-                    .dataset("events")?
-                    .read_slice_2d::<i64, _>(ndarray::s![range, ..])?;
-                Ok(Columns {
-                    t: rows.column(0).to_vec(),
-                    x: rows.column(1).to_vec(),
-                    y: rows.column(2).to_vec(),
-                    on: rows.column(3).iter().map(|&p| p > 0).collect(),
-                })
-            }
-        }
     }
 }
 
@@ -421,18 +527,21 @@ impl EventDecoder for H5Decoder {
             return Ok(());
         }
         let end = (self.position + CHUNK_EVENTS.saturating_sub(out.len())).min(self.events);
+        self.table
+            .read(self.position..end, &mut self.buffers, &mut self.columns)
+            .map_err(|e| {
+                h5_error(
+                    &self.path,
+                    &format!("reading events {}..{end}", self.position),
+                    e,
+                )
+            })?;
         let Columns {
             t,
             x: xs,
             y: ys,
             on: ps,
-        } = self.read_range(self.position..end).map_err(|e| {
-            h5_error(
-                &self.path,
-                &format!("reading events {}..{end}", self.position),
-                e,
-            )
-        })?;
+        } = &self.columns;
         for i in 0..t.len() {
             let (x, y) = (xs[i], ys[i]);
             let index = self.position + i;

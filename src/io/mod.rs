@@ -15,6 +15,7 @@ pub mod evt2;
 pub mod evt3;
 pub mod frame_list;
 pub mod h5;
+mod h5_direct;
 pub mod ijrr;
 pub mod npy;
 pub mod order;
