@@ -181,26 +181,29 @@ struct Buffers {
     seconds: Vec<f64>,
 }
 
+/// The four columns of an event_utils file.
+struct EventColumns {
+    ts: Column,
+    xs: Column,
+    ys: Column,
+    ps: Column,
+}
+
 /// The four event columns of an event_utils file, or the N x 4 table of a v2e file.
 enum EventTable {
-    EventUtils {
-        ts: Column,
-        xs: Column,
-        ys: Column,
-        ps: Column,
-    },
+    EventUtils(Box<EventColumns>),
     V2e(hdf5::Dataset),
 }
 
 impl EventTable {
     fn open(path: &Path, file: &hdf5::File, layout: Layout) -> hdf5::Result<Self> {
         Ok(match layout {
-            Layout::EventUtils => EventTable::EventUtils {
+            Layout::EventUtils => EventTable::EventUtils(Box::new(EventColumns {
                 ts: Column::open(path, file, "events/ts")?,
                 xs: Column::open(path, file, "events/xs")?,
                 ys: Column::open(path, file, "events/ys")?,
                 ps: Column::open(path, file, "events/ps")?,
-            },
+            })),
             Layout::V2e => EventTable::V2e(file.dataset("events")?),
         })
     }
@@ -215,9 +218,9 @@ impl EventTable {
         columns.x.clear();
         columns.y.clear();
         match self {
-            EventTable::EventUtils { xs, ys, .. } => {
-                xs.ints(range.clone(), &mut buffers.bytes, &mut columns.x)?;
-                ys.ints(range, &mut buffers.bytes, &mut columns.y)?;
+            EventTable::EventUtils(c) => {
+                c.xs.ints(range.clone(), &mut buffers.bytes, &mut columns.x)?;
+                c.ys.ints(range, &mut buffers.bytes, &mut columns.y)?;
             }
             EventTable::V2e(ds) => {
                 let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, 1..3])?;
@@ -238,9 +241,9 @@ impl EventTable {
         columns.t.clear();
         columns.on.clear();
         match self {
-            EventTable::EventUtils { ts, ps, .. } => {
+            EventTable::EventUtils(c) => {
                 buffers.seconds.clear();
-                ts.floats(range.clone(), &mut buffers.bytes, &mut buffers.seconds)?;
+                c.ts.floats(range.clone(), &mut buffers.bytes, &mut buffers.seconds)?;
                 // a non-finite time becomes i64::MIN and is reported by read_chunk
                 columns.t.extend(buffers.seconds.iter().map(|&s| {
                     if s.is_finite() {
@@ -249,7 +252,7 @@ impl EventTable {
                         TimeUs::MIN
                     }
                 }));
-                ps.flags(range.clone(), &mut buffers.bytes, &mut columns.on)?;
+                c.ps.flags(range.clone(), &mut buffers.bytes, &mut columns.on)?;
                 self.coordinates(range, buffers, columns)
             }
             EventTable::V2e(ds) => {

@@ -84,11 +84,8 @@ impl DirectColumn {
                 &mut size,
             )
         });
-        (status >= 0 && address != hdf5_sys::h5::HADDR_UNDEF && size > 0).then_some((
-            address as u64,
-            size as u64,
-            mask,
-        ))
+        (status >= 0 && address != hdf5_sys::h5::HADDR_UNDEF && size > 0)
+            .then_some((address, size, mask))
     }
 
     /// The raw little-endian bytes of elements `range` into `out` (cleared first, so that
