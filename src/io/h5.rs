@@ -1,6 +1,7 @@
 //! HDF5 event files in the two layouts researchers meet most:
 //!
-//! - event_utils / event_cnn_minimal (Stoffregen et al. 2020): `events/ts` (float64 seconds),
+//! - event_utils / event_cnn_minimal (Stoffregen et al. 2020): `events/ts` (float64 seconds;
+//!   integer timestamps, which some writers store, are read as microseconds),
 //!   `events/xs`, `events/ys` (integers), `events/ps` (bool or 0/1 or -1/1), frames as
 //!   `images/image%09d` with a `timestamp` attribute in seconds, and a root attribute
 //!   `sensor_resolution` = (H, W). Writers disagree on that order, so the claim is checked
@@ -183,6 +184,8 @@ struct Buffers {
 
 /// The four columns of an event_utils file.
 struct EventColumns {
+    /// `events/ts` holds integers: microseconds rather than seconds.
+    integer_times: bool,
     ts: Column,
     xs: Column,
     ys: Column,
@@ -199,6 +202,10 @@ impl EventTable {
     fn open(path: &Path, file: &hdf5::File, layout: Layout) -> hdf5::Result<Self> {
         Ok(match layout {
             Layout::EventUtils => EventTable::EventUtils(Box::new(EventColumns {
+                integer_times: matches!(
+                    file.dataset("events/ts")?.dtype()?.to_descriptor()?,
+                    TypeDescriptor::Integer(_) | TypeDescriptor::Unsigned(_)
+                ),
                 ts: Column::open(path, file, "events/ts")?,
                 xs: Column::open(path, file, "events/xs")?,
                 ys: Column::open(path, file, "events/ys")?,
@@ -242,6 +249,12 @@ impl EventTable {
         columns.on.clear();
         match self {
             EventTable::EventUtils(c) => {
+                if c.integer_times {
+                    // integer timestamps are microseconds (seconds as integers make no sense)
+                    c.ts.ints(range.clone(), &mut buffers.bytes, &mut columns.t)?;
+                    c.ps.flags(range.clone(), &mut buffers.bytes, &mut columns.on)?;
+                    return self.coordinates(range, buffers, columns);
+                }
                 buffers.seconds.clear();
                 c.ts.floats(range.clone(), &mut buffers.bytes, &mut buffers.seconds)?;
                 // a non-finite time becomes i64::MIN and is reported by read_chunk

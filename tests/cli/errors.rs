@@ -206,3 +206,42 @@ fn bad_options_are_usage_errors() {
         "{e}"
     );
 }
+
+#[test]
+fn hdf5_with_integer_microsecond_times_and_signed_polarity() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("int_times.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let events = file.create_group("events").unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&[1_000i64, 2_500, 7_000])
+            .create("ts")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&[1u16, 2, 3])
+            .create("xs")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&[4u16, 5, 6])
+            .create("ys")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&[1i8, -1, 1])
+            .create("ps")
+            .unwrap();
+    }
+    let s = json(&["stats", path.to_str().unwrap(), "--sensor", "8x8"]);
+    assert_eq!(
+        (s["t_first_us"].as_i64(), s["t_last_us"].as_i64()),
+        (Some(1_000), Some(7_000))
+    );
+    assert_eq!(
+        (s["events"].as_u64(), s["on_events"].as_u64()),
+        (Some(3), Some(2))
+    );
+}
