@@ -63,7 +63,7 @@ fn parse_sensor(text: &str) -> Result<Sensor, String> {
 pub enum Command {
     /// Format, sensor size, event count, time span and frame count of a recording.
     Info(info::InfoArgs),
-    /// Rewrite a recording as an IJRR folder or an event_utils HDF5 file.
+    /// Rewrite a recording as an IJRR folder, an event_utils HDF5 file or Prophesee EVT3.
     Convert(convert::ConvertArgs),
     /// Event statistics: rates, timeline, hot pixels, background rate, intervals.
     Stats(stats::StatsArgs),
