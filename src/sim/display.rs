@@ -88,27 +88,37 @@ impl DisplayModel {
         if self.kernel.len() == 1 {
             return lit;
         }
+        // separable: rows, then columns (a transposed view of the same pass)
+        let horizontal = self.blur_pass(&lit, width, height, 1, width);
+        self.blur_pass(&horizontal, width, height, width, 1)
+    }
+
+    /// One 1-D pass of the blur along the axis whose neighbours are `step` apart in memory
+    /// (1 along rows, `width` along columns); `line_step` separates the lines of the pass.
+    fn blur_pass(
+        &self,
+        input: &[f32],
+        width: usize,
+        height: usize,
+        step: usize,
+        line_step: usize,
+    ) -> Vec<f32> {
+        let (length, lines) = if step == 1 {
+            (width, height)
+        } else {
+            (height, width)
+        };
         let radius = (self.kernel.len() / 2) as isize;
-        let mut horizontal = vec![0f32; lit.len()];
-        for y in 0..height {
-            for x in 0..width {
+        let mut out = vec![0f32; input.len()];
+        for line in 0..lines {
+            let base = line * line_step;
+            for i in 0..length {
                 let mut acc = 0.0;
                 for (k, w) in self.kernel.iter().enumerate() {
-                    let sx = reflect_101(x as isize + k as isize - radius, width);
-                    acc += w * lit[y * width + sx];
+                    let j = reflect_101(i as isize + k as isize - radius, length);
+                    acc += w * input[base + j * step];
                 }
-                horizontal[y * width + x] = acc;
-            }
-        }
-        let mut out = vec![0f32; lit.len()];
-        for y in 0..height {
-            for x in 0..width {
-                let mut acc = 0.0;
-                for (k, w) in self.kernel.iter().enumerate() {
-                    let sy = reflect_101(y as isize + k as isize - radius, height);
-                    acc += w * horizontal[sy * width + x];
-                }
-                out[y * width + x] = acc;
+                out[base + i * step] = acc;
             }
         }
         out
@@ -119,15 +129,13 @@ impl DisplayModel {
 mod tests {
     use super::*;
 
+    /// The oracle's display (calib/screens/lcd_75hz_gamma2.toml).
     fn params() -> DisplayParams {
-        DisplayParams {
-            refresh_hz: 75.0,
-            gamma: 2.0,
-            black_level: 0.005,
-            white_dn: 200.0,
-            blur_px: Some(0.8),
-            time_offset_s: None,
-        }
+        DisplayParams::from_toml(
+            include_str!("../../calib/screens/lcd_75hz_gamma2.toml"),
+            "lcd_75hz_gamma2.toml",
+        )
+        .unwrap()
     }
 
     #[test]
@@ -147,6 +155,24 @@ mod tests {
         for (k, e) in expected.iter().enumerate() {
             assert!((d.kernel[k] - *e as f32).abs() < 1e-7);
             assert!((d.kernel[6 - k] - *e as f32).abs() < 1e-7);
+        }
+    }
+
+    #[test]
+    fn blur_of_a_point_is_the_kernel_in_both_directions() {
+        let d = DisplayModel::new(&params());
+        // a single lit pixel at (5, 4) of a 11x9 black screen, after subtracting black
+        let mut screen = vec![0.0f32; 11 * 9];
+        screen[4 * 11 + 5] = 255.0;
+        let camera = d.camera_dn(&screen, 11, 9);
+        let black = d.luminance_dn(0.0);
+        let peak = d.luminance_dn(255.0) - black;
+        for (dy, wy) in d.kernel.iter().enumerate() {
+            for (dx, wx) in d.kernel.iter().enumerate() {
+                let (x, y) = (5 + dx - 3, 4 + dy - 3);
+                let expected = black + peak * wx * wy;
+                assert!((camera[y * 11 + x] - expected).abs() < 1e-4, "({x}, {y})");
+            }
         }
     }
 

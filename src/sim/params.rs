@@ -36,6 +36,22 @@ pub struct DisplayParams {
     pub time_offset_s: Option<f64>,
 }
 
+impl DisplayParams {
+    /// Parses a screen model (the `[display]` table's keys, as in `calib/screens/`).
+    pub fn from_toml(text: &str, source_name: &str) -> Result<Self, ParamsError> {
+        let display: DisplayParams = toml::from_str(text).map_err(|e| ParamsError {
+            source_name: source_name.to_string(),
+            key: "display".into(),
+            problem: format!("cannot be read: {}", e.message()),
+            fix: "a screen model has refresh_hz, gamma, black_level, white_dn and optionally blur_px and time_offset_s".into(),
+        })?;
+        let mut check = PixelParams::ideal(1.0, 1.0);
+        check.display = Some(display);
+        check.validate(source_name)?;
+        Ok(check.display.expect("set above"))
+    }
+}
+
 /// The pixel model's parameters (PARAMS.toml).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -232,14 +232,11 @@ fn display_model_matches_the_oracle_camera_frames() {
     let mut npz =
         NpzReader::new(std::fs::File::open(case.join("display_model_reference.npz")).unwrap())
             .unwrap();
-    let params = ctcal::sim::DisplayParams {
-        refresh_hz: 75.0,
-        gamma: 2.0,
-        black_level: 0.005,
-        white_dn: 200.0,
-        blur_px: Some(0.8),
-        time_offset_s: None,
-    };
+    let params = ctcal::sim::DisplayParams::from_toml(
+        include_str!("../../calib/screens/lcd_75hz_gamma2.toml"),
+        "lcd_75hz_gamma2.toml",
+    )
+    .unwrap();
     let model = ctcal::sim::display::DisplayModel::new(&params);
     let stimulus = ctcal::io::FrameList::read(&case.join("stimulus.txt")).unwrap();
     for k in [0usize, 1, 74] {
