@@ -81,10 +81,10 @@ impl Row {
         self.window_high[x] = log_map.inverse(r + self.theta_on[x]) * (1.0 - WINDOW_MARGIN);
     }
 
-    fn load(&self, x: usize, step: &Step) -> PixelState {
-        let model = step.model;
+    /// Pixel `x` as one [`PixelState`].
+    pub fn load(&self, x: usize, model: &PixelModel, log_map: &LogMap) -> PixelState {
         let input = if model.intensity_window {
-            step.log_map.apply(self.dn[x])
+            log_map.apply(self.dn[x])
         } else {
             self.input[x]
         };
@@ -297,7 +297,7 @@ impl Row {
     /// The continuous-time update of one pixel (see [`PixelState::advance`]).
     #[inline(never)]
     fn full_update(&mut self, x: usize, step: &Step, u1: f32, dn1: f32) {
-        let mut pixel = self.load(x, step);
+        let mut pixel = self.load(x, step.model, &step.log_map);
         let mut sink = EventSink {
             events: &mut self.events,
             origin_us: step.origin,

@@ -107,18 +107,7 @@ impl Simulator {
 
     /// The state of pixel (x, y) (for inspection and tests).
     pub fn pixel(&self, x: usize, y: usize) -> PixelState {
-        let row = &self.rows[y];
-        let mut p = PixelState::new(row.input[x], row.dn[x], row.theta_on[x], row.theta_off[x]);
-        if self.model.intensity_window {
-            p.input = self.log_map.apply(row.dn[x]);
-        }
-        p.reference = row.reference[x];
-        p.filtered = if self.model.cutoff_hz.is_some() {
-            row.filtered[x]
-        } else {
-            p.input
-        };
-        p
+        self.rows[y].load(x, &self.model, &self.log_map)
     }
 
     /// The first sample: sets every pixel's reference and filter to this frame (no events).

@@ -217,11 +217,6 @@ impl StatsAccumulator {
         self.events
     }
 
-    /// Largest coordinates seen (`None` before any event).
-    pub fn stream_started(&self) -> bool {
-        self.stream_first.is_some()
-    }
-
     /// Final statistics for `sensor`, with the recording's frame times.
     /// `None` when no event was selected.
     pub fn finish(self, sensor: &ResolvedSensor, frame_times: &[TimeUs]) -> Option<SequenceStats> {

@@ -280,7 +280,7 @@ impl Scene {
         match self {
             Scene::Texture(t_scene, canvas) => t_scene.render(canvas, width, height, rows, t, out),
             Scene::Checkerboard(c) => c.render(width, rows, t, out),
-            Scene::MultiObject(m) => m.render(width, height, rows, t, out),
+            Scene::MultiObject(m) => m.render(width, rows, t, out),
         }
     }
 

@@ -261,14 +261,7 @@ impl MultiObjectWorld {
     }
 
     /// Renders rows `rows` into `out` (those rows only).
-    pub fn render(
-        &self,
-        width: usize,
-        height: usize,
-        rows: std::ops::Range<usize>,
-        t: f64,
-        out: &mut [f32],
-    ) {
+    pub fn render(&self, width: usize, rows: std::ops::Range<usize>, t: f64, out: &mut [f32]) {
         // background: the image is the texture seen through the inverse of its motion
         let (centre, angle, scale) = self.background.pose(t);
         let (s, c) = angle.sin_cos();
@@ -281,7 +274,6 @@ impl MultiObjectWorld {
                 out[(y - first) * width + x] = texture.sample(qx, qy);
             }
         }
-        let _ = height;
         for object in &self.objects {
             let (centre, angle, scale) = object.trajectory.pose(t);
             let reach = object.shape.radius() * scale + 1.0;
