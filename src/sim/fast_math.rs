@@ -32,9 +32,13 @@ pub fn ln(x: f32) -> f32 {
 #[inline(always)]
 pub fn exp(x: f32) -> f32 {
     let x = x.clamp(-87.0, 88.0);
-    // round x / ln2 to the nearest integer with the 1.5 * 2^23 trick (no floor instruction)
+    // round x / ln2 to the nearest integer with the 1.5 * 2^23 trick (no floor instruction):
+    // after the addition the integer sits in the low mantissa bits, read back with integer
+    // arithmetic (a float-to-int cast saturates, which does not vectorise)
     const SHIFT: f32 = 12_582_912.0;
-    let k = (x * std::f32::consts::LOG2_E + SHIFT) - SHIFT;
+    let shifted = x * std::f32::consts::LOG2_E + SHIFT;
+    let k = shifted - SHIFT;
+    let k_int = shifted.to_bits() as i32 - SHIFT.to_bits() as i32;
     // Cody-Waite: ln 2 in two parts so that k * ln2 is exact enough for large k
     const LN2_HI: f32 = 0.693_145_75;
     const LN2_LO: f32 = 1.428_606_8e-6;
@@ -43,7 +47,7 @@ pub fn exp(x: f32) -> f32 {
     let low = (1.0 + r) + r2 * (0.5 + r * (1.0 / 6.0));
     let high = (1.0 / 24.0 + r * (1.0 / 120.0)) + r2 * (1.0 / 720.0);
     let p = low + r4 * high;
-    let scale = f32::from_bits(((k as i32 + 127) as u32) << 23);
+    let scale = f32::from_bits(((k_int + 127) as u32) << 23);
     p * scale
 }
 

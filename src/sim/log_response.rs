@@ -45,12 +45,12 @@ impl LogMap {
         match self.kind {
             LogResponse::V2e => {
                 if value > 20f32.ln() {
-                    value.exp()
+                    fast_math::exp(value)
                 } else {
                     value / LINEAR_SLOPE
                 }
             }
-            LogResponse::Eps => 255.0 * (value.exp() - self.eps),
+            LogResponse::Eps => 255.0 * (fast_math::exp(value) - self.eps),
         }
     }
 

@@ -89,8 +89,10 @@ pub struct EventSink<'a> {
 impl EventSink<'_> {
     #[inline]
     fn emit(&mut self, t_us: f64, on: bool) {
+        // times since the first sample are never negative: adding a half and truncating
+        // rounds to the nearest microsecond without a libm call
         self.events.push(Event {
-            t: self.origin_us + t_us.round() as TimeUs,
+            t: self.origin_us + (t_us + 0.5) as TimeUs,
             x: self.x,
             y: self.y,
             on,
