@@ -8,8 +8,9 @@
 //!    thresholds (`L^-1(ref - theta_off)`, `L^-1(ref + theta_on)`, narrowed by 1e-5 so
 //!    rounding never lets a crossing through), so no logarithm is taken for quiet pixels.
 //!    Otherwise the pass takes the log of the new frame, advances the filter, and checks the
-//!    extreme points of the level over the interval (behind a first-order filter with linear
-//!    input the level stays between the input end points and its own start).
+//!    extreme points of the level over the interval: its end points, and behind the filter
+//!    (`tau y' = u - y` with `u` linear) the input's start value when the level can turn
+//!    where it meets a falling (or rising) input.
 //! 2. The continuous-time update of [`super::pixel`] for every other ("busy") pixel.
 
 use super::effects::bandwidth;
@@ -196,10 +197,15 @@ impl Row {
             // comparisons only (no min/max), so the loop vectorises
             let (top, bottom) = (theta_on[x] + r - drift, r - theta_off[x]);
             let inside = |v: f32| ((v < top) & (v > bottom)) as u32;
-            let mut quiet = inside(u0) & inside(u_end);
-            if FILTER {
-                quiet &= inside(y0) & inside(y1);
-            }
+            let mut quiet = if FILTER {
+                // Behind the filter the level moves monotonically between its end points
+                // unless it meets the input, which is a maximum only when the input falls
+                // (then it lies below the input's start u0), a minimum only when it rises.
+                let interior = ((u_end < u0) & (y0 < u0)) | ((u_end > u0) & (y0 > u0));
+                inside(y0) & inside(y1) & (inside(u0) | !interior as u32)
+            } else {
+                inside(u0) & inside(u_end)
+            };
             if HOLD && !FILTER {
                 quiet &= inside(u1[x]);
             }
