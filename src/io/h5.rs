@@ -121,7 +121,7 @@ impl Column {
         out: &mut Vec<i64>,
     ) -> hdf5::Result<()> {
         match self.raw(&range, bytes) {
-            Some(kind) => kind.extend_i64(bytes, out),
+            Some(kind) => kind.decode(bytes, out, |v| v, |f| f as i64),
             None => out.extend(self.dataset.read_slice_1d::<i64, _>(range)?.iter()),
         }
         Ok(())
@@ -135,7 +135,7 @@ impl Column {
         out: &mut Vec<f64>,
     ) -> hdf5::Result<()> {
         match self.raw(&range, bytes) {
-            Some(kind) => kind.extend_f64(bytes, out),
+            Some(kind) => kind.decode(bytes, out, |v| v as f64, |f| f),
             None => out.extend(self.dataset.read_slice_1d::<f64, _>(range)?.iter()),
         }
         Ok(())
@@ -149,9 +149,7 @@ impl Column {
         out: &mut Vec<bool>,
     ) -> hdf5::Result<()> {
         if let Some(kind) = self.raw(&range, bytes) {
-            let mut values = Vec::with_capacity(range.len());
-            kind.extend_f64(bytes, &mut values);
-            out.extend(values.iter().map(|&p| p > 0.0));
+            kind.decode(bytes, out, |p| p > 0, |p| p > 0.0);
             return Ok(());
         }
         match self.dataset.dtype()?.to_descriptor()? {

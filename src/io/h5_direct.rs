@@ -273,71 +273,50 @@ impl ElementKind {
         })
     }
 
-    /// Appends the element values of raw little-endian `bytes` to `out` as f64 (exact for
-    /// every integer that fits 53 bits).
-    pub fn extend_f64(self, bytes: &[u8], out: &mut Vec<f64>) {
+    /// Appends the element values of raw little-endian `bytes` to `out`, converted by
+    /// `integer` (integer, boolean and enum elements) or `float` (float elements).
+    pub fn decode<T>(
+        self,
+        bytes: &[u8],
+        out: &mut Vec<T>,
+        integer: impl Fn(i64) -> T,
+        float: impl Fn(f64) -> T,
+    ) {
+        fn le<const N: usize>(b: &[u8]) -> [u8; N] {
+            b.try_into().expect("chunks_exact gives N bytes")
+        }
+        let ints = |width: usize, f: fn(&[u8]) -> i64| bytes.chunks_exact(width).map(f);
         match self {
+            ElementKind::Signed(1) => out.extend(bytes.iter().map(|&b| integer(b as i8 as i64))),
+            ElementKind::Unsigned(1) => out.extend(bytes.iter().map(|&b| integer(b as i64))),
+            ElementKind::Signed(2) => {
+                out.extend(ints(2, |b| i16::from_le_bytes(le(b)) as i64).map(integer))
+            }
+            ElementKind::Unsigned(2) => {
+                out.extend(ints(2, |b| u16::from_le_bytes(le(b)) as i64).map(integer))
+            }
+            ElementKind::Signed(4) => {
+                out.extend(ints(4, |b| i32::from_le_bytes(le(b)) as i64).map(integer))
+            }
+            ElementKind::Unsigned(4) => {
+                out.extend(ints(4, |b| u32::from_le_bytes(le(b)) as i64).map(integer))
+            }
+            ElementKind::Signed(_) => {
+                out.extend(ints(8, |b| i64::from_le_bytes(le(b))).map(integer))
+            }
+            ElementKind::Unsigned(_) => {
+                out.extend(ints(8, |b| u64::from_le_bytes(le(b)) as i64).map(integer))
+            }
             ElementKind::Float(8) => out.extend(
                 bytes
                     .chunks_exact(8)
-                    .map(|b| f64::from_le_bytes(b.try_into().expect("8"))),
+                    .map(|b| float(f64::from_le_bytes(le(b)))),
             ),
             ElementKind::Float(_) => out.extend(
                 bytes
                     .chunks_exact(4)
-                    .map(|b| f32::from_le_bytes(b.try_into().expect("4")) as f64),
+                    .map(|b| float(f32::from_le_bytes(le(b)) as f64)),
             ),
-            _ => {
-                let start = out.len();
-                let mut ints = Vec::new();
-                self.extend_i64(bytes, &mut ints);
-                out.extend(ints.iter().map(|&v| v as f64));
-                debug_assert_eq!(out.len() - start, ints.len());
-            }
-        }
-    }
-
-    /// Appends the element values of raw little-endian `bytes` to `out` as i64 (floats
-    /// truncated).
-    pub fn extend_i64(self, bytes: &[u8], out: &mut Vec<i64>) {
-        match self {
-            ElementKind::Signed(1) => out.extend(bytes.iter().map(|&b| b as i8 as i64)),
-            ElementKind::Unsigned(1) => out.extend(bytes.iter().map(|&b| b as i64)),
-            ElementKind::Signed(2) => out.extend(
-                bytes
-                    .chunks_exact(2)
-                    .map(|b| i16::from_le_bytes([b[0], b[1]]) as i64),
-            ),
-            ElementKind::Unsigned(2) => out.extend(
-                bytes
-                    .chunks_exact(2)
-                    .map(|b| u16::from_le_bytes([b[0], b[1]]) as i64),
-            ),
-            ElementKind::Signed(4) => out.extend(
-                bytes
-                    .chunks_exact(4)
-                    .map(|b| i32::from_le_bytes(b.try_into().expect("4")) as i64),
-            ),
-            ElementKind::Unsigned(4) => out.extend(
-                bytes
-                    .chunks_exact(4)
-                    .map(|b| u32::from_le_bytes(b.try_into().expect("4")) as i64),
-            ),
-            ElementKind::Signed(_) => out.extend(
-                bytes
-                    .chunks_exact(8)
-                    .map(|b| i64::from_le_bytes(b.try_into().expect("8"))),
-            ),
-            ElementKind::Unsigned(_) => out.extend(
-                bytes
-                    .chunks_exact(8)
-                    .map(|b| u64::from_le_bytes(b.try_into().expect("8")) as i64),
-            ),
-            ElementKind::Float(_) => {
-                let mut floats = Vec::new();
-                self.extend_f64(bytes, &mut floats);
-                out.extend(floats.iter().map(|&v| v as i64));
-            }
         }
     }
 }
