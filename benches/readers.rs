@@ -3,7 +3,7 @@
 //! synthetic recordings (`ctcal::synthetic`).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter};
+use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter, OutputPolicy};
 use ctcal::stats::{StatsAccumulator, StatsOptions};
 use ctcal::synthetic::SyntheticEvents;
 use ctcal::{CHUNK_EVENTS, OpenOptions, Recording, Sensor};
@@ -26,15 +26,15 @@ fn readers(c: &mut Criterion) {
     let dir = tempfile::tempdir().expect("temp dir");
     let events = SyntheticEvents::new(SENSOR, 2e6, 1).take(4_000_000);
     let text = dir.path().join("text");
-    let mut w = IjrrWriter::create(&text, SENSOR).unwrap();
+    let mut w = IjrrWriter::create(&text, SENSOR, &OutputPolicy::default()).unwrap();
     w.write_events(&events).unwrap();
     w.finish().unwrap();
     let evt3 = dir.path().join("events.raw");
-    let mut w = Evt3Writer::create(&evt3, SENSOR).unwrap();
+    let mut w = Evt3Writer::create(&evt3, SENSOR, &OutputPolicy::default()).unwrap();
     w.write_events(&events).unwrap();
     w.finish().unwrap();
     let h5 = dir.path().join("events.h5");
-    let mut w = H5Writer::create(&h5, SENSOR).unwrap();
+    let mut w = H5Writer::create(&h5, SENSOR, &OutputPolicy::default()).unwrap();
     w.write_events(&events).unwrap();
     w.finish().unwrap();
 

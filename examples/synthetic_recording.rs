@@ -3,7 +3,7 @@
 //!
 //! cargo run --release --example synthetic_recording -- OUT.raw|OUT.h5|OUT_DIR EVENTS [WxH] [RATE_PER_S]
 
-use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter};
+use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter, OutputPolicy};
 use ctcal::synthetic::SyntheticEvents;
 use ctcal::{CHUNK_EVENTS, EventChunk, Sensor};
 
@@ -25,10 +25,11 @@ fn main() -> anyhow::Result<()> {
         H5(H5Writer),
         Ijrr(IjrrWriter),
     }
+    let policy = OutputPolicy::default();
     let mut writer = match out.extension().and_then(|e| e.to_str()) {
-        Some("raw") => Writer::Evt3(Evt3Writer::create(&out, sensor)?),
-        Some("h5") => Writer::H5(H5Writer::create(&out, sensor)?),
-        _ => Writer::Ijrr(IjrrWriter::create(&out, sensor)?),
+        Some("raw") => Writer::Evt3(Evt3Writer::create(&out, sensor, &policy)?),
+        Some("h5") => Writer::H5(H5Writer::create(&out, sensor, &policy)?),
+        _ => Writer::Ijrr(IjrrWriter::create(&out, sensor, &policy)?),
     };
     let mut chunk = EventChunk::with_capacity(CHUNK_EVENTS);
     let mut written = 0u64;

@@ -20,6 +20,7 @@
 //! `ctcal` binary presents them.
 
 pub mod events;
+pub mod files;
 pub mod io;
 pub mod sensors;
 

@@ -3,7 +3,8 @@
 
 use super::{BadInput, Global, warn};
 use clap::{Args, Subcommand};
-use ctcal::io::write::{Staged, format_seconds, save_png};
+use ctcal::io::write::{format_seconds, save_png};
+use ctcal::sim::budget::{MAX_SIDE, Work};
 use ctcal::sim::scene::stimulus::StimulusSpec;
 use std::path::PathBuf;
 
@@ -49,22 +50,31 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
             args.squares
         ))
     })?;
-    for (name, value) in [
-        ("--refresh-hz", args.refresh_hz),
-        ("--square-px", args.square_px),
-        ("--duration-s", args.duration_s),
+    for (name, value, max) in [
+        ("--refresh-hz", args.refresh_hz, 1000.0),
+        ("--square-px", args.square_px, MAX_SIDE as f64),
+        ("--duration-s", args.duration_s, 86_400.0),
     ] {
-        if !(value.is_finite() && value > 0.0) {
-            return Err(BadInput(format!("{name} must be positive")).into());
+        if !(value.is_finite() && value > 0.0 && value <= max) {
+            return Err(BadInput(format!(
+                "{name} {value} must be a positive number up to {max}\n  fix: give {name} in its unit (Hz, pixels or seconds)"
+            ))
+            .into());
         }
     }
-    if !(args.speed_px_s.is_finite() && args.speed_px_s >= 0.0)
-        || args.width == 0
-        || args.height == 0
-    {
-        return Err(
-            BadInput("--speed-px-s must be >= 0 and the screen size positive".into()).into(),
-        );
+    if !(args.speed_px_s.is_finite() && args.speed_px_s >= 0.0 && args.speed_px_s <= 1e5) {
+        return Err(BadInput(format!(
+            "--speed-px-s {} must be between 0 and 100000 pixels per second",
+            args.speed_px_s
+        ))
+        .into());
+    }
+    if args.width == 0 || args.height == 0 || args.width > MAX_SIDE || args.height > MAX_SIDE {
+        return Err(BadInput(format!(
+            "the screen is {}x{}; --width and --height must be 1..={MAX_SIDE} pixels",
+            args.width, args.height
+        ))
+        .into());
     }
     let spec = StimulusSpec {
         width: args.width,
@@ -92,30 +102,32 @@ pub fn run(command: &CalibCommand, global: &Global) -> anyhow::Result<()> {
             "the board fills the screen along one axis, so it cannot move along it",
         );
     }
-    let staged = Staged::new(&args.out)?;
-    let partial = staged.partial.clone();
-    std::fs::create_dir_all(partial.join("stimulus"))?;
+    Work::new(spec.frame_count() as f64, args.width, args.height).check(
+        "the stimulus",
+        "lower --duration-s, --refresh-hz or the screen size",
+        global.force,
+    )?;
+    let staged = global.outputs([]).folder(&args.out)?;
+    let write_error = |e: std::io::Error| ctcal::InputError::write(&args.out, e);
+    std::fs::create_dir_all(staged.dir().join("stimulus")).map_err(write_error)?;
     let mut index = Vec::new();
     for k in 0..spec.frame_count() {
         let frame = spec.render(k);
         let name = format!("stimulus/frame_{k:08}.png");
-        save_png(&partial.join(&name), &frame)?;
+        save_png(&staged.dir().join(&name), &frame).map_err(write_error)?;
         format_seconds(frame.t, &mut index);
         index.extend_from_slice(format!(" {name}\n").as_bytes());
     }
-    std::fs::write(partial.join("stimulus.txt"), &index)?;
-    std::fs::write(
-        partial.join("stimulus.json"),
-        serde_json::to_string_pretty(&spec)?,
-    )?;
+    staged.write("stimulus.txt", &index)?;
+    staged.write("stimulus.json", super::output::json_text(&spec)?.as_bytes())?;
     staged.commit()?;
     if !global.quiet {
-        println!(
-            "wrote {} frames at {} Hz to {}",
+        super::output::stdout(&format!(
+            "wrote {} frames at {} Hz to {}\n",
             spec.frame_count(),
             args.refresh_hz,
             args.out.display()
-        );
+        ))?;
     }
     Ok(())
 }

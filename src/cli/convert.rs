@@ -22,7 +22,8 @@ pub struct ConvertArgs {
     /// Output folder (IJRR) or file (HDF5).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
-    /// Output layout (default: h5 when --out ends in .h5/.hdf5, evt3 for .raw, else ijrr).
+    /// Output layout (default from --out: .h5/.hdf5 -> h5, .raw/.evt3 -> evt3, no extension ->
+    /// an ijrr folder).
     #[arg(long, value_enum)]
     pub to: Option<OutputFormat>,
     /// Accept timestamps that go backwards and write the events sorted by time.
@@ -36,26 +37,31 @@ enum Writer {
     Evt3(Evt3Writer),
 }
 
-pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
-    let to = args.to.unwrap_or_else(|| {
-        let ext = args
-            .out
-            .extension()
-            .and_then(|e| e.to_str())
-            .unwrap_or("")
-            .to_ascii_lowercase();
-        if ext == "h5" || ext == "hdf5" {
-            OutputFormat::H5
-        } else {
-            OutputFormat::Ijrr
-        }
-    });
-    let recording = Recording::open(&args.input.input, &args.input.open_options())?;
-    if recording.path.canonicalize().ok() == args.out.canonicalize().ok() {
-        return Err(
-            BadInput("--out names the input itself; choose another output path".into()).into(),
-        );
+/// The output layout `--out`'s extension asks for, when `--to` is not given.
+pub fn layout_from_extension(out: &std::path::Path) -> Result<OutputFormat, BadInput> {
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "" => Ok(OutputFormat::Ijrr),
+        "h5" | "hdf5" => Ok(OutputFormat::H5),
+        "raw" | "evt3" => Ok(OutputFormat::Evt3),
+        other => Err(BadInput(format!(
+            "{}: ctcal cannot write .{other} files\n  fix: pass --to ijrr (a folder), --to h5 (event_utils HDF5) or --to evt3 (Prophesee RAW), or end --out in .h5, .raw or no extension",
+            out.display()
+        ))),
     }
+}
+
+pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
+    let to = match args.to {
+        Some(to) => to,
+        None => layout_from_extension(&args.out)?,
+    };
+    let recording = Recording::open(&args.input.input, &args.input.open_options())?;
+    let policy = global.outputs([args.input.input.as_path(), recording.event_file()]);
     for note in &recording.notes {
         warn(global, note);
     }
@@ -79,9 +85,13 @@ pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
         warn(global, w);
     }
     let mut writer = match to {
-        OutputFormat::Ijrr => Writer::Ijrr(IjrrWriter::create(&args.out, resolved.sensor)?),
-        OutputFormat::H5 => Writer::H5(H5Writer::create(&args.out, resolved.sensor)?),
-        OutputFormat::Evt3 => Writer::Evt3(Evt3Writer::create(&args.out, resolved.sensor)?),
+        OutputFormat::Ijrr => {
+            Writer::Ijrr(IjrrWriter::create(&args.out, resolved.sensor, &policy)?)
+        }
+        OutputFormat::H5 => Writer::H5(H5Writer::create(&args.out, resolved.sensor, &policy)?),
+        OutputFormat::Evt3 => {
+            Writer::Evt3(Evt3Writer::create(&args.out, resolved.sensor, &policy)?)
+        }
     };
     let mut write = |chunk: &ctcal::EventChunk| -> anyhow::Result<()> {
         match &mut writer {

@@ -68,7 +68,7 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
     };
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(&info, target)?;
+        emit_json(&info, target, &global.outputs([args.input.input.as_path()]))?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) {
         output::print_table(&[
@@ -94,7 +94,7 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
                 info.timestamps_backwards.to_string(),
             ),
             ("frames".into(), info.frames.to_string()),
-        ]);
+        ])?;
     }
     Ok(())
 }

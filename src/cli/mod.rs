@@ -9,8 +9,9 @@ mod simulate;
 mod stats;
 
 use clap::{Args, Parser, Subcommand};
+use ctcal::io::write::OutputPolicy;
 use ctcal::{Format, OpenOptions, Sensor};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// ctcal: contrast thresholds, noise and statistics of event cameras and datasets.
 #[derive(Parser, Debug)]
@@ -31,6 +32,21 @@ pub struct Global {
     /// Bound the number of worker threads (default: all cores).
     #[arg(long, global = true, value_name = "N")]
     pub threads: Option<usize>,
+    /// Write into an existing folder ctcal did not create (replacing only the files ctcal
+    /// writes), replace a file ctcal did not write, write inside an input folder, and run
+    /// work beyond the stated budgets.
+    #[arg(long, global = true)]
+    pub force: bool,
+}
+
+/// The most worker threads ctcal starts (more only cost memory and scheduling).
+pub const MAX_THREADS: usize = 256;
+
+impl Global {
+    /// The output rules for a command reading `inputs`.
+    pub fn outputs<'a>(&self, inputs: impl IntoIterator<Item = &'a Path>) -> OutputPolicy {
+        OutputPolicy::new(self.force).protect_all(inputs)
+    }
 }
 
 /// How to open an input recording.
@@ -82,13 +98,21 @@ pub struct BadInput(pub String);
 /// Runs the command line; returns the process exit code.
 pub fn run() -> i32 {
     let cli = Cli::parse();
-    if let Some(n) = cli.global.threads
-        && let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
+    if let Some(n) = cli.global.threads {
+        if n == 0 || n > MAX_THREADS {
+            eprintln!(
+                "error: --threads {n} is outside 1..={MAX_THREADS}\n  fix: give a number of threads up to the machine's cores ({})",
+                std::thread::available_parallelism().map_or(1, |n| n.get())
+            );
+            return 2;
+        }
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
             .build_global()
-    {
-        eprintln!("error: cannot start {n} threads: {e}");
-        return 1;
+        {
+            eprintln!("error: cannot start {n} threads: {e}");
+            return 1;
+        }
     }
     let result = match &cli.command {
         Command::Info(args) => info::run(args, &cli.global),
@@ -99,11 +123,21 @@ pub fn run() -> i32 {
     };
     match result {
         Ok(()) => 0,
+        // the reader of stdout went away (`ctcal stats ... | head`): nothing is wrong
+        Err(error) if is_broken_pipe(&error) => 0,
         Err(error) => {
             eprintln!("error: {error:#}");
             exit_code(&error)
         }
     }
+}
+
+fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe)
+    })
 }
 
 /// 2 for problems with the input or usage, 1 for everything else.
@@ -115,10 +149,7 @@ fn exit_code(error: &anyhow::Error) -> i32 {
         if cause.is::<BadInput>() {
             return 2;
         }
-        if let Some(e) = cause.downcast_ref::<ctcal::sim::SimError>() {
-            return if e.is_bad_input() { 2 } else { 1 };
-        }
-        if cause.is::<ctcal::sim::ParamsError>() {
+        if cause.is::<ctcal::sim::SimError>() || cause.is::<ctcal::sim::ParamsError>() {
             return 2;
         }
     }

@@ -1,8 +1,12 @@
-//! Output helpers: `--json PATH` (written atomically) or `--json -` (stdout, and nothing else
-//! on stdout), and aligned key/value tables for people.
+//! Output helpers: `--json PATH` (written through the output rules of
+//! `ctcal::io::write::destination`) or `--json -` (stdout, and nothing else on stdout), and
+//! aligned key/value tables for people. Everything on stdout goes through [`stdout`], whose
+//! errors (a closed pipe: `ctcal stats ... | head`) end the command quietly.
 
 use anyhow::Context;
+use ctcal::io::write::OutputPolicy;
 use serde::Serialize;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Where `--json` goes.
@@ -22,28 +26,55 @@ impl JsonTarget {
     }
 }
 
-/// Writes `value` as pretty JSON to `target`.
-pub fn emit_json<T: Serialize>(value: &T, target: &JsonTarget) -> anyhow::Result<()> {
-    let mut text = serde_json::to_string_pretty(value).context("serialising JSON")?;
+/// A JSON result stamped with the version of ctcal that made it (first key), which is also
+/// how ctcal recognises a JSON file it may overwrite.
+#[derive(Serialize)]
+struct Stamped<'a, T: Serialize> {
+    ctcal_version: &'static str,
+    #[serde(flatten)]
+    value: &'a T,
+}
+
+/// The pretty JSON text of `value`, stamped with ctcal's version.
+pub fn json_text<T: Serialize>(value: &T) -> anyhow::Result<String> {
+    let mut text = serde_json::to_string_pretty(&Stamped {
+        ctcal_version: env!("CARGO_PKG_VERSION"),
+        value,
+    })
+    .context("serialising JSON")?;
     text.push('\n');
+    Ok(text)
+}
+
+/// Writes `value` as pretty JSON to `target`.
+pub fn emit_json<T: Serialize>(
+    value: &T,
+    target: &JsonTarget,
+    policy: &OutputPolicy,
+) -> anyhow::Result<()> {
+    let text = json_text(value)?;
     match target {
-        JsonTarget::Stdout => {
-            use std::io::Write;
-            let mut out = std::io::stdout().lock();
-            out.write_all(text.as_bytes())?;
-            out.flush()?;
-        }
-        JsonTarget::File(path) => ctcal::io::write::write_file_atomically(path, text.as_bytes())?,
+        JsonTarget::Stdout => stdout(&text)?,
+        JsonTarget::File(path) => policy.file(path)?.write_all(text.as_bytes())?,
     }
     Ok(())
 }
 
+/// Writes `text` to stdout (the only way the binary writes there).
+pub fn stdout(text: &str) -> std::io::Result<()> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())?;
+    out.flush()
+}
+
 /// Prints `rows` as an aligned two-column table to stdout.
-pub fn print_table(rows: &[(String, String)]) {
+pub fn print_table(rows: &[(String, String)]) -> std::io::Result<()> {
     let width = rows.iter().map(|(k, _)| k.len()).max().unwrap_or(0);
+    let mut text = String::new();
     for (key, value) in rows {
-        println!("{key:<width$}  {value}");
+        text.push_str(&format!("{key:<width$}  {value}\n"));
     }
+    stdout(&text)
 }
 
 /// Formats seconds with a sensible number of digits.

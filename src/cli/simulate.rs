@@ -4,9 +4,10 @@ use super::{BadInput, Global, JsonTarget, emit_json, output, progress_bar};
 use clap::{Args, ValueEnum};
 use ctcal::io::write::{H5Writer, IjrrWriter};
 use ctcal::io::{FrameList, npy};
+use ctcal::sim::budget::{MAX_SIDE, Work};
 use ctcal::sim::display::DisplayModel;
 use ctcal::sim::scene::{SceneSource, SceneSpec, aps};
-use ctcal::sim::source::{DisplaySource, FolderSource};
+use ctcal::sim::source::{DisplaySource, LoadedFrames};
 use ctcal::sim::{FrameSource, PixelMaps, PixelParams, SimError};
 use ctcal::{EventChunk, Frame, Sensor};
 use serde::Serialize;
@@ -34,7 +35,7 @@ pub struct SimulateArgs {
     /// Output folder (IJRR) or HDF5 file.
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
-    /// Output layout (default: h5 when --out ends in .h5, else ijrr).
+    /// Output layout (default from --out: .h5/.hdf5 -> h5, no extension -> an ijrr folder).
     #[arg(long, value_enum)]
     pub to: Option<SimOutput>,
     /// Per-pixel ON thresholds, an (H, W) .npy array (instead of drawing them).
@@ -88,7 +89,7 @@ enum Writer {
 }
 
 impl Writer {
-    fn events(&mut self, chunk: &EventChunk) -> Result<(), SimError> {
+    fn events(&mut self, chunk: &EventChunk) -> anyhow::Result<()> {
         match self {
             Writer::Ijrr(w) => w.write_events(chunk)?,
             Writer::H5(w) => w.write_events(chunk)?,
@@ -96,7 +97,7 @@ impl Writer {
         Ok(())
     }
 
-    fn frame(&mut self, frame: &Frame) -> Result<(), SimError> {
+    fn frame(&mut self, frame: &Frame) -> anyhow::Result<()> {
         match self {
             Writer::Ijrr(w) => w.write_frame(frame)?,
             Writer::H5(w) => w.write_frame(frame)?,
@@ -121,7 +122,7 @@ fn frame_index(dir: &Path) -> Result<PathBuf, BadInput> {
     )))
 }
 
-fn load_maps(args: &SimulateArgs, sensor: Sensor) -> Result<PixelMaps, SimError> {
+fn load_maps(args: &SimulateArgs, sensor: Sensor) -> anyhow::Result<PixelMaps> {
     let read = |path: &Option<PathBuf>| {
         path.as_deref()
             .map(|p| npy::read_pixel_map(p, sensor))
@@ -134,15 +135,35 @@ fn load_maps(args: &SimulateArgs, sensor: Sensor) -> Result<PixelMaps, SimError>
     })
 }
 
-pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
-    let params = PixelParams::from_file(&args.params)?;
-    let started = std::time::Instant::now();
-    let (mut source, scene_spec, render_hz, aps_frames): (
-        Box<dyn FrameSource>,
-        Option<SceneSpec>,
-        Option<f64>,
-        Vec<Frame>,
-    ) = match (&args.frames, &args.scene) {
+/// The output layout `--out`'s extension asks for, when `--to` is not given.
+fn layout_from_extension(out: &Path) -> Result<SimOutput, BadInput> {
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    match ext.as_str() {
+        "" => Ok(SimOutput::Ijrr),
+        "h5" | "hdf5" => Ok(SimOutput::H5),
+        other => Err(BadInput(format!(
+            "{}: ctcal simulate cannot write .{other} files\n  fix: pass --to ijrr (a folder) or --to h5, or end --out in .h5 or no extension",
+            out.display()
+        ))),
+    }
+}
+
+/// What is simulated: the frame source, the scene it came from (if any), and the work.
+struct SimInput {
+    source: Box<dyn FrameSource>,
+    scene_spec: Option<SceneSpec>,
+    render_hz: Option<f64>,
+    aps_frames: Vec<Frame>,
+    work: Work,
+}
+
+/// Opens `--frames` or `--scene` (checking the scene's work against the budget).
+fn open_input(args: &SimulateArgs, global: &Global) -> anyhow::Result<SimInput> {
+    Ok(match (&args.frames, &args.scene) {
         (Some(dir), _) => {
             let list = FrameList::read(&frame_index(dir)?)?;
             if list.len() < 2 {
@@ -152,44 +173,104 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
                 ))
                 .into());
             }
-            (Box::new(FolderSource::new(list)?), None, None, Vec::new())
+            let (w, h) = list.image_size()?.expect("two frames listed");
+            let (w, h) = (w as usize, h as usize);
+            if w > MAX_SIDE || h > MAX_SIDE {
+                return Err(BadInput(format!(
+                    "{}: the frames are {w}x{h}, larger than the {MAX_SIDE}x{MAX_SIDE} ctcal simulates\n  fix: downscale the frames",
+                    list.index_path.display()
+                ))
+                .into());
+            }
+            let work = Work::new(list.len() as f64, w, h);
+            let source = LoadedFrames::new(list.len(), (w, h), move |i| {
+                list.load(i).map_err(SimError::source)
+            });
+            SimInput {
+                source: Box::new(source),
+                scene_spec: None,
+                render_hz: None,
+                aps_frames: Vec::new(),
+                work,
+            }
         }
         (None, Some(path)) => {
             let spec = SceneSpec::from_file(path)?;
             let scene = spec.realise()?;
             let source = SceneSource::new(&spec, scene.clone());
             let hz = source.render_hz();
+            let work = spec.work(hz);
+            work.check(
+                &path.display().to_string(),
+                "lower render_hz, duration_s, the APS rate or the sensor size",
+                global.force,
+            )?;
             let frames = match &spec.aps {
                 Some(a) => aps::render(&scene, spec.width, spec.height, spec.duration_s, hz, a),
                 None => Vec::new(),
             };
-            (Box::new(source), Some(spec), Some(hz), frames)
+            SimInput {
+                source: Box::new(source),
+                scene_spec: Some(spec),
+                render_hz: Some(hz),
+                aps_frames: frames,
+                work,
+            }
         }
         (None, None) => unreachable!("clap requires --frames or --scene"),
+    })
+}
+
+pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
+    let to = match args.to {
+        Some(to) => to,
+        None => layout_from_extension(&args.out)?,
     };
+    let params = PixelParams::from_file(&args.params)?;
+    let mut inputs: Vec<&Path> = vec![args.params.as_path()];
+    inputs.extend(args.frames.as_deref());
+    inputs.extend(args.scene.as_deref());
+    for map in [&args.ct_on_map, &args.ct_off_map, &args.leak_factor_map] {
+        inputs.extend(map.as_deref());
+    }
+    let policy = global.outputs(inputs);
+    let started = std::time::Instant::now();
+    let SimInput {
+        mut source,
+        scene_spec,
+        render_hz,
+        aps_frames,
+        mut work,
+    } = open_input(args, global)?;
     if let Some(display) = &params.display {
+        // the display adds a sample at every refresh
+        let span_s = match (&scene_spec, &args.frames) {
+            (Some(spec), _) => spec.duration_s,
+            _ => 0.0,
+        };
+        work.samples += span_s * display.refresh_hz;
         source = Box::new(DisplaySource::new(source, DisplayModel::new(display)));
     }
+    let what = args
+        .frames
+        .as_deref()
+        .or(args.scene.as_deref())
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    work.check(
+        &what,
+        "simulate fewer frames, a shorter scene or a smaller sensor",
+        global.force,
+    )?;
     let (width, height) = source.size();
     let sensor = Sensor::new(width as u16, height as u16);
     let maps = load_maps(args, sensor)?;
-    let to = args.to.unwrap_or(
-        if args
-            .out
-            .extension()
-            .is_some_and(|e| e == "h5" || e == "hdf5")
-        {
-            SimOutput::H5
-        } else {
-            SimOutput::Ijrr
-        },
-    );
     let mut writer = match to {
-        SimOutput::Ijrr => Writer::Ijrr(IjrrWriter::create(&args.out, sensor)?),
-        SimOutput::H5 => Writer::H5(H5Writer::create(&args.out, sensor)?),
+        SimOutput::Ijrr => Writer::Ijrr(IjrrWriter::create(&args.out, sensor, &policy)?),
+        SimOutput::H5 => Writer::H5(H5Writer::create(&args.out, sensor, &policy)?),
     };
     let bar = progress_bar(global, source.len_hint().unwrap_or(0), "simulating");
-    let summary = ctcal::sim::run(
+    let summary = ctcal::sim::run::<anyhow::Error>(
         source.as_mut(),
         &params,
         maps,
@@ -243,6 +324,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
                 samples_per_second,
             },
             target,
+            &policy,
         )?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) && !global.quiet {
@@ -268,7 +350,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
                 ),
             ),
             ("written".into(), args.out.display().to_string()),
-        ]);
+        ])?;
     }
     Ok(())
 }

@@ -54,10 +54,14 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
     let stats = compute(&recording, args, global)?;
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(&stats, target)?;
+        emit_json(
+            &stats,
+            target,
+            &global.outputs([args.input.input.as_path()]),
+        )?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) {
-        print_human(&stats);
+        print_human(&stats)?;
     }
     Ok(())
 }
@@ -102,7 +106,7 @@ fn compute(
     })
 }
 
-fn print_human(s: &SequenceStats) {
+fn print_human(s: &SequenceStats) -> std::io::Result<()> {
     let rate = |r: Option<f64>| {
         r.map_or("undefined (zero duration)".to_string(), |r| {
             format!("{r:.6}")
@@ -196,5 +200,5 @@ fn print_human(s: &SequenceStats) {
             None => "none".into(),
         },
     ));
-    output::print_table(&rows);
+    output::print_table(&rows)
 }

@@ -17,11 +17,12 @@ pub enum InputError {
         source: std::io::Error,
     },
 
-    #[error("{}: cannot write: {source}\n  fix: check that the output folder exists, is writable and has space", path.display())]
+    /// (The I/O error is part of the message, not a separate cause, so that it is shown
+    /// once.)
+    #[error("{}: cannot write: {error}\n  fix: {}", path.display(), write_fix(error))]
     Write {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
 
     #[error("{}: unknown format ({detail})\n  fix: pass --format ijrr|h5|aedat4|evt2|evt3|dat if the file is one of these", path.display())]
@@ -92,10 +93,10 @@ impl InputError {
         }
     }
 
-    pub fn write(path: &Path, source: std::io::Error) -> Self {
+    pub fn write(path: &Path, error: std::io::Error) -> Self {
         InputError::Write {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 
@@ -129,10 +130,26 @@ impl InputError {
         }
     }
 
-    /// Whether the user can fix this by changing the input (exit code 2), as opposed to an
-    /// environment failure while writing.
+    /// Whether the user can fix this (exit code 2): every input problem, and output problems
+    /// too (a full disk, a read-only folder, a refused path), which name the path and a fix.
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, InputError::Write { .. })
+        true
+    }
+}
+
+/// The fix for a failed write, by its cause.
+fn write_fix(error: &std::io::Error) -> &'static str {
+    use std::io::ErrorKind as K;
+    match error.kind() {
+        K::StorageFull | K::QuotaExceeded => {
+            "free space on that disk, or write the output to another disk"
+        }
+        K::PermissionDenied | K::ReadOnlyFilesystem => {
+            "write to a folder you may write in (check its permissions)"
+        }
+        K::NotFound => "check that the output's folder exists",
+        K::BrokenPipe => "the program reading the output stopped early",
+        _ => "check that the output's folder exists, is writable and has space",
     }
 }
 

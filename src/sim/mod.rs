@@ -5,6 +5,7 @@
 //! seed whatever the thread count, documents each effect's equation and source in
 //! [`effects`], and is validated against the v2e oracle cases (`../shared/data/oracle`).
 
+pub mod budget;
 pub mod display;
 pub mod effects;
 pub mod fast_math;
@@ -23,26 +24,45 @@ pub use simulator::{PixelMaps, Simulator};
 pub use source::{FrameSource, Sample};
 
 use crate::events::{EventChunk, TimeUs};
-use crate::io::InputError;
+use std::path::{Path, PathBuf};
 
-/// What can go wrong in a simulation.
+/// What can go wrong in a simulation. Every variant is something the user can fix (a
+/// parameter, a scene, an input file), and says how.
 #[derive(Debug, thiserror::Error)]
 pub enum SimError {
-    #[error(transparent)]
-    Input(#[from] InputError),
+    /// A file the simulator reads itself (parameters, scene, texture).
+    #[error("{}: {problem}\n  fix: {fix}", path.display())]
+    File {
+        path: PathBuf,
+        problem: String,
+        fix: String,
+    },
     #[error(transparent)]
     Params(#[from] ParamsError),
     #[error("{0}")]
     Invalid(String),
+    /// An error of the frame source or event sink the caller supplied (a reader, a writer).
+    #[error("{0}")]
+    Source(Box<dyn std::error::Error + Send + Sync>),
 }
 
 impl SimError {
-    /// Whether the user can fix this by changing the input (exit code 2).
-    pub fn is_bad_input(&self) -> bool {
-        match self {
-            SimError::Input(e) => e.is_bad_input(),
-            SimError::Params(_) | SimError::Invalid(_) => true,
+    pub fn file(path: &Path, problem: impl Into<String>, fix: impl Into<String>) -> Self {
+        SimError::File {
+            path: path.to_path_buf(),
+            problem: problem.into(),
+            fix: fix.into(),
         }
+    }
+
+    /// A file that cannot be read (missing, a folder, a FIFO, ...).
+    pub fn not_a_file(path: &Path, problem: crate::files::NotAFile) -> Self {
+        Self::file(path, problem.problem(), problem.fix())
+    }
+
+    /// An error from the caller's frame source or event sink.
+    pub fn source(error: impl std::error::Error + Send + Sync + 'static) -> Self {
+        SimError::Source(Box::new(error))
     }
 }
 
@@ -57,14 +77,15 @@ pub struct SimSummary {
 }
 
 /// Runs `params` over every sample of `source`, passing each batch of time-sorted events
-/// to `sink`. The first sample only sets the pixels' reference levels.
-pub fn run(
+/// to `sink` (whose own errors pass through). The first sample only sets the pixels'
+/// reference levels.
+pub fn run<E: From<SimError>>(
     source: &mut dyn FrameSource,
     params: &PixelParams,
     maps: PixelMaps,
-    mut sink: impl FnMut(&EventChunk) -> Result<(), SimError>,
+    mut sink: impl FnMut(&EventChunk) -> Result<(), E>,
     mut progress: impl FnMut(u64),
-) -> Result<SimSummary, SimError> {
+) -> Result<SimSummary, E> {
     let (width, height) = source.size();
     let mut simulator = Simulator::new(params, width, height, maps);
     let mut summary = SimSummary::default();
@@ -73,7 +94,7 @@ pub fn run(
         summary.on_events += chunk.on.iter().filter(|&&p| p).count() as u64;
     };
     let Some(first) = source.next_frame()? else {
-        return Err(SimError::Invalid("the input has no frames".into()));
+        return Err(SimError::Invalid("the input has no frames".into()).into());
     };
     simulator.start(first.t, &first.dn);
     summary.samples = 1;
@@ -84,7 +105,8 @@ pub fn run(
             return Err(SimError::Invalid(format!(
                 "input sample times go backwards ({} us after {} us)",
                 sample.t, summary.t_last_sample_us
-            )));
+            ))
+            .into());
         }
         let events = simulator.step(sample.t, &sample.dn, sample.transition);
         count(events, &mut summary);

@@ -144,6 +144,14 @@ impl PixelParams {
 
     /// Parses PARAMS.toml text; `source_name` names it in errors.
     pub fn from_toml(text: &str, source_name: &str) -> Result<Self, ParamsError> {
+        if let Some(key) = first_non_finite(text) {
+            return Err(ParamsError {
+                source_name: source_name.to_string(),
+                key,
+                problem: "is not a finite number".into(),
+                fix: "give a real number (nan and inf are not parameter values)".into(),
+            });
+        }
         let params: PixelParams = toml::from_str(text).map_err(|e| ParamsError {
             source_name: source_name.to_string(),
             key: e
@@ -159,7 +167,7 @@ impl PixelParams {
 
     /// Reads and validates a PARAMS.toml file.
     pub fn from_file(path: &Path) -> Result<Self, crate::sim::SimError> {
-        let text = std::fs::read_to_string(path).map_err(|e| crate::io::InputError::io(path, e))?;
+        let text = read_text_file(path)?;
         Ok(Self::from_toml(&text, &path.display().to_string())?)
     }
 
@@ -294,9 +302,55 @@ impl PixelParams {
     }
 }
 
+/// Reads a parameter or scene file (a regular file of at most 1 MB).
+pub(crate) fn read_text_file(path: &Path) -> Result<String, crate::sim::SimError> {
+    crate::files::read_small_text(path, 1 << 20)
+        .map_err(|e| crate::sim::SimError::not_a_file(path, e))
+}
+
+/// The dotted key of the first NaN or infinite number in TOML `text` (TOML allows `nan` and
+/// `inf`), or `None`; unreadable TOML is left to the typed parser's error.
+pub(crate) fn first_non_finite(text: &str) -> Option<String> {
+    fn walk(value: &toml::Value, key: String) -> Option<String> {
+        match value {
+            toml::Value::Float(f) if !f.is_finite() => Some(key),
+            toml::Value::Table(t) => t.iter().find_map(|(k, v)| {
+                walk(
+                    v,
+                    if key.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{key}.{k}")
+                    },
+                )
+            }),
+            toml::Value::Array(a) => a
+                .iter()
+                .enumerate()
+                .find_map(|(i, v)| walk(v, format!("{key}[{i}]"))),
+            _ => None,
+        }
+    }
+    let table: toml::Table = toml::from_str(text).ok()?;
+    walk(&toml::Value::Table(table), String::new())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nan_and_inf_anywhere_name_their_key() {
+        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = nan\n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("`ct_off`") && e.to_string().contains("finite"));
+        let e = PixelParams::from_toml(
+            "ct_on = 0.3\nct_off = 0.3\n[display]\nrefresh_hz = 60.0\ngamma = inf\nblack_level = 0.0\nwhite_dn = 200.0\n",
+            "p.toml",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("`display.gamma`"), "{e}");
+        assert_eq!(first_non_finite("a = [1.0, -inf]"), Some("a[1]".into()));
+    }
 
     #[test]
     fn thresholds_alone_make_an_ideal_pixel() {

@@ -115,6 +115,9 @@ impl Simulator {
         assert_eq!(dn.len(), self.width * self.height, "frame size");
         self.origin = Some(t);
         self.previous_us = 0.0;
+        if let Some((buffer, _)) = &mut self.jitter {
+            buffer.start(t);
+        }
         let params = &self.params;
         let (width, n) = (self.width, self.width * self.height);
         let mut threshold_rng = generator(self.seed, Stream::Thresholds, 0);

@@ -1,12 +1,11 @@
 //! Inputs of the simulator: a stream of intensity samples (camera DN frames with times and
-//! how the input moves between them), from an IJRR frame folder, a scene, or a display
-//! showing either.
+//! how the input moves between them), from frames in memory, frames the caller decodes one
+//! at a time, a scene, or a display showing any of them.
 
 use super::SimError;
 use super::display::DisplayModel;
 use super::pixel::Transition;
-use crate::events::TimeUs;
-use crate::io::FrameList;
+use crate::events::{Frame, TimeUs};
 
 /// One intensity sample.
 #[derive(Clone, Debug)]
@@ -28,53 +27,120 @@ pub trait FrameSource {
     fn next_frame(&mut self) -> Result<Option<Sample>, SimError>;
 }
 
-/// Frames of an `images.txt` folder; the sensor size is the image size.
-pub struct FolderSource {
-    list: FrameList,
-    next: usize,
+/// 8-bit frames held in memory (decoded once), replayed as samples: the input of every
+/// re-simulation an estimator or a fit runs many times. [`Self::rewind`] starts over.
+#[derive(Clone, Debug)]
+pub struct MemoryFrames<'a> {
+    frames: &'a [Frame],
     size: (usize, usize),
+    next: usize,
+    transition: Transition,
 }
 
-impl FolderSource {
-    pub fn new(list: FrameList) -> Result<Self, SimError> {
-        let Some((w, h)) = list.image_size()? else {
-            return Err(SimError::Input(crate::io::InputError::invalid(
-                &list.index_path,
-                "lists no frames",
-                "give a folder whose images.txt names at least two frames",
-            )));
+impl<'a> MemoryFrames<'a> {
+    /// Frames of one size in time order (checked); `transition` says how the input moves
+    /// between them (linear for video, hold for a display).
+    pub fn new(frames: &'a [Frame], transition: Transition) -> Result<Self, SimError> {
+        let Some(first) = frames.first() else {
+            return Err(SimError::Invalid("no frames to simulate from".into()));
         };
+        let size = (first.width as usize, first.height as usize);
+        for (i, pair) in frames.windows(2).enumerate() {
+            if (pair[1].width as usize, pair[1].height as usize) != size {
+                return Err(SimError::Invalid(format!(
+                    "frame {} is {}x{} but frame 0 is {}x{}",
+                    i + 1,
+                    pair[1].width,
+                    pair[1].height,
+                    size.0,
+                    size.1
+                )));
+            }
+            if pair[1].t < pair[0].t {
+                return Err(SimError::Invalid(format!(
+                    "frame {} at {} us is earlier than frame {} at {} us",
+                    i + 1,
+                    pair[1].t,
+                    i,
+                    pair[0].t
+                )));
+            }
+        }
         Ok(Self {
-            list,
+            frames,
+            size,
             next: 0,
-            size: (w as usize, h as usize),
+            transition,
         })
+    }
+
+    /// Starts again at the first frame.
+    pub fn rewind(&mut self) {
+        self.next = 0;
     }
 }
 
-impl FrameSource for FolderSource {
+impl FrameSource for MemoryFrames<'_> {
     fn size(&self) -> (usize, usize) {
         self.size
     }
 
     fn len_hint(&self) -> Option<u64> {
-        Some(self.list.len() as u64)
+        Some(self.frames.len() as u64)
     }
 
     fn next_frame(&mut self) -> Result<Option<Sample>, SimError> {
-        if self.next >= self.list.len() {
+        let Some(frame) = self.frames.get(self.next) else {
+            return Ok(None);
+        };
+        self.next += 1;
+        Ok(Some(Sample {
+            t: frame.t,
+            dn: frame.pixels.iter().map(|&p| p as f32).collect(),
+            transition: self.transition,
+        }))
+    }
+}
+
+/// Frames decoded one at a time by the caller's `load(i)` (e.g. PNGs listed in an
+/// `images.txt`), so that a long frame sequence is never all in memory.
+pub struct LoadedFrames<F> {
+    count: usize,
+    size: (usize, usize),
+    next: usize,
+    load: F,
+}
+
+impl<F: FnMut(usize) -> Result<Frame, SimError>> LoadedFrames<F> {
+    /// `count` frames of `size` (W, H); a frame of another size is an error.
+    pub fn new(count: usize, size: (usize, usize), load: F) -> Self {
+        Self {
+            count,
+            size,
+            next: 0,
+            load,
+        }
+    }
+}
+
+impl<F: FnMut(usize) -> Result<Frame, SimError>> FrameSource for LoadedFrames<F> {
+    fn size(&self) -> (usize, usize) {
+        self.size
+    }
+
+    fn len_hint(&self) -> Option<u64> {
+        Some(self.count as u64)
+    }
+
+    fn next_frame(&mut self) -> Result<Option<Sample>, SimError> {
+        if self.next >= self.count {
             return Ok(None);
         }
-        let frame = self.list.load(self.next)?;
+        let frame = (self.load)(self.next)?;
         if (frame.width as usize, frame.height as usize) != self.size {
-            return Err(SimError::Input(crate::io::InputError::corrupt(
-                &self.list.index_path,
-                format!("line {}", self.list.entries[self.next].line),
-                format!(
-                    "image is {}x{} but the first image is {}x{}",
-                    frame.width, frame.height, self.size.0, self.size.1
-                ),
-                "give frames of one size",
+            return Err(SimError::Invalid(format!(
+                "frame {} is {}x{} but the first frame is {}x{}: give frames of one size",
+                self.next, frame.width, frame.height, self.size.0, self.size.1
             )));
         }
         self.next += 1;

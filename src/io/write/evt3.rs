@@ -4,7 +4,7 @@
 //! across long gaps the high word is repeated every 1024 steps so that a decoder can count
 //! the 24-bit clock's loops. Used to write large test recordings and for `convert --to evt3`.
 
-use super::Staged;
+use super::{OutputPolicy, Staged};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::io::error::InputError;
 use std::io::Write;
@@ -23,7 +23,11 @@ pub struct Evt3Writer {
 }
 
 impl Evt3Writer {
-    pub fn create(target: &Path, sensor: Sensor) -> Result<Self, InputError> {
+    pub fn create(
+        target: &Path,
+        sensor: Sensor,
+        policy: &OutputPolicy,
+    ) -> Result<Self, InputError> {
         if sensor.width > 2048 || sensor.height > 2048 {
             return Err(InputError::invalid(
                 target,
@@ -31,9 +35,13 @@ impl Evt3Writer {
                 "write HDF5 or IJRR instead",
             ));
         }
-        let staged = Staged::new(target)?;
-        let file =
-            std::fs::File::create(&staged.partial).map_err(|e| InputError::write(target, e))?;
+        let staged = policy.file(target)?;
+        let file = std::fs::OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(!staged.in_place)
+            .open(&staged.partial)
+            .map_err(|e| InputError::write(target, e))?;
         let mut out = std::io::BufWriter::with_capacity(1 << 20, file);
         write!(
             out,
@@ -65,7 +73,7 @@ impl Evt3Writer {
             let t = chunk.t[i];
             if t < 0 || t < self.last_t {
                 return Err(InputError::invalid(
-                    &self.staged.target,
+                    &self.staged.shown,
                     format!("EVT3 needs non-negative, time-sorted events (event {i} at {t} us)"),
                     "sort the events first (--sort)",
                 ));
@@ -95,7 +103,7 @@ impl Evt3Writer {
         }
         self.out
             .write_all(&self.words)
-            .map_err(|e| InputError::write(&self.staged.target, e))?;
+            .map_err(|e| InputError::write(&self.staged.shown, e))?;
         self.words.clear();
         Ok(())
     }
@@ -103,7 +111,7 @@ impl Evt3Writer {
     pub fn finish(mut self) -> Result<(), InputError> {
         self.out
             .flush()
-            .map_err(|e| InputError::write(&self.staged.target, e))?;
+            .map_err(|e| InputError::write(&self.staged.shown, e))?;
         drop(self.out);
         self.staged.commit()
     }
@@ -129,7 +137,8 @@ mod tests {
         assert!(t > 2 * (1 << 24));
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("synthetic.raw");
-        let mut writer = Evt3Writer::create(&path, Sensor::new(1280, 720)).unwrap();
+        let mut writer =
+            Evt3Writer::create(&path, Sensor::new(1280, 720), &OutputPolicy::default()).unwrap();
         writer.write_events(&events).unwrap();
         writer.finish().unwrap();
         let header = PropheseeHeader::read(&path).unwrap();

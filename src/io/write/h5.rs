@@ -1,7 +1,7 @@
 //! event_utils HDF5 files (Stoffregen et al. 2020's layout): `events/ts` (float64 seconds),
 //! `events/xs`, `events/ys` (int16), `events/ps` (bool), frames as `images/image%09d`.
 
-use super::Staged;
+use super::{OutputPolicy, Staged};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::io::error::InputError;
 use std::path::Path;
@@ -23,8 +23,19 @@ pub struct H5Writer {
 const H5_CHUNK: usize = 1 << 16;
 
 impl H5Writer {
-    pub fn create(target: &Path, sensor: Sensor) -> Result<Self, InputError> {
-        let staged = Staged::new(target)?;
+    pub fn create(
+        target: &Path,
+        sensor: Sensor,
+        policy: &OutputPolicy,
+    ) -> Result<Self, InputError> {
+        let staged = policy.file(target)?;
+        if staged.in_place {
+            return Err(InputError::invalid(
+                target,
+                "is a device or pipe; HDF5 needs a regular file it can seek in",
+                "give the path of a file (e.g. out.h5)",
+            ));
+        }
         let err = |e: hdf5::Error| InputError::write(target, std::io::Error::other(e.to_string()));
         let file = hdf5::File::create(&staged.partial).map_err(err)?;
         let events = file.create_group("events").map_err(err)?;
@@ -56,7 +67,7 @@ impl H5Writer {
     }
 
     fn err(&self, e: hdf5::Error) -> InputError {
-        InputError::write(&self.staged.target, std::io::Error::other(e.to_string()))
+        InputError::write(&self.staged.shown, std::io::Error::other(e.to_string()))
     }
 
     pub fn write_events(&mut self, chunk: &EventChunk) -> Result<(), InputError> {
@@ -65,7 +76,7 @@ impl H5Writer {
         }
         if self.sensor.width > i16::MAX as u16 || self.sensor.height > i16::MAX as u16 {
             return Err(InputError::invalid(
-                &self.staged.target,
+                &self.staged.shown,
                 format!(
                     "the {} sensor does not fit event_utils' int16 coordinates",
                     self.sensor
@@ -130,6 +141,13 @@ impl H5Writer {
         let first = self.first.unwrap_or(0);
         let result = (|| -> hdf5::Result<()> {
             let f = &self.file;
+            f.new_attr::<hdf5::types::VarLenUnicode>()
+                .create("ctcal_version")?
+                .write_scalar(
+                    &env!("CARGO_PKG_VERSION")
+                        .parse::<hdf5::types::VarLenUnicode>()
+                        .expect("a version has no NUL"),
+                )?;
             f.new_attr_builder()
                 .with_data(&[self.sensor.height as i64, self.sensor.width as i64])
                 .create("sensor_resolution")?;

@@ -2,7 +2,7 @@
 //! `t x y p` with t in seconds to the microsecond and p 0/1; frames as `images.txt` +
 //! `images/frame_XXXXXXXX.png`.
 
-use super::{Staged, format_seconds, save_png};
+use super::{OutputPolicy, StagedFolder, format_seconds, save_png};
 use crate::events::{EventChunk, Frame, Sensor};
 use crate::io::error::InputError;
 use std::io::Write;
@@ -10,7 +10,7 @@ use std::path::Path;
 
 /// Writes an IJRR folder.
 pub struct IjrrWriter {
-    staged: Staged,
+    staged: StagedFolder,
     events: std::io::BufWriter<std::fs::File>,
     line: Vec<u8>,
     frames: Vec<u8>,
@@ -18,12 +18,15 @@ pub struct IjrrWriter {
 }
 
 impl IjrrWriter {
-    /// Starts a folder at `target`; `sensor` becomes the `width height` first line.
-    pub fn create(target: &Path, sensor: Sensor) -> Result<Self, InputError> {
-        let staged = Staged::new(target)?;
-        let partial = staged.partial.clone();
-        std::fs::create_dir_all(&partial).map_err(|e| InputError::write(target, e))?;
-        let file = std::fs::File::create(partial.join("events.txt"))
+    /// Starts a folder at `target` (where `policy` allows); `sensor` becomes the
+    /// `width height` first line.
+    pub fn create(
+        target: &Path,
+        sensor: Sensor,
+        policy: &OutputPolicy,
+    ) -> Result<Self, InputError> {
+        let staged = policy.folder(target)?;
+        let file = std::fs::File::create(staged.dir().join("events.txt"))
             .map_err(|e| InputError::write(target, e))?;
         let mut events = std::io::BufWriter::with_capacity(1 << 20, file);
         writeln!(events, "{} {}", sensor.width, sensor.height)
@@ -52,21 +55,21 @@ impl IjrrWriter {
                 .extend_from_slice(if chunk.on[i] { b" 1\n" } else { b" 0\n" });
             self.events
                 .write_all(&self.line)
-                .map_err(|e| InputError::write(&self.staged.target, e))?;
+                .map_err(|e| InputError::write(&self.staged.shown, e))?;
         }
         Ok(())
     }
 
     /// Adds a frame (PNG in `images/`, a line in `images.txt`).
     pub fn write_frame(&mut self, frame: &Frame) -> Result<(), InputError> {
-        let folder = self.staged.partial.join("images");
+        let folder = self.staged.dir().join("images");
         if self.frame_count == 0 {
             std::fs::create_dir_all(&folder)
-                .map_err(|e| InputError::write(&self.staged.target, e))?;
+                .map_err(|e| InputError::write(&self.staged.shown, e))?;
         }
         let name = format!("images/frame_{:08}.png", self.frame_count);
-        save_png(&self.staged.partial.join(&name), frame)
-            .map_err(|e| InputError::write(&self.staged.target, e))?;
+        save_png(&self.staged.dir().join(&name), frame)
+            .map_err(|e| InputError::write(&self.staged.shown, e))?;
         format_seconds(frame.t, &mut self.frames);
         self.frames
             .extend_from_slice(format!(" {name}\n").as_bytes());
@@ -76,18 +79,16 @@ impl IjrrWriter {
 
     /// Adds another file to the folder (e.g. provenance), written with it.
     pub fn add_file(&mut self, name: &str, bytes: &[u8]) -> Result<(), InputError> {
-        std::fs::write(self.staged.partial.join(name), bytes)
-            .map_err(|e| InputError::write(&self.staged.target, e))
+        self.staged.write(name, bytes)
     }
 
     /// Flushes and moves the folder into place.
     pub fn finish(mut self) -> Result<(), InputError> {
         self.events
             .flush()
-            .map_err(|e| InputError::write(&self.staged.target, e))?;
+            .map_err(|e| InputError::write(&self.staged.shown, e))?;
         if self.frame_count > 0 {
-            std::fs::write(self.staged.partial.join("images.txt"), &self.frames)
-                .map_err(|e| InputError::write(&self.staged.target, e))?;
+            self.staged.write("images.txt", &self.frames)?;
         }
         drop(self.events);
         self.staged.commit()

@@ -81,7 +81,7 @@ pub enum Scene {
 }
 
 fn scene_error(path: &Path, problem: impl Into<String>, fix: impl Into<String>) -> SimError {
-    SimError::Input(crate::io::InputError::invalid(path, problem, fix))
+    SimError::file(path, problem, fix)
 }
 
 impl SceneSpec {
@@ -112,7 +112,14 @@ impl SceneSpec {
 
     /// Reads and checks a scene file.
     pub fn from_file(path: &Path) -> Result<Self, SimError> {
-        let text = std::fs::read_to_string(path).map_err(|e| crate::io::InputError::io(path, e))?;
+        let text = super::params::read_text_file(path)?;
+        if let Some(key) = super::params::first_non_finite(&text) {
+            return Err(scene_error(
+                path,
+                format!("`{key}` is not a finite number"),
+                "give a real number (nan and inf are not scene values)",
+            ));
+        }
         let mut spec: SceneSpec = toml::from_str(&text).map_err(|e| {
             scene_error(
                 path,
@@ -131,39 +138,223 @@ impl SceneSpec {
     }
 
     fn validate(&self, path: &Path) -> Result<(), SimError> {
-        if self.width == 0
-            || self.height == 0
-            || self.width > u16::MAX as usize
-            || self.height > u16::MAX as usize
-        {
+        use super::budget::MAX_SIDE;
+        if self.width == 0 || self.height == 0 || self.width > MAX_SIDE || self.height > MAX_SIDE {
             return Err(scene_error(
                 path,
-                format!("size {}x{} is not a sensor size", self.width, self.height),
+                format!(
+                    "size {}x{} is not a sensor size (1..={MAX_SIDE} pixels a side)",
+                    self.width, self.height
+                ),
                 "give width and height in pixels",
             ));
         }
-        if !(self.duration_s.is_finite() && self.duration_s > 0.0) {
+        let check = |key: &str, value: f64, lo: f64, hi: f64, fix: &str| {
+            if value.is_finite() && value >= lo && value <= hi {
+                Ok(())
+            } else {
+                Err(scene_error(
+                    path,
+                    format!("`{key}` = {value} is outside {lo}..={hi}"),
+                    fix,
+                ))
+            }
+        };
+        let range = |key: &str, [lo, hi]: [f64; 2], min: f64, max: f64| {
+            if lo.is_finite() && hi.is_finite() && min <= lo && lo <= hi && hi <= max {
+                Ok(())
+            } else {
+                Err(scene_error(
+                    path,
+                    format!("`{key}` = [{lo}, {hi}] is not a range within {min}..={max}"),
+                    "give [low, high] with low <= high",
+                ))
+            }
+        };
+        if self.duration_s.is_nan() || self.duration_s <= 0.0 {
             return Err(scene_error(
                 path,
-                "duration_s must be positive",
+                "`duration_s` must be positive",
                 "give the scene length in seconds",
             ));
         }
-        if self.render_hz.is_some_and(|r| !(r.is_finite() && r > 0.0)) {
-            return Err(scene_error(
-                path,
-                "render_hz must be positive",
-                "remove it to let ctcal choose",
-            ));
+        check(
+            "duration_s",
+            self.duration_s,
+            0.0,
+            86_400.0,
+            "give the scene length in seconds",
+        )?;
+        if let Some(r) = self.render_hz {
+            check("render_hz", r, 1e-3, 1e6, "remove it to let ctcal choose")?;
         }
-        if let Some(aps) = &self.aps
-            && !(aps.rate_hz > 0.0 && aps.exposure_s >= 0.0 && aps.exposure_s <= 1.0 / aps.rate_hz)
-        {
-            return Err(scene_error(
-                path,
-                "aps needs rate_hz > 0 and 0 <= exposure_s <= 1/rate_hz",
-                "fix the [aps] table",
-            ));
+        if let Some(aps) = &self.aps {
+            check(
+                "aps.rate_hz",
+                aps.rate_hz,
+                1e-3,
+                1e4,
+                "give the APS frame rate in Hz",
+            )?;
+            if !(aps.exposure_s >= 0.0 && aps.exposure_s <= 1.0 / aps.rate_hz) {
+                return Err(scene_error(
+                    path,
+                    "aps needs 0 <= exposure_s <= 1/rate_hz",
+                    "fix the [aps] table",
+                ));
+            }
+        }
+        let texture = |prefix: &str, t: &canvas::TextureParams| -> Result<(), SimError> {
+            check(
+                &format!("{prefix}canvas_px"),
+                t.canvas_px as f64,
+                8.0,
+                8192.0,
+                "give the texture canvas side in pixels",
+            )?;
+            check(
+                &format!("{prefix}min_dn"),
+                t.min_dn,
+                1e-3,
+                1e6,
+                "give intensities in camera DN",
+            )?;
+            check(
+                &format!("{prefix}max_dn"),
+                t.max_dn,
+                t.min_dn,
+                1e6,
+                "max_dn must be at least min_dn",
+            )?;
+            check(
+                &format!("{prefix}mean_dn"),
+                t.mean_dn,
+                1e-3,
+                1e6,
+                "give intensities in camera DN",
+            )?;
+            check(
+                &format!("{prefix}log_std"),
+                t.log_std,
+                0.0,
+                10.0,
+                "give the log-intensity spread",
+            )?;
+            check(
+                &format!("{prefix}spectrum_beta"),
+                t.spectrum_beta,
+                -10.0,
+                10.0,
+                "give the spectral exponent (1 for natural images)",
+            )?;
+            check(
+                &format!("{prefix}blur_px"),
+                t.blur_px,
+                0.0,
+                1e3,
+                "give the texture blur in pixels",
+            )
+        };
+        const SPEED: f64 = 1e6;
+        match self.kind {
+            SceneKind::Texture => {
+                if let Some(t) = &self.texture {
+                    texture("texture.", &t.texture)?;
+                    for (key, v) in [
+                        ("texture.vx_px_s", t.vx_px_s),
+                        ("texture.vy_px_s", t.vy_px_s),
+                        ("texture.omega_deg_s", t.omega_deg_s),
+                        ("texture.offset_px[0]", t.offset_px[0]),
+                        ("texture.offset_px[1]", t.offset_px[1]),
+                        ("texture.mod_amp_ln", t.mod_amp_ln),
+                        ("texture.mod_hz", t.mod_hz),
+                    ] {
+                        check(key, v, -SPEED, SPEED, "give a finite value")?;
+                    }
+                }
+            }
+            SceneKind::Checkerboard => {
+                if let Some(c) = &self.checkerboard {
+                    check(
+                        "checkerboard.square_px",
+                        c.square_px,
+                        0.5,
+                        1e5,
+                        "give the square side in pixels",
+                    )?;
+                    check(
+                        "checkerboard.lo_dn",
+                        c.lo_dn,
+                        0.0,
+                        1e6,
+                        "give intensities in camera DN",
+                    )?;
+                    check(
+                        "checkerboard.hi_dn",
+                        c.hi_dn,
+                        0.0,
+                        1e6,
+                        "give intensities in camera DN",
+                    )?;
+                    for (key, v) in [
+                        ("checkerboard.vx_px_s", c.vx_px_s),
+                        ("checkerboard.vy_px_s", c.vy_px_s),
+                        ("checkerboard.origin_px[0]", c.origin_px[0]),
+                        ("checkerboard.origin_px[1]", c.origin_px[1]),
+                    ] {
+                        check(key, v, -SPEED, SPEED, "give a finite value")?;
+                    }
+                }
+            }
+            SceneKind::MultiObject => {
+                if let Some(m) = &self.multi_object {
+                    if m.objects[0] > m.objects[1] || m.objects[1] > multi_object::MAX_OBJECTS {
+                        return Err(scene_error(
+                            path,
+                            format!(
+                                "`multi_object.objects` = [{}, {}] is not a range within 0..={}",
+                                m.objects[0],
+                                m.objects[1],
+                                multi_object::MAX_OBJECTS
+                            ),
+                            "give [fewest, most] objects",
+                        ));
+                    }
+                    range(
+                        "multi_object.background_velocity_px_s",
+                        m.background_velocity_px_s,
+                        0.0,
+                        SPEED,
+                    )?;
+                    range(
+                        "multi_object.background_angular_velocity_deg_s",
+                        m.background_angular_velocity_deg_s,
+                        0.0,
+                        SPEED,
+                    )?;
+                    range(
+                        "multi_object.background_scale",
+                        m.background_scale,
+                        1e-3,
+                        1e3,
+                    )?;
+                    range(
+                        "multi_object.object_velocity_px_s",
+                        m.object_velocity_px_s,
+                        0.0,
+                        SPEED,
+                    )?;
+                    range(
+                        "multi_object.object_angular_velocity_deg_s",
+                        m.object_angular_velocity_deg_s,
+                        0.0,
+                        SPEED,
+                    )?;
+                    range("multi_object.object_scale", m.object_scale, 1e-3, 1e3)?;
+                    range("multi_object.object_size_px", m.object_size_px, 0.5, 1e4)?;
+                    texture("multi_object.background_texture.", &m.background_texture)?;
+                }
+            }
         }
         let table = match self.kind {
             SceneKind::Texture => self.texture.is_some(),
@@ -182,6 +373,17 @@ impl SceneSpec {
             ));
         }
         Ok(())
+    }
+
+    /// The work of simulating this scene at `render_hz` (with its APS frames), for
+    /// [`super::budget::Work::check`].
+    pub fn work(&self, render_hz: f64) -> super::budget::Work {
+        let mut samples = self.duration_s * render_hz + 1.0;
+        if let Some(aps) = &self.aps {
+            let frames = (self.duration_s * aps.rate_hz).floor() + 1.0;
+            samples += frames * ((aps.exposure_s * render_hz).ceil() + 2.0);
+        }
+        super::budget::Work::new(samples, self.width, self.height)
     }
 
     /// Draws everything random about the scene from its seed.
@@ -228,7 +430,13 @@ impl SceneSpec {
 /// Grey images (`*.png`) of a folder, as textures.
 fn load_textures(dir: &Path) -> Result<Vec<Canvas>, SimError> {
     let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(|e| crate::io::InputError::io(dir, e))?
+        .map_err(|e| {
+            SimError::file(
+                dir,
+                format!("cannot list textures_dir: {e}"),
+                "check the folder's path and permissions",
+            )
+        })?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png")))
         .collect();
@@ -243,6 +451,7 @@ fn load_textures(dir: &Path) -> Result<Vec<Canvas>, SimError> {
     paths
         .iter()
         .map(|p| {
+            crate::files::check_regular(p).map_err(|e| SimError::not_a_file(p, e))?;
             let image = image::open(p)
                 .map_err(|e| {
                     scene_error(

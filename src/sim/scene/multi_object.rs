@@ -37,6 +37,9 @@ pub struct MultiObjectScene {
     pub background_texture: TextureParams,
 }
 
+/// The most foreground objects a scene may have.
+pub const MAX_OBJECTS: u32 = 1000;
+
 fn default_object_size() -> [f64; 2] {
     [12.0, 40.0]
 }
