@@ -76,7 +76,8 @@ fn readers(c: &mut Criterion) {
                 acc.add(chunk);
             }
             let resolved = recording.resolve_sensor(stream.max_coordinates());
-            acc.finish(&resolved, &[]).map(|s| s.events)
+            acc.finish(resolved.sensor, &resolved.source, &[])
+                .map(|s| s.events)
         })
     });
     group.finish();

@@ -14,6 +14,15 @@ pub type TimeUs = i64;
 /// Number of events a reader puts in one chunk (a few MB of struct-of-arrays).
 pub const CHUNK_EVENTS: usize = 1 << 18;
 
+/// The largest sensor side ctcal accepts from a file's metadata or infers from coordinates
+/// (more than any sensor sold); a larger sensor must be given with `--sensor`, so that a
+/// damaged header or coordinate cannot make ctcal allocate gigabytes of per-pixel state.
+pub const MAX_SENSOR_SIDE: u16 = 4096;
+
+/// Times further than this from zero (2^61 us, about 73,000 years) are damage: keeping
+/// every time below it lets any difference of two times fit in an `i64`.
+pub const TIME_LIMIT_US: i64 = 1 << 61;
+
 /// A sensor's pixel array size.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Sensor {
@@ -29,6 +38,11 @@ impl Sensor {
     /// Number of pixels.
     pub fn pixels(&self) -> usize {
         self.width as usize * self.height as usize
+    }
+
+    /// Whether neither side exceeds [`MAX_SENSOR_SIDE`].
+    pub fn is_plausible(&self) -> bool {
+        self.width <= MAX_SENSOR_SIDE && self.height <= MAX_SENSOR_SIDE
     }
 
     /// Whether pixel `(x, y)` lies on the sensor.

@@ -22,24 +22,39 @@ pub struct StatsArgs {
     /// Rate-timeline window in seconds.
     #[arg(long, value_name = "S", default_value_t = 0.01)]
     pub window: f64,
+    /// Background activity: an event is supported (not noise) when one of its 8 neighbours
+    /// fired within this many seconds before it.
+    #[arg(long, value_name = "S", default_value_t = 0.01)]
+    pub support_window: f64,
     /// Accept timestamps that go backwards and sort the events (in memory).
     #[arg(long)]
     pub sort: bool,
 }
 
+/// The longest span, in seconds, a time option may give (any recording is shorter; the
+/// limit keeps every time in microseconds far from overflow).
+const MAX_SECONDS: f64 = 1e12;
+
 pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
-    if !(args.window.is_finite() && args.window > 0.0) {
-        return Err(BadInput(format!(
-            "--window {} must be a positive number of seconds",
-            args.window
-        ))
-        .into());
+    for (name, value) in [
+        ("--window", args.window),
+        ("--support-window", args.support_window),
+    ] {
+        if !(value.is_finite() && value > 0.0 && value <= MAX_SECONDS) {
+            return Err(BadInput(format!(
+                "{name} {value} must be a positive number of seconds up to {MAX_SECONDS:e}"
+            ))
+            .into());
+        }
     }
     for (name, value) in [("--start", args.start), ("--end", args.end)] {
-        if value.is_some_and(|v| !v.is_finite() || v < 0.0) {
-            return Err(
-                BadInput(format!("{name} must be a non-negative number of seconds")).into(),
-            );
+        if let Some(v) = value
+            && !(v.is_finite() && (0.0..=MAX_SECONDS).contains(&v))
+        {
+            return Err(BadInput(format!(
+                "{name} {v} must be a number of seconds from the first event, between 0 and {MAX_SECONDS:e}"
+            ))
+            .into());
         }
     }
     if let (Some(s), Some(e)) = (args.start, args.end)
@@ -75,6 +90,7 @@ fn compute(
         start_s: args.start,
         end_s: args.end,
         window_s: args.window,
+        support_window_s: args.support_window,
     };
     let mut accumulator = StatsAccumulator::new(options, recording.sensor);
     let max_coordinates = if args.sort {
@@ -97,13 +113,20 @@ fn compute(
         warn(global, w);
     }
     let frame_times = recording.frame_times()?;
-    accumulator.finish(&resolved, &frame_times).ok_or_else(|| {
-        ctcal::InputError::EmptyWindow {
-            path: recording.path.clone(),
-            detail: format!("--start {:?} --end {:?}", args.start, args.end),
-        }
-        .into()
-    })
+    let window = |flag: &str, value: Option<f64>| value.map(|v| format!("{flag} {v} s"));
+    accumulator
+        .finish(resolved.sensor, &resolved.source, &frame_times)
+        .ok_or_else(|| {
+            ctcal::InputError::EmptyWindow {
+                path: recording.path.clone(),
+                detail: [window("--start", args.start), window("--end", args.end)]
+                    .into_iter()
+                    .flatten()
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            }
+            .into()
+        })
 }
 
 fn print_human(s: &SequenceStats) -> std::io::Result<()> {
@@ -147,11 +170,16 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
             format!("{:.2} %", 100.0 * s.active_pixel_fraction),
         ),
         (
-            "background rate".into(),
+            "background activity".into(),
             format!(
-                "{:.4} Hz (median pixel, hot excluded)",
-                s.background_rate_hz
+                "{:.4} Hz per pixel (events with no neighbour event in the {} before; hot pixels excluded)",
+                s.background_rate_hz,
+                output::seconds(s.support_window_s)
             ),
+        ),
+        (
+            "median pixel rate".into(),
+            format!("{:.4} Hz", s.median_pixel_rate_hz),
         ),
         (
             "same-pixel interval".into(),

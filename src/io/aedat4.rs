@@ -380,8 +380,7 @@ impl EventDecoder for Aedat4Decoder {
                 let x = i16::from_le_bytes([e[8], e[9]]);
                 let y = i16::from_le_bytes([e[10], e[11]]);
                 let index = (self.pending_at / 16) + i;
-                let inside =
-                    x >= 0 && y >= 0 && self.sensor.is_none_or(|s| s.contains(x as u16, y as u16));
+                let inside = x >= 0 && y >= 0 && super::within(self.sensor, x as u32, y as u32);
                 if !inside {
                     return Err(super::outside_sensor(
                         &self.packets.path,
@@ -389,8 +388,8 @@ impl EventDecoder for Aedat4Decoder {
                             "packet at byte offset {}, event {index}",
                             self.packet_offset
                         ),
-                        x as u32,
-                        y as u32,
+                        x as i64,
+                        y as i64,
                         self.sensor,
                     ));
                 }

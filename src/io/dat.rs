@@ -76,14 +76,12 @@ impl EventDecoder for DatDecoder {
                 let x = (data & 0x3fff) as u16;
                 let y = ((data >> 14) & 0x3fff) as u16;
                 let offset = base + (i * size) as u64;
-                if let Some(s) = self.sensor
-                    && !s.contains(x, y)
-                {
+                if !super::within(self.sensor, x as u32, y as u32) {
                     return Err(super::outside_sensor(
                         &self.path,
                         format!("byte offset {offset}"),
-                        x as u32,
-                        y as u32,
+                        x as i64,
+                        y as i64,
                         self.sensor,
                     ));
                 }

@@ -40,8 +40,8 @@ pub enum InputError {
     OutsideSensor {
         path: PathBuf,
         place: String,
-        x: u32,
-        y: u32,
+        x: i64,
+        y: i64,
         width: u16,
         height: u16,
         claimed: String,

@@ -59,14 +59,12 @@ impl State {
                 let t = (high << 6 | ((word >> 22) & 0x3f) as u64) as i64;
                 let x = ((word >> 11) & 0x7ff) as u16;
                 let y = (word & 0x7ff) as u16;
-                if let Some(s) = self.sensor
-                    && !s.contains(x, y)
-                {
+                if !super::within(self.sensor, x as u32, y as u32) {
                     return Err(super::outside_sensor(
                         &self.path,
                         format!("byte offset {offset}"),
-                        x as u32,
-                        y as u32,
+                        x as i64,
+                        y as i64,
                         self.sensor,
                     ));
                 }

@@ -68,14 +68,12 @@ impl State {
         if !self.seen_time_high {
             return Ok(());
         }
-        if let Some(s) = self.sensor
-            && !s.contains(x, self.y)
-        {
+        if !super::within(self.sensor, x as u32, self.y as u32) {
             return Err(super::outside_sensor(
                 &self.path,
                 format!("byte offset {offset}"),
-                x as u32,
-                self.y as u32,
+                x as i64,
+                self.y as i64,
                 self.sensor,
             ));
         }

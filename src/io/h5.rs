@@ -385,8 +385,8 @@ pub fn probe(path: &Path) -> Result<H5Info, InputError> {
                 return Err(InputError::OutsideSensor {
                     path: path.to_path_buf(),
                     place: "root attribute sensor_resolution".into(),
-                    x: max_x as u32,
-                    y: max_y as u32,
+                    x: max_x,
+                    y: max_y,
                     width: w,
                     height: h,
                     claimed: format!(
@@ -568,8 +568,8 @@ impl EventDecoder for H5Decoder {
                 return Err(super::outside_sensor(
                     &self.path,
                     format!("event index {index}"),
-                    x.max(0) as u32,
-                    y.max(0) as u32,
+                    x as i64,
+                    y as i64,
                     self.sensor,
                 ));
             }

@@ -160,16 +160,12 @@ impl LineParser {
         let Some(on) = text::parse_polarity(fields[3]) else {
             return Err(self.bad_line(raw, "the polarity must be 0, 1 or -1"));
         };
-        let inside = match self.sensor {
-            Some(s) => x < s.width as u32 && y < s.height as u32,
-            None => x <= u16::MAX as u32 && y <= u16::MAX as u32,
-        };
-        if !inside {
+        if !super::within(self.sensor, x, y) {
             return Err(super::outside_sensor(
                 &self.path,
                 format!("line {}", self.line),
-                x,
-                y,
+                x as i64,
+                y as i64,
                 self.sensor,
             ));
         }

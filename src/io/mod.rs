@@ -31,7 +31,7 @@ pub use frame_list::FrameList;
 pub use order::OrderCheck;
 pub use recording::{EventStream, OpenOptions, Recording, ResolvedSensor};
 
-use crate::events::{EventChunk, Sensor};
+use crate::events::{EventChunk, MAX_SENSOR_SIDE, Sensor};
 use serde::Serialize;
 use std::path::Path;
 
@@ -103,16 +103,25 @@ pub trait EventDecoder: Send {
     fn progress(&self) -> Progress;
 }
 
-/// The error for an event outside the sensor (or outside u16 range when the sensor is not
-/// known yet).
+/// Whether `(x, y)` may be an event of `sensor`; while the sensor is not known, of a sensor
+/// of at most [`MAX_SENSOR_SIDE`] a side.
+#[inline(always)]
+pub(crate) fn within(sensor: Option<Sensor>, x: u32, y: u32) -> bool {
+    let (w, h) = sensor.map_or((MAX_SENSOR_SIDE, MAX_SENSOR_SIDE), |s| (s.width, s.height));
+    x < w as u32 && y < h as u32
+}
+
+/// The error for an event outside the sensor (or beyond [`MAX_SENSOR_SIDE`] when the sensor
+/// is not known).
 pub(crate) fn outside_sensor(
     path: &Path,
     place: String,
-    x: u32,
-    y: u32,
+    x: i64,
+    y: i64,
     sensor: Option<Sensor>,
 ) -> InputError {
-    let (width, height) = sensor.map_or((u16::MAX, u16::MAX), |s| (s.width, s.height));
+    let (width, height) =
+        sensor.map_or((MAX_SENSOR_SIDE, MAX_SENSOR_SIDE), |s| (s.width, s.height));
     InputError::OutsideSensor {
         path: path.to_path_buf(),
         place,
@@ -123,7 +132,7 @@ pub(crate) fn outside_sensor(
         claimed: String::new(),
         fix: match sensor {
             Some(_) => "if the sensor is larger than the file says, pass --sensor WxH; otherwise the file is damaged".into(),
-            None => "coordinates must fit in 16 bits; the file is damaged".into(),
+            None => format!("the file does not state its sensor and ctcal infers at most {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE}: if the sensor really is that large, pass --sensor WxH; otherwise the file is damaged"),
         },
     }
 }

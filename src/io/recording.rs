@@ -7,7 +7,9 @@ use super::{
     EventDecoder, FrameList, InputError, Progress, aedat4, dat, detect, evt2, evt3, h5, ijrr,
     prophesee,
 };
-use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor, TimeUs};
+use crate::events::{
+    CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TIME_LIMIT_US, TimeUs,
+};
 use crate::sensors;
 use std::path::{Path, PathBuf};
 
@@ -135,7 +137,20 @@ impl Recording {
                 (Some(s), Some("--sensor".to_string()))
             }
             (Some(s), _) => (Some(s), Some("--sensor".to_string())),
-            (None, Some((s, origin))) => (Some(s), Some(origin)),
+            (None, Some((s, origin))) => {
+                if !s.is_plausible() {
+                    return Err(InputError::invalid(
+                        path,
+                        format!(
+                            "{origin} says the sensor is {s}, larger than {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE} (more than any sensor sold)"
+                        ),
+                        format!(
+                            "if the sensor really is that large, pass --sensor {s}; otherwise the file is damaged"
+                        ),
+                    ));
+                }
+                (Some(s), Some(origin))
+            }
             (None, None) => (None, None),
         };
         Ok(Self {
@@ -295,6 +310,16 @@ impl EventStream {
     pub fn next_chunk(&mut self) -> Result<Option<&EventChunk>, InputError> {
         self.chunk.clear();
         self.decoder.read_chunk(&mut self.chunk)?;
+        if let Some((place, t)) = &self.decoder.order().out_of_range {
+            return Err(InputError::corrupt(
+                &self.path,
+                place.clone(),
+                format!(
+                    "timestamp {t} us lies beyond +-{TIME_LIMIT_US} us (about 73,000 years) of zero"
+                ),
+                "the file is damaged at this place; cut the recording before it or copy it again from the source",
+            ));
+        }
         if self.chunk.is_empty() {
             if self.events == 0 {
                 return Err(InputError::Empty {

@@ -1,10 +1,17 @@
 //! Dataset statistics in one streaming pass: event counts and rates (events per pixel per
 //! second, the quantity Stoffregen et al. 2020 match between real and simulated data), the
-//! rate over time, active-pixel fraction, hot pixels, background rate and same-pixel
+//! rate over time, active-pixel fraction, hot pixels, background activity and same-pixel
 //! inter-event intervals.
 //!
-//! Memory is bounded by the sensor (16 bytes per pixel) and a fixed-size interval
-//! histogram, not by the recording's length; events must arrive time-sorted.
+//! Background activity is counted as the background-activity filter of Delbruck (2008)
+//! defines noise: an event is *supported* when one of its 8 neighbours fired within the
+//! preceding support window (default 10 ms); unsupported events per pixel per second, hot
+//! pixels excluded, is the background rate. (Edges moving over the sensor give their events
+//! neighbours within milliseconds; leak and shot-noise events are isolated.)
+//!
+//! Memory is bounded by the sensor (16 bytes per pixel), a fixed-size interval histogram and
+//! the non-empty windows of the rate timeline, never by the time span a file claims; events
+//! must arrive time-sorted.
 
 pub mod hot_pixels;
 pub mod intervals;
@@ -12,12 +19,15 @@ pub mod pixel_grid;
 pub mod timeline;
 
 use crate::events::{EventChunk, Sensor, TimeUs, us_to_s};
-use crate::io::ResolvedSensor;
 use hot_pixels::HotPixel;
 use intervals::IntervalHistogram;
 use pixel_grid::PixelGrid;
 use serde::Serialize;
+use timeline::SparseTimeline;
 pub use timeline::{FrameSummary, RateWindow};
+
+/// How `background_rate_hz` is defined (reported with it).
+pub const BACKGROUND_RATE_METHOD: &str = "events without spatio-temporal support (no event of any of the 8 neighbours in the preceding support window, Delbruck 2008's background-activity filter) per pixel per second, hot pixels excluded";
 
 /// Hints the cache to load `value` (no effect on results; a no-op off x86-64).
 #[inline(always)]
@@ -43,6 +53,8 @@ pub struct StatsOptions {
     pub end_s: Option<f64>,
     /// Width of the rate-timeline windows, seconds.
     pub window_s: f64,
+    /// Support window of the background-activity count, seconds.
+    pub support_window_s: f64,
 }
 
 impl Default for StatsOptions {
@@ -51,6 +63,7 @@ impl Default for StatsOptions {
             start_s: None,
             end_s: None,
             window_s: 0.01,
+            support_window_s: 0.01,
         }
     }
 }
@@ -86,8 +99,14 @@ pub struct SequenceStats {
     pub rate_timeline: Vec<RateWindow>,
     pub hot_pixels: Vec<HotPixel>,
     pub hot_pixel_method: &'static str,
-    /// Median over all pixels (hot pixels excluded) of each pixel's events / duration_s.
+    /// Background activity: unsupported events per pixel per second, hot pixels excluded
+    /// (see [`BACKGROUND_RATE_METHOD`]).
     pub background_rate_hz: f64,
+    pub background_rate_method: &'static str,
+    /// The support window of `background_rate_hz`, seconds.
+    pub support_window_s: f64,
+    /// Median over all pixels of each pixel's events / duration_s.
+    pub median_pixel_rate_hz: f64,
     pub inter_event_interval_s: IntervalSummary,
     pub frames: Option<FrameSummary>,
 }
@@ -96,6 +115,7 @@ pub struct SequenceStats {
 pub struct StatsAccumulator {
     options: StatsOptions,
     window_us: TimeUs,
+    support_us: TimeUs,
     stream_first: Option<TimeUs>,
     select_from: TimeUs,
     select_to: TimeUs,
@@ -107,20 +127,45 @@ pub struct StatsAccumulator {
     /// Scratch: pixel index of each event of the chunk being added.
     indices: Vec<u32>,
     intervals: IntervalHistogram,
-    timeline: Vec<u64>,
-    window_end: TimeUs,
+    windows: WindowCounter,
+}
+
+/// The rate timeline being counted: finished windows, and the current one's index, end and
+/// count so far.
+#[derive(Default)]
+struct WindowCounter {
+    timeline: SparseTimeline,
+    index: u64,
+    end: TimeUs,
+    count: u64,
+}
+
+impl WindowCounter {
+    /// Records the finished window and starts the one holding `t` (skipping empty ones
+    /// without storing them).
+    #[cold]
+    fn close(&mut self, t: TimeUs, first: TimeUs, window_us: TimeUs) {
+        if self.count > 0 {
+            self.timeline.add(self.index, self.count);
+        }
+        self.index = (t.saturating_sub(first) / window_us) as u64;
+        self.end = first.saturating_add((self.index as TimeUs + 1).saturating_mul(window_us));
+        self.count = 0;
+    }
 }
 
 impl StatsAccumulator {
     /// `sensor`: the sensor when known in advance (else the grid grows as events arrive).
     pub fn new(options: StatsOptions, sensor: Option<Sensor>) -> Self {
         let window_us = ((options.window_s * 1e6).round() as TimeUs).max(1);
+        let support_us = ((options.support_window_s * 1e6).round() as TimeUs).max(0);
         let pixels = sensor.map_or_else(PixelGrid::default, |s| {
             PixelGrid::new(s.width as usize, s.height as usize)
         });
         Self {
             options,
             window_us,
+            support_us,
             stream_first: None,
             select_from: TimeUs::MIN,
             select_to: TimeUs::MAX,
@@ -131,8 +176,7 @@ impl StatsAccumulator {
             pixels,
             indices: Vec::new(),
             intervals: IntervalHistogram::default(),
-            timeline: Vec::new(),
-            window_end: 0,
+            windows: WindowCounter::default(),
         }
     }
 
@@ -159,8 +203,7 @@ impl StatsAccumulator {
         let (ts, xs, ys) = (&chunk.t[lo..hi], &chunk.x[lo..hi], &chunk.y[lo..hi]);
         if self.first.is_none() {
             self.first = Some(ts[0]);
-            self.window_end = ts[0] + self.window_us;
-            self.timeline.push(0);
+            self.windows.end = ts[0].saturating_add(self.window_us);
         }
         let max_x = xs.iter().copied().max().expect("non-empty");
         let max_y = ys.iter().copied().max().expect("non-empty");
@@ -171,45 +214,61 @@ impl StatsAccumulator {
         self.last = *ts.last().expect("non-empty");
     }
 
-    /// The per-event kernel: counts, same-pixel intervals, timeline.
+    /// The per-event kernel: counts, spatio-temporal support, same-pixel intervals,
+    /// timeline.
     #[inline(never)]
     fn accumulate(&mut self, ts: &[TimeUs], xs: &[u16], ys: &[u16]) {
-        let width = self.pixels.width;
-        // pixel indices first (a vectorised pass), so the main loop can prefetch the cell
-        // of an event a few places ahead: events hop between rows, and overlapping those
-        // cache misses is most of the kernel's speed
+        let stride = self.pixels.stride();
+        // cell indices first (a vectorised pass), so the main loop can prefetch the
+        // neighbourhood of an event a few places ahead: events hop between rows, and
+        // overlapping those cache misses is most of the kernel's speed
         self.indices.clear();
         self.indices.extend(
             xs.iter()
                 .zip(ys)
-                .map(|(&x, &y)| y as u32 * width as u32 + x as u32),
+                .map(|(&x, &y)| ((y as usize + 1) * stride + x as usize + 1) as u32),
         );
         let indices = &self.indices;
         let cells = &mut self.pixels.cells;
         let intervals = &mut self.intervals;
-        let mut window_count = *self.timeline.last().expect("started");
+        let first = self.first.expect("started");
+        let support_us = self.support_us;
+        let window_us = self.window_us;
+        let windows = &mut self.windows;
         const AHEAD: usize = 16;
         for (i, &t) in ts.iter().enumerate() {
             if let Some(&ahead) = indices.get(i + AHEAD) {
-                prefetch(&cells[ahead as usize]);
+                let ahead = ahead as usize;
+                prefetch(&cells[ahead - stride - 1]);
+                prefetch(&cells[ahead - stride + 1]);
+                prefetch(&cells[ahead - 1]);
+                prefetch(&cells[ahead + 1]);
+                prefetch(&cells[ahead + stride - 1]);
+                prefetch(&cells[ahead + stride + 1]);
             }
-            let cell = &mut cells[indices[i] as usize];
+            let k = indices[i] as usize;
+            // the latest event among the 8 neighbours (border cells never fire)
+            let neighbours = cells[k - stride - 1]
+                .last
+                .max(cells[k - stride].last)
+                .max(cells[k - stride + 1].last)
+                .max(cells[k - 1].last)
+                .max(cells[k + 1].last)
+                .max(cells[k + stride - 1].last)
+                .max(cells[k + stride].last)
+                .max(cells[k + stride + 1].last);
+            let cell = &mut cells[k];
             if cell.count > 0 {
-                intervals.add((t - cell.last) as u64);
+                intervals.add(t.wrapping_sub(cell.last) as u64);
             }
             cell.count += 1;
+            cell.unsupported += (neighbours < t.saturating_sub(support_us)) as u32;
             cell.last = t;
-            if t >= self.window_end {
-                *self.timeline.last_mut().expect("started") = window_count;
-                while t >= self.window_end {
-                    self.timeline.push(0);
-                    self.window_end += self.window_us;
-                }
-                window_count = 0;
+            if t >= windows.end {
+                windows.close(t, first, window_us);
             }
-            window_count += 1;
+            windows.count += 1;
         }
-        *self.timeline.last_mut().expect("started") = window_count;
     }
 
     /// Events selected so far.
@@ -217,24 +276,35 @@ impl StatsAccumulator {
         self.events
     }
 
-    /// Final statistics for `sensor`, with the recording's frame times.
-    /// `None` when no event was selected.
-    pub fn finish(self, sensor: &ResolvedSensor, frame_times: &[TimeUs]) -> Option<SequenceStats> {
+    /// Final statistics for `sensor` (how it is known: `sensor_source`), with the
+    /// recording's frame times. `None` when no event was selected.
+    pub fn finish(
+        mut self,
+        sensor: Sensor,
+        sensor_source: &str,
+        frame_times: &[TimeUs],
+    ) -> Option<SequenceStats> {
         let first = self.first?;
-        let (width, height) = (sensor.sensor.width as usize, sensor.sensor.height as usize);
+        if self.windows.count > 0 {
+            self.windows
+                .timeline
+                .add(self.windows.index, self.windows.count);
+        }
+        let (width, height) = (sensor.width as usize, sensor.height as usize);
         let pixels = (width * height) as f64;
         let duration_s = us_to_s(self.last - first);
         let per_pixel_per_second =
             |n: u64| (duration_s > 0.0).then(|| n as f64 / (pixels * duration_s));
         let counts = self.pixels.counts(width, height);
+        let unsupported = self.pixels.map(width, height, |c| c.unsupported);
         let active = counts.iter().filter(|&&c| c > 0).count();
         let hot = hot_pixels::find_hot_pixels(&counts, width, height, duration_s);
-        let background_rate_hz = background_rate(&counts, width, &hot, duration_s);
+        let background_rate_hz = background_rate(&unsupported, width, &hot, duration_s);
         let off = self.events - self.on;
         Some(SequenceStats {
-            width: sensor.sensor.width,
-            height: sensor.sensor.height,
-            sensor_source: sensor.source.clone(),
+            width: sensor.width,
+            height: sensor.height,
+            sensor_source: sensor_source.to_string(),
             events: self.events,
             on_events: self.on,
             off_events: off,
@@ -247,7 +317,7 @@ impl StatsAccumulator {
             off_per_pixel_per_second: per_pixel_per_second(off),
             active_pixel_fraction: active as f64 / pixels,
             rate_timeline: timeline::rate_timeline(
-                &self.timeline,
+                &self.windows.timeline,
                 self.window_us,
                 self.last - first,
                 us_to_s(first - self.stream_first.unwrap_or(first)),
@@ -256,6 +326,9 @@ impl StatsAccumulator {
             hot_pixels: hot,
             hot_pixel_method: hot_pixels::METHOD,
             background_rate_hz,
+            background_rate_method: BACKGROUND_RATE_METHOD,
+            support_window_s: us_to_s(self.support_us),
+            median_pixel_rate_hz: median_rate(&counts, duration_s),
             inter_event_interval_s: IntervalSummary {
                 p5: self.intervals.quantile_us(0.05).map(|us| us * 1e-6),
                 median: self.intervals.quantile_us(0.5).map(|us| us * 1e-6),
@@ -267,34 +340,35 @@ impl StatsAccumulator {
     }
 }
 
-/// Median over all pixels, hot ones excluded, of events / duration.
-fn background_rate(counts: &[u32], width: usize, hot: &[HotPixel], duration_s: f64) -> f64 {
+/// Unsupported events per pixel per second over the pixels that are not hot.
+fn background_rate(unsupported: &[u32], width: usize, hot: &[HotPixel], duration_s: f64) -> f64 {
     if duration_s <= 0.0 {
         return 0.0;
     }
-    let mut kept: Vec<u32> = counts.to_vec();
-    let mut hot_index: Vec<usize> = hot
+    let hot_events: u64 = hot
         .iter()
-        .map(|h| h.y as usize * width + h.x as usize)
-        .collect();
-    hot_index.sort_unstable();
-    let mut write = 0;
-    for (i, &c) in counts.iter().enumerate() {
-        if hot_index.binary_search(&i).is_err() {
-            kept[write] = c;
-            write += 1;
-        }
-    }
-    kept.truncate(write);
-    if kept.is_empty() {
+        .map(|h| unsupported[h.y as usize * width + h.x as usize] as u64)
+        .sum();
+    let total: u64 = unsupported.iter().map(|&c| c as u64).sum();
+    let kept = unsupported.len() - hot.len();
+    if kept == 0 {
         return 0.0;
     }
-    let mid = kept.len() / 2;
-    let upper = *kept.select_nth_unstable(mid).1 as f64;
-    let median = if kept.len() % 2 == 1 {
+    (total - hot_events) as f64 / (kept as f64 * duration_s)
+}
+
+/// Median over all pixels of events / duration.
+fn median_rate(counts: &[u32], duration_s: f64) -> f64 {
+    if duration_s <= 0.0 || counts.is_empty() {
+        return 0.0;
+    }
+    let mut sorted = counts.to_vec();
+    let mid = sorted.len() / 2;
+    let upper = *sorted.select_nth_unstable(mid).1 as f64;
+    let median = if sorted.len() % 2 == 1 {
         upper
     } else {
-        (*kept[..mid].iter().max().expect("len >= 2") as f64 + upper) / 2.0
+        (*sorted[..mid].iter().max().expect("len >= 2") as f64 + upper) / 2.0
     };
     median / duration_s
 }
@@ -304,12 +378,34 @@ mod tests {
     use super::*;
     use crate::events::Event;
 
-    fn resolved(w: u16, h: u16) -> ResolvedSensor {
-        ResolvedSensor {
-            sensor: Sensor::new(w, h),
-            source: "test".into(),
-            warning: None,
-        }
+    fn event(t: TimeUs, x: u16, y: u16) -> Event {
+        Event { t, x, y, on: true }
+    }
+
+    #[test]
+    fn support_needs_a_neighbour_within_the_window_before() {
+        // a 4x3 sensor; window 10 ms
+        let chunk: EventChunk = [
+            event(0, 1, 1),       // alone: unsupported
+            event(5_000, 2, 2),   // diagonal neighbour 5 ms before: supported
+            event(5_000, 0, 0),   // neighbour (1,1) 5 ms before: supported
+            event(30_000, 3, 0),  // neighbours (2,1),(2,0),(3,1) never fired: unsupported
+            event(31_000, 1, 1),  // own pixel fired before, neighbours 26 ms ago: unsupported
+            event(32_000, 0, 1),  // (1,1) 1 ms before: supported
+            event(100_000, 3, 2), // (2,2) fired 95 ms ago: unsupported
+        ]
+        .into_iter()
+        .collect();
+        let mut acc = StatsAccumulator::new(StatsOptions::default(), Some(Sensor::new(4, 3)));
+        acc.add(&chunk);
+        let s = acc.finish(Sensor::new(4, 3), "test", &[]).unwrap();
+        // 4 unsupported events over 12 pixels and 0.1 s
+        assert!(
+            (s.background_rate_hz - 4.0 / (12.0 * 0.1)).abs() < 1e-12,
+            "{}",
+            s.background_rate_hz
+        );
+        assert_eq!(s.support_window_s, 0.01);
     }
 
     #[test]
@@ -349,7 +445,9 @@ mod tests {
         };
         let mut acc = StatsAccumulator::new(options, Some(Sensor::new(2, 2)));
         acc.add(&chunk);
-        let s = acc.finish(&resolved(2, 2), &[0, 40_000, 80_000]).unwrap();
+        let s = acc
+            .finish(Sensor::new(2, 2), "test", &[0, 40_000, 80_000])
+            .unwrap();
         assert_eq!((s.events, s.on_events, s.off_events), (4, 2, 2));
         assert_eq!(s.duration_s, 1.0);
         assert_eq!(s.events_per_pixel_per_second, Some(1.0));
@@ -364,7 +462,11 @@ mod tests {
         assert_eq!(s.rate_timeline[1].events, 2);
         assert_eq!(s.rate_timeline[1].events_per_pixel_per_second, 1.0);
         // per-pixel counts 3, 0, 0, 1 -> median 0.5 events over 1 s
-        assert_eq!(s.background_rate_hz, 0.5);
+        assert_eq!(s.median_pixel_rate_hz, 0.5);
+        // (1,1) at 0.25 s has no neighbour event in the 10 ms before it, nor have the three
+        // events of (0,0) (its neighbour (1,1) fired 250 ms before 0.5 s): 4 unsupported
+        // events over 4 pixels and 1 s
+        assert_eq!(s.background_rate_hz, 1.0);
         assert_eq!(
             s.frames,
             Some(FrameSummary {
@@ -388,10 +490,11 @@ mod tests {
             start_s: Some(0.2),
             end_s: Some(0.5),
             window_s: 0.1,
+            ..Default::default()
         };
         let mut acc = StatsAccumulator::new(options, None);
         acc.add(&chunk);
-        let s = acc.finish(&resolved(1, 1), &[]).unwrap();
+        let s = acc.finish(Sensor::new(1, 1), "test", &[]).unwrap();
         assert_eq!(s.events, 4);
         assert_eq!((s.t_first_us, s.t_last_us), (1_200_000, 1_500_000));
         assert!((s.rate_timeline[0].t_s - 0.2).abs() < 1e-12);

@@ -1,19 +1,37 @@
-//! Per-pixel running state of the statistics pass: count and last event time, together in
-//! one 16-byte cell so that each event touches one cache line. The grid grows when the
-//! sensor size is not known in advance (it is inferred from the coordinates at the end).
+//! Per-pixel running state of the statistics pass: last event time, count and the count of
+//! events without spatio-temporal support, together in one 16-byte cell so that each event
+//! touches one cache line of its own row. The grid has a one-pixel border of cells that
+//! never fire, so that the 8 neighbours of any pixel can be read without bounds checks.
+//! It grows when the sensor size is not known in advance (it is inferred from the
+//! coordinates at the end); readers bound coordinates by `MAX_SENSOR_SIDE`, and so is the
+//! grid.
 
-use crate::events::TimeUs;
+use crate::events::{MAX_SENSOR_SIDE, TimeUs};
 
 /// One pixel's running state.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug)]
 pub struct PixelCell {
+    /// Time of the last event (`TimeUs::MIN` before the first).
     pub last: TimeUs,
     pub count: u32,
+    /// Events with no event of an 8-neighbour in the preceding support window.
+    pub unsupported: u32,
 }
 
-/// A row-major grid of [`PixelCell`]s that can grow.
+impl Default for PixelCell {
+    fn default() -> Self {
+        Self {
+            last: TimeUs::MIN,
+            count: 0,
+            unsupported: 0,
+        }
+    }
+}
+
+/// A row-major grid of [`PixelCell`]s with a one-cell border, that can grow.
 #[derive(Clone, Debug, Default)]
 pub struct PixelGrid {
+    /// Pixels per row and rows (without the border).
     pub width: usize,
     pub height: usize,
     pub cells: Vec<PixelCell>,
@@ -24,8 +42,20 @@ impl PixelGrid {
         Self {
             width,
             height,
-            cells: vec![PixelCell::default(); width * height],
+            cells: vec![PixelCell::default(); (width + 2) * (height + 2)],
         }
+    }
+
+    /// Cells per stored row (the width plus the border).
+    #[inline(always)]
+    pub fn stride(&self) -> usize {
+        self.width + 2
+    }
+
+    /// The cell index of pixel (x, y).
+    #[inline(always)]
+    pub fn index(&self, x: u16, y: u16) -> usize {
+        (y as usize + 1) * self.stride() + x as usize + 1
     }
 
     /// Makes the grid contain pixel (`max_x`, `max_y`), keeping the cells' contents.
@@ -34,30 +64,48 @@ impl PixelGrid {
         if need_w <= self.width && need_h <= self.height {
             return;
         }
-        // grow generously so that a stream of slowly rising maxima does not re-layout often
-        let width = self.width.max(need_w.next_power_of_two().max(need_w));
-        let height = self.height.max(need_h.next_power_of_two().max(need_h));
-        let mut cells = vec![PixelCell::default(); width * height];
-        for y in 0..self.height {
-            cells[y * width..y * width + self.width]
-                .copy_from_slice(&self.cells[y * self.width..(y + 1) * self.width]);
-        }
-        *self = Self {
-            width,
-            height,
-            cells,
+        // grow generously so that a stream of slowly rising maxima does not re-layout
+        // often, but never past the largest sensor
+        let limit = MAX_SENSOR_SIDE as usize;
+        let grow = |have: usize, need: usize| {
+            if need <= have {
+                have
+            } else {
+                need.max(have + have / 2).max(64).min(limit.max(need))
+            }
         };
+        let width = grow(self.width, need_w);
+        let height = grow(self.height, need_h);
+        let mut grown = Self::new(width, height);
+        for y in 0..self.height {
+            let from = (y + 1) * self.stride() + 1;
+            let to = (y + 1) * grown.stride() + 1;
+            grown.cells[to..to + self.width].copy_from_slice(&self.cells[from..from + self.width]);
+        }
+        *self = grown;
     }
 
-    /// Counts as a `width x height` map (pixels outside the grid count zero).
-    pub fn counts(&self, width: usize, height: usize) -> Vec<u32> {
-        let mut out = vec![0u32; width * height];
+    /// A `width x height` map of one value per pixel (pixels outside the grid give
+    /// `PixelCell::default()`'s value).
+    pub fn map<T: Copy>(
+        &self,
+        width: usize,
+        height: usize,
+        value: impl Fn(&PixelCell) -> T,
+    ) -> Vec<T> {
+        let empty = value(&PixelCell::default());
+        let mut out = vec![empty; width * height];
         for y in 0..height.min(self.height) {
             for x in 0..width.min(self.width) {
-                out[y * width + x] = self.cells[y * self.width + x].count;
+                out[y * width + x] = value(&self.cells[self.index(x as u16, y as u16)]);
             }
         }
         out
+    }
+
+    /// Event counts as a `width x height` map.
+    pub fn counts(&self, width: usize, height: usize) -> Vec<u32> {
+        self.map(width, height, |c| c.count)
     }
 }
 
@@ -68,13 +116,22 @@ mod tests {
     #[test]
     fn growing_keeps_every_cell_in_place() {
         let mut g = PixelGrid::new(3, 2);
-        let (x, y) = (2, 1);
-        g.cells[y * 3 + x].count = 7;
+        let i = g.index(2, 1);
+        g.cells[i].count = 7;
         g.ensure(10, 4);
         assert!(g.width >= 11 && g.height >= 5);
-        assert_eq!(g.cells[y * g.width + x].count, 7);
+        assert_eq!(g.cells[g.index(2, 1)].count, 7);
         let counts = g.counts(4, 3);
-        assert_eq!(counts[y * 4 + x], 7);
+        assert_eq!(counts[4 + 2], 7);
         assert_eq!(counts.iter().sum::<u32>(), 7);
+        // the border stays untouched
+        assert_eq!(g.cells[0].last, TimeUs::MIN);
+    }
+
+    #[test]
+    fn growth_stops_at_the_largest_sensor() {
+        let mut g = PixelGrid::new(3000, 1);
+        g.ensure(3500, 0);
+        assert_eq!(g.width, MAX_SENSOR_SIDE as usize);
     }
 }

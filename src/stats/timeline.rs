@@ -16,21 +16,47 @@ pub struct RateWindow {
     pub events_per_pixel_per_second: f64,
 }
 
-/// Window rates over the selected span `span_us` from per-window `counts`; the windows are
-/// `round(span / window)` (at least one) and the remainder joins the last window, so every
-/// window is between half and one and a half windows long.
+/// The most windows a rate timeline has; a longer recording (or one whose timestamps jump)
+/// gets proportionally wider windows, so output stays bounded whatever the time span.
+pub const MAX_WINDOWS: usize = 100_000;
+
+/// Counts of the non-empty windows of a rate timeline, as `(window index, events)` in
+/// increasing index order: memory follows the events, not the time span they cover.
+#[derive(Clone, Debug, Default)]
+pub struct SparseTimeline {
+    pub windows: Vec<(u64, u64)>,
+}
+
+impl SparseTimeline {
+    /// Adds `events` to window `index` (indices never decrease).
+    #[inline]
+    pub fn add(&mut self, index: u64, events: u64) {
+        match self.windows.last_mut() {
+            Some((last, count)) if *last == index => *count += events,
+            _ => self.windows.push((index, events)),
+        }
+    }
+}
+
+/// Window rates over the selected span `span_us` from the sparse per-window counts of
+/// `window_us` windows: the windows are `round(span / window)` (at least one) and the
+/// remainder joins the last window, so every window is between half and one and a half
+/// windows long. Beyond [`MAX_WINDOWS`] windows, `factor` windows are merged into one.
 pub fn rate_timeline(
-    counts: &[u64],
+    counts: &SparseTimeline,
     window_us: TimeUs,
     span_us: TimeUs,
     offset_s: f64,
     pixels: f64,
 ) -> Vec<RateWindow> {
-    let windows = ((span_us as f64 / window_us as f64).round() as usize).max(1);
-    let mut merged: Vec<u64> = counts.iter().take(windows).copied().collect();
-    let tail: u64 = counts.iter().skip(windows).sum();
-    if let Some(last) = merged.last_mut() {
-        *last += tail;
+    let natural = ((span_us as f64 / window_us as f64).round() as u64).max(1);
+    let factor = natural.div_ceil(MAX_WINDOWS as u64).max(1);
+    let window_us = window_us.saturating_mul(factor as TimeUs);
+    let windows = ((span_us as f64 / window_us as f64).round() as usize).clamp(1, MAX_WINDOWS);
+    let mut merged = vec![0u64; windows];
+    for &(index, events) in &counts.windows {
+        let k = ((index / factor) as usize).min(windows - 1);
+        merged[k] += events;
     }
     let n = merged.len();
     merged
@@ -84,4 +110,30 @@ pub fn frame_summary(times: &[TimeUs]) -> Option<FrameSummary> {
         count: times.len(),
         median_interval_s,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_huge_gap_costs_no_memory_and_the_output_stays_bounded() {
+        // two bursts 1e7 s apart: 1e9 windows of 10 ms
+        let mut sparse = SparseTimeline::default();
+        sparse.add(0, 5);
+        sparse.add(0, 5);
+        sparse.add(1_000_000_000, 7);
+        assert_eq!(sparse.windows, vec![(0, 10), (1_000_000_000, 7)]);
+        let span = 10_000_000_000_000; // 1e7 s in us
+        let windows = rate_timeline(&sparse, 10_000, span, 0.0, 1.0);
+        assert_eq!(windows.len(), MAX_WINDOWS);
+        assert_eq!(windows[0].events, 10);
+        assert_eq!(windows.last().unwrap().events, 7);
+        assert_eq!(windows.iter().map(|w| w.events).sum::<u64>(), 17);
+        assert!(
+            (windows[0].window_s - 100.0).abs() < 1e-9,
+            "{}",
+            windows[0].window_s
+        );
+    }
 }
