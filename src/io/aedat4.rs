@@ -12,7 +12,7 @@
 use super::error::{FIX_TRUNCATED, InputError};
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
-use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor};
+use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor, TimeUs};
 use flatbuffers::{Follow, ForwardsUOffset, Table, Vector, Verifiable, Verifier};
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
@@ -95,6 +95,17 @@ impl Aedat4Header {
         let mut length = [0u8; 4];
         read_exact(&mut file, &mut length, path, 14, "the header length")?;
         let length = u32::from_le_bytes(length) as usize;
+        let file_size = file.metadata().map_err(|e| InputError::io(path, e))?.len();
+        if 18 + length as u64 > file_size {
+            return Err(InputError::corrupt(
+                path,
+                "byte offset 14",
+                format!(
+                    "the header claims {length} bytes, more than the {file_size}-byte file holds"
+                ),
+                FIX_TRUNCATED,
+            ));
+        }
         let mut buffer = vec![0u8; length];
         read_exact(&mut file, &mut buffer, path, 18, "the IOHeader")?;
         let header = flatbuffers::root::<IoHeader>(&buffer).map_err(|e| {
@@ -202,6 +213,9 @@ fn parse_description(xml: &str) -> Result<(Vec<Stream>, Option<String>), String>
     Ok((streams, source))
 }
 
+/// The most bytes one packet may decompress to (DV writes packets of a few MB at most).
+const MAX_PACKET_BYTES: u64 = 256 << 20;
+
 /// Reads packets one at a time, decompressing those of one stream.
 struct PacketReader {
     path: PathBuf,
@@ -282,18 +296,33 @@ impl PacketReader {
                 "a packet",
             )?;
             self.decoded.clear();
+            // a packet decompresses to at most MAX_PACKET_BYTES: more is a decompression
+            // bomb or damage, never an event packet
+            let limit = MAX_PACKET_BYTES + 1;
             let result = match self.compression {
                 Compression::None => {
                     self.decoded.extend_from_slice(&self.raw);
                     Ok(())
                 }
                 Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(&self.raw[..])
+                    .take(limit)
                     .read_to_end(&mut self.decoded)
                     .map(|_| ()),
                 Compression::Zstd => zstd::stream::read::Decoder::new(&self.raw[..])
-                    .and_then(|mut d| d.read_to_end(&mut self.decoded))
+                    .and_then(|d| d.take(limit).read_to_end(&mut self.decoded))
                     .map(|_| ()),
             };
+            if self.decoded.len() as u64 > MAX_PACKET_BYTES {
+                return Err(InputError::corrupt(
+                    &self.path,
+                    format!("byte offset {offset} (packet of stream {stream})"),
+                    format!(
+                        "the packet decompresses to more than {} MB",
+                        MAX_PACKET_BYTES >> 20
+                    ),
+                    FIX_TRUNCATED,
+                ));
+            }
             result.map_err(|e| {
                 InputError::corrupt(
                     &self.path,
@@ -418,17 +447,45 @@ impl EventDecoder for Aedat4Decoder {
 
 /// Decodes every frame of the file's first frame stream (grey; colour is converted with
 /// ITU-R BT.601 weights). Frame time: the exposure midpoint where the packet gives the
-/// exposure, else the frame's own timestamp.
+/// exposure, else the frame's own timestamp. Frames must share one size and come in time
+/// order (as IJRR frame lists must).
 pub fn read_frames(path: &Path, header: &Aedat4Header) -> Result<Vec<Frame>, InputError> {
+    let mut frames = Vec::new();
+    for_each_frame(path, header, true, |frame| frames.push(frame))?;
+    Ok(frames)
+}
+
+/// The frames' timestamps (each packet is decompressed and checked, its pixels dropped).
+pub fn read_frame_times(path: &Path, header: &Aedat4Header) -> Result<Vec<TimeUs>, InputError> {
+    let mut times = Vec::new();
+    for_each_frame(path, header, false, |frame| times.push(frame.t))?;
+    Ok(times)
+}
+
+fn for_each_frame(
+    path: &Path,
+    header: &Aedat4Header,
+    keep_pixels: bool,
+    mut f: impl FnMut(Frame),
+) -> Result<(), InputError> {
     let Some(stream) = header.frame_stream() else {
-        return Ok(Vec::new());
+        return Ok(());
     };
     let mut packets = PacketReader::open(path, header)?;
-    let mut frames = Vec::new();
+    let mut previous: Option<(TimeUs, u32, u32)> = None;
     while let Some(offset) = packets.next(stream)? {
         let frame = flatbuffers::size_prefixed_root::<FramePacket>(&packets.decoded)
             .map_err(|e| packets.invalid(offset, "frame", e))?;
-        let (w, h) = (frame.width().max(0) as u32, frame.height().max(0) as u32);
+        let (w, h) = (frame.width(), frame.height());
+        let limit = crate::events::MAX_SENSOR_SIDE as i16;
+        if w <= 0 || h <= 0 || w > limit || h > limit {
+            return Err(packets.invalid(
+                offset,
+                "frame",
+                format!("frame size {w}x{h} (1..={limit} pixels a side expected)"),
+            ));
+        }
+        let (w, h) = (w as u32, h as u32);
         let data = frame.pixels().map(|p| p.bytes()).unwrap_or_default();
         let channels = match frame.format() {
             0 => 1,
@@ -452,7 +509,33 @@ pub fn read_frames(path: &Path, header: &Aedat4Header) -> Result<Vec<Frame>, Inp
                 ),
             ));
         }
-        let pixels = if channels == 1 {
+        let (start, end) = (frame.exposure_start_t(), frame.exposure_end_t());
+        let (t, exposure_us) = if end > start && start > 0 {
+            (start + (end - start) / 2, Some(end - start))
+        } else {
+            (frame.t(), None)
+        };
+        if let Some((t0, w0, h0)) = previous {
+            if (w, h) != (w0, h0) {
+                return Err(packets.invalid(
+                    offset,
+                    "frame",
+                    format!("the frame is {w}x{h}, the first frame {w0}x{h0}"),
+                ));
+            }
+            if t < t0 {
+                return Err(InputError::corrupt(
+                    &packets.path,
+                    format!("byte offset {offset} (frame packet)"),
+                    format!("frame time {t} us is earlier than the frame before ({t0} us)"),
+                    "the file is damaged; frames must come in time order",
+                ));
+            }
+        }
+        previous = Some((t, w, h));
+        let pixels = if !keep_pixels {
+            Vec::new()
+        } else if channels == 1 {
             data.to_vec()
         } else {
             data.chunks_exact(channels)
@@ -462,13 +545,7 @@ pub fn read_frames(path: &Path, header: &Aedat4Header) -> Result<Vec<Frame>, Inp
                 })
                 .collect()
         };
-        let (start, end) = (frame.exposure_start_t(), frame.exposure_end_t());
-        let (t, exposure_us) = if end > start && start > 0 {
-            (start + (end - start) / 2, Some(end - start))
-        } else {
-            (frame.t(), None)
-        };
-        frames.push(Frame {
+        f(Frame {
             t,
             width: w,
             height: h,
@@ -476,7 +553,7 @@ pub fn read_frames(path: &Path, header: &Aedat4Header) -> Result<Vec<Frame>, Inp
             exposure_us,
         });
     }
-    Ok(frames)
+    Ok(())
 }
 
 // --- FlatBuffer accessors (field slots from the dv-processing schemas) ---

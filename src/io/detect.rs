@@ -19,11 +19,13 @@ pub fn detect(path: &Path) -> Result<Format, InputError> {
         if path.join("events.txt").is_file() {
             return Ok(Format::Ijrr);
         }
-        return Err(InputError::UnknownFormat {
-            path: path.to_path_buf(),
-            detail: "a folder without events.txt".into(),
-        });
+        return Err(InputError::unknown(
+            path,
+            "a folder without events.txt",
+            "point ctcal at an IJRR folder (events.txt, optional images.txt) or at a recording file",
+        ));
     }
+    crate::files::check_regular(path).map_err(|e| InputError::not_a_file(path, e))?;
     let mut head = Vec::new();
     std::fs::File::open(path)
         .and_then(|f| f.take(1 << 16).read_to_end(&mut head))
@@ -35,6 +37,13 @@ pub fn detect(path: &Path) -> Result<Format, InputError> {
     }
     if aedat4::has_magic(&head) {
         return Ok(Format::Aedat4);
+    }
+    if let Some(kind) = image_kind(&head) {
+        return Err(InputError::unknown(
+            path,
+            format!("a {kind} image, not an event recording"),
+            "give the recording: its folder (events.txt, images.txt) or its event file; frames are found through images.txt",
+        ));
     }
     if [0usize, 512, 1024, 2048]
         .iter()
@@ -52,32 +61,48 @@ pub fn detect(path: &Path) -> Result<Format, InputError> {
         return match header.evt_version() {
             Some(3) => Ok(Format::Evt3),
             Some(2) => Ok(Format::Evt2),
-            Some(v) => Err(InputError::UnknownFormat {
-                path: path.to_path_buf(),
-                detail: format!("Prophesee RAW EVT {v}, which ctcal does not decode"),
-            }),
+            Some(v) => Err(InputError::unknown(
+                path,
+                format!("Prophesee RAW EVT {v}, which ctcal does not decode"),
+                "convert it to EVT 3.0 or 2.0 with Metavision (metavision_file_to_raw) or to HDF5",
+            )),
             None if extension == "dat"
                 || header.get("Width").is_some()
                 || header.get("Version").is_some() =>
             {
                 Ok(Format::Dat)
             }
-            None => Err(InputError::UnknownFormat {
-                path: path.to_path_buf(),
-                detail: "a Prophesee header without an `evt` line".into(),
-            }),
+            None => Err(InputError::unknown(
+                path,
+                "a Prophesee header without an `evt` line",
+                "pass --format evt2, evt3 or dat to say which it is",
+            )),
         };
     }
     if looks_like_event_text(&head) {
         return Ok(Format::Ijrr);
     }
-    Err(InputError::UnknownFormat {
-        path: path.to_path_buf(),
-        detail: format!(
-            "first bytes {:02x?} match no known signature",
-            &head[..head.len().min(8)]
-        ),
-    })
+    let first: Vec<String> = head.iter().take(8).map(|b| format!("{b:02x}")).collect();
+    Err(InputError::unknown(
+        path,
+        format!("first bytes {} match no known signature", first.join(" ")),
+        super::error::FIX_UNKNOWN_FORMAT,
+    ))
+}
+
+/// The kind of image a file starts like, if any.
+fn image_kind(head: &[u8]) -> Option<&'static str> {
+    const KINDS: [(&[u8], &str); 5] = [
+        (b"\x89PNG\r\n\x1a\n", "PNG"),
+        (b"\xff\xd8\xff", "JPEG"),
+        (b"II*\x00", "TIFF"),
+        (b"MM\x00*", "TIFF"),
+        (b"BM", "BMP"),
+    ];
+    KINDS
+        .iter()
+        .find(|(magic, _)| head.starts_with(magic))
+        .map(|(_, kind)| *kind)
 }
 
 /// Whether the first non-comment line is `t x y p` (or a `width height` line).

@@ -25,8 +25,12 @@ pub enum InputError {
         error: std::io::Error,
     },
 
-    #[error("{}: unknown format ({detail})\n  fix: pass --format ijrr|h5|aedat4|evt2|evt3|dat if the file is one of these", path.display())]
-    UnknownFormat { path: PathBuf, detail: String },
+    #[error("{}: unknown format ({detail})\n  fix: {fix}", path.display())]
+    UnknownFormat {
+        path: PathBuf,
+        detail: String,
+        fix: String,
+    },
 
     #[error("{}: {place}: {problem}\n  fix: {fix}", path.display())]
     Corrupt {
@@ -78,7 +82,29 @@ pub enum InputError {
     },
 }
 
+/// The fix for a file whose format is not recognised.
+pub const FIX_UNKNOWN_FORMAT: &str =
+    "pass --format ijrr|h5|aedat4|evt2|evt3|dat if the file is one of these";
+
 impl InputError {
+    /// A file that cannot be read as a regular file (missing, a folder, a FIFO, ...).
+    pub fn not_a_file(path: &Path, problem: crate::files::NotAFile) -> Self {
+        match problem {
+            crate::files::NotAFile::Missing => InputError::NotFound {
+                path: path.to_path_buf(),
+            },
+            other => InputError::invalid(path, other.problem(), other.fix()),
+        }
+    }
+
+    pub(crate) fn unknown(path: &Path, detail: impl Into<String>, fix: impl Into<String>) -> Self {
+        InputError::UnknownFormat {
+            path: path.to_path_buf(),
+            detail: detail.into(),
+            fix: fix.into(),
+        }
+    }
+
     /// An I/O error while reading `path`, mapping "not found" to [`InputError::NotFound`].
     pub fn io(path: &Path, source: std::io::Error) -> Self {
         if source.kind() == std::io::ErrorKind::NotFound {

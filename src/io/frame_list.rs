@@ -26,6 +26,8 @@ pub struct FrameList {
 impl FrameList {
     /// Reads an index file; times must not decrease and every named image must exist.
     pub fn read(index_path: &Path) -> Result<Self, InputError> {
+        crate::files::check_regular(index_path)
+            .map_err(|e| InputError::not_a_file(index_path, e))?;
         let bytes = std::fs::read(index_path).map_err(|e| InputError::io(index_path, e))?;
         let folder = index_path.parent().unwrap_or(Path::new("."));
         let mut entries: Vec<FrameEntry> = Vec::new();

@@ -113,16 +113,33 @@ impl Column {
         column.read_into(range.clone(), bytes).map(|_| *kind)
     }
 
-    /// Appends the values of `range` as i64, whatever the stored integer type.
+    /// Appends the values of `range` as i64, whatever the stored type: integers as they are,
+    /// floats that hold an integer converted, any other float (NaN, infinite, fractional)
+    /// as [`NOT_AN_INTEGER`].
     fn ints(
         &self,
         range: std::ops::Range<usize>,
         bytes: &mut Vec<u8>,
         out: &mut Vec<i64>,
     ) -> hdf5::Result<()> {
-        match self.raw(&range, bytes) {
-            Some(kind) => kind.decode(bytes, out, |v| v, |f| f as i64),
-            None => out.extend(self.dataset.read_slice_1d::<i64, _>(range)?.iter()),
+        if let Some(kind) = self.raw(&range, bytes) {
+            kind.decode(bytes, out, |v| v, float_to_int);
+            return Ok(());
+        }
+        match self.dataset.dtype()?.to_descriptor()? {
+            TypeDescriptor::Boolean => out.extend(
+                self.dataset
+                    .read_slice_1d::<bool, _>(range)?
+                    .iter()
+                    .map(|&b| b as i64),
+            ),
+            TypeDescriptor::Float(_) => out.extend(
+                self.dataset
+                    .read_slice_1d::<f64, _>(range)?
+                    .iter()
+                    .map(|&f| float_to_int(f)),
+            ),
+            _ => out.extend(self.dataset.read_slice_1d::<i64, _>(range)?.iter()),
         }
         Ok(())
     }
@@ -140,36 +157,25 @@ impl Column {
         }
         Ok(())
     }
+}
 
-    /// Appends polarities (booleans, integers or floats; > 0 is ON).
-    fn flags(
-        &self,
-        range: std::ops::Range<usize>,
-        bytes: &mut Vec<u8>,
-        out: &mut Vec<bool>,
-    ) -> hdf5::Result<()> {
-        if let Some(kind) = self.raw(&range, bytes) {
-            kind.decode(bytes, out, |p| p > 0, |p| p > 0.0);
-            return Ok(());
-        }
-        match self.dataset.dtype()?.to_descriptor()? {
-            TypeDescriptor::Boolean => {
-                out.extend(self.dataset.read_slice_1d::<bool, _>(range)?.iter())
-            }
-            TypeDescriptor::Float(_) => out.extend(
-                self.dataset
-                    .read_slice_1d::<f64, _>(range)?
-                    .iter()
-                    .map(|&p| p > 0.0),
-            ),
-            _ => out.extend(
-                self.dataset
-                    .read_slice_1d::<i64, _>(range)?
-                    .iter()
-                    .map(|&p| p > 0),
-            ),
-        }
-        Ok(())
+/// Marks a float coordinate or polarity that is not an integer (NaN, infinite, fractional).
+const NOT_AN_INTEGER: i64 = i64::MIN;
+
+fn float_to_int(f: f64) -> i64 {
+    if f.is_finite() && f.fract() == 0.0 && f.abs() < 9e18 {
+        f as i64
+    } else {
+        NOT_AN_INTEGER
+    }
+}
+
+/// A stored value for messages (`NaN or a fraction` for [`NOT_AN_INTEGER`]).
+fn shown(v: i64) -> String {
+    if v == NOT_AN_INTEGER {
+        "NaN, infinite or not an integer".into()
+    } else {
+        v.to_string()
     }
 }
 
@@ -196,7 +202,32 @@ enum EventTable {
     V2e(hdf5::Dataset),
 }
 
+/// Where each event field is stored, for messages.
+struct FieldNames {
+    t: &'static str,
+    x: &'static str,
+    y: &'static str,
+    p: &'static str,
+}
+
 impl EventTable {
+    fn names(&self) -> FieldNames {
+        match self {
+            EventTable::EventUtils(_) => FieldNames {
+                t: "events/ts",
+                x: "events/xs",
+                y: "events/ys",
+                p: "events/ps",
+            },
+            EventTable::V2e(_) => FieldNames {
+                t: "events[:, 0]",
+                x: "events[:, 1]",
+                y: "events[:, 2]",
+                p: "events[:, 3]",
+            },
+        }
+    }
+
     fn open(path: &Path, file: &hdf5::File, layout: Layout) -> hdf5::Result<Self> {
         Ok(match layout {
             Layout::EventUtils => EventTable::EventUtils(Box::new(EventColumns {
@@ -244,13 +275,13 @@ impl EventTable {
         columns: &mut Columns,
     ) -> hdf5::Result<()> {
         columns.t.clear();
-        columns.on.clear();
+        columns.p.clear();
         match self {
             EventTable::EventUtils(c) => {
                 if c.integer_times {
                     // integer timestamps are microseconds (seconds as integers make no sense)
                     c.ts.ints(range.clone(), &mut buffers.bytes, &mut columns.t)?;
-                    c.ps.flags(range.clone(), &mut buffers.bytes, &mut columns.on)?;
+                    c.ps.ints(range.clone(), &mut buffers.bytes, &mut columns.p)?;
                     return self.coordinates(range, buffers, columns);
                 }
                 buffers.seconds.clear();
@@ -263,7 +294,7 @@ impl EventTable {
                         TimeUs::MIN
                     }
                 }));
-                c.ps.flags(range.clone(), &mut buffers.bytes, &mut columns.on)?;
+                c.ps.ints(range.clone(), &mut buffers.bytes, &mut columns.p)?;
                 self.coordinates(range, buffers, columns)
             }
             EventTable::V2e(ds) => {
@@ -273,7 +304,7 @@ impl EventTable {
                 columns.y.clear();
                 columns.x.extend(rows.column(1).iter());
                 columns.y.extend(rows.column(2).iter());
-                columns.on.extend(rows.column(3).iter().map(|&p| p > 0));
+                columns.p.extend(rows.column(3).iter());
                 Ok(())
             }
         }
@@ -321,8 +352,12 @@ fn coordinate_extent(
                 return Err(InputError::corrupt(
                     path,
                     format!("event index {}", start + i),
-                    format!("coordinate out of range (x={x}, y={y})"),
-                    "the file is damaged or uses another coordinate convention; rewrite it with x, y in 0..W-1, 0..H-1",
+                    format!(
+                        "coordinate out of range (x = {}, y = {})",
+                        shown(x),
+                        shown(y)
+                    ),
+                    "the file is damaged or uses another coordinate convention; rewrite it with whole x, y in 0..W-1, 0..H-1",
                 ));
             }
             max_x = max_x.max(x);
@@ -333,36 +368,89 @@ fn coordinate_extent(
     Ok((max_x, max_y))
 }
 
+/// The filters h5py and PyTables users meet, by HDF5 filter id.
+fn filter_name(id: i32) -> String {
+    match id {
+        32000 => "LZF (h5py's compression=\"lzf\", filter 32000)".into(),
+        32001 => "Blosc (filter 32001)".into(),
+        32004 => "LZ4 (filter 32004)".into(),
+        32008 => "bitshuffle (filter 32008)".into(),
+        32015 => "Zstandard (filter 32015)".into(),
+        other => format!("filter {other}"),
+    }
+}
+
+/// Checks a dataset before anything is allocated from what it claims: its rank, that
+/// libhdf5 can undo its filters, and that its logical size is plausible for the bytes it
+/// stores (deflate cannot compress more than about 1032:1, so a dataset claiming far more
+/// than 1100 times its stored bytes is damage, not data). Returns its shape.
+fn check_dataset(
+    path: &Path,
+    file: &hdf5::File,
+    name: &str,
+    rank: usize,
+) -> Result<Vec<usize>, InputError> {
+    let ds = file.dataset(name).map_err(|e| h5_error(path, name, e))?;
+    let shape = ds.shape();
+    if shape.len() != rank {
+        let what = if shape.is_empty() {
+            "a scalar".to_string()
+        } else {
+            format!("{}-dimensional (shape {shape:?})", shape.len())
+        };
+        return Err(InputError::hdf5(
+            path,
+            format!("{name} is {what}; ctcal expects a {rank}-dimensional dataset"),
+            "check that the file is an event_utils or v2e HDF5 file (h5ls -r shows its layout)",
+        ));
+    }
+    for filter in ds.filters() {
+        if !filter.decode_enabled() {
+            return Err(InputError::hdf5(
+                path,
+                format!(
+                    "{name} is compressed with {}, which this libhdf5 cannot decompress",
+                    filter_name(filter.id())
+                ),
+                "rewrite the file with gzip compression, e.g. `h5repack -f GZIP=4 in.h5 out.h5` (or in h5py: compression=\"gzip\")",
+            ));
+        }
+    }
+    let element = ds.dtype().map(|d| d.size()).unwrap_or(1) as f64;
+    let logical = shape.iter().map(|&n| n as f64).product::<f64>() * element;
+    let stored = ds.storage_size() as f64;
+    if logical > 1100.0 * stored.max(4096.0) {
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "{name} claims shape {shape:?} ({logical:.3e} bytes) but stores only {stored:.0} bytes"
+            ),
+            "the file is damaged or was written incompletely; rewrite it from the source",
+        ));
+    }
+    Ok(shape)
+}
+
 /// Inspects an HDF5 event file and checks its sensor claim against the coordinates.
 pub fn probe(path: &Path) -> Result<H5Info, InputError> {
     let file = open_file(path)?;
     let layout = layout_of(path, &file)?;
     let events = match layout {
         Layout::EventUtils => {
-            let n = file
-                .dataset("events/ts")
-                .map_err(|e| h5_error(path, "events/ts", e))?
-                .shape();
-            let n = n.first().copied().unwrap_or(0);
-            for name in ["xs", "ys", "ps"] {
-                let ds = file
-                    .dataset(&format!("events/{name}"))
-                    .map_err(|e| h5_error(path, name, e))?;
-                let len = ds.shape().first().copied().unwrap_or(0);
+            let n = check_dataset(path, &file, "events/ts", 1)?[0];
+            for name in ["events/xs", "events/ys", "events/ps"] {
+                let len = check_dataset(path, &file, name, 1)?[0];
                 if len != n {
                     return Err(InputError::hdf5(
                         path,
-                        format!("events/{name} has {len} entries but events/ts has {n}"),
+                        format!("{name} has {len} entries but events/ts has {n}"),
                         "the file is damaged or was written incompletely; rewrite it",
                     ));
                 }
             }
             n
         }
-        Layout::V2e => file
-            .dataset("events")
-            .map_err(|e| h5_error(path, "events", e))?
-            .shape()[0],
+        Layout::V2e => check_dataset(path, &file, "events", 2)?[0],
     };
     let (sensor, sensor_note) = match claimed_resolution(&file) {
         None => (None, None),
@@ -397,10 +485,7 @@ pub fn probe(path: &Path) -> Result<H5Info, InputError> {
             }
         }
     };
-    let frame_count = match layout {
-        Layout::EventUtils => image_names(&file).len(),
-        Layout::V2e => file.dataset("frame").map(|d| d.shape()[0]).unwrap_or(0),
-    };
+    let frame_count = frame_index(path, &file, layout)?.times.len();
     Ok(H5Info {
         layout,
         events,
@@ -422,84 +507,187 @@ fn image_names(file: &hdf5::File) -> Vec<String> {
     names
 }
 
-/// Reads every frame.
-pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError> {
-    let file = open_file(path)?;
+/// Checks a frame size read from a file.
+fn frame_size(
+    path: &Path,
+    name: &str,
+    height: usize,
+    width: usize,
+) -> Result<(u32, u32), InputError> {
+    let limit = crate::events::MAX_SENSOR_SIDE as usize;
+    if width == 0 || height == 0 || width > limit || height > limit {
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "{name} holds {width}x{height} frames; ctcal reads frames of 1..={limit} pixels a side"
+            ),
+            "the file is damaged, or its frames are not grey (H, W) images",
+        ));
+    }
+    Ok((width as u32, height as u32))
+}
+
+/// The frames' times, (H, W) and how to read each, checked as IJRR frame lists are: one
+/// size, times that never decrease.
+struct FrameIndex {
+    times: Vec<TimeUs>,
+    /// Dataset of each frame (event_utils) or `None` (v2e: rows of `frame`).
+    datasets: Vec<Option<String>>,
+    size: (u32, u32),
+}
+
+fn frame_index(path: &Path, file: &hdf5::File, layout: Layout) -> Result<FrameIndex, InputError> {
     let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
-    let mut frames = Vec::new();
-    match info.layout {
+    let mut index = FrameIndex {
+        times: Vec::new(),
+        datasets: Vec::new(),
+        size: (0, 0),
+    };
+    match layout {
         Layout::EventUtils => {
-            for name in image_names(&file) {
-                let ds = file
-                    .dataset(&format!("images/{name}"))
-                    .map_err(|e| err(&name, e))?;
+            for name in image_names(file) {
+                let full = format!("images/{name}");
+                let shape = check_dataset(path, file, &full, 2)?;
+                let size = frame_size(path, &full, shape[0], shape[1])?;
+                let ds = file.dataset(&full).map_err(|e| err(&full, e))?;
                 let t: f64 = ds
                     .attr("timestamp")
                     .and_then(|a| a.read_scalar::<f64>())
-                    .map_err(|e| err(&format!("images/{name} attribute `timestamp`"), e))?;
-                let image = ds.read_dyn::<u8>().map_err(|e| err(&name, e))?;
-                let shape = image.shape().to_vec();
-                if shape.len() != 2 {
+                    .map_err(|e| err(&format!("{full} attribute `timestamp`"), e))?;
+                if !t.is_finite() || t.abs() > 1e12 {
                     return Err(InputError::hdf5(
                         path,
-                        format!(
-                            "images/{name} has shape {shape:?}; ctcal reads grey (H, W) images"
-                        ),
-                        "store frames as 8-bit grey (H, W) datasets",
+                        format!("{full} has timestamp {t}"),
+                        "frame timestamps are seconds; the file is damaged",
                     ));
                 }
-                frames.push(Frame {
-                    t: crate::events::s_to_us(t),
-                    width: shape[1] as u32,
-                    height: shape[0] as u32,
-                    pixels: image.iter().copied().collect(),
-                    exposure_us: None,
-                });
+                index.push(
+                    path,
+                    &full,
+                    crate::events::s_to_us(t),
+                    size,
+                    Some(full.clone()),
+                )?;
             }
         }
         Layout::V2e => {
-            let Ok(ds) = file.dataset("frame") else {
-                return Ok(frames);
-            };
-            let stack = ds.read_dyn::<u8>().map_err(|e| err("frame", e))?;
-            let ts: Vec<i64> = file
+            if file.dataset("frame").is_err() {
+                return Ok(index);
+            }
+            let shape = check_dataset(path, file, "frame", 3)?;
+            let size = frame_size(path, "frame", shape[1], shape[2])?;
+            let times: Vec<i64> = file
                 .dataset("frame_ts")
                 .and_then(|d| d.read_raw::<i64>())
                 .map_err(|e| err("frame_ts", e))?;
-            let shape = stack.shape().to_vec();
-            if shape.len() != 3 || ts.len() != shape[0] {
+            if times.len() != shape[0] {
                 return Err(InputError::hdf5(
                     path,
                     format!(
-                        "frame has shape {shape:?} and frame_ts {} entries",
-                        ts.len()
+                        "frame holds {} frames but frame_ts {} timestamps",
+                        shape[0],
+                        times.len()
                     ),
-                    "v2e frames are (N, H, W) with N timestamps in frame_ts",
+                    "v2e frames are (N, H, W) with N timestamps (microseconds) in frame_ts",
                 ));
             }
-            let size = shape[1] * shape[2];
-            let flat: Vec<u8> = stack.iter().copied().collect();
-            for (i, &t) in ts.iter().enumerate() {
-                frames.push(Frame {
-                    t: t as TimeUs,
-                    width: shape[2] as u32,
-                    height: shape[1] as u32,
-                    pixels: flat[i * size..(i + 1) * size].to_vec(),
-                    exposure_us: None,
-                });
+            for (i, &t) in times.iter().enumerate() {
+                index.push(path, &format!("frame_ts[{i}]"), t, size, None)?;
             }
         }
+    }
+    Ok(index)
+}
+
+impl FrameIndex {
+    fn push(
+        &mut self,
+        path: &Path,
+        place: &str,
+        t: TimeUs,
+        size: (u32, u32),
+        dataset: Option<String>,
+    ) -> Result<(), InputError> {
+        if let Some(&previous) = self.times.last() {
+            if size != self.size {
+                return Err(InputError::corrupt(
+                    path,
+                    place,
+                    format!(
+                        "the frame is {}x{}, the first frame {}x{}",
+                        size.0, size.1, self.size.0, self.size.1
+                    ),
+                    "give frames of one size",
+                ));
+            }
+            if t < previous {
+                return Err(InputError::corrupt(
+                    path,
+                    place,
+                    format!("frame time {t} us is earlier than the frame before ({previous} us)"),
+                    "store frames in time order",
+                ));
+            }
+        }
+        self.size = size;
+        self.times.push(t);
+        self.datasets.push(dataset);
+        Ok(())
+    }
+}
+
+/// Frame timestamps, without reading any image.
+pub fn read_frame_times(path: &Path, info: &H5Info) -> Result<Vec<TimeUs>, InputError> {
+    let file = open_file(path)?;
+    Ok(frame_index(path, &file, info.layout)?.times)
+}
+
+/// Reads every frame.
+pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError> {
+    let file = open_file(path)?;
+    let index = frame_index(path, &file, info.layout)?;
+    let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
+    let (width, height) = index.size;
+    let stack = match info.layout {
+        Layout::V2e if !index.times.is_empty() => {
+            Some(file.dataset("frame").map_err(|e| err("frame", e))?)
+        }
+        _ => None,
+    };
+    let mut frames = Vec::with_capacity(index.times.len());
+    for (i, (&t, dataset)) in index.times.iter().zip(&index.datasets).enumerate() {
+        let pixels: Vec<u8> = match (dataset, &stack) {
+            (Some(name), _) => file
+                .dataset(name)
+                .and_then(|ds| ds.read_raw::<u8>())
+                .map_err(|e| err(name, e))?,
+            (None, Some(stack)) => stack
+                .read_slice_2d::<u8, _>(ndarray::s![i, .., ..])
+                .map_err(|e| err(&format!("frame[{i}]"), e))?
+                .iter()
+                .copied()
+                .collect(),
+            (None, None) => unreachable!("v2e frames have the stack"),
+        };
+        frames.push(Frame {
+            t,
+            width,
+            height,
+            pixels,
+            exposure_us: None,
+        });
     }
     Ok(frames)
 }
 
-/// One slice of the event columns, before validation (coordinates may be out of range).
+/// One slice of the event columns, before validation (coordinates may be out of range,
+/// polarities any integer).
 #[derive(Default)]
 struct Columns {
     t: Vec<TimeUs>,
     x: Vec<i64>,
     y: Vec<i64>,
-    on: Vec<bool>,
+    p: Vec<i64>,
 }
 
 /// Streaming HDF5 event reader.
@@ -554,35 +742,59 @@ impl EventDecoder for H5Decoder {
             t,
             x: xs,
             y: ys,
-            on: ps,
+            p: ps,
         } = &self.columns;
+        let names = self.table.names();
         for i in 0..t.len() {
             let (x, y) = (xs[i], ys[i]);
             let index = self.position + i;
-            let inside = x >= 0
-                && y >= 0
-                && x <= u16::MAX as i64
-                && y <= u16::MAX as i64
-                && self.sensor.is_none_or(|s| s.contains(x as u16, y as u16));
-            if !inside {
+            if x == NOT_AN_INTEGER || y == NOT_AN_INTEGER {
+                let (name, value) = if x == NOT_AN_INTEGER {
+                    (names.x, x)
+                } else {
+                    (names.y, y)
+                };
+                return Err(InputError::corrupt(
+                    &self.path,
+                    format!("{name}[{index}]"),
+                    format!("the coordinate is {}", shown(value)),
+                    "coordinates must be whole pixel numbers; the file is damaged or was written from floating-point data: rewrite it with integer x and y",
+                ));
+            }
+            if !(x >= 0 && y >= 0 && super::within(self.sensor, x as u32, y as u32))
+                || x > u32::MAX as i64
+                || y > u32::MAX as i64
+            {
                 return Err(super::outside_sensor(
                     &self.path,
-                    format!("event index {index}"),
-                    x as i64,
-                    y as i64,
+                    format!("event index {index} ({}, {})", names.x, names.y),
+                    x,
+                    y,
                     self.sensor,
                 ));
             }
             if t[i] == TimeUs::MIN {
                 return Err(InputError::corrupt(
                     &self.path,
-                    format!("event index {index}"),
+                    format!("{}[{index}]", names.t),
                     "the timestamp is not a finite number",
                     "the file is damaged; rewrite it from the source recording",
                 ));
             }
-            self.order.check(t[i], || format!("event index {index}"));
-            out.push(t[i], x as u16, y as u16, ps[i]);
+            let on = match ps[i] {
+                1 => true,
+                0 | -1 => false,
+                other => {
+                    return Err(InputError::corrupt(
+                        &self.path,
+                        format!("{}[{index}]", names.p),
+                        format!("the polarity is {}", shown(other)),
+                        "polarities are 1 (ON) and 0 or -1 (OFF); the file is damaged or uses another convention",
+                    ));
+                }
+            };
+            self.order.check(t[i], || format!("{}[{index}]", names.t));
+            out.push(t[i], x as u16, y as u16, on);
         }
         self.position = end;
         Ok(())

@@ -34,12 +34,16 @@ impl IjrrFiles {
                 path.to_path_buf(),
             )
         };
-        if !events.is_file() {
-            return Err(InputError::invalid(
-                path,
-                "the folder holds no events.txt",
-                "point ctcal at an IJRR folder (events.txt, optional images.txt) or at an event file",
-            ));
+        match crate::files::check_regular(&events) {
+            Ok(_) => {}
+            Err(crate::files::NotAFile::Missing) => {
+                return Err(InputError::invalid(
+                    path,
+                    "the folder holds no events.txt",
+                    "point ctcal at an IJRR folder (events.txt, optional images.txt) or at an event file",
+                ));
+            }
+            Err(e) => return Err(InputError::not_a_file(&events, e)),
         }
         let existing = |name: &str| Some(folder.join(name)).filter(|p| p.is_file());
         Ok(Self {

@@ -66,7 +66,24 @@ impl Recording {
             });
         }
         let format = match options.format {
-            Some(f) => f,
+            Some(forced) => {
+                // the content may still say what it is: a forced format that does not fit is
+                // named as such, rather than reported later as damage
+                if !path.is_dir() {
+                    crate::files::check_regular(path)
+                        .map_err(|e| InputError::not_a_file(path, e))?;
+                }
+                match detect(path) {
+                    Ok(found) if found != forced => {
+                        return Err(InputError::invalid(
+                            path,
+                            format!("--format {forced} does not fit: the content is {found}"),
+                            "drop --format (ctcal detects the format from the content), or give the right one",
+                        ));
+                    }
+                    _ => forced,
+                }
+            }
             None => detect(path)?,
         };
         let mut notes = Vec::new();
@@ -279,7 +296,9 @@ impl Recording {
                 Some(images) => Ok(FrameList::read(images)?.times()),
                 None => Ok(Vec::new()),
             },
-            _ => Ok(self.frames()?.iter().map(|f| f.t).collect()),
+            Source::H5(info) => h5::read_frame_times(&self.path, info),
+            Source::Aedat4(header) => aedat4::read_frame_times(&self.path, header),
+            _ => Ok(Vec::new()),
         }
     }
 
