@@ -261,8 +261,8 @@ impl Row {
     pub fn vector_phase(&mut self, step: &Step, dn1: &[f32], u1: &mut [f32]) {
         self.events.clear();
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU supports AVX2, checked on the line above.
+        if use_avx2() {
+            // SAFETY: use_avx2() is true only when the CPU supports AVX2.
             unsafe { self.vector_work_avx2(step, dn1, u1) };
             return;
         }
@@ -330,4 +330,16 @@ impl Row {
 fn select(quiet: u32, new: f32, old: f32) -> f32 {
     let mask = 0u32.wrapping_sub(quiet);
     f32::from_bits((new.to_bits() & mask) | (old.to_bits() & !mask))
+}
+
+/// Whether the AVX2 code path runs: when the CPU has AVX2, unless the environment variable
+/// `CTCAL_SIMD=scalar` asks for the portable path (to check that both give identical
+/// events).
+#[cfg(target_arch = "x86_64")]
+fn use_avx2() -> bool {
+    static AVX2: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *AVX2.get_or_init(|| {
+        std::arch::is_x86_feature_detected!("avx2")
+            && std::env::var("CTCAL_SIMD").map_or(true, |v| v != "scalar")
+    })
 }

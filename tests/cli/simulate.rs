@@ -110,7 +110,6 @@ fn per_pixel_thresholds_with_50_hz_frames_and_upsampling() {
 fn bandwidth_reduces_counts_in_the_dark_as_the_oracle_shows() {
     let oracle_ratio = oracle_counts("d_bw_middim_texture").0 as f64
         / oracle_counts("d_ctrl_middim_texture").0 as f64;
-    assert!((oracle_ratio - 0.822).abs() < 0.001);
     let with = simulate(
         "ct_on = 0.3\nct_off = 0.3\ncutoff_hz = 30.0\n",
         &oracle("d_bw_middim_texture"),
@@ -137,10 +136,28 @@ fn leak_alone_makes_the_oracle_count_of_on_events() {
         &case,
         &["--leak-factor-map", map.to_str().unwrap()],
     );
-    let (n, on, _) = counts(&read_events(&sim.out));
+    let ours = read_events(&sim.out);
+    let (n, on, _) = counts(&ours);
     let (n_o, _, _) = oracle_counts("c_leak_static");
     assert_eq!(on, n, "a static scene with leak makes only ON events");
-    assert!(relative(n, n_o) < 0.15, "{n} vs {n_o}");
+    // the leak is deterministic given each pixel's factor: the totals agree to 0.1 %
+    assert!(relative(n, n_o) < 0.001, "{n} vs {n_o}");
+    // and pixel by pixel: a pixel's ON count is its drift over 4 s, leak_rate * factor * 4,
+    // give or take the one event the phase of the last crossing decides
+    let factors: ndarray::Array2<f32> = ndarray_npy::read_npy(&map).unwrap();
+    let ours_map = count_map(&ours, 240, 180);
+    let theirs_map = count_map(&read_events(&case), 240, 180);
+    let mut within_one = 0;
+    for (i, &f) in factors.iter().enumerate() {
+        let expected = 4.0 * f as f64;
+        assert!(
+            (ours_map[i] - expected).abs() <= 1.0,
+            "pixel {i}: {} events for factor {f}",
+            ours_map[i]
+        );
+        within_one += ((ours_map[i] - theirs_map[i]).abs() <= 1.0) as usize;
+    }
+    assert!(within_one as f64 / factors.len() as f64 > 0.99);
 }
 
 #[test]
@@ -153,9 +170,18 @@ fn shot_noise_in_a_static_scene_matches_the_oracle_count() {
         &["--leak-factor-map", map.to_str().unwrap()],
     );
     let (n, on, _) = counts(&read_events(&sim.out));
-    let (n_o, _, _) = oracle_counts("c_noisy_static");
-    assert!(relative(n, n_o) < 0.15, "{n} vs {n_o}");
-    assert!((on as f64 / n as f64 - 0.5).abs() < 0.02);
+    let (n_o, on_o, _) = oracle_counts("c_noisy_static");
+    // the noise count is Poisson: within 4 sigma of the oracle's
+    let sigma = (n_o as f64).sqrt();
+    assert!(
+        (n as f64 - n_o as f64).abs() < 4.0 * sigma,
+        "{n} vs {n_o} (sigma {sigma:.0})"
+    );
+    let sigma_on = (on_o as f64).sqrt();
+    assert!(
+        (on as f64 - on_o as f64).abs() < 4.0 * sigma_on,
+        "{on} vs {on_o}"
+    );
 }
 
 /// Shortest interval between consecutive events of one pixel, microseconds.
@@ -172,33 +198,138 @@ fn shortest_same_pixel_interval(events: &ctcal::EventChunk, width: usize, height
     shortest
 }
 
+/// Median of the intervals between consecutive events of one pixel, microseconds.
+fn median_same_pixel_interval(events: &ctcal::EventChunk, width: usize, height: usize) -> f64 {
+    let mut last = vec![i64::MIN; width * height];
+    let mut intervals = Vec::new();
+    for e in events.iter() {
+        let slot = &mut last[e.y as usize * width + e.x as usize];
+        if *slot != i64::MIN {
+            intervals.push(e.t - *slot);
+        }
+        *slot = e.t;
+    }
+    intervals.sort_unstable();
+    intervals[intervals.len() / 2] as f64
+}
+
+/// The dev_refractory scene (params.json `scene`) rendered by ctcal at the oracle's 1.05 kHz,
+/// so that each edge's 15 ms transit over a pixel is resolved as it was for v2e (its 50 Hz
+/// APS frames would spread it over 20-40 ms, and the 5 ms period would rarely bind).
+const REFRACTORY_SCENE: &str = "kind = \"checkerboard\"\nwidth = 240\nheight = 180\nduration_s = 1.0\nrender_hz = 1050.0\n[checkerboard]\nsquare_px = 48.0\nlo_dn = 60.0\nhi_dn = 160.0\nvx_px_s = -66.0\nvy_px_s = 15.0\norigin_px = [17.3, -29.6]\n";
+
 #[test]
-fn refractory_period_keeps_the_count_and_spaces_the_events() {
-    let case = oracle("dev_refractory");
-    let sim = simulate(
-        "ct_on = 0.25\nct_off = 0.25\nrefractory_s = 0.005\n",
-        &case,
-        &[],
+fn refractory_period_spaces_the_events_as_the_oracle_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    std::fs::write(&scene, REFRACTORY_SCENE).unwrap();
+    let run =
+        |params: &str| read_events(&simulate_input(params, "--scene", &scene, "out", &[]).out);
+    let ours = run("ct_on = 0.25\nct_off = 0.25\nrefractory_s = 0.005\n");
+    let theirs = read_events(&oracle("dev_refractory"));
+    // the count cannot tell the period on from off (a suppressed change fires later), the
+    // timing can: no interval below the period, and the median interval is the period
+    // itself, because an edge's crossings come faster than one per 5 ms. v2e fires a
+    // pending change at its next simulation frame (every 952 us), so its median is the
+    // period rounded up to that grid: the two agree within one of its frames.
+    assert!(
+        relative(ours.len(), theirs.len()) < 0.02,
+        "{} vs {}",
+        ours.len(),
+        theirs.len()
     );
-    let ours = read_events(&sim.out);
-    let (n_o, _, _) = oracle_counts("dev_refractory");
-    assert!(relative(ours.len(), n_o) < 0.05, "{} vs {n_o}", ours.len());
     assert!(shortest_same_pixel_interval(&ours, 240, 180) >= 5000);
-    assert!(shortest_same_pixel_interval(&read_events(&case), 240, 180) >= 5000);
-    // Interpolated between the 50 Hz frames, an edge sweeps a pixel's 3 thresholds in about
-    // 5 ms, so 5 ms barely binds here; a longer period shows the effect: it spaces events
-    // that would otherwise come closer, and delays rather than drops them.
-    let free = simulate("ct_on = 0.25\nct_off = 0.25\n", &case, &[]);
-    let free_events = read_events(&free.out);
-    assert!(shortest_same_pixel_interval(&free_events, 240, 180) < 8000);
-    let long = simulate(
-        "ct_on = 0.25\nct_off = 0.25\nrefractory_s = 0.008\n",
-        &case,
-        &[],
+    let (median, median_o) = (
+        median_same_pixel_interval(&ours, 240, 180),
+        median_same_pixel_interval(&theirs, 240, 180),
     );
-    let long_events = read_events(&long.out);
-    assert!(shortest_same_pixel_interval(&long_events, 240, 180) >= 8000);
-    assert!(relative(long_events.len(), free_events.len()) < 0.05);
+    assert!(
+        (median - 5000.0).abs() <= 1.0 && median_o - median <= 952.0 && median_o >= median,
+        "median interval {median} us vs the oracle's {median_o} us"
+    );
+    // without the period most intervals are shorter than 5 ms
+    let free = run("ct_on = 0.25\nct_off = 0.25\n");
+    let free_median = median_same_pixel_interval(&free, 240, 180);
+    assert!(free_median < 0.8 * median_o, "free median {free_median} us");
+    // a longer period delays rather than drops events
+    let long = run("ct_on = 0.25\nct_off = 0.25\nrefractory_s = 0.008\n");
+    assert!(shortest_same_pixel_interval(&long, 240, 180) >= 8000);
+    assert!(relative(long.len(), free.len()) < 0.05);
+}
+
+#[test]
+fn event_times_match_the_oracle_within_a_frame_interval() {
+    // a_ideal_texture gives every 2 ms simulation frame. v2e stamps a frame's single event
+    // of a pixel at the frame's end (params.json model_facts.timestamps, M = 1); ctcal puts
+    // it at its interpolated crossing inside the frame. So the k-th event of a pixel is
+    // earlier than v2e's by between 0 and one frame interval, by half of it on average.
+    let case = oracle("a_ideal_texture");
+    let sim = simulate("ct_on = 0.3\nct_off = 0.3\n", &case, &[]);
+    let per_pixel = |events: &ctcal::EventChunk| {
+        let mut map: Vec<Vec<(i64, bool)>> = vec![Vec::new(); 240 * 180];
+        for e in events.iter() {
+            map[e.y as usize * 240 + e.x as usize].push((e.t, e.on));
+        }
+        map
+    };
+    let (ours, theirs) = (
+        per_pixel(&read_events(&sim.out)),
+        per_pixel(&read_events(&case)),
+    );
+    let mut offsets = Vec::new();
+    for (a, b) in ours.iter().zip(&theirs) {
+        for (&(ta, pa), &(tb, pb)) in a.iter().zip(b) {
+            if pa != pb {
+                break; // a lost or extra event: the rest of this pixel does not pair up
+            }
+            offsets.push(ta - tb);
+        }
+    }
+    assert!(offsets.len() > 220_000, "{} pairs", offsets.len());
+    let inside = offsets
+        .iter()
+        .filter(|&&d| (-2001..=1).contains(&d))
+        .count();
+    let share = inside as f64 / offsets.len() as f64;
+    assert!(
+        share > 0.99,
+        "{share} of the events within one frame before v2e's"
+    );
+    let mean = offsets.iter().sum::<i64>() as f64 / offsets.len() as f64;
+    assert!((-1200.0..-700.0).contains(&mean), "mean offset {mean} us");
+}
+
+#[test]
+fn avx2_and_portable_paths_give_identical_events() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = dir.path().join("p.toml");
+    // the quiet-pixel pass is vectorised in every configuration: ideal, filtered, noisy
+    for (name, text) in [
+        ("ideal", "ct_on = 0.3\nct_off = 0.3\n"),
+        (
+            "all",
+            "ct_on = 0.35\nct_off = 0.45\nct_sigma = 0.03\nrefractory_s = 0.0005\ncutoff_hz = 300.0\nleak_rate_hz = 0.1\nshot_noise_rate_hz = 1.0\nseed = 4\n",
+        ),
+    ] {
+        std::fs::write(&params, text).unwrap();
+        let mut outputs = Vec::new();
+        for simd in ["auto", "scalar"] {
+            let out = dir.path().join(format!("{name}_{simd}"));
+            ctcal()
+                .env("CTCAL_SIMD", simd)
+                .args(["simulate", "--params", params.to_str().unwrap()])
+                .args(["--frames", oracle("d_bw_middim_texture").to_str().unwrap()])
+                .args(["--out", out.to_str().unwrap()])
+                .assert()
+                .success();
+            outputs.push(std::fs::read(out.join("events.txt")).unwrap());
+        }
+        assert!(outputs[0].len() > 1_000_000, "{name}");
+        assert!(
+            outputs[0] == outputs[1],
+            "{name}: AVX2 and portable events differ"
+        );
+    }
 }
 
 #[test]

@@ -3,7 +3,7 @@
 
 use crate::common::*;
 
-const CONTRACT_KEYS: [&str; 20] = [
+const CONTRACT_KEYS: [&str; 21] = [
     "width",
     "height",
     "events",
@@ -21,9 +21,10 @@ const CONTRACT_KEYS: [&str; 20] = [
     "hot_pixels",
     "hot_pixel_method",
     "background_rate_hz",
+    "background_rate_method",
+    "median_pixel_rate_hz",
     "inter_event_interval_s",
     "frames",
-    "t_first_us",
 ];
 
 #[test]
@@ -32,6 +33,8 @@ fn json_carries_every_contract_key() {
     for key in CONTRACT_KEYS {
         assert!(s.get(key).is_some(), "missing {key}");
     }
+    let distinct: std::collections::BTreeSet<_> = CONTRACT_KEYS.iter().collect();
+    assert_eq!(distinct.len(), CONTRACT_KEYS.len(), "a key listed twice");
     let duration = s["duration_s"].as_f64().unwrap();
     assert!((duration - (174_156 - 3_811) as f64 / 1e6).abs() < 1e-12);
     let expected = 50_000.0 / (240.0 * 180.0 * duration);

@@ -11,22 +11,9 @@
 //! most once per period. (In a real DVS the reference follows the input during reset, which
 //! would lose the change instead; v2e's choice is kept so simulations match v2e's.)
 
-/// The earliest time (microseconds) a pixel that last fired at `last_event_us` may fire.
+/// The earliest time (microseconds) a pixel that last fired at `last_event_us` may fire
+/// (its behaviour is tested with the pixel, `pixel.rs`, and against the oracle).
 #[inline]
 pub fn earliest_event_us(last_event_us: f64, refractory_us: f64) -> f64 {
     last_event_us + refractory_us
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_pixel_may_fire_once_the_period_has_passed() {
-        assert_eq!(earliest_event_us(1000.0, 5000.0), 6000.0);
-        assert_eq!(
-            earliest_event_us(f64::NEG_INFINITY, 5000.0),
-            f64::NEG_INFINITY
-        );
-    }
 }
