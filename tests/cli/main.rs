@@ -4,7 +4,9 @@
 mod common;
 mod convert;
 mod errors;
+mod limits;
 mod readers;
+mod safety;
 mod samples;
 mod simulate;
 mod stats;

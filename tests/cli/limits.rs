@@ -1,0 +1,551 @@
+//! Bounded work for any input, and the small things users hit at once: every hostile or
+//! mistaken input of the safety issue gets exit code 2 with the file, the place and a fix,
+//! quickly, instead of a panic, a hang or a request for gigabytes. (Peak memory of the
+//! cases that used to ask for gigabytes is asserted in-process by `tests/hostile.rs`.)
+
+use crate::common::*;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path.to_str().unwrap().to_string()
+}
+
+/// An event_utils HDF5 file from columns of any types.
+fn h5_events<X: hdf5::H5Type, P: hdf5::H5Type>(
+    path: &Path,
+    ts: &[f64],
+    xs: &[X],
+    ys: &[X],
+    ps: &[P],
+) {
+    let file = hdf5::File::create(path).unwrap();
+    let events = file.create_group("events").unwrap();
+    events
+        .new_dataset_builder()
+        .with_data(ts)
+        .create("ts")
+        .unwrap();
+    events
+        .new_dataset_builder()
+        .with_data(xs)
+        .create("xs")
+        .unwrap();
+    events
+        .new_dataset_builder()
+        .with_data(ys)
+        .create("ys")
+        .unwrap();
+    events
+        .new_dataset_builder()
+        .with_data(ps)
+        .create("ps")
+        .unwrap();
+}
+
+#[test]
+fn a_sensor_over_4096_pixels_needs_sensor_given() {
+    let dir = tempfile::tempdir().unwrap();
+    // from an IJRR `width height` line
+    let text = write(
+        dir.path(),
+        "big.txt",
+        b"5000 100\n0.1 4500 10 1\n0.2 1 1 0\n",
+    );
+    let e = bad_input(&["stats", &text]);
+    assert!(
+        e.contains("big.txt")
+            && e.contains("5000x100")
+            && e.contains("width height")
+            && e.contains("--sensor"),
+        "{e}"
+    );
+    let s = json(&["stats", &text, "--sensor", "5000x100"]);
+    assert_eq!(s["events"], 2);
+    // from a Prophesee header
+    let mut raw = b"% evt 3.0\n% geometry 8000x8000\n% end\n".to_vec();
+    raw.extend_from_slice(&[0x00, 0x80, 0x00, 0x60, 0x05, 0x20]);
+    let raw = write(dir.path(), "big.raw", &raw);
+    let e = bad_input(&["stats", &raw]);
+    assert!(e.contains("geometry") && e.contains("8000x8000"), "{e}");
+    // from sensor_resolution
+    let h5 = dir.path().join("big.h5");
+    h5_events(&h5, &[0.1, 0.2], &[1i16, 2], &[1i16, 2], &[true, false]);
+    hdf5::File::open_rw(&h5)
+        .unwrap()
+        .new_attr_builder()
+        .with_data(&[100i64, 9000])
+        .create("sensor_resolution")
+        .unwrap();
+    let e = bad_input(&["stats", h5.to_str().unwrap()]);
+    assert!(
+        e.contains("sensor_resolution") && e.contains("9000x100"),
+        "{e}"
+    );
+    // from the largest coordinate when nothing states the size
+    let far = write(dir.path(), "far.txt", b"0.1 1 1 1\n0.2 60000 3 0\n");
+    let e = bad_input(&["stats", &far]);
+    assert!(
+        e.contains("line 2") && e.contains("60000") && e.contains("4096") && e.contains("--sensor"),
+        "{e}"
+    );
+}
+
+#[test]
+fn time_options_beyond_any_recording_are_errors() {
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    for args in [
+        ["--start", "1e300"],
+        ["--end", "1e19"],
+        ["--start", "-1"],
+        ["--end", "nan"],
+    ] {
+        let flag = format!("{}={}", args[0], args[1]);
+        let e = bad_input(&["stats", input, &flag]);
+        assert!(
+            e.contains(args[0]) && e.contains("seconds"),
+            "{args:?}: {e}"
+        );
+    }
+    let e = bad_input(&["stats", input, "--start", "5"]);
+    assert!(e.contains("--start 5 s") && !e.contains("Some("), "{e}");
+}
+
+#[test]
+fn absurd_timestamps_are_refused_where_they_are() {
+    let dir = tempfile::tempdir().unwrap();
+    // 1e300 s cannot be microseconds at all
+    let text = write(dir.path(), "huge.txt", b"0.1 1 1 1\n1e300 2 2 1\n");
+    let e = bad_input(&["stats", &text]);
+    assert!(e.contains("line 2"), "{e}");
+    // 3e12 s fits in 64 bits of microseconds, but lies beyond 2^61 us
+    let text = write(dir.path(), "far.txt", b"0.1 1 1 1\n3e12 2 2 1\n");
+    let e = bad_input(&["stats", &text]);
+    assert!(e.contains("line 2") && e.contains("beyond"), "{e}");
+}
+
+#[test]
+fn a_gap_of_ten_million_seconds_gives_a_bounded_timeline() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = write(
+        dir.path(),
+        "gap.txt",
+        b"240 180\n0.000001 1 1 1\n0.000002 2 2 0\n10000000.0 3 3 1\n",
+    );
+    let started = Instant::now();
+    let s = json(&["stats", &text]);
+    assert!(started.elapsed() < Duration::from_secs(20));
+    let timeline = s["rate_timeline"].as_array().unwrap();
+    assert!(timeline.len() <= 100_000, "{}", timeline.len());
+    let total: u64 = timeline.iter().map(|w| w["events"].as_u64().unwrap()).sum();
+    assert_eq!(total, 3);
+}
+
+#[test]
+fn hdf5_coordinates_and_polarities_are_checked_by_dataset_and_index() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("nan_x.h5");
+    h5_events(
+        &path,
+        &[0.1, 0.2, 0.3],
+        &[1.0f64, f64::NAN, 3.0],
+        &[1.0f64, 2.0, 3.0],
+        &[1u8, 0, 1],
+    );
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(e.contains("events/xs[1]") && e.contains("NaN"), "{e}");
+    let path = dir.path().join("negative_x.h5");
+    h5_events(&path, &[0.1, 0.2], &[1i32, -5], &[1i32, 2], &[1u8, 0]);
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(e.contains("x=-5") && e.contains("event index 1"), "{e}");
+    let path = dir.path().join("nan_p.h5");
+    h5_events(
+        &path,
+        &[0.1, 0.2],
+        &[1i16, 2],
+        &[1i16, 2],
+        &[1.0f64, f64::NAN],
+    );
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(e.contains("events/ps[1]") && e.contains("polarity"), "{e}");
+    let path = dir.path().join("two.h5");
+    h5_events(&path, &[0.1, 0.2], &[1i16, 2], &[1i16, 2], &[1u8, 2]);
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(e.contains("events/ps[1]") && e.contains("is 2"), "{e}");
+}
+
+#[test]
+fn hdf5_frames_are_checked_before_they_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    // a scalar `frame` (v2e layout) used to panic
+    let path = dir.path().join("scalar_frame.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        file.new_dataset_builder()
+            .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
+            .create("events")
+            .unwrap();
+        file.new_dataset::<u8>().create("frame").unwrap();
+    }
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(e.contains("frame is a scalar"), "{e}");
+    // a frame stack claiming terabytes it does not store
+    let path = dir.path().join("huge_frames.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        file.new_dataset_builder()
+            .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
+            .create("events")
+            .unwrap();
+        file.new_dataset::<u8>()
+            .chunk((1, 64, 64))
+            .deflate(1)
+            .shape((1_000_000, 4000, 4000))
+            .create("frame")
+            .unwrap();
+        file.new_dataset_builder()
+            .with_data(&[0u32; 2])
+            .create("frame_ts")
+            .unwrap();
+    }
+    let started = Instant::now();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(started.elapsed() < Duration::from_secs(20));
+    assert!(
+        e.contains("claims shape") && e.contains("stores only"),
+        "{e}"
+    );
+    // frames of two sizes, and frames out of order, as for IJRR folders
+    for (name, sizes, times) in [
+        ("sizes.h5", [(4usize, 4usize), (4, 5)], [0.1, 0.2]),
+        ("order.h5", [(4, 4), (4, 4)], [0.2, 0.1]),
+    ] {
+        let path = dir.path().join(name);
+        h5_events(&path, &[0.1, 0.2], &[1i16, 2], &[1i16, 2], &[true, false]);
+        {
+            // every handle closed before ctcal reads the file
+            let file = hdf5::File::open_rw(&path).unwrap();
+            let images = file.create_group("images").unwrap();
+            for (i, ((h, w), t)) in sizes.iter().zip(times).enumerate() {
+                let ds = images
+                    .new_dataset_builder()
+                    .with_data(&ndarray::Array2::<u8>::zeros((*h, *w)))
+                    .create(format!("image{i:09}").as_str())
+                    .unwrap();
+                ds.new_attr::<f64>()
+                    .create("timestamp")
+                    .unwrap()
+                    .write_scalar(&t)
+                    .unwrap();
+            }
+        }
+        let e = bad_input(&["stats", path.to_str().unwrap(), "--sensor", "8x8"]);
+        assert!(e.contains("images/image000000001"), "{name}: {e}");
+        assert!(
+            e.contains("first frame") || e.contains("earlier"),
+            "{name}: {e}"
+        );
+    }
+}
+
+/// Registers a stand-in for h5py's LZF filter (id 32000) in this process, so that a file
+/// using it can be written; a fresh ctcal process has no such filter, as a user's machine
+/// has none.
+fn register_fake_lzf() {
+    use hdf5_sys::h5z::{H5Z_CLASS_T_VERS, H5Z_class2_t, H5Zregister};
+    extern "C" fn identity(
+        _flags: std::ffi::c_uint,
+        _cd_nelmts: usize,
+        _cd_values: *const std::ffi::c_uint,
+        nbytes: usize,
+        _buf_size: *mut usize,
+        _buf: *mut *mut std::ffi::c_void,
+    ) -> usize {
+        nbytes
+    }
+    static NAME: &[u8] = b"lzf stand-in\0";
+    let class = H5Z_class2_t {
+        version: H5Z_CLASS_T_VERS as i32,
+        id: 32000,
+        encoder_present: 1,
+        decoder_present: 1,
+        name: NAME.as_ptr().cast(),
+        can_apply: None,
+        set_local: None,
+        filter: Some(identity),
+    };
+    // SAFETY: `class` is a valid filter class whose name is a static C string;
+    // libhdf5 copies the struct; called under hdf5-metno's lock.
+    let status =
+        hdf5::sync::sync(|| unsafe { H5Zregister((&class as *const H5Z_class2_t).cast()) });
+    assert!(status >= 0);
+}
+
+#[test]
+fn an_lzf_compressed_hdf5_names_the_filter_and_the_fix() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("lzf.h5");
+    register_fake_lzf();
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let events = file.create_group("events").unwrap();
+        let lzf = hdf5::filters::Filter::user(32000, &[]);
+        events
+            .new_dataset_builder()
+            .with_data(&[0.1f64, 0.2])
+            .chunk(2)
+            .set_filters(std::slice::from_ref(&lzf))
+            .create("ts")
+            .unwrap();
+        for name in ["xs", "ys"] {
+            events
+                .new_dataset_builder()
+                .with_data(&[1i16, 2])
+                .create(name)
+                .unwrap();
+        }
+        events
+            .new_dataset_builder()
+            .with_data(&[true, false])
+            .create("ps")
+            .unwrap();
+    }
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("lzf.h5")
+            && e.contains("events/ts")
+            && e.contains("LZF")
+            && e.contains("h5repack"),
+        "{e}"
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn fifos_and_folders_where_a_file_is_expected_are_refused_at_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.raw");
+    assert!(
+        std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .unwrap()
+            .success()
+    );
+    let fifo = fifo.to_str().unwrap();
+    let started = Instant::now();
+    for args in [
+        vec!["stats", fifo],
+        vec!["info", fifo, "--format", "evt3"],
+        vec![
+            "simulate", "--params", fifo, "--scene", "x.toml", "--out", "o",
+        ],
+    ] {
+        let e = bad_input(&args);
+        assert!(
+            e.contains("pipe.raw") && e.contains("FIFO"),
+            "{args:?}: {e}"
+        );
+    }
+    let folder = dir.path().to_str().unwrap();
+    let e = bad_input(&[
+        "simulate", "--params", folder, "--scene", "x.toml", "--out", "o",
+    ]);
+    assert!(e.contains("is a folder"), "{e}");
+    assert!(started.elapsed() < Duration::from_secs(20), "no hang");
+}
+
+#[test]
+fn simulation_work_and_values_are_validated_with_limits() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = write(dir.path(), "p.toml", b"ct_on = 0.3\nct_off = 0.3\n");
+    let out = dir.path().join("o");
+    let out = out.to_str().unwrap();
+    let scene = |text: &str| write(dir.path(), "s.toml", text.as_bytes());
+    let texture = "kind = \"texture\"\nheight = 48\n[texture]\nvx_px_s = 30.0\n";
+    let cases = [
+        (format!("width = 100000\nduration_s = 1.0\n{texture}"), "width"),
+        (format!("width = 64\nduration_s = 1.0\nrender_hz = 1e9\n{texture}"), "render_hz"),
+        (format!("width = 64\nduration_s = 1e9\n{texture}"), "duration_s"),
+        (format!("width = 64\nduration_s = nan\n{texture}"), "duration_s"),
+        (format!("width = 64\nduration_s = 1.0\n{texture}canvas_px = 100000\n"), "canvas_px"),
+        (
+            "kind = \"multi_object\"\nwidth = 64\nheight = 48\nduration_s = 0.1\n[multi_object]\nobjects = [10, 5]\nbackground_velocity_px_s = [5.0, 10.0]\nbackground_angular_velocity_deg_s = [0.0, 5.0]\nbackground_scale = [1.0, 1.2]\nobject_velocity_px_s = [40.0, 80.0]\nobject_angular_velocity_deg_s = [0.0, 20.0]\nobject_scale = [0.5, 1.0]\n".to_string(),
+            "objects",
+        ),
+        (
+            "kind = \"checkerboard\"\nwidth = 64\nheight = 48\nduration_s = 0.1\n[checkerboard]\nsquare_px = 8.0\nlo_dn = 60.0\nhi_dn = inf\n".to_string(),
+            "hi_dn",
+        ),
+    ];
+    for (text, key) in cases {
+        let path = scene(&text);
+        let started = Instant::now();
+        let e = bad_input(&[
+            "simulate", "--params", &params, "--scene", &path, "--out", out,
+        ]);
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "{key}: slow refusal"
+        );
+        assert!(e.contains(key) && e.contains("fix:"), "{key}: {e}");
+    }
+    // the work budget: a 2000x2000 scene at 10 kHz for 10 s, refused with the estimate
+    let path = scene(
+        "width = 2000\nheight = 2000\nduration_s = 10.0\nrender_hz = 10000.0\nkind = \"texture\"\n[texture]\nvx_px_s = 30.0\n",
+    );
+    let e = bad_input(&[
+        "simulate", "--params", &params, "--scene", &path, "--out", out,
+    ]);
+    assert!(e.contains("pixel updates") && e.contains("--force"), "{e}");
+    // NaN in PARAMS names the key
+    let nan = write(
+        dir.path(),
+        "nan.toml",
+        b"ct_on = 0.3\nct_off = 0.3\nleak_rate_hz = nan\n",
+    );
+    let e = bad_input(&[
+        "simulate",
+        "--params",
+        &nan,
+        "--frames",
+        oracle("a_ideal_texture").to_str().unwrap(),
+        "--out",
+        out,
+    ]);
+    assert!(e.contains("leak_rate_hz") && e.contains("finite"), "{e}");
+    // thread counts
+    for n in ["0", "100000"] {
+        let e = bad_input(&[
+            "--threads",
+            n,
+            "info",
+            real("ijrr_slider_depth_50k").to_str().unwrap(),
+        ]);
+        assert!(e.contains("--threads"), "{e}");
+    }
+    // the calibration stimulus
+    let e = bad_input(&["calib", "checkerboard", "--out", out, "--refresh-hz", "1e9"]);
+    assert!(e.contains("--refresh-hz"), "{e}");
+    let e = bad_input(&["calib", "checkerboard", "--out", out, "--width", "100000"]);
+    assert!(e.contains("--width"), "{e}");
+    assert!(!Path::new(out).exists());
+}
+
+#[test]
+fn stats_into_a_closed_pipe_exits_quietly() {
+    use std::io::Read;
+    use std::process::Stdio;
+    // a timeline of 17,000 windows: far more JSON than a pipe buffer holds
+    for _ in 0..5 {
+        let mut child = std::process::Command::new(assert_cmd::cargo::cargo_bin("ctcal"))
+            .args(["stats", real("ijrr_slider_depth_50k").to_str().unwrap()])
+            .args(["--window", "0.00001", "--json", "-"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = [0u8; 100];
+        child.stdout.take().unwrap().read_exact(&mut first).unwrap();
+        // the reader (`head`) is gone now
+        let output = child.wait_with_output().unwrap();
+        assert_eq!(
+            output.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(
+            output.stderr.is_empty(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+    }
+}
+
+#[test]
+fn convert_writes_what_the_extension_says_or_refuses() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    let raw = dir.path().join("x.raw");
+    ctcal()
+        .args(["convert", input, "--out"])
+        .arg(&raw)
+        .assert()
+        .success();
+    assert!(raw.is_file(), "a .raw output is an EVT3 file, not a folder");
+    assert_eq!(json(&["info", raw.to_str().unwrap()])["format"], "evt3");
+    for ext in ["aedat4", "dat", "csv"] {
+        let out = dir.path().join(format!("x.{ext}"));
+        let e = bad_input(&["convert", input, "--out", out.to_str().unwrap()]);
+        assert!(
+            e.contains(&format!(".{ext}")) && e.contains("--to ijrr") && e.contains("--to evt3"),
+            "{e}"
+        );
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn jittered_events_stay_sorted_inside_the_simulated_span() {
+    let dir = tempfile::tempdir().unwrap();
+    let params = write(
+        dir.path(),
+        "p.toml",
+        b"ct_on = 0.3\nct_off = 0.3\ntimestamp_jitter_s = 0.0005\nseed = 3\n",
+    );
+    let out = dir.path().join("o");
+    ctcal()
+        .args([
+            "simulate",
+            "--params",
+            &params,
+            "--frames",
+            oracle("a_ideal_texture").to_str().unwrap(),
+            "--out",
+        ])
+        .arg(&out)
+        .assert()
+        .success();
+    let events = read_events(&out);
+    let frames = ctcal::io::FrameList::read(&oracle("a_ideal_texture").join("images.txt")).unwrap();
+    let (first, last) = (frames.entries[0].t, frames.entries.last().unwrap().t);
+    assert!(events.is_time_sorted());
+    assert!(
+        events.t[0] >= first && *events.t.last().unwrap() <= last,
+        "{} .. {}",
+        events.t[0],
+        events.t.last().unwrap()
+    );
+}
+
+#[test]
+fn messages_give_the_right_advice() {
+    let dir = tempfile::tempdir().unwrap();
+    // a PNG is not an event recording
+    let png = real("ijrr_slider_depth_50k").join("images/frame_00000000.png");
+    let e = bad_input(&["stats", png.to_str().unwrap()]);
+    assert!(
+        e.contains("PNG image, not an event recording") && !e.contains("--format"),
+        "{e}"
+    );
+    // a forced format that does not fit says so
+    let e = bad_input(&[
+        "stats",
+        real("evk4_faery_evt3.raw").to_str().unwrap(),
+        "--format",
+        "evt2",
+    ]);
+    assert!(
+        e.contains("--format evt2 does not fit") && e.contains("evt3"),
+        "{e}"
+    );
+    let text = write(dir.path(), "e.txt", b"0.1 1 1 1\n");
+    let e = bad_input(&["stats", &text, "--format", "aedat4"]);
+    assert!(e.contains("--format aedat4 does not fit"), "{e}");
+    assert!(!e.contains("Some("), "{e}");
+}
