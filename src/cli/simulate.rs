@@ -159,6 +159,8 @@ struct SimInput {
     render_hz: Option<f64>,
     aps_frames: Vec<Frame>,
     work: Work,
+    /// The input's time span, seconds.
+    span_s: f64,
 }
 
 /// Opens `--frames` or `--scene` (checking the scene's work against the budget).
@@ -183,6 +185,7 @@ fn open_input(args: &SimulateArgs, global: &Global) -> anyhow::Result<SimInput> 
                 .into());
             }
             let work = Work::new(list.len() as f64, w, h);
+            let span_s = (list.entries[list.len() - 1].t - list.entries[0].t) as f64 * 1e-6;
             let source = LoadedFrames::new(list.len(), (w, h), move |i| {
                 list.load(i).map_err(SimError::source)
             });
@@ -192,6 +195,7 @@ fn open_input(args: &SimulateArgs, global: &Global) -> anyhow::Result<SimInput> 
                 render_hz: None,
                 aps_frames: Vec::new(),
                 work,
+                span_s,
             }
         }
         (None, Some(path)) => {
@@ -211,6 +215,7 @@ fn open_input(args: &SimulateArgs, global: &Global) -> anyhow::Result<SimInput> 
             };
             SimInput {
                 source: Box::new(source),
+                span_s: spec.duration_s,
                 scene_spec: Some(spec),
                 render_hz: Some(hz),
                 aps_frames: frames,
@@ -241,13 +246,10 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         render_hz,
         aps_frames,
         mut work,
+        span_s,
     } = open_input(args, global)?;
     if let Some(display) = &params.display {
         // the display adds a sample at every refresh
-        let span_s = match (&scene_spec, &args.frames) {
-            (Some(spec), _) => spec.duration_s,
-            _ => 0.0,
-        };
         work.samples += span_s * display.refresh_hz;
         source = Box::new(DisplaySource::new(source, DisplayModel::new(display)));
     }

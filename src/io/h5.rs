@@ -380,6 +380,9 @@ fn filter_name(id: i32) -> String {
     }
 }
 
+/// The largest chunk ctcal reads (libhdf5 and the direct reader hold one whole chunk).
+const MAX_CHUNK_BYTES: f64 = 256e6;
+
 /// Checks a dataset before anything is allocated from what it claims: its rank, that
 /// libhdf5 can undo its filters, and that its logical size is plausible for the bytes it
 /// stores (deflate cannot compress more than about 1032:1, so a dataset claiming far more
@@ -417,6 +420,18 @@ fn check_dataset(
         }
     }
     let element = ds.dtype().map(|d| d.size()).unwrap_or(1) as f64;
+    if let Some(chunk) = ds.chunk() {
+        let chunk_bytes = chunk.iter().map(|&n| n as f64).product::<f64>() * element;
+        if chunk_bytes > MAX_CHUNK_BYTES {
+            return Err(InputError::hdf5(
+                path,
+                format!(
+                    "{name} is stored in chunks of {chunk_bytes:.3e} bytes, more than the {MAX_CHUNK_BYTES:.0e} ctcal reads at once"
+                ),
+                "the file is damaged, or rewrite it with smaller chunks (h5repack -l CHUNK=65536)",
+            ));
+        }
+    }
     let logical = shape.iter().map(|&n| n as f64).product::<f64>() * element;
     let stored = ds.storage_size() as f64;
     if logical > 1100.0 * stored.max(4096.0) {

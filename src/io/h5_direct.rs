@@ -24,6 +24,8 @@ enum Stage {
 pub struct DirectColumn {
     dataset: hdf5::Dataset,
     file: std::fs::File,
+    /// Bytes in the file: a chunk said to lie beyond is damage, not data.
+    file_len: u64,
     len: usize,
     chunk_len: usize,
     element_size: usize,
@@ -56,9 +58,12 @@ impl DirectColumn {
                 _ => return None,
             });
         }
+        let file = std::fs::File::open(path).ok()?;
+        let file_len = file.metadata().ok()?.len();
         Some(Self {
             dataset: dataset.clone(),
-            file: std::fs::File::open(path).ok()?,
+            file,
+            file_len,
             len: shape[0],
             chunk_len: chunk[0],
             element_size: dtype.size(),
@@ -84,8 +89,13 @@ impl DirectColumn {
                 &mut size,
             )
         });
-        (status >= 0 && address != hdf5_sys::h5::HADDR_UNDEF && size > 0)
-            .then_some((address, size, mask))
+        (status >= 0
+            && address != hdf5_sys::h5::HADDR_UNDEF
+            && size > 0
+            && address
+                .checked_add(size)
+                .is_some_and(|end| end <= self.file_len))
+        .then_some((address, size, mask))
     }
 
     /// The raw little-endian bytes of elements `range` into `out` (cleared first, so that
