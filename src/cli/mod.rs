@@ -3,7 +3,9 @@
 
 mod calib;
 mod convert;
+mod estimate;
 mod info;
+mod load;
 mod output;
 mod simulate;
 mod stats;
@@ -88,6 +90,9 @@ pub enum Command {
     /// Calibration stimuli to play on a monitor.
     #[command(subcommand)]
     Calib(calib::CalibCommand),
+    /// Contrast thresholds: from grey frames (aps), event rate (eppps) or a screen (screen).
+    #[command(subcommand)]
+    Estimate(estimate::EstimateCommand),
 }
 
 /// A problem with the command line or the input that the user can fix (exit code 2).
@@ -120,6 +125,7 @@ pub fn run() -> i32 {
         Command::Stats(args) => stats::run(args, &cli.global),
         Command::Simulate(args) => simulate::run(args, &cli.global),
         Command::Calib(command) => calib::run(command, &cli.global),
+        Command::Estimate(command) => estimate::run(command, &cli.global),
     };
     match result {
         Ok(()) => 0,
@@ -149,7 +155,10 @@ fn exit_code(error: &anyhow::Error) -> i32 {
         if cause.is::<BadInput>() {
             return 2;
         }
-        if cause.is::<ctcal::sim::SimError>() || cause.is::<ctcal::sim::ParamsError>() {
+        if cause.is::<ctcal::sim::SimError>()
+            || cause.is::<ctcal::sim::ParamsError>()
+            || cause.is::<ctcal::estimate::EstimateError>()
+        {
             return 2;
         }
     }

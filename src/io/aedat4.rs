@@ -450,8 +450,23 @@ impl EventDecoder for Aedat4Decoder {
 /// exposure, else the frame's own timestamp. Frames must share one size and come in time
 /// order (as IJRR frame lists must).
 pub fn read_frames(path: &Path, header: &Aedat4Header) -> Result<Vec<Frame>, InputError> {
+    read_frames_where(path, header, |_, _| true)
+}
+
+/// The frames whose index and time `keep` accepts.
+pub fn read_frames_where(
+    path: &Path,
+    header: &Aedat4Header,
+    keep: impl Fn(usize, TimeUs) -> bool,
+) -> Result<Vec<Frame>, InputError> {
     let mut frames = Vec::new();
-    for_each_frame(path, header, true, |frame| frames.push(frame))?;
+    let mut index = 0;
+    for_each_frame(path, header, true, |frame| {
+        if keep(index, frame.t) {
+            frames.push(frame);
+        }
+        index += 1;
+    })?;
     Ok(frames)
 }
 

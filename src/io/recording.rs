@@ -289,6 +289,52 @@ impl Recording {
         }
     }
 
+    /// The frames whose index and time `keep` accepts, decoded (the others are not kept in
+    /// memory).
+    pub fn frames_where(
+        &self,
+        keep: impl Fn(usize, TimeUs) -> bool,
+    ) -> Result<Vec<Frame>, InputError> {
+        match &self.source {
+            Source::Ijrr(files) => match &files.images {
+                Some(images) => {
+                    let list = FrameList::read(images)?;
+                    let mut frames = Vec::new();
+                    for (i, entry) in list.entries.iter().enumerate() {
+                        if keep(i, entry.t) {
+                            frames.push(list.load(i)?);
+                        }
+                    }
+                    if let Some(first) = frames.first()
+                        && let Some(other) = frames
+                            .iter()
+                            .find(|f| (f.width, f.height) != (first.width, first.height))
+                    {
+                        return Err(InputError::corrupt(
+                            images,
+                            format!("frame at {} us", other.t),
+                            format!(
+                                "the image is {}x{}, the first {}x{}",
+                                other.width, other.height, first.width, first.height
+                            ),
+                            "give frames of one size",
+                        ));
+                    }
+                    Ok(frames)
+                }
+                None => Ok(Vec::new()),
+            },
+            Source::H5(info) => Ok(h5::read_frames(&self.path, info)?
+                .into_iter()
+                .enumerate()
+                .filter(|(i, f)| keep(*i, f.t))
+                .map(|(_, f)| f)
+                .collect()),
+            Source::Aedat4(header) => aedat4::read_frames_where(&self.path, header, keep),
+            _ => Ok(Vec::new()),
+        }
+    }
+
     /// Frame timestamps (without decoding images where the format allows).
     pub fn frame_times(&self) -> Result<Vec<TimeUs>, InputError> {
         match &self.source {

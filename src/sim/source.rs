@@ -102,6 +102,40 @@ impl FrameSource for MemoryFrames<'_> {
     }
 }
 
+/// Samples already in memory (e.g. frames upsampled once for many simulations), replayed
+/// from the start every time a source is made of them.
+pub struct ReplaySamples<'a> {
+    samples: &'a [Sample],
+    size: (usize, usize),
+    next: usize,
+}
+
+impl<'a> ReplaySamples<'a> {
+    pub fn new(samples: &'a [Sample], width: usize, height: usize) -> Self {
+        Self {
+            samples,
+            size: (width, height),
+            next: 0,
+        }
+    }
+}
+
+impl FrameSource for ReplaySamples<'_> {
+    fn size(&self) -> (usize, usize) {
+        self.size
+    }
+
+    fn len_hint(&self) -> Option<u64> {
+        Some(self.samples.len() as u64)
+    }
+
+    fn next_frame(&mut self) -> Result<Option<Sample>, SimError> {
+        let sample = self.samples.get(self.next).cloned();
+        self.next += 1;
+        Ok(sample)
+    }
+}
+
 /// Frames decoded one at a time by the caller's `load(i)` (e.g. PNGs listed in an
 /// `images.txt`), so that a long frame sequence is never all in memory.
 pub struct LoadedFrames<F> {

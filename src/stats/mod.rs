@@ -16,6 +16,7 @@
 pub mod hot_pixels;
 pub mod intervals;
 pub mod pixel_grid;
+pub mod support;
 pub mod timeline;
 
 use crate::events::{EventChunk, Sensor, TimeUs, us_to_s};

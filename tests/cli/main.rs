@@ -4,6 +4,7 @@
 mod common;
 mod convert;
 mod errors;
+mod estimate;
 mod limits;
 mod readers;
 mod safety;

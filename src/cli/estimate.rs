@@ -1,0 +1,290 @@
+//! `ctcal estimate aps|eppps|screen`: contrast thresholds three ways (see `ctcal::estimate`).
+
+use super::load::{Loaded, Window, load};
+use super::{BadInput, Global, InputArgs, JsonTarget, emit_json, output};
+use clap::{Args, Subcommand, ValueEnum};
+use ctcal::estimate::CtEstimate;
+use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
+use ctcal::estimate::timing::ThresholdMaps;
+use ctcal::sim::LogResponse;
+use ctcal::sim::log_response::LogMap;
+use std::path::{Path, PathBuf};
+
+#[derive(Subcommand, Debug)]
+pub enum EstimateCommand {
+    /// From the recording's grey frames: re-simulation and event timing, per-pixel maps.
+    Aps(ApsArgs),
+}
+
+/// How the sensor maps intensity to the log domain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LogResponseArg {
+    /// ln(DN) above 20 DN, linear below (v2e).
+    V2e,
+    /// ln(DN / 255 + eps).
+    Eps,
+}
+
+/// Options every estimate takes.
+#[derive(Args, Debug)]
+pub struct CommonArgs {
+    #[command(flatten)]
+    pub input: InputArgs,
+    /// Write the estimate as JSON to PATH (`-` for stdout).
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+    /// Only the part of the recording from S seconds after its first event.
+    #[arg(long, value_name = "S")]
+    pub start: Option<f64>,
+    /// Only the part up to S seconds after the first event.
+    #[arg(long, value_name = "S")]
+    pub end: Option<f64>,
+    /// The log response of the sensor's pixels.
+    #[arg(long, value_enum, default_value = "v2e")]
+    pub log_response: LogResponseArg,
+    /// The offset of the `eps` log response.
+    #[arg(long, value_name = "EPS", default_value_t = 0.001)]
+    pub log_eps: f64,
+}
+
+impl CommonArgs {
+    fn log_map(&self) -> Result<(LogMap, String), BadInput> {
+        if !(self.log_eps.is_finite() && self.log_eps > 0.0) {
+            return Err(BadInput(format!(
+                "--log-eps {} must be positive",
+                self.log_eps
+            )));
+        }
+        Ok(match self.log_response {
+            LogResponseArg::V2e => (
+                LogMap::new(LogResponse::V2e, self.log_eps),
+                "v2e lin-log: ln(DN) above 20 DN, linear below".into(),
+            ),
+            LogResponseArg::Eps => (
+                LogMap::new(LogResponse::Eps, self.log_eps),
+                format!("ln(DN / 255 + {})", self.log_eps),
+            ),
+        })
+    }
+}
+
+#[derive(Args, Debug)]
+pub struct ApsArgs {
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Write the per-pixel maps (ct_on.npy, ct_off.npy, ct_count.npy) to this folder.
+    #[arg(long, value_name = "DIR")]
+    pub maps: Option<PathBuf>,
+    /// Exposure time of the frames, where the file does not say.
+    #[arg(long, value_name = "S")]
+    pub exposure_s: Option<f64>,
+    /// Use at most this many frames (evenly spread over the window).
+    #[arg(long, value_name = "N", default_value_t = 120)]
+    pub max_frames: usize,
+    /// Seconds to add to the frames' times (default: found where the events agree best with
+    /// the frames).
+    #[arg(long, value_name = "S", allow_hyphen_values = true)]
+    pub frame_time_offset_s: Option<f64>,
+    /// DN to add to the frames before the log (a subtracted black level); default:
+    /// estimated when frames have pixels clipped at 0.
+    #[arg(long, value_name = "DN")]
+    pub frame_offset_dn: Option<f64>,
+}
+
+pub fn run(command: &EstimateCommand, global: &Global) -> anyhow::Result<()> {
+    match command {
+        EstimateCommand::Aps(args) => run_aps(args, global),
+    }
+}
+
+/// A spinner on stderr showing the stage (hidden when quiet).
+fn stage_spinner(global: &Global) -> indicatif::ProgressBar {
+    if global.quiet {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar =
+        indicatif::ProgressBar::with_draw_target(None, indicatif::ProgressDrawTarget::stderr());
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {msg} {elapsed}")
+            .expect("valid template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}
+
+fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
+    let common = &args.common;
+    let (log_map, log_name) = common.log_map()?;
+    if let Some(e) = args.exposure_s
+        && !(e.is_finite() && (0.0..=10.0).contains(&e))
+    {
+        return Err(BadInput(format!("--exposure-s {e} must be between 0 and 10 seconds")).into());
+    }
+    if let Some(o) = args.frame_offset_dn
+        && !(o.is_finite() && (-250.0..=1000.0).contains(&o))
+    {
+        return Err(BadInput(format!(
+            "--frame-offset-dn {o} must be between -250 and 1000"
+        ))
+        .into());
+    }
+    if let Some(s) = args.frame_time_offset_s
+        && !(s.is_finite() && s.abs() <= 10.0)
+    {
+        return Err(BadInput(format!(
+            "--frame-time-offset-s {s} must be within 10 seconds"
+        ))
+        .into());
+    }
+    if args.max_frames < 2 {
+        return Err(BadInput("--max-frames must be at least 2".into()).into());
+    }
+    let policy = global.outputs([common.input.input.as_path()]);
+    if let Some(dir) = &args.maps {
+        policy.check_folder(dir)?;
+    }
+    let loaded = load(
+        &common.input,
+        &Window {
+            start_s: common.start,
+            end_s: common.end,
+            frames: Some(args.max_frames),
+            events_between_frames: true,
+        },
+        global,
+    )?;
+    let path = loaded.recording.path.clone();
+    if loaded.frames.len() < 2 {
+        return Err(BadInput(format!(
+            "{}: `estimate aps` needs grey frames; {} has {}\n  fix: use `ctcal estimate eppps`, which needs no frames",
+            path.display(),
+            if loaded.frames_available > 0 { "the selected window" } else { "the recording" },
+            if loaded.frames.len() == 1 { "only one" } else { "none" }
+        ))
+        .into());
+    }
+    let options = ApsOptions {
+        log_map,
+        log_response_name: log_name,
+        exposure_us: args.exposure_s.map(|s| (s * 1e6).round() as i64),
+        frame_offset_dn: args.frame_offset_dn,
+        frame_time_offset_s: args.frame_time_offset_s,
+        ..ApsOptions::default()
+    };
+    let excluded = vec![false; loaded.sensor.pixels()];
+    let spinner = stage_spinner(global);
+    let result = aps::estimate(
+        &ApsInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            frames: &loaded.frames,
+            excluded: &excluded,
+        },
+        &options,
+        &|stage, _| spinner.set_message(stage.to_string()),
+    );
+    spinner.finish_and_clear();
+    let mut result = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    result
+        .estimate
+        .assumptions
+        .extend(loaded.notes.iter().cloned());
+    if let Some(dir) = &args.maps {
+        write_maps(dir, &result.maps, &policy)?;
+    }
+    present(&result.estimate, &loaded, common, &policy)
+}
+
+/// Writes the threshold maps as NumPy arrays (H x W): `ct_on.npy`, `ct_off.npy` (float32,
+/// NaN without evidence) and `ct_count.npy` (uint32, samples per pixel).
+fn write_maps(
+    dir: &Path,
+    maps: &ThresholdMaps,
+    policy: &ctcal::io::write::OutputPolicy,
+) -> anyhow::Result<()> {
+    use ndarray_npy::WriteNpyExt;
+    let staged = policy.folder(dir)?;
+    let shape = (maps.height, maps.width);
+    let write = |name: &str, bytes: Vec<u8>| staged.write(name, &bytes);
+    for (name, values) in [("ct_on.npy", &maps.ct_on), ("ct_off.npy", &maps.ct_off)] {
+        let array = ndarray::Array2::from_shape_vec(shape, values.clone())?;
+        let mut bytes = Vec::new();
+        array.write_npy(&mut bytes)?;
+        write(name, bytes)?;
+    }
+    let counts = ndarray::Array2::from_shape_vec(shape, maps.count.clone())?;
+    let mut bytes = Vec::new();
+    counts.write_npy(&mut bytes)?;
+    write("ct_count.npy", bytes)?;
+    staged.commit()?;
+    Ok(())
+}
+
+/// JSON and/or the human summary.
+fn present(
+    estimate: &CtEstimate,
+    loaded: &Loaded,
+    common: &CommonArgs,
+    policy: &ctcal::io::write::OutputPolicy,
+) -> anyhow::Result<()> {
+    let target = common.json.as_deref().map(JsonTarget::parse);
+    if let Some(target) = &target {
+        emit_json(estimate, target, policy)?;
+    }
+    if matches!(target, Some(JsonTarget::Stdout)) {
+        return Ok(());
+    }
+    let interval = |v: f64, ci: [f64; 2]| format!("{v:.4}  (95 % {:.4} .. {:.4})", ci[0], ci[1]);
+    let mut rows = vec![
+        ("method".to_string(), estimate.method.to_string()),
+        (
+            "recording".into(),
+            format!(
+                "{} ({}: {}; {} events)",
+                loaded.recording.path.display(),
+                loaded.sensor,
+                loaded.sensor_source,
+                loaded.events.len()
+            ),
+        ),
+        (
+            "ct_on".into(),
+            interval(estimate.ct_on, estimate.ct_on_ci95),
+        ),
+        (
+            "ct_off".into(),
+            interval(estimate.ct_off, estimate.ct_off_ci95),
+        ),
+        ("ct".into(), interval(estimate.ct, estimate.ct_ci95)),
+    ];
+    if let (Some(s), Some(ci)) = (estimate.ct_sigma, estimate.ct_sigma_ci95) {
+        rows.push(("ct_sigma (mismatch)".into(), interval(s, ci)));
+    }
+    for e in &estimate.estimators {
+        rows.push((
+            format!("  {}", e.name),
+            format!(
+                "ON {:.4} +- {:.4}, OFF {:.4} +- {:.4}",
+                e.ct_on.value,
+                e.ct_on.total_error(),
+                e.ct_off.value,
+                e.ct_off.total_error()
+            ),
+        ));
+    }
+    if !estimate.intervals_used.is_empty() {
+        rows.push((
+            "frame intervals".into(),
+            format!(
+                "{} used, {} dropped",
+                estimate.intervals_used.len(),
+                estimate.intervals_dropped.len()
+            ),
+        ));
+    }
+    for a in &estimate.assumptions {
+        rows.push(("assumes".into(), a.clone()));
+    }
+    output::print_table(&rows)?;
+    Ok(())
+}

@@ -1,0 +1,525 @@
+//! `estimate aps`: contrast thresholds from a recording's grey (APS) frames, two independent
+//! ways, then combined (Stoffregen et al. 2020, Sec. 3.1, made automatic):
+//!
+//! 1. event timing ([`super::timing`]): per-pixel threshold samples from the log change
+//!    between consecutive events of a pixel, measured on the frames interpolated along the
+//!    optical flow; gives the maps and the frozen mismatch `ct_sigma`;
+//! 2. re-simulation ([`super::resim`]): the frames, upsampled along the flow, are simulated
+//!    with the thresholds whose counts match the real ones region by region.
+//!
+//! Each estimate's interval includes its systematic error, measured: the change of the
+//! estimate when only every 2nd or 3rd frame is used (extrapolated to infinite frame rate,
+//! [`super::interval`]), and for event timing the bias found by running the estimator on a
+//! simulation of the same frames with known thresholds (and the recording's own timestamp
+//! grid). The least-squares fit of Wang et al. (ACRA 2019, [`super::lsq`]) cross-checks
+//! the maps and gives a third, timing-free global value.
+
+use super::frames::{FrameOptions, PreparedFrames};
+use super::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
+use super::resim::{Cells, Resimulation};
+use super::timing::{ThresholdMaps, TimingEstimate, TimingOptions};
+use super::{CtEstimate, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid};
+use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
+use crate::sim::PixelParams;
+use crate::sim::log_response::LogMap;
+use serde_json::json;
+
+/// Settings of `estimate aps`.
+#[derive(Clone, Debug)]
+pub struct ApsOptions {
+    pub log_map: LogMap,
+    /// A description of the log response, for the assumptions.
+    pub log_response_name: String,
+    pub frames: FrameOptions,
+    pub timing: TimingOptions,
+    /// The exposure, where the file gives none (`--exposure-s`).
+    pub exposure_us: Option<TimeUs>,
+    /// Shift to add to the frames' times, seconds; `None`: found from the data
+    /// ([`super::align`]).
+    pub frame_time_offset_s: Option<f64>,
+    /// DN to add to the frames before the log (a subtracted black level); `None`: estimate
+    /// it when the frames show one ([`super::offset`]).
+    pub frame_offset_dn: Option<f64>,
+    /// Memory for the upsampled frames of the re-simulation, bytes.
+    pub max_upsampled_bytes: usize,
+    /// Seed of every simulation.
+    pub seed: u64,
+}
+
+impl Default for ApsOptions {
+    fn default() -> Self {
+        Self {
+            log_map: LogMap::new(crate::sim::LogResponse::V2e, 0.001),
+            log_response_name: "v2e lin-log: ln(DN) above 20 DN, linear below".into(),
+            frames: FrameOptions::default(),
+            timing: TimingOptions::default(),
+            exposure_us: None,
+            frame_time_offset_s: None,
+            frame_offset_dn: None,
+            max_upsampled_bytes: 768 << 20,
+            seed: 20_200_823,
+        }
+    }
+}
+
+/// What `estimate aps` reads.
+pub struct ApsInput<'a> {
+    pub sensor: Sensor,
+    /// Time-sorted events of the frames' time span.
+    pub events: &'a EventChunk,
+    /// Grey frames, time-sorted, one size (the sensor's).
+    pub frames: &'a [Frame],
+    /// Pixels to leave out (outside a region of interest, masked).
+    pub excluded: &'a [bool],
+}
+
+/// The estimate and the per-pixel maps.
+pub struct ApsResult {
+    pub estimate: CtEstimate,
+    pub maps: ThresholdMaps,
+}
+
+/// The support window of the re-simulation counts: a few pixel-crossing times of the
+/// recording's typical motion (10-100 ms).
+fn support_window_us(frames: &PreparedFrames) -> TimeUs {
+    let mut speeds: Vec<f64> = frames
+        .intervals
+        .iter()
+        .filter(|i| i.used && i.t_end_s > i.t_start_s)
+        .map(|i| i.motion_px / (i.t_end_s - i.t_start_s))
+        .collect();
+    if speeds.is_empty() {
+        return 30_000;
+    }
+    speeds.sort_by(f64::total_cmp);
+    let speed = speeds[speeds.len() / 2].max(1e-3);
+    ((3.0 / speed) * 1e6).clamp(10_000.0, 100_000.0) as TimeUs
+}
+
+/// The timing and re-simulation estimates of one set of frames.
+struct Pass {
+    timing: TimingEstimate,
+    resim: Option<super::resim::ResimEstimate>,
+    interval_s: f64,
+}
+
+fn run_pass(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &PreparedFrames,
+    options: &ApsOptions,
+    start: Option<(f64, f64, f64)>,
+) -> Result<Pass, EstimateError> {
+    let timing = super::timing::estimate(input.events, frames, input.sensor, excluded, &options.timing)
+        .ok_or_else(|| {
+            EstimateError::new(
+                "too few events between consecutive frames to measure thresholds (fewer than 10 pixels with a sample of each polarity)",
+                "use a longer or busier part of the recording (--start/--end), or `ctcal estimate eppps`",
+            )
+        })?;
+    let (cp, cn, sigma) = start.unwrap_or((
+        timing.on.ct,
+        timing.off.ct,
+        0.5 * (timing.on.sigma + timing.off.sigma),
+    ));
+    let cells = Cells::new(
+        frames,
+        input.sensor,
+        excluded,
+        support_window_us(frames),
+        input.events,
+    );
+    let real = cells.count(input.events);
+    let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    let resim = Resimulation {
+        runs: &runs,
+        width: frames.width,
+        height: frames.height,
+        cells: &cells,
+        real: &real,
+        grid: timestamp_grid(input.events),
+        evaluations: std::cell::Cell::new(0),
+    };
+    let resim = super::resim::fit(&resim, (cp, cn), sigma).ok();
+    let used: Vec<f64> = frames
+        .intervals
+        .iter()
+        .filter(|i| i.used)
+        .map(|i| i.t_end_s - i.t_start_s)
+        .collect();
+    let interval_s = used.iter().sum::<f64>() / used.len().max(1) as f64;
+    Ok(Pass {
+        timing,
+        resim,
+        interval_s,
+    })
+}
+
+/// Estimates the contrast thresholds of `input` from its frames.
+pub fn estimate(
+    input: &ApsInput,
+    options: &ApsOptions,
+    progress: Progress,
+) -> Result<ApsResult, EstimateError> {
+    let mut assumptions = Vec::new();
+    progress("frames: selection and optical flow", 0.0);
+    let (excluded, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
+    if hot > 0 {
+        assumptions.push(format!("{hot} hot pixels left out"));
+    }
+    let mut frames = PreparedFrames::new(
+        input.frames,
+        &input.events.t,
+        options.log_map,
+        &options.frames,
+    )?;
+    let alignment = match options.frame_time_offset_s {
+        Some(shift) => {
+            frames.shift_times((shift * 1e6).round() as TimeUs);
+            assumptions.push(format!(
+                "frame times shifted by {:.3} ms (--frame-time-offset-s)",
+                shift * 1e3
+            ));
+            None
+        }
+        None => {
+            let found = super::align::align(
+                input.events,
+                &mut frames,
+                input.sensor,
+                &excluded,
+                &options.timing,
+            );
+            if let Some(a) = &found {
+                frames.shift_times((a.shift_s * 1e6).round() as TimeUs);
+                assumptions.push(format!(
+                    "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); --frame-time-offset-s overrides",
+                    a.shift_s * 1e3,
+                    a.precision_s * 1e3,
+                    a.spread_unshifted,
+                    a.spread_aligned
+                ));
+            }
+            found
+        }
+    };
+    let black = super::offset::clipped_black_share(&frames);
+    let mut offset_report = None;
+    match options.frame_offset_dn {
+        Some(o) => {
+            frames.offset = o as f32;
+            assumptions.push(format!(
+                "frames offset by {o} DN before the log (--frame-offset-dn)"
+            ));
+        }
+        None if black >= super::offset::CLIPPED_BLACK_SHARE => {
+            match super::offset::estimate(input.events, &frames, input.sensor, &excluded) {
+                Some(found) => {
+                    frames.offset = found.offset_dn as f32;
+                    assumptions.push(format!(
+                        "{:.1} % of frame pixels are clipped at 0 DN: a black level was subtracted; {:.1} DN restored before the log (the offset that makes thresholds independent of brightness; --frame-offset-dn overrides)",
+                        100.0 * black,
+                        found.offset_dn
+                    ));
+                    offset_report = Some(found);
+                }
+                None => assumptions.push(format!(
+                    "{:.1} % of frame pixels are clipped at 0 DN (a subtracted black level?), but the events do not determine an offset; none applied (--frame-offset-dn sets one)",
+                    100.0 * black
+                )),
+            }
+        }
+        None => {}
+    }
+    let used = frames.intervals.iter().filter(|i| i.used).count();
+    let exposure = input
+        .frames
+        .iter()
+        .find_map(|f| f.exposure_us)
+        .or(options.exposure_us);
+    assumptions.push(format!("log response: {}", options.log_response_name));
+    assumptions.push(format!(
+        "frames: {} of {} intervals used; frame times are exposure midpoints (as the file gives them); {}",
+        used,
+        frames.intervals.len(),
+        match exposure {
+            Some(e) => format!("exposure {:.3} ms, treated as instantaneous (motion during it blurs frames slightly)", e as f64 / 1e3),
+            None => "exposure unknown (give --exposure-s); frames treated as instantaneous".into(),
+        }
+    ));
+    assumptions.push("between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity (no gamma, no black offset)".into());
+
+    progress("event timing and re-simulation", 0.2);
+    let full = run_pass(input, &excluded, &frames, options, None)?;
+    // the alignment's precision as a systematic error of event timing
+    let alignment_systematic = match &alignment {
+        Some(a) if a.precision_s > 0.0 => {
+            let precision = (a.precision_s * 1e6).round() as TimeUs;
+            let mut at = |shift: TimeUs| {
+                frames.shift_times(shift);
+                let t = super::timing::estimate(
+                    input.events,
+                    &frames,
+                    input.sensor,
+                    &excluded,
+                    &options.timing,
+                );
+                frames.shift_times(-shift);
+                t
+            };
+            match (at(precision), at(-precision)) {
+                (Some(a), Some(b)) => (
+                    0.5 * (a.on.ct - b.on.ct).abs(),
+                    0.5 * (a.off.ct - b.off.ct).abs(),
+                ),
+                _ => (0.0, 0.0),
+            }
+        }
+        _ => (0.0, 0.0),
+    };
+
+    // frame-rate systematic: every 2nd and 3rd frame
+    progress("frame-rate check (every 2nd and 3rd frame)", 0.5);
+    let mut passes = vec![(1usize, &full)];
+    let subsampled: Vec<(usize, Pass)> = [2usize, 3]
+        .iter()
+        .filter_map(|&step| {
+            let f = frames.every(step, &options.frames)?;
+            let start = full.resim.as_ref().map(|r| {
+                (
+                    r.ct_on,
+                    r.ct_off,
+                    0.5 * (full.timing.on.sigma + full.timing.off.sigma),
+                )
+            });
+            run_pass(input, &excluded, &f, options, start)
+                .ok()
+                .map(|p| (step, p))
+        })
+        .collect();
+    passes.extend(subsampled.iter().map(|(s, p)| (*s, p)));
+    let series = |value: &dyn Fn(&Pass) -> Option<f64>| -> Vec<FrameRatePoint> {
+        passes
+            .iter()
+            .filter_map(|(step, p)| {
+                Some(FrameRatePoint {
+                    frame_step: *step,
+                    frame_interval_s: p.interval_s,
+                    value: value(p)?,
+                })
+            })
+            .collect()
+    };
+
+    // self-calibration of the timing estimator on a simulation of the same frames
+    progress("self-calibration on a simulation of the frames", 0.8);
+    let sigma = 0.5 * (full.timing.on.sigma + full.timing.off.sigma);
+    let grid = timestamp_grid(input.events);
+    if let Some((period, _)) = grid {
+        assumptions.push(format!(
+            "timestamps are quantised to {period} us (events share stamps: a simulator's frames); the self-calibration simulation is quantised alike"
+        ));
+    }
+    let shift = alignment
+        .as_ref()
+        .map_or(0, |a| (a.shift_s * 1e6).round() as TimeUs);
+    let calibration = self_calibrate(
+        input,
+        &excluded,
+        &mut frames,
+        options,
+        &full.timing,
+        sigma,
+        grid,
+        (shift, alignment.is_some()),
+    );
+
+    // event timing: corrected value, statistical and systematic errors
+    let timing_series_on = series(&|p| Some(p.timing.on.ct));
+    let timing_series_off = series(&|p| Some(p.timing.off.ct));
+    let (bias_on, bias_off, sigma_bias) = calibration.map_or((0.0, 0.0, 0.0), |c| c);
+    let timing_measure =
+        |estimate: f64, se: f64, bias: f64, series: &[FrameRatePoint], alignment: f64| {
+            let (_, frame_rate) = frame_rate_systematic(series);
+            // half the applied correction stays in the interval
+            Measured::new(
+                estimate - bias,
+                se,
+                frame_rate.hypot(0.5 * bias).hypot(alignment),
+            )
+        };
+    let timing_on = timing_measure(
+        full.timing.on.ct,
+        full.timing.on.standard_error,
+        bias_on,
+        &timing_series_on,
+        alignment_systematic.0,
+    );
+    let timing_off = timing_measure(
+        full.timing.off.ct,
+        full.timing.off.standard_error,
+        bias_off,
+        &timing_series_off,
+        alignment_systematic.1,
+    );
+    let mut estimators = vec![EstimatorReport {
+        name: "event_timing",
+        description: "per-pixel log change between consecutive events, from frames interpolated along the optical flow; mean over pixels",
+        ct_on: timing_on.clone(),
+        ct_off: timing_off.clone(),
+        frame_rate_series_on: timing_series_on,
+        frame_rate_series_off: timing_series_off,
+        details: json!({
+            "on": full.timing.on,
+            "off": full.timing.off,
+            "self_calibration_bias_on": bias_on,
+            "self_calibration_bias_off": bias_off,
+            "self_calibration_bias_sigma": sigma_bias,
+            "alignment_systematic_on": alignment_systematic.0,
+            "alignment_systematic_off": alignment_systematic.1,
+        }),
+    }];
+    let mut on_estimates = vec![timing_on.clone()];
+    let mut off_estimates = vec![timing_off.clone()];
+    if let Some(r) = &full.resim {
+        let series_on = series(&|p| p.resim.as_ref().map(|r| r.ct_on));
+        let series_off = series(&|p| p.resim.as_ref().map(|r| r.ct_off));
+        let on = Measured::new(
+            r.ct_on,
+            r.standard_error_on,
+            frame_rate_systematic(&series_on).1,
+        );
+        let off = Measured::new(
+            r.ct_off,
+            r.standard_error_off,
+            frame_rate_systematic(&series_off).1,
+        );
+        on_estimates.push(on.clone());
+        off_estimates.push(off.clone());
+        estimators.push(EstimatorReport {
+            name: "resimulation",
+            description: "the frames upsampled along the optical flow and simulated; thresholds whose counts match the real ones in every region and interval (median log ratio)",
+            ct_on: on,
+            ct_off: off,
+            frame_rate_series_on: series_on,
+            frame_rate_series_off: series_off,
+            details: serde_json::to_value(r).unwrap_or_default(),
+        });
+    } else {
+        assumptions.push("the re-simulation found no thresholds whose counts cross the real ones; only event timing is used".into());
+    }
+    let combined = |estimates: &[Measured]| {
+        let refs: Vec<&Measured> = estimates.iter().collect();
+        let (value, error) = combine(&refs).expect("the timing estimate is finite");
+        Measured::new(value, error, 0.0)
+    };
+    let on = combined(&on_estimates);
+    let off = combined(&off_estimates);
+
+    // the least-squares cross-check
+    let lsq = super::lsq::fit(
+        input.events,
+        &frames,
+        input.sensor,
+        &excluded,
+        Some((&full.timing.maps.ct_on, &full.timing.maps.ct_off)),
+    );
+
+    let mut estimate = CtEstimate::from_parts("aps", &on, &off);
+    estimate.intervals_used = frames.used_intervals();
+    estimate.intervals_dropped = frames
+        .intervals
+        .iter()
+        .filter(|i| !i.used)
+        .cloned()
+        .collect();
+    let sigma_value = (sigma - sigma_bias).max(0.0);
+    let sigma_se =
+        0.5 * (full.timing.on.sigma_standard_error + full.timing.off.sigma_standard_error);
+    let sigma_measure = Measured::new(
+        sigma_value,
+        sigma_se,
+        (0.5 * sigma_bias).abs().max(0.1 * sigma_value),
+    );
+    estimate.ct_sigma = Some(sigma_value);
+    estimate.ct_sigma_ci95 = Some([sigma_measure.ci95[0].max(0.0), sigma_measure.ci95[1]]);
+    estimate.assumptions = assumptions;
+    estimate.estimators = estimators;
+    let maps = &full.timing.maps;
+    estimate.extra.insert(
+        "maps".into(),
+        json!({
+            "pixels_on": maps.ct_on.iter().filter(|v| v.is_finite()).count(),
+            "pixels_off": maps.ct_off.iter().filter(|v| v.is_finite()).count(),
+            "least_squares_cross_check": lsq,
+        }),
+    );
+    estimate
+        .extra
+        .insert("frame_time_alignment".into(), json!(alignment));
+    estimate.extra.insert(
+        "frame_offset_dn".into(),
+        json!({"value": frames.offset, "estimate": offset_report}),
+    );
+    estimate.extra.insert(
+        "time_span_s".into(),
+        json!([
+            us_to_s(frames.times[0]),
+            us_to_s(*frames.times.last().expect("two frames"))
+        ]),
+    );
+    progress("done", 1.0);
+    Ok(ApsResult {
+        estimate,
+        maps: full.timing.maps,
+    })
+}
+
+/// The timing estimator's bias, found by running the same pipeline on a simulation of the
+/// same frames with the thresholds `timing` found (and `sigma`), stamped on the recording's
+/// timestamp grid: the simulation sees the frames where the alignment put them, the
+/// estimator starts from the file's frame times and aligns again (when the recording was
+/// aligned), as it did on the real events. Returns (ON bias, OFF bias, sigma bias);
+/// `frames` are left as they were.
+#[allow(clippy::too_many_arguments)]
+fn self_calibrate(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &mut PreparedFrames,
+    options: &ApsOptions,
+    timing: &TimingEstimate,
+    sigma: f64,
+    grid: Option<(TimeUs, TimeUs)>,
+    (shift, realign): (TimeUs, bool),
+) -> Option<(f64, f64, f64)> {
+    let mut params = PixelParams::ideal(timing.on.ct, timing.off.ct);
+    if sigma > 0.0 {
+        params.ct_sigma = Some(sigma);
+    }
+    params.seed = Some(options.seed);
+    let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    let mut simulated = super::resim::simulate(&runs, frames.width, frames.height, &params).ok()?;
+    drop(runs);
+    if let Some(grid) = grid {
+        quantise(&mut simulated, grid);
+    }
+    // back to the file's frame times, then the same alignment as for the real events
+    frames.shift_times(-shift);
+    let again_shift = if realign {
+        super::align::align(&simulated, frames, input.sensor, excluded, &options.timing)
+            .map_or(0, |a| (a.shift_s * 1e6).round() as TimeUs)
+    } else {
+        shift
+    };
+    frames.shift_times(again_shift);
+    let again =
+        super::timing::estimate(&simulated, frames, input.sensor, excluded, &options.timing);
+    frames.shift_times(shift - again_shift);
+    let again = again?;
+    let sigma_again = 0.5 * (again.on.sigma + again.off.sigma);
+    Some((
+        again.on.ct - timing.on.ct,
+        again.off.ct - timing.off.ct,
+        sigma_again - sigma,
+    ))
+}

@@ -1,0 +1,394 @@
+//! Contrast thresholds by re-simulating the recording's own frames (Stoffregen et al. 2020,
+//! Sec. 3.1, "APS re-simulation"): events are simulated from the frames, upsampled along the
+//! optical flow ([`super::frames`]), with candidate thresholds, and the ON and OFF thresholds
+//! are those whose simulated counts best match the real ones in every region (16 x 16 pixel
+//! tiles) and every frame interval, not only in total.
+//!
+//! The mismatch is a chi-square distance over the cells, `sum (r - s)^2 / (r + s + 1)`, for
+//! ON and OFF counts. With few events per cell that distance is biased (it favours
+//! simulations with more events), so cells are made large enough to hold about 20 real
+//! events on average: consecutive intervals are grouped, and tiles grow when even the whole
+//! recording is too sparse. The distance is it is minimised with argmin's Brent search for each polarity in turn
+//! (ON counts depend on `Cp` and barely on `Cn`, and the other way round). The simulator is
+//! deterministic for a seed, so the objective is the same function at every evaluation
+//! (common random numbers). Both the real and the simulated events go through the same
+//! spatio-temporal support filter, so that the noise of a real sensor (which the ideal
+//! model does not make) does not count, and isolated signal events are dropped on both sides
+//! alike.
+
+use super::EstimateError;
+use super::frames::PreparedFrames;
+use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::sim::source::ReplaySamples;
+use crate::sim::{PixelMaps, PixelParams, Sample};
+use crate::stats::support::supported;
+use argmin::core::{CostFunction, Error as ArgminError, Executor};
+use serde::Serialize;
+
+/// Side of the count tiles, pixels (before they grow for sparse recordings).
+pub const TILE_PX: usize = 16;
+
+/// Real events a cell should hold on average.
+const EVENTS_PER_CELL: f64 = 20.0;
+
+/// ON and OFF counts per (interval, tile).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Counts {
+    pub on: Vec<u32>,
+    pub off: Vec<u32>,
+}
+
+/// The cells of a recording: tiles of the sensor times the used frame intervals.
+#[derive(Clone, Debug)]
+pub struct Cells {
+    tile_px: usize,
+    tiles_x: usize,
+    tiles: usize,
+    /// Per interval of the frames: its cell row, or `None` when unused.
+    interval_row: Vec<Option<usize>>,
+    /// Per interval of the frames: its position among the used ones.
+    used_index: Vec<Option<usize>>,
+    rows: usize,
+    times: Vec<TimeUs>,
+    excluded: Vec<bool>,
+    /// Per used interval (in order), the pixels without a reliable intensity.
+    unreliable: Vec<Vec<bool>>,
+    width: usize,
+    support_us: TimeUs,
+    sensor: Sensor,
+}
+
+impl Cells {
+    /// Cells for `frames`, sized so that the `events` (the real recording) fill each with
+    /// about 20 events on average.
+    pub fn new(
+        frames: &PreparedFrames,
+        sensor: Sensor,
+        excluded: &[bool],
+        support_us: TimeUs,
+        events: &EventChunk,
+    ) -> Self {
+        let used = frames.flows.iter().filter(|f| f.is_some()).count().max(1);
+        let mut cells = Self::with_layout(frames, sensor, excluded, support_us, TILE_PX, 1);
+        let total = {
+            let c = cells.count(events);
+            c.on.iter().chain(&c.off).map(|&v| v as f64).sum::<f64>()
+        };
+        let mut tile_px = TILE_PX;
+        loop {
+            let tiles = (sensor.width as usize).div_ceil(tile_px)
+                * (sensor.height as usize).div_ceil(tile_px);
+            // intervals per group so that a cell holds EVENTS_PER_CELL on average
+            let group = ((EVENTS_PER_CELL * (tiles * used) as f64) / (2.0 * total.max(1.0)))
+                .ceil()
+                .max(1.0) as usize;
+            if group <= used || tile_px >= sensor.width.max(sensor.height) as usize {
+                cells = Self::with_layout(
+                    frames,
+                    sensor,
+                    excluded,
+                    support_us,
+                    tile_px,
+                    group.min(used),
+                );
+                break;
+            }
+            tile_px *= 2;
+        }
+        cells
+    }
+
+    fn with_layout(
+        frames: &PreparedFrames,
+        sensor: Sensor,
+        excluded: &[bool],
+        support_us: TimeUs,
+        tile_px: usize,
+        group: usize,
+    ) -> Self {
+        let tiles_x = (sensor.width as usize).div_ceil(tile_px);
+        let tiles_y = (sensor.height as usize).div_ceil(tile_px);
+        let mut used = 0;
+        let used_index: Vec<Option<usize>> = frames
+            .flows
+            .iter()
+            .map(|f| {
+                f.as_ref().map(|_| {
+                    used += 1;
+                    used - 1
+                })
+            })
+            .collect();
+        let interval_row = used_index.iter().map(|u| u.map(|u| u / group)).collect();
+        let unreliable = (0..frames.flows.len())
+            .filter(|&k| frames.flows[k].is_some())
+            .map(|k| {
+                (0..sensor.pixels())
+                    .map(|p| !frames.reliable(k, p))
+                    .collect()
+            })
+            .collect();
+        Self {
+            tile_px,
+            tiles_x,
+            tiles: tiles_x * tiles_y,
+            rows: used.div_ceil(group),
+            unreliable,
+            interval_row,
+            used_index,
+            times: frames.times.clone(),
+            excluded: excluded.to_vec(),
+            width: sensor.width as usize,
+            support_us,
+            sensor,
+        }
+    }
+
+    /// Counts `events` (time-sorted) into the cells; events outside used intervals, of
+    /// excluded pixels or without support are not counted.
+    pub fn count(&self, events: &EventChunk) -> Counts {
+        let support = supported(events, self.sensor, self.support_us);
+        let n = self.rows * self.tiles;
+        let mut counts = Counts {
+            on: vec![0; n],
+            off: vec![0; n],
+        };
+        for (i, (&t, &supported)) in events.t.iter().zip(&support).enumerate() {
+            let Some(k) = self.times.partition_point(|&s| s <= t).checked_sub(1) else {
+                continue;
+            };
+            let Some(Some(row)) = self.interval_row.get(k) else {
+                continue;
+            };
+            let (x, y) = (events.x[i] as usize, events.y[i] as usize);
+            let pixel = y * self.width + x;
+            let used = self.used_index[k].expect("a row is a used interval");
+            if !supported || self.excluded[pixel] || self.unreliable[used][pixel] {
+                continue;
+            }
+            let cell = row * self.tiles + (y / self.tile_px) * self.tiles_x + x / self.tile_px;
+            if events.on[i] {
+                counts.on[cell] += 1;
+            } else {
+                counts.off[cell] += 1;
+            }
+        }
+        counts
+    }
+}
+
+/// The mismatch of simulated counts `s` against real counts `r`: the median over cells
+/// holding at least 5 real events of `ln((s + 1/2) / (r + 1/2))`. When `s` and `r` have the
+/// same expectation their difference is symmetric, so the median is 0 (a chi-square
+/// distance, by contrast, favours simulations with more events when cells are sparse).
+/// Positive: the simulation makes too many events (the threshold is too low).
+pub fn log_ratio(real: &[u32], simulated: &[u32]) -> f64 {
+    let mut ratios: Vec<f64> = real
+        .iter()
+        .zip(simulated)
+        .filter(|(r, _)| **r >= 5)
+        .map(|(&r, &s)| ((s as f64 + 0.5) / (r as f64 + 0.5)).ln())
+        .collect();
+    if ratios.is_empty() {
+        // too sparse for cells: the totals
+        let (r, s): (f64, f64) = (
+            real.iter().map(|&v| v as f64).sum(),
+            simulated.iter().map(|&v| v as f64).sum(),
+        );
+        return ((s + 0.5) / (r + 0.5)).ln();
+    }
+    let mid = ratios.len() / 2;
+    *ratios.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// Simulates the upsampled runs with `params`, all events together.
+pub fn simulate(
+    runs: &[Vec<Sample>],
+    width: usize,
+    height: usize,
+    params: &PixelParams,
+) -> Result<EventChunk, EstimateError> {
+    let mut all = EventChunk::default();
+    for run in runs {
+        let mut source = ReplaySamples::new(run, width, height);
+        crate::sim::run::<crate::sim::SimError>(
+            &mut source,
+            params,
+            PixelMaps::default(),
+            |chunk| {
+                all.extend_from(chunk);
+                Ok(())
+            },
+            |_| {},
+        )
+        .map_err(|e| {
+            EstimateError::new(format!("re-simulation failed: {e}"), "report this as a bug")
+        })?;
+    }
+    all.sort_by_time();
+    Ok(all)
+}
+
+/// The result of the re-simulation fit.
+#[derive(Clone, Debug, Serialize)]
+pub struct ResimEstimate {
+    pub ct_on: f64,
+    pub ct_off: f64,
+    /// Median absolute log ratio of simulated to real counts over the cells at the
+    /// optimum, ON and OFF: how well the model explains each region and interval.
+    pub cell_mismatch_on: f64,
+    pub cell_mismatch_off: f64,
+    /// Standard errors from the spread of the cells' log ratios.
+    pub standard_error_on: f64,
+    pub standard_error_off: f64,
+    pub cells: usize,
+    pub simulations: usize,
+}
+
+/// The input of one re-simulation fit.
+pub struct Resimulation<'a> {
+    pub runs: &'a [Vec<Sample>],
+    pub width: usize,
+    pub height: usize,
+    pub cells: &'a Cells,
+    pub real: &'a Counts,
+    /// The recording's timestamp grid, applied to simulated events too.
+    pub grid: Option<(TimeUs, TimeUs)>,
+    pub evaluations: std::cell::Cell<usize>,
+}
+
+impl Resimulation<'_> {
+    fn counts(&self, params: &PixelParams) -> Result<Counts, EstimateError> {
+        self.evaluations.set(self.evaluations.get() + 1);
+        let mut events = simulate(self.runs, self.width, self.height, params)?;
+        if let Some(grid) = self.grid {
+            super::quantise(&mut events, grid);
+        }
+        Ok(self.cells.count(&events))
+    }
+}
+
+/// The count mismatch of one polarity as a function of its threshold, the other fixed:
+/// a root-finding problem for argmin's Brent solver.
+struct Mismatch<'a, 'b> {
+    resim: &'b Resimulation<'a>,
+    base: PixelParams,
+    on: bool,
+}
+
+impl CostFunction for Mismatch<'_, '_> {
+    type Param = f64;
+    type Output = f64;
+    fn cost(&self, threshold: &f64) -> Result<f64, ArgminError> {
+        let mut p = self.base.clone();
+        if self.on {
+            p.ct_on = *threshold;
+        } else {
+            p.ct_off = *threshold;
+        }
+        let simulated = self.resim.counts(&p)?;
+        Ok(if self.on {
+            log_ratio(&self.resim.real.on, &simulated.on)
+        } else {
+            log_ratio(&self.resim.real.off, &simulated.off)
+        })
+    }
+}
+
+/// Fits `Cp` and `Cn` from `start` (e.g. the timing estimate), with frozen mismatch
+/// `sigma` (a fixed seed, so the same pixels at every evaluation). Two rounds of a Brent
+/// root search per polarity, each from a bracket around the current value, widened until
+/// the mismatch changes sign.
+pub fn fit(
+    resim: &Resimulation,
+    start: (f64, f64),
+    sigma: f64,
+) -> Result<ResimEstimate, EstimateError> {
+    let mut base = PixelParams::ideal(start.0, start.1);
+    if sigma > 0.0 {
+        base.ct_sigma = Some(sigma);
+    }
+    base.seed = Some(20_200_823);
+    let mut estimate = [start.0, start.1];
+    for round in 0..2 {
+        for (slot, on) in [(0, true), (1, false)] {
+            base.ct_on = estimate[0];
+            base.ct_off = estimate[1];
+            let problem = Mismatch {
+                resim,
+                base: base.clone(),
+                on,
+            };
+            let current = estimate[slot];
+            let mut width = if round == 0 { 0.08 } else { 0.03 };
+            let bracket = loop {
+                let (lo, hi) = (current * (1.0 - width), current * (1.0 + width));
+                let cost = |c: f64| {
+                    problem
+                        .cost(&c)
+                        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
+                };
+                let (f_lo, f_hi) = (cost(lo)?, cost(hi)?);
+                if f_lo >= 0.0 && f_hi <= 0.0 {
+                    break Some((lo, hi));
+                }
+                if width > 0.6 {
+                    break None;
+                }
+                width *= 2.0;
+            };
+            let Some((lo, hi)) = bracket else {
+                return Err(EstimateError::new(
+                    format!(
+                        "the re-simulated {} counts do not cross the real ones for thresholds within 60 % of {current:.3}",
+                        if on { "ON" } else { "OFF" }
+                    ),
+                    "the frames do not explain the events (check the frame times and exposure, or use `estimate eppps`)",
+                ));
+            };
+            let solver = argmin::solver::brent::BrentRoot::new(lo, hi, 0.002 * current);
+            let result = Executor::new(problem, solver)
+                .configure(|state| state.param(current).max_iters(20))
+                .run()
+                .map_err(|e| {
+                    EstimateError::new(
+                        format!("the re-simulation fit failed: {e}"),
+                        "report this as a bug",
+                    )
+                })?;
+            estimate[slot] = result.state.best_param.unwrap_or(current);
+        }
+    }
+    base.ct_on = estimate[0];
+    base.ct_off = estimate[1];
+    let simulated = resim.counts(&base)?;
+    let spread = |r: &[u32], s: &[u32]| {
+        let mut logs: Vec<f64> = r
+            .iter()
+            .zip(s)
+            .filter(|(r, _)| **r >= 5)
+            .map(|(&r, &s)| ((s as f64 + 0.5) / (r as f64 + 0.5)).ln().abs())
+            .collect();
+        if logs.is_empty() {
+            return (0.0, 0.0, 0);
+        }
+        let n = logs.len();
+        let mid = n / 2;
+        let mad = *logs.select_nth_unstable_by(mid, f64::total_cmp).1;
+        // the median log ratio moves 1:1 with ln(threshold); its standard error is
+        // 1.2533 * (1.4826 * MAD) / sqrt(n)
+        (mad, 1.2533 * 1.4826 * mad / (n as f64).sqrt(), n)
+    };
+    let (mismatch_on, se_on, cells) = spread(&resim.real.on, &simulated.on);
+    let (mismatch_off, se_off, _) = spread(&resim.real.off, &simulated.off);
+    Ok(ResimEstimate {
+        ct_on: estimate[0],
+        ct_off: estimate[1],
+        cell_mismatch_on: mismatch_on,
+        cell_mismatch_off: mismatch_off,
+        standard_error_on: se_on * estimate[0],
+        standard_error_off: se_off * estimate[1],
+        cells,
+        simulations: resim.evaluations.get(),
+    })
+}
