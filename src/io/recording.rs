@@ -94,18 +94,25 @@ impl Recording {
                 let mut sensor = header
                     .sensor
                     .map(|s| (s, "the `width height` first line of events.txt".to_string()));
-                if sensor.is_none()
-                    && let Some(images) = &files.images
-                    && let Some((w, h)) = FrameList::read(images)?.image_size()?
-                {
-                    let (w, h) = (
-                        u16::try_from(w).unwrap_or(u16::MAX),
-                        u16::try_from(h).unwrap_or(u16::MAX),
-                    );
-                    sensor = Some((
-                        Sensor::new(w, h),
-                        "the size of the images in images.txt".to_string(),
-                    ));
+                // frames (or, for an on-screen recording, the stimulus mapped 1:1 onto the
+                // sensor) give the size
+                for (index, origin) in [
+                    (&files.images, "the size of the images in images.txt"),
+                    (
+                        &files.stimulus,
+                        "the size of the stimulus in stimulus.txt (screen mapped 1:1)",
+                    ),
+                ] {
+                    if sensor.is_none()
+                        && let Some(index) = index
+                        && let Some((w, h)) = FrameList::read(index)?.image_size()?
+                    {
+                        let (w, h) = (
+                            u16::try_from(w).unwrap_or(u16::MAX),
+                            u16::try_from(h).unwrap_or(u16::MAX),
+                        );
+                        sensor = Some((Sensor::new(w, h), origin.to_string()));
+                    }
                 }
                 (Source::Ijrr(files), sensor)
             }
