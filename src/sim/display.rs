@@ -78,8 +78,11 @@ impl DisplayModel {
         let lit: Vec<f32> = screen
             .iter()
             .map(|&dn| {
-                if dn.fract() == 0.0 && (0.0..=255.0).contains(&dn) {
-                    self.lut[dn as usize]
+                // whole screen DN (every 8-bit stimulus) read from the table; the cast
+                // saturates, so anything else fails the comparison
+                let index = dn as usize;
+                if index < 256 && index as f32 == dn {
+                    self.lut[index]
                 } else {
                     self.luminance_dn(dn)
                 }
@@ -88,37 +91,47 @@ impl DisplayModel {
         if self.kernel.len() == 1 {
             return lit;
         }
-        // separable: rows, then columns (a transposed view of the same pass)
-        let horizontal = self.blur_pass(&lit, width, height, 1, width);
-        self.blur_pass(&horizontal, width, height, width, 1)
+        // separable: along rows, then across rows; both passes run over contiguous rows
+        self.blur_columns(&self.blur_rows(&lit, width, height), width, height)
     }
 
-    /// One 1-D pass of the blur along the axis whose neighbours are `step` apart in memory
-    /// (1 along rows, `width` along columns); `line_step` separates the lines of the pass.
-    fn blur_pass(
-        &self,
-        input: &[f32],
-        width: usize,
-        height: usize,
-        step: usize,
-        line_step: usize,
-    ) -> Vec<f32> {
-        let (length, lines) = if step == 1 {
-            (width, height)
-        } else {
-            (height, width)
-        };
-        let radius = (self.kernel.len() / 2) as isize;
+    /// The blur along each row (interior samples read directly, only the border reflects).
+    fn blur_rows(&self, input: &[f32], width: usize, height: usize) -> Vec<f32> {
+        let radius = self.kernel.len() / 2;
         let mut out = vec![0f32; input.len()];
-        for line in 0..lines {
-            let base = line * line_step;
-            for i in 0..length {
+        for y in 0..height {
+            let row = &input[y * width..(y + 1) * width];
+            let target = &mut out[y * width..(y + 1) * width];
+            for (i, value) in target.iter_mut().enumerate() {
                 let mut acc = 0.0;
-                for (k, w) in self.kernel.iter().enumerate() {
-                    let j = reflect_101(i as isize + k as isize - radius, length);
-                    acc += w * input[base + j * step];
+                if i >= radius && i + radius < width {
+                    for (k, w) in self.kernel.iter().enumerate() {
+                        acc += w * row[i - radius + k];
+                    }
+                } else {
+                    for (k, w) in self.kernel.iter().enumerate() {
+                        acc +=
+                            w * row[reflect_101(i as isize + k as isize - radius as isize, width)];
+                    }
                 }
-                out[base + i * step] = acc;
+                *value = acc;
+            }
+        }
+        out
+    }
+
+    /// The blur across rows: each output row is the weighted sum of whole input rows.
+    fn blur_columns(&self, input: &[f32], width: usize, height: usize) -> Vec<f32> {
+        let radius = self.kernel.len() / 2;
+        let mut out = vec![0f32; input.len()];
+        for y in 0..height {
+            let target = &mut out[y * width..(y + 1) * width];
+            for (k, &w) in self.kernel.iter().enumerate() {
+                let source = reflect_101(y as isize + k as isize - radius as isize, height);
+                let row = &input[source * width..(source + 1) * width];
+                for (o, &v) in target.iter_mut().zip(row) {
+                    *o += w * v;
+                }
             }
         }
         out
