@@ -16,7 +16,7 @@
 
 use super::frames::{FrameOptions, PreparedFrames};
 use super::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
-use super::resim::{Cells, Resimulation};
+use super::resim::{Cells, Intervals, Resimulation};
 use super::timing::{ThresholdMaps, TimingEstimate, TimingOptions};
 use super::{CtEstimate, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
@@ -123,7 +123,7 @@ fn run_pass(
         0.5 * (timing.on.sigma + timing.off.sigma),
     ));
     let cells = Cells::new(
-        frames,
+        Intervals::of_frames(frames, input.sensor),
         input.sensor,
         excluded,
         support_window_us(frames),
@@ -167,70 +167,13 @@ pub fn estimate(
     if hot > 0 {
         assumptions.push(format!("{hot} hot pixels left out"));
     }
-    let mut frames = PreparedFrames::new(
-        input.frames,
-        &input.events.t,
-        options.log_map,
-        &options.frames,
-    )?;
-    let alignment = match options.frame_time_offset_s {
-        Some(shift) => {
-            frames.shift_times((shift * 1e6).round() as TimeUs);
-            assumptions.push(format!(
-                "frame times shifted by {:.3} ms (--frame-time-offset-s)",
-                shift * 1e3
-            ));
-            None
-        }
-        None => {
-            let found = super::align::align(
-                input.events,
-                &mut frames,
-                input.sensor,
-                &excluded,
-                &options.timing,
-            );
-            if let Some(a) = &found {
-                frames.shift_times((a.shift_s * 1e6).round() as TimeUs);
-                assumptions.push(format!(
-                    "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); --frame-time-offset-s overrides",
-                    a.shift_s * 1e3,
-                    a.precision_s * 1e3,
-                    a.spread_unshifted,
-                    a.spread_aligned
-                ));
-            }
-            found
-        }
-    };
-    let black = super::offset::clipped_black_share(&frames);
-    let mut offset_report = None;
-    match options.frame_offset_dn {
-        Some(o) => {
-            frames.offset = o as f32;
-            assumptions.push(format!(
-                "frames offset by {o} DN before the log (--frame-offset-dn)"
-            ));
-        }
-        None if black >= super::offset::CLIPPED_BLACK_SHARE => {
-            match super::offset::estimate(input.events, &frames, input.sensor, &excluded) {
-                Some(found) => {
-                    frames.offset = found.offset_dn as f32;
-                    assumptions.push(format!(
-                        "{:.1} % of frame pixels are clipped at 0 DN: a black level was subtracted; {:.1} DN restored before the log (the offset that makes thresholds independent of brightness; --frame-offset-dn overrides)",
-                        100.0 * black,
-                        found.offset_dn
-                    ));
-                    offset_report = Some(found);
-                }
-                None => assumptions.push(format!(
-                    "{:.1} % of frame pixels are clipped at 0 DN (a subtracted black level?), but the events do not determine an offset; none applied (--frame-offset-dn sets one)",
-                    100.0 * black
-                )),
-            }
-        }
-        None => {}
-    }
+    let Prepared {
+        mut frames,
+        alignment,
+        offset: offset_report,
+        assumptions: prepared_notes,
+    } = prepare(input, &excluded, options)?;
+    assumptions.extend(prepared_notes);
     let used = frames.intervals.iter().filter(|i| i.used).count();
     let exposure = input
         .frames
@@ -472,6 +415,95 @@ pub fn estimate(
     Ok(ApsResult {
         estimate,
         maps: full.timing.maps,
+    })
+}
+
+/// Frames ready for estimation, and what was found about them.
+pub struct Prepared {
+    pub frames: PreparedFrames,
+    pub alignment: Option<super::align::Alignment>,
+    pub offset: Option<super::offset::BlackOffset>,
+    pub assumptions: Vec<String>,
+}
+
+/// Prepares `input.frames` as every frame-based method needs them: selection and flow
+/// ([`PreparedFrames`]), the frame-time alignment ([`super::align`]) and the black offset
+/// ([`super::offset`]), each unless `options` sets it.
+pub fn prepare(
+    input: &ApsInput,
+    excluded: &[bool],
+    options: &ApsOptions,
+) -> Result<Prepared, EstimateError> {
+    let mut assumptions = Vec::new();
+    let mut frames = PreparedFrames::new(
+        input.frames,
+        &input.events.t,
+        options.log_map,
+        &options.frames,
+    )?;
+    let alignment = match options.frame_time_offset_s {
+        Some(shift) => {
+            frames.shift_times((shift * 1e6).round() as TimeUs);
+            assumptions.push(format!(
+                "frame times shifted by {:.3} ms (--frame-time-offset-s)",
+                shift * 1e3
+            ));
+            None
+        }
+        None => {
+            let found = super::align::align(
+                input.events,
+                &mut frames,
+                input.sensor,
+                excluded,
+                &options.timing,
+            );
+            if let Some(a) = &found {
+                frames.shift_times((a.shift_s * 1e6).round() as TimeUs);
+                assumptions.push(format!(
+                    "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); --frame-time-offset-s overrides",
+                    a.shift_s * 1e3,
+                    a.precision_s * 1e3,
+                    a.spread_unshifted,
+                    a.spread_aligned
+                ));
+            }
+            found
+        }
+    };
+    let black = super::offset::clipped_black_share(&frames);
+    let mut offset_report = None;
+    match options.frame_offset_dn {
+        Some(o) => {
+            frames.offset = o as f32;
+            assumptions.push(format!(
+                "frames offset by {o} DN before the log (--frame-offset-dn)"
+            ));
+        }
+        None if black >= super::offset::CLIPPED_BLACK_SHARE => {
+            match super::offset::estimate(input.events, &frames, input.sensor, excluded) {
+                Some(found) => {
+                    frames.offset = found.offset_dn as f32;
+                    assumptions.push(format!(
+                        "{:.1} % of frame pixels are clipped at 0 DN: a black level was subtracted; {:.1} DN restored before the log (the offset that makes thresholds independent of brightness; --frame-offset-dn overrides)",
+                        100.0 * black,
+                        found.offset_dn
+                    ));
+                    offset_report = Some(found);
+                }
+                None => assumptions.push(format!(
+                    "{:.1} % of frame pixels are clipped at 0 DN (a subtracted black level?), but the events do not determine an offset; none applied (--frame-offset-dn sets one)",
+                    100.0 * black
+                )),
+            }
+        }
+        None => {}
+    }
+    Ok(Prepared {
+        frames,
+        alignment,
+        offset: offset_report,
+        assumptions,
     })
 }
 

@@ -38,7 +38,7 @@ pub struct Counts {
     pub off: Vec<u32>,
 }
 
-/// The cells of a recording: tiles of the sensor times the used frame intervals.
+/// The cells of a recording: tiles of the sensor times the used intervals.
 #[derive(Clone, Debug)]
 pub struct Cells {
     tile_px: usize,
@@ -51,27 +51,68 @@ pub struct Cells {
     rows: usize,
     times: Vec<TimeUs>,
     excluded: Vec<bool>,
-    /// Per used interval (in order), the pixels without a reliable intensity.
+    /// Per used interval (in order), the pixels without a reliable intensity (empty: all
+    /// reliable).
     unreliable: Vec<Vec<bool>>,
     width: usize,
     support_us: TimeUs,
     sensor: Sensor,
 }
 
+/// The intervals cells are made of: boundary times, and per interval whether it is used
+/// and which pixels have no reliable intensity in it (an empty mask: all have).
+#[derive(Clone, Debug)]
+pub struct Intervals {
+    pub times: Vec<TimeUs>,
+    pub masks: Vec<Option<Vec<bool>>>,
+}
+
+impl Intervals {
+    /// The used intervals of `frames` and their unreliable pixels.
+    pub fn of_frames(frames: &PreparedFrames, sensor: Sensor) -> Self {
+        Self {
+            times: frames.times.clone(),
+            masks: (0..frames.flows.len())
+                .map(|k| {
+                    frames.flows[k].as_ref().map(|_| {
+                        (0..sensor.pixels())
+                            .map(|p| !frames.reliable(k, p))
+                            .collect()
+                    })
+                })
+                .collect(),
+        }
+    }
+
+    /// Every interval between consecutive `times`, all pixels reliable.
+    pub fn all(times: Vec<TimeUs>) -> Self {
+        let n = times.len().saturating_sub(1);
+        Self {
+            times,
+            masks: vec![Some(Vec::new()); n],
+        }
+    }
+}
+
 impl Cells {
-    /// Cells for `frames`, sized so that the `events` (the real recording) fill each with
-    /// about 20 events on average.
+    /// Cells for `intervals`, sized so that the `events` (the real recording) fill each
+    /// with about 20 events on average.
     pub fn new(
-        frames: &PreparedFrames,
+        intervals: Intervals,
         sensor: Sensor,
         excluded: &[bool],
         support_us: TimeUs,
         events: &EventChunk,
     ) -> Self {
-        let used = frames.flows.iter().filter(|f| f.is_some()).count().max(1);
-        let mut cells = Self::with_layout(frames, sensor, excluded, support_us, TILE_PX, 1);
+        let used = intervals
+            .masks
+            .iter()
+            .filter(|m| m.is_some())
+            .count()
+            .max(1);
         let total = {
-            let c = cells.count(events);
+            let c = Self::with_layout(intervals.clone(), sensor, excluded, support_us, TILE_PX, 1)
+                .count(events);
             c.on.iter().chain(&c.off).map(|&v| v as f64).sum::<f64>()
         };
         let mut tile_px = TILE_PX;
@@ -83,23 +124,22 @@ impl Cells {
                 .ceil()
                 .max(1.0) as usize;
             if group <= used || tile_px >= sensor.width.max(sensor.height) as usize {
-                cells = Self::with_layout(
-                    frames,
+                return Self::with_layout(
+                    intervals,
                     sensor,
                     excluded,
                     support_us,
                     tile_px,
                     group.min(used),
                 );
-                break;
             }
             tile_px *= 2;
         }
-        cells
     }
 
-    fn with_layout(
-        frames: &PreparedFrames,
+    /// Cells of `tile_px` pixels over `group` consecutive intervals each.
+    pub fn with_layout(
+        intervals: Intervals,
         sensor: Sensor,
         excluded: &[bool],
         support_us: TimeUs,
@@ -109,25 +149,18 @@ impl Cells {
         let tiles_x = (sensor.width as usize).div_ceil(tile_px);
         let tiles_y = (sensor.height as usize).div_ceil(tile_px);
         let mut used = 0;
-        let used_index: Vec<Option<usize>> = frames
-            .flows
+        let used_index: Vec<Option<usize>> = intervals
+            .masks
             .iter()
-            .map(|f| {
-                f.as_ref().map(|_| {
+            .map(|m| {
+                m.as_ref().map(|_| {
                     used += 1;
                     used - 1
                 })
             })
             .collect();
         let interval_row = used_index.iter().map(|u| u.map(|u| u / group)).collect();
-        let unreliable = (0..frames.flows.len())
-            .filter(|&k| frames.flows[k].is_some())
-            .map(|k| {
-                (0..sensor.pixels())
-                    .map(|p| !frames.reliable(k, p))
-                    .collect()
-            })
-            .collect();
+        let unreliable = intervals.masks.into_iter().flatten().collect();
         Self {
             tile_px,
             tiles_x,
@@ -136,7 +169,7 @@ impl Cells {
             unreliable,
             interval_row,
             used_index,
-            times: frames.times.clone(),
+            times: intervals.times,
             excluded: excluded.to_vec(),
             width: sensor.width as usize,
             support_us,
@@ -163,7 +196,8 @@ impl Cells {
             let (x, y) = (events.x[i] as usize, events.y[i] as usize);
             let pixel = y * self.width + x;
             let used = self.used_index[k].expect("a row is a used interval");
-            if !supported || self.excluded[pixel] || self.unreliable[used][pixel] {
+            let mask = &self.unreliable[used];
+            if !supported || self.excluded[pixel] || (!mask.is_empty() && mask[pixel]) {
                 continue;
             }
             let cell = row * self.tiles + (y / self.tile_px) * self.tiles_x + x / self.tile_px;
