@@ -6,6 +6,8 @@ use clap::{Args, Subcommand, ValueEnum};
 use ctcal::estimate::CtEstimate;
 use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
 use ctcal::estimate::timing::ThresholdMaps;
+use ctcal::estimate::{eppps, screen};
+use ctcal::sim::DisplayParams;
 use ctcal::sim::LogResponse;
 use ctcal::sim::log_response::LogMap;
 use std::path::{Path, PathBuf};
@@ -14,6 +16,41 @@ use std::path::{Path, PathBuf};
 pub enum EstimateCommand {
     /// From the recording's grey frames: re-simulation and event timing, per-pixel maps.
     Aps(ApsArgs),
+    /// From events per pixel per second, against simulated scenes of matched dynamics.
+    Eppps(EpppsArgs),
+    /// From a recording of the `calib checkerboard` stimulus on a monitor.
+    Screen(ScreenArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct EpppsArgs {
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// Measure the dynamics from the events even when the recording has frames.
+    #[arg(long)]
+    pub ignore_frames: bool,
+    /// Calibration scene samples.
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub scenes: usize,
+    /// Use at most this many frames for the dynamics.
+    #[arg(long, value_name = "N", default_value_t = 120)]
+    pub max_frames: usize,
+}
+
+#[derive(Args, Debug)]
+pub struct ScreenArgs {
+    #[command(flatten)]
+    pub common: CommonArgs,
+    /// A folder with the stimulus's `stimulus.txt` (default: the recording folder's own).
+    #[arg(long, value_name = "DIR")]
+    pub stimulus: Option<PathBuf>,
+    /// The screen model to start from (refresh_hz, gamma, black_level, white_dn, blur_px;
+    /// see calib/screens/); default a typical 60 Hz LCD.
+    #[arg(long, value_name = "SCREEN.toml")]
+    pub screen: Option<PathBuf>,
+    /// The monitor's refresh rate, when not the stimulus's frame rate.
+    #[arg(long, value_name = "HZ")]
+    pub refresh_hz: Option<f64>,
 }
 
 /// How the sensor maps intensity to the log domain.
@@ -94,8 +131,160 @@ pub struct ApsArgs {
 pub fn run(command: &EstimateCommand, global: &Global) -> anyhow::Result<()> {
     match command {
         EstimateCommand::Aps(args) => run_aps(args, global),
+        EstimateCommand::Eppps(args) => run_eppps(args, global),
+        EstimateCommand::Screen(args) => run_screen(args, global),
     }
 }
+
+fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
+    let common = &args.common;
+    let (log_map, log_name) = common.log_map()?;
+    if args.scenes == 0 || args.scenes > 64 {
+        return Err(BadInput(format!("--scenes {} must be between 1 and 64", args.scenes)).into());
+    }
+    let policy = global.outputs([common.input.input.as_path()]);
+    let loaded = load(
+        &common.input,
+        &Window {
+            start_s: common.start,
+            end_s: common.end,
+            frames: (!args.ignore_frames).then_some(args.max_frames.max(2)),
+            events_between_frames: false,
+        },
+        global,
+    )?;
+    let path = loaded.recording.path.clone();
+    let excluded = vec![false; loaded.sensor.pixels()];
+    let spinner = stage_spinner(global);
+    let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
+    let options = ApsOptions {
+        log_map,
+        log_response_name: log_name,
+        ..ApsOptions::default()
+    };
+    let mut notes = loaded.notes.clone();
+    // frames, when there are and they are wanted, prepared as for `aps`
+    let prepared = if loaded.frames.len() >= 2 {
+        let input = ApsInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            frames: &loaded.frames,
+            excluded: &excluded,
+        };
+        match aps::prepare(&input, &excluded, &options) {
+            Ok(p) => {
+                notes.extend(p.assumptions.iter().cloned());
+                Some(p.frames)
+            }
+            Err(e) => {
+                notes.push(format!("frames not used for the dynamics: {}", e.problem));
+                None
+            }
+        }
+    } else {
+        None
+    };
+    if args.ignore_frames {
+        notes.push("frames ignored (--ignore-frames)".into());
+    }
+    let result = eppps::estimate(
+        &eppps::EpppsInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            frames: prepared.as_ref(),
+            excluded: &excluded,
+        },
+        &eppps::EpppsOptions {
+            scenes: args.scenes,
+            ..eppps::EpppsOptions::default()
+        },
+        &progress,
+    );
+    spinner.finish_and_clear();
+    let mut estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    estimate.assumptions.extend(notes);
+    present(&estimate, &loaded, common, &policy)
+}
+
+fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
+    let common = &args.common;
+    if let Some(r) = args.refresh_hz
+        && !(r.is_finite() && (1.0..=1000.0).contains(&r))
+    {
+        return Err(BadInput(format!("--refresh-hz {r} must be between 1 and 1000")).into());
+    }
+    let mut inputs = vec![common.input.input.as_path()];
+    inputs.extend(args.stimulus.as_deref());
+    inputs.extend(args.screen.as_deref());
+    let policy = global.outputs(inputs);
+    let screen = match &args.screen {
+        Some(path) => {
+            let text = ctcal::files::read_small_text(path, 1 << 20)
+                .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
+            DisplayParams::from_toml(&text, &path.display().to_string())?
+        }
+        None => DisplayParams::from_toml(DEFAULT_SCREEN, "the built-in 60 Hz LCD model")?,
+    };
+    let loaded = load(
+        &common.input,
+        &Window {
+            start_s: common.start,
+            end_s: common.end,
+            frames: None,
+            events_between_frames: false,
+        },
+        global,
+    )?;
+    let path = loaded.recording.path.clone();
+    let stimulus = match &args.stimulus {
+        Some(dir) => {
+            let index = if dir.is_dir() {
+                dir.join("stimulus.txt")
+            } else {
+                dir.clone()
+            };
+            Some(ctcal::io::FrameList::read(&index)?)
+        }
+        None => loaded.recording.stimulus()?,
+    };
+    let Some(stimulus) = stimulus else {
+        return Err(BadInput(format!(
+            "{}: `estimate screen` needs the stimulus that was played; the recording has no stimulus.txt\n  fix: pass --stimulus DIR (the folder `ctcal calib checkerboard` wrote)",
+            path.display()
+        ))
+        .into());
+    };
+    if stimulus.len() < 2 || stimulus.len() > 100_000 {
+        return Err(BadInput(format!(
+            "{}: the stimulus has {} frames; a stimulus has 2 to 100000",
+            stimulus.index_path.display(),
+            stimulus.len()
+        ))
+        .into());
+    }
+    let frames = stimulus.load_all()?;
+    let excluded = vec![false; loaded.sensor.pixels()];
+    let spinner = stage_spinner(global);
+    let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
+    let result = screen::estimate(
+        &screen::ScreenInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            stimulus: &frames,
+            screen,
+            refresh_hz: args.refresh_hz,
+            excluded: &excluded,
+        },
+        &progress,
+    );
+    spinner.finish_and_clear();
+    let mut estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    estimate.assumptions.extend(loaded.notes.iter().cloned());
+    present(&estimate, &loaded, common, &policy)
+}
+
+/// The screen model `estimate screen` starts from without `--screen`.
+const DEFAULT_SCREEN: &str = include_str!("../../calib/screens/lcd_60hz_srgb.toml");
 
 /// A spinner on stderr showing the stage (hidden when quiet).
 fn stage_spinner(global: &Global) -> indicatif::ProgressBar {
@@ -281,6 +470,35 @@ fn present(
                 estimate.intervals_dropped.len()
             ),
         ));
+    }
+    if let Some(naive) = estimate.extra.get("naive_ct").and_then(|v| v.as_f64()) {
+        rows.push(("naive_ct (no display)".into(), format!("{naive:.4}")));
+    }
+    if let Some(d) = estimate.extra.get("display") {
+        rows.push((
+            "display".into(),
+            format!(
+                "gamma {:.3}, black level {:.4}, refresh {:.2} Hz, stimulus at {:.6} s",
+                d["gamma"].as_f64().unwrap_or(f64::NAN),
+                d["black_level"].as_f64().unwrap_or(f64::NAN),
+                d["refresh_hz"].as_f64().unwrap_or(f64::NAN),
+                d["time_offset_s"].as_f64().unwrap_or(f64::NAN)
+            ),
+        ));
+    }
+    if let Some(text) = estimate
+        .extra
+        .get("display_explains")
+        .and_then(|v| v.as_str())
+    {
+        rows.push(("explains".into(), text.to_string()));
+    }
+    if let Some(position) = estimate
+        .extra
+        .get("preset_position")
+        .and_then(|v| v.as_str())
+    {
+        rows.push(("vs the paper's presets".into(), position.to_string()));
     }
     for a in &estimate.assumptions {
         rows.push(("assumes".into(), a.clone()));

@@ -10,6 +10,8 @@
 
 pub mod align;
 pub mod aps;
+pub mod dynamics;
+pub mod eppps;
 pub mod flow;
 pub mod frames;
 pub mod image;
@@ -17,6 +19,7 @@ pub mod interval;
 pub mod lsq;
 pub mod offset;
 pub mod resim;
+pub mod screen;
 pub mod timing;
 
 use crate::events::{EventChunk, Sensor, TimeUs};

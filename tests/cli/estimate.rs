@@ -191,3 +191,202 @@ fn aps_without_frames_says_which_method_to_use() {
         "{e}"
     );
 }
+
+/// `estimate eppps` on the three thresholds of one scene: ordered and within 25 %.
+fn eppps_orders_the_three_thresholds(extra: &[&str]) {
+    let mut previous = 0.0;
+    for case in ["e_ct030_texture", "e_ct060_texture", "e_ct100_texture"] {
+        let mut args = vec!["estimate", "eppps"];
+        let path = oracle(case);
+        args.push(path.to_str().unwrap());
+        args.extend(extra);
+        let e = json(&args);
+        let (truth, _) = true_thresholds(case);
+        let ct = e["ct"].as_f64().unwrap();
+        assert!(
+            (ct / truth - 1.0).abs() < 0.25,
+            "{case} {extra:?}: ct {ct} vs {truth}"
+        );
+        assert!(ct > previous, "{case}: {ct} not above {previous}");
+        previous = ct;
+        let (lo, hi) = interval(&e["ct_ci95"]);
+        assert!(lo < ct && ct < hi);
+        // the calibration curve and the paper's presets
+        let curve = e["calibration_curve"].as_array().unwrap();
+        assert!(curve.len() >= 8);
+        let rates: Vec<f64> = curve
+            .iter()
+            .map(|p| p["events_per_pixel_per_second"].as_f64().unwrap())
+            .collect();
+        assert!(
+            rates.windows(2).all(|w| w[0] > w[1]),
+            "the curve falls with CT: {rates:?}"
+        );
+        for p in curve {
+            let (lo, hi) = (p["lo"].as_f64().unwrap(), p["hi"].as_f64().unwrap());
+            assert!(lo <= p["events_per_pixel_per_second"].as_f64().unwrap() && lo <= hi);
+        }
+        assert_eq!(e["presets"].as_array().unwrap().len(), 5);
+        assert!(e["preset_position"].as_str().unwrap().contains("CT"));
+    }
+}
+
+#[test]
+fn eppps_with_frames_orders_and_recovers_the_thresholds() {
+    eppps_orders_the_three_thresholds(&[]);
+}
+
+#[test]
+fn eppps_without_frames_orders_and_recovers_the_thresholds() {
+    eppps_orders_the_three_thresholds(&["--ignore-frames"]);
+}
+
+#[test]
+fn eppps_on_real_recordings_without_and_with_frames() {
+    for input in [real("evk4_faery_evt3.raw"), real("ijrr_slider_depth_50k")] {
+        let e = json(&["estimate", "eppps", input.to_str().unwrap()]);
+        let ct = e["ct"].as_f64().unwrap();
+        let (lo, hi) = interval(&e["ct_ci95"]);
+        assert!(
+            lo < ct && ct < hi && (0.05..2.0).contains(&ct),
+            "{}: {ct}",
+            input.display()
+        );
+    }
+}
+
+#[test]
+fn screen_recovers_the_threshold_through_the_display_and_reports_the_naive_one() {
+    let case = oracle("dev_screen_checker");
+    let truth = 0.3;
+    // the display the recording was made with (calib/screens/lcd_75hz_gamma2.toml), and the
+    // generic LCD model ctcal starts from by default
+    let screens = [
+        Some(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("calib/screens/lcd_75hz_gamma2.toml"),
+        ),
+        None,
+    ];
+    for screen in screens {
+        let mut args = vec!["estimate", "screen", case.to_str().unwrap()];
+        let screen_arg;
+        if let Some(s) = &screen {
+            screen_arg = s.to_str().unwrap().to_string();
+            args.extend(["--screen", &screen_arg]);
+        }
+        let e = json(&args);
+        for key in ["ct_on", "ct_off", "ct"] {
+            let v = e[key].as_f64().unwrap();
+            assert!((v / truth - 1.0).abs() < 0.1, "{screen:?}: {key} {v}");
+            let (lo, hi) = interval(&e[format!("{key}_ci95")]);
+            assert!(lo <= truth && truth <= hi, "{screen:?}: {key} [{lo}, {hi}]");
+        }
+        assert!(e["naive_ct"].as_f64().unwrap() > 0.0);
+        let display = &e["display"];
+        assert!((display["refresh_hz"].as_f64().unwrap() - 75.0).abs() < 0.1);
+        assert!(
+            (display["gamma"].as_f64().unwrap() - 2.0).abs() < 0.3,
+            "{display}"
+        );
+        assert!(display["time_offset_s"].as_f64().unwrap().abs() < 0.002);
+        assert!(
+            e["display_explains"].as_str().unwrap().contains("naive")
+                || e["display_explains"]
+                    .as_str()
+                    .unwrap()
+                    .contains("without a display")
+        );
+        assert_eq!(
+            e["width"],
+            serde_json::Value::Null,
+            "the estimate has no stats keys"
+        );
+    }
+}
+
+#[test]
+fn screen_without_a_stimulus_names_the_fix() {
+    let e = bad_input(&[
+        "estimate",
+        "screen",
+        real("ijrr_slider_depth_50k").to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("no stimulus.txt") && e.contains("--stimulus"),
+        "{e}"
+    );
+}
+
+/// An IJRR folder with `events` (lines `t x y p`) and grey frames of `size`, each filled by
+/// `value(frame, x, y)`, at 20 ms spacing.
+fn small_recording(
+    events: &str,
+    frames: usize,
+    size: (u32, u32),
+    value: impl Fn(usize, u32, u32) -> u8,
+) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("events.txt"), events).unwrap();
+    std::fs::create_dir(dir.path().join("images")).unwrap();
+    let mut index = String::new();
+    for k in 0..frames {
+        let name = format!("images/frame_{k:08}.png");
+        image::GrayImage::from_fn(size.0, size.1, |x, y| image::Luma([value(k, x, y)]))
+            .save(dir.path().join(&name))
+            .unwrap();
+        index.push_str(&format!("{:.6} {name}\n", 0.02 * k as f64));
+    }
+    std::fs::write(dir.path().join("images.txt"), index).unwrap();
+    dir
+}
+
+/// `count` events spread over 0.1 s on a 32x24 sensor.
+fn sparse_events(count: usize) -> String {
+    (0..count)
+        .map(|i| {
+            format!(
+                "{:.6} {} {} {}\n",
+                0.001 + 0.1 * i as f64 / count as f64,
+                i % 32,
+                (i / 32) % 24,
+                i % 2
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn estimates_refuse_too_few_events_with_the_fix() {
+    let dir = small_recording(&sparse_events(40), 6, (32, 24), |k, x, y| {
+        (40 + 5 * k as u32 + x + y) as u8
+    });
+    let path = dir.path().to_str().unwrap();
+    for method in ["aps", "eppps"] {
+        let e = bad_input(&["estimate", method, path]);
+        assert!(
+            e.contains(path) && e.contains("too few") && e.contains("fix:"),
+            "{method}: {e}"
+        );
+    }
+}
+
+#[test]
+fn aps_refuses_frames_of_another_size_than_the_sensor() {
+    let events = format!("32 24\n{}", sparse_events(2000));
+    let dir = small_recording(&events, 6, (40, 30), |k, x, y| {
+        (40 + 5 * k as u32 + x + y) as u8
+    });
+    let e = bad_input(&["estimate", "aps", dir.path().to_str().unwrap()]);
+    assert!(
+        e.contains("40x30") && e.contains("32x24") && e.contains("fix:"),
+        "{e}"
+    );
+}
+
+#[test]
+fn aps_refuses_frames_that_are_all_clipped() {
+    let dir = small_recording(&sparse_events(2000), 6, (32, 24), |_, _, _| 255);
+    let e = bad_input(&["estimate", "aps", dir.path().to_str().unwrap()]);
+    assert!(e.contains("clipped") && e.contains("fix:"), "{e}");
+}

@@ -1,0 +1,147 @@
+//! How fast a recording's scene changes: what the events-per-pixel-per-second method needs
+//! to build calibration scenes that resemble it (Stoffregen et al. 2020 chose their
+//! simulated scenes "with similar motion" by hand; here it is measured).
+//!
+//! - From frames: the speed of the optical flow, and the total variation rate of the log
+//!   intensity, `R = mean over pixels of sum |L(s+1) - L(s)| / T` over the frames upsampled
+//!   along the flow. An ideal pixel of threshold `C` fires about `R / C` events per second,
+//!   so `R` is the quantity events per pixel per second is to be compared against.
+//! - From events alone: the speed of moving edges, by fitting a plane to the times of the
+//!   latest events around each event (the surface of active events; Benosman et al.,
+//!   "Event-based visual flow", IEEE TNNLS 2014); the normal speed is `1 / |grad t|`. Its
+//!   median is a statistic of the motion that is measured the same way on the simulated
+//!   calibration scenes, so that their motion can be matched to it.
+
+use super::frames::PreparedFrames;
+use crate::events::{EventChunk, Sensor, TimeUs};
+use serde::Serialize;
+
+/// Dynamics measured from frames.
+#[derive(Clone, Debug, Serialize)]
+pub struct FrameDynamics {
+    /// Median and 90th percentile of the flow speed over textured pixels, px/s.
+    pub speed_median_px_s: f64,
+    pub speed_p90_px_s: f64,
+    /// Total variation rate of the log intensity per pixel, log units per second.
+    pub log_change_rate: f64,
+}
+
+/// Measures `frames` (upsampled along their flow, `max_step_px` apart).
+pub fn from_frames(frames: &PreparedFrames, max_step_px: f64) -> Option<FrameDynamics> {
+    let mut speeds = Vec::new();
+    for (k, flow) in frames.flows.iter().enumerate() {
+        let Some(flow) = flow else { continue };
+        let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
+        let (gx, gy) = frames.dn[k].gradients();
+        // textured pixels: where events come from
+        let mut energies: Vec<f32> = gx
+            .data
+            .iter()
+            .zip(&gy.data)
+            .map(|(a, b)| a.hypot(*b))
+            .collect();
+        let mut sorted = energies.clone();
+        sorted.sort_by(f32::total_cmp);
+        let threshold = sorted[sorted.len() / 2];
+        for (i, e) in energies.iter_mut().enumerate() {
+            if *e >= threshold {
+                speeds.push(flow.u[i].hypot(flow.v[i]) as f64 / dt);
+            }
+        }
+    }
+    if speeds.is_empty() {
+        return None;
+    }
+    speeds.sort_by(f64::total_cmp);
+    let quantile = |q: f64| speeds[((speeds.len() - 1) as f64 * q) as usize];
+    let mut variation = 0.0f64;
+    let mut duration = 0.0f64;
+    let pixels = frames.width * frames.height;
+    let log = |v: f32| frames.log(v);
+    for run in frames.upsample_runs(max_step_px, 512 << 20) {
+        for pair in run.windows(2) {
+            variation += pair[0]
+                .dn
+                .iter()
+                .zip(&pair[1].dn)
+                .map(|(&a, &b)| (log(b - frames.offset) - log(a - frames.offset)).abs() as f64)
+                .sum::<f64>();
+            duration += (pair[1].t - pair[0].t) as f64 * 1e-6;
+        }
+    }
+    (duration > 0.0).then(|| FrameDynamics {
+        speed_median_px_s: quantile(0.5),
+        speed_p90_px_s: quantile(0.9),
+        log_change_rate: variation / (pixels as f64 * duration),
+    })
+}
+
+/// The median normal speed of moving edges, px/s, from plane fits to the surface of
+/// active events (at most `max_fits` fits, spread over the recording). `None` with too few
+/// good fits.
+pub fn edge_speed(events: &EventChunk, sensor: Sensor, max_fits: usize) -> Option<f64> {
+    const RADIUS: i32 = 2;
+    const WINDOW_US: TimeUs = 100_000;
+    let (w, h) = (sensor.width as i32, sensor.height as i32);
+    // latest event time per pixel and polarity
+    let mut latest = vec![[TimeUs::MIN; 2]; sensor.pixels()];
+    let stride = (events.len() / max_fits.max(1)).max(1);
+    let mut speeds = Vec::new();
+    for i in 0..events.len() {
+        let (x, y, t) = (events.x[i] as i32, events.y[i] as i32, events.t[i]);
+        let p = events.on[i] as usize;
+        latest[(y * w + x) as usize][p] = t;
+        if i % stride != 0 {
+            continue;
+        }
+        // least-squares plane t_n - t = a dx + b dy + c over recent same-polarity neighbours
+        let (mut sxx, mut sxy, mut syy, mut sx, mut sy, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let (mut sxt, mut syt, mut st) = (0.0, 0.0, 0.0);
+        for dy in -RADIUS..=RADIUS {
+            for dx in -RADIUS..=RADIUS {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w || ny >= h {
+                    continue;
+                }
+                let tn = latest[(ny * w + nx) as usize][p];
+                if tn == TimeUs::MIN || t - tn > WINDOW_US {
+                    continue;
+                }
+                let (fx, fy, ft) = (dx as f64, dy as f64, (tn - t) as f64 * 1e-6);
+                sxx += fx * fx;
+                sxy += fx * fy;
+                syy += fy * fy;
+                sx += fx;
+                sy += fy;
+                sxt += fx * ft;
+                syt += fy * ft;
+                st += ft;
+                n += 1.0;
+            }
+        }
+        if n < 6.0 {
+            continue;
+        }
+        // centre, then solve the 2x2 system for (a, b)
+        let (cxx, cxy, cyy) = (sxx - sx * sx / n, sxy - sx * sy / n, syy - sy * sy / n);
+        let (cxt, cyt) = (sxt - sx * st / n, syt - sy * st / n);
+        let det = cxx * cyy - cxy * cxy;
+        if det <= 1e-9 {
+            continue;
+        }
+        let a = (cyy * cxt - cxy * cyt) / det;
+        let b = (cxx * cyt - cxy * cxt) / det;
+        let gradient = a.hypot(b);
+        if gradient > 1e-5 {
+            let speed = 1.0 / gradient;
+            if speed < 1e4 {
+                speeds.push(speed);
+            }
+        }
+    }
+    if speeds.len() < 100 {
+        return None;
+    }
+    let mid = speeds.len() / 2;
+    Some(*speeds.select_nth_unstable_by(mid, f64::total_cmp).1)
+}
