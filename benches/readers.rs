@@ -1,9 +1,12 @@
-//! Decoder and statistics throughput: IJRR text (bytes/s), EVT3 and HDF5 (events/s), and
+//! Decoder and statistics throughput: IJRR text (bytes/s), EVT3, HDF5 (event_utils, DSEC
+//! Blosc) and ROS bags (events/s), and
 //! the statistics kernel on events already in memory (events/s), on deterministic
 //! synthetic recordings (`ctcal::synthetic`).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter, OutputPolicy};
+use ctcal::io::write::{
+    BagCompression, BagWriter, Evt3Writer, H5Writer, IjrrWriter, OutputPolicy, dsec,
+};
 use ctcal::stats::{StatsAccumulator, StatsOptions};
 use ctcal::synthetic::SyntheticEvents;
 use ctcal::{CHUNK_EVENTS, OpenOptions, Recording, Sensor};
@@ -38,6 +41,14 @@ fn readers(c: &mut Criterion) {
     w.write_events(&events).unwrap();
     w.finish().unwrap();
 
+    let bag = dir.path().join("events.bag");
+    let mut w =
+        BagWriter::create(&bag, SENSOR, BagCompression::None, &OutputPolicy::default()).unwrap();
+    w.write_events(&events).unwrap();
+    w.finish().unwrap();
+    let dsec_file = dir.path().join("dsec.h5");
+    dsec::write_dsec(&dsec_file, &events, &OutputPolicy::default()).unwrap();
+
     let mut group = c.benchmark_group("decode");
     group.sample_size(10);
     let text_bytes = std::fs::metadata(text.join("events.txt")).unwrap().len();
@@ -46,6 +57,8 @@ fn readers(c: &mut Criterion) {
     group.throughput(Throughput::Elements(events.len() as u64));
     group.bench_function("evt3", |b| b.iter(|| decode(&evt3)));
     group.bench_function("hdf5_event_utils", |b| b.iter(|| decode(&h5)));
+    group.bench_function("ros_bag", |b| b.iter(|| decode(&bag)));
+    group.bench_function("hdf5_dsec_blosc", |b| b.iter(|| decode(&dsec_file)));
     group.finish();
 
     let mut group = c.benchmark_group("stats");

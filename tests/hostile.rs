@@ -1,7 +1,8 @@
 //! Hostile files: every decoder must end in `Ok` or an `InputError` on damaged input, never
 //! panic, hang or allocate from what a header or a timestamp claims.
 //!
-//! - A property test (proptest) mutates every real recording of `../shared/data/real`
+//! - A property test (proptest) mutates every real recording of `../shared/data/real`, and
+//!   ROS bags of its events (plain and bz2 chunks),
 //!   (truncations, byte flips, zeroed and duplicated blocks, huge header values) and runs the
 //!   whole read path on each: format detection, the event stream with the statistics pass,
 //!   frame times and frames. 2,000 cases by default (`CTCAL_MUTATION_CASES` changes it).
@@ -173,6 +174,44 @@ fn seeds() -> Vec<Seed> {
             file_name: "rec.aedat4",
             bytes: bytes[..at].to_vec(),
             header_end: 18 + header,
+        });
+    }
+    // ROS bags, plain and bz2: the real slider events and one frame, written in small
+    // chunks so that a seed holds several
+    let recording = Recording::open(
+        &shared_real("ijrr_slider_depth_50k"),
+        &OpenOptions::default(),
+    )
+    .unwrap();
+    let mut events = recording.read_all(false).unwrap();
+    events.t.truncate(5000);
+    events.x.truncate(5000);
+    events.y.truncate(5000);
+    events.on.truncate(5000);
+    let frame = recording.frames().unwrap().remove(1);
+    for (name, compression) in [
+        ("bag", ctcal::io::write::BagCompression::None),
+        ("bag_bz2", ctcal::io::write::BagCompression::Bz2),
+    ] {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("seed.bag");
+        let mut writer = ctcal::io::write::BagWriter::create(
+            &path,
+            ctcal::Sensor::new(240, 180),
+            compression,
+            &ctcal::io::write::OutputPolicy::default(),
+        )
+        .unwrap()
+        .events_per_message(500)
+        .chunk_bytes(16 << 10);
+        writer.write_events(&events).unwrap();
+        writer.write_frame(&frame).unwrap();
+        writer.finish().unwrap();
+        seeds.push(Seed {
+            name,
+            file_name: "rec.bag",
+            bytes: std::fs::read(&path).unwrap(),
+            header_end: 13 + 4096,
         });
     }
     seeds

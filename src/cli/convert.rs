@@ -1,10 +1,11 @@
-//! `ctcal convert`: rewrites a recording as an IJRR folder or an event_utils HDF5 file,
-//! every event unchanged (frames too, where present).
+//! `ctcal convert`: rewrites a recording as an IJRR folder, an event_utils HDF5 file,
+//! Prophesee EVT3 or a ROS1 bag, every event unchanged (frames too, where the output holds
+//! them).
 
 use super::{BadInput, Global, InputArgs, progress_bar, warn};
 use clap::{Args, ValueEnum};
 use ctcal::Recording;
-use ctcal::io::write::{Evt3Writer, H5Writer, IjrrWriter};
+use ctcal::io::write::{BagCompression, BagWriter, Evt3Writer, H5Writer, IjrrWriter};
 use std::path::PathBuf;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -13,6 +14,8 @@ pub enum OutputFormat {
     H5,
     /// Prophesee RAW EVT 3.0 (events only).
     Evt3,
+    /// ROS1 bag: dvs_msgs/EventArray on /dvs/events, mono8 frames on /dvs/image_raw.
+    Bag,
 }
 
 #[derive(Args, Debug)]
@@ -22,19 +25,23 @@ pub struct ConvertArgs {
     /// Output folder (IJRR) or file (HDF5).
     #[arg(long, value_name = "PATH")]
     pub out: PathBuf,
-    /// Output layout (default from --out: .h5/.hdf5 -> h5, .raw/.evt3 -> evt3, no extension ->
-    /// an ijrr folder).
+    /// Output layout (default from --out: .h5/.hdf5 -> h5, .raw/.evt3 -> evt3, .bag -> bag, no
+    /// extension -> an ijrr folder).
     #[arg(long, value_enum)]
     pub to: Option<OutputFormat>,
     /// Accept timestamps that go backwards and write the events sorted by time.
     #[arg(long)]
     pub sort: bool,
+    /// Bag output: compress chunks with bz2.
+    #[arg(long)]
+    pub bz2: bool,
 }
 
 enum Writer {
     Ijrr(IjrrWriter),
     H5(H5Writer),
     Evt3(Evt3Writer),
+    Bag(BagWriter),
 }
 
 /// The output layout `--out`'s extension asks for, when `--to` is not given.
@@ -48,8 +55,9 @@ pub fn layout_from_extension(out: &std::path::Path) -> Result<OutputFormat, BadI
         "" => Ok(OutputFormat::Ijrr),
         "h5" | "hdf5" => Ok(OutputFormat::H5),
         "raw" | "evt3" => Ok(OutputFormat::Evt3),
+        "bag" => Ok(OutputFormat::Bag),
         other => Err(BadInput(format!(
-            "{}: ctcal cannot write .{other} files\n  fix: pass --to ijrr (a folder), --to h5 (event_utils HDF5) or --to evt3 (Prophesee RAW), or end --out in .h5, .raw or no extension",
+            "{}: ctcal cannot write .{other} files\n  fix: pass --to ijrr (a folder), --to h5 (event_utils HDF5), --to evt3 (Prophesee RAW) or --to bag (ROS1), or end --out in .h5, .raw, .bag or no extension",
             out.display()
         ))),
     }
@@ -92,44 +100,68 @@ pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
         OutputFormat::Evt3 => {
             Writer::Evt3(Evt3Writer::create(&args.out, resolved.sensor, &policy)?)
         }
+        OutputFormat::Bag => Writer::Bag(BagWriter::create(
+            &args.out,
+            resolved.sensor,
+            if args.bz2 {
+                BagCompression::Bz2
+            } else {
+                BagCompression::None
+            },
+            &policy,
+        )?),
     };
-    let mut write = |chunk: &ctcal::EventChunk| -> anyhow::Result<()> {
+    // frames go out beside the events of their time (a bag interleaves them)
+    let frames = recording.frames()?;
+    let mut next_frame = 0;
+    if matches!(writer, Writer::Evt3(_)) && !frames.is_empty() {
+        warn(
+            global,
+            "EVT3 holds events only; the frames were not written",
+        );
+    }
+    let mut write = |chunk: &ctcal::EventChunk, last: bool| -> anyhow::Result<()> {
         match &mut writer {
             Writer::Ijrr(w) => w.write_events(chunk)?,
             Writer::H5(w) => w.write_events(chunk)?,
             Writer::Evt3(w) => w.write_events(chunk)?,
+            Writer::Bag(w) => w.write_events(chunk)?,
+        }
+        let until = if last {
+            ctcal::TimeUs::MAX
+        } else {
+            chunk.t.last().copied().unwrap_or(ctcal::TimeUs::MIN)
+        };
+        while next_frame < frames.len() && frames[next_frame].t <= until {
+            let frame = &frames[next_frame];
+            match &mut writer {
+                Writer::Ijrr(w) => w.write_frame(frame)?,
+                Writer::H5(w) => w.write_frame(frame)?,
+                Writer::Bag(w) => w.write_frame(frame)?,
+                Writer::Evt3(_) => {}
+            }
+            next_frame += 1;
         }
         Ok(())
     };
     match &sorted {
-        Some(all) => write(all)?,
+        Some(all) => write(all, true)?,
         None => {
             let mut stream = recording.events()?;
             let bar = progress_bar(global, stream.progress().total, "converting");
             while let Some(chunk) = stream.next_chunk()? {
-                write(chunk)?;
+                write(chunk, false)?;
                 bar.set_position(stream.progress().done);
             }
+            write(&ctcal::EventChunk::default(), true)?;
             bar.finish_and_clear();
-        }
-    }
-    for frame in recording.frames()? {
-        match &mut writer {
-            Writer::Ijrr(w) => w.write_frame(&frame)?,
-            Writer::H5(w) => w.write_frame(&frame)?,
-            Writer::Evt3(_) => {
-                warn(
-                    global,
-                    "EVT3 holds events only; the frames were not written",
-                );
-                break;
-            }
         }
     }
     match writer {
         Writer::Ijrr(w) => w.finish()?,
         Writer::H5(w) => w.finish()?,
         Writer::Evt3(w) => w.finish()?,
+        Writer::Bag(w) => w.finish()?,
     }
     Ok(())
 }

@@ -18,6 +18,12 @@ pub struct InfoArgs {
 #[derive(Serialize)]
 struct Info {
     format: ctcal::Format,
+    /// HDF5: which layout.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    layout: Option<&'static str>,
+    /// ROS bags: every topic with its message type and count.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    topics: Vec<ctcal::io::bag::Topic>,
     width: u16,
     height: u16,
     sensor_source: String,
@@ -36,7 +42,16 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
     for note in &recording.notes {
         warn(global, note);
     }
-    let mut stream = recording.events()?;
+    let mut stream = match recording.events() {
+        Ok(stream) => stream,
+        Err(error) => {
+            // a bag whose events topic must be chosen: show what it holds first
+            if !recording.topics().is_empty() && !global.quiet {
+                print_topics(recording.topics())?;
+            }
+            return Err(error.into());
+        }
+    };
     stream.allow_unsorted = true;
     let bar = progress_bar(global, stream.progress().total, "reading");
     let (mut first, mut last, mut on) = (i64::MAX, i64::MIN, 0u64);
@@ -53,6 +68,8 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
     }
     let info = Info {
         format: recording.format,
+        layout: recording.layout(),
+        topics: recording.topics().to_vec(),
         width: resolved.sensor.width,
         height: resolved.sensor.height,
         sensor_source: resolved.source.clone(),
@@ -71,8 +88,12 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
         emit_json(&info, target, &global.outputs([args.input.input.as_path()]))?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) {
+        let mut format = info.format.to_string();
+        if let Some(layout) = info.layout {
+            format.push_str(&format!(" ({layout} layout)"));
+        }
         output::print_table(&[
-            ("format".into(), info.format.to_string()),
+            ("format".into(), format),
             (
                 "sensor".into(),
                 format!("{}x{} ({})", info.width, info.height, info.sensor_source),
@@ -95,6 +116,24 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
             ),
             ("frames".into(), info.frames.to_string()),
         ])?;
+        if !info.topics.is_empty() {
+            print_topics(&info.topics)?;
+        }
     }
+    Ok(())
+}
+
+/// A bag's topics, one row each.
+fn print_topics(topics: &[ctcal::io::bag::Topic]) -> anyhow::Result<()> {
+    let rows: Vec<(String, String)> = topics
+        .iter()
+        .map(|t| {
+            (
+                format!("topic {}", t.name),
+                format!("{} ({} messages)", t.message_type, t.messages),
+            )
+        })
+        .collect();
+    output::print_table(&rows)?;
     Ok(())
 }

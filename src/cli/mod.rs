@@ -57,11 +57,20 @@ pub struct InputArgs {
     /// Recording: an IJRR folder or events.txt, HDF5, AEDAT4, Prophesee RAW (EVT2/EVT3) or DAT.
     pub input: PathBuf,
     /// Read as this format instead of detecting it from the content.
-    #[arg(long, value_name = "ijrr|h5|aedat4|evt2|evt3|dat")]
+    #[arg(long, value_name = "ijrr|h5|aedat4|evt2|evt3|dat|bag")]
     pub format: Option<Format>,
     /// Sensor size WxH, overriding the file's own metadata.
     #[arg(long, value_name = "WxH", value_parser = parse_sensor)]
     pub sensor: Option<Sensor>,
+    /// ROS bags: the dvs_msgs/EventArray topic to read (when there are several).
+    #[arg(long, value_name = "NAME")]
+    pub topic: Option<String>,
+    /// ROS bags: the sensor_msgs/Image topic of the frames (when there are several).
+    #[arg(long, value_name = "NAME")]
+    pub image_topic: Option<String>,
+    /// MVSEC HDF5: which camera of the stereo pair.
+    #[arg(long, value_name = "left|right")]
+    pub side: Option<ctcal::io::h5::Side>,
 }
 
 impl InputArgs {
@@ -69,6 +78,9 @@ impl InputArgs {
         OpenOptions {
             format: self.format,
             sensor: self.sensor,
+            topic: self.topic.clone(),
+            image_topic: self.image_topic.clone(),
+            side: self.side,
         }
     }
 }

@@ -4,7 +4,7 @@
 
 use super::error::InputError;
 use super::prophesee::PropheseeHeader;
-use super::{Format, aedat4, h5, text};
+use super::{Format, aedat4, bag, h5, text};
 use std::io::Read;
 use std::path::Path;
 
@@ -37,6 +37,19 @@ pub fn detect(path: &Path) -> Result<Format, InputError> {
     }
     if aedat4::has_magic(&head) {
         return Ok(Format::Aedat4);
+    }
+    if head.starts_with(bag::records::MAGIC) {
+        return Ok(Format::Bag);
+    }
+    if head.starts_with(b"#ROSBAG V") {
+        return Err(InputError::unknown(
+            path,
+            format!(
+                "a ROS bag of version `{}`; ctcal reads ROS1 bags (V2.0)",
+                String::from_utf8_lossy(&head[..head.len().min(16)]).trim()
+            ),
+            "ROS2 bags are folders of .db3/.mcap files: convert them to a ROS1 bag (`rosbags-convert`) first",
+        ));
     }
     if let Some(kind) = image_kind(&head) {
         return Err(InputError::unknown(

@@ -84,7 +84,7 @@ pub enum InputError {
 
 /// The fix for a file whose format is not recognised.
 pub const FIX_UNKNOWN_FORMAT: &str =
-    "pass --format ijrr|h5|aedat4|evt2|evt3|dat if the file is one of these";
+    "pass --format ijrr|h5|aedat4|evt2|evt3|dat|bag if the file is one of these";
 
 impl InputError {
     /// A file that cannot be read as a regular file (missing, a folder, a FIFO, ...).

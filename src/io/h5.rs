@@ -1,4 +1,4 @@
-//! HDF5 event files in the two layouts researchers meet most:
+//! HDF5 event files in the layouts researchers meet most:
 //!
 //! - event_utils / event_cnn_minimal (Stoffregen et al. 2020): `events/ts` (float64 seconds;
 //!   integer timestamps, which some writers store, are read as microseconds),
@@ -7,16 +7,25 @@
 //!   `sensor_resolution` = (H, W). Writers disagree on that order, so the claim is checked
 //!   against the coordinates and swapped when only the swapped reading contains them;
 //! - v2e: `events` N x 4 unsigned `[t_us, x, y, p]`, frames in `frame` (N, H, W) with
-//!   `frame_ts` in microseconds.
+//!   `frame_ts` in microseconds;
+//! - MVSEC (Zhu et al., RA-L 2018): `davis/left/events` (or `davis/right`) N x 4 float64
+//!   `[x, y, t, p]` with `t` in seconds since the epoch and `p` -1/1, grey frames in
+//!   `davis/left/image_raw` (M, H, W) with `image_raw_ts` in seconds;
+//! - DSEC (Gehrig et al., RA-L 2021): `events/x`, `events/y`, `events/t` (microseconds after
+//!   the scalar `t_offset`, also microseconds), `events/p` (0/1), compressed with the Blosc
+//!   filter (id 32001, zstd inside), which ctcal decodes itself (no HDF5 plugin needed).
+//!   Times are reported as `t + t_offset`, the file's own clock.
 //!
-//! Read through `hdf5-metno` (libhdf5) in chunks of `CHUNK_EVENTS` rows.
+//! Read through `hdf5-metno` (libhdf5) in chunks of `CHUNK_EVENTS` rows; compressed 1-D
+//! columns by direct chunk access on all cores ([`super::h5_direct`]).
 
 use super::error::InputError;
-use super::h5_direct::{DirectColumn, ElementKind};
+use super::h5_direct::{DirectColumn, DirectError, ElementKind};
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
-use crate::events::{CHUNK_EVENTS, EventChunk, Frame, Sensor, TimeUs};
+use crate::events::{CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TimeUs};
 use hdf5::types::TypeDescriptor;
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// HDF5 signature at the start of a file.
@@ -26,6 +35,53 @@ pub const SIGNATURE: &[u8] = b"\x89HDF\r\n\x1a\n";
 pub enum Layout {
     EventUtils,
     V2e,
+    Mvsec(Side),
+    Dsec,
+}
+
+impl Layout {
+    /// The layout's name, for `info`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Layout::EventUtils => "event_utils",
+            Layout::V2e => "v2e",
+            Layout::Mvsec(_) => "MVSEC",
+            Layout::Dsec => "DSEC",
+        }
+    }
+}
+
+/// Which camera of a stereo MVSEC file.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Side {
+    #[default]
+    Left,
+    Right,
+}
+
+impl Side {
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Left => "left",
+            Side::Right => "right",
+        }
+    }
+
+    /// The MVSEC group of this camera.
+    fn group(self) -> String {
+        format!("davis/{}", self.name())
+    }
+}
+
+impl std::str::FromStr for Side {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "left" => Ok(Side::Left),
+            "right" => Ok(Side::Right),
+            _ => Err(format!("`{s}` is not a side (left or right)")),
+        }
+    }
 }
 
 /// What an HDF5 event file holds, checked against its data.
@@ -44,7 +100,7 @@ fn h5_error(path: &Path, what: &str, e: hdf5::Error) -> InputError {
     InputError::hdf5(
         path,
         format!("{what}: {e}"),
-        "check that the file is a complete event_utils or v2e HDF5 file (h5ls -r shows its layout)",
+        "check that the file is a complete event_utils, v2e, MVSEC or DSEC HDF5 file (h5ls -r shows its layout)",
     )
 }
 
@@ -61,18 +117,58 @@ fn missing(path: &Path, what: &str) -> InputError {
     InputError::hdf5(
         path,
         format!("no {what}"),
-        "ctcal reads the event_utils layout (events/ts, events/xs, events/ys, events/ps) and the v2e layout (events: N x 4 [t_us, x, y, p])",
+        "ctcal reads the event_utils layout (events/ts, events/xs, events/ys, events/ps), the v2e layout (events: N x 4 [t_us, x, y, p]), MVSEC (davis/left/events: N x 4 [x, y, t, p]) and DSEC (events/x, events/y, events/t, events/p)",
     )
 }
 
-fn layout_of(path: &Path, file: &hdf5::File) -> Result<Layout, InputError> {
+fn layout_of(path: &Path, file: &hdf5::File, side: Side) -> Result<Layout, InputError> {
     if let Ok(group) = file.group("events") {
-        for name in ["ts", "xs", "ys", "ps"] {
-            if !group.link_exists(name) {
-                return Err(missing(path, &format!("dataset events/{name}")));
+        // event_utils names its columns ts/xs/ys/ps, DSEC t/x/y/p
+        for (names, layout) in [
+            (["ts", "xs", "ys", "ps"], Layout::EventUtils),
+            (["t", "x", "y", "p"], Layout::Dsec),
+        ] {
+            if group.link_exists(names[0]) {
+                for name in names {
+                    if !group.link_exists(name) {
+                        return Err(missing(path, &format!("dataset events/{name}")));
+                    }
+                }
+                return Ok(layout);
             }
         }
-        return Ok(Layout::EventUtils);
+        return Err(missing(
+            path,
+            "events/ts (event_utils) or events/t (DSEC) in group `events`",
+        ));
+    }
+    if let Ok(davis) = file.group("davis") {
+        let wanted = side.group();
+        if file.link_exists(&format!("{wanted}/events")) {
+            return Ok(Layout::Mvsec(side));
+        }
+        let others: Vec<String> = davis
+            .member_names()
+            .unwrap_or_default()
+            .into_iter()
+            .filter(|n| file.link_exists(&format!("davis/{n}/events")))
+            .collect();
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "an MVSEC file without {wanted}/events (cameras with events: {})",
+                if others.is_empty() {
+                    "none".to_string()
+                } else {
+                    others.join(", ")
+                }
+            ),
+            match others.first() {
+                Some(other) => format!("pass --side {other}"),
+                None => "the file holds no MVSEC events (davis/left/events or davis/right/events)"
+                    .to_string(),
+            },
+        ));
     }
     if let Ok(ds) = file.dataset("events") {
         let shape = ds.shape();
@@ -87,7 +183,7 @@ fn layout_of(path: &Path, file: &hdf5::File) -> Result<Layout, InputError> {
     }
     Err(missing(
         path,
-        "group `events` (event_utils) or dataset `events` (v2e)",
+        "group `events` (event_utils, DSEC), dataset `events` (v2e) or group `davis` (MVSEC)",
     ))
 }
 
@@ -95,6 +191,7 @@ fn layout_of(path: &Path, file: &hdf5::File) -> Result<Layout, InputError> {
 /// inflation where the layout allows ([`super::h5_direct`]), through libhdf5 otherwise.
 /// Results go into caller buffers, which are reused from chunk to chunk.
 struct Column {
+    name: String,
     dataset: hdf5::Dataset,
     direct: Option<(DirectColumn, ElementKind)>,
 }
@@ -104,26 +201,49 @@ impl Column {
         let dataset = file.dataset(name)?;
         let kind = dataset.dtype().ok().and_then(|d| ElementKind::of(&d));
         let direct = DirectColumn::new(path, &dataset).zip(kind);
-        Ok(Self { dataset, direct })
+        Ok(Self {
+            name: name.to_string(),
+            dataset,
+            direct,
+        })
     }
 
-    /// The raw bytes of `range` into `bytes`, when the direct path can read it.
-    fn raw(&self, range: &std::ops::Range<usize>, bytes: &mut Vec<u8>) -> Option<ElementKind> {
-        let (column, kind) = self.direct.as_ref()?;
-        column.read_into(range.clone(), bytes).map(|_| *kind)
+    /// The values of `range` into `out` by the direct path, when it can read them (`false`:
+    /// read through the library); a chunk that does not decode is an error naming it.
+    fn direct<T: Copy + Default + Send>(
+        &self,
+        range: &std::ops::Range<usize>,
+        out: &mut Vec<T>,
+        integer: impl Fn(i64) -> T + Sync,
+        float: impl Fn(f64) -> T + Sync,
+    ) -> hdf5::Result<bool> {
+        let Some((column, kind)) = self.direct.as_ref() else {
+            return Ok(false);
+        };
+        // the callers pass empty buffers (reused from chunk to chunk)
+        debug_assert!(out.is_empty());
+        match column.read_decoded(range.clone(), out, |bytes, piece| {
+            kind.decode_into(bytes, piece, &integer, &float)
+        }) {
+            Ok(()) => Ok(true),
+            Err(DirectError::Unsupported) => Ok(false),
+            Err(DirectError::Damaged { chunk, problem }) => {
+                let n = column.chunk_len();
+                Err(hdf5::Error::from(format!(
+                    "{}: the chunk of elements {}..{} {problem}",
+                    self.name,
+                    chunk * n,
+                    (chunk + 1) * n
+                )))
+            }
+        }
     }
 
     /// Appends the values of `range` as i64, whatever the stored type: integers as they are,
     /// floats that hold an integer converted, any other float (NaN, infinite, fractional)
     /// as [`NOT_AN_INTEGER`].
-    fn ints(
-        &self,
-        range: std::ops::Range<usize>,
-        bytes: &mut Vec<u8>,
-        out: &mut Vec<i64>,
-    ) -> hdf5::Result<()> {
-        if let Some(kind) = self.raw(&range, bytes) {
-            kind.decode(bytes, out, |v| v, float_to_int);
+    fn ints(&self, range: std::ops::Range<usize>, out: &mut Vec<i64>) -> hdf5::Result<()> {
+        if self.direct(&range, out, |v| v, float_to_int)? {
             return Ok(());
         }
         match self.dataset.dtype()?.to_descriptor()? {
@@ -145,15 +265,9 @@ impl Column {
     }
 
     /// Appends the values of `range` as f64.
-    fn floats(
-        &self,
-        range: std::ops::Range<usize>,
-        bytes: &mut Vec<u8>,
-        out: &mut Vec<f64>,
-    ) -> hdf5::Result<()> {
-        match self.raw(&range, bytes) {
-            Some(kind) => kind.decode(bytes, out, |v| v as f64, |f| f),
-            None => out.extend(self.dataset.read_slice_1d::<f64, _>(range)?.iter()),
+    fn floats(&self, range: std::ops::Range<usize>, out: &mut Vec<f64>) -> hdf5::Result<()> {
+        if !self.direct(&range, out, |v| v as f64, |f| f)? {
+            out.extend(self.dataset.read_slice_1d::<f64, _>(range)?.iter());
         }
         Ok(())
     }
@@ -182,7 +296,6 @@ fn shown(v: i64) -> String {
 /// Reused buffers of the HDF5 reader.
 #[derive(Default)]
 struct Buffers {
-    bytes: Vec<u8>,
     seconds: Vec<f64>,
 }
 
@@ -196,10 +309,22 @@ struct EventColumns {
     ps: Column,
 }
 
-/// The four event columns of an event_utils file, or the N x 4 table of a v2e file.
+/// The four columns of a DSEC file and its time offset.
+struct DsecColumns {
+    t_offset: TimeUs,
+    t: Column,
+    x: Column,
+    y: Column,
+    p: Column,
+}
+
+/// The four event columns of an event_utils or DSEC file, or the N x 4 table of a v2e or
+/// MVSEC file.
 enum EventTable {
     EventUtils(Box<EventColumns>),
     V2e(hdf5::Dataset),
+    Mvsec(hdf5::Dataset, Side),
+    Dsec(Box<DsecColumns>),
 }
 
 /// Where each event field is stored, for messages.
@@ -225,6 +350,24 @@ impl EventTable {
                 y: "events[:, 2]",
                 p: "events[:, 3]",
             },
+            EventTable::Mvsec(_, Side::Left) => FieldNames {
+                t: "davis/left/events[:, 2]",
+                x: "davis/left/events[:, 0]",
+                y: "davis/left/events[:, 1]",
+                p: "davis/left/events[:, 3]",
+            },
+            EventTable::Mvsec(_, Side::Right) => FieldNames {
+                t: "davis/right/events[:, 2]",
+                x: "davis/right/events[:, 0]",
+                y: "davis/right/events[:, 1]",
+                p: "davis/right/events[:, 3]",
+            },
+            EventTable::Dsec(_) => FieldNames {
+                t: "events/t (+ t_offset)",
+                x: "events/x",
+                y: "events/y",
+                p: "events/p",
+            },
         }
     }
 
@@ -241,6 +384,16 @@ impl EventTable {
                 ps: Column::open(path, file, "events/ps")?,
             })),
             Layout::V2e => EventTable::V2e(file.dataset("events")?),
+            Layout::Mvsec(side) => {
+                EventTable::Mvsec(file.dataset(&format!("{}/events", side.group()))?, side)
+            }
+            Layout::Dsec => EventTable::Dsec(Box::new(DsecColumns {
+                t_offset: dsec_t_offset(file)?,
+                t: Column::open(path, file, "events/t")?,
+                x: Column::open(path, file, "events/x")?,
+                y: Column::open(path, file, "events/y")?,
+                p: Column::open(path, file, "events/p")?,
+            })),
         })
     }
 
@@ -248,20 +401,32 @@ impl EventTable {
     fn coordinates(
         &self,
         range: std::ops::Range<usize>,
-        buffers: &mut Buffers,
         columns: &mut Columns,
     ) -> hdf5::Result<()> {
         columns.x.clear();
         columns.y.clear();
         match self {
             EventTable::EventUtils(c) => {
-                c.xs.ints(range.clone(), &mut buffers.bytes, &mut columns.x)?;
-                c.ys.ints(range, &mut buffers.bytes, &mut columns.y)?;
+                c.xs.ints(range.clone(), &mut columns.x)?;
+                c.ys.ints(range, &mut columns.y)?;
             }
             EventTable::V2e(ds) => {
                 let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, 1..3])?;
                 columns.x.extend(rows.column(0).iter());
                 columns.y.extend(rows.column(1).iter());
+            }
+            EventTable::Mvsec(ds, _) => {
+                let rows = ds.read_slice_2d::<f64, _>(ndarray::s![range, 0..2])?;
+                columns
+                    .x
+                    .extend(rows.column(0).iter().map(|&v| float_to_int(v)));
+                columns
+                    .y
+                    .extend(rows.column(1).iter().map(|&v| float_to_int(v)));
+            }
+            EventTable::Dsec(c) => {
+                c.x.ints(range.clone(), &mut columns.x)?;
+                c.y.ints(range, &mut columns.y)?;
             }
         }
         Ok(())
@@ -278,24 +443,46 @@ impl EventTable {
         columns.p.clear();
         match self {
             EventTable::EventUtils(c) => {
-                if c.integer_times {
-                    // integer timestamps are microseconds (seconds as integers make no sense)
-                    c.ts.ints(range.clone(), &mut buffers.bytes, &mut columns.t)?;
-                    c.ps.ints(range.clone(), &mut buffers.bytes, &mut columns.p)?;
-                    return self.coordinates(range, buffers, columns);
+                let Columns { t, x, y, p } = columns;
+                x.clear();
+                y.clear();
+                let seconds = &mut buffers.seconds;
+                seconds.clear();
+                // the four columns at once (see the DSEC case)
+                let ((rt, rx), (ry, rp)) = rayon::join(
+                    || {
+                        rayon::join(
+                            || {
+                                if c.integer_times {
+                                    // integer timestamps are microseconds (seconds as
+                                    // integers make no sense)
+                                    c.ts.ints(range.clone(), t)
+                                } else {
+                                    c.ts.floats(range.clone(), seconds)
+                                }
+                            },
+                            || c.xs.ints(range.clone(), x),
+                        )
+                    },
+                    || {
+                        rayon::join(
+                            || c.ys.ints(range.clone(), y),
+                            || c.ps.ints(range.clone(), p),
+                        )
+                    },
+                );
+                rt.and(rx).and(ry).and(rp)?;
+                if !c.integer_times {
+                    // a non-finite time becomes i64::MIN and is reported by read_chunk
+                    t.extend(seconds.iter().map(|&s| {
+                        if s.is_finite() {
+                            crate::events::s_to_us(s)
+                        } else {
+                            TimeUs::MIN
+                        }
+                    }));
                 }
-                buffers.seconds.clear();
-                c.ts.floats(range.clone(), &mut buffers.bytes, &mut buffers.seconds)?;
-                // a non-finite time becomes i64::MIN and is reported by read_chunk
-                columns.t.extend(buffers.seconds.iter().map(|&s| {
-                    if s.is_finite() {
-                        crate::events::s_to_us(s)
-                    } else {
-                        TimeUs::MIN
-                    }
-                }));
-                c.ps.ints(range.clone(), &mut buffers.bytes, &mut columns.p)?;
-                self.coordinates(range, buffers, columns)
+                Ok(())
             }
             EventTable::V2e(ds) => {
                 let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, ..])?;
@@ -307,8 +494,69 @@ impl EventTable {
                 columns.p.extend(rows.column(3).iter());
                 Ok(())
             }
+            EventTable::Mvsec(ds, _) => {
+                let rows = ds.read_slice_2d::<f64, _>(ndarray::s![range, ..])?;
+                columns.x.clear();
+                columns.y.clear();
+                columns
+                    .x
+                    .extend(rows.column(0).iter().map(|&v| float_to_int(v)));
+                columns
+                    .y
+                    .extend(rows.column(1).iter().map(|&v| float_to_int(v)));
+                // seconds since the epoch, to the nearest microsecond (float64 resolves
+                // 0.24 us there)
+                columns.t.extend(rows.column(2).iter().map(|&s| {
+                    if s.is_finite() && s.abs() < 1e12 {
+                        crate::events::s_to_us(s)
+                    } else {
+                        TimeUs::MIN
+                    }
+                }));
+                columns
+                    .p
+                    .extend(rows.column(3).iter().map(|&v| float_to_int(v)));
+                Ok(())
+            }
+            EventTable::Dsec(c) => {
+                let Columns { t, x, y, p } = columns;
+                x.clear();
+                y.clear();
+                // the four columns at once: each column's chunks are read under libhdf5's
+                // lock one after another, but decompress while the next column is read
+                let ((rt, rx), (ry, rp)) = rayon::join(
+                    || rayon::join(|| c.t.ints(range.clone(), t), || c.x.ints(range.clone(), x)),
+                    || rayon::join(|| c.y.ints(range.clone(), y), || c.p.ints(range.clone(), p)),
+                );
+                rt.and(rx).and(ry).and(rp)?;
+                let offset = c.t_offset;
+                for t in t.iter_mut() {
+                    // an offset that overflows is damage: reported like a non-finite time
+                    *t = if *t == NOT_AN_INTEGER {
+                        TimeUs::MIN
+                    } else {
+                        t.checked_add(offset).unwrap_or(TimeUs::MIN)
+                    };
+                }
+                Ok(())
+            }
         }
     }
+}
+
+/// DSEC's `t_offset` (microseconds added to every `events/t`; 0 when absent).
+fn dsec_t_offset(file: &hdf5::File) -> hdf5::Result<TimeUs> {
+    if !file.link_exists("t_offset") {
+        return Ok(0);
+    }
+    let ds = file.dataset("t_offset")?;
+    if !ds.shape().is_empty() {
+        return Err(hdf5::Error::from(format!(
+            "t_offset has shape {:?}; DSEC stores it as a scalar (microseconds)",
+            ds.shape()
+        )));
+    }
+    ds.read_scalar::<i64>()
 }
 
 /// The claimed `sensor_resolution` (H, W), as an attribute or a dataset.
@@ -337,14 +585,14 @@ fn coordinate_extent(
 ) -> Result<(i64, i64), InputError> {
     let table = EventTable::open(path, file, layout)
         .map_err(|e| h5_error(path, "opening the event datasets", e))?;
-    let (mut buffers, mut columns) = (Buffers::default(), Columns::default());
+    let mut columns = Columns::default();
     let mut max_x = -1i64;
     let mut max_y = -1i64;
     let mut start = 0;
     while start < n {
         let end = (start + CHUNK_EVENTS).min(n);
         table
-            .coordinates(start..end, &mut buffers, &mut columns)
+            .coordinates(start..end, &mut columns)
             .map_err(|e| h5_error(path, "reading coordinates", e))?;
         let (xs, ys) = (&columns.x, &columns.y);
         for (i, (&x, &y)) in xs.iter().zip(ys).enumerate() {
@@ -447,9 +695,9 @@ fn check_dataset(
 }
 
 /// Inspects an HDF5 event file and checks its sensor claim against the coordinates.
-pub fn probe(path: &Path) -> Result<H5Info, InputError> {
+pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
     let file = open_file(path)?;
-    let layout = layout_of(path, &file)?;
+    let layout = layout_of(path, &file, side)?;
     let events = match layout {
         Layout::EventUtils => {
             let n = check_dataset(path, &file, "events/ts", 1)?[0];
@@ -466,8 +714,49 @@ pub fn probe(path: &Path) -> Result<H5Info, InputError> {
             n
         }
         Layout::V2e => check_dataset(path, &file, "events", 2)?[0],
+        Layout::Mvsec(side) => {
+            let name = format!("{}/events", side.group());
+            let shape = check_dataset(path, &file, &name, 2)?;
+            if shape[1] != 4 {
+                return Err(InputError::hdf5(
+                    path,
+                    format!("{name} has shape {shape:?}, expected N x 4"),
+                    "MVSEC files store events as N rows of [x, y, t, p]",
+                ));
+            }
+            shape[0]
+        }
+        Layout::Dsec => {
+            let n = check_dataset(path, &file, "events/t", 1)?[0];
+            for name in ["events/x", "events/y", "events/p"] {
+                let len = check_dataset(path, &file, name, 1)?[0];
+                if len != n {
+                    return Err(InputError::hdf5(
+                        path,
+                        format!("{name} has {len} entries but events/t has {n}"),
+                        "the file is damaged or was written incompletely; rewrite it",
+                    ));
+                }
+            }
+            n
+        }
     };
-    let (sensor, sensor_note) = match claimed_resolution(&file) {
+    let frames = frame_index(path, &file, layout)?;
+    let claimed = match layout {
+        // MVSEC states no resolution; its frames show the whole sensor
+        Layout::Mvsec(side) if !frames.times.is_empty() => {
+            let (w, h) = frames.size;
+            return Ok(H5Info {
+                layout,
+                events,
+                sensor: Some(Sensor::new(w as u16, h as u16)),
+                sensor_note: Some(format!("the size of {}/image_raw", side.group())),
+                frame_count: frames.times.len(),
+            });
+        }
+        _ => claimed_resolution(&file),
+    };
+    let (sensor, sensor_note) = match claimed {
         None => (None, None),
         Some((h, w)) => {
             let (max_x, max_y) = coordinate_extent(path, &file, layout, events)?;
@@ -500,13 +789,12 @@ pub fn probe(path: &Path) -> Result<H5Info, InputError> {
             }
         }
     };
-    let frame_count = frame_index(path, &file, layout)?.times.len();
     Ok(H5Info {
         layout,
         events,
         sensor,
         sensor_note,
-        frame_count,
+        frame_count: frames.times.len(),
     })
 }
 
@@ -610,6 +898,47 @@ fn frame_index(path: &Path, file: &hdf5::File, layout: Layout) -> Result<FrameIn
                 index.push(path, &format!("frame_ts[{i}]"), t, size, None)?;
             }
         }
+        Layout::Mvsec(side) => {
+            let stack = format!("{}/image_raw", side.group());
+            if !file.link_exists(&stack) {
+                return Ok(index);
+            }
+            let shape = check_dataset(path, file, &stack, 3)?;
+            let size = frame_size(path, &stack, shape[1], shape[2])?;
+            let stamps = format!("{stack}_ts");
+            let times: Vec<f64> = file
+                .dataset(&stamps)
+                .and_then(|d| d.read_raw::<f64>())
+                .map_err(|e| err(&stamps, e))?;
+            if times.len() != shape[0] {
+                return Err(InputError::hdf5(
+                    path,
+                    format!(
+                        "{stack} holds {} frames but {stamps} {} timestamps",
+                        shape[0],
+                        times.len()
+                    ),
+                    "MVSEC frames are (M, H, W) with M timestamps (seconds) in image_raw_ts",
+                ));
+            }
+            for (i, &t) in times.iter().enumerate() {
+                if !t.is_finite() || t.abs() > 1e12 {
+                    return Err(InputError::hdf5(
+                        path,
+                        format!("{stamps}[{i}] is {t}"),
+                        "frame timestamps are seconds; the file is damaged",
+                    ));
+                }
+                index.push(
+                    path,
+                    &format!("{stamps}[{i}]"),
+                    crate::events::s_to_us(t),
+                    size,
+                    None,
+                )?;
+            }
+        }
+        Layout::Dsec => {}
     }
     Ok(index)
 }
@@ -663,9 +992,14 @@ pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError>
     let index = frame_index(path, &file, info.layout)?;
     let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
     let (width, height) = index.size;
+    let stack_name = match info.layout {
+        Layout::V2e => "frame".to_string(),
+        Layout::Mvsec(side) => format!("{}/image_raw", side.group()),
+        _ => String::new(),
+    };
     let stack = match info.layout {
-        Layout::V2e if !index.times.is_empty() => {
-            Some(file.dataset("frame").map_err(|e| err("frame", e))?)
+        Layout::V2e | Layout::Mvsec(_) if !index.times.is_empty() => {
+            Some(file.dataset(&stack_name).map_err(|e| err(&stack_name, e))?)
         }
         _ => None,
     };
@@ -678,11 +1012,11 @@ pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError>
                 .map_err(|e| err(name, e))?,
             (None, Some(stack)) => stack
                 .read_slice_2d::<u8, _>(ndarray::s![i, .., ..])
-                .map_err(|e| err(&format!("frame[{i}]"), e))?
+                .map_err(|e| err(&format!("{stack_name}[{i}]"), e))?
                 .iter()
                 .copied()
                 .collect(),
-            (None, None) => unreachable!("v2e frames have the stack"),
+            (None, None) => unreachable!("v2e and MVSEC frames have the stack"),
         };
         frames.push(Frame {
             t,
@@ -759,6 +1093,73 @@ impl EventDecoder for H5Decoder {
             y: ys,
             p: ps,
         } = &self.columns;
+        // fast path: every value in range (four vectorisable min/max passes), then the
+        // columns moved over in bulk; anything out of range is found and named below
+        let limit = |sensor: Option<Sensor>| {
+            sensor.map_or((MAX_SENSOR_SIDE as i64, MAX_SENSOR_SIDE as i64), |s| {
+                (s.width as i64, s.height as i64)
+            })
+        };
+        let (width, height) = limit(self.sensor);
+        // one fused pass, split over the cores: convert while tracking the extremes, then
+        // check them
+        let start = out.len();
+        let n = t.len();
+        out.t.extend_from_slice(t);
+        out.x.resize(start + n, 0);
+        out.y.resize(start + n, 0);
+        out.on.resize(start + n, false);
+        const PIECE: usize = 1 << 14;
+        let (lo, hi) = out.x[start..]
+            .par_chunks_mut(PIECE)
+            .zip(out.y[start..].par_chunks_mut(PIECE))
+            .zip(out.on[start..].par_chunks_mut(PIECE))
+            .enumerate()
+            .map(|(k, ((x_out, y_out), on_out))| {
+                let base = k * PIECE;
+                let (mut lo, mut hi) = ([i64::MAX; 4], [i64::MIN; 4]);
+                for j in 0..x_out.len() {
+                    let i = base + j;
+                    let values = [xs[i], ys[i], ps[i], t[i]];
+                    for v in 0..4 {
+                        lo[v] = lo[v].min(values[v]);
+                        hi[v] = hi[v].max(values[v]);
+                    }
+                    x_out[j] = xs[i] as u16;
+                    y_out[j] = ys[i] as u16;
+                    on_out[j] = ps[i] == 1;
+                }
+                (lo, hi)
+            })
+            .reduce(
+                || ([i64::MAX; 4], [i64::MIN; 4]),
+                |(a_lo, a_hi), (b_lo, b_hi)| {
+                    (
+                        std::array::from_fn(|v| a_lo[v].min(b_lo[v])),
+                        std::array::from_fn(|v| a_hi[v].max(b_hi[v])),
+                    )
+                },
+            );
+        let all_valid = lo[0] >= 0
+            && hi[0] < width
+            && lo[1] >= 0
+            && hi[1] < height
+            && lo[2] >= -1
+            && hi[2] <= 1
+            && lo[3] != TimeUs::MIN;
+        if all_valid {
+            let position = self.position;
+            let names = self.table.names();
+            self.order
+                .check_all(t, |i| format!("{}[{}]", names.t, position + i));
+            self.position = end;
+            return Ok(());
+        }
+        // something is out of range: undo, and find and name it event by event
+        out.t.truncate(start);
+        out.x.truncate(start);
+        out.y.truncate(start);
+        out.on.truncate(start);
         let names = self.table.names();
         for i in 0..t.len() {
             let (x, y) = (xs[i], ys[i]);

@@ -2,14 +2,26 @@
 //!
 //! libhdf5 serialises every call (hdf5-metno holds one lock) and inflates a dataset's gzip
 //! chunks one after another, so reading an event_utils file is bound by single-threaded
-//! zlib. Here the file addresses of the needed chunks are looked up through libhdf5
-//! (`H5Dget_chunk_info_by_coord`), and the compressed bytes are read and inflated (zlib-rs)
-//! on all cores. Only the filter pipelines event files use are handled (shuffle, deflate,
-//! in any order, little-endian fixed-size elements); any other layout, filter, byte order or
-//! unallocated chunk makes [`DirectColumn::new`] decline, and the caller reads through the
-//! library instead.
+//! zlib. Here the stored bytes of the needed chunks are read through libhdf5
+//! (`H5Dget_chunk_storage_size` and `H5Dread_chunk`, each a B-tree lookup; the
+//! `H5Dget_chunk_info*` calls walk the whole index and make a pass quadratic in the number
+//! of chunks), and decompressed on all cores. Only the filter pipelines event files use are handled (shuffle, deflate,
+//! in any order, and Blosc, HDF5 filter 32001 as DSEC writes it ([`super::blosc`]; its
+//! filter is also registered with libhdf5 through `blosc-src`); little-endian
+//! fixed-size elements); any other layout, filter, byte order or unallocated chunk makes
+//! [`DirectColumn::new`] decline, and the caller reads through the library instead. A chunk
+//! that does not decode is reported as damage.
 
 use hdf5::filters::Filter;
+
+unsafe extern "C" {
+    /// libhdf5 >= 1.10.2 (not bound by hdf5-sys): the stored size of the chunk at `offset`.
+    fn H5Dget_chunk_storage_size(
+        dset_id: hdf5_sys::h5i::hid_t,
+        offset: *const hdf5_sys::h5::hsize_t,
+        chunk_bytes: *mut hdf5_sys::h5::hsize_t,
+    ) -> hdf5_sys::h5::herr_t;
+}
 use rayon::prelude::*;
 use std::path::Path;
 
@@ -18,13 +30,22 @@ use std::path::Path;
 enum Stage {
     Shuffle,
     Deflate,
+    Blosc,
+}
+
+/// Why a direct read did not give the bytes.
+#[derive(Debug)]
+pub enum DirectError {
+    /// Not readable this way (the caller reads through libhdf5).
+    Unsupported,
+    /// Chunk `chunk` does not decode.
+    Damaged { chunk: usize, problem: String },
 }
 
 /// A 1-D chunked dataset that can be read chunk by chunk, bypassing libhdf5's inflation.
 pub struct DirectColumn {
     dataset: hdf5::Dataset,
-    file: std::fs::File,
-    /// Bytes in the file: a chunk said to lie beyond is damage, not data.
+    /// Bytes in the file: a chunk said to be larger is damage, not data.
     file_len: u64,
     len: usize,
     chunk_len: usize,
@@ -55,14 +76,13 @@ impl DirectColumn {
             pipeline.push(match filter {
                 Filter::Shuffle => Stage::Shuffle,
                 Filter::Deflate(_) => Stage::Deflate,
+                Filter::Blosc(..) => Stage::Blosc,
                 _ => return None,
             });
         }
-        let file = std::fs::File::open(path).ok()?;
-        let file_len = file.metadata().ok()?.len();
+        let file_len = std::fs::metadata(path).ok()?.len();
         Some(Self {
             dataset: dataset.clone(),
-            file,
             file_len,
             len: shape[0],
             chunk_len: chunk[0],
@@ -71,102 +91,121 @@ impl DirectColumn {
         })
     }
 
-    /// Where chunk `index` lies in the file: (address, stored size, filter mask).
-    fn locate(&self, index: usize) -> Option<(u64, u64, u32)> {
+    /// The stored (filtered) bytes of chunk `index` and its filter mask; `None` when the
+    /// chunk is not allocated or its size is impossible for the file.
+    fn fetch(&self, index: usize) -> Option<(Vec<u8>, u32)> {
         let offset: [hdf5_sys::h5::hsize_t; 1] =
             [(index * self.chunk_len) as hdf5_sys::h5::hsize_t];
-        let (mut mask, mut address, mut size) =
-            (0u32, 0 as hdf5_sys::h5::haddr_t, 0 as hdf5_sys::h5::hsize_t);
         let id = self.dataset.id();
-        // SAFETY: `id` is a live dataset handle (held by `self.dataset`); the out-pointers
-        // point to locals; libhdf5 is called under hdf5-metno's global lock.
+        let mut size: hdf5_sys::h5::hsize_t = 0;
+        // SAFETY: `id` is a live dataset handle (held by `self.dataset`); the pointers point
+        // to locals; libhdf5 is called under hdf5-metno's global lock.
         let status = hdf5::sync::sync(|| unsafe {
-            hdf5_sys::h5d::H5Dget_chunk_info_by_coord(
+            H5Dget_chunk_storage_size(id, offset.as_ptr(), &mut size)
+        });
+        if status < 0 || size == 0 || size > self.file_len {
+            return None;
+        }
+        let mut data = vec![0u8; size as usize];
+        let mut mask = 0u32;
+        // SAFETY: as above; `data` has room for the chunk's stored size, which is what
+        // H5Dread_chunk writes.
+        let status = hdf5::sync::sync(|| unsafe {
+            hdf5_sys::h5d::H5Dread_chunk(
                 id,
+                hdf5_sys::h5p::H5P_DEFAULT,
                 offset.as_ptr(),
                 &mut mask,
-                &mut address,
-                &mut size,
+                data.as_mut_ptr().cast(),
             )
         });
-        (status >= 0
-            && address != hdf5_sys::h5::HADDR_UNDEF
-            && size > 0
-            && address
-                .checked_add(size)
-                .is_some_and(|end| end <= self.file_len))
-        .then_some((address, size, mask))
+        (status >= 0).then_some((data, mask))
     }
 
-    /// The raw little-endian bytes of elements `range` into `out` (cleared first, so that
-    /// buffers are reused); `None` if a chunk cannot be read this way (the caller then reads
-    /// through the library).
-    pub fn read_into(&self, range: std::ops::Range<usize>, out: &mut Vec<u8>) -> Option<()> {
+    /// The elements of `range` into `out` (replacing its contents), each chunk decompressed
+    /// and converted by `decode` (raw little-endian bytes into values) on its own core.
+    pub fn read_decoded<T: Copy + Default + Send>(
+        &self,
+        range: std::ops::Range<usize>,
+        out: &mut Vec<T>,
+        decode: impl Fn(&[u8], &mut [T]) + Sync,
+    ) -> Result<(), DirectError> {
         out.clear();
         if range.is_empty() {
-            return Some(());
+            return Ok(());
         }
         if range.end > self.len {
-            return None;
+            return Err(DirectError::Unsupported);
         }
         let first = range.start / self.chunk_len;
         let last = (range.end - 1) / self.chunk_len;
-        let located: Vec<(u64, u64, u32)> = (first..=last)
-            .map(|i| self.locate(i))
-            .collect::<Option<_>>()?;
-        let chunk_bytes = self.chunk_len * self.element_size;
-        let chunks: Vec<Vec<u8>> = located
-            .par_iter()
-            .map(|&(address, size, mask)| self.decode_chunk(address, size, mask, chunk_bytes))
-            .collect::<Option<_>>()?;
-        // copy the wanted elements of each chunk
-        let element = self.element_size;
-        for (k, chunk) in chunks.iter().enumerate() {
+        // reading is serial (libhdf5 holds one lock), decompressing and converting parallel
+        let stored: Vec<(Vec<u8>, u32)> = (first..=last)
+            .map(|i| self.fetch(i))
+            .collect::<Option<_>>()
+            .ok_or(DirectError::Unsupported)?;
+        out.resize(range.len(), T::default());
+        // each chunk's share of `out`
+        let mut pieces = Vec::with_capacity(stored.len());
+        let mut rest = out.as_mut_slice();
+        for k in 0..stored.len() {
             let chunk_start = (first + k) * self.chunk_len;
-            let from = range.start.max(chunk_start) - chunk_start;
-            let to = range.end.min(chunk_start + self.chunk_len) - chunk_start;
-            out.extend_from_slice(&chunk[from * element..to * element]);
+            let from = range.start.max(chunk_start);
+            let to = range.end.min(chunk_start + self.chunk_len);
+            let (piece, tail) = rest.split_at_mut(to - from);
+            pieces.push((piece, from - chunk_start));
+            rest = tail;
         }
-        Some(())
+        let chunk_bytes = self.chunk_len * self.element_size;
+        let element = self.element_size;
+        stored.into_par_iter().zip(pieces).enumerate().try_for_each(
+            |(k, ((data, mask), (piece, from)))| {
+                let chunk = self
+                    .decode_chunk(data, mask, chunk_bytes)
+                    .map_err(|problem| DirectError::Damaged {
+                        chunk: first + k,
+                        problem,
+                    })?;
+                decode(
+                    &chunk[from * element..(from + piece.len()) * element],
+                    piece,
+                );
+                Ok(())
+            },
+        )
+    }
+
+    /// Elements per chunk.
+    pub fn chunk_len(&self) -> usize {
+        self.chunk_len
     }
 
     fn decode_chunk(
         &self,
-        address: u64,
-        size: u64,
+        mut data: Vec<u8>,
         mask: u32,
         chunk_bytes: usize,
-    ) -> Option<Vec<u8>> {
-        let mut data = vec![0u8; size as usize];
-        read_at(&self.file, &mut data, address).ok()?;
+    ) -> Result<Vec<u8>, String> {
         // undo the filters in reverse order; bit i of the mask means filter i was skipped
         for (position, stage) in self.pipeline.iter().enumerate().rev() {
             if mask & (1 << position) != 0 {
                 continue;
             }
             data = match stage {
-                Stage::Deflate => inflate(&data, chunk_bytes)?,
+                Stage::Deflate => inflate(&data, chunk_bytes).ok_or("does not inflate")?,
                 Stage::Shuffle => unshuffle(&data, self.element_size),
+                Stage::Blosc => super::blosc::decompress(&data, chunk_bytes)?,
             };
         }
-        (data.len() == chunk_bytes).then_some(data)
-    }
-}
-
-#[cfg(unix)]
-fn read_at(file: &std::fs::File, buffer: &mut [u8], offset: u64) -> std::io::Result<()> {
-    std::os::unix::fs::FileExt::read_exact_at(file, buffer, offset)
-}
-
-#[cfg(not(unix))]
-fn read_at(file: &std::fs::File, buffer: &mut [u8], offset: u64) -> std::io::Result<()> {
-    std::os::windows::fs::FileExt::seek_read(file, buffer, offset).and_then(|n| {
-        if n == buffer.len() {
-            Ok(())
+        if data.len() == chunk_bytes {
+            Ok(data)
         } else {
-            Err(std::io::ErrorKind::UnexpectedEof.into())
+            Err(format!(
+                "decodes to {} bytes instead of {chunk_bytes}",
+                data.len()
+            ))
         }
-    })
+    }
 }
 
 /// zlib-inflates `data` into exactly `expected` bytes.
@@ -247,12 +286,14 @@ mod tests {
             let ds = file.dataset(name).unwrap();
             let column = DirectColumn::new(&path, &ds).unwrap_or_else(|| panic!("{name} declined"));
             for range in [0..10_000, 1234..5678, 999..1001, 9_999..10_000] {
-                let mut bytes = Vec::new();
-                column.read_into(range.clone(), &mut bytes).unwrap();
-                let direct: Vec<i16> = bytes
-                    .chunks_exact(2)
-                    .map(|b| i16::from_le_bytes([b[0], b[1]]))
-                    .collect();
+                let mut direct: Vec<i16> = Vec::new();
+                column
+                    .read_decoded(range.clone(), &mut direct, |bytes, out| {
+                        for (o, b) in out.iter_mut().zip(bytes.chunks_exact(2)) {
+                            *o = i16::from_le_bytes([b[0], b[1]]);
+                        }
+                    })
+                    .unwrap();
                 assert_eq!(direct, values[range].to_vec(), "{name}");
             }
         }
@@ -283,50 +324,32 @@ impl ElementKind {
         })
     }
 
-    /// Appends the element values of raw little-endian `bytes` to `out`, converted by
-    /// `integer` (integer, boolean and enum elements) or `float` (float elements).
-    pub fn decode<T>(
+    /// Writes the element values of raw little-endian `bytes` into `out` (one value per
+    /// element), converted by `integer` (integer, boolean and enum elements) or `float`
+    /// (float elements).
+    pub fn decode_into<T>(
         self,
         bytes: &[u8],
-        out: &mut Vec<T>,
+        out: &mut [T],
         integer: impl Fn(i64) -> T,
         float: impl Fn(f64) -> T,
     ) {
-        fn le<const N: usize>(b: &[u8]) -> [u8; N] {
-            b.try_into().expect("chunks_exact gives N bytes")
+        fn fill<T, const N: usize>(bytes: &[u8], out: &mut [T], f: impl Fn([u8; N]) -> T) {
+            for (o, b) in out.iter_mut().zip(bytes.chunks_exact(N)) {
+                *o = f(b.try_into().expect("chunks_exact gives N bytes"));
+            }
         }
-        let ints = |width: usize, f: fn(&[u8]) -> i64| bytes.chunks_exact(width).map(f);
         match self {
-            ElementKind::Signed(1) => out.extend(bytes.iter().map(|&b| integer(b as i8 as i64))),
-            ElementKind::Unsigned(1) => out.extend(bytes.iter().map(|&b| integer(b as i64))),
-            ElementKind::Signed(2) => {
-                out.extend(ints(2, |b| i16::from_le_bytes(le(b)) as i64).map(integer))
-            }
-            ElementKind::Unsigned(2) => {
-                out.extend(ints(2, |b| u16::from_le_bytes(le(b)) as i64).map(integer))
-            }
-            ElementKind::Signed(4) => {
-                out.extend(ints(4, |b| i32::from_le_bytes(le(b)) as i64).map(integer))
-            }
-            ElementKind::Unsigned(4) => {
-                out.extend(ints(4, |b| u32::from_le_bytes(le(b)) as i64).map(integer))
-            }
-            ElementKind::Signed(_) => {
-                out.extend(ints(8, |b| i64::from_le_bytes(le(b))).map(integer))
-            }
-            ElementKind::Unsigned(_) => {
-                out.extend(ints(8, |b| u64::from_le_bytes(le(b)) as i64).map(integer))
-            }
-            ElementKind::Float(8) => out.extend(
-                bytes
-                    .chunks_exact(8)
-                    .map(|b| float(f64::from_le_bytes(le(b)))),
-            ),
-            ElementKind::Float(_) => out.extend(
-                bytes
-                    .chunks_exact(4)
-                    .map(|b| float(f32::from_le_bytes(le(b)) as f64)),
-            ),
+            ElementKind::Signed(1) => fill(bytes, out, |b: [u8; 1]| integer(b[0] as i8 as i64)),
+            ElementKind::Unsigned(1) => fill(bytes, out, |b: [u8; 1]| integer(b[0] as i64)),
+            ElementKind::Signed(2) => fill(bytes, out, |b| integer(i16::from_le_bytes(b) as i64)),
+            ElementKind::Unsigned(2) => fill(bytes, out, |b| integer(u16::from_le_bytes(b) as i64)),
+            ElementKind::Signed(4) => fill(bytes, out, |b| integer(i32::from_le_bytes(b) as i64)),
+            ElementKind::Unsigned(4) => fill(bytes, out, |b| integer(u32::from_le_bytes(b) as i64)),
+            ElementKind::Signed(_) => fill(bytes, out, |b| integer(i64::from_le_bytes(b))),
+            ElementKind::Unsigned(_) => fill(bytes, out, |b| integer(u64::from_le_bytes(b) as i64)),
+            ElementKind::Float(8) => fill(bytes, out, |b| float(f64::from_le_bytes(b))),
+            ElementKind::Float(_) => fill(bytes, out, |b| float(f32::from_le_bytes(b) as f64)),
         }
     }
 }

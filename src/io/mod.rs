@@ -7,7 +7,9 @@
 //! together: format detection from content, the sensor size, frames and stimulus.
 
 pub mod aedat4;
+pub mod bag;
 mod blocks;
+pub mod blosc;
 pub mod dat;
 mod detect;
 pub mod error;
@@ -45,16 +47,18 @@ pub enum Format {
     Evt2,
     Evt3,
     Dat,
+    Bag,
 }
 
 impl Format {
-    pub const ALL: [Format; 6] = [
+    pub const ALL: [Format; 7] = [
         Format::Ijrr,
         Format::H5,
         Format::Aedat4,
         Format::Evt2,
         Format::Evt3,
         Format::Dat,
+        Format::Bag,
     ];
 
     /// The name used on the command line and in JSON.
@@ -66,6 +70,7 @@ impl Format {
             Format::Evt2 => "evt2",
             Format::Evt3 => "evt3",
             Format::Dat => "dat",
+            Format::Bag => "bag",
         }
     }
 }
@@ -77,7 +82,7 @@ impl std::str::FromStr for Format {
             .into_iter()
             .find(|f| f.name().eq_ignore_ascii_case(s))
             .ok_or_else(|| {
-                format!("unknown format `{s}` (one of ijrr, h5, aedat4, evt2, evt3, dat)")
+                format!("unknown format `{s}` (one of ijrr, h5, aedat4, evt2, evt3, dat, bag)")
             })
     }
 }

@@ -41,6 +41,25 @@ impl OrderCheck {
         self.last = t;
     }
 
+    /// Checks a run of times; `place(i)` names the `i`-th and is only evaluated at a
+    /// violation. Runs that are in order and in range (the usual case) take one pass.
+    pub fn check_all(&mut self, times: &[TimeUs], place: impl Fn(usize) -> String) {
+        let Some(&first) = times.first() else {
+            return;
+        };
+        let sorted = first >= self.last && times.windows(2).all(|w| w[0] <= w[1]);
+        let in_range = times
+            .iter()
+            .all(|t| t.unsigned_abs() <= TIME_LIMIT_US as u64);
+        if sorted && in_range {
+            self.last = times[times.len() - 1];
+            return;
+        }
+        for (i, &t) in times.iter().enumerate() {
+            self.check(t, || place(i));
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn record(&mut self, t: TimeUs, place: &impl Fn() -> String) {
@@ -71,5 +90,18 @@ mod tests {
         }
         assert_eq!(check.backwards, 2);
         assert_eq!(check.first, Some(("event 3".to_string(), 2, 1)));
+        // the same through the run check, across two runs
+        let mut runs = OrderCheck::default();
+        runs.check_all(&[1, 2, 2], |i| format!("event {i}"));
+        runs.check_all(&[1, 5, 3, 4], |i| format!("event {}", i + 3));
+        assert_eq!(
+            (runs.backwards, &runs.first),
+            (check.backwards, &check.first)
+        );
+        runs.check_all(&[TIME_LIMIT_US + 1], |_| "far".into());
+        assert_eq!(
+            runs.out_of_range,
+            Some(("far".to_string(), TIME_LIMIT_US + 1))
+        );
     }
 }

@@ -90,7 +90,7 @@ mod tests {
             &path,
             &OpenOptions {
                 format: Some(crate::Format::Ijrr),
-                sensor: None,
+                ..OpenOptions::default()
             },
         )
         .unwrap();

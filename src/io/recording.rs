@@ -4,7 +4,7 @@
 
 use super::Format;
 use super::{
-    EventDecoder, FrameList, InputError, Progress, aedat4, dat, detect, evt2, evt3, h5, ijrr,
+    EventDecoder, FrameList, InputError, Progress, aedat4, bag, dat, detect, evt2, evt3, h5, ijrr,
     prophesee,
 };
 use crate::events::{
@@ -20,6 +20,11 @@ pub struct OpenOptions {
     pub format: Option<Format>,
     /// The sensor size, overriding what the file says.
     pub sensor: Option<Sensor>,
+    /// ROS bags: the events topic and the image topic (default: found by message type).
+    pub topic: Option<String>,
+    pub image_topic: Option<String>,
+    /// MVSEC HDF5: which camera (default left).
+    pub side: Option<h5::Side>,
 }
 
 #[derive(Clone, Debug)]
@@ -30,6 +35,7 @@ enum Source {
     Evt2 { data_offset: u64 },
     Evt3 { data_offset: u64 },
     Dat { data_offset: u64 },
+    Bag(bag::BagInfo),
 }
 
 /// An opened recording: its format, what it says about the sensor, and access to its events
@@ -116,8 +122,25 @@ impl Recording {
                 }
                 (Source::Ijrr(files), sensor)
             }
+            Format::Bag => {
+                let info = bag::probe(
+                    path,
+                    &bag::TopicChoice {
+                        events: options.topic.clone(),
+                        images: options.image_topic.clone(),
+                    },
+                )?;
+                notes.extend(info.notes.iter().cloned());
+                let sensor = info.sensor.map(|s| {
+                    (
+                        s,
+                        "width/height of the first dvs_msgs/EventArray message".to_string(),
+                    )
+                });
+                (Source::Bag(info), sensor)
+            }
             Format::H5 => {
-                let info = h5::probe(path)?;
+                let info = h5::probe(path, options.side.unwrap_or_default())?;
                 let sensor = info.sensor.map(|s| {
                     (
                         s,
@@ -212,6 +235,7 @@ impl Recording {
                 *data_offset,
                 self.sensor,
             )?),
+            Source::Bag(info) => Box::new(bag::BagDecoder::open(&self.path, info, self.sensor)?),
         };
         Ok(EventStream {
             decoder,
@@ -292,6 +316,7 @@ impl Recording {
             },
             Source::H5(info) => h5::read_frames(&self.path, info),
             Source::Aedat4(header) => aedat4::read_frames(&self.path, header),
+            Source::Bag(info) => bag::frames_where(&self.path, info, |_, _| true),
             _ => Ok(Vec::new()),
         }
     }
@@ -338,6 +363,7 @@ impl Recording {
                 .map(|(_, f)| f)
                 .collect()),
             Source::Aedat4(header) => aedat4::read_frames_where(&self.path, header, keep),
+            Source::Bag(info) => bag::frames_where(&self.path, info, keep),
             _ => Ok(Vec::new()),
         }
     }
@@ -351,7 +377,24 @@ impl Recording {
             },
             Source::H5(info) => h5::read_frame_times(&self.path, info),
             Source::Aedat4(header) => aedat4::read_frame_times(&self.path, header),
+            Source::Bag(info) => bag::frame_times(&self.path, info),
             _ => Ok(Vec::new()),
+        }
+    }
+
+    /// The HDF5 layout (event_utils, v2e, MVSEC, DSEC), for HDF5 files.
+    pub fn layout(&self) -> Option<&'static str> {
+        match &self.source {
+            Source::H5(info) => Some(info.layout.name()),
+            _ => None,
+        }
+    }
+
+    /// The topics of a ROS bag (empty for other formats).
+    pub fn topics(&self) -> &[bag::Topic] {
+        match &self.source {
+            Source::Bag(info) => &info.topics,
+            _ => &[],
         }
     }
 

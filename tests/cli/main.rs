@@ -3,6 +3,7 @@
 
 mod common;
 mod convert;
+mod datasets;
 mod errors;
 mod estimate;
 mod limits;

@@ -1,0 +1,303 @@
+//! The seed paper's datasets as they are published (ROS1 bags, MVSEC and DSEC HDF5): each
+//! file in `../shared/data/datasets` holds the events and frames of the IJRR text recording
+//! `real/ijrr_slider_depth_50k`, written by independent writers (rosbags, h5py), and must
+//! decode to exactly those events, times shifted by the stated offsets.
+
+use super::common::*;
+use ctcal::{EventChunk, OpenOptions, Recording};
+use sha2::{Digest, Sha256};
+use std::path::PathBuf;
+
+fn dataset(name: &str) -> PathBuf {
+    shared_data().join("datasets").join(name)
+}
+
+fn dataset_truth() -> serde_json::Value {
+    let text = std::fs::read_to_string(dataset("ijrr_slider_depth_50k.truth.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+/// The dataset files and the shift of their clock against the IJRR text's.
+const FILES: [(&str, i64); 4] = [
+    ("ijrr_slider_depth_50k.bag", 0),
+    ("ijrr_slider_depth_50k_bz2.bag", 0),
+    (
+        "ijrr_slider_depth_50k_mvsec_layout.h5",
+        1_504_645_000_000_000,
+    ),
+    // DSEC: `t` counts from the first event, `t_offset` = 64e9 us
+    (
+        "ijrr_slider_depth_50k_dsec_layout.h5",
+        64_000_000_000 - 3_811,
+    ),
+];
+
+/// SHA-256 of the (t_us, x, y, p) table as little-endian int64 rows.
+fn table_hash(events: &EventChunk, shift: i64) -> String {
+    let mut hasher = Sha256::new();
+    for e in events.iter() {
+        for v in [e.t - shift, e.x as i64, e.y as i64, e.on as i64] {
+            hasher.update(v.to_le_bytes());
+        }
+    }
+    hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+#[test]
+fn every_dataset_file_decodes_to_the_ijrr_events() {
+    let truth = dataset_truth();
+    let reference = read_events(&real("ijrr_slider_depth_50k"));
+    assert_eq!(
+        table_hash(&reference, 0),
+        truth["sha256_of_txyp"].as_str().unwrap(),
+        "the hash convention"
+    );
+    for (name, shift) in FILES {
+        let events = read_events(&dataset(name));
+        assert_eq!(
+            events.len() as u64,
+            truth["events"].as_u64().unwrap(),
+            "{name}"
+        );
+        let on = events.on.iter().filter(|&&p| p).count() as u64;
+        assert_eq!(on, truth["on_events"].as_u64().unwrap(), "{name}");
+        assert_eq!(
+            events.t[0] - shift,
+            truth["t_first_us"].as_i64().unwrap(),
+            "{name}"
+        );
+        assert_eq!(
+            table_hash(&events, shift),
+            truth["sha256_of_txyp"].as_str().unwrap(),
+            "{name}"
+        );
+    }
+    // the DSEC clock is t + t_offset
+    let dsec = read_events(&dataset(FILES[3].0));
+    assert_eq!(dsec.t[0], truth["dsec_t_offset_us"].as_i64().unwrap());
+}
+
+#[test]
+fn bag_and_mvsec_frames_are_the_ijrr_frames() {
+    let reference = Recording::open(&real("ijrr_slider_depth_50k"), &OpenOptions::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    assert_eq!(reference.len(), 5);
+    for (name, shift) in &FILES[..3] {
+        let recording = Recording::open(&dataset(name), &OpenOptions::default()).unwrap();
+        let frames = recording.frames().unwrap();
+        assert_eq!(frames.len(), reference.len(), "{name}");
+        for (f, r) in frames.iter().zip(&reference) {
+            assert_eq!(f.t - shift, r.t, "{name}");
+            assert_eq!((f.width, f.height), (r.width, r.height), "{name}");
+            assert!(f.pixels == r.pixels, "{name}: pixels differ at {} us", r.t);
+        }
+        let times = recording.frame_times().unwrap();
+        assert_eq!(times, frames.iter().map(|f| f.t).collect::<Vec<_>>());
+    }
+}
+
+#[test]
+fn every_dataset_file_converts_and_reads_back_unchanged() {
+    let dir = tempfile::tempdir().unwrap();
+    for (k, (name, _)) in FILES.iter().enumerate() {
+        let original = read_events(&dataset(name));
+        for to in ["ijrr", "h5", "bag"] {
+            let out = dir.path().join(format!(
+                "{k}_{to}{}",
+                match to {
+                    "h5" => ".h5",
+                    "bag" => ".bag",
+                    _ => "",
+                }
+            ));
+            ctcal()
+                .args(["convert", dataset(name).to_str().unwrap(), "--out"])
+                .arg(&out)
+                .args(["--to", to])
+                .assert()
+                .success();
+            assert!(read_events(&out) == original, "{name} -> {to}");
+        }
+    }
+}
+
+#[test]
+fn info_lists_the_topics_of_a_bag() {
+    let info = json(&[
+        "info",
+        dataset("ijrr_slider_depth_50k_bz2.bag").to_str().unwrap(),
+    ]);
+    assert_eq!(info["format"], "bag");
+    let topics = info["topics"].as_array().unwrap();
+    let find = |name: &str| topics.iter().find(|t| t["name"] == name).unwrap();
+    assert_eq!(find("/dvs/events")["message_type"], "dvs_msgs/EventArray");
+    assert_eq!(find("/dvs/image_raw")["message_type"], "sensor_msgs/Image");
+    assert_eq!(find("/dvs/image_raw")["messages"], 5);
+    // 10 ms messages over 170 ms
+    let messages = find("/dvs/events")["messages"].as_u64().unwrap();
+    assert!((17..=19).contains(&messages), "{messages}");
+    let mvsec = json(&["info", dataset(FILES[2].0).to_str().unwrap()]);
+    assert_eq!(mvsec["layout"], "MVSEC");
+    assert_eq!(mvsec["frames"], 5);
+}
+
+#[test]
+fn a_bag_topic_of_another_type_or_missing_names_the_topics() {
+    let bag = dataset("ijrr_slider_depth_50k.bag");
+    let e = bad_input(&["stats", bag.to_str().unwrap(), "--topic", "/dvs/image_raw"]);
+    assert!(
+        e.contains("/dvs/image_raw carries sensor_msgs/Image")
+            && e.contains("--topic")
+            && e.contains("/dvs/events (dvs_msgs/EventArray"),
+        "{e}"
+    );
+    let e = bad_input(&[
+        "stats",
+        bag.to_str().unwrap(),
+        "--topic",
+        "/davis/left/events",
+    ]);
+    assert!(
+        e.contains("no topic /davis/left/events") && e.contains("fix:"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_bag_without_event_topics_says_what_it_has() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frames_only.bag");
+    let frames = Recording::open(&real("ijrr_slider_depth_50k"), &OpenOptions::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    let mut writer = ctcal::io::write::BagWriter::create(
+        &path,
+        ctcal::Sensor::new(240, 180),
+        ctcal::io::write::BagCompression::None,
+        &ctcal::io::write::OutputPolicy::default(),
+    )
+    .unwrap();
+    writer.write_frame(&frames[0]).unwrap();
+    writer.finish().unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("no dvs_msgs/EventArray topic")
+            && e.contains("/dvs/image_raw (sensor_msgs/Image, 1 messages)")
+            && e.contains("fix:"),
+        "{e}"
+    );
+}
+
+#[test]
+fn damaged_bags_name_the_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let bytes = std::fs::read(dataset("ijrr_slider_depth_50k_bz2.bag")).unwrap();
+    // cut in the middle of its chunk: the index at the end is gone too
+    let cut = dir.path().join("cut.bag");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let e = bad_input(&["stats", cut.to_str().unwrap()]);
+    assert!(
+        e.contains("cut short") && e.contains("index") && e.contains("fix:"),
+        "{e}"
+    );
+    // garbage inside the bz2 data of the chunk
+    let mut damaged = bytes.clone();
+    let middle = bytes.len() / 2;
+    damaged[middle..middle + 64].fill(0x55);
+    let path = dir.path().join("garbage.bag");
+    std::fs::write(&path, &damaged).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("chunk at byte offset") && e.contains("bz2") && e.contains("fix:"),
+        "{e}"
+    );
+}
+
+/// The byte range of chunk `index` of a 1-D dataset.
+fn chunk_location(path: &std::path::Path, dataset: &str, element: u64) -> (u64, u64) {
+    let file = hdf5::File::open(path).unwrap();
+    let ds = file.dataset(dataset).unwrap();
+    let (mut mask, mut address, mut size) = (0u32, 0u64, 0u64);
+    let offset = [element];
+    // SAFETY: a live dataset id, pointers to locals, under hdf5-metno's lock
+    let status = hdf5::sync::sync(|| unsafe {
+        hdf5_sys::h5d::H5Dget_chunk_info_by_coord(
+            ds.id(),
+            offset.as_ptr(),
+            &mut mask,
+            &mut address,
+            &mut size,
+        )
+    });
+    assert!(status >= 0);
+    (address, size)
+}
+
+#[test]
+fn a_blosc_chunk_that_does_not_decompress_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dsec.h5");
+    std::fs::copy(dataset(FILES[3].0), &path).unwrap();
+    let (address, size) = chunk_location(&path, "events/x", 5000);
+    let mut bytes = std::fs::read(&path).unwrap();
+    // keep the Blosc header, damage the compressed blocks
+    let from = address as usize + 24;
+    bytes[from..address as usize + size as usize].fill(0xa5);
+    std::fs::write(&path, &bytes).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("events/x") && e.contains("elements 4096..8192") && e.contains("fix:"),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_mvsec_file_without_the_left_camera_names_the_side_to_use() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("right_only.h5");
+    let reference = read_events(&real("ijrr_slider_depth_50k"));
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let rows: Vec<f64> = reference
+            .iter()
+            .take(1000)
+            .flat_map(|e| {
+                [
+                    e.x as f64,
+                    e.y as f64,
+                    1.5e9 + e.t as f64 * 1e-6,
+                    if e.on { 1.0 } else { -1.0 },
+                ]
+            })
+            .collect();
+        let table = ndarray::Array2::from_shape_vec((1000, 4), rows).unwrap();
+        file.create_group("davis").unwrap();
+        file.create_group("davis/right").unwrap();
+        file.new_dataset_builder()
+            .with_data(&table)
+            .create("davis/right/events")
+            .unwrap();
+    }
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("without davis/left/events") && e.contains("--side right"),
+        "{e}"
+    );
+    let s = json(&[
+        "stats",
+        path.to_str().unwrap(),
+        "--side",
+        "right",
+        "--sensor",
+        "240x180",
+    ]);
+    assert_eq!(s["events"], 1000);
+    assert_eq!(s["t_first_us"], 1_500_000_000_000_000i64 + reference.t[0]);
+}
