@@ -32,9 +32,16 @@ pub struct ConvertArgs {
     /// Accept timestamps that go backwards and write the events sorted by time.
     #[arg(long)]
     pub sort: bool,
-    /// Bag output: compress chunks with bz2.
-    #[arg(long)]
-    pub bz2: bool,
+    /// Bag output: how chunks are compressed.
+    #[arg(long, value_enum, default_value = "none")]
+    pub bag_compression: BagCompressionArg,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum BagCompressionArg {
+    None,
+    Bz2,
+    Lz4,
 }
 
 enum Writer {
@@ -103,10 +110,10 @@ pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
         OutputFormat::Bag => Writer::Bag(BagWriter::create(
             &args.out,
             resolved.sensor,
-            if args.bz2 {
-                BagCompression::Bz2
-            } else {
-                BagCompression::None
+            match args.bag_compression {
+                BagCompressionArg::None => BagCompression::None,
+                BagCompressionArg::Bz2 => BagCompression::Bz2,
+                BagCompressionArg::Lz4 => BagCompression::Lz4,
             },
             &policy,
         )?),

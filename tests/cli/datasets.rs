@@ -128,6 +128,32 @@ fn every_dataset_file_converts_and_reads_back_unchanged() {
 }
 
 #[test]
+fn bags_of_every_chunk_compression_read_back_with_their_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let source = real("ijrr_slider_depth_50k");
+    let original = read_events(&source);
+    let frames = Recording::open(&source, &OpenOptions::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    for compression in ["none", "bz2", "lz4"] {
+        let out = dir.path().join(format!("{compression}.bag"));
+        ctcal()
+            .args(["convert", source.to_str().unwrap(), "--out"])
+            .arg(&out)
+            .args(["--bag-compression", compression])
+            .assert()
+            .success();
+        assert!(read_events(&out) == original, "{compression}");
+        let read = Recording::open(&out, &OpenOptions::default())
+            .unwrap()
+            .frames()
+            .unwrap();
+        assert!(read == frames, "{compression}");
+    }
+}
+
+#[test]
 fn info_lists_the_topics_of_a_bag() {
     let info = json(&[
         "info",

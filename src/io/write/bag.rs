@@ -1,7 +1,7 @@
 //! ROS1 bag writing (the inverse of [`crate::io::bag`]): events as `dvs_msgs/EventArray`
 //! messages on `/dvs/events` (a fixed number of events each, stamped with their last
 //! event's time, as rpg_dvs_ros publishes), frames as `mono8` `sensor_msgs/Image` messages
-//! on `/dvs/image_raw`, in plain or bz2 chunks of about 768 KB (ROS's default) with the
+//! on `/dvs/image_raw`, in plain, bz2 or LZ4 chunks of about 768 KB (ROS's default) with the
 //! index section ROS tools expect (index data after each chunk, then the connections and
 //! chunk infos). Used for `convert --to bag`, bag tests and the decoding benchmark.
 
@@ -28,6 +28,8 @@ const BAG_HEADER_BYTES: usize = 4096;
 pub enum BagCompression {
     None,
     Bz2,
+    /// The LZ4 frame format (what ROS's roslz4 writes).
+    Lz4,
 }
 
 /// A message's place in the open chunk, for the index.
@@ -313,6 +315,15 @@ impl BagWriter {
                     .and_then(|_| encoder.finish())
                     .map_err(|e| InputError::write(&self.staged.shown, e))?
             }
+            BagCompression::Lz4 => {
+                let mut encoder = lz4_flex::frame::FrameEncoder::new(Vec::new());
+                encoder
+                    .write_all(&self.chunk)
+                    .map_err(|e| InputError::write(&self.staged.shown, e))?;
+                encoder
+                    .finish()
+                    .map_err(|e| InputError::write(&self.staged.shown, std::io::Error::other(e)))?
+            }
         };
         let uncompressed = if self.compression == BagCompression::None {
             data.len()
@@ -327,6 +338,7 @@ impl BagWriter {
             match self.compression {
                 BagCompression::None => b"none",
                 BagCompression::Bz2 => b"bz2",
+                BagCompression::Lz4 => b"lz4",
             },
         );
         field(&mut header, "size", &(uncompressed as u32).to_le_bytes());
