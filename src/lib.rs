@@ -23,6 +23,7 @@ pub mod estimate;
 pub mod events;
 pub mod files;
 pub mod io;
+pub mod selection;
 pub mod sensors;
 
 pub use events::{CHUNK_EVENTS, Event, EventChunk, Frame, Sensor, TimeUs};

@@ -1,7 +1,7 @@
 //! `ctcal estimate aps|eppps|screen`: contrast thresholds three ways (see `ctcal::estimate`).
 
 use super::load::{Loaded, Window, load};
-use super::{BadInput, Global, InputArgs, JsonTarget, emit_json, output};
+use super::{BadInput, Global, InputArgs, JsonTarget, SelectionArgs, emit_json, output};
 use clap::{Args, Subcommand, ValueEnum};
 use ctcal::estimate::CtEstimate;
 use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
@@ -82,6 +82,9 @@ pub struct CommonArgs {
     /// The offset of the `eps` log response.
     #[arg(long, value_name = "EPS", default_value_t = 0.001)]
     pub log_eps: f64,
+    /// Which pixels to use (hot pixels are always left out of estimates).
+    #[command(flatten)]
+    pub selection: SelectionArgs,
 }
 
 impl CommonArgs {
@@ -151,10 +154,11 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
             frames: (!args.ignore_frames).then_some(args.max_frames.max(2)),
             events_between_frames: false,
         },
+        &common.selection,
         global,
     )?;
     let path = loaded.recording.path.clone();
-    let excluded = vec![false; loaded.sensor.pixels()];
+    let excluded = loaded.excluded.clone();
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
     let options = ApsOptions {
@@ -233,6 +237,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
             frames: None,
             events_between_frames: false,
         },
+        &common.selection,
         global,
     )?;
     let path = loaded.recording.path.clone();
@@ -263,7 +268,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         .into());
     }
     let frames = stimulus.load_all()?;
-    let excluded = vec![false; loaded.sensor.pixels()];
+    let excluded = loaded.excluded.clone();
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
     let result = screen::estimate(
@@ -340,6 +345,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
             frames: Some(args.max_frames),
             events_between_frames: true,
         },
+        &common.selection,
         global,
     )?;
     let path = loaded.recording.path.clone();
@@ -360,7 +366,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
         frame_time_offset_s: args.frame_time_offset_s,
         ..ApsOptions::default()
     };
-    let excluded = vec![false; loaded.sensor.pixels()];
+    let excluded = loaded.excluded.clone();
     let spinner = stage_spinner(global);
     let result = aps::estimate(
         &ApsInput {

@@ -1,7 +1,7 @@
 //! Reading a recording for the estimators and the fit: the events of a time window in
 //! memory, and the grey frames of that window (at most `max_frames`, evenly spread).
 
-use super::{BadInput, Global, InputArgs, progress_bar, warn};
+use super::{BadInput, Global, InputArgs, SelectionArgs, progress_bar, warn};
 use ctcal::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
 use ctcal::{InputError, Recording};
 
@@ -17,6 +17,8 @@ pub struct Loaded {
     pub frames: Vec<Frame>,
     /// Frames in the window before thinning to `max_frames`.
     pub frames_available: usize,
+    /// One flag per pixel: left out by `--roi` / `--mask` (what the estimators take).
+    pub excluded: Vec<bool>,
     pub notes: Vec<String>,
 }
 
@@ -50,22 +52,20 @@ pub fn check_window(start: Option<f64>, end: Option<f64>) -> Result<(), BadInput
     Ok(())
 }
 
-/// Reads `input` for an estimate.
-pub fn load(input: &InputArgs, window: &Window, global: &Global) -> anyhow::Result<Loaded> {
+/// Reads `input` for an estimate, and the pixels `selection` keeps.
+pub fn load(
+    input: &InputArgs,
+    window: &Window,
+    selection: &SelectionArgs,
+    global: &Global,
+) -> anyhow::Result<Loaded> {
     check_window(window.start_s, window.end_s)?;
     let recording = Recording::open(&input.input, &input.open_options())?;
     for note in &recording.notes {
         warn(global, note);
     }
     // the first event fixes the clock of --start/--end
-    let first = {
-        let mut stream = recording.events()?;
-        stream.allow_unsorted = true;
-        stream
-            .next_chunk()?
-            .map(|c| c.t[0])
-            .expect("a stream that is not empty")
-    };
+    let first = recording.first_event_time()?;
     let to_us = |s: f64| first + (s * 1e6).round() as TimeUs;
     let (mut from, mut to) = (
         window.start_s.map_or(TimeUs::MIN, to_us),
@@ -96,7 +96,7 @@ pub fn load(input: &InputArgs, window: &Window, global: &Global) -> anyhow::Resu
             to = to.min(frames[frames.len() - 1].t);
         }
     }
-    let mut stream = recording.events()?;
+    let mut stream = recording.events_between(from, to)?;
     let bar = progress_bar(global, stream.progress().total, "reading events");
     let mut events = EventChunk::default();
     while stream.next_chunk()?.is_some() {
@@ -153,7 +153,12 @@ pub fn load(input: &InputArgs, window: &Window, global: &Global) -> anyhow::Resu
         ))
         .into());
     }
+    let kept = selection.build(resolved.sensor, &recording.path)?;
+    if !kept.is_all() {
+        notes.push(format!("pixels: {}", kept.description()));
+    }
     Ok(Loaded {
+        excluded: kept.excluded(),
         sensor: resolved.sensor,
         sensor_source: resolved.source,
         recording,

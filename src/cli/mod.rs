@@ -85,6 +85,56 @@ impl InputArgs {
     }
 }
 
+/// Which pixels to analyse (every command that measures takes these).
+#[derive(Args, Debug, Clone, Default)]
+pub struct SelectionArgs {
+    /// Only the pixels X0 <= x < X1, Y0 <= y < Y1 (X1 and Y1 excluded, as in array slices).
+    #[arg(long, value_name = "X0,Y0,X1,Y1", value_parser = ctcal::selection::Roi::parse)]
+    pub roi: Option<ctcal::selection::Roi>,
+    /// Only the pixels a mask keeps: a PNG or .npy array of the sensor's size (H x W),
+    /// non-zero = keep.
+    #[arg(long, value_name = "FILE")]
+    pub mask: Option<PathBuf>,
+    /// Leave out the hot pixels the statistics find (a first pass finds them).
+    #[arg(long)]
+    pub exclude_hot_pixels: bool,
+}
+
+impl SelectionArgs {
+    /// Whether anything narrows the sensor.
+    pub fn is_set(&self) -> bool {
+        self.roi.is_some() || self.mask.is_some() || self.exclude_hot_pixels
+    }
+
+    /// The region and mask for `sensor` (hot pixels are left out by the caller, who finds
+    /// them); `input` names the recording in errors.
+    pub fn build(
+        &self,
+        sensor: Sensor,
+        input: &Path,
+    ) -> anyhow::Result<ctcal::selection::PixelSelection> {
+        let fail = |e: ctcal::selection::SelectionError| {
+            BadInput(format!(
+                "{}: {}\n  fix: {}",
+                input.display(),
+                e.problem,
+                e.fix
+            ))
+        };
+        let mut selection = ctcal::selection::PixelSelection::all(sensor);
+        if let Some(roi) = self.roi {
+            selection = selection.roi(roi).map_err(fail)?;
+        }
+        if let Some(path) = &self.mask {
+            let mask = ctcal::io::mask::read_mask(path, sensor)?;
+            selection = selection
+                .mask(&mask, &path.display().to_string())
+                .map_err(fail)?;
+        }
+        Ok(selection)
+    }
+}
+
 fn parse_sensor(text: &str) -> Result<Sensor, String> {
     Sensor::parse(text).ok_or_else(|| format!("`{text}` is not WxH (e.g. 346x260)"))
 }

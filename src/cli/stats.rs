@@ -1,6 +1,8 @@
 //! `ctcal stats`: event statistics of a recording (see `ctcal::stats`).
 
-use super::{BadInput, Global, InputArgs, JsonTarget, emit_json, output, progress_bar, warn};
+use super::{
+    BadInput, Global, InputArgs, JsonTarget, SelectionArgs, emit_json, output, progress_bar, warn,
+};
 use clap::Args;
 use ctcal::Recording;
 use ctcal::stats::{SequenceStats, StatsAccumulator, StatsOptions};
@@ -29,6 +31,8 @@ pub struct StatsArgs {
     /// Accept timestamps that go backwards and sort the events (in memory).
     #[arg(long)]
     pub sort: bool,
+    #[command(flatten)]
+    pub selection: SelectionArgs,
 }
 
 /// The longest span, in seconds, a time option may give (any recording is shorter; the
@@ -86,19 +90,75 @@ fn compute(
     args: &StatsArgs,
     global: &Global,
 ) -> anyhow::Result<SequenceStats> {
-    let options = StatsOptions {
+    let mut options = StatsOptions {
         start_s: args.start,
         end_s: args.end,
         window_s: args.window,
         support_window_s: args.support_window,
+        ..StatsOptions::default()
     };
+    if !args.selection.is_set() {
+        return pass(recording, options, args, global);
+    }
+    // a selection needs the sensor first: infer it in a first pass when the file is silent
+    let sensor = match recording.sensor {
+        Some(sensor) => sensor,
+        None => {
+            let mut stream = recording.events()?;
+            stream.allow_unsorted = args.sort;
+            while stream.next_chunk()?.is_some() {}
+            let resolved = recording.resolve_sensor(stream.max_coordinates());
+            if let Some(w) = &resolved.warning {
+                warn(global, w);
+            }
+            resolved.sensor
+        }
+    };
+    let selection = args.selection.build(sensor, &recording.path)?;
+    options.selection = Some(selection.clone());
+    if !args.selection.exclude_hot_pixels {
+        return pass(recording, options, args, global);
+    }
+    // hot pixels: found by a first pass over the selection, then left out
+    let first = pass(recording, options.clone(), args, global)?;
+    let hot = first.hot_pixels;
+    options.selection = Some(selection.without(hot.iter().map(|h| (h.x, h.y)), "hot pixels"));
+    let mut stats = pass(recording, options, args, global)?;
+    stats.excluded_hot_pixels = hot;
+    Ok(stats)
+}
+
+/// One statistics pass over the recording.
+fn pass(
+    recording: &Recording,
+    options: StatsOptions,
+    args: &StatsArgs,
+    global: &Global,
+) -> anyhow::Result<SequenceStats> {
+    let mut options = options;
+    // a time window: seek to it where the file has an index (DSEC, MVSEC)
+    let windowed = !args.sort && (args.start.is_some() || args.end.is_some());
+    let origin = if windowed {
+        Some(recording.first_event_time()?)
+    } else {
+        None
+    };
+    options.origin_us = origin;
     let mut accumulator = StatsAccumulator::new(options, recording.sensor);
     let max_coordinates = if args.sort {
         let all = recording.read_all(true)?;
         accumulator.add(&all);
         all.max_coordinates()
     } else {
-        let mut stream = recording.events()?;
+        let mut stream = match origin {
+            Some(origin) => {
+                let at = |s: Option<f64>, default| {
+                    s.map_or(default, |s| origin.saturating_add((s * 1e6).round() as i64))
+                };
+                recording.events_between(at(args.start, i64::MIN), at(args.end, i64::MAX))?
+            }
+            None => recording.events()?,
+        };
         let bar = progress_bar(global, stream.progress().total, "reading");
         let read_ahead = rayon::current_num_threads() > 1;
         ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, progress| {
@@ -155,6 +215,10 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
                 s.t_last_us,
                 output::seconds(s.duration_s)
             ),
+        ),
+        (
+            "pixels".into(),
+            format!("{} ({})", s.pixels_kept, s.selection),
         ),
         ("events/pixel/s".into(), rate(s.events_per_pixel_per_second)),
         (

@@ -1055,6 +1055,16 @@ pub struct H5Decoder {
 
 impl H5Decoder {
     pub fn open(path: &Path, info: &H5Info, sensor: Option<Sensor>) -> Result<Self, InputError> {
+        Self::open_rows(path, info, sensor, 0..info.events)
+    }
+
+    /// A decoder of the event rows `rows` only (after a seek, [`index_window`]).
+    pub fn open_rows(
+        path: &Path,
+        info: &H5Info,
+        sensor: Option<Sensor>,
+        rows: std::ops::Range<usize>,
+    ) -> Result<Self, InputError> {
         let file = open_file(path)?;
         let table = EventTable::open(path, &file, info.layout)
             .map_err(|e| h5_error(path, "opening the event datasets", e))?;
@@ -1064,12 +1074,209 @@ impl H5Decoder {
             table,
             buffers: Buffers::default(),
             columns: Columns::default(),
-            position: 0,
-            events: info.events,
+            position: rows.start.min(info.events),
+            events: rows.end.min(info.events),
             sensor,
             order: OrderCheck::default(),
         })
     }
+}
+
+/// One element of a 1-D dataset.
+fn element<T: hdf5::H5Type + Copy>(file: &hdf5::File, name: &str, index: usize) -> hdf5::Result<T> {
+    let values = file
+        .dataset(name)?
+        .read_slice_1d::<T, _>(index..index + 1)?;
+    values
+        .first()
+        .copied()
+        .ok_or_else(|| hdf5::Error::from(format!("{name}[{index}] is missing")))
+}
+
+/// The time of the first event (in the file's clock), read without decoding the rest; `None`
+/// for layouts without an index to seek with.
+pub fn first_time(path: &Path, info: &H5Info) -> Result<Option<TimeUs>, InputError> {
+    if info.events == 0 {
+        return Ok(None);
+    }
+    let file = open_file(path)?;
+    let err = |e| h5_error(path, "reading the first event's time", e);
+    Ok(match info.layout {
+        Layout::Dsec => {
+            let t: i64 = element::<u64>(&file, "events/t", 0)
+                .map(|t| t as i64)
+                .or_else(|_| element::<i64>(&file, "events/t", 0))
+                .map_err(err)?;
+            t.checked_add(dsec_t_offset(&file).map_err(err)?)
+        }
+        Layout::Mvsec(side) => {
+            let row = file
+                .dataset(&format!("{}/events", side.group()))
+                .and_then(|d| d.read_slice_2d::<f64, _>(ndarray::s![0..1, 2..3]))
+                .map_err(err)?;
+            row.iter()
+                .next()
+                .filter(|s| s.is_finite() && s.abs() < 1e12)
+                .map(|&s| crate::events::s_to_us(s))
+        }
+        _ => None,
+    })
+}
+
+/// The first row whose time is at least `t`, searched from the row `near` (galloping away
+/// from it, then bisecting), in rows sorted by time `0..n`.
+fn first_row_at_or_after(
+    near: usize,
+    n: usize,
+    t: TimeUs,
+    time_at: &impl Fn(usize) -> Result<TimeUs, InputError>,
+) -> Result<usize, InputError> {
+    let at_or_after =
+        |row: usize| -> Result<bool, InputError> { Ok(row >= n || time_at(row)? >= t) };
+    // a bracket lo < answer <= hi, lo = usize::MAX meaning "before row 0"
+    let (mut lo, mut hi) = if at_or_after(near)? {
+        let mut step = 1;
+        let mut hi = near;
+        loop {
+            if hi == 0 {
+                break (None, 0);
+            }
+            let probe = hi.saturating_sub(step);
+            if at_or_after(probe)? {
+                hi = probe;
+                step *= 2;
+            } else {
+                break (Some(probe), hi);
+            }
+        }
+    } else {
+        let mut step = 1;
+        let mut lo = near;
+        loop {
+            let probe = (lo + step).min(n);
+            if at_or_after(probe)? {
+                break (Some(lo), probe);
+            }
+            lo = probe;
+            step *= 2;
+        }
+    };
+    while let Some(l) = lo {
+        if hi - l <= 1 {
+            break;
+        }
+        let mid = l + (hi - l) / 2;
+        if at_or_after(mid)? {
+            hi = mid;
+        } else {
+            lo = Some(mid);
+        }
+    }
+    if lo.is_none() {
+        // every row from 0 to hi is at or after t
+        hi = 0;
+    }
+    Ok(hi)
+}
+
+/// The rows that can hold the events of times `from..=to`, found with the file's own index
+/// (DSEC `ms_to_idx`: the first event of each millisecond; MVSEC `image_raw_event_inds`: the
+/// event nearest each frame, from which the exact ends are found on the event times), so
+/// that a window is read without
+/// scanning what lies before it. DSEC rows may hold a few events outside the window (the
+/// caller trims); MVSEC rows are exact. `None` when the layout has no usable index.
+pub fn index_window(
+    path: &Path,
+    info: &H5Info,
+    from: TimeUs,
+    to: TimeUs,
+) -> Result<Option<std::ops::Range<usize>>, InputError> {
+    let file = open_file(path)?;
+    let n = info.events;
+    let found = match info.layout {
+        Layout::Dsec if file.link_exists("ms_to_idx") => {
+            let offset = dsec_t_offset(&file).map_err(|e| h5_error(path, "t_offset", e))?;
+            let ms = check_dataset(path, &file, "ms_to_idx", 1)?[0];
+            if ms == 0 {
+                return Ok(None);
+            }
+            let at = |k: usize| -> Result<usize, InputError> {
+                let v: u64 =
+                    element(&file, "ms_to_idx", k).map_err(|e| h5_error(path, "ms_to_idx", e))?;
+                Ok((v as usize).min(n))
+            };
+            let millisecond = |t: TimeUs| (t.saturating_sub(offset)).div_euclid(1000);
+            let first = millisecond(from).clamp(0, ms as i64 - 1) as usize;
+            let last = millisecond(to).saturating_add(1);
+            let start = if from <= offset { 0 } else { at(first)? };
+            let end = if last < 0 {
+                0
+            } else if (last as u64) < ms as u64 {
+                at(last as usize)?
+            } else {
+                n
+            };
+            Some(start..end.max(start))
+        }
+        Layout::Mvsec(side) => {
+            let inds = format!("{}/image_raw_event_inds", side.group());
+            let stamps = format!("{}/image_raw_ts", side.group());
+            if !file.link_exists(&inds) || !file.link_exists(&stamps) {
+                return Ok(None);
+            }
+            let err = |e| h5_error(path, &inds, e);
+            let times: Vec<f64> = file
+                .dataset(&stamps)
+                .and_then(|d| d.read_raw())
+                .map_err(err)?;
+            let indices: Vec<i64> = file
+                .dataset(&inds)
+                .and_then(|d| d.read_raw())
+                .map_err(err)?;
+            let usable = times.len() == indices.len()
+                && indices.windows(2).all(|w| w[0] <= w[1])
+                && indices.iter().all(|&i| i >= 0 && i as usize <= n)
+                && times.iter().all(|t| t.is_finite());
+            if !usable || times.is_empty() {
+                return Ok(None);
+            }
+            let us: Vec<TimeUs> = times.iter().map(|&t| crate::events::s_to_us(t)).collect();
+            // the frames around the window give rows near its ends (the event nearest each
+            // frame); the exact ends are then found on the event times themselves
+            let events = file
+                .dataset(&format!("{}/events", side.group()))
+                .map_err(|e| h5_error(path, "events", e))?;
+            let time_at = |row: usize| -> Result<TimeUs, InputError> {
+                let v = events
+                    .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, 2..3])
+                    .map_err(|e| h5_error(path, "events", e))?;
+                Ok(v.iter().next().map_or(TimeUs::MAX, |&s| {
+                    if s.is_finite() && s.abs() < 1e12 {
+                        crate::events::s_to_us(s)
+                    } else {
+                        TimeUs::MAX
+                    }
+                }))
+            };
+            let before = us.partition_point(|&t| t <= from);
+            let near_start = if before >= 1 {
+                indices[before - 1] as usize
+            } else {
+                0
+            };
+            let after = us.partition_point(|&t| t < to);
+            let near_end = if after < indices.len() {
+                indices[after] as usize
+            } else {
+                n
+            };
+            let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
+            let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
+            Some(start..end.max(start))
+        }
+        _ => None,
+    };
+    Ok(found)
 }
 
 impl EventDecoder for H5Decoder {
@@ -1224,6 +1431,31 @@ impl EventDecoder for H5Decoder {
         Progress {
             done: self.position as u64,
             total: self.events as u64,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_row_of_a_time_is_found_from_any_starting_row() {
+        // times with repeats and gaps
+        let times: Vec<TimeUs> = [0, 0, 3, 5, 5, 5, 9, 12, 12, 20, 21, 30]
+            .into_iter()
+            .collect();
+        let n = times.len();
+        let time_at = |row: usize| -> Result<TimeUs, InputError> { Ok(times[row]) };
+        for t in -1..=32 {
+            let expected = times.partition_point(|&v| v < t);
+            for near in 0..=n {
+                assert_eq!(
+                    first_row_at_or_after(near, n, t, &time_at).unwrap(),
+                    expected,
+                    "t {t} from row {near}"
+                );
+            }
         }
     }
 }

@@ -19,6 +19,7 @@ pub mod frame_list;
 pub mod h5;
 mod h5_direct;
 pub mod ijrr;
+pub mod mask;
 pub mod npy;
 pub mod order;
 pub mod prophesee;

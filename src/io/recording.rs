@@ -212,9 +212,47 @@ impl Recording {
 
     /// A fresh stream over the events (each call starts at the beginning).
     pub fn events(&self) -> Result<EventStream, InputError> {
+        self.stream(None)
+    }
+
+    /// The time of the first event (a seek and one value for indexed layouts, the first
+    /// chunk otherwise).
+    pub fn first_event_time(&self) -> Result<TimeUs, InputError> {
+        if let Source::H5(info) = &self.source
+            && let Some(t) = h5::first_time(&self.path, info)?
+        {
+            return Ok(t);
+        }
+        let mut stream = self.events()?;
+        stream.allow_unsorted = true;
+        Ok(stream
+            .next_chunk()?
+            .map(|c| c.t[0])
+            .expect("a stream that is not empty"))
+    }
+
+    /// A stream that holds at least the events of times `from..=to` (file clock), seeking
+    /// with the file's own index where it has one (DSEC, MVSEC), else from the start; the
+    /// caller trims to the window. An empty window is not an error here.
+    pub fn events_between(&self, from: TimeUs, to: TimeUs) -> Result<EventStream, InputError> {
+        let rows = match &self.source {
+            Source::H5(info) => h5::index_window(&self.path, info, from, to)?,
+            _ => None,
+        };
+        let mut stream = self.stream(rows)?;
+        stream.allow_empty = true;
+        Ok(stream)
+    }
+
+    fn stream(&self, rows: Option<std::ops::Range<usize>>) -> Result<EventStream, InputError> {
         let decoder: Box<dyn EventDecoder> = match &self.source {
             Source::Ijrr(files) => Box::new(ijrr::IjrrDecoder::open(&files.events, self.sensor)?),
-            Source::H5(info) => Box::new(h5::H5Decoder::open(&self.path, info, self.sensor)?),
+            Source::H5(info) => Box::new(h5::H5Decoder::open_rows(
+                &self.path,
+                info,
+                self.sensor,
+                rows.unwrap_or(0..info.events),
+            )?),
             Source::Aedat4(header) => Box::new(aedat4::Aedat4Decoder::open(
                 &self.path,
                 header,
@@ -245,6 +283,7 @@ impl Recording {
             max_x: None,
             max_y: 0,
             allow_unsorted: false,
+            allow_empty: false,
         })
     }
 
@@ -418,6 +457,9 @@ pub struct EventStream {
     max_y: u16,
     /// Accept decreasing timestamps (the caller sorts).
     pub allow_unsorted: bool,
+    /// A stream without events ends quietly (a window the caller checks) rather than with
+    /// [`InputError::Empty`].
+    pub allow_empty: bool,
 }
 
 impl EventStream {
@@ -436,7 +478,7 @@ impl EventStream {
             ));
         }
         if self.chunk.is_empty() {
-            if self.events == 0 {
+            if self.events == 0 && !self.allow_empty {
                 return Err(InputError::Empty {
                     path: self.path.clone(),
                 });

@@ -9,6 +9,9 @@
 //! pixels excluded, is the background rate. (Edges moving over the sensor give their events
 //! neighbours within milliseconds; leak and shot-noise events are isolated.)
 //!
+//! With a [`PixelSelection`] (region, mask, pixels left out) every per-pixel quantity is
+//! taken over the kept pixels only; support still looks at every neighbour.
+//!
 //! Memory is bounded by the sensor (16 bytes per pixel), a fixed-size interval histogram and
 //! the non-empty windows of the rate timeline, never by the time span a file claims; events
 //! must arrive time-sorted.
@@ -20,6 +23,7 @@ pub mod support;
 pub mod timeline;
 
 use crate::events::{EventChunk, Sensor, TimeUs, us_to_s};
+use crate::selection::PixelSelection;
 use hot_pixels::HotPixel;
 use intervals::IntervalHistogram;
 use pixel_grid::PixelGrid;
@@ -56,6 +60,11 @@ pub struct StatsOptions {
     pub window_s: f64,
     /// Support window of the background-activity count, seconds.
     pub support_window_s: f64,
+    /// The pixels to measure (default: all).
+    pub selection: Option<PixelSelection>,
+    /// The time of the recording's first event, when the events added do not start there
+    /// (a reader that seeked to `start_s`); `start_s`/`end_s` count from it.
+    pub origin_us: Option<TimeUs>,
 }
 
 impl Default for StatsOptions {
@@ -65,6 +74,8 @@ impl Default for StatsOptions {
             end_s: None,
             window_s: 0.01,
             support_window_s: 0.01,
+            selection: None,
+            origin_us: None,
         }
     }
 }
@@ -110,6 +121,14 @@ pub struct SequenceStats {
     pub median_pixel_rate_hz: f64,
     pub inter_event_interval_s: IntervalSummary,
     pub frames: Option<FrameSummary>,
+    /// Pixels every per-pixel quantity divides by (all of the sensor's, unless a region,
+    /// mask or exclusion was applied), and what was applied.
+    pub pixels_kept: u64,
+    pub selection: String,
+    /// Hot pixels left out before measuring (`--exclude-hot-pixels`), as a first pass found
+    /// them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub excluded_hot_pixels: Vec<HotPixel>,
 }
 
 /// Accumulates statistics chunk by chunk.
@@ -125,8 +144,11 @@ pub struct StatsAccumulator {
     events: u64,
     on: u64,
     pixels: PixelGrid,
-    /// Scratch: pixel index of each event of the chunk being added.
+    /// Scratch: pixel index of each event of the chunk being added, and whether it is kept.
     indices: Vec<u32>,
+    kept: Vec<bool>,
+    /// The selection as one flag per grid cell (border included), when there is one.
+    kept_cells: Option<Vec<bool>>,
     intervals: IntervalHistogram,
     windows: WindowCounter,
 }
@@ -160,8 +182,18 @@ impl StatsAccumulator {
     pub fn new(options: StatsOptions, sensor: Option<Sensor>) -> Self {
         let window_us = ((options.window_s * 1e6).round() as TimeUs).max(1);
         let support_us = ((options.support_window_s * 1e6).round() as TimeUs).max(0);
+        // a selection fixes the sensor
+        let sensor = options.selection.as_ref().map(|s| s.sensor()).or(sensor);
         let pixels = sensor.map_or_else(PixelGrid::default, |s| {
             PixelGrid::new(s.width as usize, s.height as usize)
+        });
+        let kept_cells = options.selection.as_ref().map(|selection| {
+            let mut cells = vec![false; pixels.cells.len()];
+            let width = selection.sensor().width as usize;
+            for (i, &keep) in selection.kept_mask().iter().enumerate() {
+                cells[pixels.index((i % width) as u16, (i / width) as u16)] = keep;
+            }
+            cells
         });
         Self {
             options,
@@ -176,6 +208,8 @@ impl StatsAccumulator {
             on: 0,
             pixels,
             indices: Vec::new(),
+            kept: Vec::new(),
+            kept_cells,
             intervals: IntervalHistogram::default(),
             windows: WindowCounter::default(),
         }
@@ -187,7 +221,7 @@ impl StatsAccumulator {
             return;
         }
         if self.stream_first.is_none() {
-            let t0 = chunk.t[0];
+            let t0 = self.options.origin_us.unwrap_or(chunk.t[0]);
             self.stream_first = Some(t0);
             if let Some(s) = self.options.start_s {
                 self.select_from = t0 + (s * 1e6).round() as TimeUs;
@@ -202,23 +236,50 @@ impl StatsAccumulator {
             return;
         }
         let (ts, xs, ys) = (&chunk.t[lo..hi], &chunk.x[lo..hi], &chunk.y[lo..hi]);
-        if self.first.is_none() {
-            self.first = Some(ts[0]);
-            self.windows.end = ts[0].saturating_add(self.window_us);
-        }
+        let on = &chunk.on[lo..hi];
         let max_x = xs.iter().copied().max().expect("non-empty");
         let max_y = ys.iter().copied().max().expect("non-empty");
         self.pixels.ensure(max_x, max_y);
-        self.accumulate(ts, xs, ys);
-        self.events += ts.len() as u64;
-        self.on += chunk.on[lo..hi].iter().map(|&p| p as u64).sum::<u64>();
-        self.last = *ts.last().expect("non-empty");
+        let Some(kept_cells) = &self.kept_cells else {
+            if self.first.is_none() {
+                self.first = Some(ts[0]);
+                self.windows.end = ts[0].saturating_add(self.window_us);
+            }
+            self.accumulate::<false>(ts, xs, ys);
+            self.events += ts.len() as u64;
+            self.on += on.iter().map(|&p| p as u64).sum::<u64>();
+            self.last = *ts.last().expect("non-empty");
+            return;
+        };
+        // a selection: every event updates its pixel (support, per-pixel counts), only the
+        // kept ones count towards the totals, the timeline and the intervals
+        let grid = &self.pixels;
+        self.kept.clear();
+        self.kept.extend(
+            xs.iter()
+                .zip(ys)
+                .map(|(&x, &y)| kept_cells[grid.index(x, y)]),
+        );
+        if let Some(i) = self.kept.iter().position(|&k| k)
+            && self.first.is_none()
+        {
+            self.first = Some(ts[i]);
+            self.windows.end = ts[i].saturating_add(self.window_us);
+        }
+        self.accumulate::<true>(ts, xs, ys);
+        let kept = &self.kept;
+        self.events += kept.iter().filter(|&&k| k).count() as u64;
+        self.on += on.iter().zip(kept).filter(|&(&p, &k)| p && k).count() as u64;
+        if let Some(i) = kept.iter().rposition(|&k| k) {
+            self.last = ts[i];
+        }
     }
 
     /// The per-event kernel: counts, spatio-temporal support, same-pixel intervals,
-    /// timeline.
+    /// timeline (with `SELECTED`, intervals and timeline only for the events `self.kept`
+    /// flags).
     #[inline(never)]
-    fn accumulate(&mut self, ts: &[TimeUs], xs: &[u16], ys: &[u16]) {
+    fn accumulate<const SELECTED: bool>(&mut self, ts: &[TimeUs], xs: &[u16], ys: &[u16]) {
         let stride = self.pixels.stride();
         // cell indices first (a vectorised pass), so the main loop can prefetch the
         // neighbourhood of an event a few places ahead: events hop between rows, and
@@ -232,7 +293,9 @@ impl StatsAccumulator {
         let indices = &self.indices;
         let cells = &mut self.pixels.cells;
         let intervals = &mut self.intervals;
-        let first = self.first.expect("started");
+        // (with a selection, only read for kept events, which set it)
+        let first = self.first.unwrap_or(0);
+        let kept = &self.kept;
         let support_us = self.support_us;
         let window_us = self.window_us;
         let windows = &mut self.windows;
@@ -259,12 +322,16 @@ impl StatsAccumulator {
                 .max(cells[k + stride].last)
                 .max(cells[k + stride + 1].last);
             let cell = &mut cells[k];
-            if cell.count > 0 {
+            let counted = !SELECTED || kept[i];
+            if cell.count > 0 && counted {
                 intervals.add(t.wrapping_sub(cell.last) as u64);
             }
             cell.count += 1;
             cell.unsupported += (neighbours < t.saturating_sub(support_us)) as u32;
             cell.last = t;
+            if !counted {
+                continue;
+            }
             if t >= windows.end {
                 windows.close(t, first, window_us);
             }
@@ -291,16 +358,31 @@ impl StatsAccumulator {
                 .timeline
                 .add(self.windows.index, self.windows.count);
         }
+        let selection = self.options.selection.take();
+        // a selection fixes the sensor
+        let sensor = selection.as_ref().map_or(sensor, |s| s.sensor());
         let (width, height) = (sensor.width as usize, sensor.height as usize);
-        let pixels = (width * height) as f64;
+        let keep = |i: usize| selection.as_ref().is_none_or(|s| s.kept_mask()[i]);
+        let kept_pixels = selection.as_ref().map_or(width * height, |s| s.kept());
+        let pixels = kept_pixels.max(1) as f64;
         let duration_s = us_to_s(self.last - first);
         let per_pixel_per_second =
             |n: u64| (duration_s > 0.0).then(|| n as f64 / (pixels * duration_s));
-        let counts = self.pixels.counts(width, height);
+        let all_counts = self.pixels.counts(width, height);
         let unsupported = self.pixels.map(width, height, |c| c.unsupported);
+        let counts: Vec<u32> = (0..all_counts.len())
+            .filter(|&i| keep(i))
+            .map(|i| all_counts[i])
+            .collect();
         let active = counts.iter().filter(|&&c| c > 0).count();
-        let hot = hot_pixels::find_hot_pixels(&counts, width, height, duration_s);
-        let background_rate_hz = background_rate(&unsupported, width, &hot, duration_s);
+        // hot pixels are judged against their real neighbours, kept or not
+        let hot: Vec<HotPixel> =
+            hot_pixels::find_hot_pixels(&all_counts, width, height, duration_s)
+                .into_iter()
+                .filter(|h| keep(h.y as usize * width + h.x as usize))
+                .collect();
+        let background_rate_hz =
+            background_rate(&unsupported, width, &hot, duration_s, &keep, kept_pixels);
         let off = self.events - self.on;
         Some(SequenceStats {
             width: sensor.width,
@@ -330,6 +412,9 @@ impl StatsAccumulator {
             background_rate_method: BACKGROUND_RATE_METHOD,
             support_window_s: us_to_s(self.support_us),
             median_pixel_rate_hz: median_rate(&counts, duration_s),
+            pixels_kept: kept_pixels as u64,
+            selection: selection.map_or_else(|| "the whole sensor".into(), |s| s.description()),
+            excluded_hot_pixels: Vec::new(),
             inter_event_interval_s: IntervalSummary {
                 p5: self.intervals.quantile_us(0.05).map(|us| us * 1e-6),
                 median: self.intervals.quantile_us(0.5).map(|us| us * 1e-6),
@@ -341,8 +426,16 @@ impl StatsAccumulator {
     }
 }
 
-/// Unsupported events per pixel per second over the pixels that are not hot.
-fn background_rate(unsupported: &[u32], width: usize, hot: &[HotPixel], duration_s: f64) -> f64 {
+/// Unsupported events per pixel per second over the kept pixels that are not hot (`hot`
+/// holds kept pixels only).
+fn background_rate(
+    unsupported: &[u32],
+    width: usize,
+    hot: &[HotPixel],
+    duration_s: f64,
+    keep: &impl Fn(usize) -> bool,
+    kept_pixels: usize,
+) -> f64 {
     if duration_s <= 0.0 {
         return 0.0;
     }
@@ -350,8 +443,11 @@ fn background_rate(unsupported: &[u32], width: usize, hot: &[HotPixel], duration
         .iter()
         .map(|h| unsupported[h.y as usize * width + h.x as usize] as u64)
         .sum();
-    let total: u64 = unsupported.iter().map(|&c| c as u64).sum();
-    let kept = unsupported.len() - hot.len();
+    let total: u64 = (0..unsupported.len())
+        .filter(|&i| keep(i))
+        .map(|i| unsupported[i] as u64)
+        .sum();
+    let kept = kept_pixels - hot.len();
     if kept == 0 {
         return 0.0;
     }

@@ -327,3 +327,56 @@ fn an_mvsec_file_without_the_left_camera_names_the_side_to_use() {
     assert_eq!(s["events"], 1000);
     assert_eq!(s["t_first_us"], 1_500_000_000_000_000i64 + reference.t[0]);
 }
+
+#[test]
+fn time_windows_read_the_same_events_and_seek_with_the_file_index() {
+    let reference = json(&[
+        "stats",
+        real("ijrr_slider_depth_50k").to_str().unwrap(),
+        "--start",
+        "0.05",
+        "--end",
+        "0.1",
+    ]);
+    for (name, shift) in FILES {
+        let s = json(&[
+            "stats",
+            dataset(name).to_str().unwrap(),
+            "--start",
+            "0.05",
+            "--end",
+            "0.1",
+        ]);
+        for key in ["events", "on_events", "active_pixel_fraction"] {
+            assert_eq!(s[key], reference[key], "{name}: {key}");
+        }
+        assert_eq!(
+            s["t_first_us"].as_i64().unwrap() - shift,
+            reference["t_first_us"].as_i64().unwrap(),
+            "{name}"
+        );
+    }
+    // DSEC (ms_to_idx) and MVSEC (image_raw_event_inds) start reading near the window
+    for (name, _) in &FILES[2..] {
+        let recording = Recording::open(&dataset(name), &OpenOptions::default()).unwrap();
+        let first = recording.first_event_time().unwrap();
+        let (from, to) = (first + 100_000, first + 120_000);
+        let mut stream = recording.events_between(from, to).unwrap();
+        let mut read = EventChunk::default();
+        while let Some(chunk) = stream.next_chunk().unwrap() {
+            read.extend_from(chunk);
+        }
+        let inside = read_events(&dataset(name))
+            .t
+            .iter()
+            .filter(|&&t| (from..=to).contains(&t))
+            .count();
+        let kept = read.t.iter().filter(|&&t| (from..=to).contains(&t)).count();
+        assert_eq!(kept, inside, "{name}: every event of the window");
+        assert!(
+            read.len() < 25_000,
+            "{name}: read {} of 50000 events",
+            read.len()
+        );
+    }
+}

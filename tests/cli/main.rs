@@ -10,5 +10,6 @@ mod limits;
 mod readers;
 mod safety;
 mod samples;
+mod selection;
 mod simulate;
 mod stats;
