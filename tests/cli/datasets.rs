@@ -233,6 +233,23 @@ fn damaged_bags_name_the_place() {
         e.contains("cut short") && e.contains("index") && e.contains("fix:"),
         "{e}"
     );
+    // a bag that was never closed (no index) and is cut inside its chunk: found by scanning
+    let mut unclosed = bytes[..bytes.len() / 2].to_vec();
+    let field = unclosed
+        .windows(10)
+        .position(|w| w == b"index_pos=")
+        .expect("the bag header names index_pos")
+        + 10;
+    unclosed[field..field + 8].fill(0);
+    let path = dir.path().join("unclosed.bag");
+    std::fs::write(&path, &unclosed).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("record at byte offset 4109")
+            && e.contains("the file ends")
+            && e.contains("fix:"),
+        "{e}"
+    );
     // garbage inside the bz2 data of the chunk
     let mut damaged = bytes.clone();
     let middle = bytes.len() / 2;
