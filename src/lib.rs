@@ -22,6 +22,7 @@
 pub mod estimate;
 pub mod events;
 pub mod files;
+pub mod fit;
 pub mod io;
 pub mod selection;
 pub mod sensors;

@@ -88,7 +88,7 @@ pub struct CommonArgs {
 }
 
 impl CommonArgs {
-    fn log_map(&self) -> Result<(LogMap, String), BadInput> {
+    pub(super) fn log_map(&self) -> Result<(LogMap, String), BadInput> {
         if !(self.log_eps.is_finite() && self.log_eps > 0.0) {
             return Err(BadInput(format!(
                 "--log-eps {} must be positive",
@@ -292,7 +292,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
 const DEFAULT_SCREEN: &str = include_str!("../../calib/screens/lcd_60hz_srgb.toml");
 
 /// A spinner on stderr showing the stage (hidden when quiet).
-fn stage_spinner(global: &Global) -> indicatif::ProgressBar {
+pub(super) fn stage_spinner(global: &Global) -> indicatif::ProgressBar {
     if global.quiet {
         return indicatif::ProgressBar::hidden();
     }

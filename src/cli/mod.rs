@@ -4,6 +4,7 @@
 mod calib;
 mod convert;
 mod estimate;
+mod fit;
 mod info;
 mod load;
 mod output;
@@ -155,6 +156,8 @@ pub enum Command {
     /// Contrast thresholds: from grey frames (aps), event rate (eppps) or a screen (screen).
     #[command(subcommand)]
     Estimate(estimate::EstimateCommand),
+    /// Fit every simulator parameter; add the effects the residuals call for.
+    Fit(fit::FitArgs),
 }
 
 /// A problem with the command line or the input that the user can fix (exit code 2).
@@ -188,6 +191,7 @@ pub fn run() -> i32 {
         Command::Simulate(args) => simulate::run(args, &cli.global),
         Command::Calib(command) => calib::run(command, &cli.global),
         Command::Estimate(command) => estimate::run(command, &cli.global),
+        Command::Fit(args) => fit::run(args, &cli.global),
     };
     match result {
         Ok(()) => 0,

@@ -28,6 +28,16 @@ impl LogMap {
 
     /// The log-domain value of intensity `dn` (camera DN).
     #[inline(always)]
+    /// Which response this is.
+    pub fn response(&self) -> LogResponse {
+        self.kind
+    }
+
+    /// The offset of the `eps` response.
+    pub fn eps(&self) -> f64 {
+        self.eps as f64
+    }
+
     pub fn apply(&self, dn: f32) -> f32 {
         match self.kind {
             LogResponse::V2e => {

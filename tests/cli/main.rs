@@ -6,6 +6,7 @@ mod convert;
 mod datasets;
 mod errors;
 mod estimate;
+mod fit;
 mod limits;
 mod readers;
 mod safety;

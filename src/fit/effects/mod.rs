@@ -1,0 +1,217 @@
+//! The effect library: each effect a real sensor shows and the ideal pixel model lacks,
+//! with its residual signature (how a model without it is wrong), the evidence read from
+//! the residuals, and the parameter it adds to the simulator with a starting value and a
+//! search range. One module per effect:
+//!
+//! | effect | signature | parameter |
+//! |---|---|---|
+//! | [`bandwidth`] | a count deficit that grows as intensity falls (and change gets faster) | `cutoff_hz` |
+//! | [`leak`] | ON excess among unsupported events | `leak_rate_hz` |
+//! | [`shot_noise`] | excess of both polarities among unsupported events, stronger in the dark | `shot_noise_rate_hz` |
+//! | [`hot_pixels`] | a few pixels far above their neighbours | masked; `hot_pixel_fraction`, `hot_pixel_rate_hz` |
+//! | [`refractory`] | a gap in the shortest same-pixel intervals | `refractory_s` |
+//! | [`mismatch`] | per-pixel thresholds that differ (event timing), counts more dispersed | `ct_sigma` |
+//! | [`display`] | a spectral line at the refresh rate | `[display]` (through `estimate screen`) |
+//! | [`jitter`] | same-pixel intervals shorter than the timestamps allow | `timestamp_jitter_s` |
+
+pub mod bandwidth;
+pub mod display;
+pub mod hot_pixels;
+pub mod jitter;
+pub mod leak;
+pub mod mismatch;
+pub mod refractory;
+pub mod shot_noise;
+
+use super::observe::{Geometry, Observed, Subset};
+use crate::sim::PixelParams;
+use serde::{Deserialize, Serialize};
+
+/// An effect of the sensor model (the CLI's effect names).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Effect {
+    Mismatch,
+    Refractory,
+    Bandwidth,
+    Leak,
+    ShotNoise,
+    HotPixels,
+    TimestampJitter,
+    Display,
+}
+
+impl Effect {
+    pub const ALL: [Effect; 8] = [
+        Effect::HotPixels,
+        Effect::Bandwidth,
+        Effect::Leak,
+        Effect::ShotNoise,
+        Effect::Refractory,
+        Effect::Mismatch,
+        Effect::TimestampJitter,
+        Effect::Display,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::Mismatch => "mismatch",
+            Effect::Refractory => "refractory",
+            Effect::Bandwidth => "bandwidth",
+            Effect::Leak => "leak",
+            Effect::ShotNoise => "shot_noise",
+            Effect::HotPixels => "hot_pixels",
+            Effect::TimestampJitter => "timestamp_jitter",
+            Effect::Display => "display",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Effect> {
+        Effect::ALL.into_iter().find(|e| e.name() == name)
+    }
+
+    /// The PARAMS.toml key the effect's searched parameter sets (`None`: set in closed
+    /// form, or not by a search).
+    pub fn parameter(self) -> Option<&'static str> {
+        match self {
+            Effect::Mismatch => Some("ct_sigma"),
+            Effect::Refractory => Some("refractory_s"),
+            Effect::Bandwidth => Some("cutoff_hz"),
+            Effect::Leak => Some("leak_rate_hz"),
+            Effect::ShotNoise => Some("shot_noise_rate_hz"),
+            Effect::TimestampJitter => Some("timestamp_jitter_s"),
+            Effect::HotPixels | Effect::Display => None,
+        }
+    }
+
+    /// Sets the searched parameter.
+    pub fn set(self, params: &mut PixelParams, value: f64) {
+        let slot = match self {
+            Effect::Mismatch => &mut params.ct_sigma,
+            Effect::Refractory => &mut params.refractory_s,
+            Effect::Bandwidth => &mut params.cutoff_hz,
+            Effect::Leak => &mut params.leak_rate_hz,
+            Effect::ShotNoise => &mut params.shot_noise_rate_hz,
+            Effect::TimestampJitter => &mut params.timestamp_jitter_s,
+            Effect::HotPixels | Effect::Display => return,
+        };
+        *slot = Some(value);
+    }
+
+    /// The range searched around a starting value (a factor either side, or the
+    /// effect's own plausible range).
+    pub fn range(self, start: f64) -> (f64, f64) {
+        match self {
+            Effect::Bandwidth => (2.0, 5000.0),
+            Effect::Mismatch => ((start / 3.0).max(0.002), (start * 3.0).min(0.3)),
+            Effect::TimestampJitter => (5e-6, 5e-3),
+            _ => (start / 5.0, start * 5.0),
+        }
+    }
+}
+
+impl std::fmt::Display for Effect {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// What the evidence of every effect reads: the recording's and the current model's
+/// statistics on the fit blocks, and what is known besides.
+pub struct Context<'a> {
+    pub real: &'a Observed,
+    pub sim: &'a Observed,
+    pub geometry: &'a Geometry,
+    /// Pixels compared (not left out, not masked).
+    pub kept: &'a [bool],
+    pub model: &'a PixelParams,
+    /// The estimators' frozen mismatch with its 95 % interval, when measured.
+    pub mismatch_estimate: Option<(f64, [f64; 2])>,
+    /// The recording's timestamp grid period, when its stamps are quantised.
+    pub timestamp_grid_us: Option<i64>,
+    pub subset: Subset,
+}
+
+/// How strongly the residuals call for an effect.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Evidence {
+    pub effect: Effect,
+    /// Strength in standard errors (z); an effect is tried when it reaches
+    /// [`EVIDENCE_THRESHOLD`] and its size is large enough to matter (`relevant`).
+    pub score: f64,
+    pub relevant: bool,
+    /// What was seen, in words and numbers.
+    pub text: String,
+    /// Where the parameter search starts.
+    #[serde(skip)]
+    pub start: Option<f64>,
+}
+
+/// The evidence (in standard errors) an effect needs to be tried.
+pub const EVIDENCE_THRESHOLD: f64 = 5.0;
+
+impl Evidence {
+    pub fn none(effect: Effect, text: impl Into<String>) -> Self {
+        Self {
+            effect,
+            score: 0.0,
+            relevant: false,
+            text: text.into(),
+            start: None,
+        }
+    }
+
+    /// Whether the effect should be tried.
+    pub fn calls_for(&self) -> bool {
+        self.relevant && self.score >= EVIDENCE_THRESHOLD
+    }
+}
+
+/// The evidence for `effect` in `context`.
+pub fn evidence(effect: Effect, context: &Context) -> Evidence {
+    match effect {
+        Effect::Bandwidth => bandwidth::evidence(context),
+        Effect::Leak => leak::evidence(context),
+        Effect::ShotNoise => shot_noise::evidence(context),
+        Effect::HotPixels => hot_pixels::evidence(context),
+        Effect::Refractory => refractory::evidence(context),
+        Effect::Mismatch => mismatch::evidence(context),
+        Effect::Display => display::evidence(context),
+        Effect::TimestampJitter => jitter::evidence(context),
+    }
+}
+
+/// Unsupported events of the fit blocks, summed over intensity: (real OFF, real ON,
+/// simulated OFF, simulated ON), and the pixel-seconds they came from.
+pub(crate) fn background_totals(c: &Context) -> ([f64; 4], f64) {
+    let (r, s) = (
+        c.real.background_of(c.geometry, c.subset),
+        c.sim.background_of(c.geometry, c.subset),
+    );
+    let mut totals = [0.0; 4];
+    for i in 0..r.len() {
+        totals[i % 2] += r[i] as f64;
+        totals[2 + i % 2] += s[i] as f64;
+    }
+    let exposure = (0..super::observe::INTENSITY_BINS)
+        .map(|b| c.geometry.exposure_of(b, c.subset))
+        .sum();
+    (totals, exposure)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_set_their_key() {
+        for e in Effect::ALL {
+            assert_eq!(Effect::parse(e.name()), Some(e));
+        }
+        let mut p = PixelParams::ideal(0.3, 0.3);
+        Effect::Bandwidth.set(&mut p, 40.0);
+        Effect::ShotNoise.set(&mut p, 0.7);
+        assert_eq!((p.cutoff_hz, p.shot_noise_rate_hz), (Some(40.0), Some(0.7)));
+        assert_eq!(Effect::Leak.parameter(), Some("leak_rate_hz"));
+    }
+}

@@ -1,0 +1,231 @@
+//! The sim-to-real distance: one number for how unlike a recording a simulation of it is,
+//! made of components that each look at one statistic ([`super::observe`]), so that a user
+//! sees which statistic the model still misses:
+//!
+//! - `counts`: root mean square over count cells (intensity x rate of change x polarity,
+//!   supported events) of `ln((s + 1/2) / (r + 1/2))`, each cell weighted by its events,
+//!   over cells with at least 40 events in the two together;
+//! - `background`: the same over intensity bins and polarities for the rates of unsupported
+//!   events, with a floor of 0.01 Hz per pixel (below which noise is not told apart);
+//! - `intervals`: total-variation distance between the normalised same-pixel interval
+//!   histograms (0: the same shape, 1: disjoint);
+//! - `polarity`: `|ln(ON/OFF)|` difference;
+//! - `active`: log ratio of the numbers of pixels that fired;
+//! - `dispersion`: log ratio of the pooled within-tile index of dispersion of per-pixel
+//!   counts (variance over mean), which threshold mismatch raises.
+//!
+//! The total is the root sum of squares. Every component is dimensionless and about as
+//! large as the relative error it measures, so none needs a weight.
+
+use super::observe::{Geometry, INTENSITY_BINS, Observed, Subset, TILE_PX};
+use serde::Serialize;
+
+/// The name of the distance, as reported.
+pub const ERROR_METRIC: &str = "root sum of squares of: event-weighted RMS log count ratio over intensity x rate-of-change x polarity cells (supported events); event-weighted RMS log ratio of unsupported-event rates per intensity and polarity (floor 0.01 Hz/pixel); total-variation distance of same-pixel interval histograms; |ln(ON/OFF)| difference; |log ratio| of active pixels; |log ratio| of the within-tile index of dispersion of per-pixel counts";
+
+/// The components of the distance and their total.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Components {
+    pub counts: f64,
+    pub background: f64,
+    pub intervals: f64,
+    pub polarity: f64,
+    pub active: f64,
+    pub dispersion: f64,
+    pub total: f64,
+}
+
+/// Events a count cell needs (real and simulated together) to be compared.
+const MIN_CELL_EVENTS: u32 = 40;
+/// The rate below which unsupported events are not told apart, events per pixel-second.
+pub const BACKGROUND_FLOOR_HZ: f64 = 0.01;
+
+fn log_ratio(s: f64, r: f64) -> f64 {
+    ((s + 0.5) / (r + 0.5)).ln()
+}
+
+/// Root mean square of `(value, weight)` pairs.
+fn weighted_rms(values: &[(f64, f64)]) -> f64 {
+    let w: f64 = values.iter().map(|v| v.1).sum();
+    if w <= 0.0 {
+        0.0
+    } else {
+        (values.iter().map(|(v, w)| w * v * v).sum::<f64>() / w).sqrt()
+    }
+}
+
+/// The count-cell log ratios (simulated over real) of `subset`, with the real count of each.
+pub fn cell_ratios(
+    real: &Observed,
+    sim: &Observed,
+    g: &Geometry,
+    subset: Subset,
+) -> Vec<(f64, u32, usize)> {
+    let (r, s) = (real.cells_of(g, subset), sim.cells_of(g, subset));
+    r.iter()
+        .zip(&s)
+        .enumerate()
+        .filter(|(_, (r, s))| **r + **s >= MIN_CELL_EVENTS)
+        .map(|(i, (&r, &s))| (log_ratio(s as f64, r as f64), r, i))
+        .collect()
+}
+
+/// The simulated events of each cell of [`cell_ratios`] (for weights).
+fn cell_weights(
+    sim: &Observed,
+    g: &Geometry,
+    subset: Subset,
+    ratios: &[(f64, u32, usize)],
+) -> Vec<(f64, f64)> {
+    let s = sim.cells_of(g, subset);
+    ratios
+        .iter()
+        .map(|&(ratio, r, i)| (ratio, 0.5 * (r as f64 + s[i] as f64)))
+        .collect()
+}
+
+/// Unsupported-event rates per `[intensity][polarity]` of `subset` (events per
+/// pixel-second), `None` where the bin has no exposure.
+pub fn background_rates(o: &Observed, g: &Geometry, subset: Subset) -> Vec<Option<f64>> {
+    let counts = o.background_of(g, subset);
+    (0..INTENSITY_BINS * 2)
+        .map(|i| {
+            let exposure = g.exposure_of(i / 2, subset);
+            (exposure > 1.0).then(|| counts[i] as f64 / exposure)
+        })
+        .collect()
+}
+
+/// Pooled within-tile index of dispersion of per-pixel counts (tiles with at least 2
+/// events per pixel on average), or `None` without such tiles.
+pub fn dispersion(counts: &[u32], g: &Geometry, kept: &[bool]) -> Option<f64> {
+    let (w, h) = (g.sensor.width as usize, g.sensor.height as usize);
+    let (mut deviation, mut mean_total) = (0.0, 0.0);
+    for ty in (0..h).step_by(TILE_PX) {
+        for tx in (0..w).step_by(TILE_PX) {
+            let values: Vec<f64> = (ty..(ty + TILE_PX).min(h))
+                .flat_map(|y| (tx..(tx + TILE_PX).min(w)).map(move |x| y * w + x))
+                .filter(|&p| kept[p])
+                .map(|p| counts[p] as f64)
+                .collect();
+            if values.len() < 16 {
+                continue;
+            }
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            if mean < 2.0 {
+                continue;
+            }
+            deviation += values.iter().map(|v| (v - mean).powi(2)).sum::<f64>();
+            mean_total += mean * values.len() as f64;
+        }
+    }
+    (mean_total > 0.0).then(|| deviation / mean_total)
+}
+
+/// Normalised histogram.
+pub fn normalised(h: &[u32]) -> Vec<f64> {
+    let total: f64 = h.iter().map(|&v| v as f64).sum();
+    h.iter()
+        .map(|&v| if total > 0.0 { v as f64 / total } else { 0.0 })
+        .collect()
+}
+
+/// The distance of `sim` from `real` over `subset`; `kept` flags the pixels compared
+/// (neither left out by the user nor masked as hot).
+pub fn distance(
+    real: &Observed,
+    sim: &Observed,
+    g: &Geometry,
+    subset: Subset,
+    kept: &[bool],
+) -> Components {
+    let ratios = cell_ratios(real, sim, g, subset);
+    let counts = weighted_rms(&cell_weights(sim, g, subset, &ratios));
+    // unsupported events: the rate ratio with the floor, weighted by events (a bin needs
+    // 20 events in the two, or exposure enough for the floor to make 20)
+    let (rb, sb) = (real.background_of(g, subset), sim.background_of(g, subset));
+    let background = weighted_rms(
+        &(0..rb.len())
+            .filter_map(|i| {
+                let exposure = g.exposure_of(i / 2, subset);
+                let floor = BACKGROUND_FLOOR_HZ * exposure;
+                let (r, s) = (rb[i] as f64, sb[i] as f64);
+                (r + s >= 20.0 || floor >= 20.0)
+                    .then(|| (((s + floor) / (r + floor)).ln(), 0.5 * (r + s) + floor))
+            })
+            .collect::<Vec<_>>(),
+    );
+    let (ri, si) = (
+        normalised(&real.intervals_of(g, subset)),
+        normalised(&sim.intervals_of(g, subset)),
+    );
+    let intervals = 0.5 * ri.iter().zip(&si).map(|(a, b)| (a - b).abs()).sum::<f64>();
+    let ([r_off, r_on], [s_off, s_on]) = (real.polarity_of(g, subset), sim.polarity_of(g, subset));
+    let polarity =
+        (log_ratio(s_on as f64, s_off as f64) - log_ratio(r_on as f64, r_off as f64)).abs();
+    let (rp, sp) = (real.pixels_of(g, subset), sim.pixels_of(g, subset));
+    let active_of = |c: &[u32]| c.iter().zip(kept).filter(|&(&n, &k)| k && n > 0).count() as f64;
+    let active = log_ratio(active_of(&sp), active_of(&rp)).abs();
+    let dispersion = match (dispersion(&rp, g, kept), dispersion(&sp, g, kept)) {
+        (Some(r), Some(s)) => (s / r).ln().abs(),
+        _ => 0.0,
+    };
+    let total = [counts, background, intervals, polarity, active, dispersion]
+        .iter()
+        .map(|v| v * v)
+        .sum::<f64>()
+        .sqrt();
+    Components {
+        counts,
+        background,
+        intervals,
+        polarity,
+        active,
+        dispersion,
+        total,
+    }
+}
+
+/// The median count-cell log ratio of each polarity over `subset` (OFF, ON): where the
+/// thresholds are right, as many cells have too many simulated events as too few.
+pub fn median_ratios(
+    real: &Observed,
+    sim: &Observed,
+    g: &Geometry,
+    subset: Subset,
+) -> [Option<f64>; 2] {
+    let ratios = cell_ratios(real, sim, g, subset);
+    [0, 1].map(|pol| {
+        let mut v: Vec<f64> = ratios
+            .iter()
+            .filter(|(_, r, i)| i % 2 == pol && *r >= 5)
+            .map(|c| c.0)
+            .collect();
+        if v.is_empty() {
+            return None;
+        }
+        let mid = v.len() / 2;
+        Some(*v.select_nth_unstable_by(mid, f64::total_cmp).1)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rms_and_log_ratio() {
+        assert_eq!(weighted_rms(&[]), 0.0);
+        assert!((weighted_rms(&[(3.0, 1.0), (4.0, 1.0)]) - (12.5f64).sqrt()).abs() < 1e-12);
+        assert!((weighted_rms(&[(3.0, 3.0), (1.0, 1.0)]) - 7f64.sqrt()).abs() < 1e-12);
+        assert_eq!(log_ratio(9.5, 9.5), 0.0);
+        assert!((log_ratio(19.5, 9.5) - 2f64.ln()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn normalised_histograms_sum_to_one() {
+        let n = normalised(&[1, 3, 0]);
+        assert_eq!(n, vec![0.25, 0.75, 0.0]);
+        assert_eq!(normalised(&[0, 0]), vec![0.0, 0.0]);
+    }
+}

@@ -1,0 +1,184 @@
+//! Fitting the simulator to a recording, and closing the loop: start from the ideal pixel
+//! with the estimated thresholds, look at where the model is still wrong, trace that
+//! residual to the effect whose signature it carries ([`effects`]), add the effect, fit its
+//! parameter with the thresholds, and keep it only if the error on held-out data falls;
+//! repeat until nothing helps.
+//!
+//! - The recording's grey frames, upsampled along the optical flow, are simulated with the
+//!   candidate model ([`search`]), and the simulation is compared with the recording
+//!   statistic by statistic ([`observe`]) under one sim-to-real distance ([`metric`]).
+//! - Time is cut into blocks; a fraction is held out of every fit, and an effect is kept
+//!   only if the distance on the held-out blocks falls by at least 2 % ([`selection`]).
+//! - Thresholds come from `estimate aps` (event timing and re-simulation); in a static
+//!   scene (no change in the frames) they cannot be measured and stay at a stated default.
+//!
+//! The approach is that of Stoffregen et al. (ECCV 2020), who matched simulator settings
+//! to datasets by hand through events per pixel per second, made automatic and extended to
+//! every effect of the pixel model (Lichtsteiner et al. 2008; v2e, Hu et al. 2021).
+
+pub mod effects;
+pub mod metric;
+pub mod observe;
+pub mod residuals;
+pub mod search;
+pub mod selection;
+
+use crate::estimate::EstimateError;
+use crate::events::{EventChunk, Frame, Sensor};
+use crate::sim::PixelParams;
+use crate::stats::hot_pixels::HotPixel;
+use effects::Effect;
+use metric::Components;
+use residuals::{Bin, Residuals};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// A fit cannot be made from this input: what is missing and what to do.
+pub type FitError = EstimateError;
+
+/// Which effects the fit considers.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EffectChoice {
+    /// Every effect, each tried when its residual signature calls for it.
+    Auto,
+    /// None: the ideal pixel with fitted thresholds.
+    None,
+    /// These, in this order, each tried whatever the evidence (and kept only if the
+    /// held-out error falls).
+    List(Vec<Effect>),
+}
+
+/// Settings of a fit.
+#[derive(Clone, Debug)]
+pub struct FitOptions {
+    pub effects: EffectChoice,
+    /// Fraction of the time blocks held out of the fit.
+    pub holdout: f64,
+    /// Number of time blocks.
+    pub blocks: usize,
+    /// The estimator's settings (log response, frame options) for the starting thresholds.
+    pub aps: crate::estimate::aps::ApsOptions,
+    /// Thresholds used where a static scene cannot measure them.
+    pub default_threshold: f64,
+    pub seed: u64,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            effects: EffectChoice::Auto,
+            holdout: 0.3,
+            blocks: 10,
+            aps: crate::estimate::aps::ApsOptions::default(),
+            default_threshold: 0.3,
+            seed: 2020,
+        }
+    }
+}
+
+/// What a fit reads.
+pub struct FitInput<'a> {
+    pub sensor: Sensor,
+    /// Time-sorted events.
+    pub events: &'a EventChunk,
+    /// Grey frames (time-sorted, the sensor's size).
+    pub frames: &'a [Frame],
+    /// Pixels left out (region of interest, mask).
+    pub excluded: &'a [bool],
+}
+
+/// A parameter with its standard error.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Uncertain {
+    pub value: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standard_error: Option<f64>,
+}
+
+/// An effect the loop added.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AddedEffect {
+    pub effect: Effect,
+    pub evidence: String,
+    /// Held-out error after adding it.
+    pub error_after: f64,
+}
+
+/// The residuals a step changed, before and after (for the report's plots).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StepResiduals {
+    pub by_intensity: Vec<Bin>,
+    pub by_rate_of_change: Vec<Bin>,
+}
+
+impl From<&Residuals> for StepResiduals {
+    fn from(r: &Residuals) -> Self {
+        Self {
+            by_intensity: r.by_intensity.clone(),
+            by_rate_of_change: r.by_rate_of_change.clone(),
+        }
+    }
+}
+
+/// One step of the loop: an effect tried (or a parameter left out), and why it was kept
+/// or not.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Step {
+    /// The effect's name (or `thresholds`).
+    pub effect: String,
+    pub evidence: String,
+    /// The evidence in standard errors.
+    pub score: f64,
+    /// The parameters fitted in this step.
+    pub parameters: BTreeMap<String, f64>,
+    /// Held-out error of the model before and with the effect.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_before: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_after: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub components_after: Option<Components>,
+    pub kept: bool,
+    pub reason: String,
+    pub simulations: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_before: Option<StepResiduals>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_after: Option<StepResiduals>,
+}
+
+/// The result of `ctcal fit` (the JSON keys of `../shared/CLI.md`, and more).
+#[derive(Clone, Debug, Serialize)]
+pub struct FitResult {
+    /// The fitted model (PARAMS.toml keys).
+    pub params: PixelParams,
+    pub uncertainties: BTreeMap<String, Uncertain>,
+    pub effects_added: Vec<AddedEffect>,
+    pub error_metric: &'static str,
+    /// Held-out error of the ideal model (fitted thresholds) and of the final model.
+    pub error_before: f64,
+    pub error_after: f64,
+    pub components_before: Components,
+    pub components_after: Components,
+    pub steps: Vec<Step>,
+    /// Pixels masked as hot (named, not simulated).
+    pub hot_pixels_masked: Vec<HotPixel>,
+    /// Residuals of the ideal model and of the final one (fit blocks).
+    pub residuals_before: Residuals,
+    pub residuals_after: Residuals,
+    pub assumptions: Vec<String>,
+    pub holdout: Holdout,
+    pub simulations: usize,
+}
+
+/// How the data were split.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Holdout {
+    pub fraction: f64,
+    pub blocks: usize,
+    pub held_out_blocks: Vec<usize>,
+    pub fit_seconds: f64,
+    pub held_out_seconds: f64,
+}
+
+pub use selection::fit;

@@ -1,0 +1,449 @@
+//! The statistics the fit compares between a recording and a simulation of it, computed
+//! the same way for both ([`Observed`]) on a common [`Geometry`]:
+//!
+//! - counts of events with spatio-temporal support (an 8-neighbour event in the preceding
+//!   10 ms: the background-activity filter of Delbruck 2008) per cell of scene intensity
+//!   (six bins of the frames' DN) x local rate of log-intensity change (seven bins, from the
+//!   frames) x polarity: large cells, so that systematic residuals dominate the Poisson
+//!   noise of the counts, along the two axes the pixel's dynamics depend on;
+//! - the same events per sensor region (a 4 x 3 grid) and polarity (for the residuals);
+//! - events without support per intensity bin and polarity: where noise (shot noise,
+//!   leak) shows;
+//! - the histogram of same-pixel inter-event intervals (log bins, 10 us to 10 s):
+//!   refractory periods and timestamp jitter shape it;
+//! - per-pixel counts: dispersion within tiles (threshold mismatch), hot pixels;
+//! - the event-rate timeline in 1 ms bins (its spectrum shows a display's refresh).
+//!
+//! Everything is kept per time block: the used frame intervals are grouped into blocks, and
+//! some blocks are held out of the fit ([`Subset`]) to judge each added effect on data the
+//! fit has not seen.
+
+use crate::estimate::frames::PreparedFrames;
+use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::stats::support::supported;
+
+/// Upper edges of the intensity bins (frame DN; the last bin holds the rest).
+pub const INTENSITY_EDGES: [f32; 5] = [10.0, 20.0, 40.0, 80.0, 160.0];
+/// Number of intensity bins.
+pub const INTENSITY_BINS: usize = INTENSITY_EDGES.len() + 1;
+/// Upper edges of the bins of log-intensity change rate (log units per second).
+pub const CHANGE_EDGES: [f32; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+pub const CHANGE_BINS: usize = CHANGE_EDGES.len() + 1;
+/// Sensor regions for the count cells: a grid of this many columns and rows.
+pub const REGIONS_X: usize = 4;
+pub const REGIONS_Y: usize = 3;
+pub const REGIONS: usize = REGIONS_X * REGIONS_Y;
+/// Same-pixel interval histogram: log bins from 10 us, this many per decade, 6 decades.
+pub const INTERVAL_FIRST_S: f64 = 1e-5;
+pub const INTERVAL_BINS_PER_DECADE: usize = 8;
+pub const INTERVAL_BINS: usize = 6 * INTERVAL_BINS_PER_DECADE + 2;
+/// Support window of the background counts, microseconds.
+pub const SUPPORT_US: TimeUs = 10_000;
+/// Side of the tiles of the dispersion statistic, pixels.
+pub const TILE_PX: usize = 16;
+/// Width of the timeline bins, microseconds.
+pub const TIMELINE_BIN_US: TimeUs = 1000;
+
+/// Count cells per block: intensity x change x polarity.
+pub const CELLS: usize = INTENSITY_BINS * CHANGE_BINS * 2;
+
+/// The index of a count cell.
+#[inline]
+pub fn cell_index(intensity: usize, change: usize, polarity: usize) -> usize {
+    (intensity * CHANGE_BINS + change) * 2 + polarity
+}
+
+/// The (intensity, change, polarity) of a count cell index.
+#[inline]
+pub fn cell_of(index: usize) -> (usize, usize, usize) {
+    (
+        index / (2 * CHANGE_BINS),
+        (index / 2) % CHANGE_BINS,
+        index % 2,
+    )
+}
+
+/// Which blocks a statistic is taken over.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Subset {
+    /// The blocks the fit uses.
+    Fit,
+    /// The blocks held out of the fit.
+    HeldOut,
+    /// Every block.
+    All,
+    /// One block (for the spread of a statistic over blocks).
+    Block(usize),
+}
+
+/// The bin of an interval of `seconds`.
+pub fn interval_bin(seconds: f64) -> usize {
+    if seconds < INTERVAL_FIRST_S {
+        return 0;
+    }
+    let k = ((seconds / INTERVAL_FIRST_S).log10() * INTERVAL_BINS_PER_DECADE as f64) as usize + 1;
+    k.min(INTERVAL_BINS - 1)
+}
+
+/// The lower edge of interval bin `k`, seconds.
+pub fn interval_bin_start(k: usize) -> f64 {
+    if k == 0 {
+        0.0
+    } else {
+        INTERVAL_FIRST_S * 10f64.powf((k - 1) as f64 / INTERVAL_BINS_PER_DECADE as f64)
+    }
+}
+
+fn bin_of(edges: &[f32], value: f32) -> u8 {
+    edges.iter().take_while(|&&e| value >= e).count() as u8
+}
+
+/// What the statistics of a recording and of its simulations share: the frame intervals and
+/// their blocks, each pixel's intensity and change bins per interval, the regions, the
+/// pixels left out, and the pixel-time of each intensity bin.
+pub struct Geometry {
+    pub sensor: Sensor,
+    times: Vec<TimeUs>,
+    /// Block of each frame interval (`None`: the interval is not used).
+    interval_block: Vec<Option<usize>>,
+    pub blocks: usize,
+    pub held_out: Vec<bool>,
+    region: Vec<u8>,
+    /// Pixels left out by the user (region of interest, mask).
+    excluded: Vec<bool>,
+    /// Per frame interval: each pixel's intensity bin (`u8::MAX`: no reliable intensity),
+    /// and change bin (empty for unused intervals).
+    intensity: Vec<Vec<u8>>,
+    change: Vec<Vec<u8>>,
+    /// Pixel-seconds per block and intensity bin (reliable, kept pixels).
+    pub exposure: Vec<[f64; INTENSITY_BINS]>,
+    /// First and last time of the used intervals.
+    pub span: (TimeUs, TimeUs),
+    /// Representative DN of each intensity bin (geometric middle).
+    pub intensity_centres: [f64; INTENSITY_BINS],
+    /// Representative change rate of each change bin (log units per second).
+    pub change_centres: [f64; CHANGE_BINS],
+}
+
+impl Geometry {
+    /// The geometry of `frames` (prepared by the estimators), with about `blocks` time
+    /// blocks of which every `1 / holdout`-th is held out.
+    pub fn new(frames: &PreparedFrames, excluded: &[bool], blocks: usize, holdout: f64) -> Self {
+        let sensor = Sensor::new(frames.width as u16, frames.height as u16);
+        let (w, h) = (frames.width, frames.height);
+        let pixels = w * h;
+        let used: Vec<usize> = (0..frames.flows.len())
+            .filter(|&k| frames.flows[k].is_some())
+            .collect();
+        let blocks = blocks.clamp(1, used.len().max(1));
+        // blocks of about equal duration over the used intervals
+        let durations: Vec<f64> = used
+            .iter()
+            .map(|&k| (frames.times[k + 1] - frames.times[k]) as f64)
+            .collect();
+        let total: f64 = durations.iter().sum();
+        let mut interval_block = vec![None; frames.flows.len()];
+        let mut elapsed = 0.0;
+        for (i, &k) in used.iter().enumerate() {
+            let middle = elapsed + durations[i] / 2.0;
+            interval_block[k] = Some(((middle / total * blocks as f64) as usize).min(blocks - 1));
+            elapsed += durations[i];
+        }
+        let held_out = held_out_blocks(blocks, holdout);
+        let region: Vec<u8> = (0..pixels)
+            .map(|p| {
+                let (x, y) = (p % w, p / w);
+                ((y * REGIONS_Y / h) * REGIONS_X + x * REGIONS_X / w) as u8
+            })
+            .collect();
+        let mut intensity = vec![Vec::new(); frames.flows.len()];
+        let mut change = vec![Vec::new(); frames.flows.len()];
+        let mut exposure = vec![[0.0; INTENSITY_BINS]; blocks];
+        for &k in &used {
+            let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
+            let (a, b) = (&frames.dn[k].data, &frames.dn[k + 1].data);
+            let mut bins = vec![u8::MAX; pixels];
+            let mut rates = vec![0u8; pixels];
+            let block = interval_block[k].expect("used");
+            for p in 0..pixels {
+                rates[p] = bin_of(
+                    &CHANGE_EDGES,
+                    ((frames.log(b[p]) - frames.log(a[p])).abs() as f64 / dt.max(1e-6)) as f32,
+                );
+                if frames.reliable(k, p) {
+                    let bin = bin_of(&INTENSITY_EDGES, 0.5 * (a[p] + b[p]));
+                    bins[p] = bin;
+                    if !excluded[p] {
+                        exposure[block][bin as usize] += dt;
+                    }
+                }
+            }
+            intensity[k] = bins;
+            change[k] = rates;
+        }
+        let span = match (used.first(), used.last()) {
+            (Some(&a), Some(&b)) => (frames.times[a], frames.times[b + 1]),
+            _ => (0, 0),
+        };
+        let mut centres = [0.0; INTENSITY_BINS];
+        let mut lower = 3.0f64;
+        for (i, centre) in centres.iter_mut().enumerate() {
+            let upper = INTENSITY_EDGES.get(i).map_or(255.0, |&e| e as f64);
+            *centre = (lower * upper).sqrt();
+            lower = upper;
+        }
+        let mut change_centres = [0.0; CHANGE_BINS];
+        let mut lower = 0.1f64;
+        for (i, centre) in change_centres.iter_mut().enumerate() {
+            let upper = CHANGE_EDGES
+                .get(i)
+                .map_or(2.0 * lower.max(8.0), |&e| e as f64);
+            *centre = (lower * upper).sqrt();
+            lower = upper;
+        }
+        Self {
+            change_centres,
+            sensor,
+            times: frames.times.clone(),
+            interval_block,
+            blocks,
+            held_out,
+            region,
+            excluded: excluded.to_vec(),
+            intensity,
+            change,
+            exposure,
+            span,
+            intensity_centres: centres,
+        }
+    }
+
+    /// Whether block `b` belongs to `subset`.
+    #[inline]
+    pub fn in_subset(&self, b: usize, subset: Subset) -> bool {
+        match subset {
+            Subset::All => true,
+            Subset::Fit => !self.held_out[b],
+            Subset::HeldOut => self.held_out[b],
+            Subset::Block(k) => b == k,
+        }
+    }
+
+    /// Pixel-seconds of intensity bin `bin` over `subset`.
+    pub fn exposure_of(&self, bin: usize, subset: Subset) -> f64 {
+        (0..self.blocks)
+            .filter(|&b| self.in_subset(b, subset))
+            .map(|b| self.exposure[b][bin])
+            .sum()
+    }
+
+    /// Seconds of `subset`.
+    pub fn duration_of(&self, subset: Subset) -> f64 {
+        (0..self.times.len().saturating_sub(1))
+            .filter(|&k| self.interval_block[k].is_some_and(|b| self.in_subset(b, subset)))
+            .map(|k| (self.times[k + 1] - self.times[k]) as f64 * 1e-6)
+            .sum()
+    }
+
+    /// Pixels not left out by the user.
+    pub fn kept_pixels(&self) -> usize {
+        self.excluded.iter().filter(|&&e| !e).count()
+    }
+}
+
+/// Blocks held out: evenly spread, `fraction` of them (at least one when there are two or
+/// more blocks and `fraction > 0`).
+fn held_out_blocks(blocks: usize, fraction: f64) -> Vec<bool> {
+    let mut held = vec![false; blocks];
+    if blocks < 2 || fraction <= 0.0 {
+        return held;
+    }
+    let n = ((blocks as f64 * fraction).round() as usize).clamp(1, blocks - 1);
+    for i in 0..n {
+        // the middle of each of n equal parts
+        held[((2 * i + 1) * blocks) / (2 * n)] = true;
+    }
+    held
+}
+
+/// The statistics of one event set on a [`Geometry`].
+#[derive(Clone, Debug)]
+pub struct Observed {
+    blocks: usize,
+    /// Supported events `[block][intensity][change][polarity]`.
+    pub cells: Vec<u32>,
+    /// Unsupported events `[block][intensity][polarity]`.
+    pub background: Vec<u32>,
+    /// Supported events `[block][region][polarity]`.
+    pub by_region: Vec<u32>,
+    /// `[block][interval bin]`.
+    pub intervals: Vec<u32>,
+    /// Events per pixel, `[block][pixel]`.
+    pub pixel_counts: Vec<u32>,
+    /// `[block][polarity]`.
+    pub polarity: Vec<[u64; 2]>,
+    /// Events per 1 ms bin from the start of the used span.
+    pub timeline: Vec<u32>,
+}
+
+impl Observed {
+    /// The statistics of the time-sorted `events`, leaving out the pixels `masked` flags
+    /// (hot pixels) besides the geometry's own exclusions.
+    pub fn new(events: &EventChunk, geometry: &Geometry, masked: &[bool]) -> Self {
+        let g = geometry;
+        let blocks = g.blocks;
+        let pixels = g.sensor.pixels();
+        let mut o = Self {
+            blocks,
+            cells: vec![0; blocks * CELLS],
+            background: vec![0; blocks * INTENSITY_BINS * 2],
+            by_region: vec![0; blocks * REGIONS * 2],
+            intervals: vec![0; blocks * INTERVAL_BINS],
+            pixel_counts: vec![0; blocks * pixels],
+            polarity: vec![[0; 2]; blocks],
+            timeline: vec![0; ((g.span.1 - g.span.0) / TIMELINE_BIN_US).max(0) as usize + 1],
+        };
+        if events.is_empty() {
+            return o;
+        }
+        let support = supported(events, g.sensor, SUPPORT_US);
+        let width = g.sensor.width as usize;
+        let mut last = vec![TimeUs::MIN; pixels];
+        let mut k = 0usize;
+        for (i, &is_supported) in support.iter().enumerate() {
+            let t = events.t[i];
+            let p = events.y[i] as usize * width + events.x[i] as usize;
+            let previous = std::mem::replace(&mut last[p], t);
+            // the frame interval of t (events arrive sorted)
+            while k + 1 < g.times.len() && g.times[k + 1] <= t {
+                k += 1;
+            }
+            if t < g.times[0] || k + 1 >= g.times.len() {
+                continue;
+            }
+            let Some(block) = g.interval_block[k] else {
+                continue;
+            };
+            if g.excluded[p] || masked[p] {
+                continue;
+            }
+            let pol = events.on[i] as usize;
+            o.pixel_counts[block * pixels + p] += 1;
+            o.polarity[block][pol] += 1;
+            if previous != TimeUs::MIN {
+                o.intervals[block * INTERVAL_BINS + interval_bin((t - previous) as f64 * 1e-6)] +=
+                    1;
+            }
+            let slot = ((t - g.span.0) / TIMELINE_BIN_US) as usize;
+            if let Some(bin) = o.timeline.get_mut(slot) {
+                *bin += 1;
+            }
+            let intensity = g.intensity[k][p];
+            if intensity == u8::MAX {
+                continue;
+            }
+            let intensity = intensity as usize;
+            if is_supported {
+                let change = g.change[k][p] as usize;
+                o.cells[block * CELLS + cell_index(intensity, change, pol)] += 1;
+                o.by_region[(block * REGIONS + g.region[p] as usize) * 2 + pol] += 1;
+            } else {
+                o.background[(block * INTENSITY_BINS + intensity) * 2 + pol] += 1;
+            }
+        }
+        o
+    }
+
+    /// Count cells (see [`cell_index`]) summed over `subset`.
+    pub fn cells_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
+        sum_blocks(&self.cells, CELLS, self.blocks, |b| g.in_subset(b, subset))
+    }
+
+    /// Supported events `[region][polarity]` over `subset`.
+    pub fn regions_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
+        sum_blocks(&self.by_region, REGIONS * 2, self.blocks, |b| {
+            g.in_subset(b, subset)
+        })
+    }
+
+    /// Unsupported events `[intensity][polarity]` over `subset`.
+    pub fn background_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
+        sum_blocks(&self.background, INTENSITY_BINS * 2, self.blocks, |b| {
+            g.in_subset(b, subset)
+        })
+    }
+
+    /// The same-pixel interval histogram over `subset`.
+    pub fn intervals_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
+        sum_blocks(&self.intervals, INTERVAL_BINS, self.blocks, |b| {
+            g.in_subset(b, subset)
+        })
+    }
+
+    /// ON and OFF events over `subset`.
+    pub fn polarity_of(&self, g: &Geometry, subset: Subset) -> [u64; 2] {
+        let mut out = [0; 2];
+        for b in (0..self.blocks).filter(|&b| g.in_subset(b, subset)) {
+            out[0] += self.polarity[b][0];
+            out[1] += self.polarity[b][1];
+        }
+        out
+    }
+
+    /// Per-pixel counts over `subset`.
+    pub fn pixels_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
+        let pixels = self.pixel_counts.len() / self.blocks;
+        sum_blocks(&self.pixel_counts, pixels, self.blocks, |b| {
+            g.in_subset(b, subset)
+        })
+    }
+
+    /// Events over `subset`.
+    pub fn total(&self, g: &Geometry, subset: Subset) -> u64 {
+        let [off, on] = self.polarity_of(g, subset);
+        on + off
+    }
+}
+
+fn sum_blocks(
+    values: &[u32],
+    size: usize,
+    blocks: usize,
+    keep: impl Fn(usize) -> bool,
+) -> Vec<u32> {
+    let mut out = vec![0; size];
+    for b in (0..blocks).filter(|&b| keep(b)) {
+        for (o, &v) in out.iter_mut().zip(&values[b * size..(b + 1) * size]) {
+            *o += v;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interval_bins_are_log_spaced_from_10_us() {
+        assert_eq!(interval_bin(5e-6), 0);
+        assert_eq!(interval_bin(1e-5), 1);
+        assert_eq!(interval_bin(1e-4), 1 + INTERVAL_BINS_PER_DECADE);
+        assert_eq!(interval_bin(5e-3), 1 + 2 * 8 + (8.0 * 0.69897f64) as usize);
+        assert_eq!(interval_bin(1e3), INTERVAL_BINS - 1);
+        assert!((interval_bin_start(1 + 8) - 1e-4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn held_out_blocks_are_spread() {
+        assert_eq!(
+            held_out_blocks(10, 0.3),
+            [
+                false, true, false, false, false, true, false, false, true, false
+            ]
+        );
+        assert_eq!(held_out_blocks(3, 0.3), [false, true, false]);
+        assert_eq!(held_out_blocks(1, 0.3), [false]);
+        assert_eq!(held_out_blocks(4, 0.0), [false; 4]);
+    }
+}

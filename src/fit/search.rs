@@ -1,0 +1,325 @@
+//! The simulation side of the fit: a model simulated on the recording's own frames
+//! (upsampled along the optical flow, [`crate::estimate::frames`]), its statistics, and the
+//! two searches:
+//!
+//! - thresholds, profiled out: for any other parameters, `Cp` and `Cn` are those at which
+//!   the median count-cell log ratio of each polarity is zero (as many cells over-predicted
+//!   as under-predicted); counts scale about as `1 / C`, so a secant step in `ln C` from the
+//!   current thresholds converges in two or three simulations;
+//! - an effect's parameter: argmin's Brent minimisation (golden section with parabolic
+//!   steps; Brent, "Algorithms for minimization without derivatives", 1973) of the distance
+//!   on the fit blocks over the logarithm of the parameter, thresholds profiled at every
+//!   point.
+//!
+//! The simulator is deterministic for a seed, and every simulation uses the same one, so
+//! the objective is the same function at every evaluation (common random numbers: the same
+//! pixels draw the same mismatch, leak factors and noise).
+
+use super::metric::{Components, distance, median_ratios};
+use super::observe::{Geometry, Observed, Subset};
+use crate::estimate::{EstimateError, quantise, resim};
+use crate::events::TimeUs;
+use crate::sim::{PixelParams, Sample};
+use argmin::core::{CostFunction, Error as ArgminError, Executor};
+use argmin::solver::brent::BrentOpt;
+use std::cell::{Cell, RefCell};
+
+/// The recording's frames as simulator input, with what every comparison needs.
+pub struct Simulation<'a> {
+    pub runs: &'a [Vec<Sample>],
+    pub width: usize,
+    pub height: usize,
+    pub geometry: &'a Geometry,
+    /// The recording's events, and their statistics (with the current mask).
+    pub events: &'a crate::events::EventChunk,
+    pub real: Observed,
+    /// The recording's timestamp grid, applied to simulated events too.
+    pub grid: Option<(TimeUs, TimeUs)>,
+    pub seed: u64,
+    /// Simulations run so far.
+    pub count: Cell<usize>,
+}
+
+/// A simulated model: its parameters (thresholds profiled) and statistics.
+#[derive(Clone)]
+pub struct Simulated {
+    pub params: PixelParams,
+    pub observed: Observed,
+}
+
+impl Simulation<'_> {
+    /// The statistics of `params` simulated on the frames; `masked` pixels left out. Hot
+    /// pixels are never simulated here (they are masked in the recording instead).
+    pub fn observe(
+        &self,
+        params: &PixelParams,
+        masked: &[bool],
+    ) -> Result<Observed, EstimateError> {
+        self.count.set(self.count.get() + 1);
+        let mut p = params.clone();
+        p.seed = Some(self.seed);
+        p.hot_pixel_fraction = None;
+        p.hot_pixel_rate_hz = None;
+        let mut events = resim::simulate(self.runs, self.width, self.height, &p)?;
+        if let Some(grid) = self.grid {
+            quantise(&mut events, grid);
+        }
+        Ok(Observed::new(&events, self.geometry, masked))
+    }
+
+    /// `params` with its thresholds profiled (see the module docs), unless `fixed`.
+    pub fn profile(
+        &self,
+        params: &PixelParams,
+        masked: &[bool],
+        fixed: bool,
+    ) -> Result<Simulated, EstimateError> {
+        let mut p = params.clone();
+        let mut observed = self.observe(&p, masked)?;
+        if fixed {
+            return Ok(Simulated {
+                params: p,
+                observed,
+            });
+        }
+        // per polarity (OFF, ON): the last two (ln C, median log ratio)
+        let mut history: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+        for _ in 0..4 {
+            let medians = median_ratios(&self.real, &observed, self.geometry, Subset::Fit);
+            let mut moved = false;
+            for pol in 0..2 {
+                let Some(m) = medians[pol] else { continue };
+                let c = if pol == 1 { p.ct_on } else { p.ct_off };
+                history[pol].push((c.ln(), m));
+                if m.abs() < 0.003 {
+                    continue;
+                }
+                // slope of the ratio in ln C: -1 to start (counts ~ 1 / C), then measured
+                let slope = match history[pol].as_slice() {
+                    [.., (x0, y0), (x1, y1)] if (x1 - x0).abs() > 1e-6 => {
+                        ((y1 - y0) / (x1 - x0)).clamp(-3.0, -0.2)
+                    }
+                    _ => -1.0,
+                };
+                let next = (c.ln() - m / slope)
+                    .exp()
+                    .clamp(c / 2.0, c * 2.0)
+                    .clamp(0.02, 5.0);
+                if pol == 1 {
+                    p.ct_on = next;
+                } else {
+                    p.ct_off = next;
+                }
+                moved = true;
+            }
+            if !moved {
+                break;
+            }
+            observed = self.observe(&p, masked)?;
+        }
+        Ok(Simulated {
+            params: p,
+            observed,
+        })
+    }
+
+    /// The distance of `observed` from the recording over `subset`.
+    pub fn distance(&self, observed: &Observed, subset: Subset, kept: &[bool]) -> Components {
+        distance(&self.real, observed, self.geometry, subset, kept)
+    }
+
+    /// The recording's statistics with `masked` pixels left out.
+    pub fn observe_real(&self, masked: &[bool]) -> Observed {
+        Observed::new(self.events, self.geometry, masked)
+    }
+}
+
+/// One evaluation of a parameter search.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Evaluation {
+    pub value: f64,
+    pub fit_error: f64,
+    pub ct_on: f64,
+    pub ct_off: f64,
+}
+
+/// The search of one effect's parameter.
+struct Search<'a, 'b> {
+    simulation: &'b Simulation<'a>,
+    effect: super::effects::Effect,
+    masked: &'b [bool],
+    kept: &'b [bool],
+    fixed_thresholds: bool,
+    /// Every point evaluated, and the best model so far.
+    evaluations: RefCell<Vec<Evaluation>>,
+    best: RefCell<Option<(f64, Simulated)>>,
+    /// The thresholds of the last point (the next starts there).
+    warm: RefCell<PixelParams>,
+    failure: RefCell<Option<EstimateError>>,
+}
+
+impl CostFunction for Search<'_, '_> {
+    type Param = f64;
+    type Output = f64;
+
+    fn cost(&self, log_value: &f64) -> Result<f64, ArgminError> {
+        let value = log_value.exp();
+        let mut p = self.warm.borrow().clone();
+        self.effect.set(&mut p, value);
+        let simulated = match self
+            .simulation
+            .profile(&p, self.masked, self.fixed_thresholds)
+        {
+            Ok(s) => s,
+            Err(e) => {
+                *self.failure.borrow_mut() = Some(e);
+                return Err(ArgminError::msg("simulation failed"));
+            }
+        };
+        let error = self
+            .simulation
+            .distance(&simulated.observed, Subset::Fit, self.kept)
+            .total;
+        self.evaluations.borrow_mut().push(Evaluation {
+            value,
+            fit_error: error,
+            ct_on: simulated.params.ct_on,
+            ct_off: simulated.params.ct_off,
+        });
+        {
+            let mut warm = self.warm.borrow_mut();
+            warm.ct_on = simulated.params.ct_on;
+            warm.ct_off = simulated.params.ct_off;
+        }
+        let mut best = self.best.borrow_mut();
+        if best.as_ref().is_none_or(|(e, _)| error < *e) {
+            *best = Some((error, simulated));
+        }
+        Ok(error)
+    }
+}
+
+/// The result of a parameter search.
+pub struct Searched {
+    pub value: f64,
+    pub model: Simulated,
+    pub fit_error: f64,
+    /// Standard error of the value, from the curvature of the fit error around the
+    /// minimum against `noise` (how much the error moves by chance).
+    pub standard_error: Option<f64>,
+    pub evaluations: Vec<Evaluation>,
+}
+
+/// Searches `effect`'s parameter over `range` (Brent in its logarithm) on top of `base`.
+#[allow(clippy::too_many_arguments)]
+pub fn search(
+    simulation: &Simulation,
+    base: &PixelParams,
+    effect: super::effects::Effect,
+    range: (f64, f64),
+    masked: &[bool],
+    kept: &[bool],
+    fixed_thresholds: bool,
+    noise: f64,
+) -> Result<Searched, EstimateError> {
+    let problem = Search {
+        simulation,
+        effect,
+        masked,
+        kept,
+        fixed_thresholds,
+        evaluations: RefCell::new(Vec::new()),
+        best: RefCell::new(None),
+        warm: RefCell::new(base.clone()),
+        failure: RefCell::new(None),
+    };
+    let solver = BrentOpt::new(range.0.ln(), range.1.ln()).set_tolerance(0.03, 0.01);
+    let result = Executor::new(problem, solver)
+        .configure(|s| s.max_iters(16))
+        .run();
+    let problem = match result {
+        Ok(r) => r.problem.problem.expect("the executor keeps its problem"),
+        Err(e) => {
+            return Err(EstimateError::new(
+                format!("the {effect} search failed: {e}"),
+                "report this as a bug",
+            ));
+        }
+    };
+    if let Some(e) = problem.failure.into_inner() {
+        return Err(e);
+    }
+    let evaluations = problem.evaluations.into_inner();
+    let Some((fit_error, model)) = problem.best.into_inner() else {
+        return Err(EstimateError::new(
+            format!("the {effect} search evaluated nothing"),
+            "report this as a bug",
+        ));
+    };
+    let value = evaluations
+        .iter()
+        .find(|e| e.fit_error == fit_error)
+        .map_or(range.0, |e| e.value);
+    Ok(Searched {
+        standard_error: curvature_error(&evaluations, value, noise),
+        value,
+        model,
+        fit_error,
+        evaluations,
+    })
+}
+
+/// The standard error of a searched value: a parabola `e(x) = a (x - x0)^2 + b` through
+/// the evaluations nearest the minimum (in `x = ln value`), and the distance at which the
+/// error rises by `noise`: `sigma(ln value) = sqrt(noise / a)`.
+pub fn curvature_error(evaluations: &[Evaluation], value: f64, noise: f64) -> Option<f64> {
+    let x0 = value.ln();
+    let mut near: Vec<(f64, f64)> = evaluations
+        .iter()
+        .map(|e| (e.value.ln() - x0, e.fit_error))
+        .collect();
+    near.sort_by(|a, b| a.0.abs().total_cmp(&b.0.abs()));
+    near.dedup_by(|a, b| (a.0 - b.0).abs() < 1e-9);
+    near.truncate(5);
+    if near.len() < 3 || noise <= 0.0 {
+        return None;
+    }
+    // least squares of e = a x^2 + c x + b
+    let n = near.len() as f64;
+    let (mut s4, mut s3, mut s2, mut s1, mut y2, mut y1, mut y0) =
+        (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    for &(x, y) in &near {
+        s4 += x.powi(4);
+        s3 += x.powi(3);
+        s2 += x * x;
+        s1 += x;
+        y2 += y * x * x;
+        y1 += y * x;
+        y0 += y;
+    }
+    let m = nalgebra::Matrix3::new(s4, s3, s2, s3, s2, s1, s2, s1, n);
+    let solution = m.lu().solve(&nalgebra::Vector3::new(y2, y1, y0))?;
+    let a = solution[0];
+    (a > 0.0).then(|| value * (noise / a).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn curvature_gives_the_width_of_a_parabola() {
+        // e = 4 (ln v - ln 2)^2 + 1: rises by 0.04 at ln v - ln 2 = 0.1
+        let evaluations: Vec<Evaluation> = [-0.3, -0.1, 0.0, 0.05, 0.2]
+            .iter()
+            .map(|&d: &f64| Evaluation {
+                value: 2.0 * d.exp(),
+                fit_error: 4.0 * d * d + 1.0,
+                ct_on: 0.3,
+                ct_off: 0.3,
+            })
+            .collect();
+        let se = curvature_error(&evaluations, 2.0, 0.04).unwrap();
+        assert!((se - 0.2).abs() < 1e-9, "{se}");
+    }
+}

@@ -1,0 +1,311 @@
+//! `ctcal fit`: the closed loop on the v2e oracle cases (each made with known effects) and
+//! on real recordings, and a recovery property test on recordings ctcal simulates itself.
+
+use super::common::*;
+use ctcal::fit::{EffectChoice, FitInput, FitOptions};
+use ctcal::sim::scene::{SceneSource, SceneSpec, aps};
+use ctcal::sim::{PixelMaps, PixelParams};
+use proptest::prelude::*;
+
+fn fit(path: &std::path::Path, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec!["fit", path.to_str().unwrap()];
+    args.extend(extra);
+    json(&args)
+}
+
+fn added(f: &serde_json::Value) -> Vec<String> {
+    f["effects_added"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| e["effect"].as_str().unwrap().to_string())
+        .collect()
+}
+
+fn param(f: &serde_json::Value, key: &str) -> Option<f64> {
+    f["params"][key].as_f64()
+}
+
+fn emulator(case: &str, key: &str) -> f64 {
+    oracle_params(case)["emulator_args"][key].as_f64().unwrap()
+}
+
+/// Every key of the contract, and errors that fell.
+fn check_contract(f: &serde_json::Value) {
+    for key in [
+        "params",
+        "effects_added",
+        "error_metric",
+        "error_before",
+        "error_after",
+        "steps",
+    ] {
+        assert!(f.get(key).is_some(), "missing {key}");
+    }
+    let (before, after) = (
+        f["error_before"].as_f64().unwrap(),
+        f["error_after"].as_f64().unwrap(),
+    );
+    assert!(after <= before + 1e-12, "{after} > {before}");
+    for e in f["effects_added"].as_array().unwrap() {
+        assert!(e["evidence"].as_str().unwrap().len() > 10);
+        assert!(e["error_after"].as_f64().unwrap() < before);
+    }
+}
+
+#[test]
+fn bandwidth_is_added_where_pixels_are_slow_and_only_there() {
+    let f = fit(&oracle("d_bw_middim_texture"), &[]);
+    check_contract(&f);
+    assert!(
+        added(&f).contains(&"bandwidth".to_string()),
+        "{:?}",
+        added(&f)
+    );
+    for key in ["ct_on", "ct_off"] {
+        let v = param(&f, key).unwrap();
+        assert!((v / 0.3 - 1.0).abs() < 0.10, "{key} {v}");
+    }
+    let (before, after) = (
+        f["error_before"].as_f64().unwrap(),
+        f["error_after"].as_f64().unwrap(),
+    );
+    assert!(after <= 0.7 * before, "held-out error {before} -> {after}");
+    let control = fit(&oracle("d_ctrl_middim_texture"), &[]);
+    check_contract(&control);
+    assert!(
+        !added(&control).contains(&"bandwidth".to_string()),
+        "{:?}",
+        added(&control)
+    );
+    assert!(param(&control, "cutoff_hz").is_none());
+}
+
+#[test]
+fn shot_noise_is_added_to_noisy_recordings_at_its_rate() {
+    for case in ["c_noisy_texture", "c_noisy_static"] {
+        let f = fit(&oracle(case), &[]);
+        check_contract(&f);
+        assert!(
+            added(&f).contains(&"shot_noise".to_string()),
+            "{case}: {:?}",
+            added(&f)
+        );
+        let rate = param(&f, "shot_noise_rate_hz").unwrap();
+        let truth = emulator(case, "shot_noise_rate_hz");
+        assert!(
+            (rate / truth - 1.0).abs() < 0.5,
+            "{case}: {rate} vs {truth}"
+        );
+    }
+}
+
+#[test]
+fn leak_is_added_to_a_static_scene_at_its_rate() {
+    let f = fit(&oracle("c_leak_static"), &[]);
+    check_contract(&f);
+    assert_eq!(added(&f), vec!["leak".to_string()]);
+    let rate = param(&f, "leak_rate_hz").unwrap();
+    let truth = emulator("c_leak_static", "leak_rate_hz");
+    assert!((rate / truth - 1.0).abs() < 0.3, "{rate} vs {truth}");
+    // a static scene cannot show its thresholds: the step says so
+    let thresholds = &f["steps"][0];
+    assert_eq!(thresholds["effect"], "thresholds");
+    assert_eq!(thresholds["kept"], false);
+    assert!(
+        thresholds["reason"]
+            .as_str()
+            .unwrap()
+            .contains("static scene")
+    );
+}
+
+#[test]
+fn exactly_the_injected_hot_pixels_are_masked() {
+    let f = fit(&oracle("dev_hot_pixels"), &[]);
+    check_contract(&f);
+    assert!(added(&f).contains(&"hot_pixels".to_string()));
+    let mut masked: Vec<(u64, u64)> = f["hot_pixels_masked"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+        .collect();
+    let mut injected: Vec<(u64, u64)> =
+        oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+            .collect();
+    masked.sort_unstable();
+    injected.sort_unstable();
+    assert_eq!(masked, injected);
+    assert!(param(&f, "hot_pixel_fraction").unwrap() > 0.0);
+}
+
+#[test]
+fn refractory_is_added_with_its_period() {
+    let f = fit(&oracle("dev_refractory"), &[]);
+    check_contract(&f);
+    assert!(
+        added(&f).contains(&"refractory".to_string()),
+        "{:?}",
+        added(&f)
+    );
+    let period = param(&f, "refractory_s").unwrap();
+    assert!((period / 0.005 - 1.0).abs() < 0.3, "{period}");
+}
+
+#[test]
+fn ideal_recordings_get_no_effect_and_their_thresholds() {
+    for (case, truth) in [("a_ideal_texture", 0.3), ("e_ct060_texture", 0.6)] {
+        let f = fit(&oracle(case), &[]);
+        check_contract(&f);
+        assert!(added(&f).is_empty(), "{case}: {:?}", added(&f));
+        for key in ["ct_on", "ct_off"] {
+            let v = param(&f, key).unwrap();
+            assert!((v / truth - 1.0).abs() < 0.03, "{case} {key} {v}");
+        }
+        assert_eq!(f["error_before"], f["error_after"]);
+    }
+}
+
+#[test]
+fn real_recordings_fit_end_to_end() {
+    for input in [real("davis346_faery.aedat4"), real("ijrr_slider_depth_50k")] {
+        let f = fit(&input, &[]);
+        check_contract(&f);
+        for key in ["ct_on", "ct_off"] {
+            let v = param(&f, key).unwrap();
+            assert!((0.05..2.0).contains(&v), "{}: {key} {v}", input.display());
+            let se = f["uncertainties"][key]["standard_error"].as_f64().unwrap();
+            assert!(se > 0.0 && se < v, "{}: {key} +- {se}", input.display());
+        }
+        // every step names its effect and why it was or was not kept
+        for step in f["steps"].as_array().unwrap() {
+            assert!(!step["reason"].as_str().unwrap().is_empty());
+        }
+        assert!(
+            f["residuals_after"]["by_intensity"]
+                .as_array()
+                .unwrap()
+                .len()
+                == 6
+        );
+    }
+}
+
+#[test]
+fn effect_choices_and_bad_input() {
+    // none: the ideal pixel with fitted thresholds
+    let f = fit(&oracle("c_noisy_texture"), &["--effects", "none"]);
+    assert!(added(&f).is_empty());
+    assert_eq!(f["steps"].as_array().unwrap().len(), 1);
+    // a list is tried in its order, whatever the evidence
+    let f = fit(&oracle("c_leak_static"), &["--effects", "shot_noise,leak"]);
+    let tried: Vec<&str> = f["steps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .skip(1)
+        .map(|s| s["effect"].as_str().unwrap())
+        .collect();
+    assert_eq!(tried, vec!["shot_noise", "leak"]);
+    assert!(added(&f).contains(&"leak".to_string()));
+    let e = bad_input(&[
+        "fit",
+        oracle("a_ideal_texture").to_str().unwrap(),
+        "--effects",
+        "glare",
+    ]);
+    assert!(
+        e.contains("`glare` is not an effect") && e.contains("shot_noise"),
+        "{e}"
+    );
+    let e = bad_input(&["fit", real("evk4_faery_evt3.raw").to_str().unwrap()]);
+    assert!(
+        e.contains("evk4_faery_evt3.raw") && e.contains("grey frames") && e.contains("fix:"),
+        "{e}"
+    );
+    let e = bad_input(&[
+        "fit",
+        oracle("a_ideal_texture").to_str().unwrap(),
+        "--holdout",
+        "0.9",
+    ]);
+    assert!(e.contains("--holdout"), "{e}");
+}
+
+/// A recording ctcal simulates itself: a translating 1/f texture of 160 x 120 pixels seen
+/// for 0.8 s, 40 Hz APS frames, events from the scene rendered at 1 kHz through `params`.
+fn simulated_recording(params: &PixelParams, seed: u64) -> (ctcal::EventChunk, Vec<ctcal::Frame>) {
+    let mut spec = SceneSpec::moving_texture(160, 120, 0.8, 1000.0);
+    spec.seed = seed;
+    spec.aps = Some(ctcal::sim::scene::ApsSpec {
+        rate_hz: 40.0,
+        exposure_s: 0.0,
+    });
+    let scene = spec.realise().unwrap();
+    let frames = aps::render(
+        &scene,
+        spec.width,
+        spec.height,
+        spec.duration_s,
+        1000.0,
+        spec.aps.as_ref().unwrap(),
+    );
+    let mut source = SceneSource::new(&spec, scene);
+    let mut events = ctcal::EventChunk::default();
+    ctcal::sim::run::<ctcal::sim::SimError>(
+        &mut source,
+        params,
+        PixelMaps::default(),
+        |chunk| {
+            events.extend_from(chunk);
+            Ok(())
+        },
+        |_| {},
+    )
+    .unwrap();
+    events.sort_by_time();
+    (events, frames)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 3, failure_persistence: None, ..ProptestConfig::default() })]
+
+    /// The fit of a recording made with known parameters recovers them: the thresholds
+    /// within 10 %, shot noise (when made) added at its rate within 50 %, and no effect the
+    /// recording was not made with.
+    #[test]
+    fn a_fit_recovers_the_parameters_of_a_simulated_recording(
+        ct_on in 0.2f64..0.5,
+        asymmetry in 0.8f64..1.25,
+        noise in prop_oneof![Just(0.0f64), 0.5f64..2.0],
+        seed in 1u64..1000,
+    ) {
+        let mut params = PixelParams::ideal(ct_on, ct_on * asymmetry);
+        if noise > 0.0 {
+            params.shot_noise_rate_hz = Some(noise);
+        }
+        params.seed = Some(seed);
+        let (events, frames) = simulated_recording(&params, seed);
+        let sensor = ctcal::Sensor::new(160, 120);
+        let excluded = vec![false; sensor.pixels()];
+        let result = ctcal::fit::fit(
+            &FitInput { sensor, events: &events, frames: &frames, excluded: &excluded },
+            &FitOptions { effects: EffectChoice::Auto, ..FitOptions::default() },
+            &|_, _| {},
+        ).unwrap();
+        let added: Vec<&str> = result.effects_added.iter().map(|e| e.effect.name()).collect();
+        prop_assert!((result.params.ct_on / params.ct_on - 1.0).abs() < 0.1, "ON {} vs {}", result.params.ct_on, params.ct_on);
+        prop_assert!((result.params.ct_off / params.ct_off - 1.0).abs() < 0.1, "OFF {} vs {}", result.params.ct_off, params.ct_off);
+        if noise > 0.0 {
+            prop_assert!(added.contains(&"shot_noise"), "{added:?}");
+            let rate = result.params.shot_noise_rate_hz.unwrap();
+            prop_assert!((rate / noise - 1.0).abs() < 0.5, "shot noise {rate} vs {noise}");
+        }
+        prop_assert!(added.iter().all(|e| *e == "shot_noise" || *e == "leak"), "{added:?}");
+    }
+}
