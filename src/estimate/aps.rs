@@ -174,6 +174,15 @@ pub fn estimate(
         assumptions: prepared_notes,
     } = prepare(input, &excluded, options)?;
     assumptions.extend(prepared_notes);
+    let change = super::dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
+    if change < super::dynamics::STATIC_CHANGE_RATE {
+        return Err(EstimateError::new(
+            format!(
+                "the frames show a static scene (log intensity changes by {change:.4} per pixel per second): nothing crosses a threshold, so the events are noise and do not measure thresholds"
+            ),
+            "use a part of the recording where the scene moves (--start/--end); measure the noise with `ctcal fit` or `ctcal stats`",
+        ));
+    }
     let used = frames.intervals.iter().filter(|i| i.used).count();
     let exposure = input
         .frames

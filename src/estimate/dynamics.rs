@@ -16,6 +16,11 @@ use super::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
 use serde::Serialize;
 
+/// Below this total-variation rate of the log intensity (per pixel per second) the frames
+/// show a static scene: nothing there crosses a threshold, so thresholds cannot be measured
+/// from it (its events are noise).
+pub const STATIC_CHANGE_RATE: f64 = 0.02;
+
 /// Dynamics measured from frames.
 #[derive(Clone, Debug, Serialize)]
 pub struct FrameDynamics {

@@ -331,13 +331,20 @@ pub fn estimate(
     // round suffices
     let rounds = if frame_dynamics.is_some() { 1 } else { 3 };
     let mut near = (0.0, f64::INFINITY);
-    for round in 0..rounds {
+    // the recording's own edge speed (without frames, where the search starts)
+    let real_speed = speed;
+    let mut real_window = support_us(speed);
+    let mut round = 0;
+    while round < rounds {
         progress(
             "simulating calibration scenes",
             (round as f64 + 0.1) / rounds as f64,
         );
         let window = support_us(speed);
-        real = rates(input.events, input.sensor, &excluded, window);
+        if window != real_window {
+            real = rates(input.events, input.sensor, &excluded, window);
+            real_window = window;
+        }
         // a few hundred pixels of travel are enough: fast scenes are simulated shorter
         let length = (300.0 / speed.max(1.0)).clamp(0.25, options.duration_s);
         let samples = if round + 1 < rounds {
@@ -384,6 +391,7 @@ pub fn estimate(
         if found.is_empty() {
             // outside the simulated range: the next round simulates every threshold
             near = (0.0, f64::INFINITY);
+            round += 1;
             continue;
         }
         estimate = found.iter().sum::<f64>() / found.len() as f64;
@@ -392,14 +400,19 @@ pub fn estimate(
             // the edge speed of a calibration scene at the estimate, against the recording's
             let scene_events = simulate(&renders[0], estimate)?;
             let scene_sensor = Sensor::new(width as u16, height as u16);
-            let (Some(real_speed), Some(scene_speed)) = (
-                dynamics::edge_speed(input.events, input.sensor, 200_000),
-                dynamics::edge_speed(&scene_events, scene_sensor, 200_000),
-            ) else {
+            let Some(scene_speed) = dynamics::edge_speed(&scene_events, scene_sensor, 200_000)
+            else {
                 break;
             };
-            speed *= (real_speed / scene_speed).clamp(0.25, 4.0);
+            let correction = (real_speed / scene_speed).clamp(0.25, 4.0);
+            speed *= correction;
+            // matched within 10 %: the next round is the last
+            if (correction - 1.0).abs() < 0.1 {
+                round = rounds - 1;
+                continue;
+            }
         }
+        round += 1;
     }
     progress("inverting the calibration curves", 0.9);
     let scale = |r: &Rendered| {

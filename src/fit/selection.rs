@@ -25,8 +25,6 @@ use std::collections::BTreeMap;
 const MIN_RELATIVE_GAIN: f64 = 0.02;
 /// ...and by at least this much.
 const MIN_ABSOLUTE_GAIN: f64 = 0.002;
-/// Below this rate of log-intensity change (per pixel per second) the frames are static.
-const STATIC_CHANGE_RATE: f64 = 0.02;
 
 /// What is known besides the residuals: the estimators' mismatch (value, 95 % interval)
 /// and the recording's timestamp grid.
@@ -120,7 +118,7 @@ pub fn fit(
     assumptions.extend(prepared.assumptions.iter().cloned());
     let frames = prepared.frames;
     let change_rate = dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
-    let static_scene = change_rate < STATIC_CHANGE_RATE;
+    let static_scene = change_rate < dynamics::STATIC_CHANGE_RATE;
 
     // the starting thresholds
     let default = options.default_threshold;

@@ -390,3 +390,9 @@ fn aps_refuses_frames_that_are_all_clipped() {
     let e = bad_input(&["estimate", "aps", dir.path().to_str().unwrap()]);
     assert!(e.contains("clipped") && e.contains("fix:"), "{e}");
 }
+
+#[test]
+fn aps_refuses_a_static_scene_whose_events_are_noise() {
+    let e = bad_input(&["estimate", "aps", oracle("c_noisy_static").to_str().unwrap()]);
+    assert!(e.contains("static scene") && e.contains("ctcal fit"), "{e}");
+}
