@@ -283,6 +283,17 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     for frame in &aps_frames {
         writer.frame(frame)?;
     }
+    // a simulated recording of an on-screen stimulus carries the stimulus, so that
+    // `estimate screen` finds it beside the events
+    if let (Some(dir), Writer::Ijrr(w)) = (&args.frames, &mut writer) {
+        let index = frame_index(dir)?;
+        if index.file_name().is_some_and(|n| n == "stimulus.txt") {
+            let list = FrameList::read(&index)?;
+            for i in 0..list.len() {
+                w.write_stimulus_frame(&list.load(i)?)?;
+            }
+        }
+    }
     let wall_s = started.elapsed().as_secs_f64();
     let duration_s = (summary.t_last_sample_us - summary.t_first_sample_us) as f64 * 1e-6;
     let result = Provenance {

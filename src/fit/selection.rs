@@ -347,6 +347,26 @@ pub fn fit(
         }
         steps.push(step);
     }
+    // effects added early were fitted without the later ones (mismatch before the noise
+    // it partly stood in for): each searched parameter is fitted once more with all the
+    // others in place, and the new value kept if the held-out error falls
+    let searched: Vec<Effect> = added
+        .iter()
+        .map(|a| a.effect)
+        .filter(|e| e.parameter().is_some())
+        .collect();
+    if searched.len() > 1 {
+        progress("refitting the effects together", 0.9);
+        for effect in searched {
+            let step = refit(&simulation, &mut state, effect, fixed, noise)?;
+            if step.kept
+                && let Some(entry) = added.iter_mut().find(|a| a.effect == effect)
+            {
+                entry.error_after = step.error_after.unwrap_or(entry.error_after);
+            }
+            steps.push(step);
+        }
+    }
     // effects not called for, for the record
     if !forced {
         let context = context_of(&state, &geometry, known);
@@ -626,6 +646,79 @@ fn try_effect(
         }
     } else if effect == Effect::HotPixels {
         simulation.real = state.real.clone();
+    }
+    Ok(step)
+}
+
+/// Fits `effect`'s parameter again with every other parameter as it now is; keeps the new
+/// value if the held-out error falls.
+fn refit(
+    simulation: &Simulation,
+    state: &mut State,
+    effect: Effect,
+    fixed: bool,
+    noise: f64,
+) -> Result<Step, FitError> {
+    let key = effect.parameter().expect("a searched effect");
+    let current = match effect {
+        Effect::Mismatch => state.model.params.ct_sigma,
+        Effect::Refractory => state.model.params.refractory_s,
+        Effect::Bandwidth => state.model.params.cutoff_hz,
+        Effect::Leak => state.model.params.leak_rate_hz,
+        Effect::ShotNoise => state.model.params.shot_noise_rate_hz,
+        Effect::TimestampJitter => state.model.params.timestamp_jitter_s,
+        Effect::HotPixels | Effect::Display => None,
+    }
+    .expect("a kept effect has its parameter");
+    let count_before = simulation.count.get();
+    let before = distance_of(simulation, state);
+    let searched = search(
+        simulation,
+        &state.model.params,
+        effect,
+        (current / 3.0, current * 3.0),
+        &state.masked,
+        &state.kept,
+        fixed,
+        noise,
+    )?;
+    let after = simulation.distance(&searched.model.observed, Subset::HeldOut, &state.kept);
+    let kept = after.total < before.total;
+    let mut parameters = sorted_thresholds(&searched.model.params);
+    parameters.insert(key.into(), searched.value);
+    let step = Step {
+        effect: format!("{} (refit)", effect.name()),
+        evidence: format!("{key} was {current:.6} when the effect was added"),
+        score: 0.0,
+        parameters,
+        error_before: Some(before.total),
+        error_after: Some(after.total),
+        components_after: Some(after.clone()),
+        kept,
+        reason: if kept {
+            format!(
+                "{key} {current:.6} -> {:.6}; held-out error {:.4} -> {:.4}",
+                searched.value, before.total, after.total
+            )
+        } else {
+            format!(
+                "{key} stays {current:.6}: the refit ({:.6}) does not lower the held-out error ({:.4} -> {:.4})",
+                searched.value, before.total, after.total
+            )
+        },
+        simulations: simulation.count.get() - count_before,
+        residuals_before: None,
+        residuals_after: None,
+    };
+    if kept {
+        state.model = searched.model;
+        state.uncertainty.insert(
+            key.into(),
+            Uncertain {
+                value: searched.value,
+                standard_error: searched.standard_error,
+            },
+        );
     }
     Ok(step)
 }

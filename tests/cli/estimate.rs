@@ -393,6 +393,10 @@ fn aps_refuses_frames_that_are_all_clipped() {
 
 #[test]
 fn aps_refuses_a_static_scene_whose_events_are_noise() {
-    let e = bad_input(&["estimate", "aps", oracle("c_noisy_static").to_str().unwrap()]);
+    let e = bad_input(&[
+        "estimate",
+        "aps",
+        oracle("c_noisy_static").to_str().unwrap(),
+    ]);
     assert!(e.contains("static scene") && e.contains("ctcal fit"), "{e}");
 }

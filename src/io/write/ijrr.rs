@@ -1,6 +1,7 @@
 //! IJRR folders: `events.txt` with a `width height` first line (as rpg_e2vid writes), then
 //! `t x y p` with t in seconds to the microsecond and p 0/1; frames as `images.txt` +
-//! `images/frame_XXXXXXXX.png`.
+//! `images/frame_XXXXXXXX.png`, and for a recording of an on-screen stimulus the stimulus
+//! as `stimulus.txt` + `stimulus/frame_XXXXXXXX.png`.
 
 use super::{OutputPolicy, StagedFolder, format_seconds, save_png};
 use crate::events::{EventChunk, Frame, Sensor};
@@ -13,9 +14,13 @@ pub struct IjrrWriter {
     staged: StagedFolder,
     events: std::io::BufWriter<std::fs::File>,
     line: Vec<u8>,
-    frames: Vec<u8>,
-    frame_count: usize,
+    /// The index lines and counts of `images/` and `stimulus/`.
+    frames: [Vec<u8>; 2],
+    frame_count: [usize; 2],
 }
+
+/// The two kinds of frame lists an IJRR folder holds.
+const FRAME_LISTS: [(&str, &str); 2] = [("images", "images.txt"), ("stimulus", "stimulus.txt")];
 
 impl IjrrWriter {
     /// Starts a folder at `target` (where `policy` allows); `sensor` becomes the
@@ -35,8 +40,8 @@ impl IjrrWriter {
             staged,
             events,
             line: Vec::with_capacity(64),
-            frames: Vec::new(),
-            frame_count: 0,
+            frames: [Vec::new(), Vec::new()],
+            frame_count: [0, 0],
         })
     }
 
@@ -62,18 +67,27 @@ impl IjrrWriter {
 
     /// Adds a frame (PNG in `images/`, a line in `images.txt`).
     pub fn write_frame(&mut self, frame: &Frame) -> Result<(), InputError> {
-        let folder = self.staged.dir().join("images");
-        if self.frame_count == 0 {
-            std::fs::create_dir_all(&folder)
+        self.add_to_list(0, frame)
+    }
+
+    /// Adds a frame of the on-screen stimulus (PNG in `stimulus/`, a line in
+    /// `stimulus.txt`).
+    pub fn write_stimulus_frame(&mut self, frame: &Frame) -> Result<(), InputError> {
+        self.add_to_list(1, frame)
+    }
+
+    fn add_to_list(&mut self, list: usize, frame: &Frame) -> Result<(), InputError> {
+        let (folder, _) = FRAME_LISTS[list];
+        if self.frame_count[list] == 0 {
+            std::fs::create_dir_all(self.staged.dir().join(folder))
                 .map_err(|e| InputError::write(&self.staged.shown, e))?;
         }
-        let name = format!("images/frame_{:08}.png", self.frame_count);
+        let name = format!("{folder}/frame_{:08}.png", self.frame_count[list]);
         save_png(&self.staged.dir().join(&name), frame)
             .map_err(|e| InputError::write(&self.staged.shown, e))?;
-        format_seconds(frame.t, &mut self.frames);
-        self.frames
-            .extend_from_slice(format!(" {name}\n").as_bytes());
-        self.frame_count += 1;
+        format_seconds(frame.t, &mut self.frames[list]);
+        self.frames[list].extend_from_slice(format!(" {name}\n").as_bytes());
+        self.frame_count[list] += 1;
         Ok(())
     }
 
@@ -87,8 +101,10 @@ impl IjrrWriter {
         self.events
             .flush()
             .map_err(|e| InputError::write(&self.staged.shown, e))?;
-        if self.frame_count > 0 {
-            self.staged.write("images.txt", &self.frames)?;
+        for (list, (_, index)) in FRAME_LISTS.iter().enumerate() {
+            if self.frame_count[list] > 0 {
+                self.staged.write(index, &self.frames[list])?;
+            }
         }
         drop(self.events);
         self.staged.commit()
