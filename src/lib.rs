@@ -24,6 +24,7 @@ pub mod events;
 pub mod files;
 pub mod fit;
 pub mod io;
+pub mod report;
 pub mod selection;
 pub mod sensors;
 

@@ -158,7 +158,6 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
         global,
     )?;
     let path = loaded.recording.path.clone();
-    let excluded = loaded.excluded.clone();
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
     let options = ApsOptions {
@@ -166,6 +165,33 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
         log_response_name: log_name,
         ..ApsOptions::default()
     };
+    let result = eppps_of(
+        &loaded,
+        &options,
+        eppps::EpppsOptions {
+            scenes: args.scenes,
+            ..eppps::EpppsOptions::default()
+        },
+        &progress,
+    );
+    spinner.finish_and_clear();
+    let mut estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    if args.ignore_frames {
+        estimate
+            .assumptions
+            .push("frames ignored (--ignore-frames)".into());
+    }
+    present(&estimate, &loaded, common, &policy)
+}
+
+/// `estimate eppps` of a loaded recording (its frames, where loaded, give the dynamics).
+pub(super) fn eppps_of(
+    loaded: &Loaded,
+    options: &ApsOptions,
+    eppps_options: eppps::EpppsOptions,
+    progress: ctcal::estimate::Progress,
+) -> Result<CtEstimate, ctcal::estimate::EstimateError> {
+    let excluded = &loaded.excluded;
     let mut notes = loaded.notes.clone();
     // frames, when there are and they are wanted, prepared as for `aps`
     let prepared = if loaded.frames.len() >= 2 {
@@ -173,9 +199,9 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
             sensor: loaded.sensor,
             events: &loaded.events,
             frames: &loaded.frames,
-            excluded: &excluded,
+            excluded,
         };
-        match aps::prepare(&input, &excluded, &options) {
+        match aps::prepare(&input, excluded, options) {
             Ok(p) => {
                 notes.extend(p.assumptions.iter().cloned());
                 Some(p.frames)
@@ -188,26 +214,18 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
     } else {
         None
     };
-    if args.ignore_frames {
-        notes.push("frames ignored (--ignore-frames)".into());
-    }
-    let result = eppps::estimate(
+    let mut estimate = eppps::estimate(
         &eppps::EpppsInput {
             sensor: loaded.sensor,
             events: &loaded.events,
             frames: prepared.as_ref(),
-            excluded: &excluded,
+            excluded,
         },
-        &eppps::EpppsOptions {
-            scenes: args.scenes,
-            ..eppps::EpppsOptions::default()
-        },
-        &progress,
-    );
-    spinner.finish_and_clear();
-    let mut estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+        &eppps_options,
+        progress,
+    )?;
     estimate.assumptions.extend(notes);
-    present(&estimate, &loaded, common, &policy)
+    Ok(estimate)
 }
 
 fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
@@ -227,7 +245,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
                 .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
             DisplayParams::from_toml(&text, &path.display().to_string())?
         }
-        None => DisplayParams::from_toml(DEFAULT_SCREEN, "the built-in 60 Hz LCD model")?,
+        None => default_screen(),
     };
     let loaded = load(
         &common.input,
@@ -268,28 +286,45 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         .into());
     }
     let frames = stimulus.load_all()?;
-    let excluded = loaded.excluded.clone();
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
-    let result = screen::estimate(
+    let result = screen_of(&loaded, &frames, screen, args.refresh_hz, &progress);
+    spinner.finish_and_clear();
+    let estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    present(&estimate, &loaded, common, &policy)
+}
+
+/// `estimate screen` of a loaded recording and the stimulus it showed.
+pub(super) fn screen_of(
+    loaded: &Loaded,
+    stimulus: &[ctcal::Frame],
+    screen: DisplayParams,
+    refresh_hz: Option<f64>,
+    progress: ctcal::estimate::Progress,
+) -> Result<CtEstimate, ctcal::estimate::EstimateError> {
+    let mut estimate = screen::estimate(
         &screen::ScreenInput {
             sensor: loaded.sensor,
             events: &loaded.events,
-            stimulus: &frames,
+            stimulus,
             screen,
-            refresh_hz: args.refresh_hz,
-            excluded: &excluded,
+            refresh_hz,
+            excluded: &loaded.excluded,
         },
-        &progress,
-    );
-    spinner.finish_and_clear();
-    let mut estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+        progress,
+    )?;
     estimate.assumptions.extend(loaded.notes.iter().cloned());
-    present(&estimate, &loaded, common, &policy)
+    Ok(estimate)
 }
 
 /// The screen model `estimate screen` starts from without `--screen`.
 const DEFAULT_SCREEN: &str = include_str!("../../calib/screens/lcd_60hz_srgb.toml");
+
+/// The built-in screen model (a typical 60 Hz LCD).
+pub(super) fn default_screen() -> DisplayParams {
+    DisplayParams::from_toml(DEFAULT_SCREEN, "the built-in 60 Hz LCD model")
+        .expect("the built-in screen model is valid")
+}
 
 /// A spinner on stderr showing the stage (hidden when quiet).
 pub(super) fn stage_spinner(global: &Global) -> indicatif::ProgressBar {

@@ -2,12 +2,14 @@
 //! the shared flags, output helpers and the mapping from errors to exit codes.
 
 mod calib;
+mod config;
 mod convert;
 mod estimate;
 mod fit;
 mod info;
 mod load;
 mod output;
+mod report;
 mod simulate;
 mod stats;
 
@@ -158,6 +160,12 @@ pub enum Command {
     Estimate(estimate::EstimateCommand),
     /// Fit every simulator parameter; add the effects the residuals call for.
     Fit(fit::FitArgs),
+    /// A paper-style report: statistics, every estimate and the fit of each recording,
+    /// plots, tables and simulator configurations.
+    Report(report::ReportArgs),
+    /// Simulator configurations (ESIM, esim_config_generator, v2e, ctcal) from fits or a
+    /// report.
+    Config(config::ConfigArgs),
 }
 
 /// A problem with the command line or the input that the user can fix (exit code 2).
@@ -192,6 +200,8 @@ pub fn run() -> i32 {
         Command::Calib(command) => calib::run(command, &cli.global),
         Command::Estimate(command) => estimate::run(command, &cli.global),
         Command::Fit(args) => fit::run(args, &cli.global),
+        Command::Report(args) => report::run(args, &cli.global),
+        Command::Config(args) => config::run(args, &cli.global),
     };
     match result {
         Ok(()) => 0,

@@ -169,6 +169,10 @@ pub struct FitResult {
     pub assumptions: Vec<String>,
     pub holdout: Holdout,
     pub simulations: usize,
+    /// Exposure of the grey frames (the file's, else `--exposure-s`), for the simulator
+    /// configurations.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frame_exposure_us: Option<crate::TimeUs>,
 }
 
 /// How the data were split.

@@ -467,6 +467,11 @@ pub fn fit(
             held_out_seconds: geometry.duration_of(Subset::HeldOut),
         },
         simulations: simulation.count.get(),
+        frame_exposure_us: input
+            .frames
+            .iter()
+            .find_map(|f| f.exposure_us)
+            .or(options.aps.exposure_us),
     })
 }
 

@@ -113,14 +113,20 @@ impl SceneSpec {
     /// Reads and checks a scene file.
     pub fn from_file(path: &Path) -> Result<Self, SimError> {
         let text = super::params::read_text_file(path)?;
-        if let Some(key) = super::params::first_non_finite(&text) {
+        Self::from_toml(&text, path)
+    }
+
+    /// Parses and checks scene text; `path` names it in errors and anchors relative
+    /// texture folders.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self, SimError> {
+        if let Some(key) = super::params::first_non_finite(text) {
             return Err(scene_error(
                 path,
                 format!("`{key}` is not a finite number"),
                 "give a real number (nan and inf are not scene values)",
             ));
         }
-        let mut spec: SceneSpec = toml::from_str(&text).map_err(|e| {
+        let mut spec: SceneSpec = toml::from_str(text).map_err(|e| {
             scene_error(
                 path,
                 format!("cannot read the scene: {}", e.message()),
