@@ -9,6 +9,7 @@ mod estimate;
 mod fit;
 mod limits;
 mod readers;
+mod report;
 mod safety;
 mod samples;
 mod selection;

@@ -1,0 +1,609 @@
+//! `ctcal report` and `ctcal config` on the committed data samples (recordings ctcal
+//! simulated with known parameters): every part of the report is there, the estimates lie
+//! beside the truth, the tables agree across formats and are snapshotted, the HTML page
+//! renders in a real browser, and the configurations read back into the simulator.
+
+use crate::common::{bad_input, ctcal, json};
+use polars::prelude::*;
+use serde_json::Value;
+use sha2::{Digest, Sha256};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+fn project() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The report of `data_samples`, made once for every test here (run from the project root
+/// as a user would: `ctcal report data_samples --out DIR`).
+fn sample_report() -> &'static Path {
+    static REPORT: OnceLock<PathBuf> = OnceLock::new();
+    REPORT.get_or_init(|| {
+        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sample_report");
+        if out.exists() {
+            std::fs::remove_dir_all(&out).unwrap();
+        }
+        let output = ctcal()
+            .current_dir(project())
+            .args(["report", "data_samples", "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "ctcal report failed: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        out
+    })
+}
+
+fn results() -> Value {
+    let text = std::fs::read_to_string(sample_report().join("results.json")).unwrap();
+    serde_json::from_str(&text).unwrap()
+}
+
+fn sequence<'a>(results: &'a Value, name: &str) -> &'a Value {
+    results["sequences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|s| s["name"] == name)
+        .unwrap_or_else(|| panic!("sequence {name} in results.json"))
+}
+
+/// Every file under `dir`, relative, sorted.
+fn files(dir: &Path) -> Vec<String> {
+    fn walk(root: &Path, dir: &Path, out: &mut Vec<String>) {
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                walk(root, &path, out);
+            } else {
+                out.push(path.strip_prefix(root).unwrap().display().to_string());
+            }
+        }
+    }
+    let mut out = Vec::new();
+    walk(dir, dir, &mut out);
+    out.sort();
+    out
+}
+
+fn sha256(path: &Path) -> String {
+    Sha256::digest(std::fs::read(path).unwrap())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect()
+}
+
+const TABLES: [&str; 5] = [
+    "statistics",
+    "thresholds",
+    "fitted_parameters",
+    "fit_steps",
+    "datasets",
+];
+
+#[test]
+fn the_sample_report_has_every_part() {
+    let dir = sample_report();
+    let all = files(dir);
+    for part in [
+        "index.html",
+        "report.md",
+        "results.json",
+        ".ctcal-output.json",
+    ] {
+        assert!(all.contains(&part.to_string()), "{part} in {all:?}");
+    }
+    for table in TABLES {
+        for ext in ["csv", "parquet", "tex", "md"] {
+            let name = format!("tables/{table}.{ext}");
+            assert!(all.contains(&name), "{name}");
+        }
+    }
+    // a plot is a PNG, an SVG and the CSV of its data
+    let stems = |ext: &str| -> Vec<String> {
+        all.iter()
+            .filter(|f| f.starts_with("plots/") && f.ends_with(ext))
+            .map(|f| f.trim_end_matches(ext).to_string())
+            .collect()
+    };
+    let pngs = stems(".png");
+    assert_eq!(pngs, stems(".svg"));
+    assert_eq!(pngs, stems(".csv"));
+    for plot in [
+        "plots/events_per_pixel_per_second",
+        "plots/texture_davis240c/thresholds",
+        "plots/texture_davis240c/threshold_maps",
+        "plots/texture_davis240c/calibration_curve",
+        "plots/texture_davis240c/fit_residuals",
+        "plots/screen_checkerboard/thresholds",
+    ] {
+        assert!(pngs.contains(&plot.to_string()), "{plot} in {pngs:?}");
+    }
+    for png in &pngs {
+        let bytes = std::fs::read(dir.join(format!("{png}.png"))).unwrap();
+        assert_eq!(&bytes[1..4], b"PNG", "{png}");
+    }
+    // the texture has frames and was fitted: every format of configuration; the on-screen
+    // recording has no frames, so no fit and no configuration of its own
+    for name in ["esim.flagfile", "v2e_args.txt", "params.toml"] {
+        assert!(all.contains(&format!("configs/texture_davis240c/{name}")));
+    }
+    assert!(all.contains(&"configs/esim_config_generator.json".to_string()));
+    assert!(
+        !all.iter()
+            .any(|f| f.starts_with("configs/screen_checkerboard"))
+    );
+
+    // how it was made, and from what
+    let r = results();
+    assert_eq!(r["ctcal_version"], env!("CARGO_PKG_VERSION"));
+    assert_eq!(r["seed"], 2020);
+    let command: Vec<&str> = r["command_line"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    assert_eq!(command[0], "ctcal");
+    assert!(command.windows(2).any(|w| w == ["report", "data_samples"]));
+    for s in r["sequences"].as_array().unwrap() {
+        let inputs = s["inputs"].as_array().unwrap();
+        assert!(!inputs.is_empty());
+        for input in inputs {
+            let path = project().join(input["path"].as_str().unwrap());
+            assert_eq!(input["sha256"], sha256(&path), "{}", path.display());
+            assert_eq!(
+                input["bytes"].as_u64().unwrap(),
+                std::fs::metadata(&path).unwrap().len()
+            );
+        }
+    }
+    let screen = sequence(&r, "screen_checkerboard");
+    assert!(screen["fit"].is_null());
+    let why = screen["fit_not_applied"].as_str().unwrap();
+    assert!(why.contains("grey frames"), "{why}");
+
+    // the Markdown report shows every PNG and every table
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    for png in &pngs {
+        let link = format!("]({png}.png)");
+        assert!(md.contains(&link), "{link} in report.md");
+    }
+    for table in TABLES {
+        let header = std::fs::read_to_string(dir.join(format!("tables/{table}.md"))).unwrap();
+        let first = header.lines().next().unwrap();
+        assert!(md.contains(first), "the {table} table in report.md");
+    }
+}
+
+/// (ct_on, ct_off) of a method's estimate.
+fn thresholds_of(s: &Value, method: &str) -> (f64, f64) {
+    let e = s["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == method)
+        .unwrap_or_else(|| panic!("{method} in methods"));
+    let e = &e["estimate"];
+    assert!(e.is_object(), "{method} applied: {s:#}");
+    (e["ct_on"].as_f64().unwrap(), e["ct_off"].as_f64().unwrap())
+}
+
+fn within(found: f64, truth: f64, relative: f64, what: &str) {
+    assert!(
+        (found - truth).abs() <= relative * truth,
+        "{what}: {found:.4} vs true {truth} (allowed {:.0} %)",
+        relative * 100.0
+    );
+}
+
+#[test]
+fn estimates_lie_beside_the_truth_the_samples_were_made_with() {
+    let r = results();
+    // the texture: simulated at ON 0.35, OFF 0.45 with mismatch, noise, leak, bandwidth
+    let texture = sequence(&r, "texture_davis240c");
+    assert_eq!(texture["truth"]["params"]["ct_on"], 0.35);
+    assert_eq!(texture["truth"]["params"]["ct_off"], 0.45);
+    let (on, off) = thresholds_of(texture, "aps");
+    within(on, 0.35, 0.08, "aps ON");
+    within(off, 0.45, 0.08, "aps OFF");
+    let fit = &texture["fit"];
+    let (on, off) = (
+        fit["params"]["ct_on"].as_f64().unwrap(),
+        fit["params"]["ct_off"].as_f64().unwrap(),
+    );
+    within(on, 0.35, 0.05, "fit ON");
+    within(off, 0.45, 0.05, "fit OFF");
+    // the closed loop lowers the sim-to-real error several times over
+    let before = fit["error_before"].as_f64().unwrap();
+    let after = fit["error_after"].as_f64().unwrap();
+    assert!(after < before / 3.0, "error {before} -> {after}");
+    // the on-screen checkerboard: 0.3 both ways, through a gamma-2 LCD
+    let screen = sequence(&r, "screen_checkerboard");
+    let (on, off) = thresholds_of(screen, "screen");
+    within(on, 0.3, 0.10, "screen ON");
+    within(off, 0.3, 0.10, "screen OFF");
+    // the dataset row is the mean over its sequences
+    let dataset = &r["datasets"][0];
+    assert_eq!(dataset["name"], "data_samples");
+    let rates: Vec<f64> = ["screen_checkerboard", "texture_davis240c"]
+        .iter()
+        .map(|n| {
+            sequence(&r, n)["stats"]["events_per_pixel_per_second"]
+                .as_f64()
+                .unwrap()
+        })
+        .collect();
+    let mean = dataset["events_per_pixel_per_second"]["mean"]
+        .as_f64()
+        .unwrap();
+    assert!((mean - (rates[0] + rates[1]) / 2.0).abs() < 1e-12);
+}
+
+fn read_csv(path: &Path) -> DataFrame {
+    CsvReadOptions::default()
+        .with_has_header(true)
+        .try_into_reader_with_file_path(Some(path.to_path_buf()))
+        .unwrap()
+        .finish()
+        .unwrap()
+}
+
+fn read_parquet(path: &Path) -> DataFrame {
+    ParquetReader::new(std::fs::File::open(path).unwrap())
+        .finish()
+        .unwrap()
+}
+
+#[test]
+fn tables_agree_across_formats_and_are_stable() {
+    let dir = sample_report().join("tables");
+    for table in TABLES {
+        let csv = read_csv(&dir.join(format!("{table}.csv")));
+        let parquet = read_parquet(&dir.join(format!("{table}.parquet")));
+        assert_eq!(csv.shape(), parquet.shape(), "{table}");
+        assert_eq!(
+            csv.get_column_names(),
+            parquet.get_column_names(),
+            "{table}"
+        );
+        let md = std::fs::read_to_string(dir.join(format!("{table}.md"))).unwrap();
+        assert_eq!(md.lines().count(), csv.height() + 2, "{table}.md rows");
+        let tex = std::fs::read_to_string(dir.join(format!("{table}.tex"))).unwrap();
+        assert_eq!(
+            tex.lines().filter(|l| l.ends_with("\\\\")).count(),
+            csv.height() + 1,
+            "{table}.tex rows"
+        );
+    }
+    // the same numbers: the parquet thresholds to full precision
+    let parquet = read_parquet(&dir.join("thresholds.parquet"));
+    let r = results();
+    let texture = sequence(&r, "texture_davis240c");
+    let (aps_on, _) = thresholds_of(texture, "aps");
+    let sequences = parquet.column("sequence").unwrap().str().unwrap();
+    let methods = parquet.column("method").unwrap().str().unwrap();
+    let ct_on = parquet.column("ct_on").unwrap().f64().unwrap();
+    let row = (0..parquet.height())
+        .find(|&i| sequences.get(i) == Some("texture_davis240c") && methods.get(i) == Some("aps"))
+        .unwrap();
+    assert_eq!(ct_on.get(row), Some(aps_on));
+    // per-sequence Parquet for datasets that outgrow one machine
+    let one = read_parquet(&dir.join("texture_davis240c/thresholds.parquet"));
+    assert_eq!(one.height(), 3);
+
+    // tables and configurations as a reader sees them; the report is deterministic, so
+    // any change of a number is a change of ctcal, to be reviewed
+    for name in [
+        "thresholds.md",
+        "fitted_parameters.md",
+        "fit_steps.md",
+        "datasets.tex",
+    ] {
+        let text = std::fs::read_to_string(dir.join(name)).unwrap();
+        insta::assert_snapshot!(name, text);
+    }
+    let configs = sample_report().join("configs");
+    for name in [
+        "texture_davis240c/esim.flagfile",
+        "texture_davis240c/v2e_args.txt",
+        "texture_davis240c/params.toml",
+        "esim_config_generator.json",
+    ] {
+        let text = std::fs::read_to_string(configs.join(name)).unwrap();
+        insta::assert_snapshot!(name.replace('/', "__"), text);
+    }
+}
+
+/// What a browser shows of the page: written by the page's script into `#result`.
+const BROWSER_CHECK: &str = r#"<!doctype html><html><body>
+<iframe id="report" src="REPORT_URL" width="1200" height="900"></iframe>
+<pre id="result">pending</pre>
+<script>
+const frame = document.getElementById('report');
+frame.addEventListener('load', () => {
+  setTimeout(() => {
+    const doc = frame.contentDocument;
+    const lines = [];
+    for (const img of doc.images) {
+      let inked = -1;
+      if (img.complete && img.naturalWidth > 0) {
+        const canvas = document.createElement('canvas');
+        canvas.width = img.naturalWidth; canvas.height = img.naturalHeight;
+        const ctx = canvas.getContext('2d');
+        ctx.drawImage(img, 0, 0);
+        const data = ctx.getImageData(0, 0, canvas.width, canvas.height).data;
+        let n = 0;
+        for (let i = 0; i < data.length; i += 4) {
+          if (data[i] < 200 || data[i + 1] < 200 || data[i + 2] < 200) n++;
+        }
+        inked = n / (data.length / 4);
+      }
+      lines.push('img ' + img.getAttribute('src') + ' ' + img.naturalWidth + ' ' + inked.toFixed(4));
+    }
+    for (const table of doc.querySelectorAll('table')) {
+      lines.push('table ' + table.rows.length + ' ' + table.rows[0].cells.length);
+    }
+    lines.push('h2 ' + doc.querySelectorAll('h2').length);
+    document.getElementById('result').textContent = lines.join('\n');
+  }, 500);
+});
+</script></body></html>"#;
+
+#[test]
+fn the_html_report_renders_in_a_browser() {
+    let chromium = ["/usr/bin/chromium", "/usr/bin/chromium-browser"]
+        .into_iter()
+        .find(|p| Path::new(p).exists())
+        .expect("chromium is needed to check the HTML report: run `bash .ci/install-deps`");
+    let report = sample_report().canonicalize().unwrap();
+    let check = tempfile::tempdir().unwrap();
+    let page = check.path().join("check.html");
+    let url = format!("file://{}", report.join("index.html").display());
+    std::fs::write(&page, BROWSER_CHECK.replace("REPORT_URL", &url)).unwrap();
+    let output = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--allow-file-access-from-files",
+            "--virtual-time-budget=20000",
+            "--dump-dom",
+        ])
+        .arg(format!("file://{}", page.display()))
+        .output()
+        .unwrap();
+    let dom = String::from_utf8_lossy(&output.stdout);
+    let result = dom
+        .split("<pre id=\"result\">")
+        .nth(1)
+        .and_then(|r| r.split("</pre>").next())
+        .unwrap_or_else(|| panic!("no result from chromium: {dom}"));
+    assert_ne!(result, "pending", "the page did not load");
+    let images: Vec<&str> = result.lines().filter(|l| l.starts_with("img ")).collect();
+    let pngs = files(&report)
+        .into_iter()
+        .filter(|f| f.ends_with(".png"))
+        .count();
+    assert_eq!(images.len(), pngs, "every plot on the page:\n{result}");
+    for line in &images {
+        let fields: Vec<&str> = line.split(' ').collect();
+        let width: u32 = fields[2].parse().unwrap();
+        let inked: f64 = fields[3].parse().unwrap();
+        assert!(width >= 400, "{line}: loaded at a readable size");
+        // drawn, not blank, not a solid block
+        assert!((0.01..0.95).contains(&inked), "{line}: inked fraction");
+    }
+    let tables: Vec<&str> = result.lines().filter(|l| l.starts_with("table ")).collect();
+    assert_eq!(tables.len(), TABLES.len(), "{result}");
+    for line in tables {
+        let rows: usize = line.split(' ').nth(1).unwrap().parse().unwrap();
+        assert!(rows >= 2, "{line}: a header and rows");
+    }
+}
+
+#[test]
+fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
+    let report = sample_report();
+    let run = |args: &[&str]| -> String {
+        let output = ctcal().args(args).output().unwrap();
+        assert!(
+            output.status.success(),
+            "ctcal {args:?}: {}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        String::from_utf8(output.stdout).unwrap()
+    };
+    let report_arg = report.to_str().unwrap();
+    // one sequence fitted: the report's own files, whichever way asked
+    let v2e = run(&["config", report_arg, "--format", "v2e"]);
+    assert_eq!(
+        v2e,
+        std::fs::read_to_string(report.join("configs/texture_davis240c/v2e_args.txt")).unwrap()
+    );
+    for (flag, keys) in [
+        (
+            "esim",
+            &[
+                "--contrast_threshold_pos=",
+                "--contrast_threshold_neg=",
+                "--contrast_threshold_sigma_pos=",
+                "--refractory_period_ns=",
+                "--log_eps=",
+            ][..],
+        ),
+        (
+            "v2e",
+            &[
+                "--pos_thres ",
+                "--neg_thres ",
+                "--sigma_thres ",
+                "--shot_noise_rate_hz ",
+            ][..],
+        ),
+        (
+            "esim-generator",
+            &[
+                "\"contrast_threshold_mean\"",
+                "\"ct_diff_sigma\"",
+                "\"min_C\"",
+                "\"max_C\"",
+            ][..],
+        ),
+    ] {
+        let text = run(&["config", report_arg, "--format", flag]);
+        for key in keys {
+            assert!(text.contains(key), "{key} in the {flag} config:\n{text}");
+        }
+    }
+
+    // a fit's JSON (as `ctcal fit --json` writes it) gives the same parameters
+    let work = tempfile::tempdir().unwrap();
+    let r = results();
+    let fit = sequence(&r, "texture_davis240c")["fit"].clone();
+    let fit_json = work.path().join("fit.json");
+    std::fs::write(&fit_json, serde_json::to_string(&fit).unwrap()).unwrap();
+    let from_fit = run(&["config", fit_json.to_str().unwrap(), "--format", "v2e"]);
+    assert_eq!(from_fit, v2e);
+
+    // ctcal's own PARAMS.toml drives `ctcal simulate` with exactly the fitted parameters
+    let params = work.path().join("params.toml");
+    run(&[
+        "config",
+        fit_json.to_str().unwrap(),
+        "--format",
+        "ctcal",
+        "--seed",
+        "5",
+        "--out",
+        params.to_str().unwrap(),
+    ]);
+    let scene = project().join("calib/scenes/sample_texture_davis240c.toml");
+    let sim = json(&[
+        "simulate",
+        "--scene",
+        scene.to_str().unwrap(),
+        "--params",
+        params.to_str().unwrap(),
+        "--out",
+        work.path().join("sim").to_str().unwrap(),
+    ]);
+    for key in ["ct_on", "ct_off", "ct_sigma", "shot_noise_rate_hz"] {
+        let fitted = fit["params"][key].as_f64().unwrap();
+        let simulated = sim["params"][key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key} in {sim:#}"));
+        assert_eq!(fitted, simulated, "{key}");
+    }
+    assert_eq!(sim["params"]["seed"], 5);
+    assert!(sim["events"].as_u64().unwrap() > 10_000);
+}
+
+#[test]
+fn config_and_report_refuse_bad_input_with_a_fix() {
+    let work = tempfile::tempdir().unwrap();
+    let w = |name: &str| work.path().join(name).display().to_string();
+    // config
+    let e = bad_input(&["config", &w("missing.json"), "--format", "v2e"]);
+    assert!(e.contains("missing.json"), "{e}");
+    std::fs::create_dir(work.path().join("empty")).unwrap();
+    let e = bad_input(&["config", &w("empty"), "--format", "v2e"]);
+    assert!(e.contains("results.json") && e.contains("fix:"), "{e}");
+    std::fs::write(work.path().join("stats.json"), r#"{"events": 3}"#).unwrap();
+    let e = bad_input(&["config", &w("stats.json"), "--format", "v2e"]);
+    assert!(e.contains("stats.json") && e.contains("params"), "{e}");
+    std::fs::write(work.path().join("broken.json"), "{\"params\": ").unwrap();
+    let e = bad_input(&["config", &w("broken.json"), "--format", "v2e"]);
+    assert!(e.contains("broken.json"), "{e}");
+    let report = sample_report().to_str().unwrap().to_string();
+    let e = bad_input(&["config", &report, "--format", "carla"]);
+    assert!(
+        e.contains("carla") && e.contains("esim") && e.contains("v2e"),
+        "{e}"
+    );
+
+    // report
+    let samples = project().join("data_samples");
+    let samples = samples.to_str().unwrap();
+    let e = bad_input(&["report", &w("nowhere"), "--out", &w("r1")]);
+    assert!(e.contains("nowhere") && e.contains("fix:"), "{e}");
+    let e = bad_input(&["report", &w("empty"), "--out", &w("r2")]);
+    assert!(
+        e.contains("holds no recording") && e.contains("fix:"),
+        "{e}"
+    );
+    let e = bad_input(&["report", "--dataset", samples, "--out", &w("r3")]);
+    assert!(e.contains("NAME=INPUT"), "{e}");
+    let e = bad_input(&["report", "--out", &w("r4")]);
+    assert!(e.contains("no recordings given"), "{e}");
+    // a user's folder is refused before any work, and left as it was
+    let users = work.path().join("thesis");
+    std::fs::create_dir(&users).unwrap();
+    std::fs::write(users.join("chapter1.tex"), "precious").unwrap();
+    let e = bad_input(&["report", samples, "--out", users.to_str().unwrap()]);
+    assert!(e.contains("--force") || e.contains("new folder"), "{e}");
+    assert_eq!(files(&users), vec!["chapter1.tex".to_string()]);
+    assert_eq!(
+        std::fs::read_to_string(users.join("chapter1.tex")).unwrap(),
+        "precious"
+    );
+    // an output inside an input
+    let inside = project().join("data_samples/report");
+    let e = bad_input(&["report", samples, "--out", inside.to_str().unwrap()]);
+    assert!(e.contains("input"), "{e}");
+    assert!(!inside.exists(), "nothing written inside the input");
+    let e = bad_input(&[
+        "report",
+        "--dataset",
+        &format!("samples={samples}"),
+        "--out",
+        inside.to_str().unwrap(),
+    ]);
+    assert!(e.contains("input"), "{e}");
+    for r in ["r1", "r2", "r3", "r4"] {
+        assert!(!work.path().join(r).exists(), "{r} left behind");
+    }
+}
+
+#[test]
+fn named_datasets_are_summarised_one_row_each() {
+    let work = tempfile::tempdir().unwrap();
+    let out = work.path().join("report");
+    let samples = project().join("data_samples");
+    ctcal()
+        .args(["report", "--no-fit", "--dataset"])
+        .arg(format!(
+            "texture={}",
+            samples.join("texture_davis240c").display()
+        ))
+        .arg("--dataset")
+        .arg(format!(
+            "on screen={}",
+            samples.join("screen_checkerboard").display()
+        ))
+        .arg("--out")
+        .arg(&out)
+        .assert()
+        .success();
+    let r: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let names: Vec<&str> = r["datasets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d["name"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["texture", "on_screen"]);
+    for s in r["sequences"].as_array().unwrap() {
+        assert!(s["fit"].is_null());
+        assert_eq!(s["fit_not_applied"], "left out (--no-fit)");
+    }
+    let table = read_csv(&out.join("tables/datasets.csv"));
+    assert_eq!(table.height(), 2);
+    // no fit, no configuration
+    assert!(!out.join("configs").exists());
+}
