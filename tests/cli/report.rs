@@ -607,3 +607,45 @@ fn named_datasets_are_summarised_one_row_each() {
     // no fit, no configuration
     assert!(!out.join("configs").exists());
 }
+
+#[test]
+fn the_committed_sample_report_is_what_ctcal_makes_today() {
+    let committed = project().join("reports/sample");
+    let fresh = sample_report();
+    let mut compared = 0;
+    for file in files(fresh) {
+        let text = file.starts_with("tables/") && !file.ends_with(".parquet")
+            || file.starts_with("configs/");
+        if !text {
+            continue;
+        }
+        let path = committed.join(&file);
+        let got = std::fs::read_to_string(&path).unwrap_or_else(|_| {
+            panic!(
+                "{} missing: run `cargo run --release -- report data_samples --out reports/sample`",
+                path.display()
+            )
+        });
+        assert_eq!(
+            got,
+            std::fs::read_to_string(fresh.join(&file)).unwrap(),
+            "{file} differs: run `cargo run --release -- report data_samples --out reports/sample`"
+        );
+        compared += 1;
+    }
+    assert!(compared >= 19, "{compared} files compared");
+    // the Markdown report, but for the --out path on its command line
+    let body = |path: &Path| -> String {
+        std::fs::read_to_string(path.join("report.md"))
+            .unwrap()
+            .lines()
+            .filter(|l| !l.contains("--out"))
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    assert_eq!(body(&committed), body(fresh));
+    // the PNG plots are all there (rendering is checked in the browser test)
+    for file in files(fresh).iter().filter(|f| f.ends_with(".png")) {
+        assert!(committed.join(file).is_file(), "{file} in reports/sample");
+    }
+}
