@@ -57,7 +57,8 @@ impl Global {
 /// How to open an input recording.
 #[derive(Args, Debug, Clone)]
 pub struct InputArgs {
-    /// Recording: an IJRR folder or events.txt, HDF5, AEDAT4, Prophesee RAW (EVT2/EVT3) or DAT.
+    /// Recording: an IJRR folder or events.txt, HDF5 (event_utils, v2e, MVSEC, DSEC), AEDAT4,
+    /// Prophesee RAW (EVT2/EVT3) or DAT, or a ROS bag.
     pub input: PathBuf,
     /// Read as this format instead of detecting it from the content.
     #[arg(long, value_name = "ijrr|h5|aedat4|evt2|evt3|dat|bag")]
