@@ -1,0 +1,112 @@
+//! The events-per-pixel-per-second against threshold calibration curve of `estimate eppps`,
+//! with the recording's rate and the estimate marked.
+
+use super::style::*;
+use super::{DrawResult, FONT, Figure, err};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+
+/// A point of the e/pix/s calibration curve.
+#[derive(serde::Deserialize)]
+pub(super) struct CurvePoint {
+    pub(super) ct: f64,
+    pub(super) events_per_pixel_per_second: f64,
+    pub(super) lo: f64,
+    pub(super) hi: f64,
+}
+
+/// The eppps calibration curve of a sequence.
+pub(super) struct Calibration {
+    pub(super) curve: Vec<CurvePoint>,
+    pub(super) recording: f64,
+    pub(super) estimate: f64,
+}
+
+impl Figure for Calibration {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let values = self
+            .curve
+            .iter()
+            .flat_map(|p| [p.lo, p.hi, p.events_per_pixel_per_second])
+            .chain([self.recording]);
+        let mut chart = ChartBuilder::on(root)
+            .caption(
+                "Calibration curve: simulated scenes of matched dynamics",
+                (FONT, 20),
+            )
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(log_axis(0.07f64..2.2), log_axis(log_range(values)))
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_label_formatter(&log_tick)
+            .y_label_formatter(&log_tick)
+            .light_line_style(RGBColor(242, 242, 242))
+            .x_desc("contrast threshold")
+            .y_desc("events / pixel / s")
+            .label_style((FONT, 14))
+            .draw()
+            .map_err(err)?;
+        let band: Vec<(f64, f64)> = self
+            .curve
+            .iter()
+            .map(|p| (p.ct, p.hi))
+            .chain(self.curve.iter().rev().map(|p| (p.ct, p.lo)))
+            .filter(|p| p.1 > 0.0)
+            .collect();
+        chart
+            .draw_series(std::iter::once(Polygon::new(band, PALETTE[0].mix(0.2))))
+            .map_err(err)?;
+        chart
+            .draw_series(LineSeries::new(
+                self.curve
+                    .iter()
+                    .map(|p| (p.ct, p.events_per_pixel_per_second)),
+                PALETTE[0].stroke_width(2),
+            ))
+            .map_err(err)?
+            .label("simulated (mean, range over scenes)")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PALETTE[0].stroke_width(2)));
+        chart
+            .draw_series(LineSeries::new(
+                [(0.07, self.recording), (2.2, self.recording)],
+                PALETTE[1].stroke_width(2),
+            ))
+            .map_err(err)?
+            .label(format!("the recording: {:.3} e/pix/s", self.recording))
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PALETTE[1].stroke_width(2)));
+        chart
+            .draw_series(std::iter::once(Circle::new(
+                (self.estimate, self.recording),
+                7,
+                PALETTE[1].filled(),
+            )))
+            .map_err(err)?
+            .label(format!("estimate CT {:.3}", self.estimate))
+            .legend(|(x, y)| Circle::new((x + 10, y), 5, PALETTE[1].filled()));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 14))
+            .draw()
+            .map_err(err)?;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut out = String::from("ct,events_per_pixel_per_second,lo,hi\n");
+        for p in &self.curve {
+            let _ = writeln!(
+                out,
+                "{},{},{},{}",
+                p.ct, p.events_per_pixel_per_second, p.lo, p.hi
+            );
+        }
+        let _ = writeln!(out, "{},{},,", self.estimate, self.recording);
+        out
+    }
+}

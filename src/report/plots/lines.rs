@@ -1,0 +1,161 @@
+//! Named (x, y) series on linear or logarithmic axes: rate timelines, residuals of the fit
+//! and same-pixel interval distributions; two side by side as a pair.
+
+use super::style::*;
+use super::{DrawResult, FONT, Figure, err};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+
+/// A set of named (x, y) series on linear or log axes.
+pub(super) struct Lines {
+    pub(super) title: String,
+    pub(super) x_label: String,
+    pub(super) y_label: String,
+    pub(super) log_x: bool,
+    pub(super) series: Vec<(String, Vec<(f64, f64)>)>,
+    /// Draw a horizontal line at zero.
+    pub(super) zero: bool,
+}
+
+impl Figure for Lines {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let points = || {
+            self.series
+                .iter()
+                .flat_map(|s| s.1.iter())
+                .filter(|p| p.0.is_finite() && p.1.is_finite())
+        };
+        let (mut x0, mut x1, mut y0, mut y1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for &(x, y) in points() {
+            if self.log_x && x <= 0.0 {
+                continue;
+            }
+            x0 = x0.min(x);
+            x1 = x1.max(x);
+            y0 = y0.min(y);
+            y1 = y1.max(y);
+        }
+        if !x0.is_finite() {
+            (x0, x1, y0, y1) = (1.0, 10.0, 0.0, 1.0);
+        }
+        if self.zero {
+            y0 = y0.min(0.0);
+            y1 = y1.max(0.0);
+        }
+        let pad = ((y1 - y0) * 0.08).max(1e-6);
+        let (y0, y1) = (y0 - pad, y1 + pad);
+        let colours = |k: usize| PALETTE[k % PALETTE.len()];
+        macro_rules! finish {
+            ($chart:expr) => {{
+                let mut chart = $chart;
+                let mut mesh = chart.configure_mesh();
+                mesh.x_desc(self.x_label.as_str())
+                    .y_desc(self.y_label.as_str())
+                    .light_line_style(RGBColor(242, 242, 242))
+                    .y_label_formatter(&linear_tick)
+                    .label_style((FONT, 14));
+                if self.log_x {
+                    mesh.x_label_formatter(&|v: &f64| log_tick(v));
+                } else {
+                    mesh.x_label_formatter(&|v: &f64| linear_tick(v));
+                }
+                mesh.draw().map_err(err)?;
+                if self.zero {
+                    chart
+                        .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], BLACK.mix(0.4)))
+                        .map_err(err)?;
+                }
+                for (k, (label, series)) in self.series.iter().enumerate() {
+                    let colour = colours(k);
+                    let valid: Vec<(f64, f64)> = series
+                        .iter()
+                        .copied()
+                        .filter(|p| {
+                            p.0.is_finite() && p.1.is_finite() && (!self.log_x || p.0 > 0.0)
+                        })
+                        .collect();
+                    chart
+                        .draw_series(LineSeries::new(valid.clone(), colour.stroke_width(2)))
+                        .map_err(err)?
+                        .label(label.clone())
+                        .legend(move |(x, y)| {
+                            PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
+                        });
+                    chart
+                        .draw_series(valid.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                        .map_err(err)?;
+                }
+                if self.series.len() > 1 {
+                    chart
+                        .configure_series_labels()
+                        .background_style(WHITE.mix(0.85))
+                        .border_style(BLACK)
+                        .label_font((FONT, 13))
+                        .draw()
+                        .map_err(err)?;
+                }
+            }};
+        }
+        let builder = |root| {
+            let mut b = ChartBuilder::on(root);
+            b.caption(self.title.as_str(), (FONT, 19))
+                .margin(12)
+                .x_label_area_size(45)
+                .y_label_area_size(65);
+            b
+        };
+        if self.log_x {
+            let range = (x0 / 1.3)..(x1 * 1.3);
+            finish!(
+                builder(root)
+                    .build_cartesian_2d(log_axis(range), y0..y1)
+                    .map_err(err)?
+            );
+        } else {
+            let px = ((x1 - x0) * 0.02).max(1e-9);
+            finish!(
+                builder(root)
+                    .build_cartesian_2d((x0 - px)..(x1 + px), y0..y1)
+                    .map_err(err)?
+            );
+        }
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut out = String::from("series,x,y\n");
+        for (label, points) in &self.series {
+            for (x, y) in points {
+                let _ = writeln!(out, "{},{x},{y}", label.replace(',', ";"));
+            }
+        }
+        out
+    }
+}
+
+/// Two line figures side by side.
+pub(super) struct Pair(pub(super) Lines, pub(super) Lines);
+
+impl Figure for Pair {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let (left, right) = root.split_horizontally(root.dim_in_pixel().0 as i32 / 2);
+        self.0.draw(&left)?;
+        self.1.draw(&right)
+    }
+
+    fn csv(&self) -> String {
+        let mut out = String::from("panel,series,x,y\n");
+        for (panel, lines) in [(&self.0.title, &self.0), (&self.1.title, &self.1)] {
+            for line in lines.csv().lines().skip(1) {
+                let _ = writeln!(out, "{},{line}", panel.replace(',', ";"));
+            }
+        }
+        out
+    }
+}

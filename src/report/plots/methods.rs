@@ -1,0 +1,143 @@
+//! The thresholds of every method for one sequence, with their 95 % intervals and the
+//! truth where the recording carries it.
+
+use super::style::*;
+use super::{DrawResult, FONT, Figure, err};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::fmt::Write as _;
+
+/// One method's thresholds with their 95 % intervals.
+pub(super) struct MethodRow {
+    pub(super) method: String,
+    pub(super) on: f64,
+    pub(super) on_ci95: Option<[f64; 2]>,
+    pub(super) off: f64,
+    pub(super) off_ci95: Option<[f64; 2]>,
+}
+
+/// The thresholds of every method of a sequence.
+pub(super) struct Methods {
+    pub(super) rows: Vec<MethodRow>,
+    pub(super) truth: Option<(f64, f64)>,
+}
+
+impl Figure for Methods {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let n = self.rows.len().max(1) as f64;
+        let values: Vec<f64> = self
+            .rows
+            .iter()
+            .flat_map(|r| {
+                [r.on, r.off]
+                    .into_iter()
+                    .chain(r.on_ci95.into_iter().flatten())
+                    .chain(r.off_ci95.into_iter().flatten())
+            })
+            .chain(self.truth.into_iter().flat_map(|t| [t.0, t.1]))
+            .filter(|v| v.is_finite())
+            .collect();
+        let hi = values.iter().copied().fold(0.1, f64::max) * 1.15;
+        let names: Vec<String> = self.rows.iter().map(|r| r.method.clone()).collect();
+        let mut chart = ChartBuilder::on(root)
+            .caption("Contrast thresholds by method (95 % intervals)", (FONT, 20))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(60)
+            .build_cartesian_2d(-0.5f64..(n - 0.5), 0f64..hi)
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .disable_x_mesh()
+            .y_label_formatter(&linear_tick)
+            .x_labels(self.rows.len().max(1))
+            .x_label_formatter(&|x| {
+                let k = x.round();
+                if (x - k).abs() < 0.01 && k >= 0.0 && (k as usize) < names.len() {
+                    names[k as usize].clone()
+                } else {
+                    String::new()
+                }
+            })
+            .y_desc("threshold (log units)")
+            .label_style((FONT, 14))
+            .draw()
+            .map_err(err)?;
+        if let Some((on, off)) = self.truth {
+            for (value, colour, label) in
+                [(on, PALETTE[0], "true ON"), (off, PALETTE[1], "true OFF")]
+            {
+                chart
+                    .draw_series(LineSeries::new(
+                        [(-0.5, value), (n - 0.5, value)],
+                        colour.mix(0.5).stroke_width(1),
+                    ))
+                    .map_err(err)?
+                    .label(label)
+                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.mix(0.5)));
+            }
+        }
+        for (shift, colour, label, pick) in [
+            (-0.1, PALETTE[0], "ON", 0usize),
+            (0.1, PALETTE[1], "OFF", 1usize),
+        ] {
+            let points: Vec<(f64, f64, Option<[f64; 2]>)> = self
+                .rows
+                .iter()
+                .enumerate()
+                .map(|(k, r)| {
+                    let (v, ci) = if pick == 0 {
+                        (r.on, r.on_ci95)
+                    } else {
+                        (r.off, r.off_ci95)
+                    };
+                    (k as f64 + shift, v, ci)
+                })
+                .collect();
+            chart
+                .draw_series(points.iter().filter_map(|(x, _, ci)| {
+                    ci.map(|[lo, hi]| {
+                        PathElement::new([(*x, lo), (*x, hi)], colour.stroke_width(2))
+                    })
+                }))
+                .map_err(err)?;
+            chart
+                .draw_series(
+                    points
+                        .iter()
+                        .map(|(x, v, _)| Circle::new((*x, *v), 6, colour.filled())),
+                )
+                .map_err(err)?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 14))
+            .draw()
+            .map_err(err)?;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut out = String::from("method,ct_on,ct_on_lo,ct_on_hi,ct_off,ct_off_lo,ct_off_hi\n");
+        let ci = |c: Option<[f64; 2]>| c.map_or(",".to_string(), |[a, b]| format!("{a},{b}"));
+        for r in &self.rows {
+            let _ = writeln!(
+                out,
+                "{},{},{},{},{}",
+                r.method,
+                r.on,
+                ci(r.on_ci95),
+                r.off,
+                ci(r.off_ci95)
+            );
+        }
+        if let Some((on, off)) = self.truth {
+            let _ = writeln!(out, "truth,{on},,,{off},,");
+        }
+        out
+    }
+}
