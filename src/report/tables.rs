@@ -224,7 +224,9 @@ pub fn fit_steps(sequences: &[&SequenceReport]) -> Table {
         for step in &f.steps {
             name.push(q.name.clone());
             effect.push(step.effect.clone());
-            score.push(Some(step.score));
+            // the starting point and the refits test no effect: no evidence to show
+            let tests_an_effect = step.effect != "thresholds" && !step.effect.ends_with("(refit)");
+            score.push(tests_an_effect.then_some(step.score));
             before.push(step.error_before);
             after.push(step.error_after);
             kept.push(if step.kept { "yes" } else { "no" }.to_string());
