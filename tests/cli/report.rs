@@ -398,6 +398,41 @@ fn the_html_report_renders_in_a_browser() {
         // drawn, not blank, not a solid block
         assert!((0.01..0.95).contains(&inked), "{line}: inked fraction");
     }
+    // the page itself rendered to PNG, as a person would see its top: drawn, with colour
+    let shot = check.path().join("page.png");
+    let status = std::process::Command::new(chromium)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--hide-scrollbars",
+            "--window-size=1200,2400",
+            "--virtual-time-budget=10000",
+        ])
+        .arg(format!("--screenshot={}", shot.display()))
+        .arg(&url)
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "chromium screenshot failed");
+    let page = image::open(&shot).unwrap().to_rgb8();
+    assert_eq!(page.dimensions(), (1200, 2400));
+    let inked = page
+        .pixels()
+        .filter(|p| p.0.iter().any(|&c| c < 200))
+        .count() as f64
+        / (1200.0 * 2400.0);
+    assert!(inked > 0.01, "the page is nearly blank: {inked}");
+    let coloured = page
+        .pixels()
+        .filter(|p| {
+            let [r, g, b] = p.0;
+            r.max(g).max(b) - r.min(g).min(b) > 60
+        })
+        .count();
+    assert!(
+        coloured > 5_000,
+        "no plot colours on the page: {coloured} pixels"
+    );
     let tables: Vec<&str> = result.lines().filter(|l| l.starts_with("table ")).collect();
     assert_eq!(tables.len(), TABLES.len(), "{result}");
     for line in tables {
@@ -425,45 +460,79 @@ fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
         v2e,
         std::fs::read_to_string(report.join("configs/texture_davis240c/v2e_args.txt")).unwrap()
     );
-    for (flag, keys) in [
-        (
-            "esim",
-            &[
-                "--contrast_threshold_pos=",
-                "--contrast_threshold_neg=",
-                "--contrast_threshold_sigma_pos=",
-                "--refractory_period_ns=",
-                "--log_eps=",
-            ][..],
-        ),
-        (
-            "v2e",
-            &[
-                "--pos_thres ",
-                "--neg_thres ",
-                "--sigma_thres ",
-                "--shot_noise_rate_hz ",
-            ][..],
-        ),
-        (
-            "esim-generator",
-            &[
-                "\"contrast_threshold_mean\"",
-                "\"ct_diff_sigma\"",
-                "\"min_C\"",
-                "\"max_C\"",
-            ][..],
-        ),
-    ] {
-        let text = run(&["config", report_arg, "--format", flag]);
-        for key in keys {
-            assert!(text.contains(key), "{key} in the {flag} config:\n{text}");
-        }
-    }
+    // every parameter in the tool's own names (the report issue's lists), and nothing else
+    let esim = [
+        "--contrast_threshold_pos",
+        "--contrast_threshold_neg",
+        "--contrast_threshold_sigma_pos",
+        "--contrast_threshold_sigma_neg",
+        "--refractory_period_ns",
+        "--log_eps",
+        "--use_log_image",
+        "--exposure_time_ms",
+        "--random_seed",
+    ];
+    let v2e_names = [
+        "--pos_thres",
+        "--neg_thres",
+        "--sigma_thres",
+        "--cutoff_hz",
+        "--leak_rate_hz",
+        "--shot_noise_rate_hz",
+        "--refractory_period",
+        "--leak_jitter_fraction",
+        "--noise_rate_cov_decades",
+        "--dvs_emulator_seed",
+    ];
+    let flags = |text: &str, separator: char| -> Vec<String> {
+        text.lines()
+            .filter(|l| l.starts_with("--"))
+            .map(|l| l.split(separator).next().unwrap().to_string())
+            .collect()
+    };
+    let esim_text = run(&["config", report_arg, "--format", "esim"]);
+    assert_eq!(flags(&esim_text, '='), esim, "{esim_text}");
+    // nanoseconds, an integer
+    let refractory = esim_text
+        .lines()
+        .find_map(|l| l.strip_prefix("--refractory_period_ns="))
+        .unwrap();
+    refractory.parse::<u64>().unwrap();
+    assert_eq!(flags(&v2e, ' '), v2e_names, "{v2e}");
+    let generator: Value =
+        serde_json::from_str(&run(&["config", report_arg, "--format", "esim-generator"])).unwrap();
+    let mut keys: Vec<&str> = generator["camera_params"]
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    keys.sort();
+    assert_eq!(
+        keys,
+        [
+            "contrast_threshold_mean",
+            "ct_diff_sigma",
+            "hard_c_t_sigmas",
+            "max_C",
+            "min_C",
+            "refractory_period_ns",
+            "sim_framerate"
+        ]
+    );
+    // the range covers the fitted thresholds with margin for training
+    let r = results();
+    let fit_params = &sequence(&r, "texture_davis240c")["fit"]["params"];
+    let (on, off) = (
+        fit_params["ct_on"].as_f64().unwrap(),
+        fit_params["ct_off"].as_f64().unwrap(),
+    );
+    let camera = &generator["camera_params"];
+    assert!(camera["min_C"].as_f64().unwrap() < on.min(off));
+    assert!(camera["max_C"].as_f64().unwrap() > on.max(off));
 
     // a fit's JSON (as `ctcal fit --json` writes it) gives the same parameters
     let work = tempfile::tempdir().unwrap();
-    let r = results();
     let fit = sequence(&r, "texture_davis240c")["fit"].clone();
     let fit_json = work.path().join("fit.json");
     std::fs::write(&fit_json, serde_json::to_string(&fit).unwrap()).unwrap();

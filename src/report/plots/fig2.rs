@@ -95,14 +95,18 @@ impl Figure for Fig2<'_> {
                         .map(|v| Circle::new((position(i), v), 6, colour.filled()))
                 }))
                 .map_err(err)?;
-            // sequence names beside their dots, while they fit
-            if members.len() <= 8 {
+            // sequence names beside their dots, cut to the room before the next dot (about
+            // 7 pixels a character at this size); none where fewer than 6 characters fit
+            let room_units = if members.len() > 1 { 0.5 / count } else { 0.7 };
+            let pixels_per_unit = chart.plotting_area().dim_in_pixel().0 as f64 / n;
+            let characters = (room_units * pixels_per_unit / 7.0) as usize;
+            if characters >= 6 {
                 chart
                     .draw_series(members.iter().enumerate().filter_map(|(i, s)| {
                         s.stats.events_per_pixel_per_second.map(|v| {
                             Text::new(
-                                s.name.clone(),
-                                (position(i) + 0.03, v),
+                                shorten(&s.name, characters),
+                                (position(i) + 10.0 / pixels_per_unit, v),
                                 (FONT, 12).into_font().color(&RGBColor(60, 60, 60)),
                             )
                         })
@@ -130,5 +134,25 @@ impl Figure for Fig2<'_> {
             let _ = writeln!(out, "preset,,,{},{}", p.ct, p.events_per_pixel_per_second);
         }
         out
+    }
+}
+
+/// `name` cut to `characters`, with an ellipsis where it was cut.
+fn shorten(name: &str, characters: usize) -> String {
+    if name.chars().count() <= characters {
+        return name.to_string();
+    }
+    let kept: String = name.chars().take(characters.saturating_sub(1)).collect();
+    format!("{kept}…")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::shorten;
+
+    #[test]
+    fn long_names_are_cut_with_an_ellipsis() {
+        assert_eq!(shorten("texture", 7), "texture");
+        assert_eq!(shorten("texture_davis240c", 8), "texture…");
     }
 }
