@@ -106,6 +106,27 @@ impl CommonArgs {
             ),
         })
     }
+
+    /// Reads the recording in `--start`/`--end` and the selected pixels, with at most
+    /// `frames` frames (none if `None`).
+    pub(super) fn load(
+        &self,
+        frames: Option<usize>,
+        events_between_frames: bool,
+        global: &Global,
+    ) -> anyhow::Result<Loaded> {
+        load(
+            &self.input,
+            &Window {
+                start_s: self.start,
+                end_s: self.end,
+                frames,
+                events_between_frames,
+            },
+            &self.selection,
+            global,
+        )
+    }
 }
 
 #[derive(Args, Debug)]
@@ -146,15 +167,9 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
         return Err(BadInput(format!("--scenes {} must be between 1 and 64", args.scenes)).into());
     }
     let policy = global.outputs([common.input.input.as_path()]);
-    let loaded = load(
-        &common.input,
-        &Window {
-            start_s: common.start,
-            end_s: common.end,
-            frames: (!args.ignore_frames).then_some(args.max_frames.max(2)),
-            events_between_frames: false,
-        },
-        &common.selection,
+    let loaded = common.load(
+        (!args.ignore_frames).then_some(args.max_frames.max(2)),
+        false,
         global,
     )?;
     let path = loaded.recording.path.clone();
@@ -247,17 +262,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         }
         None => default_screen(),
     };
-    let loaded = load(
-        &common.input,
-        &Window {
-            start_s: common.start,
-            end_s: common.end,
-            frames: None,
-            events_between_frames: false,
-        },
-        &common.selection,
-        global,
-    )?;
+    let loaded = common.load(None, false, global)?;
     let path = loaded.recording.path.clone();
     let stimulus = match &args.stimulus {
         Some(dir) => {
@@ -372,17 +377,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     if let Some(dir) = &args.maps {
         policy.check_folder(dir)?;
     }
-    let loaded = load(
-        &common.input,
-        &Window {
-            start_s: common.start,
-            end_s: common.end,
-            frames: Some(args.max_frames),
-            events_between_frames: true,
-        },
-        &common.selection,
-        global,
-    )?;
+    let loaded = common.load(Some(args.max_frames), true, global)?;
     let path = loaded.recording.path.clone();
     if loaded.frames.len() < 2 {
         return Err(BadInput(format!(

@@ -2,7 +2,6 @@
 //! residuals call for them and the held-out error falls (see `ctcal::fit`).
 
 use super::estimate::{CommonArgs, stage_spinner};
-use super::load::{Window, load};
 use super::{BadInput, Global, JsonTarget, emit_json, output};
 use clap::Args;
 use ctcal::estimate::aps::ApsOptions;
@@ -74,17 +73,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     }
     let (log_map, log_name) = common.log_map()?;
     let policy = global.outputs([common.input.input.as_path()]);
-    let loaded = load(
-        &common.input,
-        &Window {
-            start_s: common.start,
-            end_s: common.end,
-            frames: Some(args.max_frames),
-            events_between_frames: true,
-        },
-        &common.selection,
-        global,
-    )?;
+    let loaded = common.load(Some(args.max_frames), true, global)?;
     let path = loaded.recording.path.clone();
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());

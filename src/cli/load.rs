@@ -17,6 +17,8 @@ pub struct Loaded {
     pub frames: Vec<Frame>,
     /// Frames in the window before thinning to `max_frames`.
     pub frames_available: usize,
+    /// The pixels `--roi` / `--mask` keep.
+    pub selection: ctcal::selection::PixelSelection,
     /// One flag per pixel: left out by `--roi` / `--mask` (what the estimators take).
     pub excluded: Vec<bool>,
     pub notes: Vec<String>,
@@ -159,6 +161,7 @@ pub fn load(
     }
     Ok(Loaded {
         excluded: kept.excluded(),
+        selection: kept,
         sensor: resolved.sensor,
         sensor_source: resolved.source,
         recording,

@@ -147,33 +147,26 @@ fn inputs(args: &ReportArgs) -> Result<Vec<Input>, BadInput> {
     }
     let mut seen: BTreeMap<String, usize> = BTreeMap::new();
     for input in &mut all {
-        let safe: String = input
-            .name
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '-' {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect();
+        let safe = path_safe(&input.name);
         let n = seen.entry(safe.clone()).or_insert(0);
         *n += 1;
         input.name = if *n == 1 { safe } else { format!("{safe}_{n}") };
-        input.dataset = input
-            .dataset
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '-' {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect();
+        input.dataset = path_safe(&input.dataset);
     }
     Ok(all)
+}
+
+/// A name usable as a file or folder name: ASCII letters, digits and `-`, the rest `_`.
+fn path_safe(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// SHA-256 and size of a file.
@@ -324,9 +317,7 @@ fn sequence(
     bars.stages[0].inc(1);
 
     // statistics of the events in memory
-    let selection = args
-        .selection
-        .build(loaded.sensor, &loaded.recording.path)?;
+    let selection = loaded.selection.clone();
     let mut accumulator = StatsAccumulator::new(
         StatsOptions {
             selection: (!selection.is_all()).then_some(selection),

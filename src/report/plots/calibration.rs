@@ -87,13 +87,7 @@ impl Figure for Calibration {
             .map_err(err)?
             .label(format!("estimate CT {:.3}", self.estimate))
             .legend(|(x, y)| Circle::new((x + 10, y), 5, PALETTE[1].filled()));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, 14)?;
         Ok(())
     }
 

@@ -77,13 +77,7 @@ impl Figure for Histograms {
                     Rectangle::new([(x, y - 5), (x + 15, y + 5)], colour.mix(0.45).filled())
                 });
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, 14)?;
         Ok(())
     }
 

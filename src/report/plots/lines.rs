@@ -92,13 +92,7 @@ impl Figure for Lines {
                         .map_err(err)?;
                 }
                 if self.series.len() > 1 {
-                    chart
-                        .configure_series_labels()
-                        .background_style(WHITE.mix(0.85))
-                        .border_style(BLACK)
-                        .label_font((FONT, 13))
-                        .draw()
-                        .map_err(err)?;
+                    draw_legend(&mut chart, 13)?;
                 }
             }};
         }

@@ -111,13 +111,7 @@ impl Figure for Methods {
                 .label(label)
                 .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(err)?;
+        draw_legend(&mut chart, 14)?;
         Ok(())
     }
 

@@ -1,6 +1,8 @@
 //! Shared look of the report's plots: the palette, the viridis colour map and the tick
-//! labels and key points of linear and logarithmic axes.
+//! labels and key points of linear and logarithmic axes, and the legend box.
 
+use super::FONT;
+use plotters::coord::CoordTranslate;
 use plotters::coord::combinators::WithKeyPoints;
 use plotters::prelude::*;
 
@@ -100,4 +102,18 @@ pub(super) fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f6
         return 0.01..10.0;
     }
     (lo / 2.0)..(hi * 2.0)
+}
+
+/// The legend box every figure uses: translucent white over the plot, black border.
+pub(super) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    font_size: u32,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, font_size))
+        .draw()
+        .map_err(|e| e.to_string())
 }
