@@ -459,7 +459,17 @@ fn present(
     if matches!(target, Some(JsonTarget::Stdout)) {
         return Ok(());
     }
-    let interval = |v: f64, ci: [f64; 2]| format!("{v:.4}  (95 % {:.4} .. {:.4})", ci[0], ci[1]);
+    let value = |key: &str, v: Option<f64>, ci: Option<ctcal::estimate::Interval>| match v {
+        Some(v) => {
+            let [lo, hi] = ci.unwrap_or([None, None]);
+            let side = |b: Option<f64>| b.map_or("open".to_string(), |b| format!("{b:.4}"));
+            format!("{v:.4}  (95 % {} .. {})", side(lo), side(hi))
+        }
+        None => format!(
+            "not determinable: {}",
+            estimate.why.get(key).map_or("no reason given", |w| w.as_str())
+        ),
+    };
     let mut rows = vec![
         ("method".to_string(), estimate.method.to_string()),
         (
@@ -474,16 +484,19 @@ fn present(
         ),
         (
             "ct_on".into(),
-            interval(estimate.ct_on, estimate.ct_on_ci95),
+            value("ct_on", estimate.ct_on, estimate.ct_on_ci95),
         ),
         (
             "ct_off".into(),
-            interval(estimate.ct_off, estimate.ct_off_ci95),
+            value("ct_off", estimate.ct_off, estimate.ct_off_ci95),
         ),
-        ("ct".into(), interval(estimate.ct, estimate.ct_ci95)),
+        ("ct".into(), value("ct", estimate.ct, estimate.ct_ci95)),
     ];
     if let (Some(s), Some(ci)) = (estimate.ct_sigma, estimate.ct_sigma_ci95) {
-        rows.push(("ct_sigma (mismatch)".into(), interval(s, ci)));
+        rows.push((
+            "ct_sigma (mismatch)".into(),
+            value("ct_sigma", Some(s), Some(ci.map(Some))),
+        ));
     }
     for e in &estimate.estimators {
         rows.push((

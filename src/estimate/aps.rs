@@ -18,7 +18,7 @@ use super::frames::{FrameOptions, PreparedFrames};
 use super::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
 use super::resim::{Cells, Intervals, Resimulation};
 use super::timing::{ThresholdMaps, TimingEstimate, TimingOptions};
-use super::{CtEstimate, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid};
+use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
 use crate::sim::PixelParams;
 use crate::sim::log_response::LogMap;
@@ -362,8 +362,10 @@ pub fn estimate(
     }
     let combined = |estimates: &[Measured]| {
         let refs: Vec<&Measured> = estimates.iter().collect();
-        let (value, error) = combine(&refs).expect("the timing estimate is finite");
-        Measured::new(value, error, 0.0)
+        match combine(&refs) {
+            Some((value, error)) => Measured::new(value, error, 0.0),
+            None => Measured::new(f64::NAN, f64::NAN, 0.0),
+        }
     };
     let on = combined(&on_estimates);
     let off = combined(&off_estimates);
@@ -377,7 +379,7 @@ pub fn estimate(
         Some((&full.timing.maps.ct_on, &full.timing.maps.ct_off)),
     );
 
-    let mut estimate = CtEstimate::from_parts("aps", &on, &off);
+    let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames
         .intervals

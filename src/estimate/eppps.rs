@@ -26,7 +26,7 @@
 use super::dynamics::{self, FrameDynamics};
 use super::frames::PreparedFrames;
 use super::interval::{Measured, z95};
-use super::{CtEstimate, EstimateError, EstimatorReport, Progress};
+use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::sim::scene::canvas::TextureParams;
 use crate::sim::scene::multi_object::MultiObjectScene;
@@ -461,7 +461,16 @@ pub fn estimate(
     };
     let on = measure(&on_samples, "ON")?;
     let off = measure(&off_samples, "OFF")?;
-    let mut result = CtEstimate::from_parts("eppps", &on, &off);
+    let mut result = CtEstimate::from_parts(
+        "eppps",
+        &on,
+        &off,
+        Determinable {
+            lo: CT_GRID[0],
+            hi: CT_GRID[CT_GRID.len() - 1],
+            what: "the calibration curve",
+        },
+    );
     // the calibration curve (rate where the scene moves, as inverted) and the presets
     let point = |k: usize| -> CurvePoint {
         let values: Vec<f64> = curves

@@ -12,6 +12,7 @@ pub mod align;
 pub mod aps;
 pub mod dynamics;
 pub mod eppps;
+pub mod event_flow;
 pub mod flow;
 pub mod frames;
 pub mod image;
@@ -25,6 +26,7 @@ pub mod timing;
 use crate::events::{EventChunk, Sensor, TimeUs};
 use interval::{FrameRatePoint, Measured};
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// An estimate cannot be made from this input: what is missing and what to do.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -59,17 +61,25 @@ pub struct EstimatorReport {
     pub details: serde_json::Value,
 }
 
-/// The result of `ctcal estimate` (the JSON keys of `../shared/CLI.md`).
+/// A 95 % interval; a side is `None` (JSON `null`) where it is open: the value was
+/// extrapolated beyond what the method simulated, so nothing bounds it on that side.
+pub type Interval = [Option<f64>; 2];
+
+/// The result of `ctcal estimate` (the JSON keys of `../shared/CLI.md`). A threshold the
+/// data do not determine is `None` (JSON `null`), with the reason under `why`.
 #[derive(Clone, Debug, Serialize)]
 pub struct CtEstimate {
     pub method: &'static str,
-    pub ct_on: f64,
-    pub ct_off: f64,
+    pub ct_on: Option<f64>,
+    pub ct_off: Option<f64>,
     /// Mean of the two.
-    pub ct: f64,
-    pub ct_on_ci95: [f64; 2],
-    pub ct_off_ci95: [f64; 2],
-    pub ct_ci95: [f64; 2],
+    pub ct: Option<f64>,
+    pub ct_on_ci95: Option<Interval>,
+    pub ct_off_ci95: Option<Interval>,
+    pub ct_ci95: Option<Interval>,
+    /// Why a value is `None`, by its key.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub why: BTreeMap<String, String>,
     /// Frame intervals used, `[t_start_s, t_end_s]` in the recording's clock (aps).
     pub intervals_used: Vec<[f64; 2]>,
     pub assumptions: Vec<String>,
@@ -87,21 +97,123 @@ pub struct CtEstimate {
     pub extra: serde_json::Map<String, serde_json::Value>,
 }
 
+/// The range of thresholds a method's result can be trusted in: inside it a value is a
+/// result; outside it (but positive) it is an extrapolation, kept with its interval open on
+/// the far side.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Determinable {
+    pub lo: f64,
+    pub hi: f64,
+    /// What the range is, for the assumption that names an extrapolation.
+    pub what: &'static str,
+}
+
+impl Determinable {
+    /// Any positive threshold.
+    pub const POSITIVE: Determinable = Determinable {
+        lo: 0.0,
+        hi: f64::INFINITY,
+        what: "positive thresholds",
+    };
+}
+
+/// One polarity's value as reported: a result, an extrapolation (one side of its interval
+/// open) or not determinable (with the reason).
+fn checked(
+    name: &str,
+    m: &Measured,
+    range: Determinable,
+) -> Result<(f64, Interval, Option<String>), String> {
+    if !m.value.is_finite() {
+        return Err(format!(
+            "the method gave no finite {name} ({}): the data do not determine it",
+            m.value
+        ));
+    }
+    if m.value <= 0.0 {
+        return Err(format!(
+            "the method gave {name} = {:.4}, not a threshold (<= 0): the data do not determine it (too few or inconsistent events for this method)",
+            m.value
+        ));
+    }
+    let total = m.total_error();
+    if !total.is_finite() {
+        return Err(format!(
+            "{name} = {:.4} has no finite uncertainty: not determinable",
+            m.value
+        ));
+    }
+    let lo = (m.ci95[0] > 0.0).then_some(m.ci95[0]);
+    if m.value < range.lo {
+        return Ok((
+            m.value,
+            [None, Some(m.ci95[1])],
+            Some(format!(
+                "{name} = {:.4} is an extrapolation below {} (down to {}): its interval is open below",
+                m.value, range.what, range.lo
+            )),
+        ));
+    }
+    if m.value > range.hi {
+        return Ok((
+            m.value,
+            [lo, None],
+            Some(format!(
+                "{name} = {:.4} is an extrapolation above {} (up to {}): its interval is open above",
+                m.value, range.what, range.hi
+            )),
+        ));
+    }
+    Ok((m.value, [lo.or(Some(0.0)), Some(m.ci95[1])], None))
+}
+
 impl CtEstimate {
-    /// An estimate from combined ON and OFF values.
-    pub fn from_parts(method: &'static str, on: &Measured, off: &Measured) -> Self {
+    /// An estimate from ON and OFF values, each checked: a value that is not finite or not
+    /// positive is not determinable (`None`, with the reason under `why`); one outside
+    /// `range` is an extrapolation (kept, its interval open on that side, and said in the
+    /// assumptions). A lower interval bound at or below zero is reported as 0.
+    pub fn from_parts(
+        method: &'static str,
+        on: &Measured,
+        off: &Measured,
+        range: Determinable,
+    ) -> Self {
+        let mut estimate = Self::empty(method);
+        let mut parts = [None, None];
+        for (slot, (key, m)) in [("ct_on", on), ("ct_off", off)].into_iter().enumerate() {
+            match checked(key, m, range) {
+                Ok((value, ci, note)) => {
+                    parts[slot] = Some((value, ci));
+                    estimate.assumptions.extend(note);
+                }
+                Err(why) => {
+                    estimate.why.insert(key.into(), why);
+                }
+            }
+        }
+        estimate.set_parts(parts[0], parts[1]);
+        estimate
+    }
+
+    /// An estimate that determined nothing, for `reason`.
+    pub fn not_determinable(method: &'static str, reason: &str) -> Self {
+        let mut estimate = Self::empty(method);
+        for key in ["ct_on", "ct_off", "ct"] {
+            estimate.why.insert(key.into(), reason.to_string());
+        }
+        estimate
+    }
+
+    fn empty(method: &'static str) -> Self {
         Self {
             method,
-            ct_on: on.value,
-            ct_off: off.value,
-            ct: 0.5 * (on.value + off.value),
-            ct_on_ci95: on.ci95,
-            ct_off_ci95: off.ci95,
-            // the mean of two correlated estimates: the mean of their bounds
-            ct_ci95: [
-                0.5 * (on.ci95[0] + off.ci95[0]),
-                0.5 * (on.ci95[1] + off.ci95[1]),
-            ],
+            ct_on: None,
+            ct_off: None,
+            ct: None,
+            ct_on_ci95: None,
+            ct_off_ci95: None,
+            ct_ci95: None,
+            why: BTreeMap::new(),
             intervals_used: Vec::new(),
             assumptions: Vec::new(),
             ct_sigma: None,
@@ -110,6 +222,35 @@ impl CtEstimate {
             intervals_dropped: Vec::new(),
             extra: serde_json::Map::new(),
         }
+    }
+
+    fn set_parts(&mut self, on: Option<(f64, Interval)>, off: Option<(f64, Interval)>) {
+        self.ct_on = on.map(|p| p.0);
+        self.ct_on_ci95 = on.map(|p| p.1);
+        self.ct_off = off.map(|p| p.0);
+        self.ct_off_ci95 = off.map(|p| p.1);
+        match (on, off) {
+            (Some((a, ca)), Some((b, cb))) => {
+                self.ct = Some(0.5 * (a + b));
+                // the mean of two correlated estimates: the mean of their bounds (open if
+                // either is)
+                let side = |x: Option<f64>, y: Option<f64>| Some(0.5 * (x? + y?));
+                self.ct_ci95 = Some([side(ca[0], cb[0]), side(ca[1], cb[1])]);
+            }
+            _ => {
+                self.ct = None;
+                self.ct_ci95 = None;
+                self.why.insert(
+                    "ct".into(),
+                    "the mean needs both the ON and the OFF threshold".into(),
+                );
+            }
+        }
+    }
+
+    /// Both thresholds, when both were determined.
+    pub fn thresholds(&self) -> Option<(f64, f64)> {
+        Some((self.ct_on?, self.ct_off?))
     }
 }
 

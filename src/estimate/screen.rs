@@ -27,7 +27,7 @@
 
 use super::interval::Measured;
 use super::resim::{Cells, Counts, Intervals, log_ratio};
-use super::{CtEstimate, EstimateError, EstimatorReport, Progress};
+use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::sim::display::DisplayModel;
 use crate::sim::pixel::Transition;
@@ -492,7 +492,9 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             .map(|(&r, &s)| ((s as f64 + 0.5) / (r as f64 + 0.5)).ln().abs())
             .collect();
         if logs.is_empty() {
-            return 0.1 * c;
+            // no cell holds 5 events: the spread cannot be measured, so neither can the
+            // threshold's uncertainty
+            return f64::NAN;
         }
         let mid = logs.len() / 2;
         let mad = *logs.select_nth_unstable_by(mid, f64::total_cmp).1;
@@ -508,17 +510,18 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         standard_error(&setup.real.off, &simulated.off, fitted.1),
         spread(|v| v.1),
     );
-    let mut estimate = CtEstimate::from_parts("screen", &on, &off);
+    let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
     let naive_ct = 0.5 * (naive.0 + naive.1);
     let contrast = log_variation(input.stimulus, Some(&display))
         / log_variation(input.stimulus, None).max(1e-12);
-    let gap = (estimate.ct / naive_ct).ln();
+    let ct = estimate.ct.unwrap_or(f64::NAN);
+    let gap = (ct / naive_ct).ln();
     let explained = if gap.abs() > 1e-6 {
         contrast.ln() / gap
     } else {
         1.0
     };
-    estimate.assumptions = vec![
+    estimate.assumptions.splice(0..0, [
         format!(
             "screen pixels map 1:1 onto sensor pixels; the stimulus clock starts {:.6} s into the recording (found from the event bursts at its refreshes)",
             offset_us as f64 * 1e-6
@@ -529,7 +532,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             display.white_dn
         ),
         "ideal pixels (no mismatch, noise or bandwidth); v2e lin-log response".into(),
-    ];
+    ]);
     if hot > 0 {
         estimate
             .assumptions
@@ -569,7 +572,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             display.black_level,
             contrast,
             100.0 * explained,
-            estimate.ct
+            ct
         )),
     );
     progress("done", 1.0);

@@ -144,25 +144,38 @@ pub fn fit(
         PixelParams::ideal(default, default)
     } else {
         progress("starting thresholds (estimate aps)", 0.05);
-        match aps::estimate(&aps_input, &options.aps, &|_, _| {}) {
-            Ok(found) => {
-                let e = &found.estimate;
+        let found = aps::estimate(&aps_input, &options.aps, &|_, _| {}).and_then(|found| {
+            let e = found.estimate;
+            match e.thresholds() {
+                Some(t) => Ok((e, t)),
+                None => Err(FitError::new(
+                    format!(
+                        "estimate aps determined no thresholds: {}",
+                        e.why.values().cloned().collect::<Vec<_>>().join("; ")
+                    ),
+                    "",
+                )),
+            }
+        });
+        match found {
+            Ok((e, (ct_on, ct_off))) => {
                 mismatch_estimate = e.ct_sigma.zip(e.ct_sigma_ci95);
+                let ci = |c: Option<crate::estimate::Interval>| {
+                    let [lo, hi] = c.unwrap_or([None, None]);
+                    let side = |v: Option<f64>| v.map_or("open".to_string(), |v| format!("{v:.4}"));
+                    format!("[{}, {}]", side(lo), side(hi))
+                };
                 steps.push(Step {
                     effect: "thresholds".into(),
                     evidence: format!(
-                        "estimate aps: ON {:.4} [{:.4}, {:.4}], OFF {:.4} [{:.4}, {:.4}]",
-                        e.ct_on,
-                        e.ct_on_ci95[0],
-                        e.ct_on_ci95[1],
-                        e.ct_off,
-                        e.ct_off_ci95[0],
-                        e.ct_off_ci95[1]
+                        "estimate aps: ON {ct_on:.4} {}, OFF {ct_off:.4} {}",
+                        ci(e.ct_on_ci95),
+                        ci(e.ct_off_ci95)
                     ),
                     score: 0.0,
                     parameters: BTreeMap::from([
-                        ("ct_on".to_string(), e.ct_on),
-                        ("ct_off".to_string(), e.ct_off),
+                        ("ct_on".to_string(), ct_on),
+                        ("ct_off".to_string(), ct_off),
                     ]),
                     error_before: None,
                     error_after: None,
@@ -173,7 +186,7 @@ pub fn fit(
                     residuals_before: None,
                     residuals_after: None,
                 });
-                PixelParams::ideal(e.ct_on, e.ct_off)
+                PixelParams::ideal(ct_on, ct_off)
             }
             Err(error) => {
                 steps.push(Step {

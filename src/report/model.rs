@@ -104,7 +104,11 @@ impl SequenceReport {
         }
         ["aps", "screen", "eppps"]
             .into_iter()
-            .find_map(|m| self.estimate(m).map(|e| (e.ct_on, e.ct_off, e.method)))
+            .find_map(|m| {
+                let e = self.estimate(m)?;
+                let (on, off) = e.thresholds()?;
+                Some((on, off, e.method))
+            })
     }
 }
 
@@ -181,7 +185,7 @@ pub fn datasets(sequences: &[SequenceReport]) -> Vec<DatasetReport> {
             for method in ["aps", "eppps", "screen"] {
                 let values: Vec<f64> = members
                     .iter()
-                    .filter_map(|s| s.estimate(method).map(|e| e.ct))
+                    .filter_map(|s| s.estimate(method).and_then(|e| e.ct))
                     .collect();
                 if let Some(summary) = Summary::of(&values) {
                     ct.insert(method.to_string(), summary);

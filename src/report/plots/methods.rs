@@ -5,15 +5,18 @@ use super::style::*;
 use super::{DrawResult, FONT, Figure, err};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use crate::estimate::Interval;
 use std::fmt::Write as _;
 
 /// One method's thresholds with their 95 % intervals.
 pub(super) struct MethodRow {
     pub(super) method: String,
-    pub(super) on: f64,
-    pub(super) on_ci95: Option<[f64; 2]>,
-    pub(super) off: f64,
-    pub(super) off_ci95: Option<[f64; 2]>,
+    /// `None`: not determinable.
+    pub(super) on: Option<f64>,
+    /// A side is `None` where the interval is open (an extrapolation): drawn to the axis.
+    pub(super) on_ci95: Option<Interval>,
+    pub(super) off: Option<f64>,
+    pub(super) off_ci95: Option<Interval>,
 }
 
 /// The thresholds of every method of a sequence.
@@ -33,6 +36,7 @@ impl Figure for Methods {
                     .into_iter()
                     .chain(r.on_ci95.into_iter().flatten())
                     .chain(r.off_ci95.into_iter().flatten())
+                    .flatten()
             })
             .chain(self.truth.into_iter().flat_map(|t| [t.0, t.1]))
             .filter(|v| v.is_finite())
@@ -81,24 +85,41 @@ impl Figure for Methods {
             (-0.1, PALETTE[0], "ON", 0usize),
             (0.1, PALETTE[1], "OFF", 1usize),
         ] {
-            let points: Vec<(f64, f64, Option<[f64; 2]>)> = self
+            let points: Vec<(f64, f64, Option<Interval>)> = self
                 .rows
                 .iter()
                 .enumerate()
-                .map(|(k, r)| {
+                .filter_map(|(k, r)| {
                     let (v, ci) = if pick == 0 {
                         (r.on, r.on_ci95)
                     } else {
                         (r.off, r.off_ci95)
                     };
-                    (k as f64 + shift, v, ci)
+                    Some((k as f64 + shift, v?, ci))
                 })
                 .collect();
+            // an open side runs to the axis, drawn thinner
+            let (bottom, top) = (0.0, hi);
             chart
-                .draw_series(points.iter().filter_map(|(x, _, ci)| {
-                    ci.map(|[lo, hi]| {
-                        PathElement::new([(*x, lo), (*x, hi)], colour.stroke_width(2))
-                    })
+                .draw_series(points.iter().filter_map(|(x, v, ci)| {
+                    let [lo, up] = (*ci)?;
+                    Some(PathElement::new(
+                        [(*x, lo.unwrap_or(*v)), (*x, up.unwrap_or(*v))],
+                        colour.stroke_width(2),
+                    ))
+                }))
+                .map_err(err)?;
+            chart
+                .draw_series(points.iter().flat_map(|(x, v, ci)| {
+                    let [lo, up] = ci.unwrap_or([Some(*v), Some(*v)]);
+                    [
+                        lo.is_none().then(|| (bottom, *v)),
+                        up.is_none().then(|| (*v, top)),
+                    ]
+                    .into_iter()
+                    .flatten()
+                    .map(|(a, b)| PathElement::new([(*x, a), (*x, b)], colour.mix(0.5).stroke_width(1)))
+                    .collect::<Vec<_>>()
                 }))
                 .map_err(err)?;
             chart
@@ -117,15 +138,19 @@ impl Figure for Methods {
 
     fn csv(&self) -> String {
         let mut out = String::from("method,ct_on,ct_on_lo,ct_on_hi,ct_off,ct_off_lo,ct_off_hi\n");
-        let ci = |c: Option<[f64; 2]>| c.map_or(",".to_string(), |[a, b]| format!("{a},{b}"));
+        let ci = |c: Option<Interval>| {
+            let side = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
+            c.map_or(",".to_string(), |[a, b]| format!("{},{}", side(a), side(b)))
+        };
+        let value = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
         for r in &self.rows {
             let _ = writeln!(
                 out,
                 "{},{},{},{},{}",
                 r.method,
-                r.on,
+                value(r.on),
                 ci(r.on_ci95),
-                r.off,
+                value(r.off),
                 ci(r.off_ci95)
             );
         }

@@ -130,7 +130,7 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
             &Calibration {
                 curve,
                 recording,
-                estimate: e.ct,
+                estimate: e.ct.unwrap_or(f64::NAN),
             },
         ));
     }
@@ -141,9 +141,9 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
         .map(|e| MethodRow {
             method: e.method.to_string(),
             on: e.ct_on,
-            on_ci95: Some(e.ct_on_ci95),
+            on_ci95: e.ct_on_ci95,
             off: e.ct_off,
-            off_ci95: Some(e.ct_off_ci95),
+            off_ci95: e.ct_off_ci95,
         })
         .collect();
     if let Some(f) = &s.fit {
@@ -151,13 +151,13 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
             f.uncertainties
                 .get(key)
                 .and_then(|u| u.standard_error)
-                .map(|se| [v - 1.96 * se, v + 1.96 * se])
+                .map(|se| [Some(v - 1.96 * se), Some(v + 1.96 * se)])
         };
         rows.push(MethodRow {
             method: "fit".into(),
-            on: f.params.ct_on,
+            on: Some(f.params.ct_on),
             on_ci95: ci("ct_on", f.params.ct_on),
-            off: f.params.ct_off,
+            off: Some(f.params.ct_off),
             off_ci95: ci("ct_off", f.params.ct_off),
         });
     }
