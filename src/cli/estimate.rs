@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 pub enum EstimateCommand {
     /// From the recording's grey frames: re-simulation and event timing, per-pixel maps.
     Aps(ApsArgs),
-    /// From events per pixel per second, against simulated scenes of matched dynamics.
+    /// From events per pixel of travel, against line scans through the frames or natural images.
     Eppps(EpppsArgs),
     /// From a recording of the `calib checkerboard` stimulus on a monitor.
     Screen(ScreenArgs),
@@ -26,11 +26,13 @@ pub enum EstimateCommand {
 pub struct EpppsArgs {
     #[command(flatten)]
     pub common: CommonArgs,
-    /// Measure the dynamics from the events even when the recording has frames.
+    /// Measure the flow from the events and use the natural-image prior even when the
+    /// recording has frames.
     #[arg(long)]
     pub ignore_frames: bool,
-    /// Calibration scene samples.
-    #[arg(long, value_name = "N", default_value_t = 4)]
+    /// Natural images of the prior to calibrate against (without frames), at most all of
+    /// them.
+    #[arg(long, value_name = "N", default_value_t = ctcal::estimate::eppps::prior::COUNT)]
     pub scenes: usize,
     /// Use at most this many frames for the dynamics.
     #[arg(long, value_name = "N", default_value_t = 120)]
@@ -163,8 +165,9 @@ pub fn run(command: &EstimateCommand, global: &Global) -> anyhow::Result<()> {
 fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
     let common = &args.common;
     let (log_map, log_name) = common.log_map()?;
-    if args.scenes == 0 || args.scenes > 64 {
-        return Err(BadInput(format!("--scenes {} must be between 1 and 64", args.scenes)).into());
+    let most = ctcal::estimate::eppps::prior::COUNT;
+    if args.scenes == 0 || args.scenes > most {
+        return Err(BadInput(format!("--scenes {} must be between 1 and {most}", args.scenes)).into());
     }
     let policy = global.outputs([common.input.input.as_path()]);
     let loaded = common.load(

@@ -39,6 +39,19 @@ impl Measured {
         }
     }
 
+    /// A positive value whose errors are relative (standard deviations of its logarithm):
+    /// the interval is `value exp(+-1.96 total)`, asymmetric as a multiplicative error is;
+    /// `standard_error` and `systematic` hold the errors' linear sizes at the value.
+    pub fn log_normal(value: f64, ln_standard_error: f64, ln_systematic: f64) -> Self {
+        let half = z95() * ln_standard_error.hypot(ln_systematic);
+        Self {
+            value,
+            standard_error: value * ln_standard_error,
+            systematic: value * ln_systematic,
+            ci95: [value * (-half).exp(), value * half.exp()],
+        }
+    }
+
     /// The total standard deviation.
     pub fn total_error(&self) -> f64 {
         self.standard_error.hypot(self.systematic)

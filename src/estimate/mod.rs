@@ -164,7 +164,23 @@ fn checked(
             )),
         ));
     }
-    Ok((m.value, [lo.or(Some(0.0)), Some(m.ci95[1])], None))
+    // an interval that runs past the range is open on that side
+    let (mut ci, mut notes) = ([lo.or(Some(0.0)), Some(m.ci95[1])], Vec::new());
+    if m.ci95[1] > range.hi {
+        ci[1] = None;
+        notes.push(format!(
+            "the 95 % interval of {name} runs past {} (up to {}): open above",
+            range.what, range.hi
+        ));
+    }
+    if range.lo > 0.0 && m.ci95[0] < range.lo {
+        ci[0] = None;
+        notes.push(format!(
+            "the 95 % interval of {name} runs below {} (down to {}): open below",
+            range.what, range.lo
+        ));
+    }
+    Ok((m.value, ci, (!notes.is_empty()).then(|| notes.join("; "))))
 }
 
 impl CtEstimate {

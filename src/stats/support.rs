@@ -47,6 +47,21 @@ pub fn supported(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<
     flags
 }
 
+/// For each event of the time-sorted `events`, whether a neighbour fired within `window_us`
+/// before or after it: the causal filter run forwards and on the time-reversed stream. An
+/// estimator comparing counts uses it so that an edge's first event, or any event near the
+/// start of a short recording, is not taken for noise for want of a past.
+pub fn supported_two_sided(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<bool> {
+    let forward = supported(events, sensor, window_us);
+    let mut reversed = EventChunk::default();
+    for i in (0..events.len()).rev() {
+        reversed.push(-events.t[i], events.x[i], events.y[i], events.on[i]);
+    }
+    let backward = supported(&reversed, sensor, window_us);
+    let n = events.len();
+    (0..n).map(|i| forward[i] || backward[n - 1 - i]).collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -68,6 +83,11 @@ mod tests {
             .collect();
         assert_eq!(
             supported(&burst, Sensor::new(4, 4), 10_000),
+            vec![true, true, false, false]
+        );
+        // two-sided: the first event is supported by the one 5 ms after it
+        assert_eq!(
+            supported_two_sided(&events, Sensor::new(4, 4), 10_000),
             vec![true, true, false, false]
         );
     }

@@ -1,0 +1,380 @@
+//! `estimate eppps`: the contrast threshold from how many events a recording makes for the
+//! motion it shows (Stoffregen et al., ECCV 2020, Sec. 3.1 and Fig. 2: events per pixel per
+//! second against simulated scenes), with its two mismatches corrected and its prior made
+//! explicit:
+//!
+//! 1. the recording ([`recording`]): supported events per pixel of scene travel, per
+//!    polarity, over the pixels that fired (events-only) or every reliable pixel (frames):
+//!    dividing by travel removes the speed of the motion, counting only pixels that fired
+//!    removes blank and static parts of the view;
+//! 2. the calibration ([`calibration`], [`scans`]): ideal pixels along line scans with the
+//!    recording's own travel and directions, through the recording's frames when it has them
+//!    (its contrast measured) and otherwise through natural images ([`prior`]), at 25
+//!    thresholds from 0.03 to 3;
+//! 3. the threshold at which the scans make the recording's rate, per polarity; without
+//!    frames one per prior image, combined in their logarithm, and the spread between images
+//!    is the prior's share of the interval (events alone cannot separate a scene's contrast
+//!    from the threshold). The interval also holds the recording's sampling error (bootstrap
+//!    over 32 px patches) and the flow's precision.
+
+pub mod calibration;
+pub mod prior;
+pub mod recording;
+pub mod scans;
+
+use super::interval::{Measured, z95};
+use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
+use crate::estimate::frames::PreparedFrames;
+use crate::events::{EventChunk, Sensor};
+use rayon::prelude::*;
+use recording::RecordingRates;
+use scans::{CurvePoint, curve, invert, log_slope, threshold_grid};
+use serde::Serialize;
+use serde_json::json;
+
+/// The fixed presets of the paper's Fig. 2.
+pub const PRESETS: [f64; 5] = [0.2, 0.5, 0.75, 1.0, 1.5];
+
+/// Settings of `estimate eppps`.
+#[derive(Clone, Debug)]
+pub struct EpppsOptions {
+    /// Prior images used without frames (at most [`prior::COUNT`]).
+    pub scenes: usize,
+    /// Use the frames' contrast and flow when there are frames.
+    pub use_frames: bool,
+    pub seed: u64,
+}
+
+impl Default for EpppsOptions {
+    fn default() -> Self {
+        Self {
+            scenes: prior::COUNT,
+            use_frames: true,
+            seed: 2020,
+        }
+    }
+}
+
+/// What `estimate eppps` reads.
+pub struct EpppsInput<'a> {
+    pub sensor: Sensor,
+    pub events: &'a EventChunk,
+    /// The recording's frames, prepared (when it has frames and they are used).
+    pub frames: Option<&'a PreparedFrames>,
+    pub excluded: &'a [bool],
+}
+
+/// One calibration curve: what it ran through, and the curve.
+struct Calibration {
+    name: String,
+    curve: Vec<CurvePoint>,
+}
+
+/// One point of the calibration curve as reported: events per pixel per second the
+/// recording would make (its travel, its counted pixels) at threshold `ct`.
+#[derive(Clone, Debug, Serialize)]
+pub struct ReportedPoint {
+    pub ct: f64,
+    /// Mean over calibrations, and their range.
+    pub events_per_pixel_per_second: f64,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// Where the recording falls against one fixed preset of the paper's Fig. 2.
+#[derive(Clone, Debug, Serialize)]
+pub struct PresetPoint {
+    pub ct: f64,
+    pub events_per_pixel_per_second: f64,
+}
+
+/// Estimates the threshold of `input` from its events per pixel of travel.
+pub fn estimate(
+    input: &EpppsInput,
+    options: &EpppsOptions,
+    progress: Progress,
+) -> Result<CtEstimate, EstimateError> {
+    let (excluded, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
+    check_length(input.events)?;
+    progress("flow and travel", 0.0);
+    let frames = input.frames.filter(|_| options.use_frames);
+    let rates = match frames {
+        Some(f) => recording::from_frames(input.events, f, input.sensor, &excluded),
+        None => recording::from_events(input.events, input.sensor, &excluded),
+    }
+    .ok_or_else(|| {
+        EstimateError::new(
+            "no motion to measure: no part of the view has a flow that sharpens its events (a static scene, flicker or noise)",
+            "use a part of the recording where the scene or the camera moves",
+        )
+    })?;
+    progress("calibration scans", 0.3);
+    let calibrations = calibrate(frames, &rates, &excluded, options);
+    progress("inverting the calibration curves", 0.9);
+    let on = measure(&calibrations, &rates, |p| p.on_per_px, rates.on_per_px, rates.ln_se_on);
+    let off = measure(&calibrations, &rates, |p| p.off_per_px, rates.off_per_px, rates.ln_se_off);
+    let grid = threshold_grid();
+    let mut result = CtEstimate::from_parts(
+        "eppps",
+        &on.measured,
+        &off.measured,
+        Determinable {
+            lo: grid[0],
+            hi: grid[grid.len() - 1],
+            what: "the calibration curve",
+        },
+    );
+    result.assumptions.extend(assumptions(&rates, &calibrations, frames.is_some(), hot));
+    report(&mut result, &rates, &calibrations, (&on, &off), frames.is_some());
+    progress("done", 1.0);
+    Ok(result)
+}
+
+fn check_length(events: &EventChunk) -> Result<(), EstimateError> {
+    let duration = match (events.t.first(), events.t.last()) {
+        (Some(a), Some(b)) => (b - a) as f64 * 1e-6,
+        _ => 0.0,
+    };
+    if events.len() < 1000 || duration <= 0.0 {
+        return Err(EstimateError::new(
+            format!(
+                "{} events over {duration:.3} s are too few to measure a rate",
+                events.len()
+            ),
+            "use a longer part of the recording",
+        ));
+    }
+    Ok(())
+}
+
+/// The calibration curves: one through the frames, or one per prior image.
+fn calibrate(
+    frames: Option<&PreparedFrames>,
+    rates: &RecordingRates,
+    excluded: &[bool],
+    options: &EpppsOptions,
+) -> Vec<Calibration> {
+    let grid = threshold_grid();
+    match frames {
+        Some(f) => vec![Calibration {
+            name: "the recording's frames".into(),
+            curve: curve(&calibration::frame_profiles(f, excluded), &grid, false),
+        }],
+        None => prior::images(options.scenes.max(1))
+            .par_iter()
+            .enumerate()
+            .map(|(k, image)| Calibration {
+                name: image.name.to_string(),
+                curve: scans::block_curve(
+                    &image.log,
+                    &calibration::prior_blocks(&image.log, rates, options.seed + k as u64),
+                    &grid,
+                ),
+            })
+            .collect(),
+    }
+}
+
+/// One polarity's threshold: per calibration, and combined.
+struct Polarity {
+    per_calibration: Vec<Option<f64>>,
+    measured: Measured,
+    /// Standard deviation of ln C between calibrations (the prior's spread).
+    prior_ln_sd: f64,
+}
+
+/// Inverts every calibration at the recording's `target` rate and combines them in the
+/// logarithm: the statistical error is the recording's (bootstrap), turned into threshold
+/// by the curve's slope; the systematic holds the spread between calibrations and the
+/// flow's precision.
+fn measure(
+    calibrations: &[Calibration],
+    rates: &RecordingRates,
+    rate: fn(&CurvePoint) -> f64,
+    target: f64,
+    ln_se: f64,
+) -> Polarity {
+    let per_calibration: Vec<Option<f64>> = calibrations
+        .iter()
+        .map(|c| invert(&c.curve, rate, target))
+        .collect();
+    let logs: Vec<f64> = per_calibration.iter().flatten().map(|v| v.ln()).collect();
+    if logs.len() < calibrations.len() || logs.is_empty() || !(target > 0.0) {
+        return Polarity {
+            per_calibration,
+            measured: Measured::new(f64::NAN, f64::NAN, 0.0),
+            prior_ln_sd: f64::NAN,
+        };
+    }
+    let n = logs.len() as f64;
+    let mean = logs.iter().sum::<f64>() / n;
+    let prior_ln_sd = if logs.len() > 1 {
+        (logs.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    } else {
+        0.0
+    };
+    let value = mean.exp();
+    let slope = calibrations
+        .iter()
+        .map(|c| log_slope(&c.curve, rate, value))
+        .sum::<f64>()
+        / n;
+    let stat = ln_se / slope.abs();
+    let travel = rates.travel_relative_error.hypot(rates.noise_relative_error) / slope.abs();
+    Polarity {
+        per_calibration,
+        measured: Measured::log_normal(value, stat, prior_ln_sd.hypot(travel)),
+        prior_ln_sd,
+    }
+}
+
+fn assumptions(
+    rates: &RecordingRates,
+    calibrations: &[Calibration],
+    frames: bool,
+    hot: usize,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if hot > 0 {
+        out.push(format!("{hot} hot pixels left out"));
+    }
+    out.push(format!(
+        "noise: events count at pixels with a supported event (a neighbour within {:.0} ms before or after); their unsupported events ({:.1} % of the counted) are split between noise and signal, and that +-{:.1} % is a systematic",
+        rates.support_window_us as f64 / 1e3,
+        100.0 * rates.unsupported_share,
+        100.0 * rates.noise_relative_error * 3f64.sqrt()
+    ));
+    out.push(format!(
+        "travel from the flow of {}: median speed {:.1} px/s; {}",
+        rates.flow_source,
+        rates.speed_median_px_s,
+        if frames {
+            format!("{} reliable pixels of the {} kept count", rates.counted_units, rates.kept_pixels)
+        } else {
+            format!(
+                "{} of the {} 8 x 8 px tiles have signal and count (blank or static parts of the view do not)",
+                rates.counted_units,
+                rates.kept_pixels.div_ceil(scans::TILE_PX * scans::TILE_PX)
+            )
+        },
+    ));
+    if frames {
+        out.push("calibration: ideal pixels along each pixel's own path through the frames (the scene's contrast measured); ON = OFF threshold in the scans".into());
+    } else {
+        out.push(format!(
+            "prior: events alone do not fix the scene's log contrast, so line scans through {} natural images (calib/priors/natural: {}) stand for it, with the recording's travel and flow directions; their spread between images is in the interval; a scene of unusual contrast (a printed pattern, a high-contrast lab scene) moves the threshold with it",
+            calibrations.len(),
+            calibrations.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", ")
+        ));
+        out.push(format!(
+            "prior images: sRGB decoded to linear luminance, log taken above a floor of {} % of white",
+            100.0 * prior::LUMINANCE_FLOOR
+        ));
+        out.push(format!(
+            "flow precision: half a pixel of displacement per window, or the split-half spread where larger: {:.1} % of the travel, a systematic error",
+            100.0 * rates.travel_relative_error
+        ));
+    }
+    out.push(format!(
+        "scans start from the state {} px of the same motion left (the recording is part of a longer one); ideal pixels: bandwidth, refractory period and noise of the real sensor are not in the scans",
+        scans::BURN_IN_PX
+    ));
+    out
+}
+
+/// The curve in the recording's terms: events per kept pixel per second it would make.
+fn reported_curve(rates: &RecordingRates, calibrations: &[Calibration]) -> Vec<ReportedPoint> {
+    let scale = rates.counted_travel_px / (rates.kept_pixels.max(1) as f64 * rates.duration_s.max(1e-9));
+    let grid = threshold_grid();
+    (0..grid.len())
+        .map(|k| {
+            let values: Vec<f64> = calibrations
+                .iter()
+                .map(|c| (c.curve[k].on_per_px + c.curve[k].off_per_px) * scale)
+                .collect();
+            ReportedPoint {
+                ct: grid[k],
+                events_per_pixel_per_second: values.iter().sum::<f64>() / values.len().max(1) as f64,
+                lo: values.iter().copied().fold(f64::INFINITY, f64::min),
+                hi: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+            }
+        })
+        .collect()
+}
+
+/// The reported curve at `ct`, interpolated in log-log.
+fn curve_at(curve: &[ReportedPoint], ct: f64) -> Option<f64> {
+    curve.windows(2).find(|w| w[0].ct <= ct && ct <= w[1].ct).and_then(|w| {
+        let (a, b) = (w[0].events_per_pixel_per_second, w[1].events_per_pixel_per_second);
+        (a > 0.0 && b > 0.0).then(|| {
+            let f = (ct.ln() - w[0].ct.ln()) / (w[1].ct.ln() - w[0].ct.ln());
+            (a.ln() + f * (b.ln() - a.ln())).exp()
+        })
+    })
+}
+
+fn report(
+    result: &mut CtEstimate,
+    rates: &RecordingRates,
+    calibrations: &[Calibration],
+    (on, off): (&Polarity, &Polarity),
+    frames_used: bool,
+) {
+    let curve = reported_curve(rates, calibrations);
+    let compared = (rates.on_per_px + rates.off_per_px) * rates.counted_travel_px
+        / (rates.kept_pixels.max(1) as f64 * rates.duration_s.max(1e-9));
+    let presets: Vec<PresetPoint> = PRESETS
+        .iter()
+        .filter_map(|&ct| {
+            Some(PresetPoint {
+                ct,
+                events_per_pixel_per_second: curve_at(&curve, ct)?,
+            })
+        })
+        .collect();
+    let position = presets
+        .windows(2)
+        .find(|w| w[0].events_per_pixel_per_second >= compared && compared >= w[1].events_per_pixel_per_second)
+        .map(|w| format!("between the presets CT {} and CT {}", w[0].ct, w[1].ct))
+        .unwrap_or_else(|| match presets.first() {
+            Some(p) if compared > p.events_per_pixel_per_second => {
+                format!("above the CT {} preset", PRESETS[0])
+            }
+            _ => format!("below the CT {} preset", PRESETS[PRESETS.len() - 1]),
+        });
+    result.estimators = vec![EstimatorReport {
+        name: "events_per_pixel_of_travel",
+        description: "the threshold at which ideal pixels along line scans with the recording's travel make its supported ON (OFF) events per pixel of travel; one per calibration, combined in the logarithm",
+        ct_on: on.measured.clone(),
+        ct_off: off.measured.clone(),
+        frame_rate_series_on: Vec::new(),
+        frame_rate_series_off: Vec::new(),
+        details: json!({
+            "calibrations": calibrations.iter().map(|c| c.name.clone()).collect::<Vec<_>>(),
+            "per_calibration_on": on.per_calibration,
+            "per_calibration_off": off.per_calibration,
+            "prior_ln_sd_on": on.prior_ln_sd,
+            "prior_ln_sd_off": off.prior_ln_sd,
+            "z95": z95(),
+        }),
+    }];
+    result.extra.insert("calibration_curve".into(), json!(curve));
+    result.extra.insert("presets".into(), json!(presets));
+    result.extra.insert("preset_position".into(), json!(position));
+    result.extra.insert(
+        "recording".into(),
+        json!({
+            "events_per_pixel_per_second": compared,
+            "supported_events_per_pixel_per_second": rates.events_per_pixel_per_second,
+            "on_per_pixel_of_travel": rates.on_per_px,
+            "off_per_pixel_of_travel": rates.off_per_px,
+            "counted_units": rates.counted_units,
+            "counted_unit": if frames_used { "pixel" } else { "8 x 8 px tile" },
+            "kept_pixels": rates.kept_pixels,
+            "travel_px": rates.counted_travel_px,
+            "speed_median_px_s": rates.speed_median_px_s,
+            "flow": rates.flow_source,
+            "counted": "events with spatio-temporal support, over the pixels that count, in the windows with a flow; events_per_pixel_per_second is that count per kept pixel per second",
+        }),
+    );
+}
