@@ -15,6 +15,13 @@
 //! - Threshold noise: temporal, not frozen. When `sigma_C > 0`, every pixel draws
 //!   `C = C_p + N(0, sigma_C)` (floor 0.01) once per sample interval in which it changes, for
 //!   the polarity of that change, and uses it for all of that interval's crossings.
+//!   ESIM's search starts at `r + p C` and stops at the first level outside `(L_a, L_b]`, so
+//!   a draw smaller than the change already gained since the last crossing (`C < L_a - r`)
+//!   fires nothing and leaves `r` where it was; on a monotonic ramp the pixel then stays
+//!   silent until the signal turns. On the side-by-side texture of `tests/cli/peers.rs`
+//!   (C = 0.3) the default `sigma_C` = 0.021 gives 3130 events against 4614 without noise
+//!   (-32 %); without noise ESIM matches ctcal's ideal pixel with the eps response (4598:
+//!   ties where 8-bit frames return to a level exactly).
 //! - Refractory: a crossing less than `refractory_period_ns` after the pixel's last event is
 //!   dropped, but the reference still moves to it (the change is lost, not delayed). A
 //!   last-event time of exactly 0 counts as "never fired", as in ESIM.

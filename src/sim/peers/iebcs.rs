@@ -34,7 +34,18 @@
 //! - No leak.
 //!
 //! Random draws use ctcal's generators (numpy's cannot be reproduced), so agreement with
-//! the Python code is statistical.
+//! the Python code is statistical. Side by side with the real code (`DvsSensor.update(E,
+//! 1000)` with `initCamera`'s `NOISE_FREQ` noise) on 40 frames (1 kHz) of a 64x48 texture
+//! moving at (300, 120) px/s, 20 seeds each (`tests/cli/peers.rs` rechecks the counts):
+//!
+//! | input, parameters | real: events (sd), ON | ctcal: events (sd), ON | count-map corr. (real vs real) |
+//! |---|---|---|---|
+//! | 8-bit frames, the example's | 2732.4 (7.9), 1184.7 | 2730.7 (9.7), 1186.7 | 0.940 (0.938) |
+//! | frames at 15 %, the example's | 3029.0 (16.1), 1328.2 | 3034.8 (14.0), 1333.2 | 0.906 (0.897) |
+//! | 8-bit frames; th_noise 0.05, jit 50, ref 500, bgnp 5, bgnn 2 | 3514.1 (23.9), 1762.5 | 3500.9 (28.1), 1755.5 | 0.555 (0.567) |
+//!
+//! Events per 1 ms bin correlate at 0.982, 0.986 and 0.927 (real vs real 0.981, 0.988,
+//! 0.934).
 
 use super::super::rng::{Stream, generator};
 use super::super::{FrameSource, SimError};

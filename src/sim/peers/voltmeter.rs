@@ -32,6 +32,17 @@
 //! DVS240 only; it has none for the DVXplorer. Random draws use ctcal's generators (the
 //! code's torch draws cannot be reproduced), so agreement with the Python code is
 //! statistical.
+//!
+//! Side by side with the real code (`EventSim.generate_events`, torch 2.15, DAVIS346
+//! parameters) on 40 frames (1 kHz) of a 64x48 texture moving at (300, 120) px/s, 20 seeds
+//! each (`tests/cli/peers.rs` rechecks the counts):
+//!
+//! | input | real: events (sd), ON | ctcal: events (sd), ON | count-map corr. (real vs real) |
+//! |---|---|---|---|
+//! | 8-bit frames | 6450.0 (2.8), 2892.8 | 6449.1 (2.2), 2892.2 | 0.9986 (0.9982) |
+//! | frames at 15 % | 1728.5 (1.3), 772.7 | 1728.4 (1.2), 772.6 | 0.9993 (1.0000) |
+//!
+//! Events per 1 ms bin correlate at 0.9995 and 0.9993 (real vs real 0.9997, 0.9994).
 
 use super::super::rng::{Stream, generator};
 use super::super::{FrameSource, SimError};
