@@ -28,9 +28,24 @@
 //! - Noise (`NOISE_FREQ`, what `initCamera` sets up): every pixel fires ON noise exactly
 //!   every `1e6 / bgnp` us and OFF noise every `1e6 / bgnn` us, with a uniform random phase,
 //!   at most one of each per frame interval; a noise event resets `v` and `v_ref` to the
-//!   current frame's `ln(E + 1)` and ignores the refractory period. (The example then loads
-//!   measured noise distributions, `data/noise_*_161lux.npy`; those data are not bundled
-//!   with ctcal, so this model is not offered. A rate of 0 here means no noise.)
+//!   current frame's `ln(E + 1)` and ignores the refractory period. A rate of 0 here means
+//!   no noise.
+//! - Noise (`NOISE_MEASURE`, `init_bgn_hist`, which the example uses with
+//!   `data/noise_{pos,neg}_161lux.npy`): with `noise_distributions` given, each pixel takes a
+//!   random row of the measured ON and of the OFF cumulative distributions over 72 frequency
+//!   bins (1..9 x 10^-3 .. 10^4 Hz), normalised by its second-to-last bin (an empty row means
+//!   0.001 Hz), and each delay to its next noise event is `1e6 / f` us for the first bin
+//!   whose cumulative value reaches a uniform draw; the first is that delay times a uniform
+//!   draw. Rows are assigned as IEBCS indexes them: a random row for each of the `W H`
+//!   indices, pixel (x, y) taking index `x H + y` for its first delay and `y H + x` for the
+//!   later ones (wrapped modulo `W H` for a sensor taller than wide, where IEBCS would
+//!   fail). So a pixel's first delay comes from another distribution than its later
+//!   ones, and since two thirds of the 161 lux ON rows are empty (0.001 Hz), two thirds of
+//!   the pixels stay silent for their first (up to 1e9 us) delay: over 2 s (2000 frames)
+//!   of a static 64x48 scene the real code makes 382.3 noise events (sd 46, 10 seeds) and
+//!   this one 368.8 (sd 24), against 646 at the long-run mean rate (0.105 Hz ON, 0.002 Hz
+//!   OFF); on the moving texture below, 2732.4 (sd 10.1) and 2729.9 events. ctcal does not
+//!   bundle those data files: give their paths.
 //! - No leak.
 //!
 //! Random draws use ctcal's generators (numpy's cannot be reproduced), so agreement with
@@ -53,6 +68,7 @@ use crate::events::EventChunk;
 use rand::{Rng, RngExt};
 use rand_distr::{Distribution, Normal, StandardNormal};
 use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
 /// IEBCS's sensor parameters (the arguments of `DvsSensor.initCamera`), with the example's
 /// values, plus the illuminance the example maps 255 DN to.
@@ -79,6 +95,10 @@ pub struct Params {
     pub bgnn_hz: f64,
     /// Illuminance of 255 DN, lux (the example's `/ 255.0 * 1e4`).
     pub lux_at_255: f64,
+    /// Measured ON and OFF noise distributions (`.npy`, last axis 72) for the
+    /// `NOISE_MEASURE` model, instead of the fixed rates `bgnp_hz` and `bgnn_hz`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_distributions: Option<[PathBuf; 2]>,
 }
 
 impl Default for Params {
@@ -94,6 +114,7 @@ impl Default for Params {
             bgnp_hz: 0.1,
             bgnn_hz: 0.01,
             lux_at_255: 1e4,
+            noise_distributions: None,
         }
     }
 }
@@ -112,6 +133,27 @@ impl Params {
     /// The noise period in us (`np.uint64(1e6 / rate)`), `None` for no noise.
     fn noise_period(rate_hz: f64) -> Option<u64> {
         (rate_hz > 0.0).then(|| ((1e6 / rate_hz) as u64).max(1))
+    }
+
+    /// The noise model these parameters ask for (reading the distributions, if any).
+    fn noise_model(&self) -> Result<NoiseModel, SimError> {
+        Ok(match &self.noise_distributions {
+            None => NoiseModel::Freq([
+                Self::noise_period(self.bgnp_hz),
+                Self::noise_period(self.bgnn_hz),
+            ]),
+            Some([on, off]) => {
+                NoiseModel::Measured([Distributions::read(on)?, Distributions::read(off)?])
+            }
+        })
+    }
+
+    /// The mean ON and OFF noise rates of a pixel, Hz.
+    pub fn noise_rates(&self) -> Result<[f64; 2], SimError> {
+        Ok(match self.noise_model()? {
+            NoiseModel::Freq(_) => [self.bgnp_hz, self.bgnn_hz],
+            NoiseModel::Measured([on, off]) => [on.mean_rate_hz(), off.mean_rate_hz()],
+        })
     }
 
     pub(super) fn check(&self) -> Result<(), SimError> {
@@ -138,6 +180,83 @@ impl Params {
     }
 }
 
+/// IEBCS's 72 noise frequency bins (`FREQ`): 1..9 x 10^d Hz for d = -3..4.
+pub fn noise_bin_hz(k: usize) -> f64 {
+    (k % 9 + 1) as f64 * 10f64.powi(k as i32 / 9 - 3)
+}
+
+/// Where noise events come from.
+enum NoiseModel {
+    /// `NOISE_FREQ`: fixed ON and OFF periods, us.
+    Freq([Option<u64>; 2]),
+    /// `NOISE_MEASURE`: ON and OFF distributions.
+    Measured([Distributions; 2]),
+}
+
+/// Normalised cumulative noise distributions, one row per measured pixel.
+struct Distributions {
+    rows: Vec<[f64; 72]>,
+}
+
+impl Distributions {
+    /// Reads a `.npy` array whose last axis has IEBCS's 72 bins and normalises each row
+    /// as `init_bgn_hist` does.
+    fn read(path: &Path) -> Result<Self, SimError> {
+        let fix =
+            "give IEBCS's data/noise_pos_*.npy and data/noise_neg_*.npy (float64, last axis 72)";
+        let array = ndarray_npy::read_npy::<_, ndarray::ArrayD<f64>>(path).map_err(|e| {
+            SimError::file(path, format!("cannot read the distributions: {e}"), fix)
+        })?;
+        if array.shape().last() != Some(&72) || array.is_empty() {
+            return Err(SimError::file(
+                path,
+                format!("shape {:?} does not end in 72 bins", array.shape()),
+                fix,
+            ));
+        }
+        let flat: Vec<f64> = array.iter().copied().collect();
+        let rows = flat
+            .chunks_exact(72)
+            .map(|chunk| {
+                let mut row: [f64; 72] = chunk.try_into().expect("72 values");
+                if row.iter().sum::<f64>() == 0.0 || row[70] <= 0.0 {
+                    // empty (or unnormalisable): all mass in the first, 0.001 Hz bin
+                    row = [0.0; 72];
+                    row[0] = 1.0;
+                } else {
+                    let total = row[70];
+                    row.iter_mut().for_each(|v| *v /= total);
+                }
+                row
+            })
+            .collect();
+        Ok(Self { rows })
+    }
+
+    /// `get_next_noise`: the delay (us) to a pixel's next noise event from row `row`.
+    fn next_delay(&self, row: u32, rng: &mut impl Rng) -> u64 {
+        let u: f64 = rng.random();
+        let cumulative = &self.rows[row as usize];
+        let k = cumulative.iter().position(|&c| c >= u).unwrap_or(70);
+        (1e6 / noise_bin_hz(k)) as u64
+    }
+
+    /// The noise rate of a pixel with a random row: the mean over rows of one over the
+    /// mean delay, Hz.
+    fn mean_rate_hz(&self) -> f64 {
+        let rate = |row: &[f64; 72]| {
+            let mut previous = 0.0;
+            let mut mean_delay_s = 0.0;
+            for (k, &c) in row.iter().enumerate().take(71) {
+                mean_delay_s += (c.min(1.0) - previous).max(0.0) / noise_bin_hz(k);
+                previous = previous.max(c.min(1.0));
+            }
+            1.0 / mean_delay_s
+        };
+        self.rows.iter().map(rate).sum::<f64>() / self.rows.len() as f64
+    }
+}
+
 /// One IEBCS pixel (the per-pixel arrays of `DvsSensor`).
 #[derive(Clone, Copy, Debug)]
 struct Pixel {
@@ -154,6 +273,8 @@ struct Pixel {
     tau_p: f64,
     bgn_pos_next: u64,
     bgn_neg_next: u64,
+    /// The pixel's rows of the ON and OFF distributions (`NOISE_MEASURE`).
+    noise_rows: [u32; 2],
 }
 
 /// What the sensor holds besides its pixels.
@@ -162,7 +283,7 @@ struct Sensor<'a, R> {
     rng: R,
     on_threshold: Normal<f64>,
     off_threshold: Normal<f64>,
-    periods: [Option<u64>; 2],
+    noise: NoiseModel,
 }
 
 impl<R: Rng> Sensor<'_, R> {
@@ -172,6 +293,15 @@ impl<R: Rng> Sensor<'_, R> {
 
     fn draw_off(&mut self) -> f64 {
         self.off_threshold.sample(&mut self.rng).clamp(-1000.0, 0.0)
+    }
+
+    /// The delay from a noise event of polarity `k` (0 ON, 1 OFF) to the next, `None` for
+    /// no noise.
+    fn noise_delay(&mut self, k: usize, row: u32) -> Option<u64> {
+        match &self.noise {
+            NoiseModel::Freq(periods) => periods[k],
+            NoiseModel::Measured(d) => Some(d[k].next_delay(row, &mut self.rng)),
+        }
     }
 
     /// `get_latency_tau`: the delay from `time_px` to the event, us.
@@ -214,22 +344,23 @@ impl<R: Rng> Sensor<'_, R> {
         if p.cur_ref < end {
             end_refractory(p);
         }
-        // background noise (NOISE_FREQ)
-        for (on, period) in [(true, self.periods[0]), (false, self.periods[1])] {
-            let next = if on {
-                &mut p.bgn_pos_next
-            } else {
-                &mut p.bgn_neg_next
-            };
-            if let Some(period) = period
-                && end > *next
-            {
-                emit(*next, on);
-                p.time_px = *next;
-                *next += period;
-                p.cur_v = img_l;
-                p.last_v = img_l;
+        // background noise (check_noise, check_noise_hist)
+        for (k, on) in [(0, true), (1, false)] {
+            let next = if on { p.bgn_pos_next } else { p.bgn_neg_next };
+            if end <= next {
+                continue;
             }
+            emit(next, on);
+            p.time_px = next;
+            let after =
+                next.saturating_add(self.noise_delay(k, p.noise_rows[k]).unwrap_or(u64::MAX));
+            if on {
+                p.bgn_pos_next = after;
+            } else {
+                p.bgn_neg_next = after;
+            }
+            p.cur_v = img_l;
+            p.last_v = img_l;
         }
         let target = if lit { settle(p, end) } else { 0.0 };
         let dif = target - p.last_v;
@@ -265,6 +396,51 @@ impl<R: Rng> Sensor<'_, R> {
     }
 }
 
+/// Every pixel's first noise times (`init_bgn`, `init_bgn_hist`): a uniform phase within
+/// the period, or, for measured distributions, a random row for each of the `W H` indices,
+/// pixel (x, y) drawing its first delay (times a uniform fraction) from index `x H + y` and
+/// keeping index `y H + x` (modulo `W H`) for the later ones, as IEBCS indexes them.
+fn first_noise(pixels: &mut [Pixel], (w, h): (usize, usize), noise: &NoiseModel, seed: u64) {
+    let mut rng = generator(seed, Stream::Thresholds, 1);
+    match noise {
+        NoiseModel::Freq(periods) => {
+            for (k, period) in periods.iter().enumerate() {
+                for p in pixels.iter_mut() {
+                    let phase = period.map_or(u64::MAX, |period| rng.random_range(0..period));
+                    *if k == 0 {
+                        &mut p.bgn_pos_next
+                    } else {
+                        &mut p.bgn_neg_next
+                    } = phase;
+                }
+            }
+        }
+        NoiseModel::Measured(distributions) => {
+            let tables: Vec<Vec<u32>> = distributions
+                .iter()
+                .map(|d| {
+                    (0..w * h)
+                        .map(|_| rng.random_range(0..d.rows.len() as u32))
+                        .collect()
+                })
+                .collect();
+            for (i, p) in pixels.iter_mut().enumerate() {
+                let (x, y) = (i % w, i / w);
+                for (k, d) in distributions.iter().enumerate() {
+                    p.noise_rows[k] = tables[k][(y * h + x) % (w * h)];
+                    let delay = d.next_delay(tables[k][x * h + y], &mut rng) as f64;
+                    let first = (delay * rng.random::<f64>()) as u64;
+                    *if k == 0 {
+                        &mut p.bgn_pos_next
+                    } else {
+                        &mut p.bgn_neg_next
+                    } = first;
+                }
+            }
+        }
+    }
+}
+
 /// Runs IEBCS over `source`: the first sample initialises the sensor (`init_image`), each
 /// later one is an `update` over the time since the previous sample.
 pub fn simulate(
@@ -277,20 +453,15 @@ pub fn simulate(
     let Some(first) = source.next_frame()? else {
         return Err(SimError::Invalid("the input has no frames".into()));
     };
-    let periods = [
-        Params::noise_period(params.bgnp_hz),
-        Params::noise_period(params.bgnn_hz),
-    ];
+    let noise = params.noise_model()?;
     let normal = |mean: f64| Normal::new(mean, params.th_noise).expect("checked finite");
     let mut sensor = Sensor {
         params,
         rng: generator(seed, Stream::Rows, 1),
         on_threshold: normal(params.th_pos),
         off_threshold: normal(-params.th_neg),
-        periods,
+        noise,
     };
-    let mut init = generator(seed, Stream::Thresholds, 1);
-    let mut phase = |period: Option<u64>| period.map_or(u64::MAX, |p| init.random_range(0..p));
     let mut pixels: Vec<Pixel> = first
         .dn
         .iter()
@@ -305,11 +476,13 @@ pub fn simulate(
                 cur_ref: NOT_REFRACTORY,
                 time_px: 0,
                 tau_p: params.tau_us * 1e3 / (lux + 1.0),
-                bgn_pos_next: phase(periods[0]),
-                bgn_neg_next: phase(periods[1]),
+                bgn_pos_next: u64::MAX,
+                bgn_neg_next: u64::MAX,
+                noise_rows: [0, 0],
             }
         })
         .collect();
+    first_noise(&mut pixels, source.size(), &sensor.noise, seed);
     for p in &mut pixels {
         p.th_pos = sensor.draw_on();
     }
@@ -461,5 +634,58 @@ mod tests {
         assert_eq!(a, run(&p, &times, &dn, 5));
         assert!(a.is_time_sorted());
         assert!(a.len() > 10, "{}", a.len());
+    }
+
+    #[test]
+    fn measured_noise_draws_delays_from_each_pixels_distribution() {
+        // ON rows: one all at the 10 Hz bin (k = 36), one empty (0.001 Hz); OFF: empty.
+        // Over 2 s of a static 8x8 scene a pixel whose first-delay index (x H + y) and
+        // later index (y H + x) both drew the 10 Hz row fires exactly 20 ON events 100 ms
+        // apart; with only the first, one; with an empty first row, none (its first delay is
+        // a fraction of 1e9 us)
+        let dir = tempfile::tempdir().unwrap();
+        let mut on = ndarray::Array3::<f64>::zeros((1, 2, 72));
+        for k in 36..71 {
+            on[[0, 0, k]] = 3.0;
+        }
+        let off = ndarray::Array3::<f64>::zeros((1, 2, 72));
+        let paths = [dir.path().join("pos.npy"), dir.path().join("neg.npy")];
+        ndarray_npy::write_npy(&paths[0], &on).unwrap();
+        ndarray_npy::write_npy(&paths[1], &off).unwrap();
+        assert_eq!(noise_bin_hz(36), 10.0);
+        let p = Params {
+            noise_distributions: Some(paths),
+            ..quiet()
+        };
+        let rates = p.noise_rates().unwrap();
+        assert!((rates[0] - (10.0 + 0.001) / 2.0).abs() < 1e-9, "{rates:?}");
+        assert!((rates[1] - 0.001).abs() < 1e-12);
+        let times: Vec<i64> = (0..=2000).map(|k| k * 1000).collect();
+        let samples: Vec<Sample> = times
+            .iter()
+            .map(|&t| Sample {
+                t,
+                dn: vec![80.0; 64],
+                transition: Transition::Linear,
+            })
+            .collect();
+        let events = simulate(&mut ReplaySamples::new(&samples, 8, 8), &p, 2).unwrap();
+        assert!(events.on.iter().all(|&on| on));
+        let mut per_pixel = [0usize; 64];
+        for e in events.iter() {
+            per_pixel[e.y as usize * 8 + e.x as usize] += 1;
+        }
+        assert!(
+            per_pixel.iter().all(|&n| [0, 1, 20].contains(&n)),
+            "{per_pixel:?}"
+        );
+        // a quarter each of 20 and 1 (binomial sd 3.5); the diagonal uses one index twice
+        let with = |count| per_pixel.iter().filter(|&&n| n == count).count();
+        assert!(
+            (5..=28).contains(&with(20)) && (5..=28).contains(&with(1)),
+            "{per_pixel:?}"
+        );
+        let diagonal_ones = (0..8).filter(|&i| per_pixel[i * 9] == 1).count();
+        assert_eq!(diagonal_ones, 0);
     }
 }

@@ -65,9 +65,10 @@ impl Peer {
         }
     }
 
-    /// The peer's parameters in ctcal's terms.
-    pub fn truth(&self) -> Truth {
-        match self {
+    /// The peer's parameters in ctcal's terms (reading IEBCS's measured noise
+    /// distributions, if it is given them, for their mean rates).
+    pub fn truth(&self) -> Result<Truth, SimError> {
+        Ok(match self {
             Peer::Esim(p) => Truth {
                 ct_on: p.contrast_threshold_pos,
                 ct_off: p.contrast_threshold_neg,
@@ -103,6 +104,15 @@ impl Peer {
             }
             Peer::Iebcs(p) => {
                 let offset = 255.0 / p.lux_at_255;
+                let [on_rate_hz, off_rate_hz] = p.noise_rates()?;
+                let model = match &p.noise_distributions {
+                    None => "fixed period per pixel, random phase; resets the pixel".into(),
+                    Some([on, off]) => format!(
+                        "measured distributions {} and {}, a random row per pixel; resets the pixel",
+                        on.display(),
+                        off.display()
+                    ),
+                };
                 Truth {
                     ct_on: p.th_pos,
                     ct_off: p.th_neg,
@@ -115,9 +125,9 @@ impl Peer {
                         semantics: "drop",
                     },
                     noise: Noise {
-                        on_rate_hz: p.bgnp_hz,
-                        off_rate_hz: p.bgnn_hz,
-                        model: "fixed period per pixel, random phase; resets the pixel".into(),
+                        on_rate_hz,
+                        off_rate_hz,
+                        model,
                     },
                     cutoff: Some(Cutoff {
                         hz_at_255: (p.lux_at_255 + 1.0) * 1e3 / (std::f64::consts::TAU * p.tau_us),
@@ -130,7 +140,7 @@ impl Peer {
                     ..Truth::ideal()
                 }
             }
-        }
+        })
     }
 }
 
@@ -284,7 +294,7 @@ pub fn write_case(
         ctcal_version: env!("CARGO_PKG_VERSION"),
         simulator,
         source: source_ref,
-        truth: peer.truth(),
+        truth: peer.truth()?,
         peer: peer.clone(),
         seed,
         scene: scene.clone(),
@@ -309,15 +319,17 @@ mod tests {
 
     #[test]
     fn truths_are_in_log_units_of_the_compared_quantity() {
-        let esim = Peer::Esim(esim::Params::default()).truth();
+        let esim = Peer::Esim(esim::Params::default()).truth().unwrap();
         assert_eq!((esim.ct_on, esim.ct_sigma), (1.0, 0.021));
         assert!((esim.log_offset_dn.unwrap() - 0.255).abs() < 1e-12);
-        let volt = Peer::Voltmeter(voltmeter::Params::dvs346()).truth();
+        let volt = Peer::Voltmeter(voltmeter::Params::dvs346())
+            .truth()
+            .unwrap();
         assert!((volt.ct_on - 1.0 / 5.265).abs() < 1e-12);
         assert_eq!(volt.log_offset_dn, Some(20.0));
         assert!((volt.leak.on_rate_hz - 0.1).abs() < 1e-12);
         assert!((volt.leak.on_rate_hz_per_dn - 0.005).abs() < 1e-12);
-        let iebcs = Peer::Iebcs(iebcs::Params::default()).truth();
+        let iebcs = Peer::Iebcs(iebcs::Params::default()).truth().unwrap();
         assert_eq!(iebcs.ct_on, 0.4);
         assert!((iebcs.refractory.period_s - 1e-4).abs() < 1e-15);
         assert!((iebcs.log_offset_dn.unwrap() - 0.0255).abs() < 1e-12);
