@@ -5,7 +5,8 @@
 //!
 //! - Log response: the image is read as `I = DN / 255` (float) and the pixel compares
 //!   `L = ln(eps + I)` (`use_log_image`, `log_eps` = 1e-3 by default), i.e. `ln(DN + 255 eps)`
-//!   up to a constant: `log_offset_dn = 0.255`. Without `use_log_image` it compares `I`.
+//!   up to a constant: `log_offset_dn = 0.255`. Without `use_log_image` it compares `I`
+//!   (thresholds in units of `DN / 255`, no log offset).
 //! - Time discretisation: between two samples `L` is linear in time. Every pixel keeps a
 //!   reference `r` (the last crossing level, starting at the first image); when
 //!   `|L_b - L_a| > 1e-6` the crossings `r + k p C` (`p` the sign of `L_b - L_a`) that lie in
@@ -28,6 +29,9 @@
 //! - No leak, no shot noise, no bandwidth limit, no latency.
 //!
 //! Event times: ESIM works in nanoseconds; ctcal rounds them to the nearest microsecond.
+//! The input is taken as given: ESIM's own renderer and adaptive frame sampling
+//! (`simulation_adaptive_sampling_lambda`) are not reproduced, so the frame rate is the
+//! scene's `render_hz`.
 
 use super::super::rng::{Stream, generator};
 use super::super::{FrameSource, SimError};

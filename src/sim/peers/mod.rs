@@ -8,7 +8,7 @@
 //! |---|---|---|---|---|---|---|
 //! | ESIM | `ln(DN/255 + 1e-3)` | redrawn per pixel per frame interval | drops events, reference moves | none | none | none |
 //! | DVS-Voltmeter | `k1 ln(DN + k2)` in volts, threshold 1 | none (diffusion) | none | `k4 + k5 DN` | none | diffusion `k3 sqrt(DN)/(DN+k2) + k6` |
-//! | IEBCS | `ln(DN/255 * 1e4 + 1)` | redrawn after every event | drops changes, reference reset at its end | none | low-pass `tau (1 klux / E)`, latency + jitter | fixed-rate ON/OFF |
+//! | IEBCS | `ln(DN/255 * 1e4 + 1)` | redrawn after every event | drops changes, reference reset at its end | none | low-pass `tau (1 klux / E)`, latency + jitter | fixed-rate or measured ON/OFF |
 //!
 //! [`write_case`] renders a scene through one of them into an IJRR folder with the truth in
 //! ctcal's terms (`params.json`, [`CaseTruth`]).
