@@ -11,6 +11,7 @@ pub mod effects;
 pub mod fast_math;
 pub mod log_response;
 pub mod params;
+pub mod peers;
 pub mod pixel;
 pub mod rng;
 mod row;

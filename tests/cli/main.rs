@@ -8,6 +8,7 @@ mod errors;
 mod estimate;
 mod fit;
 mod limits;
+mod peers;
 mod readers;
 mod report;
 mod safety;
