@@ -199,7 +199,7 @@ pub fn estimate(
             None => "exposure unknown (give --exposure-s); frames treated as instantaneous".into(),
         }
     ));
-    assumptions.push("between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity (no gamma, no black offset)".into());
+    assumptions.push("between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity up to the offset b (no gamma: a gamma scales every log change alike, so it cannot be told from the thresholds by events and frames; frames encoded with gamma g give thresholds 1/g times the true ones)".into());
 
     progress("event timing and re-simulation", 0.2);
     let full = run_pass(input, &excluded, &frames, options, None)?;
@@ -291,13 +291,13 @@ pub fn estimate(
     let timing_series_off = series(&|p| Some(p.timing.off.ct));
     let (bias_on, bias_off, sigma_bias) = calibration.map_or((0.0, 0.0, 0.0), |c| c);
     let timing_measure =
-        |estimate: f64, se: f64, bias: f64, series: &[FrameRatePoint], alignment: f64| {
+        |estimate: f64, se: f64, bias: f64, series: &[FrameRatePoint], alignment: f64, offset: f64| {
             let (_, frame_rate) = frame_rate_systematic(series);
             // half the applied correction stays in the interval
             Measured::new(
                 estimate - bias,
                 se,
-                frame_rate.hypot(0.5 * bias).hypot(alignment),
+                frame_rate.hypot(0.5 * bias).hypot(alignment).hypot(offset),
             )
         };
     let timing_on = timing_measure(
@@ -306,6 +306,7 @@ pub fn estimate(
         bias_on,
         &timing_series_on,
         alignment_systematic.0,
+        full.timing.on.offset_systematic,
     );
     let timing_off = timing_measure(
         full.timing.off.ct,
@@ -313,6 +314,7 @@ pub fn estimate(
         bias_off,
         &timing_series_off,
         alignment_systematic.1,
+        full.timing.off.offset_systematic,
     );
     let mut estimators = vec![EstimatorReport {
         name: "event_timing",
@@ -336,15 +338,21 @@ pub fn estimate(
     if let Some(r) = &full.resim {
         let series_on = series(&|p| p.resim.as_ref().map(|r| r.ct_on));
         let series_off = series(&|p| p.resim.as_ref().map(|r| r.ct_off));
+        // the offset moves the re-simulation as it moves the timing (the same frames
+        // through the same log)
         let on = Measured::new(
             r.ct_on,
             r.standard_error_on,
-            frame_rate_systematic(&series_on).1,
+            frame_rate_systematic(&series_on)
+                .1
+                .hypot(full.timing.on.offset_systematic),
         );
         let off = Measured::new(
             r.ct_off,
             r.standard_error_off,
-            frame_rate_systematic(&series_off).1,
+            frame_rate_systematic(&series_off)
+                .1
+                .hypot(full.timing.off.offset_systematic),
         );
         on_estimates.push(on.clone());
         off_estimates.push(off.clone());
@@ -416,6 +424,24 @@ pub fn estimate(
         json!({"value": frames.offset, "estimate": offset_report}),
     );
     estimate.extra.insert(
+        "photoreceptor_lag".into(),
+        json!({
+            "tau_times_dn_s": full.timing.lag.tau_times_dn,
+            "standard_error": full.timing.lag.standard_error,
+            "cutoff_hz_at_median_dn": full.timing.lag.cutoff_hz_at_median_dn,
+            "meaning": "the photoreceptor's lag behind the light, tau = tau_times_dn / (DN + b), measured from how pairs of events straddling a change of speed deviate; taken out of the thresholds",
+        }),
+    );
+    estimate.extra.insert(
+        "leak_drift".into(),
+        json!({
+            "log_units_per_second_at_median_dn": full.timing.drift.at_median_dn,
+            "standard_error": full.timing.drift.standard_error,
+            "per_dn": full.timing.drift.per_dn,
+            "meaning": "the memorised level's downward drift the event timing measured (ON events come early, OFF late); taken out of the thresholds",
+        }),
+    );
+    estimate.extra.insert(
         "time_span_s".into(),
         json!([
             us_to_s(frames.times[0]),
@@ -433,13 +459,13 @@ pub fn estimate(
 pub struct Prepared {
     pub frames: PreparedFrames,
     pub alignment: Option<super::align::Alignment>,
-    pub offset: Option<super::offset::BlackOffset>,
+    pub offset: Option<super::timing::Offset>,
     pub assumptions: Vec<String>,
 }
 
 /// Prepares `input.frames` as every frame-based method needs them: selection and flow
-/// ([`PreparedFrames`]), the frame-time alignment ([`super::align`]) and the black offset
-/// ([`super::offset`]), each unless `options` sets it.
+/// ([`PreparedFrames`]), the frame-time alignment ([`super::align`]) and the log offset
+/// `b` of `ln(DN + b)` ([`super::timing`]), each unless `options` sets it.
 pub fn prepare(
     input: &ApsInput,
     excluded: &[bool],
@@ -482,40 +508,53 @@ pub fn prepare(
             found
         }
     };
-    let black = super::offset::clipped_black_share(&frames);
-    let mut offset_report = None;
-    match options.frame_offset_dn {
+    let offset = match options.frame_offset_dn {
         Some(o) => {
             frames.offset = o as f32;
-            assumptions.push(format!(
-                "frames offset by {o} DN before the log (--frame-offset-dn)"
-            ));
+            frames.offset_range = (o as f32, o as f32);
+            assumptions.push(format!("frames offset by {o} DN before the log (as given)"));
+            None
         }
-        None if black >= super::offset::CLIPPED_BLACK_SHARE => {
-            match super::offset::estimate(input.events, &frames, input.sensor, excluded) {
-                Some(found) => {
-                    frames.offset = found.offset_dn as f32;
-                    assumptions.push(format!(
-                        "{:.1} % of frame pixels are clipped at 0 DN: a black level was subtracted; {:.1} DN restored before the log (the offset that makes thresholds independent of brightness; --frame-offset-dn overrides)",
-                        100.0 * black,
-                        found.offset_dn
-                    ));
-                    offset_report = Some(found);
-                }
-                None => assumptions.push(format!(
-                    "{:.1} % of frame pixels are clipped at 0 DN (a subtracted black level?), but the events do not determine an offset; none applied (--frame-offset-dn sets one)",
-                    100.0 * black
-                )),
+        None => {
+            let fitting = TimingOptions {
+                fit_offset: true,
+                ..options.timing.clone()
+            };
+            let found = super::timing::estimate(input.events, &frames, input.sensor, excluded, &fitting)
+                .map(|t| t.offset);
+            if let Some(o) = &found {
+                frames.offset = o.offset_dn;
+                frames.offset_range = o.systematic_range;
+                assumptions.push(offset_assumption(o));
             }
+            found
         }
-        None => {}
-    }
+    };
     Ok(Prepared {
         frames,
         alignment,
-        offset: offset_report,
+        offset,
         assumptions,
     })
+}
+
+/// The offset, in words for the assumptions.
+fn offset_assumption(o: &super::timing::Offset) -> String {
+    let side = |v: Option<f32>| v.map_or("open".to_string(), |v| format!("{v:.1}"));
+    match o.source {
+        "fitted" => format!(
+            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN is in their intervals",
+            o.offset_dn,
+            side(o.ci95[0]),
+            side(o.ci95[1]),
+            o.systematic_range.0,
+            o.systematic_range.1
+        ),
+        _ => format!(
+            "the frames' log offset b in ln(DN + b) is not determined (no offset makes the thresholds independent of brightness); b = {:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",
+            o.offset_dn, o.systematic_range.0, o.systematic_range.1
+        ),
+    }
 }
 
 /// The timing estimator's bias, found by running the same pipeline on a simulation of the

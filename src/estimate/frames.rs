@@ -78,8 +78,11 @@ pub struct PreparedFrames {
     pub intervals: Vec<IntervalInfo>,
     pub log_map: LogMap,
     /// DN added to every frame value before the log response (a subtracted black level
-    /// restored, [`super::offset`]).
+    /// restored, found by [`super::timing`]).
     pub offset: f32,
+    /// The offsets the thresholds' systematic error spans (the offset's 95 % interval, or
+    /// its prior range where the data do not bound it).
+    pub offset_range: (f32, f32),
 }
 
 impl PreparedFrames {
@@ -176,6 +179,7 @@ impl PreparedFrames {
             intervals,
             log_map,
             offset: 0.0,
+            offset_range: (0.0, 0.0),
         };
         if !prepared.intervals.iter().any(|i| i.used) {
             let reasons: Vec<String> = prepared
@@ -251,6 +255,7 @@ impl PreparedFrames {
             intervals,
             log_map: self.log_map,
             offset: self.offset,
+            offset_range: self.offset_range,
         })
     }
 

@@ -18,7 +18,6 @@ pub mod frames;
 pub mod image;
 pub mod interval;
 pub mod lsq;
-pub mod offset;
 pub mod resim;
 pub mod screen;
 pub mod timing;

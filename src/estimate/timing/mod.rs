@@ -1,0 +1,528 @@
+//! Contrast thresholds from event timing, per pixel.
+//!
+//! At each event the pixel's memorised level moves by exactly one threshold to the level the
+//! photoreceptor has at that moment (the remainder is kept), so between two consecutive
+//! events of one pixel, at `t_i` and `t_j`, its log intensity changed by exactly
+//! `L(t_j) - L(t_i) = +Cp` if the second event is ON and `-Cn` if it is OFF, whatever the
+//! first one was (Lichtsteiner et al., JSSC 2008; the "event generation model" of Gallego et
+//! al., TPAMI 2022). Measuring `L` at the event times from the frames, interpolated along the
+//! optical flow ([`crate::estimate::frames`]), gives one sample of the pixel's threshold per
+//! event ([`samples`]).
+//!
+//! The samples are fitted together ([`model`]): the thresholds, the leak drift (which makes
+//! ON events come early and OFF events late, in proportion to the time between them) and the
+//! frames' log offset `b` in `ln(DN + b)` (the one at which thresholds do not depend on
+//! brightness; its interval, and what it does to the thresholds, are reported). Per pixel
+//! the corrected samples are averaged into threshold maps; the frozen mismatch `ct_sigma` is
+//! the spread of the map with each pixel's estimation noise removed: `sigma^2 = Var_p(C_p) -
+//! mean_p(s^2 / n_p)`, `s^2` the pooled within-pixel variance of the samples.
+
+pub mod model;
+pub mod samples;
+
+use crate::estimate::frames::PreparedFrames;
+use crate::events::{EventChunk, Sensor, TimeUs};
+use model::{Coefficients, fit_at, offset_interval, offset_root, resampled_weights};
+use samples::{Pair, collect};
+use serde::Serialize;
+
+/// Settings of the timing estimator.
+#[derive(Clone, Debug)]
+pub struct TimingOptions {
+    /// Spatio-temporal support window for noise rejection (`None`: keep every event).
+    pub support_window_us: Option<TimeUs>,
+    /// Kept samples lie within this fraction of the mode on either side... below: mode *
+    /// (1 - window), above: mode * (1 + 2 window).
+    pub mode_window: f64,
+    /// Bootstrap resamples for the statistical interval.
+    pub bootstrap: usize,
+    /// Fit the frames' log offset (else the frames' own, `PreparedFrames::offset`, is used).
+    pub fit_offset: bool,
+    /// Fit the leak drift.
+    pub fit_leak: bool,
+}
+
+impl Default for TimingOptions {
+    fn default() -> Self {
+        Self {
+            support_window_us: None,
+            mode_window: 0.5,
+            bootstrap: 200,
+            fit_offset: false,
+            fit_leak: true,
+        }
+    }
+}
+
+/// The threshold estimate of one polarity.
+#[derive(Clone, Debug, Serialize)]
+pub struct PolarityEstimate {
+    /// Mean over pixels of each pixel's threshold.
+    pub ct: f64,
+    /// Standard error of `ct` (bootstrap over pixels).
+    pub standard_error: f64,
+    /// How far `ct` moves across the offset's 95 % interval (half the range), a systematic.
+    pub offset_systematic: f64,
+    /// Frozen mismatch, estimation noise removed.
+    pub sigma: f64,
+    pub sigma_standard_error: f64,
+    /// Samples kept, and pixels with at least one.
+    pub samples: usize,
+    pub pixels: usize,
+    /// Samples rejected as noise (outside the mode window).
+    pub rejected: usize,
+    /// Robust relative spread of the kept samples (1.4826 MAD / mode): how consistently the
+    /// frames explain the events.
+    pub sample_spread: f64,
+}
+
+/// Per-pixel thresholds (NaN without a sample) and sample counts, row-major.
+#[derive(Clone, Debug)]
+pub struct ThresholdMaps {
+    pub width: usize,
+    pub height: usize,
+    pub ct_on: Vec<f32>,
+    pub ct_off: Vec<f32>,
+    pub count: Vec<u32>,
+}
+
+/// The frames' log offset as the timing found (or was given) it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Offset {
+    /// DN added to the frames before the log.
+    pub offset_dn: f32,
+    /// Its 95 % interval; a side is `None` where the data do not bound it.
+    pub ci95: [Option<f32>; 2],
+    /// The offsets the thresholds' systematic error spans: the interval, with the prior
+    /// range ([`OFFSET_PRIOR`]) where the data leave a side open.
+    pub systematic_range: (f32, f32),
+    /// `fitted`, `given` (by the caller), or `not determined` (the thresholds do not become
+    /// independent of brightness at any offset: the frames' own kept, the prior range spanned).
+    pub source: &'static str,
+}
+
+/// The range of offsets taken where the data do not bound it, DN: from none to the largest
+/// met in practice with margin. DVS-Voltmeter's fits to real sensors put it at 20 (DAVIS346)
+/// and 23 (DVS240) in 8-bit DN (Lin et al., ECCV 2022, `config.py`); DAVIS APS frames are
+/// written with a black level of some tens of DN subtracted.
+pub const OFFSET_PRIOR: (f32, f32) = (0.0, 60.0);
+
+/// The leak drift the timing found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Drift {
+    /// Log units per second at DN 0, and its growth per DN.
+    pub at_zero_dn: f64,
+    pub per_dn: f64,
+    /// At the frames' median DN, with its bootstrap standard error.
+    pub at_median_dn: f64,
+    pub standard_error: f64,
+}
+
+/// Result of the timing estimator.
+#[derive(Clone, Debug)]
+pub struct TimingEstimate {
+    pub on: PolarityEstimate,
+    pub off: PolarityEstimate,
+    pub maps: ThresholdMaps,
+    pub offset: Offset,
+    pub drift: Drift,
+    pub lag: Lag,
+}
+
+/// The photoreceptor lag the timing found.
+#[derive(Clone, Debug, Serialize)]
+pub struct Lag {
+    /// `tau (DN + b)`, seconds x DN, with its bootstrap standard error.
+    pub tau_times_dn: f64,
+    pub standard_error: f64,
+    /// The cutoff it stands for at the frames' median DN, Hz (`None` where the lag is not
+    /// positive).
+    pub cutoff_hz_at_median_dn: Option<f64>,
+}
+
+/// The offsets the data may choose from when they constrain it, DN (a black level above
+/// the frame's range would make no sense).
+const OFFSET_SEARCH: (f32, f32) = (-0.9, 255.0);
+
+/// Estimates per-pixel thresholds from the timing of `events` (time-sorted) against
+/// `frames`. Pixels where `excluded` is set (hot pixels, outside a region) are left out.
+/// `None` when there are too few samples.
+pub fn estimate(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    excluded: &[bool],
+    options: &TimingOptions,
+) -> Option<TimingEstimate> {
+    let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
+    let pixels = sensor.pixels();
+    let fit = |b: f32| {
+        fit_at(&pairs, &frames.log_map, b, options.mode_window, pixels, options.fit_leak)
+    };
+    let offset = find_offset(&pairs, frames, options, &fit);
+    let (coefficients, values, weights) = fit(offset.offset_dn)?;
+    // the thresholds across the offset's interval
+    let (lo, hi) = offset.systematic_range;
+    let ends: Vec<Coefficients> = [lo, hi]
+        .iter()
+        .filter(|&&b| b != offset.offset_dn)
+        .filter_map(|&b| fit(b).map(|f| f.0))
+        .collect();
+    let shift = |pick: fn(&Coefficients) -> f64| {
+        ends.iter()
+            .map(|e| (pick(e) - pick(&coefficients)).abs())
+            .fold(0.0, f64::max)
+            / 1.96
+    };
+    let boot = bootstrap(&pairs, &values, &weights, pixels, options);
+    let on = polarity(&pairs, &values, &weights, &coefficients, true, sensor)?;
+    let off = polarity(&pairs, &values, &weights, &coefficients, false, sensor)?;
+    let median_dn = median_level(&pairs);
+    let cutoff = coefficients.cutoff_hz(median_dn, offset.offset_dn as f64);
+    let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
+    Some(TimingEstimate {
+        on: PolarityEstimate {
+            standard_error: boot.on,
+            offset_systematic: shift(|c| c.c_on),
+            sigma_standard_error: boot.sigma_on,
+            ..on.0
+        },
+        off: PolarityEstimate {
+            standard_error: boot.off,
+            offset_systematic: shift(|c| c.c_off),
+            sigma_standard_error: boot.sigma_off,
+            ..off.0
+        },
+        maps: maps(sensor, &on.1, &off.1),
+        offset,
+        lag: Lag {
+            tau_times_dn: coefficients.lag,
+            standard_error: boot.lag,
+            cutoff_hz_at_median_dn: cutoff,
+        },
+        drift: Drift {
+            at_zero_dn: coefficients.drift,
+            per_dn: coefficients.drift_per_dn,
+            at_median_dn: drift_at_median(&coefficients),
+            standard_error: boot.drift,
+        },
+    })
+}
+
+/// The offset: fitted (root of the level slope, interval from its bootstrap error), given,
+/// or not determined (the frames' own kept; its interval the whole search range).
+fn find_offset(
+    pairs: &[Pair],
+    frames: &PreparedFrames,
+    options: &TimingOptions,
+    fit: &dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)>,
+) -> Offset {
+    if !options.fit_offset {
+        return Offset {
+            offset_dn: frames.offset,
+            ci95: [Some(frames.offset); 2],
+            systematic_range: frames.offset_range,
+            source: "given",
+        };
+    }
+    let not_determined = Offset {
+        offset_dn: frames.offset,
+        ci95: [None, None],
+        systematic_range: OFFSET_PRIOR,
+        source: "not determined",
+    };
+    let floor = pairs
+        .iter()
+        .map(|p| p.dn0.min(p.dn1))
+        .fold(f32::INFINITY, f32::min);
+    let range = (OFFSET_SEARCH.0 * floor.max(0.0), OFFSET_SEARCH.1);
+    let slope = |b: f32| fit(b).map(|f| f.0.level_slope);
+    let Some(root) = offset_root(&slope, range) else {
+        return not_determined;
+    };
+    // the slope's bootstrap error at the root
+    let Some((_, values, weights)) = fit(root) else {
+        return not_determined;
+    };
+    let pixels = frames.width * frames.height;
+    let slopes: Vec<f64> = (0..40)
+        .filter_map(|k| {
+            let w = resampled_weights(pairs, &weights, pixels, 500 + k);
+            model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.level_slope)
+        })
+        .collect();
+    let bound = 1.96 * std_dev(&slopes);
+    let ci95 = offset_interval(&slope, root, bound, range);
+    Offset {
+        offset_dn: root,
+        ci95,
+        systematic_range: (
+            ci95[0].unwrap_or(OFFSET_PRIOR.0.min(root)),
+            ci95[1].unwrap_or(OFFSET_PRIOR.1.max(root)),
+        ),
+        source: "fitted",
+    }
+}
+
+/// Bootstrap standard errors over pixels (the fit's pairs and values fixed).
+struct Bootstrap {
+    on: f64,
+    off: f64,
+    sigma_on: f64,
+    sigma_off: f64,
+    drift: f64,
+    lag: f64,
+}
+
+fn bootstrap(
+    pairs: &[Pair],
+    values: &model::Values,
+    weights: &[f64],
+    pixels: usize,
+    options: &TimingOptions,
+) -> Bootstrap {
+    let mut draws: Vec<[f64; 6]> = Vec::with_capacity(options.bootstrap);
+    let median_dn = median_level(pairs);
+    for k in 0..options.bootstrap {
+        let w = resampled_weights(pairs, weights, pixels, 11 + k as u64);
+        let Some(c) = model::fit(pairs, values, &w, options.fit_leak) else {
+            continue;
+        };
+        let sigma = |on: bool| pixel_sums(pairs, values, &w, &c, on).map_or(0.0, |s| mean_and_sigma(&s.0).1);
+        draws.push([
+            c.c_on,
+            c.c_off,
+            sigma(true),
+            sigma(false),
+            c.drift + c.drift_per_dn * median_dn,
+            c.lag,
+        ]);
+    }
+    let sd = |k: usize| std_dev(&draws.iter().map(|d| d[k]).collect::<Vec<_>>());
+    Bootstrap {
+        on: sd(0),
+        off: sd(1),
+        sigma_on: sd(2),
+        sigma_off: sd(3),
+        drift: sd(4),
+        lag: sd(5),
+    }
+}
+
+/// The median DN of the pairs' middles.
+fn median_level(pairs: &[Pair]) -> f64 {
+    let mut levels: Vec<f32> = pairs.iter().map(|p| 0.5 * (p.dn0 + p.dn1)).collect();
+    if levels.is_empty() {
+        return 0.0;
+    }
+    let mid = levels.len() / 2;
+    *levels.select_nth_unstable_by(mid, f32::total_cmp).1 as f64
+}
+
+/// Per-pixel (sum, count, sum of squares) of the corrected kept samples of one polarity,
+/// with every pixel drawn `weight * n` times (1 when the weights are the fit's own), and the
+/// pixel of each entry.
+type PixelSums = (Vec<(f64, u32, f64)>, Vec<usize>);
+
+fn pixel_sums(
+    pairs: &[Pair],
+    values: &model::Values,
+    weight: &[f64],
+    c: &Coefficients,
+    on: bool,
+) -> Option<PixelSums> {
+    let mut by_pixel: std::collections::BTreeMap<u32, (f64, u32, f64, f64)> = Default::default();
+    for (i, p) in pairs.iter().enumerate() {
+        if p.on != on || weight[i] <= 0.0 {
+            continue;
+        }
+        let v = c.corrected(p, values, i);
+        let e = by_pixel.entry(p.pixel).or_default();
+        e.0 += v;
+        e.1 += 1;
+        e.2 += v * v;
+        e.3 += weight[i];
+    }
+    let mut sums = Vec::new();
+    let mut which = Vec::new();
+    for (pixel, (s, n, sq, w)) in by_pixel {
+        // a pixel drawn m times weighs m (its pairs' weights sum to m)
+        for _ in 0..(w.round() as usize).max(1) {
+            sums.push((s, n, sq));
+            which.push(pixel as usize);
+        }
+    }
+    (sums.len() >= 10).then_some((sums, which))
+}
+
+/// One polarity's estimate and its per-pixel sums.
+fn polarity(
+    pairs: &[Pair],
+    values: &model::Values,
+    weight: &[f64],
+    c: &Coefficients,
+    on: bool,
+    sensor: Sensor,
+) -> Option<(PolarityEstimate, Vec<(f64, u32)>)> {
+    let (sums, which) = pixel_sums(pairs, values, weight, c, on)?;
+    let (_, sigma) = mean_and_sigma(&sums);
+    let ct = if on { c.c_on } else { c.c_off };
+    let own: Vec<(usize, f64)> = pairs
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.on == on)
+        .map(|(i, _)| (i, c.corrected(&pairs[i], values, i)))
+        .collect();
+    let kept: Vec<f64> = own.iter().filter(|(i, _)| weight[*i] > 0.0).map(|v| v.1).collect();
+    let mut deviations: Vec<f64> = kept.iter().map(|v| (v - ct).abs()).collect();
+    let sample_spread = if deviations.is_empty() {
+        f64::NAN
+    } else {
+        let mid = deviations.len() / 2;
+        1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1 / ct
+    };
+    let mut map = vec![(0.0, 0u32); sensor.pixels()];
+    for ((s, n, _), &p) in sums.iter().zip(&which) {
+        map[p] = (*s, *n);
+    }
+    Some((
+        PolarityEstimate {
+            ct,
+            standard_error: 0.0,
+            offset_systematic: 0.0,
+            sigma,
+            sigma_standard_error: 0.0,
+            samples: kept.len(),
+            pixels: sums.len(),
+            rejected: own.len() - kept.len(),
+            sample_spread,
+        },
+        map,
+    ))
+}
+
+fn maps(sensor: Sensor, on: &[(f64, u32)], off: &[(f64, u32)]) -> ThresholdMaps {
+    let mean = |v: &[(f64, u32)]| -> Vec<f32> {
+        v.iter()
+            .map(|&(s, n)| if n > 0 { (s / n as f64) as f32 } else { f32::NAN })
+            .collect()
+    };
+    ThresholdMaps {
+        width: sensor.width as usize,
+        height: sensor.height as usize,
+        ct_on: mean(on),
+        ct_off: mean(off),
+        count: on.iter().zip(off).map(|(a, b)| a.1 + b.1).collect(),
+    }
+}
+
+/// How consistently the frames explain the events: the mean over polarities of the robust
+/// relative spread of the samples around their mode, at the frames' own offset (smallest
+/// when the frames' times are aligned with the events'). `None` with too few samples.
+pub fn spread(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    excluded: &[bool],
+    options: &TimingOptions,
+) -> Option<f64> {
+    let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
+    let values = model::values(&pairs, &frames.log_map, frames.offset);
+    let mut total = 0.0;
+    for on in [true, false] {
+        let own: Vec<f64> = pairs
+            .iter()
+            .zip(&values.y)
+            .filter(|(p, _)| p.on == on)
+            .map(|(_, &v)| v)
+            .collect();
+        let m = model::mode(&own, options.mode_window / 2.0)?;
+        let (lo, hi) = (m * (1.0 - options.mode_window), m * (1.0 + 2.0 * options.mode_window));
+        let mut deviations: Vec<f64> = own
+            .iter()
+            .filter(|&&v| v >= lo && v <= hi)
+            .map(|v| (v - m).abs())
+            .collect();
+        if deviations.len() < 10 {
+            return None;
+        }
+        let mid = deviations.len() / 2;
+        total += 0.5 * 1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1 / m;
+    }
+    Some(total)
+}
+
+/// The mean of per-pixel thresholds and the frozen spread with estimation noise removed,
+/// from per-pixel (sum, count, sum of squares).
+fn mean_and_sigma(pixels: &[(f64, u32, f64)]) -> (f64, f64) {
+    let n = pixels.len() as f64;
+    let means: Vec<f64> = pixels.iter().map(|&(s, c, _)| s / c as f64).collect();
+    let mean = means.iter().sum::<f64>() / n;
+    let between = means.iter().map(|m| (m - mean).powi(2)).sum::<f64>() / (n - 1.0).max(1.0);
+    // pooled within-pixel variance over pixels with two samples or more
+    let (mut within, mut dof) = (0.0, 0.0);
+    for &(s, c, sq) in pixels {
+        if c >= 2 {
+            within += sq - s * s / c as f64;
+            dof += (c - 1) as f64;
+        }
+    }
+    let pooled = if dof > 0.0 { within / dof } else { 0.0 };
+    let noise = pixels
+        .iter()
+        .map(|&(_, c, _)| pooled / c as f64)
+        .sum::<f64>()
+        / n;
+    (mean, (between - noise).max(0.0).sqrt())
+}
+
+fn std_dev(values: &[f64]) -> f64 {
+    if values.len() < 2 {
+        return 0.0;
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sigma_removes_the_estimation_noise_of_each_pixel() {
+        // every pixel has the same threshold 0.3 and two samples, each off by +-0.05 (all
+        // four combinations equally often): the pixel means spread by 0.035, all of it noise
+        let sample = |i: usize, bit: usize| if (i >> bit) & 1 == 0 { 0.35 } else { 0.25 };
+        let pixels: Vec<(f64, u32, f64)> = (0..1000)
+            .map(|i| {
+                let (a, b) = (sample(i, 0), sample(i, 1));
+                (a + b, 2, a * a + b * b)
+            })
+            .collect();
+        let (mean, sigma) = mean_and_sigma(&pixels);
+        assert!((mean - 0.3).abs() < 1e-3, "{mean}");
+        assert!(sigma < 0.005, "{sigma}");
+        // a real spread of 0.03 on top is recovered: shift half the pixels by +-0.03
+        let shifted: Vec<(f64, u32, f64)> = pixels
+            .iter()
+            .enumerate()
+            .map(|(i, &(s, c, _))| {
+                let d = if (i >> 2) & 1 == 0 { 0.03 } else { -0.03 };
+                let (a, b) = (sample(i, 0) + d, sample(i, 1) + d);
+                (s + 2.0 * d, c, a * a + b * b)
+            })
+            .collect();
+        let (_, sigma) = mean_and_sigma(&shifted);
+        assert!((sigma - 0.03).abs() < 0.004, "{sigma}");
+    }
+
+    #[test]
+    fn the_mode_ignores_a_broad_noise_floor() {
+        // 600 samples at 0.30 +- 0.01 and 400 spread evenly over 0..1
+        let mut values: Vec<f64> = (0..600).map(|i| 0.29 + 0.02 * (i as f64 / 600.0)).collect();
+        values.extend((0..400).map(|i| i as f64 / 400.0));
+        let m = model::mode(&values, 0.25).unwrap();
+        assert!((m - 0.30).abs() < 0.01, "{m}");
+    }
+}

@@ -1,0 +1,336 @@
+//! The event-timing model, fitted by weighted least squares over every kept pair of
+//! consecutive events ([`super::samples`]). With the frames read through `ln(DN + b)`, the
+//! log change between a pixel's two events is its threshold, less what leak added:
+//!
+//! `y = C_pol + s (D0 + D1 DN) dt + beta (level - mean level) + kappa x`
+//!
+//! - `y` the log change in the direction of the second event (positive when consistent),
+//!   `C_pol` the ON or OFF threshold;
+//! - leak drifts the memorised level down at `D = D0 + D1 DN` log units per second (v2e's
+//!   leak, and DVS-Voltmeter's which grows with brightness), so an ON event needs `D dt` less
+//!   change and an OFF event `D dt` more: `s = -1` for ON, `+1` for OFF;
+//! - `beta` the dependence on the pixel's log level: zero when the offset `b` is right,
+//!   because a threshold does not depend on brightness. The offset is the root of
+//!   `beta(b)`, its interval where `|beta|` stays within 1.96 of its bootstrap standard
+//!   error ([`offset_interval`]);
+//! - the photoreceptor's bandwidth: it follows the light with a lag `tau` that grows in the
+//!   dark (`tau ~ 1 / photocurrent ~ 1 / (DN + b)`; Lichtsteiner et al. 2008; v2e), so at an
+//!   event the frames are ahead of the pixel by `tau r`, `r` the log intensity's rate of
+//!   change there. A pair's change is then off by `tau (r_second - r_first)`: zero on a
+//!   steady ramp, large where an edge accelerates or stops. `x = s' (r1 - r0) / (DN + b)`
+//!   (`s' = +1` ON, `-1` OFF) carries it, and `kappa = tau (DN + b)` gives the cutoff,
+//!   `1 / (2 pi tau)`. Without the term a dim scene's thresholds come out high, and the
+//!   offset would absorb what is the lag.
+//!
+//! Noise events (shot noise, a neighbour's crossing, a hot pixel) break the chain; pairs far
+//! from the mode of their polarity (below `mode (1 - w)` or above `mode (1 + 2 w)`) are left
+//! out. Each pixel weighs the same in the fit (its pairs `1 / n` each), so that a pixel with
+//! a low threshold, which fires more, does not pull the thresholds down.
+
+use super::samples::Pair;
+use crate::sim::log_response::LogMap;
+use rand::{RngExt, SeedableRng};
+
+/// The fitted coefficients at one offset.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coefficients {
+    pub c_on: f64,
+    pub c_off: f64,
+    /// Leak drift at DN 0 (log units per second) and its growth per DN.
+    pub drift: f64,
+    pub drift_per_dn: f64,
+    /// Dependence on the log level (per log unit of level).
+    pub level_slope: f64,
+    /// The photoreceptor's lag times its photocurrent, `tau (DN + b)`, seconds x DN.
+    pub lag: f64,
+}
+
+impl Coefficients {
+    /// The threshold pair `i` measures, the leak's and the lag's shares taken out.
+    pub fn corrected(&self, pair: &Pair, v: &Values, i: usize) -> f64 {
+        let dn = 0.5 * (pair.dn0 + pair.dn1) as f64;
+        let s = if pair.on { -1.0 } else { 1.0 };
+        v.y[i] - s * (self.drift + self.drift_per_dn * dn) * pair.dt as f64 - self.lag * v.lag[i]
+    }
+
+    /// The photoreceptor cutoff the lag stands for at `dn` (Hz), where it is positive.
+    pub fn cutoff_hz(&self, dn: f64, b: f64) -> Option<f64> {
+        (self.lag > 0.0).then(|| (dn + b) / (std::f64::consts::TAU * self.lag))
+    }
+}
+
+/// The pairs' log changes, levels and lag covariates at offset `b`.
+pub struct Values {
+    pub y: Vec<f64>,
+    pub level: Vec<f64>,
+    pub lag: Vec<f64>,
+}
+
+pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
+    let n = pairs.len();
+    let (mut y, mut level, mut lag) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let l = |dn: f32| log.apply(dn + b) as f64;
+    for p in pairs {
+        let sign = if p.on { 1.0 } else { -1.0 };
+        y.push(sign * (l(p.dn1) - l(p.dn0)));
+        let mid = 0.5 * (p.dn0 + p.dn1);
+        level.push(l(mid));
+        let span = p.span.max(1e-6) as f64;
+        let r0 = (l(p.around[1]) - l(p.around[0])) / span;
+        let r1 = (l(p.around[3]) - l(p.around[2])) / span;
+        lag.push(sign * (r1 - r0) / (mid + b).max(1.0) as f64);
+    }
+    Values { y, level, lag }
+}
+
+/// The mode of positive `values`: from the median, repeatedly the mean within the window.
+pub fn mode(values: &[f64], window: f64) -> Option<f64> {
+    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| *v > 0.0).collect();
+    if sorted.len() < 10 {
+        return None;
+    }
+    sorted.sort_by(f64::total_cmp);
+    let mut m = sorted[sorted.len() / 2];
+    for _ in 0..50 {
+        let (lo, hi) = (m * (1.0 - window), m * (1.0 + window));
+        let a = sorted.partition_point(|&v| v < lo);
+        let b = sorted.partition_point(|&v| v <= hi);
+        if b <= a {
+            break;
+        }
+        let next = sorted[a..b].iter().sum::<f64>() / (b - a) as f64;
+        let done = (next - m).abs() < 1e-7 * m;
+        m = next;
+        if done {
+            break;
+        }
+    }
+    Some(m)
+}
+
+/// Which pairs are kept: within the window around their polarity's mode. `None` when a
+/// polarity has too few pairs for a mode.
+pub fn kept(pairs: &[Pair], y: &[f64], window: f64) -> Option<Vec<bool>> {
+    let mut keep = vec![false; pairs.len()];
+    for on in [true, false] {
+        let own: Vec<f64> = pairs.iter().zip(y).filter(|(p, _)| p.on == on).map(|(_, &v)| v).collect();
+        let m = mode(&own, window / 2.0)?;
+        let (lo, hi) = (m * (1.0 - window), m * (1.0 + 2.0 * window));
+        for (k, (p, &v)) in pairs.iter().zip(y).enumerate() {
+            if p.on == on && v >= lo && v <= hi {
+                keep[k] = true;
+            }
+        }
+    }
+    Some(keep)
+}
+
+/// Weights giving each pixel the same total: `1 / n` for its `n` kept pairs.
+pub fn pixel_weights(pairs: &[Pair], keep: &[bool], pixels: usize) -> Vec<f64> {
+    let mut n = vec![0u32; pixels];
+    for (p, &k) in pairs.iter().zip(keep) {
+        n[p.pixel as usize] += k as u32;
+    }
+    pairs
+        .iter()
+        .zip(keep)
+        .map(|(p, &k)| if k { 1.0 / n[p.pixel as usize] as f64 } else { 0.0 })
+        .collect()
+}
+
+/// Weighted least squares of the model over the pairs with positive `weight`; `leak` adds
+/// the drift columns. `None` when the system is singular.
+pub fn fit(pairs: &[Pair], v: &Values, weight: &[f64], leak: bool) -> Option<Coefficients> {
+    let wsum: f64 = weight.iter().sum();
+    if wsum <= 0.0 {
+        return None;
+    }
+    let mean_level = v.level.iter().zip(weight).map(|(l, w)| l * w).sum::<f64>() / wsum;
+    let k = if leak { 6 } else { 4 };
+    let mut xtx = nalgebra::DMatrix::<f64>::zeros(k, k);
+    let mut xty = nalgebra::DVector::<f64>::zeros(k);
+    for (i, p) in pairs.iter().enumerate() {
+        let w = weight[i];
+        if w <= 0.0 {
+            continue;
+        }
+        let s = if p.on { -1.0 } else { 1.0 };
+        let dt = p.dt as f64;
+        let dn = 0.5 * (p.dn0 + p.dn1) as f64;
+        let mut row = vec![
+            p.on as u8 as f64,
+            (!p.on) as u8 as f64,
+            v.level[i] - mean_level,
+            v.lag[i],
+        ];
+        if leak {
+            row.extend([s * dt, s * dt * dn]);
+        }
+        for a in 0..k {
+            xty[a] += w * row[a] * v.y[i];
+            for b in 0..k {
+                xtx[(a, b)] += w * row[a] * row[b];
+            }
+        }
+    }
+    let beta = xtx.lu().solve(&xty)?;
+    Some(Coefficients {
+        c_on: beta[0],
+        c_off: beta[1],
+        level_slope: beta[2],
+        lag: beta[3],
+        drift: if leak { beta[4] } else { 0.0 },
+        drift_per_dn: if leak { beta[5] } else { 0.0 },
+    })
+}
+
+/// The whole fit at offset `b`: values, kept pairs, weights and coefficients.
+pub fn fit_at(
+    pairs: &[Pair],
+    log: &LogMap,
+    b: f32,
+    window: f64,
+    pixels: usize,
+    leak: bool,
+) -> Option<(Coefficients, Values, Vec<f64>)> {
+    let v = values(pairs, log, b);
+    let keep = kept(pairs, &v.y, window)?;
+    let w = pixel_weights(pairs, &keep, pixels);
+    let c = fit(pairs, &v, &w, leak)?;
+    Some((c, v, w))
+}
+
+/// Resamples pixels with replacement: the weight of each pair multiplied by how often its
+/// pixel was drawn.
+pub fn resampled_weights(pairs: &[Pair], weight: &[f64], pixels: usize, seed: u64) -> Vec<f64> {
+    let present: Vec<u32> = {
+        let mut seen = vec![false; pixels];
+        for (p, &w) in pairs.iter().zip(weight) {
+            if w > 0.0 {
+                seen[p.pixel as usize] = true;
+            }
+        }
+        (0..pixels as u32).filter(|&p| seen[p as usize]).collect()
+    };
+    let mut times = vec![0u32; pixels];
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    for _ in 0..present.len() {
+        times[present[rng.random_range(0..present.len())] as usize] += 1;
+    }
+    pairs
+        .iter()
+        .zip(weight)
+        .map(|(p, &w)| w * times[p.pixel as usize] as f64)
+        .collect()
+}
+
+/// The offset's interval: where the level slope is within `z` of its standard error of
+/// zero, by bisection on each side of `centre` within `[lo, hi]`; a side that reaches its
+/// bound is `None` (the data do not bound the offset there).
+pub fn offset_interval(
+    slope: &dyn Fn(f32) -> Option<f64>,
+    centre: f32,
+    bound: f64,
+    (lo, hi): (f32, f32),
+) -> [Option<f32>; 2] {
+    let side = |limit: f32| -> Option<f32> {
+        let outside = |b: f32| slope(b).is_none_or(|s| s.abs() > bound);
+        if !outside(limit) {
+            return None;
+        }
+        let (mut inside, mut out) = (centre, limit);
+        for _ in 0..30 {
+            let mid = 0.5 * (inside + out);
+            if outside(mid) {
+                out = mid;
+            } else {
+                inside = mid;
+            }
+        }
+        Some(0.5 * (inside + out))
+    };
+    [side(lo), side(hi)]
+}
+
+/// The offset where the level slope crosses zero, by bisection within `[lo, hi]` (the
+/// slope rises with the offset: too small an offset exaggerates dark changes, so the
+/// thresholds fall with the level, too large one compresses them).
+pub fn offset_root(slope: &dyn Fn(f32) -> Option<f64>, (lo, hi): (f32, f32)) -> Option<f32> {
+    let (s_lo, s_hi) = (slope(lo)?, slope(hi)?);
+    if !(s_lo < 0.0 && s_hi > 0.0) {
+        return None;
+    }
+    let (mut a, mut b) = (lo, hi);
+    for _ in 0..40 {
+        let mid = 0.5 * (a + b);
+        if slope(mid)? < 0.0 {
+            a = mid;
+        } else {
+            b = mid;
+        }
+    }
+    Some(0.5 * (a + b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::LogResponse;
+
+    /// Pairs of an ideal pixel with thresholds 0.3 / 0.4 seen through `ln(DN + 25)`: each
+    /// pair's DN change is one threshold in that response, at levels from 5 to 200 DN.
+    fn pairs(drift: f64) -> Vec<Pair> {
+        let mut out = Vec::new();
+        for k in 0..4000u32 {
+            let level = 5.0 + (k % 196) as f64;
+            let on = k % 3 != 0;
+            let dt = 0.02 + 0.001 * (k % 50) as f64;
+            // the change the frames show: the threshold, less (ON) or more (OFF) the drift
+            let c = if on { 0.3 - drift * dt } else { 0.4 + drift * dt };
+            let (a, b) = if on {
+                (level, (level + 25.0) * c.exp() - 25.0)
+            } else {
+                (level, (level + 25.0) * (-c).exp() - 25.0)
+            };
+            out.push(Pair {
+                pixel: k % 1000,
+                on,
+                dn0: a as f32,
+                dn1: b as f32,
+                dt: dt as f32,
+                // a steady ramp through both events: no lag
+                around: [a as f32, a as f32, b as f32, b as f32],
+                span: 0.002,
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn the_offset_is_where_thresholds_stop_depending_on_brightness() {
+        let log = LogMap::new(LogResponse::V2e, 0.001);
+        let pairs = pairs(0.0);
+        let slope = |b: f32| fit_at(&pairs, &log, b, 0.5, 1000, false).map(|f| f.0.level_slope);
+        // without the offset the dark changes are too large: thresholds fall with the level
+        assert!(slope(0.0).unwrap() < -0.01, "{:?}", slope(0.0));
+        assert!(slope(100.0).unwrap() > 0.01, "{:?}", slope(100.0));
+        let b = offset_root(&slope, (0.0, 255.0)).unwrap();
+        assert!((b - 25.0).abs() < 0.5, "{b}");
+        let (c, _, _) = fit_at(&pairs, &log, b, 0.5, 1000, false).unwrap();
+        assert!((c.c_on - 0.3).abs() < 2e-3 && (c.c_off - 0.4).abs() < 2e-3, "{c:?}");
+    }
+
+    #[test]
+    fn leak_drift_is_taken_out_of_the_thresholds() {
+        let log = LogMap::new(LogResponse::V2e, 0.001);
+        let pairs = pairs(1.5);
+        let (c, _, _) = fit_at(&pairs, &log, 25.0, 0.5, 1000, true).unwrap();
+        assert!((c.c_on - 0.3).abs() < 2e-3 && (c.c_off - 0.4).abs() < 2e-3, "{c:?}");
+        // the drift at the pairs' middle level (the two drift terms trade off across it)
+        let at_100 = c.drift + 100.0 * c.drift_per_dn;
+        assert!((at_100 - 1.5).abs() < 0.02 && c.drift_per_dn.abs() < 1e-3, "{c:?}");
+        // without the drift term the thresholds split apart
+        let (plain, _, _) = fit_at(&pairs, &log, 25.0, 0.5, 1000, false).unwrap();
+        assert!(plain.c_on < 0.27 && plain.c_off > 0.43, "{plain:?}");
+    }
+}

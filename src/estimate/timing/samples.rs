@@ -1,0 +1,82 @@
+//! The raw material of event timing: for consecutive events of one pixel, the frame values
+//! (camera DN, interpolated along the optical flow) at both event times, the time between
+//! them and the polarity of the second. The log response is applied later, with whatever
+//! offset is being tried ([`super::model`]).
+
+use crate::estimate::frames::PreparedFrames;
+use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::stats::support::supported;
+
+/// One pair of consecutive events of a pixel.
+#[derive(Clone, Copy, Debug)]
+pub struct Pair {
+    pub pixel: u32,
+    /// Polarity of the second event.
+    pub on: bool,
+    /// Frame DN (without offset) at the first and the second event.
+    pub dn0: f32,
+    pub dn1: f32,
+    /// Seconds between the two events.
+    pub dt: f32,
+    /// DN a little before and after each event (at `t -+ h`), for the rate of change there:
+    /// `[before first, after first, before second, after second]`, and `2 h` in seconds.
+    pub around: [f32; 4],
+    pub span: f32,
+}
+
+/// Half the span over which a rate of change is measured, microseconds.
+const HALF_SPAN_US: TimeUs = 1000;
+
+/// DN just before and after `t` along the flow (one-sided at the ends of a used interval).
+fn around(frames: &PreparedFrames, x: u16, y: u16, t: TimeUs) -> Option<(f32, f32)> {
+    let before = frames.dn_at(x, y, t - HALF_SPAN_US).or_else(|| frames.dn_at(x, y, t))?;
+    let after = frames.dn_at(x, y, t + HALF_SPAN_US).or_else(|| frames.dn_at(x, y, t))?;
+    Some((before, after))
+}
+
+/// Every usable pair of `events` (time-sorted) against `frames`: both events in used
+/// intervals at a reliable pixel, and supported when `support_window_us` is set.
+pub fn collect(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    excluded: &[bool],
+    support_window_us: Option<TimeUs>,
+) -> Vec<Pair> {
+    let support = support_window_us.map(|w| supported(events, sensor, w));
+    let width = sensor.width as usize;
+    // the previous event of each pixel: its DN (NaN when unknown or noise), time, and DN
+    // around it
+    let mut previous = vec![(f32::NAN, 0 as TimeUs, (0.0f32, 0.0f32)); sensor.pixels()];
+    let mut pairs = Vec::new();
+    for i in 0..events.len() {
+        let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
+        let pixel = y as usize * width + x as usize;
+        if excluded[pixel] {
+            continue;
+        }
+        let dn = match frames.dn_at(x, y, t) {
+            Some(dn) if support.as_ref().is_none_or(|s| s[i]) => dn,
+            _ => f32::NAN,
+        };
+        let near = if dn.is_finite() {
+            around(frames, x, y, t).unwrap_or((dn, dn))
+        } else {
+            (dn, dn)
+        };
+        let (before, t_before, near_before) = previous[pixel];
+        if before.is_finite() && dn.is_finite() {
+            pairs.push(Pair {
+                pixel: pixel as u32,
+                on: events.on[i],
+                dn0: before,
+                dn1: dn,
+                dt: ((t - t_before) as f64 * 1e-6) as f32,
+                around: [near_before.0, near_before.1, near.0, near.1],
+                span: (2 * HALF_SPAN_US) as f32 * 1e-6,
+            });
+        }
+        previous[pixel] = (dn, t, near);
+    }
+    pairs
+}
