@@ -549,3 +549,157 @@ fn messages_give_the_right_advice() {
     assert!(e.contains("--format aedat4 does not fit"), "{e}");
     assert!(!e.contains("Some("), "{e}");
 }
+
+/// An `.npy` file whose header claims `shape` of `descr` values, followed by `data` bytes.
+fn npy_claiming(path: &Path, descr: &str, shape: &str, data: usize) {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    while (10 + header.len() + 1) % 64 != 0 {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.resize(bytes.len() + data, 0);
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// CRC-32 of PNG chunks.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xffff_ffffu32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// A grey PNG of `width` x `height` zeros, written row by row: a few hundred KB that decode
+/// to `width * height` bytes.
+fn png_of_zeros(path: &Path, width: u32, height: u32) {
+    use std::io::Write;
+    let mut deflate = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+    let row = vec![0u8; width as usize + 1];
+    for _ in 0..height {
+        deflate.write_all(&row).unwrap();
+    }
+    let data = deflate.finish().unwrap();
+    let chunk = |out: &mut Vec<u8>, kind: &[u8], body: &[u8]| {
+        out.extend_from_slice(&(body.len() as u32).to_be_bytes());
+        let mut typed = kind.to_vec();
+        typed.extend_from_slice(body);
+        out.extend_from_slice(&typed);
+        out.extend_from_slice(&crc32(&typed).to_be_bytes());
+    };
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]);
+    chunk(&mut png, b"IHDR", &ihdr);
+    chunk(&mut png, b"IDAT", &data);
+    chunk(&mut png, b"IEND", &[]);
+    std::fs::write(path, png).unwrap();
+}
+
+/// Every command that takes `--mask`, on the slider recording (it has frames, for `fit` and
+/// `report`); `out` is the report folder.
+fn mask_commands<'a>(input: &'a str, mask: &'a str, out: &'a str) -> Vec<Vec<&'a str>> {
+    vec![
+        vec!["stats", input, "--mask", mask],
+        vec!["estimate", "eppps", input, "--mask", mask],
+        vec!["fit", input, "--mask", mask],
+        vec!["report", input, "--no-fit", "--mask", mask, "--out", out],
+    ]
+}
+
+#[test]
+fn masks_are_checked_against_the_sensor_before_they_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    let out = dir.path().join("report");
+    let out = out.to_str().unwrap();
+    // a 1 KB .npy claiming 100000 x 100000 bytes (10 GB): used to be allocated
+    let huge = dir.path().join("huge.npy");
+    npy_claiming(&huge, "|u1", "(100000, 100000)", 1000);
+    // the sensor's shape, but the data cut short
+    let short = dir.path().join("short.npy");
+    npy_claiming(&short, "<f8", "(180, 240)", 1000);
+    // a 400 KB PNG that decodes to 20000 x 20000 (400 MB grey, 1.6 GB as RGBA)
+    let bomb = dir.path().join("bomb.png");
+    png_of_zeros(&bomb, 20_000, 20_000);
+    assert!(std::fs::metadata(&bomb).unwrap().len() < 1 << 20);
+    for (mask, expected) in [
+        (&huge, "shape (100000, 100000)"),
+        (&short, "holds 1000 bytes"),
+        (&bomb, "20000x20000"),
+    ] {
+        let mask = mask.to_str().unwrap();
+        for args in mask_commands(input, mask, out) {
+            let started = Instant::now();
+            let e = bad_input(&args);
+            assert!(
+                started.elapsed() < Duration::from_secs(20),
+                "{args:?}: {:?}",
+                started.elapsed()
+            );
+            assert!(
+                e.contains(mask) && e.contains(expected) && e.contains("fix:"),
+                "{args:?}: {e}"
+            );
+        }
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        3,
+        "no report folder or partial copy left"
+    );
+}
+
+#[test]
+fn a_mask_that_keeps_no_pixel_is_an_error_naming_it_everywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    let out = dir.path().join("report");
+    let out = out.to_str().unwrap();
+    let png = dir.path().join("nothing.png");
+    image::GrayImage::new(240, 180).save(&png).unwrap();
+    let npy = dir.path().join("nothing.npy");
+    ndarray_npy::write_npy(&npy, &ndarray::Array2::<f32>::zeros((180, 240))).unwrap();
+    for mask in [&png, &npy] {
+        let mask = mask.to_str().unwrap();
+        for args in mask_commands(input, mask, out) {
+            let e = bad_input(&args);
+            assert!(
+                e.contains(&format!("the mask {mask} keeps no pixel"))
+                    && e.contains("fix:")
+                    && !e.contains("time window"),
+                "{args:?}: {e}"
+            );
+        }
+    }
+    // inside a region: the message says so
+    let mut corner = ndarray::Array2::<u8>::zeros((180, 240));
+    corner[[0, 0]] = 1;
+    ndarray_npy::write_npy(&npy, &corner).unwrap();
+    let e = bad_input(&[
+        "fit",
+        input,
+        "--roi",
+        "100,100,200,150",
+        "--mask",
+        npy.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("keeps no pixel inside the region x 100..200, y 100..150"),
+        "{e}"
+    );
+    assert!(!Path::new(out).exists());
+}
