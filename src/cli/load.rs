@@ -155,7 +155,19 @@ pub fn load(
         ))
         .into());
     }
-    let kept = selection.build(resolved.sensor, &recording.path)?;
+    // the estimators keep several maps of one value per pixel
+    let sensor = resolved.sensor;
+    if sensor.pixels() > ctcal::stats::PIXEL_BUDGET && !global.force {
+        let (max_x, max_y) = events.max_coordinates().unwrap_or((0, 0));
+        return Err(BadInput(format!(
+            "{}: the {sensor} sensor has {} pixels; the estimators keep several maps of one value per pixel, more than the budget of {} pixels\n  fix: pass --sensor WxH with the camera's real size (the events reach x = {max_x}, y = {max_y}), or --force to use the memory anyway",
+            recording.path.display(),
+            sensor.pixels(),
+            ctcal::stats::PIXEL_BUDGET,
+        ))
+        .into());
+    }
+    let kept = selection.build(sensor, &recording.path, global.force)?;
     if !kept.is_all() {
         notes.push(format!("pixels: {}", kept.description()));
     }

@@ -192,7 +192,7 @@ impl Recording {
                             "{origin} says the sensor is {s}, larger than {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE} (more than any sensor sold)"
                         ),
                         format!(
-                            "if the sensor really is that large, pass --sensor {s}; otherwise the file is damaged"
+                            "if the header is damaged, pass --sensor WxH with the camera's real size; if the sensor really is {s}, pass --sensor {s} (statistics then keep per-pixel state only for the area the events reach)"
                         ),
                     ));
                 }

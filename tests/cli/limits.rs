@@ -703,3 +703,75 @@ fn a_mask_that_keeps_no_pixel_is_an_error_naming_it_everywhere() {
     );
     assert!(!Path::new(out).exists());
 }
+
+#[test]
+fn a_huge_sensor_keeps_state_only_for_the_area_its_events_reach() {
+    let dir = tempfile::tempdir().unwrap();
+    // a Prophesee header claiming 65535 x 65535: the error used to suggest --sensor
+    // 65535x65535, which then asked for a 68.7 GB grid and aborted
+    let mut raw = b"% evt 3.0\n% geometry 65535x65535\n% end\n".to_vec();
+    raw.extend_from_slice(&[0x00, 0x80, 0x00, 0x60, 0x05, 0x20]);
+    let raw = write(dir.path(), "huge.raw", &raw);
+    let e = bad_input(&["stats", &raw]);
+    assert!(
+        e.contains("huge.raw")
+            && e.contains("geometry")
+            && e.contains("65535x65535")
+            && e.contains("--sensor WxH with the camera's real size")
+            && e.contains("--sensor 65535x65535"),
+        "{e}"
+    );
+    // both fixes it suggests work (the memory is asserted in tests/hostile.rs)
+    for sensor in ["65535x65535", "640x480"] {
+        let s = json(&["stats", &raw, "--sensor", sensor]);
+        assert_eq!(s["events"], 1, "{sensor}");
+    }
+    // events that do spread over such a sensor: refused with the area and the fixes, and
+    // nothing written
+    let far = write(dir.path(), "far.txt", b"0.1 1 1 1\n0.2 60000 60000 0\n");
+    let out = dir.path().join("s.json");
+    let e = bad_input(&[
+        "stats",
+        &far,
+        "--sensor",
+        "65535x65535",
+        "--json",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("far.txt")
+            && e.contains("x = 60000, y = 60000")
+            && e.contains("--sensor WxH")
+            && e.contains("--force"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // the estimators (and a selection) hold maps of the whole sensor: refused, naming the
+    // area the events reach
+    let e = bad_input(&["estimate", "eppps", &raw, "--sensor", "65535x65535"]);
+    assert!(
+        e.contains("huge.raw")
+            && e.contains("65535x65535 sensor")
+            && e.contains("the events reach x = 5, y = 0")
+            && e.contains("--force"),
+        "{e}"
+    );
+    let e = bad_input(&[
+        "stats",
+        &raw,
+        "--sensor",
+        "65535x65535",
+        "--roi",
+        "0,0,10,10",
+    ]);
+    assert!(
+        e.contains("--roi") && e.contains("budget") && e.contains("--sensor WxH"),
+        "{e}"
+    );
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, vec!["far.txt", "huge.raw"]);
+}
