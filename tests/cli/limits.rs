@@ -775,3 +775,94 @@ fn a_huge_sensor_keeps_state_only_for_the_area_its_events_reach() {
     left.sort();
     assert_eq!(left, vec!["far.txt", "huge.raw"]);
 }
+
+#[test]
+fn noise_and_blur_beyond_the_budget_are_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sim");
+    let run = |params: &str, frames: &str| {
+        let path = write(dir.path(), "p.toml", params.as_bytes());
+        let mut cmd = ctcal();
+        cmd.args(["simulate", "--params", &path, "--frames"])
+            .arg(oracle(frames))
+            .arg("--out")
+            .arg(&out);
+        cmd.output().unwrap()
+    };
+    // an earlier output, which a refused run must leave as it is
+    assert!(
+        run("ct_on = 0.3\nct_off = 0.3\n", "a_ideal_texture")
+            .status
+            .success()
+    );
+    let before = std::fs::read(out.join("events.txt")).unwrap();
+    let display =
+        "[display]\nrefresh_hz = 75.0\ngamma = 2.0\nblack_level = 0.005\nwhite_dn = 200.0\n";
+    for (extra, frames, expected) in [
+        // used to abort after 21 s and 4.6 GB, leaving a partial output
+        (
+            "leak_rate_hz = 1e9",
+            "a_ideal_texture",
+            "`leak_rate_hz` is 1e9",
+        ),
+        // used to abort after 42 s and 6 GB
+        (
+            "shot_noise_rate_hz = 1e7",
+            "a_ideal_texture",
+            "`shot_noise_rate_hz` is 1e7",
+        ),
+        // within one event a microsecond, but 4e9 events
+        (
+            "leak_rate_hz = 1e5",
+            "a_ideal_texture",
+            "lower leak_rate_hz",
+        ),
+        (
+            "shot_noise_rate_hz = 2e4",
+            "a_ideal_texture",
+            "lower shot_noise_rate_hz",
+        ),
+        // used to run 110 s and write 7.3 GB
+        (
+            "hot_pixel_fraction = 0.01\nhot_pixel_rate_hz = 1e6",
+            "a_ideal_texture",
+            "lower hot_pixel_rate_hz",
+        ),
+        // used to run for minutes (a kernel of 6 million taps)
+        (
+            &format!("{display}blur_px = 1e6\n"),
+            "dev_screen_checker",
+            "`display.blur_px` is 1e6",
+        ),
+        (
+            &format!("{display}blur_px = 1000.0\n"),
+            "dev_screen_checker",
+            "the display blur (display.blur_px)",
+        ),
+    ] {
+        let started = Instant::now();
+        let output = run(&format!("ct_on = 0.3\nct_off = 0.3\n{extra}\n"), frames);
+        let e = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{extra}: {e}");
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "{extra}: {:?}",
+            started.elapsed()
+        );
+        assert!(
+            e.contains("p.toml") && e.contains(expected) && e.contains("fix:"),
+            "{extra}: {e}"
+        );
+        assert_eq!(std::fs::read(out.join("events.txt")).unwrap(), before);
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            vec!["p.toml", "sim"],
+            "{extra}: a partial output left"
+        );
+    }
+}
