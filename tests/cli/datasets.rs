@@ -397,3 +397,188 @@ fn time_windows_read_the_same_events_and_seek_with_the_file_index() {
         );
     }
 }
+
+/// A record of a bag: where it starts, its header fields and where its data lie.
+struct BagRecord {
+    start: usize,
+    fields: Vec<(String, std::ops::Range<usize>)>,
+    data: std::ops::Range<usize>,
+}
+
+impl BagRecord {
+    fn field(&self, name: &str) -> Option<std::ops::Range<usize>> {
+        self.fields
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, r)| r.clone())
+    }
+
+    fn op(&self, bytes: &[u8]) -> u8 {
+        bytes[self.field("op").unwrap().start]
+    }
+
+    fn end(&self) -> usize {
+        self.data.end
+    }
+}
+
+/// The records of `bytes[from..to]`.
+fn bag_records(bytes: &[u8], from: usize, to: usize) -> Vec<BagRecord> {
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+    let mut records = Vec::new();
+    let mut at = from;
+    while at < to {
+        let header_len = u32_at(at);
+        let mut fields = Vec::new();
+        let mut i = at + 4;
+        while i < at + 4 + header_len {
+            let n = u32_at(i);
+            let field = &bytes[i + 4..i + 4 + n];
+            let eq = field.iter().position(|&b| b == b'=').unwrap();
+            fields.push((
+                String::from_utf8_lossy(&field[..eq]).into_owned(),
+                i + 4 + eq + 1..i + 4 + n,
+            ));
+            i += 4 + n;
+        }
+        let data_start = at + 4 + header_len + 4;
+        let data_len = u32_at(at + 4 + header_len);
+        records.push(BagRecord {
+            start: at,
+            fields,
+            data: data_start..data_start + data_len,
+        });
+        at = data_start + data_len;
+    }
+    records
+}
+
+/// The uncompressed bag of the slider, its records in its (one) chunk, and the connection
+/// id of `/dvs/events`.
+fn slider_bag() -> (Vec<u8>, Vec<BagRecord>, u32) {
+    let bytes = std::fs::read(dataset("ijrr_slider_depth_50k.bag")).unwrap();
+    let top = bag_records(&bytes, 13, bytes.len());
+    let chunk = top.iter().find(|r| r.op(&bytes) == 0x05).unwrap();
+    let inner = bag_records(&bytes, chunk.data.start, chunk.data.end);
+    let events = inner
+        .iter()
+        .find(|r| r.op(&bytes) == 0x07 && &bytes[r.field("topic").unwrap()] == b"/dvs/events")
+        .unwrap();
+    let id = u32::from_le_bytes(bytes[events.field("conn").unwrap()].try_into().unwrap());
+    (bytes, inner, id)
+}
+
+/// The message records of connection `id`.
+fn messages_of<'a>(bytes: &[u8], records: &'a [BagRecord], id: u32) -> Vec<&'a BagRecord> {
+    records
+        .iter()
+        .filter(|r| r.op(bytes) == 0x02 && bytes[r.field("conn").unwrap()] == id.to_le_bytes())
+        .collect()
+}
+
+/// Where event `k` of a `dvs_msgs/EventArray` message's data starts.
+fn event_offset(bytes: &[u8], data: &std::ops::Range<usize>, k: usize) -> usize {
+    // header: seq, stamp (secs, nsecs), frame_id (length + bytes); height, width, count
+    let frame_id = u32::from_le_bytes(bytes[data.start + 12..data.start + 16].try_into().unwrap());
+    data.start + 16 + frame_id as usize + 12 + 13 * k
+}
+
+#[test]
+fn a_bag_event_far_ahead_of_its_neighbours_is_disorder_as_in_every_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bytes, records, id) = slider_bag();
+    let messages = messages_of(&bytes, &records, id);
+    // an event stamped 2^32 - 1 s (136 years later) inside message 3, and at its end
+    let last = u32::from_le_bytes(
+        bytes[event_offset(&bytes, &messages[2].data, 0) - 4..][..4]
+            .try_into()
+            .unwrap(),
+    ) as usize;
+    for (name, k, expected) in [
+        ("inside.bag", 5, "message 3 ("),
+        ("at_end.bag", last - 1, "message 4 ("),
+    ] {
+        let mut damaged = bytes.clone();
+        let at = event_offset(&bytes, &messages[2].data, k) + 4;
+        damaged[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        let path = dir.path().join(name);
+        std::fs::write(&path, &damaged).unwrap();
+        let e = bad_input(&["stats", path.to_str().unwrap()]);
+        assert!(
+            e.contains(name)
+                && e.contains("timestamps go backwards")
+                && e.contains("topic /dvs/events")
+                && e.contains(expected)
+                && e.contains("--sort"),
+            "{name}: {e}"
+        );
+    }
+    // the same damage in a text file says the same
+    let text = dir.path().join("events.txt");
+    std::fs::write(&text, "0.1 1 1 1\n4294967295.0 2 2 1\n0.2 3 3 0\n").unwrap();
+    let e = bad_input(&["stats", text.to_str().unwrap()]);
+    assert!(e.contains("timestamps go backwards"), "{e}");
+}
+
+#[test]
+fn a_bag_chunk_with_its_records_reversed_is_unsorted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bytes, records, id) = slider_bag();
+    let messages = messages_of(&bytes, &records, id);
+    // the event messages in reverse order, every other record in place
+    let mut reversed = bytes[..records[0].start].to_vec();
+    let mut next = messages.iter().rev();
+    for r in &records {
+        let source = if messages.iter().any(|m| m.start == r.start) {
+            next.next().unwrap()
+        } else {
+            r
+        };
+        reversed.extend_from_slice(&bytes[source.start..source.end()]);
+    }
+    reversed.extend_from_slice(&bytes[records.last().unwrap().end()..]);
+    assert_eq!(reversed.len(), bytes.len());
+    let path = dir.path().join("reversed.bag");
+    std::fs::write(&path, &reversed).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("reversed.bag")
+            && e.contains("timestamps go backwards")
+            && e.contains("ends before a message before it started")
+            && e.contains("--sort"),
+        "{e}"
+    );
+    // with --sort every event is there, as in the original
+    let sorted = json(&["stats", path.to_str().unwrap(), "--sort"]);
+    let original = json(&[
+        "stats",
+        dataset("ijrr_slider_depth_50k.bag").to_str().unwrap(),
+    ]);
+    for key in ["events", "on_events", "t_first_us", "t_last_us"] {
+        assert_eq!(sorted[key], original[key], "{key}");
+    }
+}
+
+#[test]
+fn a_bag_message_of_an_unknown_connection_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bytes, records, id) = slider_bag();
+    let message = messages_of(&bytes, &records, id)[4];
+    let mut damaged = bytes.clone();
+    let conn = message.field("conn").unwrap();
+    damaged[conn].copy_from_slice(&77u32.to_le_bytes());
+    let path = dir.path().join("unknown.bag");
+    std::fs::write(&path, &damaged).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("unknown.bag")
+            && e.contains(&format!(
+                "record at byte {}",
+                message.start - records[0].start
+            ))
+            && e.contains("connection id 77")
+            && e.contains("0 (/dvs/events)")
+            && e.contains("fix:"),
+        "{e}"
+    );
+}
