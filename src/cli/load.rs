@@ -99,6 +99,9 @@ pub fn load(
         }
     }
     let mut stream = recording.events_between(from, to)?;
+    for note in &stream.notes {
+        warn(global, note);
+    }
     let bar = progress_bar(global, stream.progress().total, "reading events");
     let mut events = EventChunk::default();
     while stream.next_chunk()?.is_some() {

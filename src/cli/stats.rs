@@ -163,6 +163,9 @@ fn pass(
             }
             None => recording.events()?,
         };
+        for note in &stream.notes {
+            warn(global, note);
+        }
         let bar = progress_bar(global, stream.progress().total, "reading");
         let read_ahead = rayon::current_num_threads() > 1;
         ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, progress| {

@@ -582,3 +582,131 @@ fn a_bag_message_of_an_unknown_connection_is_named() {
         "{e}"
     );
 }
+
+#[test]
+fn a_dsec_index_that_contradicts_the_times_is_checked_against_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dsec.h5");
+    std::fs::copy(dataset(FILES[3].0), &path).unwrap();
+    // millisecond 50 said to start where millisecond 53 does: a window from 50 ms used to
+    // start 3 ms late and lose the events between
+    {
+        let file = hdf5::File::open_rw(&path).unwrap();
+        let mut index: Vec<u64> = file.dataset("ms_to_idx").unwrap().read_raw().unwrap();
+        let (right, wrong) = (index[50], index[53]);
+        assert!(wrong > right + 100, "{right} {wrong}");
+        index[50] = wrong;
+        file.unlink("ms_to_idx").unwrap();
+        file.new_dataset_builder()
+            .with_data(&index)
+            .create("ms_to_idx")
+            .unwrap();
+    }
+    let window = ["--start", "0.05", "--end", "0.1", "--json", "-"];
+    let reference = json(&[
+        "stats",
+        dataset(FILES[3].0).to_str().unwrap(),
+        "--start",
+        "0.05",
+        "--end",
+        "0.1",
+    ]);
+    // not quiet: the warning is the message
+    let output = std::process::Command::new(assert_cmd::cargo::cargo_bin("ctcal"))
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .arg("stats")
+        .arg(&path)
+        .args(window)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let s: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    for key in ["events", "on_events", "t_first_us", "t_last_us"] {
+        assert_eq!(s[key], reference[key], "{key}");
+    }
+    assert!(
+        stderr.contains("dsec.h5")
+            && stderr.contains("ms_to_idx[50]")
+            && stderr.contains("contradicts events/t")
+            && stderr.contains("found on the event times"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn float32_times_that_lost_their_precision_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = read_events(&real("ijrr_slider_depth_50k"));
+    // MVSEC's layout with float32 rows: at 1.5e9 s float32 values lie 128 s apart, and
+    // the whole recording used to collapse to one time (duration 0)
+    let path = dir.path().join("mvsec_f32.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let rows: Vec<f32> = reference
+            .iter()
+            .take(1000)
+            .flat_map(|e| {
+                [
+                    e.x as f32,
+                    e.y as f32,
+                    (1_504_645_000.0 + e.t as f64 * 1e-6) as f32,
+                    if e.on { 1.0 } else { -1.0 },
+                ]
+            })
+            .collect();
+        let table = ndarray::Array2::from_shape_vec((1000, 4), rows).unwrap();
+        file.create_group("davis").unwrap();
+        file.create_group("davis/left").unwrap();
+        file.new_dataset_builder()
+            .with_data(&table)
+            .create("davis/left/events")
+            .unwrap();
+    }
+    for command in ["stats", "info"] {
+        let e = bad_input(&[command, path.to_str().unwrap(), "--sensor", "240x180"]);
+        assert!(
+            e.contains("mvsec_f32.h5")
+                && e.contains("davis/left/events[:, 2]")
+                && e.contains("float32")
+                && e.contains("1.280e2 s apart")
+                && e.contains("float64")
+                && e.contains("fix:"),
+            "{command}: {e}"
+        );
+    }
+    // float32 seconds from zero keep their microseconds over a short recording
+    let path = dir.path().join("event_utils_f32.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let events = file.create_group("events").unwrap();
+        let n = 1000;
+        let ts: Vec<f32> = reference.t[..n].iter().map(|&t| t as f32 * 1e-6).collect();
+        let xs: Vec<i16> = reference.x[..n].iter().map(|&x| x as i16).collect();
+        let ys: Vec<i16> = reference.y[..n].iter().map(|&y| y as i16).collect();
+        let ps: Vec<u8> = reference.on[..n].iter().map(|&p| p as u8).collect();
+        events
+            .new_dataset_builder()
+            .with_data(&ts)
+            .create("ts")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&xs)
+            .create("xs")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&ys)
+            .create("ys")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&ps)
+            .create("ps")
+            .unwrap();
+    }
+    let s = json(&["stats", path.to_str().unwrap(), "--sensor", "240x180"]);
+    assert_eq!(s["events"], 1000);
+    assert_eq!(s["t_first_us"], reference.t[0]);
+}
