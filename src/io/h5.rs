@@ -960,10 +960,30 @@ fn frame_index(path: &Path, file: &hdf5::File, layout: Layout) -> Result<FrameIn
             }
             let shape = check_dataset(path, file, "frame", 3)?;
             let size = frame_size(path, "frame", shape[1], shape[2])?;
-            let times: Vec<i64> = file
-                .dataset("frame_ts")
-                .and_then(|d| d.read_raw::<i64>())
-                .map_err(|e| err("frame_ts", e))?;
+            // microseconds, as integers (v2e) or floats: a float NaN or infinity must not
+            // become a time by integer conversion
+            let stamps = file.dataset("frame_ts").map_err(|e| err("frame_ts", e))?;
+            let float = matches!(
+                stamps.dtype().and_then(|d| d.to_descriptor()),
+                Ok(TypeDescriptor::Float(_))
+            );
+            let times: Vec<i64> = if float {
+                let values: Vec<f64> = stamps.read_raw().map_err(|e| err("frame_ts", e))?;
+                let mut times = Vec::with_capacity(values.len());
+                for (i, &t) in values.iter().enumerate() {
+                    if !(t.is_finite() && t.abs() <= crate::events::TIME_LIMIT_US as f64) {
+                        return Err(InputError::hdf5(
+                            path,
+                            format!("frame_ts[{i}] is {t}, not a time in microseconds"),
+                            "frame timestamps are microseconds; the file is damaged",
+                        ));
+                    }
+                    times.push(t.round() as i64);
+                }
+                times
+            } else {
+                stamps.read_raw::<i64>().map_err(|e| err("frame_ts", e))?
+            };
             if times.len() != shape[0] {
                 return Err(InputError::hdf5(
                     path,
@@ -1033,6 +1053,17 @@ impl FrameIndex {
         size: (u32, u32),
         dataset: Option<String>,
     ) -> Result<(), InputError> {
+        if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
+            return Err(InputError::corrupt(
+                path,
+                place,
+                format!(
+                    "frame time {t} us lies beyond +-{} us (about 73,000 years) of zero",
+                    crate::events::TIME_LIMIT_US
+                ),
+                "the file is damaged at this place; frame times are in the file's clock",
+            ));
+        }
         if let Some(&previous) = self.times.last() {
             if size != self.size {
                 return Err(InputError::corrupt(

@@ -866,3 +866,68 @@ fn noise_and_blur_beyond_the_budget_are_refused_before_anything_is_written() {
         );
     }
 }
+
+#[test]
+fn frame_times_are_finite_and_in_order_in_every_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    // v2e frame_ts stored as floats: NaN used to become i64::MIN, a median frame interval
+    // of -9.2e12 s
+    for (name, times, place, problem) in [
+        ("nan.h5", [f64::NAN, 1000.0, 2000.0], "frame_ts[0]", "NaN"),
+        (
+            "inf.h5",
+            [1000.0, f64::INFINITY, 3000.0],
+            "frame_ts[1]",
+            "inf",
+        ),
+        (
+            "order.h5",
+            [2000.0, 1000.0, 3000.0],
+            "frame_ts[1]",
+            "earlier",
+        ),
+    ] {
+        let path = dir.path().join(name);
+        {
+            let file = hdf5::File::create(&path).unwrap();
+            file.new_dataset_builder()
+                .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
+                .create("events")
+                .unwrap();
+            file.new_dataset_builder()
+                .with_data(&ndarray::Array3::<u8>::zeros((3, 4, 4)))
+                .create("frame")
+                .unwrap();
+            file.new_dataset_builder()
+                .with_data(&times)
+                .create("frame_ts")
+                .unwrap();
+        }
+        for command in ["stats", "info"] {
+            let e = bad_input(&[command, path.to_str().unwrap(), "--sensor", "8x8"]);
+            assert!(
+                e.contains(name) && e.contains(place) && e.contains(problem) && e.contains("fix:"),
+                "{name} {command}: {e}"
+            );
+        }
+    }
+    // an IJRR frame list with a time beyond any clock
+    let rec = dir.path().join("rec");
+    std::fs::create_dir_all(rec.join("images")).unwrap();
+    std::fs::write(rec.join("events.txt"), "0.1 1 1 1\n0.2 2 2 0\n").unwrap();
+    for name in ["a.png", "b.png"] {
+        image::GrayImage::new(4, 4)
+            .save(rec.join("images").join(name))
+            .unwrap();
+    }
+    std::fs::write(
+        rec.join("images.txt"),
+        "0.1 images/a.png\n3e12 images/b.png\n",
+    )
+    .unwrap();
+    let e = bad_input(&["stats", rec.to_str().unwrap()]);
+    assert!(
+        e.contains("images.txt") && e.contains("line 2") && e.contains("beyond"),
+        "{e}"
+    );
+}
