@@ -547,7 +547,7 @@ fn claimed_sizes_are_checked_before_anything_is_allocated_for_them() {
     let npy = dir.path().join("huge.npy");
     let mut header =
         "{'descr': '|u1', 'fortran_order': False, 'shape': (100000, 100000), }".to_string();
-    while (10 + header.len() + 1) % 64 != 0 {
+    while !(10 + header.len() + 1).is_multiple_of(64) {
         header.push(' ');
     }
     header.push('\n');

@@ -1291,6 +1291,9 @@ fn first_row_at_or_after(
     Ok(hi)
 }
 
+/// Event rows found with a file's index, and a note when the index had to be corrected.
+pub type IndexedRows = (std::ops::Range<usize>, Option<String>);
+
 /// The rows that hold the events of times `from..=to`, found with the file's own index
 /// (DSEC `ms_to_idx`: the first event of each millisecond; MVSEC `image_raw_event_inds`: the
 /// event nearest each frame), from which the exact ends are found on the event times, so
@@ -1303,7 +1306,7 @@ pub fn index_window(
     info: &H5Info,
     from: TimeUs,
     to: TimeUs,
-) -> Result<Option<(std::ops::Range<usize>, Option<String>)>, InputError> {
+) -> Result<Option<IndexedRows>, InputError> {
     let file = open_file(path)?;
     let n = info.events;
     let found = match info.layout {

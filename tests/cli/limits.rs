@@ -553,7 +553,7 @@ fn messages_give_the_right_advice() {
 /// An `.npy` file whose header claims `shape` of `descr` values, followed by `data` bytes.
 fn npy_claiming(path: &Path, descr: &str, shape: &str, data: usize) {
     let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
-    while (10 + header.len() + 1) % 64 != 0 {
+    while !(10 + header.len() + 1).is_multiple_of(64) {
         header.push(' ');
     }
     header.push('\n');
