@@ -11,14 +11,14 @@
 //! two publishers can interleave), so events are merged into time order as they stream:
 //! the events of earlier messages are held until a message starts after them. Memory is one
 //! chunk plus the overlap. Time order is checked as every other reader checks it, with that
-//! overlap as the only allowance; these count as timestamps going backwards (an unsorted
-//! file, which `--sort` accepts):
+//! overlap as the only allowance; each of these counts as a timestamp going backwards (an
+//! unsorted file, which `--sort` accepts):
 //! - an event earlier than the event before it in the same message;
 //! - a message that ends before a message before it started (reversed records);
 //! - a message that ends earlier than events already read by more than its own span (and
 //!   [`OVERLAP_SLACK_US`]): it is not an overlap but an event far ahead of its neighbours
 //!   (a damaged stamp) or records out of place;
-//! - an event earlier than events already handed on.
+//! - a message with events earlier than events already handed on.
 //!
 //! A message of a connection that no connection record before it defines is damage, named
 //! with its connection id.
@@ -521,6 +521,7 @@ impl BagDecoder {
             self.order
                 .record_backwards(within, || format!("{place}, event {i}"), ts[i - 1], ts[i]);
         }
+        let last_in_file = ts[ts.len() - 1];
         self.incoming.sort_by_time();
         let ts = &self.incoming.t;
         let (first, last) = (ts[0], ts[ts.len() - 1]);
@@ -534,8 +535,10 @@ impl BagDecoder {
         } else {
             self.handed_max
         };
-        let earlier = ts.partition_point(|&t| t < bound) as u64;
-        if earlier > 0 {
+        // counted as other readers count: once where the message goes back (its events
+        // after that are in order among themselves)
+        let goes_back = ts[0] < bound;
+        if goes_back {
             let what = if reversed {
                 "the message ends before a message before it started"
             } else if held_back {
@@ -544,10 +547,17 @@ impl BagDecoder {
                 "the message holds events earlier than events already read"
             };
             self.order
-                .record_backwards(earlier, || format!("{place}: {what}"), bound, first);
+                .record_backwards(1, || format!("{place}: {what}"), bound, first);
         }
-        self.latest = self.latest.max(last);
-        self.latest_start = self.latest_start.max(first);
+        if within > 0 || goes_back {
+            // as other readers do after a step back: go on from here, so that one bad
+            // stamp counts once, not against every message after it
+            self.latest = last_in_file;
+            self.latest_start = first;
+        } else {
+            self.latest = self.latest.max(last);
+            self.latest_start = self.latest_start.max(first);
+        }
     }
 
     /// Moves the pending events earlier than `before` to `ready`.
@@ -619,8 +629,9 @@ impl EventDecoder for BagDecoder {
             if self.next_message()? {
                 if self.out_of_place {
                     // already refused (or to be sorted): hold nothing across it, so that
-                    // memory stays one message plus the overlap
+                    // memory stays one message plus the overlap, and go on from here
                     self.release(TimeUs::MAX);
+                    self.handed_max = TimeUs::MIN;
                 } else if let Some(&first) = self.incoming.t.first() {
                     self.release(first);
                 }
