@@ -116,6 +116,22 @@ impl PixelSelection {
         for (k, &m) in self.keep.iter_mut().zip(mask) {
             *k &= m;
         }
+        // an empty selection measures nothing: every rate would divide by zero pixels
+        if !self.keep.contains(&true) {
+            let problem = if mask.contains(&true) {
+                format!(
+                    "the mask {source} keeps no pixel inside the {}",
+                    self.parts.join("; ")
+                )
+            } else {
+                format!("the mask {source} keeps no pixel (every value is zero)")
+            };
+            return Err(SelectionError {
+                problem,
+                fix: "give a mask with non-zero values at the pixels to keep (zero = leave out)"
+                    .into(),
+            });
+        }
         self.parts.push(format!("mask {source}"));
         Ok(self)
     }
@@ -223,6 +239,26 @@ mod tests {
             .unwrap_err();
         assert!(
             e.problem.contains("10 values") && e.fix.contains("240x180"),
+            "{e}"
+        );
+        // a mask that keeps nothing, alone or inside a region
+        let e = PixelSelection::all(Sensor::new(4, 3))
+            .mask(&[false; 12], "zero.png")
+            .unwrap_err();
+        assert!(
+            e.problem.contains("zero.png keeps no pixel") && e.fix.contains("non-zero"),
+            "{e}"
+        );
+        let mut corner = [false; 12];
+        corner[0] = true;
+        let e = PixelSelection::all(Sensor::new(4, 3))
+            .roi(Roi::parse("2,1,4,3").unwrap())
+            .unwrap()
+            .mask(&corner, "corner.npy")
+            .unwrap_err();
+        assert!(
+            e.problem
+                .contains("corner.npy keeps no pixel inside the region x 2..4"),
             "{e}"
         );
     }

@@ -500,3 +500,106 @@ fn flip_aedat4_time_bit(bytes: &[u8], bit: u32) -> Vec<u8> {
     out[field..field + 8].copy_from_slice(&(end as i64 + delta).to_le_bytes());
     out
 }
+
+/// A grey PNG of `width` x `height` zeros, deflated row by row (a few hundred KB).
+fn png_of_zeros(path: &Path, width: u32, height: u32) {
+    use std::io::Write;
+    let crc32 = |bytes: &[u8]| {
+        let mut crc = 0xffff_ffffu32;
+        for &b in bytes {
+            crc ^= b as u32;
+            for _ in 0..8 {
+                crc = if crc & 1 != 0 {
+                    (crc >> 1) ^ 0xedb8_8320
+                } else {
+                    crc >> 1
+                };
+            }
+        }
+        !crc
+    };
+    let mut deflate = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+    let row = vec![0u8; width as usize + 1];
+    for _ in 0..height {
+        deflate.write_all(&row).unwrap();
+    }
+    let data = deflate.finish().unwrap();
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]);
+    for (kind, body) in [(&b"IHDR"[..], &ihdr[..]), (b"IDAT", &data), (b"IEND", &[])] {
+        png.extend_from_slice(&(body.len() as u32).to_be_bytes());
+        let mut typed = kind.to_vec();
+        typed.extend_from_slice(body);
+        png.extend_from_slice(&typed);
+        png.extend_from_slice(&crc32(&typed).to_be_bytes());
+    }
+    std::fs::write(path, png).unwrap();
+}
+
+#[test]
+fn claimed_sizes_are_checked_before_anything_is_allocated_for_them() {
+    let _one = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = tempfile::tempdir().unwrap();
+    let sensor = ctcal::Sensor::new(240, 180);
+    // a 1 KB .npy mask claiming 100000 x 100000 bytes (used to allocate 10 GB)
+    let npy = dir.path().join("huge.npy");
+    let mut header =
+        "{'descr': '|u1', 'fortran_order': False, 'shape': (100000, 100000), }".to_string();
+    while !(10 + header.len() + 1).is_multiple_of(64) {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.resize(bytes.len() + 1000, 0);
+    std::fs::write(&npy, bytes).unwrap();
+    let (result, peak) = peak_during(|| ctcal::io::mask::read_mask(&npy, sensor));
+    assert!(result.unwrap_err().to_string().contains("(100000, 100000)"));
+    assert!(peak < 1 << 20, "{} KB for the .npy header", peak >> 10);
+    // a 400 KB PNG mask that decodes to 20000 x 20000 (used to take 2.3 GB)
+    let png = dir.path().join("bomb.png");
+    png_of_zeros(&png, 20_000, 20_000);
+    let (result, peak) = peak_during(|| ctcal::io::mask::read_mask(&png, sensor));
+    assert!(result.unwrap_err().to_string().contains("20000x20000"));
+    assert!(peak < 1 << 20, "{} KB for the PNG header", peak >> 10);
+    // the statistics of a 65535 x 65535 sensor whose events lie in a corner (the grid used
+    // to take 68.7 GB): state for the corner only
+    let mut text = String::from("65535 65535\n");
+    for i in 0..100_000u32 {
+        text.push_str(&format!(
+            "{}.{:06} {} {} {}\n",
+            i / 100_000,
+            i % 100_000 * 10,
+            i % 640,
+            i / 640 % 480,
+            i % 2
+        ));
+    }
+    let events = dir.path().join("events.txt");
+    std::fs::write(&events, text).unwrap();
+    let options = OpenOptions {
+        sensor: Some(ctcal::Sensor::new(65_535, 65_535)),
+        ..OpenOptions::default()
+    };
+    let (stats, peak) = peak_during(|| {
+        let recording = Recording::open(&events, &options).unwrap();
+        let mut accumulator = StatsAccumulator::new(StatsOptions::default(), recording.sensor);
+        let mut stream = recording.events().unwrap();
+        while let Some(chunk) = stream.next_chunk().unwrap() {
+            accumulator.add(chunk);
+        }
+        assert!(accumulator.over_budget().is_none());
+        let resolved = recording.resolve_sensor(stream.max_coordinates());
+        accumulator.finish(resolved.sensor, &resolved.source, &[])
+    });
+    let stats = stats.unwrap();
+    assert_eq!((stats.events, stats.width), (100_000, 65_535));
+    assert!(
+        peak < 100 << 20,
+        "{} MB for a 65535x65535 sensor",
+        peak >> 20
+    );
+}

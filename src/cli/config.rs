@@ -56,19 +56,144 @@ fn read_json(path: &Path) -> anyhow::Result<serde_json::Value> {
     })
 }
 
-/// The parameters of one fit result (`place` names it in errors).
-fn fit_params(fit: &serde_json::Value, place: &str) -> anyhow::Result<(PixelParams, Option<i64>)> {
-    let params = fit.get("params").ok_or_else(|| {
+/// The largest magnitude each numeric fit parameter may have (the PARAMS.toml keys; the
+/// `display` table's as `display.KEY`): what a camera can have, far beyond what a fit finds,
+/// so that a damaged or hand-edited fit never reaches a simulator's configuration.
+const PLAUSIBLE: [(&str, f64); 20] = [
+    // contrast thresholds and their spreads, natural-log units
+    ("ct_on", 10.0),
+    ("ct_off", 10.0),
+    ("ct_sigma", 10.0),
+    ("ct_sigma_temporal", 10.0),
+    ("refractory_s", 10.0),
+    ("cutoff_hz", 1e6),
+    ("leak_rate_hz", 1e6),
+    ("leak_spread_decades", 10.0),
+    ("shot_noise_rate_hz", 1e6),
+    ("shot_noise_bright_factor", 100.0),
+    ("hot_pixel_fraction", 1.0),
+    ("hot_pixel_rate_hz", 1e6),
+    ("timestamp_jitter_s", 10.0),
+    ("log_eps", 1e3),
+    ("display.refresh_hz", 1e5),
+    ("display.gamma", 10.0),
+    ("display.black_level", 1.0),
+    ("display.white_dn", 1e6),
+    ("display.blur_px", 4096.0),
+    ("display.time_offset_s", 1e3),
+];
+
+/// The longest frame exposure a fit may state, microseconds (10 s).
+const MAX_EXPOSURE_US: i64 = 10_000_000;
+
+/// Checks a fit result's values before they are parsed into parameters: `params` an object
+/// of numbers within [`PLAUSIBLE`], `frame_exposure_us` a positive whole number of
+/// microseconds. Errors name `file` and the JSON path of the bad value (`prefix` is where
+/// the fit lies in the file, e.g. `sequences[0].fit.`).
+fn validate_fit_json(fit: &serde_json::Value, file: &str, prefix: &str) -> Result<(), BadInput> {
+    let bad = |path: &str, problem: String, fix: &str| {
+        BadInput(format!("{file}: `{prefix}{path}` {problem}\n  fix: {fix}"))
+    };
+    const UNEDITED: &str = "give an unedited `ctcal fit` result (or correct this value)";
+    let Some(params) = fit.get("params") else {
+        return Err(BadInput(format!(
+            "{file}: {}has no `params` (not a `ctcal fit` result)\n  fix: give the JSON `ctcal fit INPUT --json FIT.json` writes, or a report folder",
+            if prefix.is_empty() {
+                String::new()
+            } else {
+                format!("`{}` ", prefix.trim_end_matches('.'))
+            }
+        )));
+    };
+    let describe = |v: &serde_json::Value| match v {
+        serde_json::Value::Array(_) => "a list".to_string(),
+        serde_json::Value::Object(_) => "an object".to_string(),
+        serde_json::Value::String(s) => format!("the string {s:?}"),
+        other => other.to_string(),
+    };
+    let Some(object) = params.as_object() else {
+        return Err(bad(
+            "params",
+            format!(
+                "is {}; a fit's parameters are an object of PARAMS.toml keys",
+                describe(params)
+            ),
+            UNEDITED,
+        ));
+    };
+    let mut values: Vec<(String, &serde_json::Value)> = Vec::new();
+    for (key, value) in object {
+        if key == "display" {
+            let Some(display) = value.as_object() else {
+                return Err(bad(
+                    "params.display",
+                    format!("is {}; the display is an object", describe(value)),
+                    UNEDITED,
+                ));
+            };
+            values.extend(display.iter().map(|(k, v)| (format!("display.{k}"), v)));
+        } else {
+            values.push((key.clone(), value));
+        }
+    }
+    for (key, value) in values {
+        let Some(&(_, max)) = PLAUSIBLE.iter().find(|(k, _)| *k == key) else {
+            continue;
+        };
+        let path = format!("params.{key}");
+        let Some(v) = value.as_f64() else {
+            return Err(bad(
+                &path,
+                format!("is {}, not a number", describe(value)),
+                UNEDITED,
+            ));
+        };
+        if !(v.is_finite() && v.abs() <= max) {
+            return Err(bad(
+                &path,
+                format!("is {v:e}, beyond any camera (at most {max:e} in magnitude)"),
+                UNEDITED,
+            ));
+        }
+    }
+    match fit.get("frame_exposure_us") {
+        None | Some(serde_json::Value::Null) => {}
+        Some(value) => match value.as_i64() {
+            Some(us) if us > 0 && us <= MAX_EXPOSURE_US => {}
+            _ => {
+                return Err(bad(
+                    "frame_exposure_us",
+                    format!(
+                        "is {}; an exposure is a whole number of microseconds, 1..={MAX_EXPOSURE_US}",
+                        describe(value)
+                    ),
+                    UNEDITED,
+                ));
+            }
+        },
+    }
+    Ok(())
+}
+
+/// The parameters of one fit result in `file`, at JSON path `prefix` (`place` names it in
+/// errors).
+fn fit_params(
+    fit: &serde_json::Value,
+    file: &str,
+    prefix: &str,
+) -> anyhow::Result<(PixelParams, Option<i64>)> {
+    validate_fit_json(fit, file, prefix)?;
+    let params: PixelParams = serde_json::from_value(fit["params"].clone()).map_err(|e| {
         BadInput(format!(
-            "{place}: has no `params` (not a `ctcal fit` result)\n  fix: give the JSON `ctcal fit INPUT --json FIT.json` writes, or a report folder"
+            "{file}: `{prefix}params`: {e}\n  fix: give an unedited `ctcal fit` result"
         ))
     })?;
-    let params: PixelParams = serde_json::from_value(params.clone()).map_err(|e| {
+    params.validate(file).map_err(|e| {
         BadInput(format!(
-            "{place}: `params`: {e}\n  fix: give an unedited `ctcal fit` result"
+            "{file}: `{prefix}params.{}` {}\n  fix: {}",
+            e.key, e.problem, e.fix
         ))
     })?;
-    params.validate(place)?;
     Ok((
         params,
         fit.get("frame_exposure_us").and_then(|v| v.as_i64()),
@@ -100,7 +225,8 @@ fn gather(inputs: &[PathBuf]) -> anyhow::Result<Fits> {
                     let name = s.get("name").and_then(|n| n.as_str()).unwrap_or("?");
                     let (p, exposure) = fit_params(
                         fit,
-                        &format!("{}: sequence {i} ({name})", results.display()),
+                        &format!("{} (sequence {name})", results.display()),
+                        &format!("sequences[{i}].fit."),
                     )?;
                     fits.params.push(p);
                     fits.exposures_us.push(exposure);
@@ -114,7 +240,7 @@ fn gather(inputs: &[PathBuf]) -> anyhow::Result<Fits> {
                 .into());
             }
         } else {
-            let (p, exposure) = fit_params(&json, &results.display().to_string())?;
+            let (p, exposure) = fit_params(&json, &results.display().to_string(), "")?;
             fits.params.push(p);
             fits.exposures_us.push(exposure);
         }

@@ -99,6 +99,9 @@ pub fn load(
         }
     }
     let mut stream = recording.events_between(from, to)?;
+    for note in &stream.notes {
+        warn(global, note);
+    }
     let bar = progress_bar(global, stream.progress().total, "reading events");
     let mut events = EventChunk::default();
     while stream.next_chunk()?.is_some() {
@@ -155,7 +158,19 @@ pub fn load(
         ))
         .into());
     }
-    let kept = selection.build(resolved.sensor, &recording.path)?;
+    // the estimators keep several maps of one value per pixel
+    let sensor = resolved.sensor;
+    if sensor.pixels() > ctcal::stats::PIXEL_BUDGET && !global.force {
+        let (max_x, max_y) = events.max_coordinates().unwrap_or((0, 0));
+        return Err(BadInput(format!(
+            "{}: the {sensor} sensor has {} pixels; the estimators keep several maps of one value per pixel, more than the budget of {} pixels\n  fix: pass --sensor WxH with the camera's real size (the events reach x = {max_x}, y = {max_y}), or --force to use the memory anyway",
+            recording.path.display(),
+            sensor.pixels(),
+            ctcal::stats::PIXEL_BUDGET,
+        ))
+        .into());
+    }
+    let kept = selection.build(sensor, &recording.path, global.force)?;
     if !kept.is_all() {
         notes.push(format!("pixels: {}", kept.description()));
     }

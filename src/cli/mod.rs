@@ -111,12 +111,24 @@ impl SelectionArgs {
     }
 
     /// The region and mask for `sensor` (hot pixels are left out by the caller, who finds
-    /// them); `input` names the recording in errors.
+    /// them); `input` names the recording in errors. A selection holds a flag per pixel: a
+    /// sensor over the pixel budget is refused unless `force`. A selection that keeps no
+    /// pixel is an error naming what emptied it.
     pub fn build(
         &self,
         sensor: Sensor,
         input: &Path,
+        force: bool,
     ) -> anyhow::Result<ctcal::selection::PixelSelection> {
+        let budget = ctcal::stats::PIXEL_BUDGET;
+        if sensor.pixels() > budget && !force {
+            return Err(BadInput(format!(
+                "{}: a pixel selection (--roi, --mask, --exclude-hot-pixels) of the {sensor} sensor keeps one flag per pixel ({} pixels), more than the budget of {budget} pixels\n  fix: pass --sensor WxH with the camera's real size, or --force to use the memory anyway",
+                input.display(),
+                sensor.pixels()
+            ))
+            .into());
+        }
         let fail = |e: ctcal::selection::SelectionError| {
             BadInput(format!(
                 "{}: {}\n  fix: {}",

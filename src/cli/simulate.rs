@@ -4,7 +4,7 @@ use super::{BadInput, Global, JsonTarget, emit_json, output, progress_bar};
 use clap::{Args, ValueEnum};
 use ctcal::io::write::{H5Writer, IjrrWriter};
 use ctcal::io::{FrameList, npy};
-use ctcal::sim::budget::{MAX_SIDE, Work};
+use ctcal::sim::budget::{EffectWork, MAX_SIDE, Work};
 use ctcal::sim::display::DisplayModel;
 use ctcal::sim::scene::{SceneSource, SceneSpec, aps};
 use ctcal::sim::source::{DisplaySource, LoadedFrames};
@@ -248,6 +248,8 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         mut work,
         span_s,
     } = open_input(args, global)?;
+    // the images of the input (a display blurs each once)
+    let images = work.samples;
     if let Some(display) = &params.display {
         // the display adds a sample at every refresh
         work.samples += span_s * display.refresh_hz;
@@ -264,6 +266,10 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         "simulate fewer frames, a shorter scene or a smaller sensor",
         global.force,
     )?;
+    // the events and blur the effects add, from the parameters: refused before the output
+    // is created
+    EffectWork::new(&params, &work, span_s, images)
+        .check(&args.params.display().to_string(), global.force)?;
     let (width, height) = source.size();
     let sensor = Sensor::new(width as u16, height as u16);
     let maps = load_maps(args, sensor)?;

@@ -95,6 +95,8 @@ fn compute(
         end_s: args.end,
         window_s: args.window,
         support_window_s: args.support_window,
+        // --force: per-pixel state beyond the budget
+        max_pixels: (!global.force).then_some(ctcal::stats::PIXEL_BUDGET),
         ..StatsOptions::default()
     };
     if !args.selection.is_set() {
@@ -114,7 +116,9 @@ fn compute(
             resolved.sensor
         }
     };
-    let selection = args.selection.build(sensor, &recording.path)?;
+    let selection = args
+        .selection
+        .build(sensor, &recording.path, global.force)?;
     options.selection = Some(selection.clone());
     if !args.selection.exclude_hot_pixels {
         return pass(recording, options, args, global);
@@ -159,6 +163,9 @@ fn pass(
             }
             None => recording.events()?,
         };
+        for note in &stream.notes {
+            warn(global, note);
+        }
         let bar = progress_bar(global, stream.progress().total, "reading");
         let read_ahead = rayon::current_num_threads() > 1;
         ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, progress| {
@@ -168,6 +175,9 @@ fn pass(
         bar.finish_and_clear();
         stream.max_coordinates()
     };
+    if let Some(over) = accumulator.over_budget() {
+        return Err(BadInput(over_budget_message(recording, over)).into());
+    }
     let resolved = recording.resolve_sensor(max_coordinates);
     if let Some(w) = &resolved.warning {
         warn(global, w);
@@ -187,6 +197,24 @@ fn pass(
             }
             .into()
         })
+}
+
+/// The error for events that reach further than the per-pixel budget.
+fn over_budget_message(recording: &Recording, over: ctcal::stats::OverBudget) -> String {
+    let sensor = recording
+        .sensor
+        .map(|s| format!(" of the {s} sensor"))
+        .unwrap_or_default();
+    format!(
+        "{}: the events reach x = {}, y = {}{sensor}: statistics of that area keep {} pixels of state (about {:.1} GB), more than the budget of {} pixels ({:.1} GB)\n  fix: if the sensor is smaller (the coordinates or the stated size are damage), pass --sensor WxH with the camera's real size; to use the memory anyway, pass --force",
+        recording.path.display(),
+        over.max_x,
+        over.max_y,
+        over.pixels,
+        over.bytes() as f64 / 1e9,
+        over.budget,
+        (over.budget * ctcal::stats::BYTES_PER_PIXEL) as f64 / 1e9,
+    )
 }
 
 fn print_human(s: &SequenceStats) -> std::io::Result<()> {

@@ -530,6 +530,17 @@ fn for_each_frame(
         } else {
             (frame.t(), None)
         };
+        if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
+            return Err(InputError::corrupt(
+                &packets.path,
+                format!("byte offset {offset} (frame packet)"),
+                format!(
+                    "frame time {t} us lies beyond +-{} us (about 73,000 years) of zero",
+                    crate::events::TIME_LIMIT_US
+                ),
+                "the file is damaged at this place; cut the recording before it or copy it again from the source",
+            ));
+        }
         if let Some((t0, w0, h0)) = previous {
             if (w, h) != (w0, h0) {
                 return Err(packets.invalid(

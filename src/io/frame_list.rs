@@ -51,6 +51,19 @@ impl FrameList {
                     "each line names a frame: its time in seconds, a space, and the image path relative to this folder",
                 ));
             };
+            // a time as events have them (not beyond 2^61 us)
+            if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
+                return Err(InputError::corrupt(
+                    index_path,
+                    format!("line {line}"),
+                    format!(
+                        "frame time {} s lies beyond +-{} s (about 73,000 years) of zero",
+                        text::excerpt(fields[0]),
+                        crate::events::TIME_LIMIT_US / 1_000_000
+                    ),
+                    "the line is damaged: give the frame's time in seconds",
+                ));
+            }
             if let Some(previous) = entries.last()
                 && t < previous.t
             {

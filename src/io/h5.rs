@@ -94,6 +94,8 @@ pub struct H5Info {
     /// How the sensor is known (or why the claim was changed).
     pub sensor_note: Option<String>,
     pub frame_count: usize,
+    /// Remarks for the user (e.g. times stored with less than microsecond precision).
+    pub notes: Vec<String>,
 }
 
 fn h5_error(path: &Path, what: &str, e: hdf5::Error) -> InputError {
@@ -741,6 +743,9 @@ pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
             n
         }
     };
+    let notes = time_precision(path, &file, layout, events)?
+        .into_iter()
+        .collect::<Vec<_>>();
     let frames = frame_index(path, &file, layout)?;
     let claimed = match layout {
         // MVSEC states no resolution; its frames show the whole sensor
@@ -752,6 +757,7 @@ pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
                 sensor: Some(Sensor::new(w as u16, h as u16)),
                 sensor_note: Some(format!("the size of {}/image_raw", side.group())),
                 frame_count: frames.times.len(),
+                notes,
             });
         }
         _ => claimed_resolution(&file),
@@ -795,7 +801,82 @@ pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
         sensor,
         sensor_note,
         frame_count: frames.times.len(),
+        notes,
     })
+}
+
+/// The coarsest spacing of stored times ctcal accepts, seconds: events less than this
+/// apart would share a time (rates per window, the support window and same-pixel intervals
+/// lose their meaning).
+pub const MAX_TIME_RESOLUTION_S: f64 = 1e-3;
+
+/// The spacing of float32 values near `t`.
+fn float32_spacing(t: f64) -> f64 {
+    let t = (t.abs() as f32).max(f32::MIN_POSITIVE);
+    (f32::from_bits(t.to_bits() + 1) - t) as f64
+}
+
+/// Checks that float times in seconds keep their precision: float32 resolves only 1 us
+/// below 16.8 s and 128 s at the epoch times MVSEC stores, where a whole recording
+/// collapses to one time. Refused when the spacing of stored values at the file's times
+/// is coarser than [`MAX_TIME_RESOLUTION_S`]; a note when coarser than a microsecond.
+fn time_precision(
+    path: &Path,
+    file: &hdf5::File,
+    layout: Layout,
+    n: usize,
+) -> Result<Option<String>, InputError> {
+    let (name, column) = match layout {
+        Layout::EventUtils => ("events/ts".to_string(), None),
+        Layout::Mvsec(side) => (format!("{}/events", side.group()), Some(2)),
+        _ => return Ok(None),
+    };
+    let ds = file.dataset(&name).map_err(|e| h5_error(path, &name, e))?;
+    let is_float32 = matches!(
+        ds.dtype().and_then(|d| d.to_descriptor()),
+        Ok(TypeDescriptor::Float(hdf5::types::FloatSize::U4))
+    );
+    if !is_float32 || n == 0 {
+        return Ok(None);
+    }
+    let time_at = |row: usize| -> Result<f64, InputError> {
+        let v = match column {
+            None => element::<f64>(file, &name, row),
+            Some(c) => ds
+                .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, c..c + 1])
+                .map(|a| a.iter().next().copied().unwrap_or(0.0)),
+        };
+        v.map_err(|e| h5_error(path, &name, e))
+    };
+    let (first, last) = (time_at(0)?, time_at(n - 1)?);
+    if !first.is_finite() || !last.is_finite() {
+        // reported with its index by the reader
+        return Ok(None);
+    }
+    let t = first.abs().max(last.abs());
+    let spacing = float32_spacing(t);
+    let field = match column {
+        None => name.clone(),
+        Some(c) => format!("{name}[:, {c}]"),
+    };
+    let problem = format!(
+        "{field} stores times as float32 seconds, which near {t:.6e} s only take values {spacing:.3e} s apart: events closer than that share one time (the {} events from {first} s to {last} s)",
+        n
+    );
+    if spacing > MAX_TIME_RESOLUTION_S {
+        return Err(InputError::hdf5(
+            path,
+            problem,
+            "the times lost their precision when the file was written: write them again from the source recording as float64 seconds (or int64 microseconds)",
+        ));
+    }
+    Ok((spacing > 1e-6).then(|| {
+        format!(
+            "{}: {problem}; times are kept only to {:.0} us",
+            path.display(),
+            spacing * 1e6
+        )
+    }))
 }
 
 fn image_names(file: &hdf5::File) -> Vec<String> {
@@ -879,10 +960,30 @@ fn frame_index(path: &Path, file: &hdf5::File, layout: Layout) -> Result<FrameIn
             }
             let shape = check_dataset(path, file, "frame", 3)?;
             let size = frame_size(path, "frame", shape[1], shape[2])?;
-            let times: Vec<i64> = file
-                .dataset("frame_ts")
-                .and_then(|d| d.read_raw::<i64>())
-                .map_err(|e| err("frame_ts", e))?;
+            // microseconds, as integers (v2e) or floats: a float NaN or infinity must not
+            // become a time by integer conversion
+            let stamps = file.dataset("frame_ts").map_err(|e| err("frame_ts", e))?;
+            let float = matches!(
+                stamps.dtype().and_then(|d| d.to_descriptor()),
+                Ok(TypeDescriptor::Float(_))
+            );
+            let times: Vec<i64> = if float {
+                let values: Vec<f64> = stamps.read_raw().map_err(|e| err("frame_ts", e))?;
+                let mut times = Vec::with_capacity(values.len());
+                for (i, &t) in values.iter().enumerate() {
+                    if !(t.is_finite() && t.abs() <= crate::events::TIME_LIMIT_US as f64) {
+                        return Err(InputError::hdf5(
+                            path,
+                            format!("frame_ts[{i}] is {t}, not a time in microseconds"),
+                            "frame timestamps are microseconds; the file is damaged",
+                        ));
+                    }
+                    times.push(t.round() as i64);
+                }
+                times
+            } else {
+                stamps.read_raw::<i64>().map_err(|e| err("frame_ts", e))?
+            };
             if times.len() != shape[0] {
                 return Err(InputError::hdf5(
                     path,
@@ -952,6 +1053,17 @@ impl FrameIndex {
         size: (u32, u32),
         dataset: Option<String>,
     ) -> Result<(), InputError> {
+        if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
+            return Err(InputError::corrupt(
+                path,
+                place,
+                format!(
+                    "frame time {t} us lies beyond +-{} us (about 73,000 years) of zero",
+                    crate::events::TIME_LIMIT_US
+                ),
+                "the file is damaged at this place; frame times are in the file's clock",
+            ));
+        }
         if let Some(&previous) = self.times.last() {
             if size != self.size {
                 return Err(InputError::corrupt(
@@ -1179,25 +1291,29 @@ fn first_row_at_or_after(
     Ok(hi)
 }
 
-/// The rows that can hold the events of times `from..=to`, found with the file's own index
+/// Event rows found with a file's index, and a note when the index had to be corrected.
+pub type IndexedRows = (std::ops::Range<usize>, Option<String>);
+
+/// The rows that hold the events of times `from..=to`, found with the file's own index
 /// (DSEC `ms_to_idx`: the first event of each millisecond; MVSEC `image_raw_event_inds`: the
-/// event nearest each frame, from which the exact ends are found on the event times), so
-/// that a window is read without
-/// scanning what lies before it. DSEC rows may hold a few events outside the window (the
-/// caller trims); MVSEC rows are exact. `None` when the layout has no usable index.
+/// event nearest each frame), from which the exact ends are found on the event times, so
+/// that a window is read without scanning what lies before it. An index that contradicts
+/// the times (a DSEC millisecond that does not start at its row) costs a longer search, not
+/// events: the rows are found on the times, and the note says where the index is wrong.
+/// `None` when the layout has no usable index.
 pub fn index_window(
     path: &Path,
     info: &H5Info,
     from: TimeUs,
     to: TimeUs,
-) -> Result<Option<std::ops::Range<usize>>, InputError> {
+) -> Result<Option<IndexedRows>, InputError> {
     let file = open_file(path)?;
     let n = info.events;
     let found = match info.layout {
         Layout::Dsec if file.link_exists("ms_to_idx") => {
             let offset = dsec_t_offset(&file).map_err(|e| h5_error(path, "t_offset", e))?;
             let ms = check_dataset(path, &file, "ms_to_idx", 1)?[0];
-            if ms == 0 {
+            if ms == 0 || n == 0 {
                 return Ok(None);
             }
             let at = |k: usize| -> Result<usize, InputError> {
@@ -1205,18 +1321,52 @@ pub fn index_window(
                     element(&file, "ms_to_idx", k).map_err(|e| h5_error(path, "ms_to_idx", e))?;
                 Ok((v as usize).min(n))
             };
+            let time_at = |row: usize| -> Result<TimeUs, InputError> {
+                if row >= n {
+                    return Ok(TimeUs::MAX);
+                }
+                let t = element::<u64>(&file, "events/t", row)
+                    .map(|t| t as i64)
+                    .or_else(|_| element::<i64>(&file, "events/t", row))
+                    .map_err(|e| h5_error(path, "events/t", e))?;
+                Ok(t.saturating_add(offset))
+            };
             let millisecond = |t: TimeUs| (t.saturating_sub(offset)).div_euclid(1000);
+            let mut notes = Vec::new();
+            // the row ms_to_idx gives for millisecond `k`, checked against the times: the
+            // first row at or after the millisecond's start
+            let checked = |k: usize, notes: &mut Vec<String>| -> Result<usize, InputError> {
+                let row = at(k)?;
+                let begins = offset.saturating_add(k as i64 * 1000);
+                let before_ok = row == 0 || time_at(row - 1)? < begins;
+                let at_ok = row >= n || time_at(row)? >= begins;
+                if !(before_ok && at_ok) {
+                    let actual = first_row_at_or_after(row, n, begins, &time_at)?;
+                    notes.push(format!(
+                        "{}: ms_to_idx[{k}] = {row} contradicts events/t: the first event of millisecond {k} is row {actual}; the window was found on the event times instead (the index is damaged: rewrite it)",
+                        path.display()
+                    ));
+                }
+                Ok(row)
+            };
             let first = millisecond(from).clamp(0, ms as i64 - 1) as usize;
             let last = millisecond(to).saturating_add(1);
-            let start = if from <= offset { 0 } else { at(first)? };
-            let end = if last < 0 {
+            let near_start = if from <= offset {
+                0
+            } else {
+                checked(first, &mut notes)?
+            };
+            let near_end = if last < 0 {
                 0
             } else if (last as u64) < ms as u64 {
-                at(last as usize)?
+                checked(last as usize, &mut notes)?
             } else {
                 n
             };
-            Some(start..end.max(start))
+            // the exact ends, on the times (the index's rows are where the search starts)
+            let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
+            let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
+            Some((start..end.max(start), notes.into_iter().next()))
         }
         Layout::Mvsec(side) => {
             let inds = format!("{}/image_raw_event_inds", side.group());
@@ -1272,7 +1422,7 @@ pub fn index_window(
             };
             let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
             let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
-            Some(start..end.max(start))
+            Some((start..end.max(start), None))
         }
         _ => None,
     };

@@ -22,10 +22,13 @@ pub fn read_mask(path: &Path, sensor: Sensor) -> Result<Vec<bool>, InputError> {
     let is_npy = path
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("npy"));
+    // what the file claims (shape, dimensions) is checked against the sensor and the file's
+    // length before anything is allocated for it
     let (width, height, keep) = if is_npy {
+        super::npy::check_header(path, sensor, "mask")?;
         read_npy(path)?
     } else {
-        read_image(path)?
+        read_image(path, sensor)?
     };
     if (width, height) != (sensor.width as usize, sensor.height as usize) {
         return Err(InputError::invalid(
@@ -37,14 +40,36 @@ pub fn read_mask(path: &Path, sensor: Sensor) -> Result<Vec<bool>, InputError> {
     Ok(keep)
 }
 
-fn read_image(path: &Path) -> Result<(usize, usize, Vec<bool>), InputError> {
-    let image = image::open(path).map_err(|e| {
+fn read_image(path: &Path, sensor: Sensor) -> Result<(usize, usize, Vec<bool>), InputError> {
+    let unreadable = |e: &dyn std::fmt::Display| {
         InputError::invalid(
             path,
             format!("not a readable image ({e})"),
             "give a PNG (non-zero = keep) or a .npy array",
         )
-    })?;
+    };
+    let open = || {
+        image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| unreadable(&e))
+    };
+    // the dimensions from the header first: a small file may decode to gigabytes
+    let (w, h) = open()?.into_dimensions().map_err(|e| unreadable(&e))?;
+    if (w as usize, h as usize) != (sensor.width as usize, sensor.height as usize) {
+        return Err(InputError::invalid(
+            path,
+            format!("the mask image is {w}x{h} (W x H) but the sensor is {sensor}"),
+            format!("give a mask of {sensor}, one value per pixel (non-zero = keep)"),
+        ));
+    }
+    let mut reader = open()?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(w);
+    limits.max_image_height = Some(h);
+    // 16-bit RGBA at most, and the decoder's working buffers
+    limits.max_alloc = Some(8 * w as u64 * h as u64 + (16 << 20));
+    reader.limits(limits);
+    let image = reader.decode().map_err(|e| unreadable(&e))?;
     let rgba = image.to_rgba8();
     let (w, h) = rgba.dimensions();
     let keep = rgba
@@ -110,6 +135,8 @@ mod tests {
             vec![false, true, true, false, false, true]
         );
         let e = read_mask(&npy, Sensor::new(2, 3)).unwrap_err().to_string();
+        assert!(e.contains("(2, 3)") && e.contains("2x3"), "{e}");
+        let e = read_mask(&png, Sensor::new(2, 3)).unwrap_err().to_string();
         assert!(e.contains("3x2") && e.contains("2x3"), "{e}");
     }
 }

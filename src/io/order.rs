@@ -60,6 +60,35 @@ impl OrderCheck {
         }
     }
 
+    /// Records `count` events that go backwards, found by a decoder that checks order its
+    /// own way (the first at `place`, `t` after `previous`).
+    pub fn record_backwards(
+        &mut self,
+        count: u64,
+        place: impl FnOnce() -> String,
+        previous: TimeUs,
+        t: TimeUs,
+    ) {
+        if count == 0 {
+            return;
+        }
+        self.backwards += count;
+        if self.first.is_none() {
+            self.first = Some((place(), previous, t));
+        }
+    }
+
+    /// Checks only that `times` lie within [`TIME_LIMIT_US`] (for a decoder that checks
+    /// their order its own way).
+    pub fn check_range(&mut self, times: &[TimeUs], place: impl Fn(usize) -> String) {
+        if let Some(i) = times
+            .iter()
+            .position(|t| t.unsigned_abs() > TIME_LIMIT_US as u64)
+        {
+            self.record_out_of_range(times[i], &|| place(i));
+        }
+    }
+
     #[cold]
     #[inline(never)]
     fn record(&mut self, t: TimeUs, place: &impl Fn() -> String) {

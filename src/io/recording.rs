@@ -154,6 +154,7 @@ impl Recording {
                 {
                     notes.push(note.clone());
                 }
+                notes.extend(info.notes.iter().cloned());
                 (Source::H5(info), sensor)
             }
             Format::Aedat4 => {
@@ -192,7 +193,7 @@ impl Recording {
                             "{origin} says the sensor is {s}, larger than {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE} (more than any sensor sold)"
                         ),
                         format!(
-                            "if the sensor really is that large, pass --sensor {s}; otherwise the file is damaged"
+                            "if the header is damaged, pass --sensor WxH with the camera's real size; if the sensor really is {s}, pass --sensor {s} (statistics then keep per-pixel state only for the area the events reach)"
                         ),
                     ));
                 }
@@ -235,12 +236,16 @@ impl Recording {
     /// with the file's own index where it has one (DSEC, MVSEC), else from the start; the
     /// caller trims to the window. An empty window is not an error here.
     pub fn events_between(&self, from: TimeUs, to: TimeUs) -> Result<EventStream, InputError> {
-        let rows = match &self.source {
-            Source::H5(info) => h5::index_window(&self.path, info, from, to)?,
-            _ => None,
+        let (rows, note) = match &self.source {
+            Source::H5(info) => match h5::index_window(&self.path, info, from, to)? {
+                Some((rows, note)) => (Some(rows), note),
+                None => (None, None),
+            },
+            _ => (None, None),
         };
         let mut stream = self.stream(rows)?;
         stream.allow_empty = true;
+        stream.notes.extend(note);
         Ok(stream)
     }
 
@@ -284,6 +289,7 @@ impl Recording {
             max_y: 0,
             allow_unsorted: false,
             allow_empty: false,
+            notes: Vec::new(),
         })
     }
 
@@ -460,6 +466,8 @@ pub struct EventStream {
     /// A stream without events ends quietly (a window the caller checks) rather than with
     /// [`InputError::Empty`].
     pub allow_empty: bool,
+    /// Remarks for the user (e.g. a file index that contradicts the times and was not used).
+    pub notes: Vec<String>,
 }
 
 impl EventStream {

@@ -52,6 +52,12 @@ impl DisplayParams {
     }
 }
 
+/// The highest event rate of one pixel a parameter may give (one event a microsecond, the
+/// time resolution of events).
+pub const MAX_PIXEL_RATE_HZ: f64 = 1e6;
+/// The widest display blur (sigma, pixels): the largest sensor side.
+pub const MAX_BLUR_PX: f64 = 4096.0;
+
 /// The pixel model's parameters (PARAMS.toml).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -221,6 +227,24 @@ impl PixelParams {
         ] {
             non_negative(key, v)?;
         }
+        // events are timed to the microsecond: no pixel fires more often than that
+        for (key, v) in [
+            ("leak_rate_hz", self.leak_rate_hz),
+            ("shot_noise_rate_hz", self.shot_noise_rate_hz),
+            ("hot_pixel_rate_hz", self.hot_pixel_rate_hz),
+        ] {
+            if let Some(v) = v
+                && v > MAX_PIXEL_RATE_HZ
+            {
+                return Err(fail(
+                    key,
+                    format!(
+                        "is {v:e} events per pixel per second; events are timed to the microsecond, so no pixel fires more than {MAX_PIXEL_RATE_HZ:e} times a second"
+                    ),
+                    "give a rate per pixel per second (real sensors: well below 1e3)",
+                ));
+            }
+        }
         if let Some(f) = self.hot_pixel_fraction
             && !(0.0..=1.0).contains(&f)
         {
@@ -245,6 +269,17 @@ impl PixelParams {
                 ));
             }
             non_negative("display.blur_px", d.blur_px)?;
+            if let Some(blur) = d.blur_px
+                && blur > MAX_BLUR_PX
+            {
+                return Err(fail(
+                    "display.blur_px",
+                    format!(
+                        "is {blur:e} pixels; a blur wider than {MAX_BLUR_PX} pixels (the largest sensor) leaves one uniform grey"
+                    ),
+                    "give the optical blur's sigma in pixels (a few pixels at most for a focused camera)",
+                ));
+            }
             if d.time_offset_s.is_some_and(|t| !t.is_finite()) {
                 return Err(fail(
                     "display.time_offset_s",

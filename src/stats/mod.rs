@@ -14,7 +14,9 @@
 //!
 //! Memory is bounded by the sensor (16 bytes per pixel), a fixed-size interval histogram and
 //! the non-empty windows of the rate timeline, never by the time span a file claims; events
-//! must arrive time-sorted.
+//! must arrive time-sorted. Per-pixel state covers the area the events reach, within
+//! [`PIXEL_BUDGET`] pixels unless [`StatsOptions::max_pixels`] says otherwise: a sensor
+//! claimed (or given) far larger than its events costs only what the events need.
 
 pub mod hot_pixels;
 pub mod intervals;
@@ -27,6 +29,7 @@ use crate::selection::PixelSelection;
 use hot_pixels::HotPixel;
 use intervals::IntervalHistogram;
 use pixel_grid::PixelGrid;
+pub use pixel_grid::{BYTES_PER_PIXEL, PIXEL_BUDGET};
 use serde::Serialize;
 use timeline::SparseTimeline;
 pub use timeline::{FrameSummary, RateWindow};
@@ -65,6 +68,27 @@ pub struct StatsOptions {
     /// The time of the recording's first event, when the events added do not start there
     /// (a reader that seeked to `start_s`); `start_s`/`end_s` count from it.
     pub origin_us: Option<TimeUs>,
+    /// The most pixels of per-pixel state to keep (`None`: no limit); events beyond it stop
+    /// the pass ([`StatsAccumulator::over_budget`]).
+    pub max_pixels: Option<usize>,
+}
+
+/// The events reach an area whose per-pixel state exceeds [`StatsOptions::max_pixels`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OverBudget {
+    /// The largest coordinates seen when the budget was passed.
+    pub max_x: u16,
+    pub max_y: u16,
+    /// Pixels of state that area needs, and the budget.
+    pub pixels: u64,
+    pub budget: usize,
+}
+
+impl OverBudget {
+    /// Bytes of state the area needs.
+    pub fn bytes(&self) -> u64 {
+        self.pixels * BYTES_PER_PIXEL as u64
+    }
 }
 
 impl Default for StatsOptions {
@@ -76,6 +100,7 @@ impl Default for StatsOptions {
             support_window_s: 0.01,
             selection: None,
             origin_us: None,
+            max_pixels: Some(PIXEL_BUDGET),
         }
     }
 }
@@ -144,6 +169,10 @@ pub struct StatsAccumulator {
     events: u64,
     on: u64,
     pixels: PixelGrid,
+    /// The sensor when known in advance (the grid grows towards it).
+    sensor: Option<Sensor>,
+    /// Set when the events passed the pixel budget (the pass then stops counting).
+    over_budget: Option<OverBudget>,
     /// Scratch: pixel index of each event of the chunk being added, and whether it is kept.
     indices: Vec<u32>,
     kept: Vec<bool>,
@@ -182,11 +211,16 @@ impl StatsAccumulator {
     pub fn new(options: StatsOptions, sensor: Option<Sensor>) -> Self {
         let window_us = ((options.window_s * 1e6).round() as TimeUs).max(1);
         let support_us = ((options.support_window_s * 1e6).round() as TimeUs).max(0);
-        // a selection fixes the sensor
+        // a selection fixes the sensor (and its grid); otherwise a sensor over the budget
+        // is not allocated up front: the grid grows to the area the events reach
         let sensor = options.selection.as_ref().map(|s| s.sensor()).or(sensor);
-        let pixels = sensor.map_or_else(PixelGrid::default, |s| {
-            PixelGrid::new(s.width as usize, s.height as usize)
-        });
+        let budget = options.max_pixels.unwrap_or(usize::MAX);
+        let pixels = match sensor {
+            Some(s) if options.selection.is_some() || s.pixels() <= budget => {
+                PixelGrid::new(s.width as usize, s.height as usize)
+            }
+            _ => PixelGrid::default(),
+        };
         let kept_cells = options.selection.as_ref().map(|selection| {
             let mut cells = vec![false; pixels.cells.len()];
             let width = selection.sensor().width as usize;
@@ -207,6 +241,8 @@ impl StatsAccumulator {
             events: 0,
             on: 0,
             pixels,
+            sensor,
+            over_budget: None,
             indices: Vec::new(),
             kept: Vec::new(),
             kept_cells,
@@ -215,9 +251,10 @@ impl StatsAccumulator {
         }
     }
 
-    /// Adds a time-sorted chunk (continuing the previous ones).
+    /// Adds a time-sorted chunk (continuing the previous ones). Once the events pass the
+    /// pixel budget ([`Self::over_budget`]) nothing more is counted.
     pub fn add(&mut self, chunk: &EventChunk) {
-        if chunk.is_empty() {
+        if chunk.is_empty() || self.over_budget.is_some() {
             return;
         }
         if self.stream_first.is_none() {
@@ -239,7 +276,9 @@ impl StatsAccumulator {
         let on = &chunk.on[lo..hi];
         let max_x = xs.iter().copied().max().expect("non-empty");
         let max_y = ys.iter().copied().max().expect("non-empty");
-        self.pixels.ensure(max_x, max_y);
+        if !self.grow_to(max_x, max_y) {
+            return;
+        }
         let Some(kept_cells) = &self.kept_cells else {
             if self.first.is_none() {
                 self.first = Some(ts[0]);
@@ -339,19 +378,57 @@ impl StatsAccumulator {
         }
     }
 
+    /// Makes the grid hold pixel (`max_x`, `max_y`); `false` (and [`Self::over_budget`]
+    /// set) when that takes more pixels than the budget.
+    fn grow_to(&mut self, max_x: u16, max_y: u16) -> bool {
+        let grid = &self.pixels;
+        let need_w = (max_x as usize + 1).max(grid.width);
+        let need_h = (max_y as usize + 1).max(grid.height);
+        if need_w == grid.width && need_h == grid.height {
+            return true;
+        }
+        let budget = self.options.max_pixels.unwrap_or(usize::MAX);
+        let pixels = need_w.saturating_mul(need_h);
+        if pixels > budget {
+            self.over_budget = Some(OverBudget {
+                max_x,
+                max_y,
+                pixels: pixels as u64,
+                budget,
+            });
+            return false;
+        }
+        let side = crate::events::MAX_SENSOR_SIDE as usize;
+        let limit = self
+            .sensor
+            .map_or((side, side), |s| (s.width as usize, s.height as usize));
+        self.pixels.ensure_within(max_x, max_y, limit, budget);
+        true
+    }
+
+    /// Whether the events passed the pixel budget ([`StatsOptions::max_pixels`]): the
+    /// statistics are then incomplete and must not be reported.
+    pub fn over_budget(&self) -> Option<OverBudget> {
+        self.over_budget
+    }
+
     /// Events selected so far.
     pub fn events(&self) -> u64 {
         self.events
     }
 
     /// Final statistics for `sensor` (how it is known: `sensor_source`), with the
-    /// recording's frame times. `None` when no event was selected.
+    /// recording's frame times. `None` when no event was selected, or when the events
+    /// passed the pixel budget (the counts are incomplete; see [`Self::over_budget`]).
     pub fn finish(
         mut self,
         sensor: Sensor,
         sensor_source: &str,
         frame_times: &[TimeUs],
     ) -> Option<SequenceStats> {
+        if self.over_budget.is_some() {
+            return None;
+        }
         let first = self.first?;
         if self.windows.count > 0 {
             self.windows
@@ -362,27 +439,37 @@ impl StatsAccumulator {
         // a selection fixes the sensor
         let sensor = selection.as_ref().map_or(sensor, |s| s.sensor());
         let (width, height) = (sensor.width as usize, sensor.height as usize);
-        let keep = |i: usize| selection.as_ref().is_none_or(|s| s.kept_mask()[i]);
+        // the per-pixel maps cover the area the grid holds (where events are; the rest of
+        // the sensor has none): the whole sensor unless it was too large to allocate
+        let (area_w, area_h) = (width.min(self.pixels.width), height.min(self.pixels.height));
+        // whether the pixel at index `i` of the area is kept
+        let keep = |i: usize| {
+            selection
+                .as_ref()
+                .is_none_or(|s| s.kept_mask()[(i / area_w) * width + i % area_w])
+        };
         let kept_pixels = selection.as_ref().map_or(width * height, |s| s.kept());
         let pixels = kept_pixels.max(1) as f64;
         let duration_s = us_to_s(self.last - first);
         let per_pixel_per_second =
             |n: u64| (duration_s > 0.0).then(|| n as f64 / (pixels * duration_s));
-        let all_counts = self.pixels.counts(width, height);
-        let unsupported = self.pixels.map(width, height, |c| c.unsupported);
+        let all_counts = self.pixels.counts(area_w, area_h);
+        let unsupported = self.pixels.map(area_w, area_h, |c| c.unsupported);
         let counts: Vec<u32> = (0..all_counts.len())
             .filter(|&i| keep(i))
             .map(|i| all_counts[i])
             .collect();
+        // kept pixels outside the area: no events
+        let silent = kept_pixels - counts.len();
         let active = counts.iter().filter(|&&c| c > 0).count();
         // hot pixels are judged against their real neighbours, kept or not
         let hot: Vec<HotPixel> =
-            hot_pixels::find_hot_pixels(&all_counts, width, height, duration_s)
+            hot_pixels::find_hot_pixels(&all_counts, area_w, area_h, duration_s)
                 .into_iter()
-                .filter(|h| keep(h.y as usize * width + h.x as usize))
+                .filter(|h| keep(h.y as usize * area_w + h.x as usize))
                 .collect();
         let background_rate_hz =
-            background_rate(&unsupported, width, &hot, duration_s, &keep, kept_pixels);
+            background_rate(&unsupported, area_w, &hot, duration_s, &keep, kept_pixels);
         let off = self.events - self.on;
         Some(SequenceStats {
             width: sensor.width,
@@ -411,7 +498,7 @@ impl StatsAccumulator {
             background_rate_hz,
             background_rate_method: BACKGROUND_RATE_METHOD,
             support_window_s: us_to_s(self.support_us),
-            median_pixel_rate_hz: median_rate(&counts, duration_s),
+            median_pixel_rate_hz: median_rate(&counts, silent, duration_s),
             pixels_kept: kept_pixels as u64,
             selection: selection.map_or_else(|| "the whole sensor".into(), |s| s.description()),
             excluded_hot_pixels: Vec::new(),
@@ -454,18 +541,27 @@ fn background_rate(
     (total - hot_events) as f64 / (kept as f64 * duration_s)
 }
 
-/// Median over all pixels of events / duration.
-fn median_rate(counts: &[u32], duration_s: f64) -> f64 {
-    if duration_s <= 0.0 || counts.is_empty() {
+/// Median over all pixels of events / duration: the pixels of `counts` and `zeros` more
+/// without events.
+fn median_rate(counts: &[u32], zeros: usize, duration_s: f64) -> f64 {
+    let n = counts.len() + zeros;
+    if duration_s <= 0.0 || n == 0 {
         return 0.0;
     }
+    // in sorted order the extra zeros come first (no count is smaller)
     let mut sorted = counts.to_vec();
-    let mid = sorted.len() / 2;
-    let upper = *sorted.select_nth_unstable(mid).1 as f64;
-    let median = if sorted.len() % 2 == 1 {
-        upper
+    let mut nth = |k: usize| -> f64 {
+        if k < zeros {
+            0.0
+        } else {
+            *sorted.select_nth_unstable(k - zeros).1 as f64
+        }
+    };
+    let mid = n / 2;
+    let median = if n % 2 == 1 {
+        nth(mid)
     } else {
-        (*sorted[..mid].iter().max().expect("len >= 2") as f64 + upper) / 2.0
+        (nth(mid - 1) + nth(mid)) / 2.0
     };
     median / duration_s
 }
@@ -571,6 +667,61 @@ mod tests {
                 median_interval_s: Some(0.04)
             })
         );
+    }
+
+    #[test]
+    fn a_huge_sensor_costs_only_the_area_its_events_reach() {
+        let chunk: EventChunk = (0..200)
+            .map(|i| Event {
+                t: i * 1000,
+                x: (i % 7) as u16,
+                y: (i % 5) as u16,
+                on: i % 3 == 0,
+            })
+            .collect();
+        let small = Sensor::new(8, 6);
+        let huge = Sensor::new(65_535, 65_535);
+        let mut a = StatsAccumulator::new(StatsOptions::default(), Some(small));
+        a.add(&chunk);
+        let a = a.finish(small, "small", &[]).unwrap();
+        let mut b = StatsAccumulator::new(StatsOptions::default(), Some(huge));
+        b.add(&chunk);
+        assert!(b.over_budget().is_none());
+        assert!(b.pixels.cells.len() < 10_000, "{}", b.pixels.cells.len());
+        let b = b.finish(huge, "huge", &[]).unwrap();
+        assert_eq!(b.events, a.events);
+        assert_eq!(b.hot_pixels, a.hot_pixels);
+        assert_eq!(b.inter_event_interval_s, a.inter_event_interval_s);
+        let scale = small.pixels() as f64 / huge.pixels() as f64;
+        assert!((b.active_pixel_fraction - a.active_pixel_fraction * scale).abs() < 1e-15);
+        assert!((b.background_rate_hz - a.background_rate_hz * scale).abs() < 1e-12);
+        assert_eq!(b.median_pixel_rate_hz, 0.0);
+        // events far apart on the huge sensor pass the budget: the pass stops
+        let far: EventChunk = [event(0, 1, 1), event(10, 60_000, 60_000)]
+            .into_iter()
+            .collect();
+        let mut c = StatsAccumulator::new(StatsOptions::default(), Some(huge));
+        c.add(&far);
+        let over = c.over_budget().unwrap();
+        assert_eq!((over.max_x, over.max_y), (60_000, 60_000));
+        assert!(over.bytes() > 100_000_000_000);
+        // unless there is no budget
+        let options = StatsOptions {
+            max_pixels: None,
+            ..Default::default()
+        };
+        let mut d = StatsAccumulator::new(options, Some(Sensor::new(5000, 2)));
+        d.add(&[event(0, 4999, 1)].into_iter().collect());
+        assert!(d.over_budget().is_none());
+    }
+
+    #[test]
+    fn median_counts_the_pixels_without_events() {
+        assert_eq!(median_rate(&[4, 2, 8], 0, 1.0), 4.0);
+        assert_eq!(median_rate(&[4, 2, 8], 1, 1.0), 3.0);
+        assert_eq!(median_rate(&[4, 2, 8], 2, 2.0), 1.0);
+        assert_eq!(median_rate(&[], 3, 1.0), 0.0);
+        assert_eq!(median_rate(&[6, 6], 0, 2.0), 3.0);
     }
 
     #[test]

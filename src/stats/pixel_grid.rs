@@ -4,9 +4,19 @@
 //! never fire, so that the 8 neighbours of any pixel can be read without bounds checks.
 //! It grows when the sensor size is not known in advance (it is inferred from the
 //! coordinates at the end); readers bound coordinates by `MAX_SENSOR_SIDE`, and so is the
-//! grid.
+//! grid. A sensor given larger than [`PIXEL_BUDGET`] pixels is not allocated up front
+//! either: the grid then grows to the area the events reach, and the statistics refuse
+//! (unless told to go on) when that area exceeds the budget.
 
 use crate::events::{MAX_SENSOR_SIDE, TimeUs};
+
+/// Pixels of per-pixel state the statistics (and the estimators) keep without being told
+/// otherwise: 4096 x 4096, the largest sensor ctcal accepts from a file (more than any
+/// sensor sold), about [`BYTES_PER_PIXEL`] bytes each (0.5 GB).
+pub const PIXEL_BUDGET: usize = MAX_SENSOR_SIDE as usize * MAX_SENSOR_SIDE as usize;
+
+/// Bytes per pixel of the statistics pass: the 16-byte cell and the maps of its final step.
+pub const BYTES_PER_PIXEL: usize = 32;
 
 /// One pixel's running state.
 #[derive(Clone, Copy, Debug)]
@@ -60,22 +70,38 @@ impl PixelGrid {
 
     /// Makes the grid contain pixel (`max_x`, `max_y`), keeping the cells' contents.
     pub fn ensure(&mut self, max_x: u16, max_y: u16) {
+        let side = MAX_SENSOR_SIDE as usize;
+        self.ensure_within(max_x, max_y, (side, side), usize::MAX);
+    }
+
+    /// Makes the grid contain pixel (`max_x`, `max_y`), growing ahead of need up to `limit`
+    /// (width, height: the sensor) and `max_pixels`, never beyond what is needed past them.
+    pub fn ensure_within(
+        &mut self,
+        max_x: u16,
+        max_y: u16,
+        limit: (usize, usize),
+        max_pixels: usize,
+    ) {
         let (need_w, need_h) = (max_x as usize + 1, max_y as usize + 1);
         if need_w <= self.width && need_h <= self.height {
             return;
         }
         // grow generously so that a stream of slowly rising maxima does not re-layout
         // often, but never past the largest sensor
-        let limit = MAX_SENSOR_SIDE as usize;
-        let grow = |have: usize, need: usize| {
+        let grow = |have: usize, need: usize, limit: usize| {
             if need <= have {
                 have
             } else {
                 need.max(have + have / 2).max(64).min(limit.max(need))
             }
         };
-        let width = grow(self.width, need_w);
-        let height = grow(self.height, need_h);
+        let mut width = grow(self.width, need_w, limit.0);
+        let mut height = grow(self.height, need_h, limit.1);
+        if width.saturating_mul(height) > max_pixels {
+            width = need_w.max(self.width);
+            height = need_h.max(self.height);
+        }
         let mut grown = Self::new(width, height);
         for y in 0..self.height {
             let from = (y + 1) * self.stride() + 1;
@@ -133,5 +159,14 @@ mod tests {
         let mut g = PixelGrid::new(3000, 1);
         g.ensure(3500, 0);
         assert_eq!(g.width, MAX_SENSOR_SIDE as usize);
+    }
+
+    #[test]
+    fn growth_ahead_of_need_stays_within_the_budget() {
+        let mut g = PixelGrid::default();
+        g.ensure_within(999, 999, (60_000, 60_000), 1_000_000);
+        assert_eq!((g.width, g.height), (1000, 1000));
+        g.ensure_within(1000, 10, (60_000, 60_000), usize::MAX);
+        assert_eq!((g.width, g.height), (1500, 1000));
     }
 }

@@ -397,3 +397,318 @@ fn time_windows_read_the_same_events_and_seek_with_the_file_index() {
         );
     }
 }
+
+/// A record of a bag: where it starts, its header fields and where its data lie.
+struct BagRecord {
+    start: usize,
+    fields: Vec<(String, std::ops::Range<usize>)>,
+    data: std::ops::Range<usize>,
+}
+
+impl BagRecord {
+    fn field(&self, name: &str) -> Option<std::ops::Range<usize>> {
+        self.fields
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, r)| r.clone())
+    }
+
+    fn op(&self, bytes: &[u8]) -> u8 {
+        bytes[self.field("op").unwrap().start]
+    }
+
+    fn end(&self) -> usize {
+        self.data.end
+    }
+}
+
+/// The records of `bytes[from..to]`.
+fn bag_records(bytes: &[u8], from: usize, to: usize) -> Vec<BagRecord> {
+    let u32_at = |i: usize| u32::from_le_bytes(bytes[i..i + 4].try_into().unwrap()) as usize;
+    let mut records = Vec::new();
+    let mut at = from;
+    while at < to {
+        let header_len = u32_at(at);
+        let mut fields = Vec::new();
+        let mut i = at + 4;
+        while i < at + 4 + header_len {
+            let n = u32_at(i);
+            let field = &bytes[i + 4..i + 4 + n];
+            let eq = field.iter().position(|&b| b == b'=').unwrap();
+            fields.push((
+                String::from_utf8_lossy(&field[..eq]).into_owned(),
+                i + 4 + eq + 1..i + 4 + n,
+            ));
+            i += 4 + n;
+        }
+        let data_start = at + 4 + header_len + 4;
+        let data_len = u32_at(at + 4 + header_len);
+        records.push(BagRecord {
+            start: at,
+            fields,
+            data: data_start..data_start + data_len,
+        });
+        at = data_start + data_len;
+    }
+    records
+}
+
+/// The uncompressed bag of the slider, its records in its (one) chunk, and the connection
+/// id of `/dvs/events`.
+fn slider_bag() -> (Vec<u8>, Vec<BagRecord>, u32) {
+    let bytes = std::fs::read(dataset("ijrr_slider_depth_50k.bag")).unwrap();
+    let top = bag_records(&bytes, 13, bytes.len());
+    let chunk = top.iter().find(|r| r.op(&bytes) == 0x05).unwrap();
+    let inner = bag_records(&bytes, chunk.data.start, chunk.data.end);
+    let events = inner
+        .iter()
+        .find(|r| r.op(&bytes) == 0x07 && &bytes[r.field("topic").unwrap()] == b"/dvs/events")
+        .unwrap();
+    let id = u32::from_le_bytes(bytes[events.field("conn").unwrap()].try_into().unwrap());
+    (bytes, inner, id)
+}
+
+/// The message records of connection `id`.
+fn messages_of<'a>(bytes: &[u8], records: &'a [BagRecord], id: u32) -> Vec<&'a BagRecord> {
+    records
+        .iter()
+        .filter(|r| r.op(bytes) == 0x02 && bytes[r.field("conn").unwrap()] == id.to_le_bytes())
+        .collect()
+}
+
+/// Where event `k` of a `dvs_msgs/EventArray` message's data starts.
+fn event_offset(bytes: &[u8], data: &std::ops::Range<usize>, k: usize) -> usize {
+    // header: seq, stamp (secs, nsecs), frame_id (length + bytes); height, width, count
+    let frame_id = u32::from_le_bytes(bytes[data.start + 12..data.start + 16].try_into().unwrap());
+    data.start + 16 + frame_id as usize + 12 + 13 * k
+}
+
+#[test]
+fn a_bag_event_far_ahead_of_its_neighbours_is_disorder_as_in_every_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bytes, records, id) = slider_bag();
+    let messages = messages_of(&bytes, &records, id);
+    // an event stamped 2^32 - 1 s (136 years later) inside message 3, and at its end
+    let last = u32::from_le_bytes(
+        bytes[event_offset(&bytes, &messages[2].data, 0) - 4..][..4]
+            .try_into()
+            .unwrap(),
+    ) as usize;
+    for (name, k, expected) in [
+        ("inside.bag", 5, "message 3 ("),
+        ("at_end.bag", last - 1, "message 4 ("),
+    ] {
+        let mut damaged = bytes.clone();
+        let at = event_offset(&bytes, &messages[2].data, k) + 4;
+        damaged[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+        let path = dir.path().join(name);
+        std::fs::write(&path, &damaged).unwrap();
+        let e = bad_input(&["stats", path.to_str().unwrap()]);
+        // one bad stamp is one step back, as a text reader counts it
+        assert!(
+            e.contains(name)
+                && e.contains("1 timestamps go backwards")
+                && e.contains("topic /dvs/events")
+                && e.contains(expected)
+                && e.contains("--sort"),
+            "{name}: {e}"
+        );
+    }
+    // the same damage in a text file says the same
+    let text = dir.path().join("events.txt");
+    std::fs::write(&text, "0.1 1 1 1\n4294967295.0 2 2 1\n0.2 3 3 0\n").unwrap();
+    let e = bad_input(&["stats", text.to_str().unwrap()]);
+    assert!(e.contains("timestamps go backwards"), "{e}");
+}
+
+#[test]
+fn a_bag_chunk_with_its_records_reversed_is_unsorted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bytes, records, id) = slider_bag();
+    let messages = messages_of(&bytes, &records, id);
+    // the event messages in reverse order, every other record in place
+    let mut reversed = bytes[..records[0].start].to_vec();
+    let mut next = messages.iter().rev();
+    for r in &records {
+        let source = if messages.iter().any(|m| m.start == r.start) {
+            next.next().unwrap()
+        } else {
+            r
+        };
+        reversed.extend_from_slice(&bytes[source.start..source.end()]);
+    }
+    reversed.extend_from_slice(&bytes[records.last().unwrap().end()..]);
+    assert_eq!(reversed.len(), bytes.len());
+    let path = dir.path().join("reversed.bag");
+    std::fs::write(&path, &reversed).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    // a step back at every message after the first, as a text reader would count
+    assert!(
+        e.contains("reversed.bag")
+            && e.contains(&format!("{} timestamps go backwards", messages.len() - 1))
+            && e.contains("ends before a message before it started")
+            && e.contains("--sort"),
+        "{e}"
+    );
+    // with --sort every event is there, as in the original
+    let sorted = json(&["stats", path.to_str().unwrap(), "--sort"]);
+    let original = json(&[
+        "stats",
+        dataset("ijrr_slider_depth_50k.bag").to_str().unwrap(),
+    ]);
+    for key in ["events", "on_events", "t_first_us", "t_last_us"] {
+        assert_eq!(sorted[key], original[key], "{key}");
+    }
+}
+
+#[test]
+fn a_bag_message_of_an_unknown_connection_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let (bytes, records, id) = slider_bag();
+    let message = messages_of(&bytes, &records, id)[4];
+    let mut damaged = bytes.clone();
+    let conn = message.field("conn").unwrap();
+    damaged[conn].copy_from_slice(&77u32.to_le_bytes());
+    let path = dir.path().join("unknown.bag");
+    std::fs::write(&path, &damaged).unwrap();
+    let e = bad_input(&["stats", path.to_str().unwrap()]);
+    assert!(
+        e.contains("unknown.bag")
+            && e.contains(&format!(
+                "record at byte {}",
+                message.start - records[0].start
+            ))
+            && e.contains("connection id 77")
+            && e.contains("0 (/dvs/events)")
+            && e.contains("fix:"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_dsec_index_that_contradicts_the_times_is_checked_against_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("dsec.h5");
+    std::fs::copy(dataset(FILES[3].0), &path).unwrap();
+    // millisecond 50 said to start where millisecond 53 does: a window from 50 ms used to
+    // start 3 ms late and lose the events between
+    {
+        let file = hdf5::File::open_rw(&path).unwrap();
+        let mut index: Vec<u64> = file.dataset("ms_to_idx").unwrap().read_raw().unwrap();
+        let (right, wrong) = (index[50], index[53]);
+        assert!(wrong > right + 100, "{right} {wrong}");
+        index[50] = wrong;
+        file.unlink("ms_to_idx").unwrap();
+        file.new_dataset_builder()
+            .with_data(&index)
+            .create("ms_to_idx")
+            .unwrap();
+    }
+    let window = ["--start", "0.05", "--end", "0.1", "--json", "-"];
+    let reference = json(&[
+        "stats",
+        dataset(FILES[3].0).to_str().unwrap(),
+        "--start",
+        "0.05",
+        "--end",
+        "0.1",
+    ]);
+    // not quiet: the warning is the message
+    let output = std::process::Command::new(assert_cmd::cargo::cargo_bin("ctcal"))
+        .env("HDF5_USE_FILE_LOCKING", "FALSE")
+        .arg("stats")
+        .arg(&path)
+        .args(window)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    let s: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    for key in ["events", "on_events", "t_first_us", "t_last_us"] {
+        assert_eq!(s[key], reference[key], "{key}");
+    }
+    assert!(
+        stderr.contains("dsec.h5")
+            && stderr.contains("ms_to_idx[50]")
+            && stderr.contains("contradicts events/t")
+            && stderr.contains("found on the event times"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn float32_times_that_lost_their_precision_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = read_events(&real("ijrr_slider_depth_50k"));
+    // MVSEC's layout with float32 rows: at 1.5e9 s float32 values lie 128 s apart, and
+    // the whole recording used to collapse to one time (duration 0)
+    let path = dir.path().join("mvsec_f32.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let rows: Vec<f32> = reference
+            .iter()
+            .take(1000)
+            .flat_map(|e| {
+                [
+                    e.x as f32,
+                    e.y as f32,
+                    (1_504_645_000.0 + e.t as f64 * 1e-6) as f32,
+                    if e.on { 1.0 } else { -1.0 },
+                ]
+            })
+            .collect();
+        let table = ndarray::Array2::from_shape_vec((1000, 4), rows).unwrap();
+        file.create_group("davis").unwrap();
+        file.create_group("davis/left").unwrap();
+        file.new_dataset_builder()
+            .with_data(&table)
+            .create("davis/left/events")
+            .unwrap();
+    }
+    for command in ["stats", "info"] {
+        let e = bad_input(&[command, path.to_str().unwrap(), "--sensor", "240x180"]);
+        assert!(
+            e.contains("mvsec_f32.h5")
+                && e.contains("davis/left/events[:, 2]")
+                && e.contains("float32")
+                && e.contains("1.280e2 s apart")
+                && e.contains("float64")
+                && e.contains("fix:"),
+            "{command}: {e}"
+        );
+    }
+    // float32 seconds from zero keep their microseconds over a short recording
+    let path = dir.path().join("event_utils_f32.h5");
+    {
+        let file = hdf5::File::create(&path).unwrap();
+        let events = file.create_group("events").unwrap();
+        let n = 1000;
+        let ts: Vec<f32> = reference.t[..n].iter().map(|&t| t as f32 * 1e-6).collect();
+        let xs: Vec<i16> = reference.x[..n].iter().map(|&x| x as i16).collect();
+        let ys: Vec<i16> = reference.y[..n].iter().map(|&y| y as i16).collect();
+        let ps: Vec<u8> = reference.on[..n].iter().map(|&p| p as u8).collect();
+        events
+            .new_dataset_builder()
+            .with_data(&ts)
+            .create("ts")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&xs)
+            .create("xs")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&ys)
+            .create("ys")
+            .unwrap();
+        events
+            .new_dataset_builder()
+            .with_data(&ps)
+            .create("ps")
+            .unwrap();
+    }
+    let s = json(&["stats", path.to_str().unwrap(), "--sensor", "240x180"]);
+    assert_eq!(s["events"], 1000);
+    assert_eq!(s["t_first_us"], reference.t[0]);
+}

@@ -245,3 +245,97 @@ fn hdf5_with_integer_microsecond_times_and_signed_polarity() {
         (Some(3), Some(2))
     );
 }
+
+#[test]
+fn config_refuses_fit_values_no_camera_has_naming_their_json_path() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.cfg");
+    let out = out.to_str().unwrap();
+    let valid = r#""ct_on": 0.3, "ct_off": 0.3"#;
+    let cases = [
+        (
+            "huge.json",
+            r#"{"params": {"ct_on": 1e308, "ct_off": 0.3}}"#.to_string(),
+            "`params.ct_on` is 1e308",
+        ),
+        (
+            "list.json",
+            r#"{"params": [0.3, 0.3]}"#.to_string(),
+            "`params` is a list",
+        ),
+        (
+            "exposure.json",
+            format!(r#"{{"params": {{{valid}}}, "frame_exposure_us": -5}}"#),
+            "`frame_exposure_us` is -5",
+        ),
+        (
+            "text.json",
+            r#"{"params": {"ct_on": "0.3", "ct_off": 0.3}}"#.to_string(),
+            "`params.ct_on` is the string \"0.3\"",
+        ),
+        (
+            "display.json",
+            format!(
+                r#"{{"params": {{{valid}, "display": {{"refresh_hz": 1e9, "gamma": 2.0, "black_level": 0.0, "white_dn": 200.0}}}}}}"#
+            ),
+            "`params.display.refresh_hz` is 1e9",
+        ),
+        (
+            "negative.json",
+            format!(r#"{{"params": {{{valid}, "leak_rate_hz": -1.0}}}}"#),
+            "`params.leak_rate_hz` is -1",
+        ),
+    ];
+    for (name, text, expected) in cases {
+        let fit = write(dir.path(), name, text.as_bytes());
+        for format in ["esim", "esim-generator", "v2e", "ctcal"] {
+            let e = bad_input(&["config", &fit, "--format", format, "--out", out]);
+            assert!(
+                e.contains(name) && e.contains(expected) && e.contains("fix:"),
+                "{name} {format}: {e}"
+            );
+            assert!(
+                !Path::new(out).exists(),
+                "{name} {format}: a config written"
+            );
+        }
+    }
+    // in a report folder, the path goes through the sequence
+    let report = dir.path().join("report");
+    std::fs::create_dir(&report).unwrap();
+    std::fs::write(
+        report.join("results.json"),
+        format!(
+            r#"{{"ctcal_version": "0.1.0", "sequences": [{{"name": "a", "fit": {{"params": {{{valid}}}}}}}, {{"name": "b", "fit": {{"params": {{"ct_on": 0.3, "ct_off": 1e308}}}}}}]}}"#
+        ),
+    )
+    .unwrap();
+    let e = bad_input(&[
+        "config",
+        report.to_str().unwrap(),
+        "--format",
+        "esim",
+        "--out",
+        out,
+    ]);
+    assert!(
+        e.contains("results.json") && e.contains("`sequences[1].fit.params.ct_off` is 1e308"),
+        "{e}"
+    );
+    assert!(!Path::new(out).exists());
+    // an ordinary fit still configures
+    let fit = write(
+        dir.path(),
+        "ok.json",
+        format!(r#"{{"params": {{{valid}}}, "frame_exposure_us": 2000}}"#).as_bytes(),
+    );
+    ctcal()
+        .args(["config", &fit, "--format", "esim", "--out", out])
+        .assert()
+        .success();
+    assert!(
+        std::fs::read_to_string(out)
+            .unwrap()
+            .contains("--exposure_time_ms=2")
+    );
+}

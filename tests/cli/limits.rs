@@ -549,3 +549,385 @@ fn messages_give_the_right_advice() {
     assert!(e.contains("--format aedat4 does not fit"), "{e}");
     assert!(!e.contains("Some("), "{e}");
 }
+
+/// An `.npy` file whose header claims `shape` of `descr` values, followed by `data` bytes.
+fn npy_claiming(path: &Path, descr: &str, shape: &str, data: usize) {
+    let mut header = format!("{{'descr': '{descr}', 'fortran_order': False, 'shape': {shape}, }}");
+    while !(10 + header.len() + 1).is_multiple_of(64) {
+        header.push(' ');
+    }
+    header.push('\n');
+    let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+    bytes.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    bytes.extend_from_slice(header.as_bytes());
+    bytes.resize(bytes.len() + data, 0);
+    std::fs::write(path, bytes).unwrap();
+}
+
+/// CRC-32 of PNG chunks.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xffff_ffffu32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// A grey PNG of `width` x `height` zeros, written row by row: a few hundred KB that decode
+/// to `width * height` bytes.
+fn png_of_zeros(path: &Path, width: u32, height: u32) {
+    use std::io::Write;
+    let mut deflate = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::best());
+    let row = vec![0u8; width as usize + 1];
+    for _ in 0..height {
+        deflate.write_all(&row).unwrap();
+    }
+    let data = deflate.finish().unwrap();
+    let chunk = |out: &mut Vec<u8>, kind: &[u8], body: &[u8]| {
+        out.extend_from_slice(&(body.len() as u32).to_be_bytes());
+        let mut typed = kind.to_vec();
+        typed.extend_from_slice(body);
+        out.extend_from_slice(&typed);
+        out.extend_from_slice(&crc32(&typed).to_be_bytes());
+    };
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = width.to_be_bytes().to_vec();
+    ihdr.extend_from_slice(&height.to_be_bytes());
+    ihdr.extend_from_slice(&[8, 0, 0, 0, 0]);
+    chunk(&mut png, b"IHDR", &ihdr);
+    chunk(&mut png, b"IDAT", &data);
+    chunk(&mut png, b"IEND", &[]);
+    std::fs::write(path, png).unwrap();
+}
+
+/// Every command that takes `--mask`, on the slider recording (it has frames, for `fit` and
+/// `report`); `out` is the report folder.
+fn mask_commands<'a>(input: &'a str, mask: &'a str, out: &'a str) -> Vec<Vec<&'a str>> {
+    vec![
+        vec!["stats", input, "--mask", mask],
+        vec!["estimate", "eppps", input, "--mask", mask],
+        vec!["fit", input, "--mask", mask],
+        vec!["report", input, "--no-fit", "--mask", mask, "--out", out],
+    ]
+}
+
+#[test]
+fn masks_are_checked_against_the_sensor_before_they_are_read() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    let out = dir.path().join("report");
+    let out = out.to_str().unwrap();
+    // a 1 KB .npy claiming 100000 x 100000 bytes (10 GB): used to be allocated
+    let huge = dir.path().join("huge.npy");
+    npy_claiming(&huge, "|u1", "(100000, 100000)", 1000);
+    // the sensor's shape, but the data cut short
+    let short = dir.path().join("short.npy");
+    npy_claiming(&short, "<f8", "(180, 240)", 1000);
+    // a 400 KB PNG that decodes to 20000 x 20000 (400 MB grey, 1.6 GB as RGBA)
+    let bomb = dir.path().join("bomb.png");
+    png_of_zeros(&bomb, 20_000, 20_000);
+    assert!(std::fs::metadata(&bomb).unwrap().len() < 1 << 20);
+    for (mask, expected) in [
+        (&huge, "shape (100000, 100000)"),
+        (&short, "holds 1000 bytes"),
+        (&bomb, "20000x20000"),
+    ] {
+        let mask = mask.to_str().unwrap();
+        for args in mask_commands(input, mask, out) {
+            let started = Instant::now();
+            let e = bad_input(&args);
+            assert!(
+                started.elapsed() < Duration::from_secs(20),
+                "{args:?}: {:?}",
+                started.elapsed()
+            );
+            assert!(
+                e.contains(mask) && e.contains(expected) && e.contains("fix:"),
+                "{args:?}: {e}"
+            );
+        }
+    }
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        3,
+        "no report folder or partial copy left"
+    );
+}
+
+#[test]
+fn a_mask_that_keeps_no_pixel_is_an_error_naming_it_everywhere() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    let out = dir.path().join("report");
+    let out = out.to_str().unwrap();
+    let png = dir.path().join("nothing.png");
+    image::GrayImage::new(240, 180).save(&png).unwrap();
+    let npy = dir.path().join("nothing.npy");
+    ndarray_npy::write_npy(&npy, &ndarray::Array2::<f32>::zeros((180, 240))).unwrap();
+    for mask in [&png, &npy] {
+        let mask = mask.to_str().unwrap();
+        for args in mask_commands(input, mask, out) {
+            let e = bad_input(&args);
+            assert!(
+                e.contains(&format!("the mask {mask} keeps no pixel"))
+                    && e.contains("fix:")
+                    && !e.contains("time window"),
+                "{args:?}: {e}"
+            );
+        }
+    }
+    // inside a region: the message says so
+    let mut corner = ndarray::Array2::<u8>::zeros((180, 240));
+    corner[[0, 0]] = 1;
+    ndarray_npy::write_npy(&npy, &corner).unwrap();
+    let e = bad_input(&[
+        "fit",
+        input,
+        "--roi",
+        "100,100,200,150",
+        "--mask",
+        npy.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("keeps no pixel inside the region x 100..200, y 100..150"),
+        "{e}"
+    );
+    assert!(!Path::new(out).exists());
+}
+
+#[test]
+fn a_huge_sensor_keeps_state_only_for_the_area_its_events_reach() {
+    let dir = tempfile::tempdir().unwrap();
+    // a Prophesee header claiming 65535 x 65535: the error used to suggest --sensor
+    // 65535x65535, which then asked for a 68.7 GB grid and aborted
+    let mut raw = b"% evt 3.0\n% geometry 65535x65535\n% end\n".to_vec();
+    raw.extend_from_slice(&[0x00, 0x80, 0x00, 0x60, 0x05, 0x20]);
+    let raw = write(dir.path(), "huge.raw", &raw);
+    let e = bad_input(&["stats", &raw]);
+    assert!(
+        e.contains("huge.raw")
+            && e.contains("geometry")
+            && e.contains("65535x65535")
+            && e.contains("--sensor WxH with the camera's real size")
+            && e.contains("--sensor 65535x65535"),
+        "{e}"
+    );
+    // both fixes it suggests work (the memory is asserted in tests/hostile.rs)
+    for sensor in ["65535x65535", "640x480"] {
+        let s = json(&["stats", &raw, "--sensor", sensor]);
+        assert_eq!(s["events"], 1, "{sensor}");
+    }
+    // events that do spread over such a sensor: refused with the area and the fixes, and
+    // nothing written
+    let far = write(dir.path(), "far.txt", b"0.1 1 1 1\n0.2 60000 60000 0\n");
+    let out = dir.path().join("s.json");
+    let e = bad_input(&[
+        "stats",
+        &far,
+        "--sensor",
+        "65535x65535",
+        "--json",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("far.txt")
+            && e.contains("x = 60000, y = 60000")
+            && e.contains("--sensor WxH")
+            && e.contains("--force"),
+        "{e}"
+    );
+    assert!(!out.exists());
+    // the estimators (and a selection) hold maps of the whole sensor: refused, naming the
+    // area the events reach
+    let e = bad_input(&["estimate", "eppps", &raw, "--sensor", "65535x65535"]);
+    assert!(
+        e.contains("huge.raw")
+            && e.contains("65535x65535 sensor")
+            && e.contains("the events reach x = 5, y = 0")
+            && e.contains("--force"),
+        "{e}"
+    );
+    let e = bad_input(&[
+        "stats",
+        &raw,
+        "--sensor",
+        "65535x65535",
+        "--roi",
+        "0,0,10,10",
+    ]);
+    assert!(
+        e.contains("--roi") && e.contains("budget") && e.contains("--sensor WxH"),
+        "{e}"
+    );
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, vec!["far.txt", "huge.raw"]);
+}
+
+#[test]
+fn noise_and_blur_beyond_the_budget_are_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sim");
+    let run = |params: &str, frames: &str| {
+        let path = write(dir.path(), "p.toml", params.as_bytes());
+        let mut cmd = ctcal();
+        cmd.args(["simulate", "--params", &path, "--frames"])
+            .arg(oracle(frames))
+            .arg("--out")
+            .arg(&out);
+        cmd.output().unwrap()
+    };
+    // an earlier output, which a refused run must leave as it is
+    assert!(
+        run("ct_on = 0.3\nct_off = 0.3\n", "a_ideal_texture")
+            .status
+            .success()
+    );
+    let before = std::fs::read(out.join("events.txt")).unwrap();
+    let display =
+        "[display]\nrefresh_hz = 75.0\ngamma = 2.0\nblack_level = 0.005\nwhite_dn = 200.0\n";
+    for (extra, frames, expected) in [
+        // used to abort after 21 s and 4.6 GB, leaving a partial output
+        (
+            "leak_rate_hz = 1e9",
+            "a_ideal_texture",
+            "`leak_rate_hz` is 1e9",
+        ),
+        // used to abort after 42 s and 6 GB
+        (
+            "shot_noise_rate_hz = 1e7",
+            "a_ideal_texture",
+            "`shot_noise_rate_hz` is 1e7",
+        ),
+        // within one event a microsecond, but 4e9 events
+        (
+            "leak_rate_hz = 1e5",
+            "a_ideal_texture",
+            "lower leak_rate_hz",
+        ),
+        (
+            "shot_noise_rate_hz = 2e4",
+            "a_ideal_texture",
+            "lower shot_noise_rate_hz",
+        ),
+        // used to run 110 s and write 7.3 GB
+        (
+            "hot_pixel_fraction = 0.01\nhot_pixel_rate_hz = 1e6",
+            "a_ideal_texture",
+            "lower hot_pixel_rate_hz",
+        ),
+        // used to run for minutes (a kernel of 6 million taps)
+        (
+            &format!("{display}blur_px = 1e6\n"),
+            "dev_screen_checker",
+            "`display.blur_px` is 1e6",
+        ),
+        (
+            &format!("{display}blur_px = 1000.0\n"),
+            "dev_screen_checker",
+            "the display blur (display.blur_px)",
+        ),
+    ] {
+        let started = Instant::now();
+        let output = run(&format!("ct_on = 0.3\nct_off = 0.3\n{extra}\n"), frames);
+        let e = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{extra}: {e}");
+        assert!(
+            started.elapsed() < Duration::from_secs(10),
+            "{extra}: {:?}",
+            started.elapsed()
+        );
+        assert!(
+            e.contains("p.toml") && e.contains(expected) && e.contains("fix:"),
+            "{extra}: {e}"
+        );
+        assert_eq!(std::fs::read(out.join("events.txt")).unwrap(), before);
+        let mut left: Vec<String> = std::fs::read_dir(dir.path())
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        left.sort();
+        assert_eq!(
+            left,
+            vec!["p.toml", "sim"],
+            "{extra}: a partial output left"
+        );
+    }
+}
+
+#[test]
+fn frame_times_are_finite_and_in_order_in_every_reader() {
+    let dir = tempfile::tempdir().unwrap();
+    // v2e frame_ts stored as floats: NaN used to become i64::MIN, a median frame interval
+    // of -9.2e12 s
+    for (name, times, place, problem) in [
+        ("nan.h5", [f64::NAN, 1000.0, 2000.0], "frame_ts[0]", "NaN"),
+        (
+            "inf.h5",
+            [1000.0, f64::INFINITY, 3000.0],
+            "frame_ts[1]",
+            "inf",
+        ),
+        (
+            "order.h5",
+            [2000.0, 1000.0, 3000.0],
+            "frame_ts[1]",
+            "earlier",
+        ),
+    ] {
+        let path = dir.path().join(name);
+        {
+            let file = hdf5::File::create(&path).unwrap();
+            file.new_dataset_builder()
+                .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
+                .create("events")
+                .unwrap();
+            file.new_dataset_builder()
+                .with_data(&ndarray::Array3::<u8>::zeros((3, 4, 4)))
+                .create("frame")
+                .unwrap();
+            file.new_dataset_builder()
+                .with_data(&times)
+                .create("frame_ts")
+                .unwrap();
+        }
+        for command in ["stats", "info"] {
+            let e = bad_input(&[command, path.to_str().unwrap(), "--sensor", "8x8"]);
+            assert!(
+                e.contains(name) && e.contains(place) && e.contains(problem) && e.contains("fix:"),
+                "{name} {command}: {e}"
+            );
+        }
+    }
+    // an IJRR frame list with a time beyond any clock
+    let rec = dir.path().join("rec");
+    std::fs::create_dir_all(rec.join("images")).unwrap();
+    std::fs::write(rec.join("events.txt"), "0.1 1 1 1\n0.2 2 2 0\n").unwrap();
+    for name in ["a.png", "b.png"] {
+        image::GrayImage::new(4, 4)
+            .save(rec.join("images").join(name))
+            .unwrap();
+    }
+    std::fs::write(
+        rec.join("images.txt"),
+        "0.1 images/a.png\n3e12 images/b.png\n",
+    )
+    .unwrap();
+    let e = bad_input(&["stats", rec.to_str().unwrap()]);
+    assert!(
+        e.contains("images.txt") && e.contains("line 2") && e.contains("beyond"),
+        "{e}"
+    );
+}

@@ -316,3 +316,93 @@ fn a_failed_simulation_leaves_nothing_and_keeps_an_existing_output() {
     assert!(wrong.is_file());
     assert_eq!(names(dir.path()), vec!["p.toml", "sim", "small.npy"]);
 }
+
+#[cfg(unix)]
+#[test]
+fn a_dangling_symlink_output_is_refused_and_creates_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    // every link points into folders that do not exist: writing through one used to create
+    // them
+    let elsewhere = dir.path().join("elsewhere");
+    let link = |name: &str, target: &str| {
+        let path = dir.path().join(name);
+        std::os::unix::fs::symlink(elsewhere.join(target), &path).unwrap();
+        path.to_str().unwrap().to_string()
+    };
+    let json_link = link("stats.json", "deep/stats.json");
+    let folder_link = link("out", "a/b");
+    let file_link = link("converted.h5", "c/converted.h5");
+    let config_link = link("esim.flagfile", "d/esim.flagfile");
+    let params = dir.path().join("p.toml");
+    std::fs::write(&params, "ct_on = 0.3\nct_off = 0.3\n").unwrap();
+    let fit = dir.path().join("fit.json");
+    std::fs::write(&fit, r#"{"params": {"ct_on": 0.3, "ct_off": 0.3}}"#).unwrap();
+    let frames = oracle("a_ideal_texture");
+    for (args, shown, target) in [
+        (
+            vec!["stats", input, "--json", &json_link],
+            "stats.json",
+            "elsewhere/deep/stats.json",
+        ),
+        (
+            vec!["convert", input, "--out", &folder_link],
+            "out",
+            "elsewhere/a/b",
+        ),
+        (
+            vec!["convert", input, "--to", "h5", "--out", &file_link],
+            "converted.h5",
+            "elsewhere/c/converted.h5",
+        ),
+        (
+            vec![
+                "simulate",
+                "--params",
+                params.to_str().unwrap(),
+                "--frames",
+                frames.to_str().unwrap(),
+                "--out",
+                &folder_link,
+            ],
+            "out",
+            "elsewhere/a/b",
+        ),
+        (
+            vec![
+                "config",
+                fit.to_str().unwrap(),
+                "--format",
+                "esim",
+                "--out",
+                &config_link,
+            ],
+            "esim.flagfile",
+            "elsewhere/d/esim.flagfile",
+        ),
+    ] {
+        let e = bad_input(&args);
+        assert!(
+            e.contains(shown)
+                && e.contains(target)
+                && e.contains("symbolic link")
+                && e.contains("does not exist")
+                && e.contains("fix:"),
+            "{args:?}: {e}"
+        );
+        assert!(!elsewhere.exists(), "{args:?} created the link's target");
+    }
+    assert_eq!(
+        names(dir.path()),
+        vec![
+            "converted.h5",
+            "esim.flagfile",
+            "fit.json",
+            "out",
+            "p.toml",
+            "stats.json"
+        ],
+        "nothing half-written beside the links"
+    );
+}

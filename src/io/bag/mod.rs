@@ -10,8 +10,18 @@
 //! Messages of one topic may overlap in time (a driver publishes by count or by time, and
 //! two publishers can interleave), so events are merged into time order as they stream:
 //! the events of earlier messages are held until a message starts after them. Memory is one
-//! chunk plus the overlap. A message that starts before events already handed on is a real
-//! disorder, reported as an unsorted file (`--sort` accepts it).
+//! chunk plus the overlap. Time order is checked as every other reader checks it, with that
+//! overlap as the only allowance; each of these counts as a timestamp going backwards (an
+//! unsorted file, which `--sort` accepts):
+//! - an event earlier than the event before it in the same message;
+//! - a message that ends before a message before it started (reversed records);
+//! - a message that ends earlier than events already read by more than its own span (and
+//!   [`OVERLAP_SLACK_US`]): it is not an overlap but an event far ahead of its neighbours
+//!   (a damaged stamp) or records out of place;
+//! - a message with events earlier than events already handed on.
+//!
+//! A message of a connection that no connection record before it defines is damage, named
+//! with its connection id.
 
 pub mod messages;
 pub mod reader;
@@ -26,6 +36,10 @@ use records::{RecordFile, op};
 use serde::Serialize;
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
+
+/// How much a message may end before the latest event already read, beyond its own span
+/// (delivery jitter between publishers).
+pub const OVERLAP_SLACK_US: TimeUs = 1_000;
 
 /// A topic of the bag.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -409,6 +423,13 @@ pub struct BagDecoder {
     message: u64,
     place: String,
     finished: bool,
+    /// The latest event and the latest message start read so far, and the latest event
+    /// handed on (for the order checks).
+    latest: TimeUs,
+    latest_start: TimeUs,
+    handed_max: TimeUs,
+    /// The message just read is out of place: everything held is handed on before it.
+    out_of_place: bool,
 }
 
 impl BagDecoder {
@@ -436,6 +457,10 @@ impl BagDecoder {
             message: 0,
             place: String::new(),
             finished: false,
+            latest: TimeUs::MIN,
+            latest_start: TimeUs::MIN,
+            handed_max: TimeUs::MIN,
+            out_of_place: false,
         })
     }
 
@@ -470,12 +495,68 @@ impl BagDecoder {
                             ));
                         }
                     }
-                    // a message's own events are in order (sorted here if not)
-                    self.incoming.sort_by_time();
+                    self.check_order();
                     return Ok(true);
                 }
                 Some(Item::Message { .. }) => {}
             }
+        }
+    }
+
+    /// Checks the order of the message just read (in `incoming`, in file order) against
+    /// itself and the messages before it (see the module notes), then sorts it.
+    fn check_order(&mut self) {
+        let ts = &self.incoming.t;
+        if ts.is_empty() {
+            self.out_of_place = false;
+            return;
+        }
+        let place = &self.place;
+        self.order
+            .check_range(ts, |i| format!("{place}, event {i}"));
+        // within the message, in file order
+        let within = ts.windows(2).filter(|w| w[1] < w[0]).count() as u64;
+        if within > 0 {
+            let i = ts.windows(2).position(|w| w[1] < w[0]).expect("counted") + 1;
+            self.order
+                .record_backwards(within, || format!("{place}, event {i}"), ts[i - 1], ts[i]);
+        }
+        let last_in_file = ts[ts.len() - 1];
+        self.incoming.sort_by_time();
+        let ts = &self.incoming.t;
+        let (first, last) = (ts[0], ts[ts.len() - 1]);
+        let span = last - first;
+        let reversed = last < self.latest_start;
+        let held_back = self.latest.saturating_sub(last) > span.saturating_add(OVERLAP_SLACK_US);
+        self.out_of_place = reversed || held_back;
+        // what the message's events must not precede
+        let bound = if self.out_of_place {
+            self.latest
+        } else {
+            self.handed_max
+        };
+        // counted as other readers count: once where the message goes back (its events
+        // after that are in order among themselves)
+        let goes_back = ts[0] < bound;
+        if goes_back {
+            let what = if reversed {
+                "the message ends before a message before it started"
+            } else if held_back {
+                "the message ends far before events already read"
+            } else {
+                "the message holds events earlier than events already read"
+            };
+            self.order
+                .record_backwards(1, || format!("{place}: {what}"), bound, first);
+        }
+        if within > 0 || goes_back {
+            // as other readers do after a step back: go on from here, so that one bad
+            // stamp counts once, not against every message after it
+            self.latest = last_in_file;
+            self.latest_start = first;
+        } else {
+            self.latest = self.latest.max(last);
+            self.latest_start = self.latest_start.max(first);
         }
     }
 
@@ -485,12 +566,14 @@ impl BagDecoder {
         if n == 0 {
             return;
         }
+        self.handed_max = self.handed_max.max(self.pending.t[n - 1]);
         for i in 0..n {
-            let t = self.pending.t[i];
-            let place = &self.place;
-            self.order.check(t, || place.clone());
-            self.ready
-                .push(t, self.pending.x[i], self.pending.y[i], self.pending.on[i]);
+            self.ready.push(
+                self.pending.t[i],
+                self.pending.x[i],
+                self.pending.y[i],
+                self.pending.on[i],
+            );
         }
         self.pending.t.drain(..n);
         self.pending.x.drain(..n);
@@ -544,7 +627,12 @@ impl EventDecoder for BagDecoder {
             self.ready.clear();
             self.handed = 0;
             if self.next_message()? {
-                if let Some(&first) = self.incoming.t.first() {
+                if self.out_of_place {
+                    // already refused (or to be sorted): hold nothing across it, so that
+                    // memory stays one message plus the overlap, and go on from here
+                    self.release(TimeUs::MAX);
+                    self.handed_max = TimeUs::MIN;
+                } else if let Some(&first) = self.incoming.t.first() {
                     self.release(first);
                 }
                 self.merge_incoming();
@@ -568,12 +656,7 @@ impl EventDecoder for BagDecoder {
 impl BagDecoder {
     /// Moves every pending event to `ready` (at the end of the bag).
     fn release_all(&mut self) {
-        let place = self.place.clone();
-        for i in 0..self.pending.len() {
-            self.order.check(self.pending.t[i], || place.clone());
-        }
-        self.ready.extend_from(&self.pending);
-        self.pending.clear();
+        self.release(TimeUs::MAX);
     }
 }
 

@@ -54,6 +54,8 @@ pub struct MessageReader {
     inner: usize,
     /// Messages handed out so far.
     pub messages: u64,
+    /// The connections defined so far (id, topic): a message must name one of them.
+    known: Vec<(u32, String)>,
 }
 
 impl MessageReader {
@@ -72,6 +74,7 @@ impl MessageReader {
             chunk_offset: start,
             inner: 0,
             messages: 0,
+            known: Vec::new(),
         })
     }
 
@@ -123,7 +126,37 @@ impl MessageReader {
                     }
                 };
                 match parsed {
-                    Parsed::Connection(c) => return Ok(Some(Item::Connection(c))),
+                    Parsed::Connection(c) => {
+                        if !self.known.iter().any(|(id, _)| *id == c.id) {
+                            self.known.push((c.id, c.topic.clone()));
+                        }
+                        return Ok(Some(Item::Connection(c)));
+                    }
+                    Parsed::Message(connection, _)
+                        if !self.known.iter().any(|(id, _)| *id == connection) =>
+                    {
+                        // its topic cannot be told: events or frames would go missing
+                        let defined = if self.known.is_empty() {
+                            "none".to_string()
+                        } else {
+                            self.known
+                                .iter()
+                                .map(|(id, topic)| format!("{id} ({topic})"))
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        };
+                        return Err(InputError::corrupt(
+                            &path,
+                            format!(
+                                "chunk at byte offset {}, record at byte {start} of the chunk",
+                                self.chunk_offset
+                            ),
+                            format!(
+                                "a message of connection id {connection}, which no connection record before it defines (defined: {defined}), so its topic is unknown"
+                            ),
+                            FIX_TRUNCATED,
+                        ));
+                    }
                     Parsed::Message(connection, range) => {
                         self.messages += 1;
                         return Ok(Some(Item::Message {

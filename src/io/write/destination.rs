@@ -153,7 +153,7 @@ impl OutputPolicy {
                 "give a file path (e.g. results.json)",
             ));
         }
-        let target = follow_symlink(path);
+        let target = follow_link(path)?;
         let canonical = canonical_future(&target);
         self.check_inputs(path, &canonical)?;
         match std::fs::metadata(&target) {
@@ -205,7 +205,7 @@ impl OutputPolicy {
 
     /// The folder a folder output at `path` writes, and what it holds already.
     fn plan_folder(&self, path: &Path) -> Result<(PathBuf, Option<ExistingFolder>), InputError> {
-        let target = follow_symlink(path);
+        let target = follow_link(path)?;
         let canonical = canonical_future(&target);
         self.check_inputs(path, &canonical)?;
         let existing = match std::fs::metadata(&target) {
@@ -301,6 +301,34 @@ impl FileKind {
             FileKind::Folder => "a folder",
             FileKind::Stream => "a device or pipe",
             FileKind::Other(what) => what,
+        }
+    }
+}
+
+/// The file a symlink at `path` points at (following chains), or `path` itself when it is
+/// no link; a link whose target does not exist (dangling, or a loop) is refused: writing
+/// through it would create the target's folders wherever the link points.
+fn follow_link(path: &Path) -> Result<PathBuf, InputError> {
+    let is_link = std::fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+    if !is_link {
+        return Ok(path.to_path_buf());
+    }
+    match std::fs::metadata(path) {
+        Ok(_) => Ok(follow_symlink(path)),
+        Err(e) => {
+            let target = std::fs::read_link(path)
+                .map(|t| t.display().to_string())
+                .unwrap_or_else(|_| "?".into());
+            let problem = if e.kind() == std::io::ErrorKind::NotFound {
+                format!("is a symbolic link to {target}, which does not exist")
+            } else {
+                format!("is a symbolic link to {target}, which cannot be followed ({e})")
+            };
+            Err(InputError::invalid(
+                path,
+                problem,
+                "create the link's target first, remove the link, or give another path",
+            ))
         }
     }
 }
