@@ -112,9 +112,41 @@ fn draw_stimulus(rng: &mut impl Rng, look: &Look, refresh_hz: f64) -> StimulusSp
     }
 }
 
+/// Significant digits a drawn number keeps.
+const DIGITS: usize = 6;
+
+/// Every number of `value` to [`DIGITS`] significant digits.
+fn round_numbers(value: &mut serde_json::Value) {
+    use serde_json::Value;
+    match value {
+        Value::Number(n) if n.is_f64() => {
+            let x = n.as_f64().expect("a float");
+            let rounded: f64 = format!("{x:.prec$e}", prec = DIGITS - 1)
+                .parse()
+                .expect("a float prints as one");
+            *value = serde_json::json!(rounded);
+        }
+        Value::Array(items) => items.iter_mut().for_each(round_numbers),
+        Value::Object(map) => map.values_mut().for_each(round_numbers),
+        _ => {}
+    }
+}
+
+/// The case with every number short, so that its JSON (read without serde_json's
+/// `float_roundtrip`) gives back exactly the same case.
+fn tidy(case: CaseSpec) -> CaseSpec {
+    let mut value = serde_json::to_value(&case).expect("cases serialise");
+    round_numbers(&mut value);
+    serde_json::from_value(value).expect("a rounded case is a case")
+}
+
 impl CaseSpec {
-    /// Draws one random recording; the same seed gives the same case.
+    /// Draws one random recording; the same seed gives the same case, and so does its JSON.
     pub fn draw(seed: u64) -> CaseSpec {
+        tidy(Self::draw_exact(seed))
+    }
+
+    fn draw_exact(seed: u64) -> CaseSpec {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let family = draw_family(&mut rng);
         let (width, height) = SENSOR_SIZES[rng.random_range(0..SENSOR_SIZES.len())];
@@ -160,6 +192,15 @@ mod tests {
         let json = serde_json::to_string(&a).unwrap();
         assert_eq!(serde_json::from_str::<CaseSpec>(&json).unwrap(), a);
         assert_ne!(a, CaseSpec::draw(8));
+    }
+
+    #[test]
+    fn every_case_survives_its_json() {
+        for seed in 0..300 {
+            let case = CaseSpec::draw(seed);
+            let json = serde_json::to_string_pretty(&case).unwrap();
+            assert_eq!(serde_json::from_str::<CaseSpec>(&json).unwrap(), case);
+        }
     }
 
     #[test]
