@@ -12,7 +12,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc;
 use std::time::Duration;
 
-/// The (case, method) runs of one case, skipping those in `done`.
+/// Writes `case`, runs `methods` on it, and removes it unless `keep`.
 fn run_case(
     case: &CaseSpec,
     methods: &[Method],
@@ -73,76 +73,125 @@ fn binary(args: &Args) -> PathBuf {
         .unwrap_or_else(|| ctcal::coverage::write::project_root().join("target/release/ctcal"))
 }
 
+/// The two results files, appended to as runs come in.
+struct ResultsFiles {
+    full: std::fs::File,
+    compact: std::fs::File,
+    written: usize,
+}
+
+impl ResultsFiles {
+    fn open(out: &Path, append: bool) -> anyhow::Result<Self> {
+        Ok(Self {
+            full: open(&out.join("results.jsonl"), append)?,
+            compact: open(&out.join("results.compact.jsonl"), append)?,
+            written: 0,
+        })
+    }
+
+    /// Appends a case's records and reports them on stderr.
+    fn append(&mut self, records: &[RunRecord]) -> anyhow::Result<()> {
+        self.written += 1;
+        for r in records {
+            writeln!(self.full, "{}", r.to_line())?;
+            writeln!(self.compact, "{}", r.compact().to_line())?;
+            let status = r.failure().map_or("ok".to_string(), |m| {
+                format!("FAILED {}", m.lines().next().unwrap_or(""))
+            });
+            let (id, method) = (&r.case.id, r.method.name());
+            eprintln!(
+                "[{}] {id} {method} {:.1} s {status}",
+                self.written, r.seconds
+            );
+        }
+        self.full.flush()?;
+        Ok(self.compact.flush()?)
+    }
+}
+
+/// What every worker shares.
+struct Plan<'a> {
+    args: &'a Args,
+    methods: &'a [Method],
+    done: BTreeSet<(String, Method)>,
+    options: RunOptions,
+    work: PathBuf,
+    next: AtomicU64,
+}
+
+impl Plan<'_> {
+    /// The methods still to run on `case`.
+    fn todo(&self, case: &CaseSpec) -> Vec<Method> {
+        self.methods
+            .iter()
+            .copied()
+            .filter(|m| m.applies_to(case) && !self.done.contains(&(case.id.clone(), *m)))
+            .collect()
+    }
+
+    /// Takes cases until none is left, sending each one's records.
+    fn work_on(&self, send: mpsc::Sender<Vec<RunRecord>>) {
+        loop {
+            let i = self.next.fetch_add(1, Ordering::SeqCst);
+            if i >= self.args.cases {
+                return;
+            }
+            let case = CaseSpec::draw(self.args.seed + i);
+            let todo = self.todo(&case);
+            if todo.is_empty() {
+                continue;
+            }
+            let records = run_case(
+                &case,
+                &todo,
+                &self.options,
+                &self.work,
+                self.args.keep_cases,
+            );
+            if send.send(records).is_err() {
+                return;
+            }
+        }
+    }
+}
+
 /// Runs every case; returns the path of the full results file.
 pub fn run_all(args: &Args, methods: &[Method]) -> anyhow::Result<PathBuf> {
     let results = args.out.join("results.jsonl");
-    let compact = args.out.join("results.compact.jsonl");
-    let done = if args.resume {
-        done_runs(&results)?
-    } else {
-        BTreeSet::new()
+    let plan = Plan {
+        args,
+        methods,
+        done: if args.resume {
+            done_runs(&results)?
+        } else {
+            BTreeSet::new()
+        },
+        options: RunOptions {
+            binary: binary(args),
+            threads: args.threads,
+            timeout: Duration::from_secs(args.timeout_s),
+        },
+        work: args.work.clone().unwrap_or_else(|| args.out.join("cases")),
+        next: AtomicU64::new(0),
     };
-    let (mut full_file, mut compact_file) =
-        (open(&results, args.resume)?, open(&compact, args.resume)?);
-    let work = args.work.clone().unwrap_or_else(|| args.out.join("cases"));
-    std::fs::create_dir_all(&work)?;
-    let options = RunOptions {
-        binary: binary(args),
-        threads: args.threads,
-        timeout: Duration::from_secs(args.timeout_s),
-    };
+    let binary = &plan.options.binary;
     anyhow::ensure!(
-        options.binary.is_file(),
+        binary.is_file(),
         "{} is not built: cargo build --release --all-targets",
-        options.binary.display()
+        binary.display()
     );
-    let next = AtomicU64::new(0);
+    std::fs::create_dir_all(&plan.work)?;
+    let mut files = ResultsFiles::open(&args.out, args.resume)?;
     let (send, receive) = mpsc::channel::<Vec<RunRecord>>();
     std::thread::scope(|scope| -> anyhow::Result<()> {
         for _ in 0..args.jobs.max(1) {
-            let send = send.clone();
-            let (next, done, work, options) = (&next, &done, &work, &options);
-            scope.spawn(move || {
-                loop {
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    if i >= args.cases {
-                        break;
-                    }
-                    let case = CaseSpec::draw(args.seed + i);
-                    let todo: Vec<Method> = methods
-                        .iter()
-                        .copied()
-                        .filter(|m| m.applies_to(&case) && !done.contains(&(case.id.clone(), *m)))
-                        .collect();
-                    if !todo.is_empty() {
-                        let records = run_case(&case, &todo, options, work, args.keep_cases);
-                        if send.send(records).is_err() {
-                            break;
-                        }
-                    }
-                }
-            });
+            let (send, plan) = (send.clone(), &plan);
+            scope.spawn(move || plan.work_on(send));
         }
         drop(send);
-        for (count, records) in receive.iter().enumerate() {
-            for r in &records {
-                writeln!(full_file, "{}", r.to_line())?;
-                writeln!(compact_file, "{}", r.compact().to_line())?;
-                let status = r.failure().map_or("ok".to_string(), |m| {
-                    format!("FAILED {}", m.lines().next().unwrap_or(""))
-                });
-                eprintln!(
-                    "[{}] {} {} {:.1} s {status}",
-                    count + 1,
-                    r.case.id,
-                    r.method.name(),
-                    r.seconds
-                );
-            }
-            full_file.flush()?;
-            compact_file.flush()?;
-        }
-        Ok(())
+        receive
+            .iter()
+            .try_for_each(|records| files.append(&records))
     })?;
     Ok(results)
 }

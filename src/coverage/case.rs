@@ -94,7 +94,7 @@ impl SceneFamily {
 pub enum RecordingSpec {
     /// A scene seen directly, with APS frames. Relative image paths in it are relative to
     /// the ctcal source tree (`calib/scenes/textures/natural/...`).
-    Scene { scene: SceneSpec },
+    Scene { scene: Box<SceneSpec> },
     /// The calibration checkerboard played on the display of `params.display`.
     Screen { stimulus: StimulusSpec },
 }

@@ -165,7 +165,7 @@ impl CaseSpec {
             RecordingSpec::Screen { stimulus }
         } else {
             RecordingSpec::Scene {
-                scene: draw_scene(&mut rng, family, &look, seed),
+                scene: Box::new(draw_scene(&mut rng, family, &look, seed)),
             }
         };
         CaseSpec {
