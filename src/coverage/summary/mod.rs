@@ -30,7 +30,7 @@ pub struct Detection {
     pub false_alarms: usize,
 }
 
-/// A reason (failure message or `why`) and how often a method gave it.
+/// A reason (failure message or `why`, numbers as `N`) and how often a method gave it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Reason {
     pub method: Method,
@@ -108,10 +108,30 @@ fn detection(records: &[RunRecord]) -> Vec<Detection> {
         .collect()
 }
 
-/// The first line of a message, numbers kept, cut to 140 characters.
+/// The first line of a message without the input's path (`error: /path/case-N: `) and
+/// with every number as `N`, so that one reason from many cases counts as one; cut to 140
+/// characters.
 fn headline(message: &str) -> String {
-    let line = message.lines().next().unwrap_or("").trim();
-    line.chars().take(140).collect()
+    let mut line = message.lines().next().unwrap_or("").trim();
+    line = line.strip_prefix("error: ").unwrap_or(line);
+    if line.starts_with('/')
+        && let Some(end) = line.find(": ")
+    {
+        line = &line[end + 2..];
+    }
+    let (mut out, mut in_number) = (String::new(), false);
+    let chars: Vec<char> = line.chars().collect();
+    for (i, &c) in chars.iter().enumerate() {
+        let decimal_point = c == '.' && chars.get(i + 1).is_some_and(char::is_ascii_digit);
+        match c {
+            '0'..='9' if !in_number => out.push('N'),
+            '0'..='9' => {}
+            _ if in_number && decimal_point => {}
+            _ => out.push(c),
+        }
+        in_number = c.is_ascii_digit() || (in_number && decimal_point);
+    }
+    out.chars().take(140).collect()
 }
 
 fn reasons(records: &[RunRecord]) -> Vec<Reason> {
@@ -205,5 +225,19 @@ impl Summary {
     /// The tables as Markdown (`COVERAGE.md` without its header).
     pub fn to_markdown(&self) -> String {
         markdown::render(self)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::headline;
+
+    #[test]
+    fn reasons_drop_the_path_and_the_numbers() {
+        assert_eq!(
+            headline("error: /runs/case-12: 336 events over 0.579 s are too few.\n  fix: x"),
+            "N events over N s are too few."
+        );
+        assert_eq!(headline("timed out after 400 s"), "timed out after N s");
     }
 }
