@@ -19,6 +19,7 @@
 //! JSON keys ending `_s`). The library never prints: it returns values and errors, and the
 //! `ctcal` binary presents them.
 
+pub mod coverage;
 pub mod estimate;
 pub mod events;
 pub mod files;

@@ -6,7 +6,7 @@ use ctcal::io::write::{H5Writer, IjrrWriter};
 use ctcal::io::{FrameList, npy};
 use ctcal::sim::budget::{EffectWork, MAX_SIDE, Work};
 use ctcal::sim::display::DisplayModel;
-use ctcal::sim::scene::{SceneSource, SceneSpec, aps};
+use ctcal::sim::scene::{SceneSource, SceneSpec};
 use ctcal::sim::source::{DisplaySource, LoadedFrames};
 use ctcal::sim::{FrameSource, PixelMaps, PixelParams, SimError};
 use ctcal::{EventChunk, Frame, Sensor};
@@ -209,10 +209,7 @@ fn open_input(args: &SimulateArgs, global: &Global) -> anyhow::Result<SimInput> 
                 "lower render_hz, duration_s, the APS rate or the sensor size",
                 global.force,
             )?;
-            let frames = match &spec.aps {
-                Some(a) => aps::render(&scene, spec.width, spec.height, spec.duration_s, hz, a),
-                None => Vec::new(),
-            };
+            let frames = spec.aps_frames(&scene, hz);
             SimInput {
                 source: Box::new(source),
                 span_s: spec.duration_s,

@@ -3,6 +3,7 @@
 
 mod common;
 mod convert;
+mod coverage;
 mod datasets;
 mod errors;
 mod estimate;

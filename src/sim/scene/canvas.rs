@@ -161,6 +161,16 @@ impl Canvas {
         Self { size, pixels: out }
     }
 
+    /// Multiplies every pixel so that the mean is `mean_dn` (an illumination change; a
+    /// black canvas stays black).
+    pub fn scale_mean(&mut self, mean_dn: f64) {
+        let mean = self.pixels.iter().map(|&p| p as f64).sum::<f64>() / self.pixels.len() as f64;
+        if mean > 0.0 {
+            let gain = (mean_dn / mean) as f32;
+            self.pixels.iter_mut().for_each(|p| *p *= gain);
+        }
+    }
+
     /// Bilinear sample at (column `x`, row `y`) with periodic wrap.
     #[inline]
     pub fn sample(&self, x: f64, y: f64) -> f32 {
@@ -196,6 +206,13 @@ mod tests {
         assert!((mean - 90f64.ln()).abs() < 0.05, "{mean}");
         assert!((sd - 0.45).abs() < 0.05, "{sd}");
         assert!(c.pixels.iter().all(|&p| (24.99..=235.01).contains(&p)));
+    }
+
+    #[test]
+    fn scaling_the_mean_is_an_illumination_change() {
+        let mut c = Canvas::from_image(2, 2, &[10, 20, 30, 40]);
+        c.scale_mean(50.0);
+        assert_eq!(c.pixels, vec![20.0, 40.0, 60.0, 80.0]);
     }
 
     #[test]

@@ -104,6 +104,8 @@ impl SceneSpec {
                 offset_px: [0.0, 0.0],
                 mod_amp_ln: 0.0,
                 mod_hz: 0.0,
+                image: None,
+                image_mean_dn: None,
             }),
             checkerboard: None,
             multi_object: None,
@@ -138,6 +140,12 @@ impl SceneSpec {
             && dir.is_relative()
         {
             m.textures_dir = Some(path.parent().unwrap_or(Path::new(".")).join(dir));
+        }
+        if let Some(t) = &mut spec.texture
+            && let Some(image) = &t.image
+            && image.is_relative()
+        {
+            t.image = Some(path.parent().unwrap_or(Path::new(".")).join(image));
         }
         spec.validate(path)?;
         Ok(spec)
@@ -277,6 +285,15 @@ impl SceneSpec {
                     ] {
                         check(key, v, -SPEED, SPEED, "give a finite value")?;
                     }
+                    if let Some(mean) = t.image_mean_dn {
+                        check(
+                            "texture.image_mean_dn",
+                            mean,
+                            1e-3,
+                            1e6,
+                            "give the image's mean intensity in camera DN",
+                        )?;
+                    }
                 }
             }
             SceneKind::Checkerboard => {
@@ -398,7 +415,7 @@ impl SceneSpec {
         Ok(match self.kind {
             SceneKind::Texture => {
                 let t = self.texture.clone().expect("validated");
-                let canvas = Canvas::generate(&t.texture, &mut rng);
+                let canvas = t.canvas(&mut rng)?;
                 Scene::Texture(t, canvas)
             }
             SceneKind::Checkerboard => {
@@ -419,6 +436,21 @@ impl SceneSpec {
                 ))
             }
         })
+    }
+
+    /// The scene's APS frames (none without an `[aps]` table), rendered at `render_hz`.
+    pub fn aps_frames(&self, scene: &Scene, render_hz: f64) -> Vec<crate::events::Frame> {
+        match &self.aps {
+            Some(a) => aps::render(
+                scene,
+                self.width,
+                self.height,
+                self.duration_s,
+                render_hz,
+                a,
+            ),
+            None => Vec::new(),
+        }
     }
 
     /// The render rate: as given, else fast enough that nothing moves more than half a
@@ -454,23 +486,23 @@ fn load_textures(dir: &Path) -> Result<Vec<Canvas>, SimError> {
             "put grey PNG textures there or remove textures_dir",
         ));
     }
-    paths
-        .iter()
-        .map(|p| {
-            crate::files::check_regular(p).map_err(|e| SimError::not_a_file(p, e))?;
-            let image = image::open(p)
-                .map_err(|e| {
-                    scene_error(
-                        p,
-                        format!("cannot decode: {e}"),
-                        "replace it with an intact PNG",
-                    )
-                })?
-                .into_luma8();
-            let (w, h) = image.dimensions();
-            Ok(Canvas::from_image(w as usize, h as usize, image.as_raw()))
-        })
-        .collect()
+    paths.iter().map(|p| load_texture(p)).collect()
+}
+
+/// A grey image (PNG) as a texture.
+pub(crate) fn load_texture(path: &Path) -> Result<Canvas, SimError> {
+    crate::files::check_regular(path).map_err(|e| SimError::not_a_file(path, e))?;
+    let image = image::open(path)
+        .map_err(|e| {
+            scene_error(
+                path,
+                format!("cannot decode: {e}"),
+                "replace it with an intact PNG",
+            )
+        })?
+        .into_luma8();
+    let (w, h) = image.dimensions();
+    Ok(Canvas::from_image(w as usize, h as usize, image.as_raw()))
 }
 
 impl Scene {

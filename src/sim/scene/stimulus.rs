@@ -6,10 +6,10 @@
 //! 255, black 0, background 128), rounded to 8 bits. Frame `k` is shown at `k / refresh_hz`.
 
 use crate::events::Frame;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Parameters of the calibration checkerboard.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StimulusSpec {
     pub width: usize,
     pub height: usize,

@@ -3,9 +3,12 @@
 //! `X = c0 + offset_x + vx t + cos(th) u - sin(th) v`, `Y = c0 + offset_y + vy t + sin(th) u +
 //! cos(th) v`, with `u = x - (W-1)/2`, `v = y - (H-1)/2`, `th = omega t` and `c0` the canvas
 //! centre; brightness may be modulated globally by `exp(mod_amp_ln * sin(2 pi mod_hz t))`.
+//! The canvas is procedural ([`TextureParams`]) or, with `image`, a grey photograph, scaled
+//! by `image_mean_dn` as a brighter or dimmer illumination would scale it.
 
 use super::canvas::{Canvas, TextureParams};
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// Parameters of the texture scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -26,9 +29,29 @@ pub struct TextureScene {
     pub mod_amp_ln: f64,
     #[serde(default)]
     pub mod_hz: f64,
+    /// A grey PNG to use as the canvas instead of a procedural texture (a relative path is
+    /// relative to the scene file); the procedural keys are then ignored.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub image: Option<PathBuf>,
+    /// With `image`: scale the image so that its mean is this many camera DN (absent: the
+    /// image's own 8-bit values).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub image_mean_dn: Option<f64>,
 }
 
 impl TextureScene {
+    /// The canvas: the image (scaled to `image_mean_dn`) or a procedural texture.
+    pub fn canvas(&self, rng: &mut impl rand::Rng) -> Result<Canvas, crate::sim::SimError> {
+        let Some(path) = &self.image else {
+            return Ok(Canvas::generate(&self.texture, rng));
+        };
+        let mut canvas = super::load_texture(path)?;
+        if let Some(mean_dn) = self.image_mean_dn {
+            canvas.scale_mean(mean_dn);
+        }
+        Ok(canvas)
+    }
+
     /// Fastest image motion, px/s (for choosing a render rate).
     pub fn max_speed_px_s(&self, width: usize, height: usize) -> f64 {
         let radius = (width as f64).hypot(height as f64) / 2.0;

@@ -1,0 +1,100 @@
+//! The methods whose intervals the study scores, how each is called, which cases it
+//! applies to, and which parameters it reports.
+
+use super::case::CaseSpec;
+use serde::{Deserialize, Serialize};
+use std::ffi::OsString;
+use std::path::Path;
+
+/// A ctcal command that reports values with 95 % intervals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// `ctcal estimate aps`: thresholds from APS frames.
+    Aps,
+    /// `ctcal estimate eppps`: thresholds from the event rate.
+    Eppps,
+    /// `ctcal estimate screen`: thresholds from an on-screen stimulus.
+    Screen,
+    /// `ctcal fit`: every simulator parameter.
+    Fit,
+}
+
+/// The parameters an estimator reports.
+const THRESHOLDS: [&str; 3] = ["ct_on", "ct_off", "ct_sigma"];
+
+/// The parameters the fit reports (the PARAMS.toml keys the study has truth for).
+const FITTED: [&str; 10] = [
+    "ct_on",
+    "ct_off",
+    "ct_sigma",
+    "cutoff_hz",
+    "leak_rate_hz",
+    "shot_noise_rate_hz",
+    "refractory_s",
+    "timestamp_jitter_s",
+    "hot_pixel_fraction",
+    "hot_pixel_rate_hz",
+];
+
+impl Method {
+    pub const ALL: [Method; 4] = [Method::Aps, Method::Eppps, Method::Screen, Method::Fit];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Aps => "aps",
+            Method::Eppps => "eppps",
+            Method::Screen => "screen",
+            Method::Fit => "fit",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<Method> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// On-screen cases go to `screen` only; every other case to the rest.
+    pub fn applies_to(self, case: &CaseSpec) -> bool {
+        (self == Method::Screen) == case.is_screen()
+    }
+
+    /// The command line after `ctcal` (without `--json -`).
+    pub fn args(self, input: &Path) -> Vec<OsString> {
+        let mut args: Vec<OsString> = match self {
+            Method::Fit => vec!["fit".into()],
+            estimate => vec!["estimate".into(), estimate.name().into()],
+        };
+        args.push(input.as_os_str().to_owned());
+        args
+    }
+
+    pub fn parameters(self) -> &'static [&'static str] {
+        match self {
+            Method::Fit => &FITTED,
+            _ => &THRESHOLDS,
+        }
+    }
+}
+
+/// The short name of a parameter in the tables (`Cp`, `Cn`, else the key).
+pub fn label(parameter: &str) -> &str {
+    match parameter {
+        "ct_on" => "Cp",
+        "ct_off" => "Cn",
+        other => other,
+    }
+}
+
+/// The effect a parameter belongs to (the fit's effect names); thresholds have none.
+pub fn effect_of(parameter: &str) -> Option<&'static str> {
+    Some(match parameter {
+        "ct_sigma" => "mismatch",
+        "cutoff_hz" => "bandwidth",
+        "leak_rate_hz" => "leak",
+        "shot_noise_rate_hz" => "shot_noise",
+        "refractory_s" => "refractory",
+        "timestamp_jitter_s" => "timestamp_jitter",
+        "hot_pixel_fraction" | "hot_pixel_rate_hz" => "hot_pixels",
+        _ => return None,
+    })
+}

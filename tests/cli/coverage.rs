@@ -1,0 +1,110 @@
+//! The coverage study's machinery (`ctcal::coverage`, the runner in `benches/coverage/`) on
+//! a seeded random subset: eight drawn cases with APS frames, written with their truth,
+//! estimated by `ctcal estimate aps` and tabulated by the same library code as the study.
+
+use ctcal::coverage::run::{RunOptions, run_method};
+use ctcal::coverage::summary::Summary;
+use ctcal::coverage::{CaseSpec, Method, Reported, RunRecord, write_case};
+use std::path::Path;
+use std::time::Duration;
+
+/// Seeds from here on are drawn; the first [`CASES`] cases with APS frames are used.
+const FIRST_SEED: u64 = 9000;
+const CASES: usize = 8;
+
+/// The coverage the aps intervals are meant to reach (95 % intervals, less the binomial
+/// slack of eight cases): to be asserted by the estimator developer once the estimators
+/// are fixed. Today's intervals are too narrow, see [`APS_COVERED_TODAY`].
+#[allow(dead_code)]
+const APS_COVERAGE_BOUNDS: [(&str, f64); 3] =
+    [("ct_on", 0.75), ("ct_off", 0.75), ("ct_sigma", 0.75)];
+
+/// Covered intervals on these eight cases, as measured when this test was written (of 7
+/// determinable each: one case is refused, too few events between frames; Cp 3/7, Cn 2/7,
+/// ct_sigma 4/7), asserted as a floor so that a fix can only raise it.
+const APS_COVERED_TODAY: [(&str, usize); 3] = [("ct_on", 3), ("ct_off", 2), ("ct_sigma", 4)];
+
+fn cases() -> Vec<CaseSpec> {
+    (FIRST_SEED..)
+        .map(CaseSpec::draw)
+        .filter(|c| Method::Aps.applies_to(c))
+        .take(CASES)
+        .collect()
+}
+
+fn run_aps(case: &CaseSpec, dir: &Path) -> RunRecord {
+    let truth = write_case(case, dir).expect("the case is written");
+    let written: CaseSpec =
+        serde_json::from_slice(&std::fs::read(dir.join("case.json")).unwrap()).unwrap();
+    assert_eq!(&written, case, "case.json reproduces the case");
+    assert!(truth.events > 0 && truth.aps_frames >= 2, "{truth:?}");
+    let options = RunOptions {
+        binary: env!("CARGO_BIN_EXE_ctcal").into(),
+        threads: 2,
+        timeout: Duration::from_secs(300),
+    };
+    let (outcome, seconds) = run_method(&options, Method::Aps, dir);
+    RunRecord::new(case.clone(), Some(truth), Method::Aps, seconds, outcome)
+}
+
+/// A number, or `null` with a reason; a refusal (exit 2) must say why.
+fn assert_answered(record: &RunRecord) {
+    let id = &record.case.id;
+    if let ctcal::coverage::Outcome::Failed {
+        exit_code, message, ..
+    } = &record.outcome
+    {
+        assert_eq!(*exit_code, Some(2), "{id}: not a refusal: {message}");
+        assert!(
+            !message.trim().is_empty(),
+            "{id}: refused without a message"
+        );
+        return;
+    }
+    for key in ["ct_on", "ct_off"] {
+        match &record.reported[key] {
+            Reported::Interval { .. } | Reported::NoInterval { .. } => {}
+            Reported::NotDeterminable { why } => assert!(!why.is_empty(), "{id} {key}"),
+            Reported::NotReported => panic!("{id}: aps did not report {key}"),
+        }
+    }
+}
+
+#[test]
+fn aps_intervals_on_a_random_subset_are_scored() {
+    let work = tempfile::tempdir().unwrap();
+    let records: Vec<RunRecord> = cases()
+        .iter()
+        .map(|case| run_aps(case, &work.path().join(&case.id)))
+        .collect();
+    records.iter().for_each(assert_answered);
+    let summary = Summary::tabulate(&records);
+    assert_eq!((summary.cases, summary.runs), (CASES, CASES));
+    for (parameter, covered_today) in APS_COVERED_TODAY {
+        let row = summary.row(Method::Aps, parameter).expect("a row");
+        assert_eq!(row.cases, CASES, "{parameter}");
+        assert_eq!(
+            row.failed + row.not_reported + row.not_determinable + row.determinable,
+            row.cases
+        );
+        assert!(row.covered >= covered_today, "{parameter}: {row:?}");
+    }
+    let breakdown = &summary.breakdowns[0];
+    assert_eq!(breakdown.parameters, ["ct_on", "ct_off", "ct_sigma"]);
+    assert!(
+        breakdown
+            .rows
+            .iter()
+            .any(|r| r.group.starts_with("family "))
+    );
+    let markdown = summary.to_markdown();
+    for line in [
+        "| aps | Cp |",
+        "| aps | Cn |",
+        "| aps | ct_sigma |",
+        "## Worst misses",
+    ] {
+        assert!(markdown.contains(line), "{line} missing:\n{markdown}");
+    }
+    eprintln!("{markdown}");
+}
