@@ -12,16 +12,7 @@ use rand::{Rng, RngExt};
 use std::path::PathBuf;
 
 /// The natural photographs (`calib/scenes/textures/natural/`, CC0 or public domain).
-pub const NATURAL_IMAGES: [&str; 8] = [
-    "camera",
-    "coffee",
-    "chelsea",
-    "astronaut",
-    "rocket",
-    "brick",
-    "grass",
-    "gravel",
-];
+pub const NATURAL_IMAGES: [&str; 6] = ["camera", "coffee", "chelsea", "brick", "grass", "gravel"];
 
 /// Where the natural photographs are, relative to the ctcal source tree.
 pub const NATURAL_DIR: &str = "calib/scenes/textures/natural";

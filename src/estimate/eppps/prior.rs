@@ -22,16 +22,16 @@ const IMAGES: [(&str, &[u8]); 6] = [
         include_bytes!("../../../calib/priors/natural/astronaut.pgm"),
     ),
     (
-        "camera",
-        include_bytes!("../../../calib/priors/natural/camera.pgm"),
+        "china",
+        include_bytes!("../../../calib/priors/natural/china.pgm"),
     ),
     (
-        "chelsea",
-        include_bytes!("../../../calib/priors/natural/chelsea.pgm"),
+        "flower",
+        include_bytes!("../../../calib/priors/natural/flower.pgm"),
     ),
     (
-        "coffee",
-        include_bytes!("../../../calib/priors/natural/coffee.pgm"),
+        "grace_hopper",
+        include_bytes!("../../../calib/priors/natural/grace_hopper.pgm"),
     ),
     (
         "rocket",
