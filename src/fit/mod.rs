@@ -147,11 +147,50 @@ pub struct Step {
     pub residuals_after: Option<StepResiduals>,
 }
 
+/// The fitted model, and which of its parameters the data do not identify: in JSON those
+/// are `null` (the model simulated needs a value; a reader must not take it for a result).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedParams {
+    pub model: PixelParams,
+    /// Parameter (PARAMS.toml key) -> why the data do not identify it.
+    pub not_identified: BTreeMap<String, String>,
+}
+
+impl std::ops::Deref for FittedParams {
+    type Target = PixelParams;
+    fn deref(&self) -> &PixelParams {
+        &self.model
+    }
+}
+
+impl std::ops::DerefMut for FittedParams {
+    fn deref_mut(&mut self) -> &mut PixelParams {
+        &mut self.model
+    }
+}
+
+impl Serialize for FittedParams {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut value = serde_json::to_value(&self.model).map_err(serde::ser::Error::custom)?;
+        if let Some(map) = value.as_object_mut() {
+            for key in self.not_identified.keys() {
+                map.insert(key.clone(), serde_json::Value::Null);
+            }
+        }
+        value.serialize(serializer)
+    }
+}
+
 /// The result of `ctcal fit` (the JSON keys of `../shared/CLI.md`, and more).
 #[derive(Clone, Debug, Serialize)]
 pub struct FitResult {
-    /// The fitted model (PARAMS.toml keys).
-    pub params: PixelParams,
+    /// The fitted model (PARAMS.toml keys; `null` where not identified).
+    pub params: FittedParams,
+    /// Per parameter of the model: whether the data identify it.
+    pub identified: BTreeMap<String, bool>,
+    /// Why a parameter is not identified (`null` in `params`).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub why: BTreeMap<String, String>,
     pub uncertainties: BTreeMap<String, Uncertain>,
     pub effects_added: Vec<AddedEffect>,
     pub error_metric: &'static str,

@@ -456,8 +456,38 @@ pub fn fit(
         geometry.kept_pixels()
     ));
     progress("done", 1.0);
+    let not_identified: BTreeMap<String, String> = if fixed {
+        ["ct_on", "ct_off"]
+            .into_iter()
+            .map(|k| {
+                (
+                    k.to_string(),
+                    "the recording does not show the thresholds (a static scene, or frames that explain almost none of its events): the model simulated them at a start value".to_string(),
+                )
+            })
+            .collect()
+    } else {
+        BTreeMap::new()
+    };
+    // every parameter the model sets (PARAMS.toml keys)
+    let identified = serde_json::to_value(&params)
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
+        .map(|(k, _)| {
+            let known = !not_identified.contains_key(&k);
+            (k, known)
+        })
+        .collect();
     Ok(FitResult {
-        params,
+        why: not_identified.clone(),
+        identified,
+        params: super::FittedParams {
+            model: params,
+            not_identified,
+        },
         uncertainties: state.uncertainty,
         effects_added: added,
         error_metric: ERROR_METRIC,

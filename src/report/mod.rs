@@ -179,7 +179,7 @@ pub fn render(report: &Report) -> Vec<OutputFile> {
     let fitted: Vec<crate::sim::PixelParams> = report
         .sequences
         .iter()
-        .filter_map(|s| s.fit.as_ref().map(|f| f.params.clone()))
+        .filter_map(|s| s.fit.as_ref().map(|f| f.params.model.clone()))
         .collect();
     if let Some(text) = configs::esim_generator(&fitted) {
         files.push(file("configs/esim_config_generator.json", text));
@@ -189,7 +189,7 @@ pub fn render(report: &Report) -> Vec<OutputFile> {
             .sequences
             .iter()
             .filter(|s| s.dataset == d.name)
-            .filter_map(|s| s.fit.as_ref().map(|f| f.params.clone()))
+            .filter_map(|s| s.fit.as_ref().map(|f| f.params.model.clone()))
             .collect();
         if members.len() > 1 {
             for format in configs::ConfigFormat::ALL {
