@@ -78,9 +78,10 @@ pub struct CommonArgs {
     /// Only the part up to S seconds after the first event.
     #[arg(long, value_name = "S")]
     pub end: Option<f64>,
-    /// The log response of the sensor's pixels.
-    #[arg(long, value_enum, default_value = "v2e")]
-    pub log_response: LogResponseArg,
+    /// The log response the frames are read through (default: v2e's lin-log, or a pure
+    /// ln(DN + b) where the events' timing says it fits better).
+    #[arg(long, value_enum)]
+    pub log_response: Option<LogResponseArg>,
     /// The offset of the `eps` log response.
     #[arg(long, value_name = "EPS", default_value_t = 0.001)]
     pub log_eps: f64,
@@ -90,6 +91,11 @@ pub struct CommonArgs {
 }
 
 impl CommonArgs {
+    /// Whether the response may be chosen from the data (none was named).
+    pub(super) fn choose_response(&self) -> bool {
+        self.log_response.is_none()
+    }
+
     pub(super) fn log_map(&self) -> Result<(LogMap, String), BadInput> {
         if !(self.log_eps.is_finite() && self.log_eps > 0.0) {
             return Err(BadInput(format!(
@@ -97,7 +103,7 @@ impl CommonArgs {
                 self.log_eps
             )));
         }
-        Ok(match self.log_response {
+        Ok(match self.log_response.unwrap_or(LogResponseArg::V2e) {
             LogResponseArg::V2e => (
                 LogMap::new(LogResponse::V2e, self.log_eps),
                 "v2e lin-log: ln(DN) above 20 DN, linear below".into(),
@@ -167,7 +173,11 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
     let (log_map, log_name) = common.log_map()?;
     let most = ctcal::estimate::eppps::prior::COUNT;
     if args.scenes == 0 || args.scenes > most {
-        return Err(BadInput(format!("--scenes {} must be between 1 and {most}", args.scenes)).into());
+        return Err(BadInput(format!(
+            "--scenes {} must be between 1 and {most}",
+            args.scenes
+        ))
+        .into());
     }
     let policy = global.outputs([common.input.input.as_path()]);
     let loaded = common.load(
@@ -181,6 +191,7 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
     let options = ApsOptions {
         log_map,
         log_response_name: log_name,
+        choose_response: common.choose_response(),
         ..ApsOptions::default()
     };
     let result = eppps_of(
@@ -394,6 +405,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     let options = ApsOptions {
         log_map,
         log_response_name: log_name,
+        choose_response: common.choose_response(),
         exposure_us: args.exposure_s.map(|s| (s * 1e6).round() as i64),
         frame_offset_dn: args.frame_offset_dn,
         frame_time_offset_s: args.frame_time_offset_s,
@@ -470,7 +482,10 @@ fn present(
         }
         None => format!(
             "not determinable: {}",
-            estimate.why.get(key).map_or("no reason given", |w| w.as_str())
+            estimate
+                .why
+                .get(key)
+                .map_or("no reason given", |w| w.as_str())
         ),
     };
     let mut rows = vec![

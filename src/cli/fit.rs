@@ -83,6 +83,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
         aps: ApsOptions {
             log_map,
             log_response_name: log_name,
+            choose_response: args.common.choose_response(),
             exposure_us: args.exposure_s.map(|s| (s * 1e6).round() as i64),
             ..ApsOptions::default()
         },

@@ -18,7 +18,9 @@ use super::frames::{FrameOptions, PreparedFrames};
 use super::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
 use super::resim::{Cells, Intervals, Resimulation};
 use super::timing::{ThresholdMaps, TimingEstimate, TimingOptions};
-use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid};
+use super::{
+    CtEstimate, Determinable, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid,
+};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
 use crate::sim::PixelParams;
 use crate::sim::log_response::LogMap;
@@ -30,6 +32,9 @@ pub struct ApsOptions {
     pub log_map: LogMap,
     /// A description of the log response, for the assumptions.
     pub log_response_name: String,
+    /// Whether a pure `ln(DN + b)` may replace `log_map` where it explains the events
+    /// better (false when the user named the response).
+    pub choose_response: bool,
     pub frames: FrameOptions,
     pub timing: TimingOptions,
     /// The exposure, where the file gives none (`--exposure-s`).
@@ -51,6 +56,7 @@ impl Default for ApsOptions {
         Self {
             log_map: LogMap::new(crate::sim::LogResponse::V2e, 0.001),
             log_response_name: "v2e lin-log: ln(DN) above 20 DN, linear below".into(),
+            choose_response: true,
             frames: FrameOptions::default(),
             timing: TimingOptions::default(),
             exposure_us: None,
@@ -290,16 +296,20 @@ pub fn estimate(
     let timing_series_on = series(&|p| Some(p.timing.on.ct));
     let timing_series_off = series(&|p| Some(p.timing.off.ct));
     let (bias_on, bias_off, sigma_bias) = calibration.map_or((0.0, 0.0, 0.0), |c| c);
-    let timing_measure =
-        |estimate: f64, se: f64, bias: f64, series: &[FrameRatePoint], alignment: f64, offset: f64| {
-            let (_, frame_rate) = frame_rate_systematic(series);
-            // half the applied correction stays in the interval
-            Measured::new(
-                estimate - bias,
-                se,
-                frame_rate.hypot(0.5 * bias).hypot(alignment).hypot(offset),
-            )
-        };
+    let timing_measure = |estimate: f64,
+                          se: f64,
+                          bias: f64,
+                          series: &[FrameRatePoint],
+                          alignment: f64,
+                          offset: f64| {
+        let (_, frame_rate) = frame_rate_systematic(series);
+        // half the applied correction stays in the interval
+        Measured::new(
+            estimate - bias,
+            se,
+            frame_rate.hypot(0.5 * bias).hypot(alignment).hypot(offset),
+        )
+    };
     let timing_on = timing_measure(
         full.timing.on.ct,
         full.timing.on.standard_error,
@@ -518,16 +528,21 @@ pub fn prepare(
         None => {
             let fitting = TimingOptions {
                 fit_offset: true,
+                choose_response: options.choose_response,
                 ..options.timing.clone()
             };
-            let found = super::timing::estimate(input.events, &frames, input.sensor, excluded, &fitting)
-                .map(|t| t.offset);
-            if let Some(o) = &found {
-                frames.offset = o.offset_dn;
-                frames.offset_range = o.systematic_range;
-                assumptions.push(offset_assumption(o));
+            let found =
+                super::timing::estimate(input.events, &frames, input.sensor, excluded, &fitting);
+            if let Some(t) = &found {
+                if t.log_map != frames.log_map {
+                    assumptions.push("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN); used throughout".into());
+                    frames.log_map = t.log_map;
+                }
+                frames.offset = t.offset.offset_dn;
+                frames.offset_range = t.offset.systematic_range;
+                assumptions.push(offset_assumption(&t.offset));
             }
-            found
+            found.map(|t| t.offset)
         }
     };
     Ok(Prepared {
@@ -536,6 +551,29 @@ pub fn prepare(
         offset,
         assumptions,
     })
+}
+
+/// The model event timing measured: its thresholds and mismatch, and the photoreceptor's
+/// cutoff and the leak where they are significant (three standard errors), in the
+/// simulator's terms (cutoff `cutoff_hz (DN + 20) / 275`, leak `leak_rate_hz * ct_on` per
+/// second).
+fn measured_model(timing: &TimingEstimate, sigma: f64) -> PixelParams {
+    let mut params = PixelParams::ideal(timing.on.ct, timing.off.ct);
+    if sigma > 0.0 {
+        params.ct_sigma = Some(sigma);
+    }
+    let lag = &timing.lag;
+    if let Some(f) = lag.cutoff_hz_at_median_dn
+        && lag.tau_times_dn > 3.0 * lag.standard_error
+        && f < 1000.0
+    {
+        params.cutoff_hz = Some(f * 275.0 / (lag.median_dn + 20.0));
+    }
+    let drift = &timing.drift;
+    if drift.at_median_dn > 3.0 * drift.standard_error && timing.on.ct > 0.0 {
+        params.leak_rate_hz = Some(drift.at_median_dn / timing.on.ct);
+    }
+    params
 }
 
 /// The offset, in words for the assumptions.
@@ -547,6 +585,18 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
             o.offset_dn,
             side(o.ci95[0]),
             side(o.ci95[1]),
+            o.systematic_range.0,
+            o.systematic_range.1
+        ),
+        "not determined: the photoreceptor's lag" => format!(
+            "the frames' log offset b in ln(DN + b) is not determined: the photoreceptor's lag (a bandwidth limit) makes dark pixels' thresholds look larger as a too small offset would; b = {:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",
+            o.offset_dn, o.systematic_range.0, o.systematic_range.1
+        ),
+        "not determined: the fitted offset lies outside the range met in practice" => format!(
+            "the frames' log offset b in ln(DN + b) is not determined: the offset at which thresholds stop depending on brightness lies outside the prior range {:.0} .. {:.0} DN (DVS-Voltmeter's real-sensor fits and DAVIS black levels), more likely an effect the timing model lacks (refractory delays, a nonlinear response) than a black level; b = {:.1} DN kept, and the thresholds' change over {:.1} .. {:.1} DN (prior and fitted) is in their intervals",
+            super::timing::OFFSET_PRIOR.0,
+            super::timing::OFFSET_PRIOR.1,
+            o.offset_dn,
             o.systematic_range.0,
             o.systematic_range.1
         ),
@@ -574,10 +624,7 @@ fn self_calibrate(
     grid: Option<(TimeUs, TimeUs)>,
     (shift, realign): (TimeUs, bool),
 ) -> Option<(f64, f64, f64)> {
-    let mut params = PixelParams::ideal(timing.on.ct, timing.off.ct);
-    if sigma > 0.0 {
-        params.ct_sigma = Some(sigma);
-    }
+    let mut params = measured_model(timing, sigma);
     params.seed = Some(options.seed);
     let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
     let mut simulated = super::resim::simulate(&runs, frames.width, frames.height, &params).ok()?;

@@ -77,7 +77,12 @@ impl Default for EventFlowOptions {
 pub const MIN_GAIN: f64 = 1.01;
 
 /// The event indices of each patch, in time order.
-fn patch_members(events: &EventChunk, sensor: Sensor, excluded: &[bool], p: usize) -> Vec<Vec<u32>> {
+fn patch_members(
+    events: &EventChunk,
+    sensor: Sensor,
+    excluded: &[bool],
+    p: usize,
+) -> Vec<Vec<u32>> {
     let tiles_x = (sensor.width as usize).div_ceil(p);
     let tiles = tiles_x * (sensor.height as usize).div_ceil(p);
     let width = sensor.width as usize;
@@ -107,15 +112,24 @@ pub fn patch_flows(
         .par_iter()
         .enumerate()
         .filter(|(_, m)| m.len() >= options.min_events)
-        .map(|(tile, m)| window_flow(events, &m[..m.len().min(options.rough_events)], corner(tile), p))
+        .map(|(tile, m)| {
+            window_flow(
+                events,
+                &m[..m.len().min(options.rough_events)],
+                corner(tile),
+                p,
+            )
+        })
         .filter(|f| f.trusted())
         .map(|f| f.speed())
         .collect();
     rough.sort_by(f64::total_cmp);
     // without a trusted rough flow every patch is one window
-    let window_us = rough.get(rough.len() / 2).map_or(TimeUs::MAX / 4, |&speed| {
-        ((options.window_travel_px / speed.max(1e-3)) * 1e6).max(1.0) as TimeUs
-    });
+    let window_us = rough
+        .get(rough.len() / 2)
+        .map_or(TimeUs::MAX / 4, |&speed| {
+            ((options.window_travel_px / speed.max(1e-3)) * 1e6).max(1.0) as TimeUs
+        });
     members
         .par_iter()
         .enumerate()
@@ -136,7 +150,8 @@ fn windows<'a>(events: &EventChunk, indices: &'a [u32], window_us: TimeUs) -> Ve
     let mut start = 0;
     while start < indices.len() {
         let t0 = events.t[indices[start] as usize];
-        let end = start + indices[start..].partition_point(|&i| events.t[i as usize] < t0 + window_us);
+        let end =
+            start + indices[start..].partition_point(|&i| events.t[i as usize] < t0 + window_us);
         out.push(&indices[start..end.max(start + 1)]);
         start = end.max(start + 1);
     }
@@ -173,7 +188,8 @@ fn relative(events: &EventChunk, window: &[u32], (x0, y0): (usize, usize)) -> Ve
 
 fn window_flow(events: &EventChunk, window: &[u32], corner: (usize, usize), p: usize) -> PatchFlow {
     let points = relative(events, window, corner);
-    let span_s = (events.t[window[window.len() - 1] as usize] - events.t[window[0] as usize]) as f64 * 1e-6;
+    let span_s =
+        (events.t[window[window.len() - 1] as usize] - events.t[window[0] as usize]) as f64 * 1e-6;
     let (v, gain) = maximise(&points, p, span_s);
     let halves: Vec<(f64, f64)> = [0usize, 1]
         .iter()
@@ -360,7 +376,10 @@ mod tests {
                     let a = (c + 0.3 * s as f64 + v.0 * t, s as f64 + v.1 * t);
                     let b = (s as f64 + v.0 * t, c + 0.2 * s as f64 + v.1 * t);
                     for (m, (x, y)) in [a, b].into_iter().enumerate() {
-                        if (0.0..64.0).contains(&x) && (0.0..64.0).contains(&y) && hash(k, s, n * 2 + m) {
+                        if (0.0..64.0).contains(&x)
+                            && (0.0..64.0).contains(&y)
+                            && hash(k, s, n * 2 + m)
+                        {
                             e.push((t * 1e6) as TimeUs, x as u16, y as u16, m == 0);
                         }
                     }
@@ -385,7 +404,10 @@ mod tests {
         let trusted: Vec<&PatchFlow> = flows.iter().filter(|f| f.trusted()).collect();
         assert!(trusted.len() * 2 >= flows.len(), "{flows:?}");
         for f in trusted {
-            assert!((f.vx - 300.0).abs() < 25.0 && (f.vy + 200.0).abs() < 25.0, "{f:?}");
+            assert!(
+                (f.vx - 300.0).abs() < 25.0 && (f.vy + 200.0).abs() < 25.0,
+                "{f:?}"
+            );
         }
     }
 }

@@ -102,13 +102,11 @@ impl SequenceReport {
         if let Some(f) = &self.fit {
             return Some((f.params.ct_on, f.params.ct_off, "fit"));
         }
-        ["aps", "screen", "eppps"]
-            .into_iter()
-            .find_map(|m| {
-                let e = self.estimate(m)?;
-                let (on, off) = e.thresholds()?;
-                Some((on, off, e.method))
-            })
+        ["aps", "screen", "eppps"].into_iter().find_map(|m| {
+            let e = self.estimate(m)?;
+            let (on, off) = e.thresholds()?;
+            Some((on, off, e.method))
+        })
     }
 }
 

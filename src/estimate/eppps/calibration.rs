@@ -35,11 +35,21 @@ pub fn prior_blocks(image: &LogImage, rates: &RecordingRates, seed: u64) -> Vec<
             let (x_lo, x_hi) = span(dx, image.width);
             let (y_lo, y_hi) = span(dy, image.height);
             let mut pick = |lo: f64, hi: f64| {
-                if hi > lo { rng.random_range(lo..hi) } else { 0.5 * (lo + hi) }
+                if hi > lo {
+                    rng.random_range(lo..hi)
+                } else {
+                    0.5 * (lo + hi)
+                }
             };
             let (x, y) = (pick(x_lo, x_hi), pick(y_lo, y_hi));
             Block {
-                corner: Scan { x, y, dx, dy, length },
+                corner: Scan {
+                    x,
+                    y,
+                    dx,
+                    dy,
+                    length,
+                },
             }
         })
         .collect()

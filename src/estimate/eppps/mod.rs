@@ -111,8 +111,20 @@ pub fn estimate(
     progress("calibration scans", 0.3);
     let calibrations = calibrate(frames, &rates, &excluded, options);
     progress("inverting the calibration curves", 0.9);
-    let on = measure(&calibrations, &rates, |p| p.on_per_px, rates.on_per_px, rates.ln_se_on);
-    let off = measure(&calibrations, &rates, |p| p.off_per_px, rates.off_per_px, rates.ln_se_off);
+    let on = measure(
+        &calibrations,
+        &rates,
+        |p| p.on_per_px,
+        rates.on_per_px,
+        rates.ln_se_on,
+    );
+    let off = measure(
+        &calibrations,
+        &rates,
+        |p| p.off_per_px,
+        rates.off_per_px,
+        rates.ln_se_off,
+    );
     let grid = threshold_grid();
     let mut result = CtEstimate::from_parts(
         "eppps",
@@ -124,8 +136,16 @@ pub fn estimate(
             what: "the calibration curve",
         },
     );
-    result.assumptions.extend(assumptions(&rates, &calibrations, frames.is_some(), hot));
-    report(&mut result, &rates, &calibrations, (&on, &off), frames.is_some());
+    result
+        .assumptions
+        .extend(assumptions(&rates, &calibrations, frames.is_some(), hot));
+    report(
+        &mut result,
+        &rates,
+        &calibrations,
+        (&on, &off),
+        frames.is_some(),
+    );
     progress("done", 1.0);
     Ok(result)
 }
@@ -199,7 +219,10 @@ fn measure(
         .map(|c| invert(&c.curve, rate, target))
         .collect();
     let logs: Vec<f64> = per_calibration.iter().flatten().map(|v| v.ln()).collect();
-    if logs.len() < calibrations.len() || logs.is_empty() || !(target > 0.0) {
+    if logs.len() < calibrations.len()
+        || logs.is_empty()
+        || target.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
+    {
         return Polarity {
             per_calibration,
             measured: Measured::new(f64::NAN, f64::NAN, 0.0),
@@ -220,7 +243,10 @@ fn measure(
         .sum::<f64>()
         / n;
     let stat = ln_se / slope.abs();
-    let travel = rates.travel_relative_error.hypot(rates.noise_relative_error) / slope.abs();
+    let travel = rates
+        .travel_relative_error
+        .hypot(rates.noise_relative_error)
+        / slope.abs();
     Polarity {
         per_calibration,
         measured: Measured::log_normal(value, stat, prior_ln_sd.hypot(travel)),
@@ -284,7 +310,8 @@ fn assumptions(
 
 /// The curve in the recording's terms: events per kept pixel per second it would make.
 fn reported_curve(rates: &RecordingRates, calibrations: &[Calibration]) -> Vec<ReportedPoint> {
-    let scale = rates.counted_travel_px / (rates.kept_pixels.max(1) as f64 * rates.duration_s.max(1e-9));
+    let scale =
+        rates.counted_travel_px / (rates.kept_pixels.max(1) as f64 * rates.duration_s.max(1e-9));
     let grid = threshold_grid();
     (0..grid.len())
         .map(|k| {
@@ -294,7 +321,8 @@ fn reported_curve(rates: &RecordingRates, calibrations: &[Calibration]) -> Vec<R
                 .collect();
             ReportedPoint {
                 ct: grid[k],
-                events_per_pixel_per_second: values.iter().sum::<f64>() / values.len().max(1) as f64,
+                events_per_pixel_per_second: values.iter().sum::<f64>()
+                    / values.len().max(1) as f64,
                 lo: values.iter().copied().fold(f64::INFINITY, f64::min),
                 hi: values.iter().copied().fold(f64::NEG_INFINITY, f64::max),
             }
@@ -304,13 +332,19 @@ fn reported_curve(rates: &RecordingRates, calibrations: &[Calibration]) -> Vec<R
 
 /// The reported curve at `ct`, interpolated in log-log.
 fn curve_at(curve: &[ReportedPoint], ct: f64) -> Option<f64> {
-    curve.windows(2).find(|w| w[0].ct <= ct && ct <= w[1].ct).and_then(|w| {
-        let (a, b) = (w[0].events_per_pixel_per_second, w[1].events_per_pixel_per_second);
-        (a > 0.0 && b > 0.0).then(|| {
-            let f = (ct.ln() - w[0].ct.ln()) / (w[1].ct.ln() - w[0].ct.ln());
-            (a.ln() + f * (b.ln() - a.ln())).exp()
+    curve
+        .windows(2)
+        .find(|w| w[0].ct <= ct && ct <= w[1].ct)
+        .and_then(|w| {
+            let (a, b) = (
+                w[0].events_per_pixel_per_second,
+                w[1].events_per_pixel_per_second,
+            );
+            (a > 0.0 && b > 0.0).then(|| {
+                let f = (ct.ln() - w[0].ct.ln()) / (w[1].ct.ln() - w[0].ct.ln());
+                (a.ln() + f * (b.ln() - a.ln())).exp()
+            })
         })
-    })
 }
 
 fn report(
@@ -334,7 +368,10 @@ fn report(
         .collect();
     let position = presets
         .windows(2)
-        .find(|w| w[0].events_per_pixel_per_second >= compared && compared >= w[1].events_per_pixel_per_second)
+        .find(|w| {
+            w[0].events_per_pixel_per_second >= compared
+                && compared >= w[1].events_per_pixel_per_second
+        })
         .map(|w| format!("between the presets CT {} and CT {}", w[0].ct, w[1].ct))
         .unwrap_or_else(|| match presets.first() {
             Some(p) if compared > p.events_per_pixel_per_second => {
@@ -358,9 +395,13 @@ fn report(
             "z95": z95(),
         }),
     }];
-    result.extra.insert("calibration_curve".into(), json!(curve));
+    result
+        .extra
+        .insert("calibration_curve".into(), json!(curve));
     result.extra.insert("presets".into(), json!(presets));
-    result.extra.insert("preset_position".into(), json!(position));
+    result
+        .extra
+        .insert("preset_position".into(), json!(position));
     result.extra.insert(
         "recording".into(),
         json!({

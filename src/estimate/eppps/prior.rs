@@ -121,7 +121,11 @@ mod tests {
                 .iter()
                 .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
             // from near the floor up to at least half of white
-            assert!(lo < -3.0 && hi > (0.5f32).ln(), "{}: {lo} .. {hi}", image.name);
+            assert!(
+                lo < -3.0 && hi > (0.5f32).ln(),
+                "{}: {lo} .. {hi}",
+                image.name
+            );
         }
         assert!((linear(255) - 1.0).abs() < 1e-6 && linear(0) == 0.0);
     }

@@ -126,14 +126,14 @@ impl Tally {
             all: vec![[0.0; 2]; pixels],
             supported: vec![[0.0; 2]; pixels],
         };
-        for i in 0..events.len() {
+        for (i, &supported) in support.iter().enumerate().take(events.len()) {
             let pixel = events.y[i] as usize * w + events.x[i] as usize;
             if excluded[pixel] || !counted(i, pixel) {
                 continue;
             }
             let pol = if events.on[i] { 0 } else { 1 };
             t.all[pixel][pol] += 1.0;
-            if support[i] {
+            if supported {
                 t.supported[pixel][pol] += 1.0;
             }
         }
@@ -200,7 +200,13 @@ fn units(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize) -> Vec<(usiz
 
 /// Rates from a tally and the pixels' paths: per unit with signal (a supported event), the
 /// geometric mean of its supported and of all its events (see the module docs).
-fn finish(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize, f: Finish) -> Option<RecordingRates> {
+fn finish(
+    tally: &Tally,
+    paths: &Paths,
+    excluded: &[bool],
+    w: usize,
+    f: Finish,
+) -> Option<RecordingRates> {
     let tiles_x = w.div_ceil(PATCH_PX);
     let mut groups: Groups = vec![[0.0; 3]; tiles_x * (excluded.len() / w).div_ceil(PATCH_PX)];
     let (mut travels, mut directions) = (Vec::new(), Vec::new());
@@ -243,7 +249,8 @@ fn finish(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize, f: Finish) 
         kept_pixels: f.kept,
         counted_travel_px: total[2],
         duration_s: f.duration,
-        events_per_pixel_per_second: f.supported_total / (f.kept.max(1) as f64 * f.duration.max(1e-9)),
+        events_per_pixel_per_second: f.supported_total
+            / (f.kept.max(1) as f64 * f.duration.max(1e-9)),
         speed_median_px_s: f.speed,
         flow_source: f.source,
         travels,
@@ -253,10 +260,18 @@ fn finish(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize, f: Finish) 
 }
 
 /// The recording's rates with travel from the events' own flow.
-pub fn from_events(events: &EventChunk, sensor: Sensor, excluded: &[bool]) -> Option<RecordingRates> {
+pub fn from_events(
+    events: &EventChunk,
+    sensor: Sensor,
+    excluded: &[bool],
+) -> Option<RecordingRates> {
     let options = EventFlowOptions::default();
     let flows = patch_flows(events, sensor, excluded, &options);
-    let mut trusted: Vec<f64> = flows.iter().filter(|f| f.trusted()).map(PatchFlow::speed).collect();
+    let mut trusted: Vec<f64> = flows
+        .iter()
+        .filter(|f| f.trusted())
+        .map(PatchFlow::speed)
+        .collect();
     if trusted.is_empty() {
         return None;
     }
@@ -274,7 +289,9 @@ pub fn from_events(events: &EventChunk, sensor: Sensor, excluded: &[bool]) -> Op
     let patch_of = |pixel: usize| (pixel / w / p) * tiles_x + (pixel % w) / p;
     let tally = Tally::new(events, sensor, excluded, &support, |i, pixel| {
         let t = events.t[i];
-        by_patch[patch_of(pixel)].iter().any(|f| f.t_start <= t && t <= f.t_end)
+        by_patch[patch_of(pixel)]
+            .iter()
+            .any(|f| f.t_start <= t && t <= f.t_end)
     });
     let (patches, travel_error) = patch_paths(&by_patch, median);
     let pixels = sensor.pixels();
@@ -298,7 +315,10 @@ pub fn from_events(events: &EventChunk, sensor: Sensor, excluded: &[bool]) -> Op
 /// Each patch's travel (px) and the direction of its longest trusted window, and the
 /// event-weighted relative precision of the travel: its windows at their own speed, or the
 /// median speed when not trusted.
-fn patch_paths(by_patch: &[Vec<&PatchFlow>], median: f64) -> (Vec<(f64, (f32, f32))>, f64) {
+/// A patch's travel (px) and direction.
+type PatchPath = (f64, (f32, f32));
+
+fn patch_paths(by_patch: &[Vec<&PatchFlow>], median: f64) -> (Vec<PatchPath>, f64) {
     let (mut weighted, mut weight) = (0.0, 0.0);
     let paths = by_patch
         .iter()

@@ -22,6 +22,8 @@ pub mod samples;
 
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::sim::LogResponse;
+use crate::sim::log_response::LogMap;
 use model::{Coefficients, fit_at, offset_interval, offset_root, resampled_weights};
 use samples::{Pair, collect};
 use serde::Serialize;
@@ -38,6 +40,9 @@ pub struct TimingOptions {
     pub bootstrap: usize,
     /// Fit the frames' log offset (else the frames' own, `PreparedFrames::offset`, is used).
     pub fit_offset: bool,
+    /// With the offset, also try a pure `ln(DN + b)` against the frames' own response and
+    /// keep the one whose samples agree better.
+    pub choose_response: bool,
     /// Fit the leak drift.
     pub fit_leak: bool,
 }
@@ -49,6 +54,7 @@ impl Default for TimingOptions {
             mode_window: 0.5,
             bootstrap: 200,
             fit_offset: false,
+            choose_response: false,
             fit_leak: true,
         }
     }
@@ -96,8 +102,9 @@ pub struct Offset {
     /// The offsets the thresholds' systematic error spans: the interval, with the prior
     /// range ([`OFFSET_PRIOR`]) where the data leave a side open.
     pub systematic_range: (f32, f32),
-    /// `fitted`, `given` (by the caller), or `not determined` (the thresholds do not become
-    /// independent of brightness at any offset: the frames' own kept, the prior range spanned).
+    /// `fitted`, `given` (by the caller), or `not determined...` (the thresholds do not
+    /// become independent of brightness at any offset, or the photoreceptor's lag hides
+    /// what the offset does: the frames' own kept, the prior range spanned).
     pub source: &'static str,
 }
 
@@ -121,6 +128,9 @@ pub struct Drift {
 /// Result of the timing estimator.
 #[derive(Clone, Debug)]
 pub struct TimingEstimate {
+    /// The log response the samples were read through (the frames' own, or pure
+    /// `ln(DN + b)` where that explains the events better).
+    pub log_map: LogMap,
     pub on: PolarityEstimate,
     pub off: PolarityEstimate,
     pub maps: ThresholdMaps,
@@ -136,9 +146,16 @@ pub struct Lag {
     pub tau_times_dn: f64,
     pub standard_error: f64,
     /// The cutoff it stands for at the frames' median DN, Hz (`None` where the lag is not
-    /// positive).
+    /// positive), and that DN.
     pub cutoff_hz_at_median_dn: Option<f64>,
+    pub median_dn: f64,
 }
+
+/// The share of the threshold (RMS over pairs) the photoreceptor's lag moves samples by,
+/// above which the lag's brightness dependence cannot be told from the offset's: the lag
+/// of a sensor without a bandwidth limit moves them by 0.2-0.3 % (v2e), interpolation of
+/// 30 Hz frames by 2-4 % (ESIM, IEBCS); a dim scene's 30 Hz photoreceptor by 22 % (v2e).
+const LAG_MASKS_OFFSET: f64 = 0.05;
 
 /// The offsets the data may choose from when they constrain it, DN (a black level above
 /// the frame's range would make no sense).
@@ -156,10 +173,17 @@ pub fn estimate(
 ) -> Option<TimingEstimate> {
     let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
     let pixels = sensor.pixels();
+    let (log_map, offset) = choose_response(&pairs, frames, options);
     let fit = |b: f32| {
-        fit_at(&pairs, &frames.log_map, b, options.mode_window, pixels, options.fit_leak)
+        fit_at(
+            &pairs,
+            &log_map,
+            b,
+            options.mode_window,
+            pixels,
+            options.fit_leak,
+        )
     };
-    let offset = find_offset(&pairs, frames, options, &fit);
     let (coefficients, values, weights) = fit(offset.offset_dn)?;
     // the thresholds across the offset's interval
     let (lo, hi) = offset.systematic_range;
@@ -181,6 +205,7 @@ pub fn estimate(
     let cutoff = coefficients.cutoff_hz(median_dn, offset.offset_dn as f64);
     let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
     Some(TimingEstimate {
+        log_map,
         on: PolarityEstimate {
             standard_error: boot.on,
             offset_systematic: shift(|c| c.c_on),
@@ -199,6 +224,7 @@ pub fn estimate(
             tau_times_dn: coefficients.lag,
             standard_error: boot.lag,
             cutoff_hz_at_median_dn: cutoff,
+            median_dn,
         },
         drift: Drift {
             at_zero_dn: coefficients.drift,
@@ -207,6 +233,60 @@ pub fn estimate(
             standard_error: boot.drift,
         },
     })
+}
+
+/// The response and offset: for each candidate response (the frames' own; with
+/// `choose_response` also a pure `ln(DN + b)`), the offset, and the candidate whose
+/// samples scatter least about the model (the weighted mean absolute residual over the mean
+/// threshold; a pure log must do 2 % better to replace the frames' own response).
+fn choose_response(
+    pairs: &[Pair],
+    frames: &PreparedFrames,
+    options: &TimingOptions,
+) -> (LogMap, Offset) {
+    let pixels = frames.width * frames.height;
+    let mut candidates = vec![frames.log_map];
+    if options.fit_offset
+        && options.choose_response
+        && frames.log_map.response() != LogResponse::Eps
+    {
+        candidates.push(LogMap::new(LogResponse::Eps, 0.0));
+    }
+    let mut best: Option<(LogMap, Offset, f64)> = None;
+    for (k, map) in candidates.into_iter().enumerate() {
+        let fit = |b: f32| {
+            fit_at(
+                pairs,
+                &map,
+                b,
+                options.mode_window,
+                pixels,
+                options.fit_leak,
+            )
+        };
+        let offset = find_offset(pairs, frames, options, &fit);
+        let score =
+            fit(offset.offset_dn).map_or(f64::INFINITY, |(c, v, w)| scatter(pairs, &c, &v, &w));
+        let margin = if k == 0 { 1.0 } else { 0.98 };
+        if best.as_ref().is_none_or(|b| score < margin * b.2) {
+            best = Some((map, offset, score));
+        }
+    }
+    let (map, offset, _) = best.expect("one candidate at least");
+    (map, offset)
+}
+
+/// Weighted mean absolute residual of the kept pairs over the mean threshold.
+fn scatter(pairs: &[Pair], c: &Coefficients, v: &model::Values, w: &[f64]) -> f64 {
+    let (mut sum, mut total) = (0.0, 0.0);
+    for (i, p) in pairs.iter().enumerate() {
+        if w[i] > 0.0 {
+            let ct = if p.on { c.c_on } else { c.c_off };
+            sum += w[i] * (c.corrected(p, v, i) - ct).abs();
+            total += w[i];
+        }
+    }
+    sum / total.max(1e-12) / (0.5 * (c.c_on + c.c_off)).max(1e-12)
 }
 
 /// The offset: fitted (root of the level slope, interval from its bootstrap error), given,
@@ -231,6 +311,15 @@ fn find_offset(
         systematic_range: OFFSET_PRIOR,
         source: "not determined",
     };
+    // a strong lag also makes dark pixels' thresholds look larger; the offset would absorb it
+    if lag_strength(pairs, frames, options, fit)
+        .is_some_and(|(share, z)| share > LAG_MASKS_OFFSET && z > 3.0)
+    {
+        return Offset {
+            source: "not determined: the photoreceptor's lag",
+            ..not_determined
+        };
+    }
     let floor = pairs
         .iter()
         .map(|p| p.dn0.min(p.dn1))
@@ -253,6 +342,18 @@ fn find_offset(
         .collect();
     let bound = 1.96 * std_dev(&slopes);
     let ci95 = offset_interval(&slope, root, bound, range);
+    if !(OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(&root) {
+        // a black level beyond any met in practice: more likely an effect the timing model
+        // lacks (refractory delays, a nonlinear response) than the frames' offset
+        return Offset {
+            systematic_range: (
+                OFFSET_PRIOR.0.min(ci95[0].unwrap_or(root)),
+                OFFSET_PRIOR.1.max(ci95[1].unwrap_or(root)),
+            ),
+            source: "not determined: the fitted offset lies outside the range met in practice",
+            ..not_determined
+        };
+    }
     Offset {
         offset_dn: root,
         ci95,
@@ -262,6 +363,38 @@ fn find_offset(
         ),
         source: "fitted",
     }
+}
+
+/// How much the photoreceptor's lag moves the samples at the frames' own offset: the
+/// weighted RMS of `kappa x` over the mean threshold, and the lag in its bootstrap standard
+/// errors.
+fn lag_strength(
+    pairs: &[Pair],
+    frames: &PreparedFrames,
+    options: &TimingOptions,
+    fit: &dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)>,
+) -> Option<(f64, f64)> {
+    let (c, values, weights) = fit(frames.offset)?;
+    let pixels = frames.width * frames.height;
+    let lags: Vec<f64> = (0..30)
+        .filter_map(|k| {
+            let w = resampled_weights(pairs, &weights, pixels, 900 + k);
+            model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.lag)
+        })
+        .collect();
+    let wsum: f64 = weights.iter().sum();
+    let rms = (values
+        .lag
+        .iter()
+        .zip(&weights)
+        .map(|(x, w)| w * (c.lag * x).powi(2))
+        .sum::<f64>()
+        / wsum.max(1e-12))
+    .sqrt();
+    Some((
+        rms / (0.5 * (c.c_on + c.c_off)),
+        c.lag / std_dev(&lags).max(1e-12),
+    ))
 }
 
 /// Bootstrap standard errors over pixels (the fit's pairs and values fixed).
@@ -288,7 +421,9 @@ fn bootstrap(
         let Some(c) = model::fit(pairs, values, &w, options.fit_leak) else {
             continue;
         };
-        let sigma = |on: bool| pixel_sums(pairs, values, &w, &c, on).map_or(0.0, |s| mean_and_sigma(&s.0).1);
+        let sigma = |on: bool| {
+            pixel_sums(pairs, values, &w, &c, on).map_or(0.0, |s| mean_and_sigma(&s.0).1)
+        };
         draws.push([
             c.c_on,
             c.c_off,
@@ -373,7 +508,11 @@ fn polarity(
         .filter(|(_, p)| p.on == on)
         .map(|(i, _)| (i, c.corrected(&pairs[i], values, i)))
         .collect();
-    let kept: Vec<f64> = own.iter().filter(|(i, _)| weight[*i] > 0.0).map(|v| v.1).collect();
+    let kept: Vec<f64> = own
+        .iter()
+        .filter(|(i, _)| weight[*i] > 0.0)
+        .map(|v| v.1)
+        .collect();
     let mut deviations: Vec<f64> = kept.iter().map(|v| (v - ct).abs()).collect();
     let sample_spread = if deviations.is_empty() {
         f64::NAN
@@ -404,7 +543,13 @@ fn polarity(
 fn maps(sensor: Sensor, on: &[(f64, u32)], off: &[(f64, u32)]) -> ThresholdMaps {
     let mean = |v: &[(f64, u32)]| -> Vec<f32> {
         v.iter()
-            .map(|&(s, n)| if n > 0 { (s / n as f64) as f32 } else { f32::NAN })
+            .map(|&(s, n)| {
+                if n > 0 {
+                    (s / n as f64) as f32
+                } else {
+                    f32::NAN
+                }
+            })
             .collect()
     };
     ThresholdMaps {
@@ -437,7 +582,10 @@ pub fn spread(
             .map(|(_, &v)| v)
             .collect();
         let m = model::mode(&own, options.mode_window / 2.0)?;
-        let (lo, hi) = (m * (1.0 - options.mode_window), m * (1.0 + 2.0 * options.mode_window));
+        let (lo, hi) = (
+            m * (1.0 - options.mode_window),
+            m * (1.0 + 2.0 * options.mode_window),
+        );
         let mut deviations: Vec<f64> = own
             .iter()
             .filter(|&&v| v >= lo && v <= hi)

@@ -68,7 +68,11 @@ pub struct Values {
 
 pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
     let n = pairs.len();
-    let (mut y, mut level, mut lag) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut y, mut level, mut lag) = (
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+        Vec::with_capacity(n),
+    );
     let l = |dn: f32| log.apply(dn + b) as f64;
     for p in pairs {
         let sign = if p.on { 1.0 } else { -1.0 };
@@ -113,7 +117,12 @@ pub fn mode(values: &[f64], window: f64) -> Option<f64> {
 pub fn kept(pairs: &[Pair], y: &[f64], window: f64) -> Option<Vec<bool>> {
     let mut keep = vec![false; pairs.len()];
     for on in [true, false] {
-        let own: Vec<f64> = pairs.iter().zip(y).filter(|(p, _)| p.on == on).map(|(_, &v)| v).collect();
+        let own: Vec<f64> = pairs
+            .iter()
+            .zip(y)
+            .filter(|(p, _)| p.on == on)
+            .map(|(_, &v)| v)
+            .collect();
         let m = mode(&own, window / 2.0)?;
         let (lo, hi) = (m * (1.0 - window), m * (1.0 + 2.0 * window));
         for (k, (p, &v)) in pairs.iter().zip(y).enumerate() {
@@ -134,7 +143,13 @@ pub fn pixel_weights(pairs: &[Pair], keep: &[bool], pixels: usize) -> Vec<f64> {
     pairs
         .iter()
         .zip(keep)
-        .map(|(p, &k)| if k { 1.0 / n[p.pixel as usize] as f64 } else { 0.0 })
+        .map(|(p, &k)| {
+            if k {
+                1.0 / n[p.pixel as usize] as f64
+            } else {
+                0.0
+            }
+        })
         .collect()
 }
 
@@ -286,7 +301,11 @@ mod tests {
             let on = k % 3 != 0;
             let dt = 0.02 + 0.001 * (k % 50) as f64;
             // the change the frames show: the threshold, less (ON) or more (OFF) the drift
-            let c = if on { 0.3 - drift * dt } else { 0.4 + drift * dt };
+            let c = if on {
+                0.3 - drift * dt
+            } else {
+                0.4 + drift * dt
+            };
             let (a, b) = if on {
                 (level, (level + 25.0) * c.exp() - 25.0)
             } else {
@@ -317,7 +336,10 @@ mod tests {
         let b = offset_root(&slope, (0.0, 255.0)).unwrap();
         assert!((b - 25.0).abs() < 0.5, "{b}");
         let (c, _, _) = fit_at(&pairs, &log, b, 0.5, 1000, false).unwrap();
-        assert!((c.c_on - 0.3).abs() < 2e-3 && (c.c_off - 0.4).abs() < 2e-3, "{c:?}");
+        assert!(
+            (c.c_on - 0.3).abs() < 2e-3 && (c.c_off - 0.4).abs() < 2e-3,
+            "{c:?}"
+        );
     }
 
     #[test]
@@ -325,10 +347,16 @@ mod tests {
         let log = LogMap::new(LogResponse::V2e, 0.001);
         let pairs = pairs(1.5);
         let (c, _, _) = fit_at(&pairs, &log, 25.0, 0.5, 1000, true).unwrap();
-        assert!((c.c_on - 0.3).abs() < 2e-3 && (c.c_off - 0.4).abs() < 2e-3, "{c:?}");
+        assert!(
+            (c.c_on - 0.3).abs() < 2e-3 && (c.c_off - 0.4).abs() < 2e-3,
+            "{c:?}"
+        );
         // the drift at the pairs' middle level (the two drift terms trade off across it)
         let at_100 = c.drift + 100.0 * c.drift_per_dn;
-        assert!((at_100 - 1.5).abs() < 0.02 && c.drift_per_dn.abs() < 1e-3, "{c:?}");
+        assert!(
+            (at_100 - 1.5).abs() < 0.02 && c.drift_per_dn.abs() < 1e-3,
+            "{c:?}"
+        );
         // without the drift term the thresholds split apart
         let (plain, _, _) = fit_at(&pairs, &log, 25.0, 0.5, 1000, false).unwrap();
         assert!(plain.c_on < 0.27 && plain.c_off > 0.43, "{plain:?}");

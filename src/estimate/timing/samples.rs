@@ -29,8 +29,12 @@ const HALF_SPAN_US: TimeUs = 1000;
 
 /// DN just before and after `t` along the flow (one-sided at the ends of a used interval).
 fn around(frames: &PreparedFrames, x: u16, y: u16, t: TimeUs) -> Option<(f32, f32)> {
-    let before = frames.dn_at(x, y, t - HALF_SPAN_US).or_else(|| frames.dn_at(x, y, t))?;
-    let after = frames.dn_at(x, y, t + HALF_SPAN_US).or_else(|| frames.dn_at(x, y, t))?;
+    let before = frames
+        .dn_at(x, y, t - HALF_SPAN_US)
+        .or_else(|| frames.dn_at(x, y, t))?;
+    let after = frames
+        .dn_at(x, y, t + HALF_SPAN_US)
+        .or_else(|| frames.dn_at(x, y, t))?;
     Some((before, after))
 }
 

@@ -3,9 +3,9 @@
 
 use super::style::*;
 use super::{DrawResult, FONT, Figure, err};
+use crate::estimate::Interval;
 use plotters::coord::Shift;
 use plotters::prelude::*;
-use crate::estimate::Interval;
 use std::fmt::Write as _;
 
 /// One method's thresholds with their 95 % intervals.
@@ -113,12 +113,14 @@ impl Figure for Methods {
                 .draw_series(points.iter().flat_map(|(x, v, ci)| {
                     let [lo, up] = ci.unwrap_or([Some(*v), Some(*v)]);
                     [
-                        lo.is_none().then(|| (bottom, *v)),
-                        up.is_none().then(|| (*v, top)),
+                        lo.is_none().then_some((bottom, *v)),
+                        up.is_none().then_some((*v, top)),
                     ]
                     .into_iter()
                     .flatten()
-                    .map(|(a, b)| PathElement::new([(*x, a), (*x, b)], colour.mix(0.5).stroke_width(1)))
+                    .map(|(a, b)| {
+                        PathElement::new([(*x, a), (*x, b)], colour.mix(0.5).stroke_width(1))
+                    })
                     .collect::<Vec<_>>()
                 }))
                 .map_err(err)?;
