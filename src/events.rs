@@ -136,6 +136,34 @@ impl EventChunk {
         (0..self.len()).map(move |i| self.get(i))
     }
 
+    /// The time-sorted union of two time-sorted chunks (`a`'s event first on equal times).
+    pub fn merged(a: &EventChunk, b: &EventChunk) -> EventChunk {
+        let mut out = EventChunk::with_capacity(a.len() + b.len());
+        let (mut i, mut j) = (0, 0);
+        while i < a.len() || j < b.len() {
+            if j == b.len() || (i < a.len() && a.t[i] <= b.t[j]) {
+                out.push_event(a.get(i));
+                i += 1;
+            } else {
+                out.push_event(b.get(j));
+                j += 1;
+            }
+        }
+        out
+    }
+
+    /// The events with `from <= t < to` (the chunk time-sorted).
+    pub fn between(&self, from: TimeUs, to: TimeUs) -> EventChunk {
+        let start = self.t.partition_point(|&t| t < from);
+        let end = self.t.partition_point(|&t| t < to);
+        EventChunk {
+            t: self.t[start..end].to_vec(),
+            x: self.x[start..end].to_vec(),
+            y: self.y[start..end].to_vec(),
+            on: self.on[start..end].to_vec(),
+        }
+    }
+
     pub fn extend_from(&mut self, other: &EventChunk) {
         self.t.extend_from_slice(&other.t);
         self.x.extend_from_slice(&other.x);
@@ -212,6 +240,22 @@ pub fn s_to_us(t: f64) -> TimeUs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn merged_keeps_time_order_and_every_event() {
+        let mut a = EventChunk::default();
+        let mut b = EventChunk::default();
+        for t in [1, 4, 4, 9] {
+            a.push(t, 1, 0, true);
+        }
+        for t in [0, 4, 10] {
+            b.push(t, 2, 0, false);
+        }
+        let m = EventChunk::merged(&a, &b);
+        assert_eq!(m.t, [0, 1, 4, 4, 4, 9, 10]);
+        assert_eq!(m.x, [2, 1, 1, 1, 2, 1, 2]);
+        assert_eq!(m.between(4, 10).t, [4, 4, 4, 9]);
+    }
 
     #[test]
     fn sensor_parses_w_by_h() {

@@ -18,9 +18,9 @@ pub struct FitArgs {
     /// display).
     #[arg(long, value_name = "auto|none|LIST", default_value = "auto")]
     pub effects: String,
-    /// Fraction of the time held out of the fit (each effect is kept only if the error on
-    /// it falls).
-    #[arg(long, value_name = "FRACTION", default_value_t = 0.3)]
+    /// Fraction of the recording held out of the fit, at its end: the first half judges
+    /// each effect, the second measures the final error.
+    #[arg(long, value_name = "FRACTION", default_value_t = 0.4)]
     pub holdout: f64,
     /// Use at most this many frames (evenly spread over the window).
     #[arg(long, value_name = "N", default_value_t = 120)]

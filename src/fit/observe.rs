@@ -68,12 +68,23 @@ pub fn cell_of(index: usize) -> (usize, usize, usize) {
 pub enum Subset {
     /// The blocks the fit uses.
     Fit,
-    /// The blocks held out of the fit.
-    HeldOut,
+    /// The blocks that judge whether an effect is kept (never fitted on).
+    Selection,
+    /// The blocks that measure the final error (never fitted on, never used to choose).
+    Test,
     /// Every block.
     All,
     /// One block (for the spread of a statistic over blocks).
     Block(usize),
+}
+
+/// What a block of time is for: fitting, choosing effects, or the final error.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    Fit,
+    Selection,
+    Test,
 }
 
 /// The bin of an interval of `seconds`.
@@ -107,7 +118,11 @@ pub struct Geometry {
     /// Block of each frame interval (`None`: the interval is not used).
     interval_block: Vec<Option<usize>>,
     pub blocks: usize,
-    pub held_out: Vec<bool>,
+    /// What each block is for.
+    pub role: Vec<Role>,
+    /// Seconds of frame intervals left out between blocks of different roles (so that a
+    /// pixel's state does not carry one role's events into the next).
+    pub guard_seconds: f64,
     region: Vec<u8>,
     /// Pixels left out by the user (region of interest, mask).
     excluded: Vec<bool>,
@@ -127,8 +142,10 @@ pub struct Geometry {
 
 impl Geometry {
     /// The geometry of `frames` (prepared by the estimators), with about `blocks` time
-    /// blocks of which every `1 / holdout`-th is held out.
-    pub fn new(frames: &PreparedFrames, excluded: &[bool], blocks: usize, holdout: f64) -> Self {
+    /// blocks: those that end by `fit_end` fit, the later ones held out in two contiguous
+    /// runs, selection then test ([`roles`]), with one frame interval of guard at each
+    /// change of role.
+    pub fn new(frames: &PreparedFrames, excluded: &[bool], blocks: usize, fit_end: TimeUs) -> Self {
         let sensor = Sensor::new(frames.width as u16, frames.height as u16);
         let (w, h) = (frames.width, frames.height);
         let pixels = w * h;
@@ -149,7 +166,14 @@ impl Geometry {
             interval_block[k] = Some(((middle / total * blocks as f64) as usize).min(blocks - 1));
             elapsed += durations[i];
         }
-        let held_out = held_out_blocks(blocks, holdout);
+        let mut block_end = vec![TimeUs::MIN; blocks];
+        for &k in &used {
+            let b = interval_block[k].expect("assigned");
+            block_end[b] = block_end[b].max(frames.times[k + 1]);
+        }
+        let fitting = block_end.iter().filter(|&&end| end <= fit_end).count();
+        let role = roles(fitting, blocks);
+        let guard_seconds = guard_intervals(&mut interval_block, &role, &durations, &used);
         let region: Vec<u8> = (0..pixels)
             .map(|p| {
                 let (x, y) = (p % w, p / w);
@@ -160,11 +184,14 @@ impl Geometry {
         let mut change = vec![Vec::new(); frames.flows.len()];
         let mut exposure = vec![[0.0; INTENSITY_BINS]; blocks];
         for &k in &used {
+            // guard intervals have no block
+            let Some(block) = interval_block[k] else {
+                continue;
+            };
             let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
             let (a, b) = (&frames.dn[k].data, &frames.dn[k + 1].data);
             let mut bins = vec![u8::MAX; pixels];
             let mut rates = vec![0u8; pixels];
-            let block = interval_block[k].expect("used");
             for p in 0..pixels {
                 rates[p] = bin_of(
                     &CHANGE_EDGES,
@@ -207,7 +234,8 @@ impl Geometry {
             times: frames.times.clone(),
             interval_block,
             blocks,
-            held_out,
+            role,
+            guard_seconds,
             region,
             excluded: excluded.to_vec(),
             intensity,
@@ -223,8 +251,9 @@ impl Geometry {
     pub fn in_subset(&self, b: usize, subset: Subset) -> bool {
         match subset {
             Subset::All => true,
-            Subset::Fit => !self.held_out[b],
-            Subset::HeldOut => self.held_out[b],
+            Subset::Fit => self.role[b] == Role::Fit,
+            Subset::Selection => self.role[b] == Role::Selection,
+            Subset::Test => self.role[b] == Role::Test,
             Subset::Block(k) => b == k,
         }
     }
@@ -249,21 +278,71 @@ impl Geometry {
     pub fn kept_pixels(&self) -> usize {
         self.excluded.iter().filter(|&&e| !e).count()
     }
+
+    /// The blocks of `role`.
+    pub fn blocks_of(&self, role: Role) -> Vec<usize> {
+        (0..self.blocks).filter(|&b| self.role[b] == role).collect()
+    }
+
+    /// The subset that judges effects: the selection blocks, or the fit blocks when there
+    /// are none (too short a recording, or `holdout` 0).
+    pub fn judging(&self) -> Subset {
+        if self.role.contains(&Role::Selection) {
+            Subset::Selection
+        } else {
+            Subset::Fit
+        }
+    }
+
+    /// The subset that measures the final error: the test blocks, else the judging ones.
+    pub fn testing(&self) -> Subset {
+        if self.role.contains(&Role::Test) {
+            Subset::Test
+        } else {
+            self.judging()
+        }
+    }
 }
 
-/// Blocks held out: evenly spread, `fraction` of them (at least one when there are two or
-/// more blocks and `fraction > 0`).
-fn held_out_blocks(blocks: usize, fraction: f64) -> Vec<bool> {
-    let mut held = vec![false; blocks];
-    if blocks < 2 || fraction <= 0.0 {
-        return held;
+/// The roles of `blocks` blocks in time order: the first `fitting` (at least one) fit,
+/// then the held-out rest split evenly into selection then test (test gets the odd one).
+/// Contiguous runs, so that the starting thresholds can be measured on the fit run alone and
+/// held-out data are a later stretch of the recording (blocked evaluation of time series:
+/// Bergmeir & Benitez, "On the use of cross-validation for time series predictor
+/// evaluation", Information Sciences 2012).
+pub fn roles(fitting: usize, blocks: usize) -> Vec<Role> {
+    let fit = fitting.clamp(1, blocks.max(1));
+    let held = blocks.saturating_sub(fit);
+    let test = held.div_ceil(2);
+    let mut role = vec![Role::Fit; fit];
+    role.extend(std::iter::repeat_n(Role::Selection, held - test));
+    role.extend(std::iter::repeat_n(Role::Test, test));
+    role
+}
+
+/// Leaves out the first used interval of every block whose role differs from the previous
+/// block's (when the block has another to keep); returns the seconds left out.
+fn guard_intervals(
+    interval_block: &mut [Option<usize>],
+    role: &[Role],
+    durations: &[f64],
+    used: &[usize],
+) -> f64 {
+    let mut guarded = 0.0;
+    let assigned = interval_block.to_vec();
+    for (i, &k) in used.iter().enumerate() {
+        let Some(b) = assigned[k] else { continue };
+        let first_of_block = i == 0 || assigned[used[i - 1]] != Some(b);
+        let role_changes = b > 0 && role[b - 1] != role[b];
+        let more_in_block = used
+            .get(i + 1)
+            .is_some_and(|&next| assigned[next] == Some(b));
+        if first_of_block && role_changes && more_in_block {
+            interval_block[k] = None;
+            guarded += durations[i] * 1e-6;
+        }
     }
-    let n = ((blocks as f64 * fraction).round() as usize).clamp(1, blocks - 1);
-    for i in 0..n {
-        // the middle of each of n equal parts
-        held[((2 * i + 1) * blocks) / (2 * n)] = true;
-    }
-    held
+    guarded
 }
 
 /// The statistics of one event set on a [`Geometry`].
@@ -435,15 +514,43 @@ mod tests {
     }
 
     #[test]
-    fn held_out_blocks_are_spread() {
+    fn roles_are_fit_then_selection_then_test() {
+        use Role::*;
         assert_eq!(
-            held_out_blocks(10, 0.3),
-            [
-                false, true, false, false, false, true, false, false, true, false
-            ]
+            roles(7, 10),
+            [Fit, Fit, Fit, Fit, Fit, Fit, Fit, Selection, Test, Test]
         );
-        assert_eq!(held_out_blocks(3, 0.3), [false, true, false]);
-        assert_eq!(held_out_blocks(1, 0.3), [false]);
-        assert_eq!(held_out_blocks(4, 0.0), [false; 4]);
+        assert_eq!(roles(6, 10)[6..], [Selection, Selection, Test, Test]);
+        assert_eq!(roles(2, 3), [Fit, Fit, Test]);
+        assert_eq!(roles(0, 1), [Fit]);
+        assert_eq!(roles(4, 4), [Fit; 4]);
+    }
+
+    #[test]
+    fn guards_sit_where_the_role_changes() {
+        use Role::*;
+        let role = [Fit, Fit, Selection, Test];
+        // three intervals per block, the last block with one
+        let used: Vec<usize> = (0..10).collect();
+        let mut block: Vec<Option<usize>> = [0, 0, 0, 1, 1, 1, 2, 2, 2, 3]
+            .into_iter()
+            .map(Some)
+            .collect();
+        let seconds = guard_intervals(&mut block, &role, &[1e6; 10], &used);
+        let expected: Vec<Option<usize>> = [
+            Some(0),
+            Some(0),
+            Some(0),
+            Some(1),
+            Some(1),
+            Some(1),
+            None,
+            Some(2),
+            Some(2),
+            Some(3),
+        ]
+        .to_vec();
+        assert_eq!(block, expected);
+        assert_eq!(seconds, 1.0);
     }
 }

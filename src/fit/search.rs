@@ -18,7 +18,7 @@
 use super::metric::{Components, distance, median_ratios};
 use super::observe::{Geometry, Observed, Subset};
 use crate::estimate::{EstimateError, quantise, resim};
-use crate::events::TimeUs;
+use crate::events::{EventChunk, TimeUs};
 use crate::sim::{PixelParams, Sample};
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
 use argmin::solver::brent::BrentOpt;
@@ -38,6 +38,10 @@ pub struct Simulation<'a> {
     pub seed: u64,
     /// Simulations run so far.
     pub count: Cell<usize>,
+    /// The named hot pixels' events (a Poisson process at each one's rate and polarity
+    /// share, measured on the fit blocks), added to every simulation so that the model and
+    /// the recording are compared on the same pixels.
+    pub hot_events: EventChunk,
 }
 
 /// A simulated model: its parameters (thresholds profiled) and statistics.
@@ -63,6 +67,9 @@ impl Simulation<'_> {
         let mut events = resim::simulate(self.runs, self.width, self.height, &p)?;
         if let Some(grid) = self.grid {
             quantise(&mut events, grid);
+        }
+        if !self.hot_events.is_empty() {
+            events = EventChunk::merged(&events, &self.hot_events);
         }
         Ok(Observed::new(&events, self.geometry, masked))
     }
@@ -90,6 +97,12 @@ impl Simulation<'_> {
             for pol in 0..2 {
                 let Some(m) = medians[pol] else { continue };
                 let c = if pol == 1 { p.ct_on } else { p.ct_off };
+                if !(c.is_finite() && c > 0.0) {
+                    return Err(EstimateError::new(
+                        format!("the threshold profile reached {c} (it must stay positive)"),
+                        "report this as a bug, with the recording",
+                    ));
+                }
                 history[pol].push((c.ln(), m));
                 if m.abs() < 0.003 {
                     continue;
@@ -207,6 +220,8 @@ pub struct Searched {
     /// Standard error of the value, from the curvature of the fit error around the
     /// minimum against `noise` (how much the error moves by chance).
     pub standard_error: Option<f64>,
+    /// The value sits at an end of the searched range: a bound, not a measurement.
+    pub at_bound: Option<f64>,
     pub evaluations: Vec<Evaluation>,
 }
 
@@ -222,6 +237,7 @@ pub fn search(
     fixed_thresholds: bool,
     noise: f64,
 ) -> Result<Searched, EstimateError> {
+    let range = valid_range(range);
     let problem = Search {
         simulation,
         effect,
@@ -260,13 +276,29 @@ pub fn search(
         .iter()
         .find(|e| e.fit_error == fit_error)
         .map_or(range.0, |e| e.value);
+    let at_bound = [range.0, range.1]
+        .into_iter()
+        .find(|end| (value / end).ln().abs() < 0.05);
     Ok(Searched {
-        standard_error: curvature_error(&evaluations, value, noise),
+        standard_error: curvature_error(&evaluations, value, noise).filter(|_| at_bound.is_none()),
+        at_bound,
         value,
         model,
         fit_error,
         evaluations,
     })
+}
+
+/// A search range with both ends positive and finite and the lower below the upper (the
+/// upper raised to twice the lower where an effect's own limits crossed).
+fn valid_range((lo, hi): (f64, f64)) -> (f64, f64) {
+    let lo = if lo.is_finite() && lo > 0.0 { lo } else { 1e-6 };
+    let hi = if hi.is_finite() && hi > 2.0 * lo {
+        hi
+    } else {
+        2.0 * lo
+    };
+    (lo, hi)
 }
 
 /// The standard error of a searched value: a parabola `e(x) = a (x - x0)^2 + b` through

@@ -21,6 +21,7 @@
 pub mod hot_pixels;
 pub mod intervals;
 pub mod pixel_grid;
+pub mod robust;
 pub mod support;
 pub mod timeline;
 

@@ -89,11 +89,7 @@ fn bootstrap(groups: &Groups) -> (f64, f64) {
 }
 
 fn std_dev(v: &[f64]) -> f64 {
-    if v.len() < 2 {
-        return f64::NAN;
-    }
-    let m = v.iter().sum::<f64>() / v.len() as f64;
-    (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (v.len() - 1) as f64).sqrt()
+    crate::stats::robust::sample_std_dev(v).unwrap_or(f64::NAN)
 }
 
 /// The support window: three pixel-crossings of the typical motion, 10-100 ms.

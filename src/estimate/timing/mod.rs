@@ -625,12 +625,7 @@ fn mean_and_sigma(pixels: &[(f64, u32, f64)]) -> (f64, f64) {
 }
 
 fn std_dev(values: &[f64]) -> f64 {
-    if values.len() < 2 {
-        return 0.0;
-    }
-    let n = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / n;
-    (values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt()
+    crate::stats::robust::sample_std_dev(values).unwrap_or(0.0)
 }
 
 #[cfg(test)]

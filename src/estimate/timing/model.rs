@@ -188,6 +188,19 @@ pub fn fit(pairs: &[Pair], v: &Values, weight: &[f64], leak: bool) -> Option<Coe
             }
         }
     }
+    // a term the pairs carry no information on (no lag where every pair is a steady ramp,
+    // no level spread) is left out: its coefficient 0
+    let largest = (0..k).map(|a| xtx[(a, a)]).fold(0.0, f64::max);
+    for a in 2..k {
+        if xtx[(a, a)] <= 1e-12 * largest {
+            for b in 0..k {
+                xtx[(a, b)] = 0.0;
+                xtx[(b, a)] = 0.0;
+            }
+            xtx[(a, a)] = 1.0;
+            xty[a] = 0.0;
+        }
+    }
     let beta = xtx.lu().solve(&xty)?;
     Some(Coefficients {
         c_on: beta[0],

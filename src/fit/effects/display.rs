@@ -5,7 +5,8 @@
 //! lacks. Evidence: the strongest line between 20 and 500 Hz in the recording's spectrum
 //! (power over the spectrum's median), against the model's at that frequency. A display's
 //! parameters are fitted from the stimulus that was played (`ctcal estimate screen`); the
-//! fit names the line and the frequency.
+//! fit names the line and the frequency. Not assessed on timestamps quantised to a coarse
+//! grid, whose own lines fill the spectrum.
 
 use super::{Context, Effect, Evidence};
 use crate::fit::residuals::power_spectrum;
@@ -23,7 +24,20 @@ pub fn line(c: &Context) -> Option<(f64, f64, f64)> {
     Some((f[k], power, sim.get(k).copied().unwrap_or(0.0)))
 }
 
+/// Timestamp grids at least this coarse (us) fill the event-rate spectrum with their own
+/// lines (a simulator's frames stamp events at fixed fractions of each interval: v2e), so a
+/// display cannot be told from them.
+const GRID_HIDES_DISPLAY_US: i64 = 100;
+
 pub fn evidence(c: &Context) -> Evidence {
+    if let Some(grid) = c.timestamp_grid_us.filter(|&g| g >= GRID_HIDES_DISPLAY_US) {
+        return Evidence::none(
+            Effect::Display,
+            &format!(
+                "the timestamps lie on a {grid} us grid (a simulator's frames): the event-rate spectrum shows the grid's lines, not a display's"
+            ),
+        );
+    }
     match line(c) {
         Some((frequency, power, simulated)) => Evidence {
             effect: Effect::Display,

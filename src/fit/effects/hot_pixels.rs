@@ -3,12 +3,16 @@
 //!
 //! Signature: pixels far above the count distribution of their neighbours in the
 //! recording but not in the model ([`crate::stats::hot_pixels`], robust z-score against the
-//! busiest 8-neighbour). They are masked (left out of every statistic, named in the result)
-//! rather than simulated: a simulator places its hot pixels at random, so comparing them
-//! pixel by pixel would be meaningless; the fraction and rate are reported for simulation.
+//! busiest 8-neighbour). They are named, and added to the model where they are: each a
+//! Poisson train at its own rate and polarity share, measured on the fit blocks ([`events`]),
+//! so that model and recording are compared on the same pixels before and after (a
+//! simulator places its hot pixels at random: the fraction and the median rate are reported
+//! for simulation).
 
 use super::{Context, Effect, Evidence};
+use crate::events::{EventChunk, TimeUs};
 use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
+use rand::{RngExt, SeedableRng};
 
 /// The recording's hot pixels (fit blocks) that the model does not have.
 pub fn find(c: &Context) -> Vec<HotPixel> {
@@ -49,5 +53,73 @@ pub fn evidence(c: &Context) -> Evidence {
                 .join(", ")
         ),
         start: None,
+    }
+}
+
+/// A named hot pixel as the model simulates it.
+#[derive(Clone, Copy, Debug)]
+pub struct HotTrain {
+    pub x: u16,
+    pub y: u16,
+    /// Events per second, and the share of them that are ON.
+    pub rate_hz: f64,
+    pub on_share: f64,
+}
+
+/// The hot pixels' own events over `span`: at each pixel a Poisson train at its rate, each
+/// event ON with its share (seeded per pixel, so every simulation adds the same events).
+pub fn events(trains: &[HotTrain], span: (TimeUs, TimeUs), seed: u64) -> EventChunk {
+    let mut all = EventChunk::default();
+    for train in trains.iter().filter(|h| h.rate_hz > 0.0) {
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(
+            seed ^ ((train.y as u64) << 16 | train.x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+        );
+        let mut own = EventChunk::default();
+        let mut t = span.0 as f64;
+        loop {
+            t += -(1.0 - rng.random::<f64>()).ln() / train.rate_hz * 1e6;
+            if t >= span.1 as f64 {
+                break;
+            }
+            let on = rng.random::<f64>() < train.on_share;
+            own.push(t as TimeUs, train.x, train.y, on);
+        }
+        all = EventChunk::merged(&all, &own);
+    }
+    all
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trains_fire_at_their_rate_and_share() {
+        let trains = [
+            HotTrain {
+                x: 3,
+                y: 4,
+                rate_hz: 1000.0,
+                on_share: 0.8,
+            },
+            HotTrain {
+                x: 7,
+                y: 1,
+                rate_hz: 200.0,
+                on_share: 0.0,
+            },
+        ];
+        let e = events(&trains, (1_000_000, 3_000_000), 9);
+        let n = |x| e.x.iter().filter(|&&v| v == x).count() as f64;
+        // Poisson counts: 2000 +- 45 and 400 +- 20
+        assert!((n(3) - 2000.0).abs() < 4.0 * 45.0, "{}", n(3));
+        assert!((n(7) - 400.0).abs() < 4.0 * 20.0, "{}", n(7));
+        let on3 = (0..e.len()).filter(|&i| e.x[i] == 3 && e.on[i]).count() as f64;
+        assert!((on3 / n(3) - 0.8).abs() < 0.04, "{}", on3 / n(3));
+        assert!((0..e.len()).all(|i| e.x[i] != 7 || !e.on[i]));
+        assert!(e.t.windows(2).all(|w| w[0] <= w[1]));
+        assert!(e.t.iter().all(|&t| (1_000_000..3_000_000).contains(&t)));
+        // the same events every time
+        assert_eq!(events(&trains, (1_000_000, 3_000_000), 9), e);
     }
 }

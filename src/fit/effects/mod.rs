@@ -98,6 +98,19 @@ impl Effect {
         *slot = Some(value);
     }
 
+    /// The searched parameter's value in `params` (`None`: not set, or no parameter).
+    pub fn value(self, params: &PixelParams) -> Option<f64> {
+        match self {
+            Effect::Mismatch => params.ct_sigma,
+            Effect::Refractory => params.refractory_s,
+            Effect::Bandwidth => params.cutoff_hz,
+            Effect::Leak => params.leak_rate_hz,
+            Effect::ShotNoise => params.shot_noise_rate_hz,
+            Effect::TimestampJitter => params.timestamp_jitter_s,
+            Effect::HotPixels | Effect::Display => None,
+        }
+    }
+
     /// The range searched around a starting value (a factor either side, or the
     /// effect's own plausible range).
     pub fn range(self, start: f64) -> (f64, f64) {

@@ -1,0 +1,230 @@
+//! The fit's result: the final model's error on the test blocks, the thresholds' standard
+//! errors, what the data identify and what they do not, and every assumption with its size.
+
+use super::super::metric::{ERROR_METRIC, cell_ratios};
+use super::super::observe::{Role, Subset};
+use super::super::residuals::{Residuals, residuals};
+use super::super::search::{Simulated, Simulation};
+use super::super::{
+    AddedEffect, FitInput, FitOptions, FitResult, FittedParams, Holdout, Step, Uncertain,
+};
+use super::State;
+use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
+use crate::stats::robust::{mad_sigma, median};
+use std::collections::BTreeMap;
+
+/// Standard errors of the thresholds from the spread of the count-cell log ratios on the
+/// fit blocks (MAD sigma, times 1.2533 for the median's efficiency, over sqrt(cells)).
+pub fn threshold_uncertainty(
+    simulation: &Simulation,
+    model: &Simulated,
+) -> BTreeMap<String, Uncertain> {
+    let ratios = cell_ratios(
+        &simulation.real,
+        &model.observed,
+        simulation.geometry,
+        Subset::Fit,
+    );
+    let se = |pol: usize, c: f64| {
+        let v: Vec<f64> = ratios
+            .iter()
+            .filter(|(_, r, i)| i % 2 == pol && *r >= 5)
+            .map(|c| c.0)
+            .collect();
+        (v.len() >= 3)
+            .then(|| mad_sigma(&v))
+            .flatten()
+            .map(|s| c * 1.2533 * s / (v.len() as f64).sqrt())
+    };
+    let p = &model.params;
+    BTreeMap::from([
+        (
+            "ct_on".to_string(),
+            Uncertain {
+                value: p.ct_on,
+                standard_error: se(1, p.ct_on),
+            },
+        ),
+        (
+            "ct_off".to_string(),
+            Uncertain {
+                value: p.ct_off,
+                standard_error: se(0, p.ct_off),
+            },
+        ),
+    ])
+}
+
+/// Says so when the ideal model already makes more isolated events than the recording: the
+/// frames' own noise becomes events when they are simulated.
+pub fn read_noise_note(simulation: &Simulation, ideal: &Simulated, assumptions: &mut Vec<String>) {
+    let g = simulation.geometry;
+    let sum = |v: Vec<u32>| v.iter().map(|&x| x as f64).sum::<f64>();
+    let r = sum(simulation.real.background_of(g, Subset::All));
+    let s = sum(ideal.observed.background_of(g, Subset::All));
+    if s > 1.2 * r && s - r > 5.0 * (r + s + 1.0).sqrt() {
+        assumptions.push(format!(
+            "the ideal model already makes {:.0} % more isolated events than the recording: the frames' own noise (read noise) becomes events when they are simulated, so sensor noise below that level cannot be measured",
+            100.0 * (s / r.max(1.0) - 1.0)
+        ));
+    }
+}
+
+/// What the loop produced, for the result.
+pub struct Parts<'a> {
+    pub before: super::super::metric::Components,
+    pub residuals_before: Residuals,
+    pub added: Vec<AddedEffect>,
+    pub steps: Vec<Step>,
+    pub assumptions: Vec<String>,
+    pub fixed: bool,
+    pub options: &'a FitOptions,
+    pub input: &'a FitInput<'a>,
+}
+
+/// The result of the fit.
+pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitResult {
+    let g = simulation.geometry;
+    let Parts {
+        before,
+        residuals_before,
+        added,
+        steps,
+        mut assumptions,
+        fixed,
+        options,
+        input,
+    } = parts;
+    let after = simulation.distance(&state.model.observed, g.testing(), &state.kept);
+    let residuals_after = residuals(&simulation.real, &state.model.observed, g, Subset::Fit);
+    state
+        .uncertainty
+        .extend(threshold_uncertainty(simulation, &state.model));
+    let mut params = state.model.params.clone();
+    params.seed = None;
+    if !state.hot.is_empty() {
+        let kept_pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
+        let rates: Vec<f64> = state.hot.iter().map(|h| h.rate_hz).collect();
+        params.hot_pixel_fraction = Some(state.hot.len() as f64 / kept_pixels as f64);
+        params.hot_pixel_rate_hz = median(&rates);
+    }
+    let not_identified = not_identified(&state, fixed);
+    if fixed {
+        state.uncertainty.remove("ct_on");
+        state.uncertainty.remove("ct_off");
+    }
+    assumptions.extend(split_assumptions(simulation, options));
+    let identified = serde_json::to_value(&params)
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
+        .map(|(k, _)| {
+            let known = !not_identified.contains_key(&k);
+            (k, known)
+        })
+        .collect();
+    FitResult {
+        why: not_identified.clone(),
+        identified,
+        params: FittedParams {
+            model: params,
+            not_identified,
+        },
+        uncertainties: state.uncertainty,
+        effects_added: added,
+        error_metric: ERROR_METRIC,
+        error_before: before.total,
+        error_after: after.total,
+        components_before: before,
+        components_after: after,
+        steps,
+        hot_pixels_masked: state.hot,
+        residuals_before,
+        residuals_after,
+        assumptions,
+        holdout: holdout(simulation, options),
+        simulations: simulation.count.get(),
+        frame_exposure_us: input
+            .frames
+            .iter()
+            .find_map(|f| f.exposure_us)
+            .or(options.aps.exposure_us),
+    }
+}
+
+/// Parameters the data do not identify, and why.
+fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
+    let mut why = BTreeMap::new();
+    if fixed {
+        for k in ["ct_on", "ct_off"] {
+            why.insert(
+                k.to_string(),
+                "the recording does not show the thresholds (a static scene, or frames that explain almost none of its events): the model simulated them at a start value".to_string(),
+            );
+        }
+    }
+    for (key, bound) in &state.at_bound {
+        why.insert(
+            key.clone(),
+            format!(
+                "the search ended at the bound {bound:.6} of its range: the data ask for at least (or at most) this much, a bound rather than a measurement"
+            ),
+        );
+    }
+    why
+}
+
+fn split_assumptions(simulation: &Simulation, options: &FitOptions) -> Vec<String> {
+    let g = simulation.geometry;
+    let chance = if g.blocks_of(Role::Fit).len() >= 3 {
+        format!(
+            "an effect is kept when its error on the selection blocks falls by more than twice the chance spread of the per-block difference between the two models (measured on the fit blocks, over sqrt of the selection blocks), and by at least {:.0} % (parsimony floor)",
+            100.0 * PARSIMONY
+        )
+    } else {
+        format!(
+            "under three fit blocks, chance cannot be measured: an effect is kept when its error on the selection blocks falls by {:.0} % (a fixed floor)",
+            100.0 * UNMEASURED_CHANCE
+        )
+    };
+    vec![
+        format!(
+            "the frames simulated after upsampling along the optical flow (0.5 px steps); {} simulations, one seed ({}) for all",
+            simulation.count.get(),
+            options.seed
+        ),
+        format!(
+            "time in {} blocks: fit {:.2} s (the first {:.0} % of the frames' span; the starting thresholds, the frames' alignment and offset and every search use it alone), selection {:.2} s (judges effects and refits), test {:.2} s (error_before and error_after only); {:.2} s of guard intervals between them unused; statistics over {} pixels",
+            g.blocks,
+            g.duration_of(Subset::Fit),
+            100.0 * (1.0 - options.holdout),
+            g.duration_of(Subset::Selection),
+            g.duration_of(Subset::Test),
+            g.guard_seconds,
+            g.kept_pixels()
+        ),
+        chance,
+    ]
+}
+
+fn holdout(simulation: &Simulation, options: &FitOptions) -> Holdout {
+    let g = simulation.geometry;
+    let selection = g.blocks_of(Role::Selection);
+    let test = g.blocks_of(Role::Test);
+    let mut held_out: Vec<usize> = selection.iter().chain(&test).copied().collect();
+    held_out.sort_unstable();
+    Holdout {
+        fraction: options.holdout,
+        blocks: g.blocks,
+        held_out_blocks: held_out,
+        selection_blocks: selection,
+        test_blocks: test,
+        fit_seconds: g.duration_of(Subset::Fit),
+        held_out_seconds: g.duration_of(Subset::Selection) + g.duration_of(Subset::Test),
+        selection_seconds: g.duration_of(Subset::Selection),
+        test_seconds: g.duration_of(Subset::Test),
+        guard_seconds: g.guard_seconds,
+    }
+}

@@ -1,0 +1,97 @@
+//! Whether a candidate model is better than the current one: its distance on the judging
+//! blocks (selection, never fitted on) must fall by more than chance. Chance is measured,
+//! not assumed: the relative fall of the distance from one model to the other, block by
+//! block over the fit blocks (those with events), scatters by `s` (sampling noise and the
+//! blocks' different content), so the relative fall over `n` judging blocks moves by about
+//! `s / sqrt(n)`; an effect is kept when its relative fall exceeds twice that (one-sided
+//! ~98 %) and a parsimony floor of 1 % (an effect too small to matter is left out even when
+//! measurable). With fewer than three fit blocks chance cannot be measured and a 2 % floor
+//! stands in (said in the assumptions).
+
+use super::super::metric::Components;
+use super::super::observe::{Observed, Role, Subset};
+use super::super::search::Simulation;
+use crate::stats::robust::sample_std_dev;
+
+/// The smallest relative gain that keeps an effect, whatever chance says.
+pub const PARSIMONY: f64 = 0.01;
+/// The relative gain needed where chance cannot be measured (under three fit blocks).
+pub const UNMEASURED_CHANCE: f64 = 0.02;
+
+/// The judgement of a candidate against the current model.
+pub struct Verdict {
+    pub before: Components,
+    pub after: Components,
+    /// The gain that chance alone would give (twice its standard error), `None` where
+    /// it could not be measured.
+    pub chance: Option<f64>,
+    pub kept: bool,
+    pub reason: String,
+}
+
+/// Judges `candidate` against `current` on the judging blocks.
+pub fn judge(
+    simulation: &Simulation,
+    current: &Observed,
+    candidate: &Observed,
+    kept_pixels: &[bool],
+) -> Verdict {
+    let g = simulation.geometry;
+    let subset = g.judging();
+    let before = simulation.distance(current, subset, kept_pixels);
+    let after = simulation.distance(candidate, subset, kept_pixels);
+    let gain = before.total - after.total;
+    let judging_blocks = (0..g.blocks).filter(|&b| g.in_subset(b, subset)).count();
+    let relative_falls: Vec<f64> = g
+        .blocks_of(Role::Fit)
+        .into_iter()
+        .filter_map(|b| {
+            let was = simulation
+                .distance(current, Subset::Block(b), kept_pixels)
+                .total;
+            let now = simulation
+                .distance(candidate, Subset::Block(b), kept_pixels)
+                .total;
+            (was > 0.0).then(|| (was - now) / was)
+        })
+        .collect();
+    let chance = (relative_falls.len() >= 3)
+        .then(|| sample_std_dev(&relative_falls))
+        .flatten()
+        .map(|s| 2.0 * s / (judging_blocks.max(1) as f64).sqrt() * before.total);
+    let floor = match chance {
+        Some(c) => c.max(PARSIMONY * before.total),
+        None => UNMEASURED_CHANCE * before.total,
+    };
+    let kept = gain > floor;
+    let change = -100.0 * gain / before.total.max(1e-12);
+    let reason = if kept {
+        format!(
+            "error on the selection blocks {:.4} -> {:.4} ({change:+.1} %; chance {})",
+            before.total,
+            after.total,
+            describe(chance)
+        )
+    } else {
+        format!(
+            "error on the selection blocks {:.4} -> {:.4} ({change:+.1} %): needs a fall of {floor:.4} (chance {}, at least {:.0} %)",
+            before.total,
+            after.total,
+            describe(chance),
+            100.0 * PARSIMONY
+        )
+    };
+    Verdict {
+        before,
+        after,
+        chance,
+        kept,
+        reason,
+    }
+}
+
+fn describe(chance: Option<f64>) -> String {
+    chance.map_or("not measurable: under three fit blocks".into(), |c| {
+        format!("{c:.4}")
+    })
+}

@@ -1,0 +1,390 @@
+//! Model selection, the closed loop, in stages:
+//!
+//! 1. the split ([`start`]): time in blocks, the first `1 - holdout` of the frames' span
+//!    fits, the rest is held out as two contiguous runs with a guard interval at each change:
+//!    selection (judges every effect and refit) then test (measures the final error once);
+//! 2. the start: `estimate aps` on the fit run alone, the frames prepared from its events;
+//! 3. the loop: from the ideal model, every effect's evidence read from the fit blocks'
+//!    residuals; the strongest tried (its parameter searched with the thresholds on the fit
+//!    blocks) and kept only if the selection error falls by more than chance ([`keep`]);
+//! 4. each searched parameter refitted with all the others in place ([`steps::refit`]);
+//! 5. the error before (ideal model) and after (final model) on the test blocks, which
+//!    neither fitted nor chose anything.
+//!
+//! Every step is recorded: the effect, its evidence, the selection error before and after,
+//! the chance level it had to beat, kept or not and why.
+
+mod finish;
+mod keep;
+mod start;
+mod steps;
+
+use super::effects::{self, Context, Effect, hot_pixels::HotTrain};
+use super::observe::{Geometry, Subset};
+use super::residuals::residuals;
+use super::search::{Simulated, Simulation};
+use super::{
+    AddedEffect, EffectChoice, FitError, FitInput, FitOptions, FitResult, Step, Uncertain,
+};
+use crate::estimate::aps::{self, ApsInput};
+use crate::estimate::{Progress, dynamics, timestamp_grid};
+use crate::events::EventChunk;
+use crate::sim::PixelParams;
+use crate::stats::hot_pixels::HotPixel;
+use std::cell::Cell;
+use std::collections::BTreeMap;
+
+/// What is known besides the residuals: the estimators' mismatch (value, 95 % interval)
+/// and the recording's timestamp grid.
+#[derive(Clone, Copy)]
+struct Known {
+    mismatch: Option<(f64, [f64; 2])>,
+    grid: Option<(i64, i64)>,
+}
+
+/// The fit's state between steps.
+pub(super) struct State {
+    model: Simulated,
+    /// Pixels masked from the statistics besides the user's (none today), and compared.
+    masked: Vec<bool>,
+    kept: Vec<bool>,
+    /// Hot pixels named (and simulated as their own event trains).
+    hot: Vec<HotPixel>,
+    uncertainty: BTreeMap<String, Uncertain>,
+    /// Parameters whose search ended at a bound of its range, and the bound.
+    at_bound: BTreeMap<String, f64>,
+}
+
+impl State {
+    fn set_uncertain(&mut self, key: String, value: Uncertain, bound: Option<f64>) {
+        match bound {
+            Some(b) => self.at_bound.insert(key.clone(), b),
+            None => self.at_bound.remove(&key),
+        };
+        self.uncertainty.insert(key, value);
+    }
+}
+
+/// Fits the simulator to `input` (see the module docs of [`crate::fit`]).
+pub fn fit(
+    input: &FitInput,
+    options: &FitOptions,
+    progress: Progress,
+) -> Result<FitResult, FitError> {
+    start::check_frames(input)?;
+    progress("frames: selection and optical flow", 0.0);
+    let end = start::fit_end(input.frames, options.holdout);
+    let run = start::FitRun::new(input, end);
+    let (frames, mut assumptions) = prepare_frames(input, &run, options)?;
+    let change_rate = dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
+    let static_scene = change_rate < dynamics::STATIC_CHANGE_RATE;
+    progress("starting thresholds (estimate aps on the fit run)", 0.05);
+    let start = start::thresholds(input, &run, options, change_rate, static_scene);
+    assumptions.extend(start.assumptions.iter().cloned());
+    let start_params = PixelParams {
+        log_response: Some(frames.log_map.response()),
+        log_eps: Some(frames.log_map.eps()),
+        ..start.params.clone()
+    };
+
+    progress("the ideal model", 0.2);
+    let geometry = Geometry::new(&frames, input.excluded, options.blocks, end);
+    let runs = frames.upsample_runs(0.5, options.aps.max_upsampled_bytes);
+    let grid = timestamp_grid(input.events);
+    let no_mask = vec![false; input.sensor.pixels()];
+    let real = super::observe::Observed::new(input.events, &geometry, &no_mask);
+    let mut simulation = Simulation {
+        runs: &runs,
+        width: frames.width,
+        height: frames.height,
+        geometry: &geometry,
+        events: input.events,
+        real,
+        grid,
+        seed: options.seed,
+        count: Cell::new(0),
+        hot_events: EventChunk::default(),
+    };
+    let (ideal, fixed) = ideal_model(&simulation, &start_params, start.fixed, &mut assumptions)?;
+    let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
+    let before = simulation.distance(&ideal.observed, geometry.testing(), &kept);
+    let residuals_before = residuals(&simulation.real, &ideal.observed, &geometry, Subset::Fit);
+    let noise = distance_noise(&simulation, &ideal.observed, &kept);
+    finish::read_noise_note(&simulation, &ideal, &mut assumptions);
+    let mut state = State {
+        uncertainty: finish::threshold_uncertainty(&simulation, &ideal),
+        model: ideal,
+        masked: no_mask,
+        kept,
+        hot: Vec::new(),
+        at_bound: BTreeMap::new(),
+    };
+    let known = Known {
+        mismatch: start.mismatch,
+        grid,
+    };
+    let mut steps = vec![start.step];
+    let loop_run = LoopRun {
+        known,
+        fixed,
+        noise,
+        fit_events: &run.events,
+    };
+    let mut added = run_loop(
+        &mut simulation,
+        &mut state,
+        options,
+        &loop_run,
+        &mut steps,
+        progress,
+    )?;
+    refit_together(
+        &simulation,
+        &mut state,
+        &loop_run,
+        &mut added,
+        &mut steps,
+        progress,
+    )?;
+    if !matches!(options.effects, EffectChoice::List(_)) {
+        let context = context_of(&state, &simulation, known);
+        for &effect in planned(options).iter() {
+            if !steps.iter().any(|s| s.effect == effect.name()) {
+                steps.push(steps::untried(&effects::evidence(effect, &context)));
+            }
+        }
+    }
+    progress("the final model on the test blocks", 0.97);
+    let result = finish::result(
+        &simulation,
+        state,
+        finish::Parts {
+            before,
+            residuals_before,
+            added,
+            steps,
+            assumptions,
+            fixed,
+            options,
+            input,
+        },
+    );
+    progress("done", 1.0);
+    Ok(result)
+}
+
+/// The frames as the simulator reads them: the frame-time alignment, the log offset and
+/// the response found on the fit run alone, applied to every frame.
+fn prepare_frames(
+    input: &FitInput,
+    run: &start::FitRun,
+    options: &FitOptions,
+) -> Result<(crate::estimate::frames::PreparedFrames, Vec<String>), FitError> {
+    let found = aps::prepare(&run.aps_input(input), input.excluded, &options.aps)?;
+    let fixed = aps::ApsOptions {
+        frame_time_offset_s: options
+            .aps
+            .frame_time_offset_s
+            .or(found.alignment.as_ref().map(|a| a.shift_s))
+            .or(Some(0.0)),
+        frame_offset_dn: Some(found.frames.offset as f64),
+        log_map: found.frames.log_map,
+        choose_response: false,
+        ..options.aps.clone()
+    };
+    let all = ApsInput {
+        sensor: input.sensor,
+        events: input.events,
+        frames: input.frames,
+        excluded: input.excluded,
+    };
+    let prepared = aps::prepare(&all, input.excluded, &fixed)?;
+    Ok((prepared.frames, found.assumptions))
+}
+
+/// The ideal model with the thresholds profiled, and whether they stay fixed (a static
+/// scene, or frames that explain under 5 % of the events: counts cannot fix thresholds).
+fn ideal_model(
+    simulation: &Simulation,
+    start: &PixelParams,
+    fixed: bool,
+    assumptions: &mut Vec<String>,
+) -> Result<(Simulated, bool), FitError> {
+    let g = simulation.geometry;
+    let no_mask = vec![false; g.sensor.pixels()];
+    let ideal = simulation.profile(start, &no_mask, fixed)?;
+    if !fixed && ideal.observed.total(g, Subset::All) * 20 < simulation.real.total(g, Subset::All) {
+        assumptions.push(
+            "the frames explain under 5 % of the events: thresholds kept where they started (not identified)".into(),
+        );
+        return Ok((simulation.profile(start, &no_mask, true)?, true));
+    }
+    Ok((ideal, fixed))
+}
+
+/// How much the distance moves by chance: the standard error of its mean over the fit
+/// blocks (2 % of it where there is a single fit block).
+fn distance_noise(
+    simulation: &Simulation,
+    observed: &super::observe::Observed,
+    kept: &[bool],
+) -> f64 {
+    let g = simulation.geometry;
+    let per_block: Vec<f64> = g
+        .blocks_of(super::observe::Role::Fit)
+        .into_iter()
+        .map(|b| simulation.distance(observed, Subset::Block(b), kept).total)
+        .collect();
+    let n = per_block.len() as f64;
+    match crate::stats::robust::sample_std_dev(&per_block) {
+        Some(sd) => sd / n.sqrt(),
+        None => 0.02 * per_block.iter().sum::<f64>() / n.max(1.0),
+    }
+}
+
+/// What every step of the loop shares.
+struct LoopRun<'a> {
+    known: Known,
+    fixed: bool,
+    noise: f64,
+    fit_events: &'a EventChunk,
+}
+
+fn planned(options: &FitOptions) -> Vec<Effect> {
+    match &options.effects {
+        EffectChoice::Auto => Effect::ALL.to_vec(),
+        EffectChoice::None => Vec::new(),
+        EffectChoice::List(list) => list.clone(),
+    }
+}
+
+/// The loop: the effect called for most strongly (or the next listed), tried, until none is
+/// left.
+fn run_loop(
+    simulation: &mut Simulation,
+    state: &mut State,
+    options: &FitOptions,
+    run: &LoopRun,
+    steps: &mut Vec<Step>,
+    progress: Progress,
+) -> Result<Vec<AddedEffect>, FitError> {
+    let planned = planned(options);
+    let forced = matches!(options.effects, EffectChoice::List(_));
+    let mut added = Vec::new();
+    let mut tried: Vec<Effect> = Vec::new();
+    for round in 0..planned.len() {
+        progress(
+            &format!("effects: round {} of at most {}", round + 1, planned.len()),
+            0.25 + 0.65 * round as f64 / planned.len().max(1) as f64,
+        );
+        let context = context_of(state, simulation, run.known);
+        let candidates: Vec<effects::Evidence> = planned
+            .iter()
+            .filter(|e| !tried.contains(e))
+            .map(|&e| effects::evidence(e, &context))
+            .collect();
+        let Some(evidence) = next_effect(candidates, forced) else {
+            break;
+        };
+        tried.push(evidence.effect);
+        let hot =
+            (evidence.effect == Effect::HotPixels).then(|| hot_trains(&context, run.fit_events));
+        let step = steps::try_effect(simulation, state, &evidence, hot, run.fixed, run.noise)?;
+        if step.kept {
+            added.push(AddedEffect {
+                effect: evidence.effect,
+                evidence: evidence.text.clone(),
+                error_after: step.error_after.unwrap_or(f64::NAN),
+            });
+        }
+        steps.push(step);
+    }
+    Ok(added)
+}
+
+/// The next effect: the first listed, or (auto) the directly measured ones first (hot
+/// pixels, the mismatch event timing measures), then the strongest residual signature.
+fn next_effect(candidates: Vec<effects::Evidence>, forced: bool) -> Option<effects::Evidence> {
+    if forced {
+        return candidates.into_iter().next();
+    }
+    let called: Vec<effects::Evidence> = candidates.into_iter().filter(|e| e.calls_for()).collect();
+    let direct = [Effect::HotPixels, Effect::Mismatch]
+        .into_iter()
+        .find_map(|d| called.iter().find(|e| e.effect == d).cloned());
+    direct.or_else(|| {
+        called
+            .into_iter()
+            .max_by(|a, b| a.score.total_cmp(&b.score))
+    })
+}
+
+/// The hot pixels of the fit blocks, each with its rate and its ON share in the fit run.
+fn hot_trains(context: &Context, fit_events: &EventChunk) -> (Vec<HotPixel>, Vec<HotTrain>) {
+    let hot = effects::hot_pixels::find(context);
+    let trains = hot
+        .iter()
+        .map(|h| {
+            let (mut on, mut all) = (0usize, 0usize);
+            for i in 0..fit_events.len() {
+                if fit_events.x[i] == h.x && fit_events.y[i] == h.y {
+                    all += 1;
+                    on += fit_events.on[i] as usize;
+                }
+            }
+            HotTrain {
+                x: h.x,
+                y: h.y,
+                rate_hz: h.rate_hz,
+                on_share: if all > 0 { on as f64 / all as f64 } else { 0.5 },
+            }
+        })
+        .collect();
+    (hot, trains)
+}
+
+/// Effects added early were fitted without the later ones (mismatch before the noise it
+/// partly stood in for): each searched parameter is fitted once more with all the others in
+/// place, and the new value kept if it wins on the selection blocks.
+fn refit_together(
+    simulation: &Simulation,
+    state: &mut State,
+    run: &LoopRun,
+    added: &mut [AddedEffect],
+    steps: &mut Vec<Step>,
+    progress: Progress,
+) -> Result<(), FitError> {
+    let searched: Vec<Effect> = added
+        .iter()
+        .map(|a| a.effect)
+        .filter(|e| e.parameter().is_some())
+        .collect();
+    if searched.len() < 2 {
+        return Ok(());
+    }
+    progress("refitting the effects together", 0.9);
+    for effect in searched {
+        let step = steps::refit(simulation, state, effect, run.fixed, run.noise)?;
+        if step.kept
+            && let Some(entry) = added.iter_mut().find(|a| a.effect == effect)
+        {
+            entry.error_after = step.error_after.unwrap_or(entry.error_after);
+        }
+        steps.push(step);
+    }
+    Ok(())
+}
+
+/// The evidence context of the current state (fit blocks).
+fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) -> Context<'a> {
+    Context {
+        real: &simulation.real,
+        sim: &state.model.observed,
+        geometry: simulation.geometry,
+        kept: &state.kept,
+        model: &state.model.params,
+        mismatch_estimate: known.mismatch,
+        timestamp_grid_us: known.grid.map(|g| g.0),
+        subset: Subset::Fit,
+    }
+}

@@ -1,0 +1,183 @@
+//! Where the fit starts: the time split (the fit run first, the held-out runs after it) and
+//! the starting thresholds, measured by `estimate aps` on the fit run alone so that nothing
+//! the loop is judged on has shaped its start.
+
+use super::super::{FitError, FitInput, FitOptions, Step};
+use crate::estimate::aps::{self, ApsInput};
+use crate::estimate::{CtEstimate, Interval};
+use crate::events::{EventChunk, Frame, TimeUs};
+use crate::sim::PixelParams;
+use std::collections::BTreeMap;
+
+/// The end of the fit run: the first `1 - holdout` of the frames' span (everything when
+/// nothing is held out).
+pub fn fit_end(frames: &[Frame], holdout: f64) -> TimeUs {
+    match (frames.first(), frames.last()) {
+        (Some(a), Some(b)) if holdout > 0.0 => {
+            a.t + ((b.t - a.t) as f64 * (1.0 - holdout)) as TimeUs
+        }
+        _ => TimeUs::MAX,
+    }
+}
+
+/// The fit run's events and frames (those up to `end`).
+pub struct FitRun {
+    pub events: EventChunk,
+    pub frames: Vec<Frame>,
+}
+
+impl FitRun {
+    pub fn new(input: &FitInput, end: TimeUs) -> Self {
+        Self {
+            events: input.events.between(TimeUs::MIN, end),
+            frames: input
+                .frames
+                .iter()
+                .filter(|f| f.t <= end)
+                .cloned()
+                .collect(),
+        }
+    }
+
+    pub fn aps_input<'a>(&'a self, input: &'a FitInput) -> ApsInput<'a> {
+        ApsInput {
+            sensor: input.sensor,
+            events: &self.events,
+            frames: &self.frames,
+            excluded: input.excluded,
+        }
+    }
+}
+
+/// The starting point: thresholds, whether they stay fixed, the mismatch the estimator
+/// measured (value, 95 % interval), the step that records it, and what it assumed.
+pub struct Start {
+    pub params: PixelParams,
+    pub fixed: bool,
+    pub mismatch: Option<(f64, [f64; 2])>,
+    pub step: Step,
+    pub assumptions: Vec<String>,
+}
+
+fn step(evidence: String, parameters: BTreeMap<String, f64>, kept: bool, reason: String) -> Step {
+    Step {
+        effect: "thresholds".into(),
+        evidence,
+        score: 0.0,
+        parameters,
+        error_before: None,
+        error_after: None,
+        components_after: None,
+        chance: None,
+        kept,
+        reason,
+        simulations: 0,
+        residuals_before: None,
+        residuals_after: None,
+    }
+}
+
+/// The starting thresholds: `estimate aps` on the fit run, or (a static scene, or aps
+/// finding none) `options.default_threshold` as a start value, said so in `assumptions`.
+pub fn thresholds(
+    input: &FitInput,
+    run: &FitRun,
+    options: &FitOptions,
+    change_rate: f64,
+    static_scene: bool,
+) -> Start {
+    let default = options.default_threshold;
+    let fallback = |evidence: String, reason: String, fixed: bool| Start {
+        params: PixelParams::ideal(default, default),
+        fixed,
+        mismatch: None,
+        assumptions: vec![format!(
+            "thresholds start at {default} (a start value, not a measurement): {reason}"
+        )],
+        step: step(evidence, BTreeMap::new(), false, reason),
+    };
+    if static_scene {
+        return fallback(
+            format!("the frames change by {change_rate:.4} log units per pixel per second"),
+            "a static scene does not show the thresholds; they stay there (leak and shot-noise rates do not depend on them)".into(),
+            true,
+        );
+    }
+    let found = aps::estimate(&run.aps_input(input), &options.aps, &|_, _| {});
+    match found.map(|f| f.estimate) {
+        Ok(e) => match e.thresholds() {
+            Some((on, off)) => measured(&e, on, off),
+            None => fallback(
+                format!(
+                    "estimate aps on the fit run determined no thresholds: {}",
+                    e.why.values().cloned().collect::<Vec<_>>().join("; ")
+                ),
+                "fitted to the counts from there".into(),
+                false,
+            ),
+        },
+        Err(error) => fallback(
+            format!("estimate aps on the fit run: {}", error.problem),
+            "fitted to the counts from there".into(),
+            false,
+        ),
+    }
+}
+
+fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
+    let ci = |c: Option<Interval>| {
+        let [lo, hi] = c.unwrap_or([None, None]);
+        let side = |v: Option<f64>| v.map_or("open".to_string(), |v| format!("{v:.4}"));
+        format!("[{}, {}]", side(lo), side(hi))
+    };
+    Start {
+        params: PixelParams::ideal(on, off),
+        fixed: false,
+        mismatch: e.ct_sigma.zip(e.ct_sigma_ci95),
+        assumptions: Vec::new(),
+        step: step(
+            format!(
+                "estimate aps on the fit run: ON {on:.4} {}, OFF {off:.4} {}",
+                ci(e.ct_on_ci95),
+                ci(e.ct_off_ci95)
+            ),
+            BTreeMap::from([("ct_on".to_string(), on), ("ct_off".to_string(), off)]),
+            true,
+            "the starting point; refitted with every effect".into(),
+        ),
+    }
+}
+
+/// Refuses a recording without frames (the fit simulates them).
+pub fn check_frames(input: &FitInput) -> Result<(), FitError> {
+    if input.frames.len() < 2 {
+        return Err(FitError::new(
+            "the fit simulates the recording from its grey frames; it has none",
+            "fit a recording with APS frames (IJRR folder, event_utils/MVSEC HDF5, AEDAT4 with frames, ROS bag with images); for event-only recordings estimate the thresholds with the eppps or screen method and read background rate, hot pixels and intervals from the statistics",
+        ));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(t: TimeUs) -> Frame {
+        Frame {
+            t,
+            width: 1,
+            height: 1,
+            pixels: vec![0],
+            exposure_us: None,
+        }
+    }
+
+    #[test]
+    fn the_fit_run_is_the_first_share_of_the_frames_span() {
+        let frames: Vec<Frame> = (0..11).map(|k| frame(1000 + 100 * k)).collect();
+        assert_eq!(fit_end(&frames, 0.4), 1000 + 600);
+        assert_eq!(fit_end(&frames, 0.0), TimeUs::MAX);
+        assert_eq!(fit_end(&[], 0.3), TimeUs::MAX);
+    }
+}

@@ -1,0 +1,249 @@
+//! One step of the loop: an effect tried (its parameter searched with the thresholds on the
+//! fit blocks, or hot pixels named and added as their own event trains) and judged on the
+//! selection blocks ([`super::keep`]); an added effect refitted with all the others in
+//! place; and the record of effects not called for.
+
+use super::super::effects::{self, Effect, hot_pixels::HotTrain};
+use super::super::observe::Subset;
+use super::super::residuals::residuals;
+use super::super::search::{Searched, Simulated, Simulation, search};
+use super::super::{FitError, Step, StepResiduals, Uncertain};
+use super::State;
+use super::keep::{Verdict, judge};
+use crate::stats::hot_pixels::HotPixel;
+use std::collections::BTreeMap;
+
+fn empty_step(effect: String, evidence: String, score: f64) -> Step {
+    Step {
+        effect,
+        evidence,
+        score,
+        parameters: BTreeMap::new(),
+        error_before: None,
+        error_after: None,
+        components_after: None,
+        chance: None,
+        kept: false,
+        reason: String::new(),
+        simulations: 0,
+        residuals_before: None,
+        residuals_after: None,
+    }
+}
+
+fn thresholds_of(model: &Simulated) -> BTreeMap<String, f64> {
+    BTreeMap::from([
+        ("ct_on".to_string(), model.params.ct_on),
+        ("ct_off".to_string(), model.params.ct_off),
+    ])
+}
+
+fn fit_residuals(simulation: &Simulation, model: &Simulated) -> StepResiduals {
+    StepResiduals::from(&residuals(
+        &simulation.real,
+        &model.observed,
+        simulation.geometry,
+        Subset::Fit,
+    ))
+}
+
+fn record(step: &mut Step, verdict: Verdict) {
+    step.error_before = Some(verdict.before.total);
+    step.error_after = Some(verdict.after.total);
+    step.components_after = Some(verdict.after);
+    step.chance = verdict.chance;
+    step.kept = verdict.kept;
+    step.reason = verdict.reason;
+}
+
+/// Tries one effect and updates `state` if it is kept.
+pub fn try_effect(
+    simulation: &mut Simulation,
+    state: &mut State,
+    evidence: &effects::Evidence,
+    hot_found: Option<(Vec<HotPixel>, Vec<HotTrain>)>,
+    fixed: bool,
+    noise: f64,
+) -> Result<Step, FitError> {
+    let effect = evidence.effect;
+    let count_before = simulation.count.get();
+    let mut step = empty_step(effect.name().into(), evidence.text.clone(), evidence.score);
+    step.residuals_before = Some(fit_residuals(simulation, &state.model));
+    let (candidate, uncertain) = match effect {
+        Effect::Display => {
+            step.reason = "a display's parameters come from the stimulus that was played (the screen method); not added".into();
+            return Ok(step);
+        }
+        Effect::HotPixels => {
+            let (hot, trains) = hot_found.unwrap_or_default();
+            let previous = std::mem::take(&mut simulation.hot_events);
+            simulation.hot_events =
+                effects::hot_pixels::events(&trains, simulation.geometry.span, simulation.seed);
+            let observed = simulation.observe(&state.model.params, &state.masked)?;
+            step.parameters
+                .insert("hot_pixels".into(), trains.len() as f64);
+            step.parameters.insert(
+                "hot_events_per_second".into(),
+                trains.iter().map(|t| t.rate_hz).sum(),
+            );
+            let verdict = judge(simulation, &state.model.observed, &observed, &state.kept);
+            if !verdict.kept {
+                simulation.hot_events = previous;
+            } else {
+                state.hot = hot;
+            }
+            let model = Simulated {
+                params: state.model.params.clone(),
+                observed,
+            };
+            return Ok(finish_step(
+                simulation,
+                state,
+                step,
+                verdict,
+                model,
+                None,
+                count_before,
+            ));
+        }
+        _ => {
+            let key = effect
+                .parameter()
+                .expect("every other effect has a parameter");
+            let start = evidence.start.unwrap_or(1.0);
+            let searched = search(
+                simulation,
+                &state.model.params,
+                effect,
+                effect.range(start),
+                &state.masked,
+                &state.kept,
+                fixed,
+                noise,
+            )?;
+            step.parameters.insert(key.into(), searched.value);
+            let uncertain = uncertain_of(key, &searched);
+            (searched.model, Some(uncertain))
+        }
+    };
+    let verdict = judge(
+        simulation,
+        &state.model.observed,
+        &candidate.observed,
+        &state.kept,
+    );
+    Ok(finish_step(
+        simulation,
+        state,
+        step,
+        verdict,
+        candidate,
+        uncertain,
+        count_before,
+    ))
+}
+
+/// The searched value with its standard error, or the bound it sits at.
+fn uncertain_of(key: &str, searched: &Searched) -> (String, Uncertain, Option<f64>) {
+    (
+        key.to_string(),
+        Uncertain {
+            value: searched.value,
+            standard_error: searched.standard_error,
+        },
+        searched.at_bound,
+    )
+}
+
+fn finish_step(
+    simulation: &Simulation,
+    state: &mut State,
+    mut step: Step,
+    verdict: Verdict,
+    candidate: Simulated,
+    uncertain: Option<(String, Uncertain, Option<f64>)>,
+    count_before: usize,
+) -> Step {
+    step.parameters.extend(thresholds_of(&candidate));
+    step.residuals_after = Some(fit_residuals(simulation, &candidate));
+    step.simulations = simulation.count.get() - count_before;
+    record(&mut step, verdict);
+    if step.kept {
+        state.model = candidate;
+        if let Some((key, value, bound)) = uncertain {
+            state.set_uncertain(key, value, bound);
+        }
+    }
+    step
+}
+
+/// Fits `effect`'s parameter again with every other parameter as it now is; keeps the new
+/// value if it wins on the selection blocks by more than chance.
+pub fn refit(
+    simulation: &Simulation,
+    state: &mut State,
+    effect: Effect,
+    fixed: bool,
+    noise: f64,
+) -> Result<Step, FitError> {
+    let key = effect.parameter().expect("a searched effect");
+    let current = effect
+        .value(&state.model.params)
+        .expect("a kept effect has its parameter");
+    let count_before = simulation.count.get();
+    let searched = search(
+        simulation,
+        &state.model.params,
+        effect,
+        (current / 3.0, current * 3.0),
+        &state.masked,
+        &state.kept,
+        fixed,
+        noise,
+    )?;
+    let verdict = judge(
+        simulation,
+        &state.model.observed,
+        &searched.model.observed,
+        &state.kept,
+    );
+    let mut step = empty_step(
+        format!("{} (refit)", effect.name()),
+        format!("{key} was {current:.6} when the effect was added"),
+        0.0,
+    );
+    step.parameters = thresholds_of(&searched.model);
+    step.parameters.insert(key.into(), searched.value);
+    step.simulations = simulation.count.get() - count_before;
+    let value = searched.value;
+    record(&mut step, verdict);
+    step.reason = if step.kept {
+        format!("{key} {current:.6} -> {value:.6}; {}", step.reason)
+    } else {
+        format!(
+            "{key} stays {current:.6} (refit {value:.6}); {}",
+            step.reason
+        )
+    };
+    if step.kept {
+        let (key, uncertain, bound) = uncertain_of(key, &searched);
+        state.model = searched.model;
+        state.set_uncertain(key, uncertain, bound);
+    }
+    Ok(step)
+}
+
+/// The record of an effect the residuals did not call for.
+pub fn untried(evidence: &effects::Evidence) -> Step {
+    let mut step = empty_step(
+        evidence.effect.name().into(),
+        evidence.text.clone(),
+        evidence.score,
+    );
+    step.reason = if evidence.score >= effects::EVIDENCE_THRESHOLD && !evidence.relevant {
+        "measurable but too small to matter".into()
+    } else {
+        "not called for by the residuals".into()
+    };
+    step
+}

@@ -1,0 +1,45 @@
+//! Summary statistics shared by the estimators and the fit: the sample standard deviation,
+//! the median and the median absolute deviation (scaled to a normal's sigma: Hampel 1974).
+
+/// The sample standard deviation (n - 1 denominator); `None` below two values.
+pub fn sample_std_dev(values: &[f64]) -> Option<f64> {
+    if values.len() < 2 {
+        return None;
+    }
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    Some((values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt())
+}
+
+/// The median (the upper middle of an even count); `None` when empty.
+pub fn median(values: &[f64]) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    let mut v = values.to_vec();
+    let mid = v.len() / 2;
+    Some(*v.select_nth_unstable_by(mid, f64::total_cmp).1)
+}
+
+/// The median absolute deviation times 1.4826 (a normal's sigma); `None` when empty.
+pub fn mad_sigma(values: &[f64]) -> Option<f64> {
+    let m = median(values)?;
+    let deviations: Vec<f64> = values.iter().map(|v| (v - m).abs()).collect();
+    Some(1.4826 * median(&deviations)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hand_computed() {
+        // mean 5, squares 9+1+1+9 = 20, / 3
+        let sd = sample_std_dev(&[2.0, 4.0, 6.0, 8.0]).unwrap();
+        assert!((sd - (20.0f64 / 3.0).sqrt()).abs() < 1e-12);
+        assert_eq!(sample_std_dev(&[1.0]), None);
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        // median 3; deviations 2, 0, 1, 7, 1 -> median 1
+        assert_eq!(mad_sigma(&[1.0, 3.0, 2.0, 10.0, 4.0]), Some(1.4826));
+    }
+}
