@@ -49,8 +49,32 @@ fn check_contract(f: &serde_json::Value) {
     assert!(after <= before + 1e-12, "{after} > {before}");
     for e in f["effects_added"].as_array().unwrap() {
         assert!(e["evidence"].as_str().unwrap().len() > 10);
-        assert!(e["error_after"].as_f64().unwrap() < before);
     }
+    // every kept step beat chance on the selection blocks; the test blocks judged nothing
+    for step in f["steps"].as_array().unwrap() {
+        if let (Some(b), Some(a), true) = (
+            step["error_before"].as_f64(),
+            step["error_after"].as_f64(),
+            step["kept"].as_bool().unwrap(),
+        ) {
+            let chance = step["chance"].as_f64().unwrap_or(0.0);
+            assert!(b - a > chance && b - a >= 0.01 * b, "{step}");
+        }
+    }
+    let h = &f["holdout"];
+    let (fit, sel, test) = (
+        h["fit_seconds"].as_f64().unwrap(),
+        h["selection_seconds"].as_f64().unwrap(),
+        h["test_seconds"].as_f64().unwrap(),
+    );
+    assert!(fit > 0.0 && sel > 0.0 && test > 0.0, "{h}");
+    assert!(
+        h["selection_blocks"].as_array().unwrap().iter().all(|s| !h["test_blocks"]
+            .as_array()
+            .unwrap()
+            .contains(s)),
+        "{h}"
+    );
 }
 
 #[test]

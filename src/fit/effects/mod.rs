@@ -98,6 +98,19 @@ impl Effect {
         *slot = Some(value);
     }
 
+    /// Removes the effect's parameter from `params` (the effect switched off).
+    pub fn clear(self, params: &mut PixelParams) {
+        match self {
+            Effect::Mismatch => params.ct_sigma = None,
+            Effect::Refractory => params.refractory_s = None,
+            Effect::Bandwidth => params.cutoff_hz = None,
+            Effect::Leak => params.leak_rate_hz = None,
+            Effect::ShotNoise => params.shot_noise_rate_hz = None,
+            Effect::TimestampJitter => params.timestamp_jitter_s = None,
+            Effect::HotPixels | Effect::Display => {}
+        }
+    }
+
     /// The searched parameter's value in `params` (`None`: not set, or no parameter).
     pub fn value(self, params: &PixelParams) -> Option<f64> {
         match self {

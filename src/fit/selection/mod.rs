@@ -146,6 +146,7 @@ pub fn fit(
         &mut steps,
         progress,
     )?;
+    prune_added(&simulation, &mut state, &loop_run, &mut added, &mut steps)?;
     if !matches!(options.effects, EffectChoice::List(_)) {
         let context = context_of(&state, &simulation, known);
         for &effect in planned(options).iter() {
@@ -319,9 +320,18 @@ fn next_effect(candidates: Vec<effects::Evidence>, forced: bool) -> Option<effec
     })
 }
 
-/// The hot pixels of the fit blocks, each with its rate and its ON share in the fit run.
+/// The hot pixels of the fit blocks that are hot on the selection blocks too (a defect
+/// persists; a busy patch of scene does not), each with its rate and ON share in the fit run.
 fn hot_trains(context: &Context, fit_events: &EventChunk) -> (Vec<HotPixel>, Vec<HotTrain>) {
-    let hot = effects::hot_pixels::find(context);
+    let judging = Context {
+        subset: context.geometry.judging(),
+        ..*context
+    };
+    let again = effects::hot_pixels::find(&judging);
+    let hot: Vec<HotPixel> = effects::hot_pixels::find(context)
+        .into_iter()
+        .filter(|h| again.iter().any(|a| (a.x, a.y) == (h.x, h.y)))
+        .collect();
     let trains = hot
         .iter()
         .map(|h| {
@@ -369,6 +379,33 @@ fn refit_together(
             && let Some(entry) = added.iter_mut().find(|a| a.effect == effect)
         {
             entry.error_after = step.error_after.unwrap_or(entry.error_after);
+        }
+        steps.push(step);
+    }
+    Ok(())
+}
+
+/// Each searched effect, once all are in, tested for whether it is still needed; those the
+/// others explain are removed (see [`steps::prune`]).
+fn prune_added(
+    simulation: &Simulation,
+    state: &mut State,
+    run: &LoopRun,
+    added: &mut Vec<AddedEffect>,
+    steps: &mut Vec<Step>,
+) -> Result<(), FitError> {
+    let searched: Vec<Effect> = added
+        .iter()
+        .map(|a| a.effect)
+        .filter(|e| e.parameter().is_some())
+        .collect();
+    if searched.len() < 2 {
+        return Ok(());
+    }
+    for effect in searched {
+        let step = steps::prune(simulation, state, effect, run.fixed)?;
+        if !step.kept {
+            added.retain(|a| a.effect != effect);
         }
         steps.push(step);
     }

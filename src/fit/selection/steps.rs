@@ -86,7 +86,19 @@ pub fn try_effect(
                 "hot_events_per_second".into(),
                 trains.iter().map(|t| t.rate_hz).sum(),
             );
-            let verdict = judge(simulation, &state.model.observed, &observed, &state.kept);
+            let mut verdict = judge(simulation, &state.model.observed, &observed, &state.kept);
+            // measured directly (found on the fit blocks, found again on the selection
+            // blocks): kept whatever the distance says, which few pixels barely move
+            verdict.kept = !trains.is_empty();
+            verdict.reason = if verdict.kept {
+                format!(
+                    "{} pixels hot on the fit and on the selection blocks alike, simulated at their own rates; {}",
+                    trains.len(),
+                    verdict.reason
+                )
+            } else {
+                "no pixel hot on the fit blocks is hot on the selection blocks too".into()
+            };
             if !verdict.kept {
                 simulation.hot_events = previous;
             } else {
@@ -229,6 +241,47 @@ pub fn refit(
         let (key, uncertain, bound) = uncertain_of(key, &searched);
         state.model = searched.model;
         state.set_uncertain(key, uncertain, bound);
+    }
+    Ok(step)
+}
+
+/// Tests whether a kept effect is still needed once the others are in (backward
+/// elimination): the model without it, thresholds profiled again, against the model with
+/// it on the selection blocks. The effect is removed when the model with it no longer wins
+/// by more than chance (an effect added early can stand in for one added later: a
+/// refractory period for a slow photoreceptor). The step is `kept` when the effect stays.
+pub fn prune(
+    simulation: &Simulation,
+    state: &mut State,
+    effect: Effect,
+    fixed: bool,
+) -> Result<Step, FitError> {
+    let key = effect.parameter().expect("a searched effect");
+    let count_before = simulation.count.get();
+    let mut reduced = state.model.params.clone();
+    effect.clear(&mut reduced);
+    let without = simulation.profile(&reduced, &state.masked, fixed)?;
+    let verdict = judge(simulation, &without.observed, &state.model.observed, &state.kept);
+    let mut step = empty_step(
+        format!("{} (still needed?)", effect.name()),
+        format!(
+            "the model without {key} (thresholds profiled again) against the model with it"
+        ),
+        0.0,
+    );
+    step.parameters = thresholds_of(&without);
+    step.simulations = simulation.count.get() - count_before;
+    let stays = verdict.kept;
+    record(&mut step, verdict);
+    step.reason = if stays {
+        format!("stays: without it {}", step.reason)
+    } else {
+        format!("removed: the others explain what it did; without it {}", step.reason)
+    };
+    if !stays {
+        state.model = without;
+        state.uncertainty.remove(key);
+        state.at_bound.remove(key);
     }
     Ok(step)
 }
