@@ -53,7 +53,19 @@ fn readers(c: &mut Criterion) {
     group.sample_size(10);
     let text_bytes = std::fs::metadata(text.join("events.txt")).unwrap().len();
     group.throughput(Throughput::Bytes(text_bytes));
-    group.bench_function("ijrr_text", |b| b.iter(|| decode(&text)));
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    group.bench_function("ijrr_text", |b| b.iter(|| one.install(|| decode(&text))));
+    // lines split between two threads (`src/io/ijrr/split.rs`)
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap();
+    group.bench_function("ijrr_text_two_threads", |b| {
+        b.iter(|| two.install(|| decode(&text)))
+    });
     group.throughput(Throughput::Elements(events.len() as u64));
     group.bench_function("evt3", |b| b.iter(|| decode(&evt3)));
     group.bench_function("hdf5_event_utils", |b| b.iter(|| decode(&h5)));

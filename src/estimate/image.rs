@@ -55,6 +55,8 @@ impl Image {
     /// Bicubic (Catmull-Rom) sample at (x, y), borders clamped. Sharper than bilinear
     /// sampling, which at a half-pixel offset averages two pixels and so lowers the
     /// contrast of fine texture (and with it the events a simulation makes from it).
+    /// Away from the border the four columns are one slice (no clamping per tap); the sums
+    /// run in the same order either way, so the result is the same to the bit.
     #[inline]
     pub fn sample_cubic(&self, x: f32, y: f32) -> f32 {
         let max_x = (self.width - 1) as isize;
@@ -66,14 +68,24 @@ impl Image {
         let (x0, y0) = (x0 as isize, y0 as isize);
         let wx = catmull_rom(fx);
         let wy = catmull_rom(fy);
+        let interior = x0 >= 1 && x0 + 2 <= max_x;
         let mut acc = 0.0;
         for (j, wyj) in wy.iter().enumerate() {
             let yy = (y0 + j as isize - 1).clamp(0, max_y) as usize;
             let row = &self.data[yy * self.width..(yy + 1) * self.width];
             let mut line = 0.0;
-            for (i, wxi) in wx.iter().enumerate() {
-                let xx = (x0 + i as isize - 1).clamp(0, max_x) as usize;
-                line += wxi * row[xx];
+            if interior {
+                let taps: &[f32; 4] = row[(x0 - 1) as usize..(x0 + 3) as usize]
+                    .try_into()
+                    .expect("four taps");
+                for (wxi, v) in wx.iter().zip(taps) {
+                    line += wxi * v;
+                }
+            } else {
+                for (i, wxi) in wx.iter().enumerate() {
+                    let xx = (x0 + i as isize - 1).clamp(0, max_x) as usize;
+                    line += wxi * row[xx];
+                }
             }
             acc += wyj * line;
         }
@@ -82,37 +94,41 @@ impl Image {
 
     /// The image blurred by a Gaussian of standard deviation `sigma` pixels (separable,
     /// kernel radius `ceil(3 sigma)`, borders clamped).
+    ///
+    /// Each output is `sum_k w_k * v_k` added up in kernel order from 0.0, as a direct loop
+    /// would; the loops run over the kernel outside and the pixels inside (on a row padded
+    /// with its clamped border), so that the inner loop is a vectorised multiply-add over a
+    /// row rather than a clamped gather per tap (a fifth of `estimate aps`).
     pub fn blurred(&self, sigma: f32) -> Image {
-        if sigma <= 0.0 {
+        if sigma <= 0.0 || self.data.is_empty() {
             return self.clone();
         }
-        let radius = (3.0 * sigma).ceil() as isize;
-        let mut kernel: Vec<f32> = (-radius..=radius)
+        let radius = (3.0 * sigma).ceil() as usize;
+        let mut kernel: Vec<f32> = (-(radius as isize)..=radius as isize)
             .map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp())
             .collect();
         let sum: f32 = kernel.iter().sum();
         kernel.iter_mut().for_each(|k| *k /= sum);
-        let (w, h) = (self.width as isize, self.height as isize);
+        let (w, h) = (self.width, self.height);
         let mut rows = vec![0f32; self.data.len()];
-        for y in 0..h {
-            for x in 0..w {
-                let mut acc = 0.0;
-                for (k, weight) in kernel.iter().enumerate() {
-                    let xx = (x + k as isize - radius).clamp(0, w - 1);
-                    acc += weight * self.data[(y * w + xx) as usize];
+        let mut padded = vec![0f32; w + 2 * radius];
+        for (src, dst) in self.data.chunks_exact(w).zip(rows.chunks_exact_mut(w)) {
+            for (i, p) in padded.iter_mut().enumerate() {
+                *p = src[i.saturating_sub(radius).min(w - 1)];
+            }
+            for (k, &weight) in kernel.iter().enumerate() {
+                for (d, &v) in dst.iter_mut().zip(&padded[k..k + w]) {
+                    *d += weight * v;
                 }
-                rows[(y * w + x) as usize] = acc;
             }
         }
         let mut out = vec![0f32; self.data.len()];
-        for y in 0..h {
-            for x in 0..w {
-                let mut acc = 0.0;
-                for (k, weight) in kernel.iter().enumerate() {
-                    let yy = (y + k as isize - radius).clamp(0, h - 1);
-                    acc += weight * rows[(yy * w + x) as usize];
+        for (y, dst) in out.chunks_exact_mut(w).enumerate() {
+            for (k, &weight) in kernel.iter().enumerate() {
+                let yy = (y + k).saturating_sub(radius).min(h - 1);
+                for (d, &v) in dst.iter_mut().zip(&rows[yy * w..(yy + 1) * w]) {
+                    *d += weight * v;
                 }
-                out[(y * w + x) as usize] = acc;
             }
         }
         Image::new(self.width, self.height, out)
@@ -198,6 +214,83 @@ mod tests {
         let b = spike.blurred(1.5);
         assert!((b.data.iter().sum::<f32>() - 1.0).abs() < 1e-4);
         assert!(b.at(10, 10) < 0.1 && b.at(10, 10) > b.at(11, 10));
+    }
+
+    /// The direct loops `blurred` and `sample_cubic` replaced (one clamped tap at a time).
+    fn reference_blur(img: &Image, sigma: f32) -> Vec<f32> {
+        let radius = (3.0 * sigma).ceil() as isize;
+        let mut kernel: Vec<f32> = (-radius..=radius)
+            .map(|i| (-(i * i) as f32 / (2.0 * sigma * sigma)).exp())
+            .collect();
+        let sum: f32 = kernel.iter().sum();
+        kernel.iter_mut().for_each(|k| *k /= sum);
+        let (w, h) = (img.width as isize, img.height as isize);
+        let pass = |data: &[f32], step: isize| -> Vec<f32> {
+            let mut out = vec![0f32; data.len()];
+            for y in 0..h {
+                for x in 0..w {
+                    let mut acc = 0.0;
+                    for (k, weight) in kernel.iter().enumerate() {
+                        let (xx, yy) = if step == 1 {
+                            ((x + k as isize - radius).clamp(0, w - 1), y)
+                        } else {
+                            (x, (y + k as isize - radius).clamp(0, h - 1))
+                        };
+                        acc += weight * data[(yy * w + xx) as usize];
+                    }
+                    out[(y * w + x) as usize] = acc;
+                }
+            }
+            out
+        };
+        pass(&pass(&img.data, 1), w)
+    }
+
+    fn reference_cubic(img: &Image, x: f32, y: f32) -> f32 {
+        let (max_x, max_y) = ((img.width - 1) as isize, (img.height - 1) as isize);
+        let (x, y) = (x.clamp(0.0, max_x as f32), y.clamp(0.0, max_y as f32));
+        let (x0, y0) = (x.floor(), y.floor());
+        let (wx, wy) = (catmull_rom(x - x0), catmull_rom(y - y0));
+        let (x0, y0) = (x0 as isize, y0 as isize);
+        let mut acc = 0.0;
+        for (j, wyj) in wy.iter().enumerate() {
+            let yy = (y0 + j as isize - 1).clamp(0, max_y) as usize;
+            let mut line = 0.0;
+            for (i, wxi) in wx.iter().enumerate() {
+                let xx = (x0 + i as isize - 1).clamp(0, max_x) as usize;
+                line += wxi * img.data[yy * img.width + xx];
+            }
+            acc += wyj * line;
+        }
+        acc
+    }
+
+    #[test]
+    fn blur_and_cubic_sampling_match_the_direct_loops_to_the_bit() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for (w, h) in [(1, 1), (3, 2), (17, 11), (64, 48)] {
+            let img = Image::new(w, h, (0..w * h).map(|_| next() * 255.0).collect());
+            for sigma in [0.5f32, 1.0, 1.7, 4.0] {
+                let fast = img.blurred(sigma).data;
+                let direct = reference_blur(&img, sigma);
+                assert!(
+                    fast.iter()
+                        .zip(&direct)
+                        .all(|(a, b)| a.to_bits() == b.to_bits())
+                );
+            }
+            for _ in 0..2_000 {
+                let (x, y) = (next() * (w + 4) as f32 - 2.0, next() * (h + 4) as f32 - 2.0);
+                let (fast, direct) = (img.sample_cubic(x, y), reference_cubic(&img, x, y));
+                assert_eq!(fast.to_bits(), direct.to_bits(), "{w}x{h} at ({x}, {y})");
+            }
+        }
     }
 
     #[test]

@@ -15,6 +15,8 @@ use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Sensor};
 use std::path::{Path, PathBuf};
 
+mod split;
+
 /// The files of an IJRR folder (or a lone `events.txt`).
 #[derive(Clone, Debug)]
 pub struct IjrrFiles {
@@ -97,7 +99,13 @@ pub fn read_header(events: &Path) -> Result<TextHeader, InputError> {
 pub struct IjrrDecoder {
     reader: BlockReader,
     lines: LineParser,
+    /// The second half of a block split between two threads (reused).
+    second_half: EventChunk,
 }
+
+/// Below this many bytes of whole lines a block is parsed on one thread (splitting costs a
+/// task hand-over, worth it only for a few thousand lines).
+const MIN_SPLIT_BYTES: usize = 256 << 10;
 
 /// Per-line parsing state, kept apart from the reader so both can be borrowed at once.
 struct LineParser {
@@ -106,6 +114,9 @@ struct LineParser {
     seen_data_line: bool,
     sensor: Option<Sensor>,
     order: OrderCheck,
+    /// `false` for the second half of a split block, whose order the first half's parser
+    /// checks after both are done (its first event follows the first half's last).
+    check_order: bool,
 }
 
 impl IjrrDecoder {
@@ -119,7 +130,9 @@ impl IjrrDecoder {
                 seen_data_line: false,
                 sensor,
                 order: OrderCheck::default(),
+                check_order: true,
             },
+            second_half: EventChunk::default(),
         })
     }
 }
@@ -173,8 +186,10 @@ impl LineParser {
                 self.sensor,
             ));
         }
-        let line = self.line;
-        self.order.check(t, || format!("line {line}"));
+        if self.check_order {
+            let line = self.line;
+            self.order.check(t, || format!("line {line}"));
+        }
         out.push(t, x as u16, y as u16, on);
         Ok(())
     }
@@ -183,6 +198,15 @@ impl LineParser {
 impl EventDecoder for IjrrDecoder {
     fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
         loop {
+            if self.lines.seen_data_line && rayon::current_num_threads() > 1 {
+                let consumed = split::parse_halves(
+                    self.reader.available(),
+                    &mut self.lines,
+                    out,
+                    &mut self.second_half,
+                )?;
+                self.reader.consume(consumed);
+            }
             let available = self.reader.available();
             let mut consumed = 0;
             while out.len() < CHUNK_EVENTS {

@@ -32,13 +32,36 @@ impl OrderCheck {
     /// Checks the next event's time; `place` is only evaluated at the first violation.
     #[inline(always)]
     pub fn check(&mut self, t: TimeUs, place: impl Fn() -> String) {
-        if t < self.last {
-            self.record(t, &place);
-        }
-        if t.unsigned_abs() > TIME_LIMIT_US as u64 {
-            self.record_out_of_range(t, &place);
+        // one branch for both checks in the per-event path; the cold path tells them apart
+        if t < self.last || t.unsigned_abs() > TIME_LIMIT_US as u64 {
+            self.record_either(t, &place);
         }
         self.last = t;
+    }
+
+    /// The time of the last event checked.
+    #[inline]
+    pub fn last(&self) -> TimeUs {
+        self.last
+    }
+
+    /// Continues after a run of events that a decoder checked itself and found in order and
+    /// within [`TIME_LIMIT_US`], the last at `t` (no earlier than [`Self::last`]).
+    #[inline]
+    pub fn skip_checked(&mut self, t: TimeUs) {
+        debug_assert!(t >= self.last && t.unsigned_abs() <= TIME_LIMIT_US as u64);
+        self.last = t;
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn record_either(&mut self, t: TimeUs, place: &impl Fn() -> String) {
+        if t < self.last {
+            self.record(t, place);
+        }
+        if t.unsigned_abs() > TIME_LIMIT_US as u64 {
+            self.record_out_of_range(t, place);
+        }
     }
 
     /// Checks a run of times; `place(i)` names the `i`-th and is only evaluated at a

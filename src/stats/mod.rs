@@ -20,6 +20,7 @@
 
 pub mod hot_pixels;
 pub mod intervals;
+mod kernel;
 pub mod pixel_grid;
 pub mod robust;
 pub mod support;
@@ -29,29 +30,14 @@ use crate::events::{EventChunk, Sensor, TimeUs, us_to_s};
 use crate::selection::PixelSelection;
 use hot_pixels::HotPixel;
 use intervals::IntervalHistogram;
+use kernel::WindowCounter;
 use pixel_grid::PixelGrid;
 pub use pixel_grid::{BYTES_PER_PIXEL, PIXEL_BUDGET};
 use serde::Serialize;
-use timeline::SparseTimeline;
 pub use timeline::{FrameSummary, RateWindow};
 
 /// How `background_rate_hz` is defined (reported with it).
 pub const BACKGROUND_RATE_METHOD: &str = "events without spatio-temporal support (no event of any of the 8 neighbours in the preceding support window, Delbruck 2008's background-activity filter) per pixel per second, hot pixels excluded";
-
-/// Hints the cache to load `value` (no effect on results; a no-op off x86-64).
-#[inline(always)]
-fn prefetch<T>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: prefetching is a hint and never faults, whatever the address.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch(
-            value as *const T as *const i8,
-            std::arch::x86_64::_MM_HINT_T0,
-        );
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
-}
 
 /// What to measure.
 #[derive(Clone, Debug)]
@@ -183,30 +169,6 @@ pub struct StatsAccumulator {
     windows: WindowCounter,
 }
 
-/// The rate timeline being counted: finished windows, and the current one's index, end and
-/// count so far.
-#[derive(Default)]
-struct WindowCounter {
-    timeline: SparseTimeline,
-    index: u64,
-    end: TimeUs,
-    count: u64,
-}
-
-impl WindowCounter {
-    /// Records the finished window and starts the one holding `t` (skipping empty ones
-    /// without storing them).
-    #[cold]
-    fn close(&mut self, t: TimeUs, first: TimeUs, window_us: TimeUs) {
-        if self.count > 0 {
-            self.timeline.add(self.index, self.count);
-        }
-        self.index = (t.saturating_sub(first) / window_us) as u64;
-        self.end = first.saturating_add((self.index as TimeUs + 1).saturating_mul(window_us));
-        self.count = 0;
-    }
-}
-
 impl StatsAccumulator {
     /// `sensor`: the sensor when known in advance (else the grid grows as events arrive).
     pub fn new(options: StatsOptions, sensor: Option<Sensor>) -> Self {
@@ -315,68 +277,27 @@ impl StatsAccumulator {
         }
     }
 
-    /// The per-event kernel: counts, spatio-temporal support, same-pixel intervals,
-    /// timeline (with `SELECTED`, intervals and timeline only for the events `self.kept`
-    /// flags).
-    #[inline(never)]
+    /// The per-event kernel over one run of events (see [`kernel`]; with `SELECTED`,
+    /// intervals and timeline only for the events `self.kept` flags).
     fn accumulate<const SELECTED: bool>(&mut self, ts: &[TimeUs], xs: &[u16], ys: &[u16]) {
         let stride = self.pixels.stride();
-        // cell indices first (a vectorised pass), so the main loop can prefetch the
-        // neighbourhood of an event a few places ahead: events hop between rows, and
-        // overlapping those cache misses is most of the kernel's speed
-        self.indices.clear();
-        self.indices.extend(
-            xs.iter()
-                .zip(ys)
-                .map(|(&x, &y)| ((y as usize + 1) * stride + x as usize + 1) as u32),
+        kernel::cell_indices(xs, ys, stride, &mut self.indices);
+        let settings = kernel::Settings {
+            stride,
+            // (with a selection, only read for kept events, which set it)
+            first: self.first.unwrap_or(0),
+            support_us: self.support_us,
+            window_us: self.window_us,
+        };
+        kernel::accumulate::<SELECTED>(
+            ts,
+            &self.indices,
+            &self.kept,
+            &settings,
+            &mut self.pixels.cells,
+            &mut self.intervals,
+            &mut self.windows,
         );
-        let indices = &self.indices;
-        let cells = &mut self.pixels.cells;
-        let intervals = &mut self.intervals;
-        // (with a selection, only read for kept events, which set it)
-        let first = self.first.unwrap_or(0);
-        let kept = &self.kept;
-        let support_us = self.support_us;
-        let window_us = self.window_us;
-        let windows = &mut self.windows;
-        const AHEAD: usize = 16;
-        for (i, &t) in ts.iter().enumerate() {
-            if let Some(&ahead) = indices.get(i + AHEAD) {
-                let ahead = ahead as usize;
-                prefetch(&cells[ahead - stride - 1]);
-                prefetch(&cells[ahead - stride + 1]);
-                prefetch(&cells[ahead - 1]);
-                prefetch(&cells[ahead + 1]);
-                prefetch(&cells[ahead + stride - 1]);
-                prefetch(&cells[ahead + stride + 1]);
-            }
-            let k = indices[i] as usize;
-            // the latest event among the 8 neighbours (border cells never fire)
-            let neighbours = cells[k - stride - 1]
-                .last
-                .max(cells[k - stride].last)
-                .max(cells[k - stride + 1].last)
-                .max(cells[k - 1].last)
-                .max(cells[k + 1].last)
-                .max(cells[k + stride - 1].last)
-                .max(cells[k + stride].last)
-                .max(cells[k + stride + 1].last);
-            let cell = &mut cells[k];
-            let counted = !SELECTED || kept[i];
-            if cell.count > 0 && counted {
-                intervals.add(t.wrapping_sub(cell.last) as u64);
-            }
-            cell.count += 1;
-            cell.unsupported += (neighbours < t.saturating_sub(support_us)) as u32;
-            cell.last = t;
-            if !counted {
-                continue;
-            }
-            if t >= windows.end {
-                windows.close(t, first, window_us);
-            }
-            windows.count += 1;
-        }
     }
 
     /// Makes the grid hold pixel (`max_x`, `max_y`); `false` (and [`Self::over_budget`]
