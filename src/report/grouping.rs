@@ -16,10 +16,12 @@ pub enum Origin {
 /// `FOLDER (WxH)`, one dataset per sensor size.
 pub fn dataset_names(recordings: &[(Origin, String)]) -> Vec<String> {
     let mixes = |folder: &str| {
-        let mut sensors = recordings.iter().filter_map(|(origin, sensor)| match origin {
-            Origin::Folder(f) if f == folder => Some(sensor),
-            _ => None,
-        });
+        let mut sensors = recordings
+            .iter()
+            .filter_map(|(origin, sensor)| match origin {
+                Origin::Folder(f) if f == folder => Some(sensor),
+                _ => None,
+            });
         let first = sensors.next();
         sensors.any(|s| Some(s) != first)
     };

@@ -23,8 +23,8 @@ pub fn png(width: usize, height: usize, hot: &[HotPixel]) -> Vec<u8> {
         .into_iter()
         .map(|k| k * 255)
         .collect();
-    let image = image::GrayImage::from_raw(width as u32, height as u32, grey)
-        .expect("one value per pixel");
+    let image =
+        image::GrayImage::from_raw(width as u32, height as u32, grey).expect("one value per pixel");
     let mut out = Vec::new();
     image
         .write_to(&mut std::io::Cursor::new(&mut out), image::ImageFormat::Png)
@@ -57,7 +57,10 @@ mod tests {
 
     #[test]
     fn hot_pixels_are_zero_and_the_rest_kept() {
-        assert_eq!(keep_flags(3, 2, &[hot(1, 0), hot(2, 1)]), [1, 0, 1, 1, 1, 0]);
+        assert_eq!(
+            keep_flags(3, 2, &[hot(1, 0), hot(2, 1)]),
+            [1, 0, 1, 1, 1, 0]
+        );
         let image = image::load_from_memory(&png(3, 2, &[hot(0, 1)]))
             .unwrap()
             .to_luma8();

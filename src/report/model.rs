@@ -111,9 +111,6 @@ pub struct SequenceOutputs {
     pub plots: Vec<PlotEntry>,
     pub configs: Vec<String>,
     pub masks: Vec<String>,
-    /// Why no simulator configuration was written although the sequence was fitted.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub configs_not_written: Option<String>,
     /// Plots that could not be drawn, with the error.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub plots_not_drawn: Vec<String>,
