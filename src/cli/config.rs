@@ -14,7 +14,7 @@ pub struct ConfigArgs {
     #[arg(value_name = "FIT.json|REPORT_DIR", required = true)]
     pub inputs: Vec<PathBuf>,
     /// The simulator the configuration is for.
-    #[arg(long, value_name = "esim|esim-generator|v2e|ctcal", value_parser = parse_format)]
+    #[arg(long, value_name = "esim|esim-generator|v2e|v2e-json|ctcal", value_parser = parse_format)]
     pub format: ConfigFormat,
     /// Where to write it (default: stdout).
     #[arg(long, value_name = "PATH")]
@@ -40,6 +40,51 @@ struct Fits {
     params: Vec<PixelParams>,
     exposures_us: Vec<Option<i64>>,
     seed: Option<u64>,
+    /// The sensor (`WxH`) of each fit, where a report says it, with the sequence's name.
+    sensors: Vec<(String, String)>,
+}
+
+/// Refuses fits of different sensors: a configuration describes one camera.
+fn one_sensor(fits: &Fits, file: &str) -> Result<Option<(u32, u32)>, BadInput> {
+    let mut distinct: Vec<&str> = fits.sensors.iter().map(|(s, _)| s.as_str()).collect();
+    distinct.sort();
+    distinct.dedup();
+    if distinct.len() > 1 {
+        let by_sensor: Vec<String> = distinct
+            .iter()
+            .map(|d| {
+                let names: Vec<&str> = fits
+                    .sensors
+                    .iter()
+                    .filter(|(s, _)| s == d)
+                    .map(|(_, n)| n.as_str())
+                    .collect();
+                format!("{d}: {}", names.join(", "))
+            })
+            .collect();
+        return Err(BadInput(format!(
+            "{file}: the fitted sequences come from {} sensors ({}); a configuration describes one camera, so none is combined across sensors\n  fix: use the per-sequence configurations in the report's configs/SEQUENCE/, or report each sensor as its own dataset (--dataset NAME=INPUT) and give `ctcal fit` results of one sensor",
+            distinct.len(),
+            by_sensor.join("; ")
+        )));
+    }
+    Ok(distinct.first().and_then(|d| {
+        let (w, h) = d.split_once('x')?;
+        Some((w.parse().ok()?, h.parse().ok()?))
+    }))
+}
+
+/// Refuses a fit whose thresholds the recording does not identify (`null` in `params`).
+fn identified(fit: &serde_json::Value, file: &str, prefix: &str) -> Result<(), BadInput> {
+    for key in ["ct_on", "ct_off"] {
+        if fit["params"].get(key).is_some_and(|v| v.is_null()) {
+            let why = fit["why"][key].as_str().unwrap_or("no reason given");
+            return Err(BadInput(format!(
+                "{file}: `{prefix}params.{key}` is null: the recording does not identify it ({why})\n  fix: configure from a fit of a recording that shows the thresholds (motion, frames that explain its events)"
+            )));
+        }
+    }
+    Ok(())
 }
 
 fn read_json(path: &Path) -> anyhow::Result<serde_json::Value> {
@@ -182,6 +227,7 @@ fn fit_params(
     file: &str,
     prefix: &str,
 ) -> anyhow::Result<(PixelParams, Option<i64>)> {
+    identified(fit, file, prefix)?;
     validate_fit_json(fit, file, prefix)?;
     let params: PixelParams = serde_json::from_value(fit["params"].clone()).map_err(|e| {
         BadInput(format!(
@@ -200,7 +246,7 @@ fn fit_params(
     ))
 }
 
-fn gather(inputs: &[PathBuf]) -> anyhow::Result<Fits> {
+fn gather(inputs: &[PathBuf]) -> anyhow::Result<(Fits, Option<(u32, u32)>)> {
     let mut fits = Fits::default();
     for path in inputs {
         let results = if path.is_dir() {
@@ -230,6 +276,10 @@ fn gather(inputs: &[PathBuf]) -> anyhow::Result<Fits> {
                     )?;
                     fits.params.push(p);
                     fits.exposures_us.push(exposure);
+                    let (w, h) = (&s["stats"]["width"], &s["stats"]["height"]);
+                    if let (Some(w), Some(h)) = (w.as_u64(), h.as_u64()) {
+                        fits.sensors.push((format!("{w}x{h}"), name.to_string()));
+                    }
                 }
             }
             if fits.params.len() == before {
@@ -245,18 +295,26 @@ fn gather(inputs: &[PathBuf]) -> anyhow::Result<Fits> {
             fits.exposures_us.push(exposure);
         }
     }
-    Ok(fits)
+    let files: Vec<String> = inputs.iter().map(|p| p.display().to_string()).collect();
+    let sensor = one_sensor(&fits, &files.join(", "))?;
+    Ok((fits, sensor))
 }
 
 pub fn run(args: &ConfigArgs, global: &Global) -> anyhow::Result<()> {
-    let fits = gather(&args.inputs)?;
+    let (fits, sensor) = gather(&args.inputs)?;
     // one exposure where every fit agrees on it
     let exposure_ms = match fits.exposures_us.as_slice() {
         [first, rest @ ..] if rest.iter().all(|e| e == first) => first.map(|e| e as f64 / 1e3),
         _ => None,
     };
     let seed = args.seed.or(fits.seed).unwrap_or(2020);
-    let text = configs::render(args.format, &fits.params, exposure_ms, seed).ok_or_else(|| {
+    let setup = configs::Setup {
+        exposure_ms,
+        seed,
+        sensor,
+        not_identified: Default::default(),
+    };
+    let text = configs::render(args.format, &fits.params, &setup).ok_or_else(|| {
         BadInput("no fits given\n  fix: give `ctcal fit` JSON files or a report folder".into())
     })?;
     match &args.out {

@@ -22,6 +22,16 @@ pub struct Report {
     pub presets: Vec<PresetLevel>,
     /// How the presets were simulated.
     pub presets_scene: String,
+    /// Recordings that could not be reported, with the error.
+    pub failed: Vec<FailedSequence>,
+}
+
+/// A recording the report could not be made of.
+#[derive(Clone, Debug, Serialize)]
+pub struct FailedSequence {
+    pub name: String,
+    pub path: String,
+    pub error: String,
 }
 
 /// An input file: where, how big and its content hash.
@@ -52,6 +62,14 @@ pub struct Truth {
     pub params: BTreeMap<String, f64>,
 }
 
+/// The per-pixel data of one recording, kept only until its plots and masks are rendered.
+#[derive(Clone, Debug, Default)]
+pub struct PixelData {
+    /// Events per pixel (kept pixels), for the count and hot-pixel maps.
+    pub counts: Vec<u32>,
+    pub maps: Option<PixelMaps>,
+}
+
 /// Per-pixel thresholds from event timing (`estimate aps`), NaN where a pixel has too
 /// little evidence.
 #[derive(Clone, Debug)]
@@ -78,13 +96,31 @@ pub struct SequenceReport {
     pub fit_not_applied: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub truth: Option<Truth>,
-    /// Events per pixel (kept pixels), for the count and hot-pixel maps.
-    #[serde(skip)]
-    pub pixel_counts: Vec<u32>,
-    #[serde(skip)]
-    pub maps: Option<PixelMaps>,
+    /// What reading the recording warned of (sensor size guessed, frames thinned, ...).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+    /// The files rendered of it (filled in by [`super::render_sequence`]).
+    pub outputs: SequenceOutputs,
     /// Seconds spent on each stage.
     pub seconds: BTreeMap<String, f64>,
+}
+
+/// The files of one sequence inside the report folder.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SequenceOutputs {
+    pub plots: Vec<PlotEntry>,
+    pub configs: Vec<String>,
+    pub masks: Vec<String>,
+    /// Plots that could not be drawn, with the error.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub plots_not_drawn: Vec<String>,
+}
+
+/// A plot of the report: its file stem under `plots/` and its title.
+#[derive(Clone, Debug, Serialize)]
+pub struct PlotEntry {
+    pub name: String,
+    pub title: String,
 }
 
 impl SequenceReport {
@@ -96,11 +132,23 @@ impl SequenceReport {
             .and_then(|m| m.estimate.as_ref())
     }
 
+    /// The sensor as `WxH`.
+    pub fn sensor(&self) -> String {
+        format!("{}x{}", self.stats.width, self.stats.height)
+    }
+
+    /// The fit's thresholds, where the recording identifies them.
+    pub fn fitted_thresholds(&self) -> Option<(f64, f64)> {
+        let f = self.fit.as_ref()?;
+        let known = |k: &str| !f.params.not_identified.contains_key(k);
+        (known("ct_on") && known("ct_off")).then_some((f.params.ct_on, f.params.ct_off))
+    }
+
     /// The best threshold estimate available (fit, then aps, screen, eppps): (ON, OFF,
     /// method).
     pub fn best_thresholds(&self) -> Option<(f64, f64, &'static str)> {
-        if let Some(f) = &self.fit {
-            return Some((f.params.ct_on, f.params.ct_off, "fit"));
+        if let Some((on, off)) = self.fitted_thresholds() {
+            return Some((on, off, "fit"));
         }
         ["aps", "screen", "eppps"].into_iter().find_map(|m| {
             let e = self.estimate(m)?;
@@ -123,6 +171,11 @@ pub struct DatasetReport {
     pub fitted: BTreeMap<String, Summary>,
     /// Effects added in how many of the fitted sequences.
     pub effects: BTreeMap<String, usize>,
+    /// The sensors (`WxH`) of its sequences.
+    pub sensors: Vec<String>,
+    /// What a reader of its aggregates must know (e.g. that it mixes sensors).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
 }
 
 /// Mean, standard deviation (of two or more values), minimum and maximum of some values.
@@ -162,6 +215,97 @@ pub struct PresetLevel {
     pub events_per_pixel_per_second: f64,
 }
 
+/// The identified numeric parameters of a fit, as (PARAMS.toml key, value): the ones the
+/// recording does not identify are left out.
+pub fn identified_params(f: &FitResult) -> Vec<(String, f64)> {
+    crate::report::configs::numeric_params(&f.params)
+        .into_iter()
+        .filter(|(k, _)| !f.params.not_identified.contains_key(k))
+        .collect()
+}
+
+/// The sensors of some sequences (`WxH`), each once, with how many sequences have it.
+pub fn sensors(sequences: &[&SequenceReport]) -> Vec<(String, usize)> {
+    let mut out: Vec<(String, usize)> = Vec::new();
+    for s in sequences {
+        let sensor = s.sensor();
+        match out.iter_mut().find(|(k, _)| *k == sensor) {
+            Some(entry) => entry.1 += 1,
+            None => out.push((sensor, 1)),
+        }
+    }
+    out
+}
+
+/// The warning for a dataset whose sequences come from sensors of different sizes.
+fn mixed_sensors_warning(sensors: &[(String, usize)]) -> Option<String> {
+    (sensors.len() > 1).then(|| {
+        format!(
+            "this dataset mixes sensors ({}): its means and spreads pool different cameras, and no simulator configuration is combined across them; name one dataset per sensor with --dataset NAME=INPUT",
+            sensors
+                .iter()
+                .map(|(s, n)| format!("{s}: {n} sequence{}", if *n == 1 { "" } else { "s" }))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    })
+}
+
+/// The aggregates of one dataset's sequences.
+fn dataset(name: String, members: &[&SequenceReport]) -> DatasetReport {
+    let rates: Vec<f64> = members
+        .iter()
+        .filter_map(|s| s.stats.events_per_pixel_per_second)
+        .collect();
+    let mut ct = BTreeMap::new();
+    for method in ["aps", "eppps", "screen"] {
+        let values: Vec<f64> = members
+            .iter()
+            .filter_map(|s| s.estimate(method).and_then(|e| e.ct))
+            .collect();
+        if let Some(summary) = Summary::of(&values) {
+            ct.insert(method.to_string(), summary);
+        }
+    }
+    let fitted_ct: Vec<f64> = members
+        .iter()
+        .filter_map(|s| s.fitted_thresholds().map(|(on, off)| 0.5 * (on + off)))
+        .collect();
+    if let Some(summary) = Summary::of(&fitted_ct) {
+        ct.insert("fit".to_string(), summary);
+    }
+    let mut fitted = BTreeMap::new();
+    let mut effects = BTreeMap::new();
+    for f in members.iter().filter_map(|s| s.fit.as_ref()) {
+        for (key, value) in identified_params(f) {
+            fitted.entry(key).or_insert_with(Vec::new).push(value);
+        }
+        for e in &f.effects_added {
+            *effects.entry(e.effect.name().to_string()).or_insert(0) += 1;
+        }
+    }
+    let sensors = sensors(members);
+    DatasetReport {
+        sequences: members.iter().map(|s| s.name.clone()).collect(),
+        events_per_pixel_per_second: Summary::of(&rates).unwrap_or(Summary {
+            n: 0,
+            mean: f64::NAN,
+            sd: None,
+            min: f64::NAN,
+            max: f64::NAN,
+        }),
+        ct,
+        fitted: fitted
+            .into_iter()
+            .filter_map(|(k, v)| Summary::of(&v).map(|s| (k, s)))
+            .collect(),
+        effects,
+        warnings: mixed_sensors_warning(&sensors).into_iter().collect(),
+        sensors: sensors.into_iter().map(|(s, _)| s).collect(),
+        name,
+    }
+}
+
 /// The aggregates of the sequences of each dataset (in the order datasets first appear).
 pub fn datasets(sequences: &[SequenceReport]) -> Vec<DatasetReport> {
     let mut names: Vec<String> = Vec::new();
@@ -175,56 +319,7 @@ pub fn datasets(sequences: &[SequenceReport]) -> Vec<DatasetReport> {
         .map(|name| {
             let members: Vec<&SequenceReport> =
                 sequences.iter().filter(|s| s.dataset == name).collect();
-            let rates: Vec<f64> = members
-                .iter()
-                .filter_map(|s| s.stats.events_per_pixel_per_second)
-                .collect();
-            let mut ct = BTreeMap::new();
-            for method in ["aps", "eppps", "screen"] {
-                let values: Vec<f64> = members
-                    .iter()
-                    .filter_map(|s| s.estimate(method).and_then(|e| e.ct))
-                    .collect();
-                if let Some(summary) = Summary::of(&values) {
-                    ct.insert(method.to_string(), summary);
-                }
-            }
-            let fits: Vec<&FitResult> = members.iter().filter_map(|s| s.fit.as_ref()).collect();
-            if let Some(summary) = Summary::of(
-                &fits
-                    .iter()
-                    .map(|f| 0.5 * (f.params.ct_on + f.params.ct_off))
-                    .collect::<Vec<_>>(),
-            ) {
-                ct.insert("fit".to_string(), summary);
-            }
-            let mut fitted = BTreeMap::new();
-            let mut effects = BTreeMap::new();
-            for f in &fits {
-                for (key, value) in crate::report::configs::numeric_params(&f.params) {
-                    fitted.entry(key).or_insert_with(Vec::new).push(value);
-                }
-                for e in &f.effects_added {
-                    *effects.entry(e.effect.name().to_string()).or_insert(0) += 1;
-                }
-            }
-            DatasetReport {
-                sequences: members.iter().map(|s| s.name.clone()).collect(),
-                events_per_pixel_per_second: Summary::of(&rates).unwrap_or(Summary {
-                    n: 0,
-                    mean: f64::NAN,
-                    sd: None,
-                    min: f64::NAN,
-                    max: f64::NAN,
-                }),
-                ct,
-                fitted: fitted
-                    .into_iter()
-                    .filter_map(|(k, v)| Summary::of(&v).map(|s| (k, s)))
-                    .collect(),
-                effects,
-                name,
-            }
+            dataset(name, &members)
         })
         .collect()
 }

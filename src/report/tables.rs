@@ -146,17 +146,23 @@ pub fn thresholds(sequences: &[&SequenceReport]) -> Table {
                     .and_then(|u| u.standard_error)
                     .map(|se| (value - 1.96 * se, value + 1.96 * se))
             };
-            let (on, off) = (f.params.ct_on, f.params.ct_off);
+            // thresholds the recording does not identify are empty, not start values
+            let fitted = q.fitted_thresholds();
+            let (on, off) = (fitted.map(|t| t.0), fitted.map(|t| t.1));
+            let side = |key: &str, v: Option<f64>, upper: bool| {
+                v.and_then(|v| ci(key, v))
+                    .map(|c| if upper { c.1 } else { c.0 })
+            };
             rows.push((
                 q.name.clone(),
                 "fit".into(),
                 [
-                    Some(on),
-                    ci("ct_on", on).map(|c| c.0),
-                    ci("ct_on", on).map(|c| c.1),
-                    Some(off),
-                    ci("ct_off", off).map(|c| c.0),
-                    ci("ct_off", off).map(|c| c.1),
+                    on,
+                    side("ct_on", on, false),
+                    side("ct_on", on, true),
+                    off,
+                    side("ct_off", off, false),
+                    side("ct_off", off, true),
                     f.params.ct_sigma,
                     truth("ct_on"),
                     truth("ct_off"),
@@ -194,7 +200,9 @@ pub fn fitted_parameters(sequences: &[&SequenceReport]) -> Table {
         for (key, value) in super::configs::numeric_params(&f.params) {
             let se = f.uncertainties.get(&key).and_then(|u| u.standard_error);
             let truth = q.truth.as_ref().and_then(|t| t.params.get(&key).copied());
-            rows.push((q.name.clone(), key, Some(value), se, truth));
+            // not identified: no value (the reason is beside the table)
+            let value = (!f.params.not_identified.contains_key(&key)).then_some(value);
+            rows.push((q.name.clone(), key, value, se, truth));
         }
     }
     table(
@@ -336,7 +344,8 @@ pub fn number(v: f64) -> String {
     }
 }
 
-fn rows(t: &Table) -> (Vec<String>, Vec<Vec<Option<String>>>) {
+/// A table's column names and its cells as text (`None` for null).
+pub(super) fn rows(t: &Table) -> (Vec<String>, Vec<Vec<Option<String>>>) {
     let columns = t.frame.columns();
     let names = columns.iter().map(|c| c.name().to_string()).collect();
     let rows = (0..t.frame.height())

@@ -12,6 +12,7 @@ mod limits;
 mod peers;
 mod readers;
 mod report;
+mod report_handover;
 mod safety;
 mod samples;
 mod selection;

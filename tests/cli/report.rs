@@ -16,7 +16,7 @@ fn project() -> &'static Path {
 
 /// The report of `data_samples`, made once for every test here (run from the project root
 /// as a user would: `ctcal report data_samples --out DIR`).
-fn sample_report() -> &'static Path {
+pub(crate) fn sample_report() -> &'static Path {
     static REPORT: OnceLock<PathBuf> = OnceLock::new();
     REPORT.get_or_init(|| {
         let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sample_report");
@@ -129,7 +129,13 @@ fn the_sample_report_has_every_part() {
     }
     // the texture has frames and was fitted: every format of configuration; the on-screen
     // recording has no frames, so no fit and no configuration of its own
-    for name in ["esim.flagfile", "v2e_args.txt", "params.toml"] {
+    for name in [
+        "esim.flagfile",
+        "esim_config_generator.json",
+        "v2e_args.sh",
+        "v2e_args.json",
+        "params.toml",
+    ] {
         assert!(all.contains(&format!("configs/texture_davis240c/{name}")));
     }
     assert!(all.contains(&"configs/esim_config_generator.json".to_string()));
@@ -173,10 +179,15 @@ fn the_sample_report_has_every_part() {
         let link = format!("]({png}.png)");
         assert!(md.contains(&link), "{link} in report.md");
     }
-    for table in TABLES {
-        let header = std::fs::read_to_string(dir.join(format!("tables/{table}.md"))).unwrap();
-        let first = header.lines().next().unwrap();
-        assert!(md.contains(first), "the {table} table in report.md");
+    // every table, headers in words with their units (the files keep machine names)
+    for header in [
+        "| dataset | sequences | event rate (events/px/s) |",
+        "| sequence | dataset | sensor | events | duration (s) |",
+        "| sequence | method | ct on (ln) | ct on lo (ln) | ct on hi (ln) |",
+        "| sequence | parameter | value | standard error | truth |",
+        "| sequence | effect | evidence | error before | error after | kept | reason |",
+    ] {
+        assert!(md.contains(header), "{header} in report.md");
     }
 }
 
@@ -227,21 +238,25 @@ fn estimates_lie_beside_the_truth_the_samples_were_made_with() {
     let (on, off) = thresholds_of(screen, "screen");
     within(on, 0.3, 0.10, "screen ON");
     within(off, 0.3, 0.10, "screen OFF");
-    // the dataset row is the mean over its sequences
-    let dataset = &r["datasets"][0];
-    assert_eq!(dataset["name"], "data_samples");
-    let rates: Vec<f64> = ["screen_checkerboard", "texture_davis240c"]
-        .iter()
-        .map(|n| {
-            sequence(&r, n)["stats"]["events_per_pixel_per_second"]
-                .as_f64()
-                .unwrap()
-        })
-        .collect();
-    let mean = dataset["events_per_pixel_per_second"]["mean"]
-        .as_f64()
-        .unwrap();
-    assert!((mean - (rates[0] + rates[1]) / 2.0).abs() < 1e-12);
+    // the samples' folder holds two sensors: one dataset per sensor (never pooled
+    // silently), each row the mean over its sequences
+    let datasets = r["datasets"].as_array().unwrap();
+    assert_eq!(datasets.len(), 2);
+    for (dataset, name, sensor) in [
+        (&datasets[0], "screen_checkerboard", "120x90"),
+        (&datasets[1], "texture_davis240c", "240x180"),
+    ] {
+        assert_eq!(dataset["name"], format!("data_samples_{sensor}"));
+        assert_eq!(dataset["sensors"], serde_json::json!([sensor]));
+        assert_eq!(dataset["sequences"], serde_json::json!([name]));
+        let rate = sequence(&r, name)["stats"]["events_per_pixel_per_second"]
+            .as_f64()
+            .unwrap();
+        let mean = dataset["events_per_pixel_per_second"]["mean"]
+            .as_f64()
+            .unwrap();
+        assert!((mean - rate).abs() < 1e-12, "{name}: {mean} vs {rate}");
+    }
 }
 
 fn read_csv(path: &Path) -> DataFrame {
@@ -310,7 +325,8 @@ fn tables_agree_across_formats_and_are_stable() {
     let configs = sample_report().join("configs");
     for name in [
         "texture_davis240c/esim.flagfile",
-        "texture_davis240c/v2e_args.txt",
+        "texture_davis240c/v2e_args.sh",
+        "texture_davis240c/v2e_args.json",
         "texture_davis240c/params.toml",
         "esim_config_generator.json",
     ] {
@@ -387,7 +403,7 @@ fn the_html_report_renders_in_a_browser() {
     let images: Vec<&str> = result.lines().filter(|l| l.starts_with("img ")).collect();
     let pngs = files(&report)
         .into_iter()
-        .filter(|f| f.ends_with(".png"))
+        .filter(|f| f.starts_with("plots/") && f.ends_with(".png"))
         .count();
     assert_eq!(images.len(), pngs, "every plot on the page:\n{result}");
     for line in &images {
@@ -458,7 +474,7 @@ fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
     let v2e = run(&["config", report_arg, "--format", "v2e"]);
     assert_eq!(
         v2e,
-        std::fs::read_to_string(report.join("configs/texture_davis240c/v2e_args.txt")).unwrap()
+        std::fs::read_to_string(report.join("configs/texture_davis240c/v2e_args.sh")).unwrap()
     );
     // every parameter in the tool's own names (the report issue's lists), and nothing else
     let esim = [
@@ -483,9 +499,12 @@ fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
         "--leak_jitter_fraction",
         "--noise_rate_cov_decades",
         "--dvs_emulator_seed",
+        "--output_width",
+        "--output_height",
     ];
     let flags = |text: &str, separator: char| -> Vec<String> {
         text.lines()
+            .map(str::trim_start)
             .filter(|l| l.starts_with("--"))
             .map(|l| l.split(separator).next().unwrap().to_string())
             .collect()
@@ -536,8 +555,18 @@ fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
     let fit = sequence(&r, "texture_davis240c")["fit"].clone();
     let fit_json = work.path().join("fit.json");
     std::fs::write(&fit_json, serde_json::to_string(&fit).unwrap()).unwrap();
+    // (a fit alone does not say the sensor size: the script says to add it)
     let from_fit = run(&["config", fit_json.to_str().unwrap(), "--format", "v2e"]);
-    assert_eq!(from_fit, v2e);
+    assert_eq!(flags(&from_fit, ' '), v2e_names[..v2e_names.len() - 2]);
+    assert!(from_fit.contains("# the sensor size is not known: add --output_width"));
+    let values = |text: &str| -> Vec<String> {
+        text.lines()
+            .map(str::trim_start)
+            .filter(|l| l.starts_with("--pos") || l.starts_with("--neg"))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(values(&from_fit), values(&v2e));
 
     // ctcal's own PARAMS.toml drives `ctcal simulate` with exactly the fitted parameters
     let params = work.path().join("params.toml");

@@ -33,11 +33,11 @@ impl Figure for Calibration {
         let mut chart = ChartBuilder::on(root)
             .caption(
                 "Calibration curve: simulated scenes of matched dynamics",
-                (FONT, 20),
+                (FONT, px(20)),
             )
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
+            .margin(px(12))
+            .x_label_area_size(px(45))
+            .y_label_area_size(px(70))
             .build_cartesian_2d(log_axis(0.07f64..2.2), log_axis(log_range(values)))
             .map_err(err)?;
         chart
@@ -47,7 +47,7 @@ impl Figure for Calibration {
             .light_line_style(RGBColor(242, 242, 242))
             .x_desc("contrast threshold")
             .y_desc("events / pixel / s")
-            .label_style((FONT, 14))
+            .label_style((FONT, px(14)))
             .draw()
             .map_err(err)?;
         let band: Vec<(f64, f64)> = self
@@ -58,35 +58,45 @@ impl Figure for Calibration {
             .filter(|p| p.1 > 0.0)
             .collect();
         chart
-            .draw_series(std::iter::once(Polygon::new(band, PALETTE[0].mix(0.2))))
+            .draw_series(std::iter::once(Polygon::new(band, SIMULATED.mix(0.2))))
             .map_err(err)?;
         chart
             .draw_series(LineSeries::new(
                 self.curve
                     .iter()
                     .map(|p| (p.ct, p.events_per_pixel_per_second)),
-                PALETTE[0].stroke_width(2),
+                SIMULATED.stroke_width(px(2)),
             ))
             .map_err(err)?
             .label("simulated (mean, range over scenes)")
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PALETTE[0].stroke_width(2)));
+            .legend(|(x, y)| {
+                PathElement::new(
+                    [(x, y), (x + px(20) as i32, y)],
+                    SIMULATED.stroke_width(px(2)),
+                )
+            });
         chart
             .draw_series(LineSeries::new(
                 [(0.07, self.recording), (2.2, self.recording)],
-                PALETTE[1].stroke_width(2),
+                RECORDING.stroke_width(px(2)),
             ))
             .map_err(err)?
             .label(format!("the recording: {:.3} e/pix/s", self.recording))
-            .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], PALETTE[1].stroke_width(2)));
+            .legend(|(x, y)| {
+                PathElement::new(
+                    [(x, y), (x + px(20) as i32, y)],
+                    RECORDING.stroke_width(px(2)),
+                )
+            });
         chart
             .draw_series(std::iter::once(Circle::new(
                 (self.estimate, self.recording),
-                7,
-                PALETTE[1].filled(),
+                px(7),
+                RECORDING.filled(),
             )))
             .map_err(err)?
             .label(format!("estimate CT {:.3}", self.estimate))
-            .legend(|(x, y)| Circle::new((x + 10, y), 5, PALETTE[1].filled()));
+            .legend(|(x, y)| Circle::new((x + px(10) as i32, y), px(5), RECORDING.filled()));
         draw_legend(&mut chart, 14)?;
         Ok(())
     }

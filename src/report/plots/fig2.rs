@@ -36,11 +36,11 @@ impl Figure for Fig2<'_> {
         let mut chart = ChartBuilder::on(root)
             .caption(
                 "Events per pixel per second: sequences and simulated presets",
-                (FONT, 20),
+                (FONT, px(20)),
             )
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
+            .margin(px(12))
+            .x_label_area_size(px(45))
+            .y_label_area_size(px(70))
             .build_cartesian_2d(-0.5f64..(n - 0.05), log_axis(log_range(values)))
             .map_err(err)?;
         chart
@@ -57,7 +57,7 @@ impl Figure for Fig2<'_> {
                 }
             })
             .y_desc("events / pixel / s")
-            .label_style((FONT, 14))
+            .label_style((FONT, px(14)))
             .draw()
             .map_err(err)?;
         for p in &self.report.presets {
@@ -67,14 +67,14 @@ impl Figure for Fig2<'_> {
                         (-0.5, p.events_per_pixel_per_second),
                         (n - 0.5, p.events_per_pixel_per_second),
                     ],
-                    RGBColor(150, 150, 150).stroke_width(1),
+                    RGBColor(150, 150, 150).stroke_width(px(1)),
                 ))
                 .map_err(err)?;
             chart
                 .draw_series(std::iter::once(Text::new(
                     format!("CT {}", p.ct),
                     (n - 0.45, p.events_per_pixel_per_second),
-                    (FONT, 13).into_font().color(&RGBColor(90, 90, 90)),
+                    (FONT, px(13)).into_font().color(&RGBColor(90, 90, 90)),
                 )))
                 .map_err(err)?;
         }
@@ -92,7 +92,7 @@ impl Figure for Fig2<'_> {
                 .draw_series(members.iter().enumerate().filter_map(|(i, s)| {
                     s.stats
                         .events_per_pixel_per_second
-                        .map(|v| Circle::new((position(i), v), 6, colour.filled()))
+                        .map(|v| Circle::new((position(i), v), px(6), colour.filled()))
                 }))
                 .map_err(err)?;
             // sequence names beside their dots, cut to the room before the next dot (about
@@ -106,8 +106,8 @@ impl Figure for Fig2<'_> {
                         s.stats.events_per_pixel_per_second.map(|v| {
                             Text::new(
                                 shorten(&s.name, characters),
-                                (position(i) + 10.0 / pixels_per_unit, v),
-                                (FONT, 12).into_font().color(&RGBColor(60, 60, 60)),
+                                (position(i) + px(10) as f64 / pixels_per_unit, v),
+                                (FONT, px(12)).into_font().color(&RGBColor(60, 60, 60)),
                             )
                         })
                     }))

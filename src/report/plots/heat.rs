@@ -64,9 +64,9 @@ impl Heat {
     ) -> DrawResult {
         let (block, bw, bh, values) = self.blocks();
         let (lo, hi) = self.range();
-        let (plot, bar) = area.split_horizontally(area.dim_in_pixel().0 as i32 - 90);
+        let (plot, bar) = area.split_horizontally(area.dim_in_pixel().0 as i32 - px(100) as i32);
         // square pixels: the spare room becomes margin
-        let (margin, caption, x_labels, y_labels) = (8u32, 30u32, 30u32, 45u32);
+        let (margin, caption, x_labels, y_labels) = (px(8), px(30), px(30), px(45));
         let (pw, ph) = plot.dim_in_pixel();
         let room_w = pw.saturating_sub(2 * margin + y_labels).max(1) as f64;
         let room_h = ph.saturating_sub(2 * margin + caption + x_labels).max(1) as f64;
@@ -74,7 +74,7 @@ impl Heat {
         let spare_w = ((room_w - scale * self.width as f64) / 2.0).max(0.0) as u32;
         let spare_h = ((room_h - scale * self.height as f64) / 2.0).max(0.0) as u32;
         let mut chart = ChartBuilder::on(&plot)
-            .caption(&self.label, (FONT, 17))
+            .caption(&self.label, (FONT, px(17)))
             .margin(margin)
             .margin_left(margin + spare_w)
             .margin_right(margin + spare_w)
@@ -89,7 +89,7 @@ impl Heat {
             .disable_mesh()
             .x_label_formatter(&linear_tick)
             .y_label_formatter(&linear_tick)
-            .label_style((FONT, 12))
+            .label_style((FONT, px(12)))
             .draw()
             .map_err(err)?;
         chart
@@ -114,8 +114,8 @@ impl Heat {
             .draw_series(marks.iter().map(|&(x, y)| {
                 Circle::new(
                     (x as f64 + 0.5, y as f64 + 0.5),
-                    8,
-                    RGBColor(230, 30, 30).stroke_width(2),
+                    px(8),
+                    RGBColor(230, 30, 30).stroke_width(px(2)),
                 )
             }))
             .map_err(err)?;
@@ -123,7 +123,9 @@ impl Heat {
         let mut scale = ChartBuilder::on(&bar)
             .margin_top(margin + spare_h + caption)
             .margin_bottom(margin + spare_h + x_labels)
-            .y_label_area_size(55)
+            .margin_left(px(6))
+            .margin_right(px(4))
+            .right_y_label_area_size(px(64))
             .build_cartesian_2d(0f64..1.0, lo..hi)
             .map_err(err)?;
         scale
@@ -132,7 +134,9 @@ impl Heat {
             .disable_x_axis()
             .y_labels(5)
             .y_label_formatter(&linear_tick)
-            .label_style((FONT, 11))
+            .y_desc(self.label.as_str())
+            .axis_desc_style((FONT, px(12)))
+            .label_style((FONT, px(11)))
             .draw()
             .map_err(err)?;
         scale

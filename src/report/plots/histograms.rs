@@ -49,10 +49,10 @@ impl Figure for Histograms {
         let (hi, width, counts) = self.bins();
         let top = counts.iter().flatten().copied().fold(1.0, f64::max) * 1.1;
         let mut chart = ChartBuilder::on(root)
-            .caption("Per-pixel thresholds (event timing)", (FONT, 20))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
+            .caption("Per-pixel thresholds (event timing)", (FONT, px(20)))
+            .margin(px(12))
+            .x_label_area_size(px(45))
+            .y_label_area_size(px(60))
             .build_cartesian_2d(0f64..hi, 0f64..top)
             .map_err(err)?;
         chart
@@ -61,11 +61,11 @@ impl Figure for Histograms {
             .y_label_formatter(&linear_tick)
             .x_desc("threshold (log units)")
             .y_desc("pixels")
-            .label_style((FONT, 14))
+            .label_style((FONT, px(14)))
             .draw()
             .map_err(err)?;
         for (k, (label, _)) in self.series.iter().enumerate() {
-            let colour = PALETTE[k % PALETTE.len()];
+            let colour = colour_for(label, k);
             chart
                 .draw_series(counts[k].iter().enumerate().map(|(i, &c)| {
                     let x = i as f64 * width;
@@ -74,7 +74,10 @@ impl Figure for Histograms {
                 .map_err(err)?
                 .label(label.clone())
                 .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 15, y + 5)], colour.mix(0.45).filled())
+                    Rectangle::new(
+                        [(x, y - px(5) as i32), (x + px(15) as i32, y + px(5) as i32)],
+                        colour.mix(0.45).filled(),
+                    )
                 });
         }
         draw_legend(&mut chart, 14)?;

@@ -50,7 +50,6 @@ impl Figure for Lines {
         }
         let pad = ((y1 - y0) * 0.08).max(1e-6);
         let (y0, y1) = (y0 - pad, y1 + pad);
-        let colours = |k: usize| PALETTE[k % PALETTE.len()];
         macro_rules! finish {
             ($chart:expr) => {{
                 let mut chart = $chart;
@@ -59,7 +58,7 @@ impl Figure for Lines {
                     .y_desc(self.y_label.as_str())
                     .light_line_style(RGBColor(242, 242, 242))
                     .y_label_formatter(&linear_tick)
-                    .label_style((FONT, 14));
+                    .label_style((FONT, px(14)));
                 if self.log_x {
                     mesh.x_label_formatter(&|v: &f64| log_tick(v));
                 } else {
@@ -72,7 +71,7 @@ impl Figure for Lines {
                         .map_err(err)?;
                 }
                 for (k, (label, series)) in self.series.iter().enumerate() {
-                    let colour = colours(k);
+                    let colour = colour_for(label, k);
                     let valid: Vec<(f64, f64)> = series
                         .iter()
                         .copied()
@@ -81,14 +80,21 @@ impl Figure for Lines {
                         })
                         .collect();
                     chart
-                        .draw_series(LineSeries::new(valid.clone(), colour.stroke_width(2)))
+                        .draw_series(LineSeries::new(valid.clone(), colour.stroke_width(px(2))))
                         .map_err(err)?
                         .label(label.clone())
                         .legend(move |(x, y)| {
-                            PathElement::new([(x, y), (x + 20, y)], colour.stroke_width(2))
+                            PathElement::new(
+                                [(x, y), (x + px(20) as i32, y)],
+                                colour.stroke_width(px(2)),
+                            )
                         });
                     chart
-                        .draw_series(valid.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                        .draw_series(
+                            valid
+                                .iter()
+                                .map(|&p| Circle::new(p, px(3), colour.filled())),
+                        )
                         .map_err(err)?;
                 }
                 if self.series.len() > 1 {
@@ -98,10 +104,10 @@ impl Figure for Lines {
         }
         let builder = |root| {
             let mut b = ChartBuilder::on(root);
-            b.caption(self.title.as_str(), (FONT, 19))
-                .margin(12)
-                .x_label_area_size(45)
-                .y_label_area_size(65);
+            b.caption(self.title.as_str(), (FONT, px(19)))
+                .margin(px(12))
+                .x_label_area_size(px(45))
+                .y_label_area_size(px(65));
             b
         };
         if self.log_x {

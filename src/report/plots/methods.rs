@@ -44,10 +44,13 @@ impl Figure for Methods {
         let hi = values.iter().copied().fold(0.1, f64::max) * 1.15;
         let names: Vec<String> = self.rows.iter().map(|r| r.method.clone()).collect();
         let mut chart = ChartBuilder::on(root)
-            .caption("Contrast thresholds by method (95 % intervals)", (FONT, 20))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(60)
+            .caption(
+                "Contrast thresholds by method (95 % intervals)",
+                (FONT, px(20)),
+            )
+            .margin(px(12))
+            .x_label_area_size(px(45))
+            .y_label_area_size(px(60))
             .build_cartesian_2d(-0.5f64..(n - 0.5), 0f64..hi)
             .map_err(err)?;
         chart
@@ -64,7 +67,7 @@ impl Figure for Methods {
                 }
             })
             .y_desc("threshold (log units)")
-            .label_style((FONT, 14))
+            .label_style((FONT, px(14)))
             .draw()
             .map_err(err)?;
         if let Some((on, off)) = self.truth {
@@ -74,11 +77,13 @@ impl Figure for Methods {
                 chart
                     .draw_series(LineSeries::new(
                         [(-0.5, value), (n - 0.5, value)],
-                        colour.mix(0.5).stroke_width(1),
+                        colour.mix(0.5).stroke_width(px(1)),
                     ))
                     .map_err(err)?
                     .label(label)
-                    .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], colour.mix(0.5)));
+                    .legend(move |(x, y)| {
+                        PathElement::new([(x, y), (x + px(20) as i32, y)], colour.mix(0.5))
+                    });
             }
         }
         for (shift, colour, label, pick) in [
@@ -105,7 +110,7 @@ impl Figure for Methods {
                     let [lo, up] = (*ci)?;
                     Some(PathElement::new(
                         [(*x, lo.unwrap_or(*v)), (*x, up.unwrap_or(*v))],
-                        colour.stroke_width(2),
+                        colour.stroke_width(px(2)),
                     ))
                 }))
                 .map_err(err)?;
@@ -119,7 +124,7 @@ impl Figure for Methods {
                     .into_iter()
                     .flatten()
                     .map(|(a, b)| {
-                        PathElement::new([(*x, a), (*x, b)], colour.mix(0.5).stroke_width(1))
+                        PathElement::new([(*x, a), (*x, b)], colour.mix(0.5).stroke_width(px(1)))
                     })
                     .collect::<Vec<_>>()
                 }))
@@ -128,11 +133,11 @@ impl Figure for Methods {
                 .draw_series(
                     points
                         .iter()
-                        .map(|(x, v, _)| Circle::new((*x, *v), 6, colour.filled())),
+                        .map(|(x, v, _)| Circle::new((*x, *v), px(6), colour.filled())),
                 )
                 .map_err(err)?
                 .label(label)
-                .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
+                .legend(move |(x, y)| Circle::new((x + px(10) as i32, y), px(5), colour.filled()));
         }
         draw_legend(&mut chart, 14)?;
         Ok(())

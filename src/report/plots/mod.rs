@@ -18,7 +18,7 @@ mod lines;
 mod methods;
 mod style;
 
-use super::model::{Report, SequenceReport};
+use super::model::{PixelData, Report, SequenceReport};
 use calibration::{Calibration, CurvePoint};
 use fig2::Fig2;
 use heat::{Counts, Heat, ThresholdMaps};
@@ -29,7 +29,10 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 pub(super) const FONT: &str = "sans-serif";
+/// A figure's size in layout units: the SVG's pixels; the PNG has [`PNG_SCALE`] times as
+/// many each way (1800 px wide, for print).
 pub(super) const SIZE: (u32, u32) = (900, 560);
+pub(super) const PNG_SCALE: u32 = 2;
 
 fn register_fonts() {
     static FONTS: std::sync::Once = std::sync::Once::new();
@@ -65,15 +68,17 @@ pub(super) fn err<E: std::fmt::Display>(e: E) -> String {
 
 fn render(name: String, title: &str, figure: &impl Figure) -> Result<Plot, String> {
     register_fonts();
-    let (w, h) = SIZE;
+    let (w, h) = (SIZE.0 * PNG_SCALE, SIZE.1 * PNG_SCALE);
     let mut pixels = vec![255u8; (w * h * 3) as usize];
-    {
+    style::scaled(PNG_SCALE, || -> DrawResult {
         let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
         figure.draw(&root)?;
-        root.present().map_err(err)?;
-    }
-    let image = image::RgbImage::from_raw(w, h, pixels).ok_or("bitmap size")?;
+        root.present().map_err(err)
+    })?;
+    let (w, h) = SIZE;
+    let image =
+        image::RgbImage::from_raw(w * PNG_SCALE, h * PNG_SCALE, pixels).ok_or("bitmap size")?;
     let mut png = Vec::new();
     image
         .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
@@ -94,24 +99,34 @@ fn render(name: String, title: &str, figure: &impl Figure) -> Result<Plot, Strin
     })
 }
 
-/// Every plot of the report.
-pub fn all(report: &Report) -> Vec<Result<Plot, String>> {
-    let mut plots = vec![render(
+/// The paper's Fig. 2 of the whole report.
+pub fn fig2(report: &Report) -> Result<Plot, String> {
+    render(
         "events_per_pixel_per_second".into(),
         "Events per pixel per second by dataset, beside the simulated presets (Stoffregen et al. 2020, Fig. 2)",
         &Fig2 { report },
-    )];
-    for s in &report.sequences {
-        plots.extend(sequence(s));
+    )
+}
+
+/// Series of a distribution cut to the range where some series has a non-zero share (the
+/// empty bins at either end say nothing and would stretch the log axis).
+fn over_the_data(mut series: Vec<(String, Vec<(f64, f64)>)>) -> Vec<(String, Vec<(f64, f64)>)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (x, _) in series.iter().flat_map(|s| s.1.iter()).filter(|p| p.1 > 0.0) {
+        lo = lo.min(*x);
+        hi = hi.max(*x);
     }
-    plots
+    for s in &mut series {
+        s.1.retain(|p| p.0 >= lo && p.0 <= hi);
+    }
+    series
 }
 
 /// Residual bins with fewer events (real and simulated together) are not drawn.
 const MIN_RESIDUAL_EVENTS: u64 = 20;
 
 /// The plots of one sequence.
-pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
+pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, String>> {
     let mut plots = Vec::new();
     let name = |what: &str| format!("{}/{what}", s.name);
     if let Some(e) = s.estimate("eppps")
@@ -153,13 +168,15 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
                 .and_then(|u| u.standard_error)
                 .map(|se| [Some(v - 1.96 * se), Some(v + 1.96 * se)])
         };
-        rows.push(MethodRow {
-            method: "fit".into(),
-            on: Some(f.params.ct_on),
-            on_ci95: ci("ct_on", f.params.ct_on),
-            off: Some(f.params.ct_off),
-            off_ci95: ci("ct_off", f.params.ct_off),
-        });
+        if let Some((on, off)) = s.fitted_thresholds() {
+            rows.push(MethodRow {
+                method: "fit".into(),
+                on: Some(on),
+                on_ci95: ci("ct_on", on),
+                off: Some(off),
+                off_ci95: ci("ct_off", off),
+            });
+        }
     }
     if !rows.is_empty() {
         let truth = s
@@ -172,7 +189,7 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
             &Methods { rows, truth },
         ));
     }
-    if let Some(maps) = &s.maps {
+    if let Some(maps) = &pixels.maps {
         let heat = |values: &[f32], label: &str| Heat {
             width: maps.width,
             height: maps.height,
@@ -223,7 +240,7 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
             zero: false,
         },
     ));
-    if !s.pixel_counts.is_empty() {
+    if !pixels.counts.is_empty() {
         let (w, h) = (s.stats.width as usize, s.stats.height as usize);
         plots.push(render(
             name("pixel_counts"),
@@ -235,8 +252,8 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
                 heat: Heat {
                     width: w,
                     height: h,
-                    values: s
-                        .pixel_counts
+                    values: pixels
+                        .counts
                         .iter()
                         .map(|&c| (c as f64 + 1.0).log10())
                         .collect(),
@@ -316,11 +333,11 @@ pub fn sequence(s: &SequenceReport) -> Vec<Result<Plot, String>> {
                 x_label: "interval (s)".into(),
                 y_label: "share of intervals per bin".into(),
                 log_x: true,
-                series: vec![
+                series: over_the_data(vec![
                     distribution("recording", &after.real, &after.bin_start_s),
                     distribution("ideal model", &before.simulated, &before.bin_start_s),
                     distribution("fitted model", &after.simulated, &after.bin_start_s),
-                ],
+                ]),
                 zero: false,
             },
         ));
@@ -350,11 +367,26 @@ mod tests {
         .unwrap();
         assert_eq!(&plot.png[1..4], b"PNG");
         let image = image::load_from_memory(&plot.png).unwrap().to_rgb8();
-        assert_eq!(image.dimensions(), SIZE);
-        // the line is drawn in the first palette colour
-        assert!(image.pixels().any(|p| p.0 == [31, 119, 180]));
+        assert_eq!(image.dimensions(), (1800, 1120));
+        // a series of no fixed meaning takes the first colour left for such series (blue
+        // and red mean ON and OFF)
+        assert!(image.pixels().any(|p| p.0 == [255, 127, 14]));
+        assert!(!image.pixels().any(|p| p.0 == [31, 119, 180]));
         assert!(plot.svg.starts_with("<svg") && plot.svg.contains("lines"));
         assert_eq!(plot.csv, "series,x,y\na,1,2\na,10,-1\n");
+    }
+
+    #[test]
+    fn one_colour_per_meaning() {
+        use super::style::{OFF, ON, colour_for};
+        assert_eq!(colour_for("ON", 5), ON);
+        assert_eq!(colour_for("true OFF", 0), OFF);
+        assert_eq!(colour_for("ideal model", 0), colour_for("ideal model", 3));
+        for k in 0..8 {
+            assert_ne!(colour_for("+ leak", k), ON);
+            assert_ne!(colour_for("+ leak", k), OFF);
+            assert_ne!(colour_for("+ leak", k), colour_for("fitted model", 0));
+        }
     }
 
     #[test]

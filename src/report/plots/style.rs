@@ -6,6 +6,25 @@ use plotters::coord::CoordTranslate;
 use plotters::coord::combinators::WithKeyPoints;
 use plotters::prelude::*;
 
+thread_local! {
+    /// Pixels per layout unit of the figure being drawn (2 for the PNGs, 1 for the SVGs).
+    static SCALE: std::cell::Cell<u32> = const { std::cell::Cell::new(1) };
+}
+
+/// A size in layout units (fonts, margins, strokes, marks) in pixels of the figure being
+/// drawn.
+pub(super) fn px(n: u32) -> u32 {
+    n * SCALE.with(|s| s.get())
+}
+
+/// Runs `draw` with `scale` pixels per layout unit.
+pub(super) fn scaled<T>(scale: u32, draw: impl FnOnce() -> T) -> T {
+    let before = SCALE.with(|s| s.replace(scale));
+    let out = draw();
+    SCALE.with(|s| s.set(before));
+    out
+}
+
 /// Colours of series, in order.
 pub(super) const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
@@ -17,6 +36,27 @@ pub(super) const PALETTE: [RGBColor; 8] = [
     RGBColor(227, 119, 194),
     RGBColor(23, 190, 207),
 ];
+
+/// One colour per meaning across every figure: ON and OFF thresholds, the recording, the
+/// ideal (thresholds only) model and simulations of it, the fitted model; other series take
+/// the rest of the palette in order.
+pub(super) const ON: RGBColor = PALETTE[0];
+pub(super) const OFF: RGBColor = PALETTE[1];
+pub(super) const RECORDING: RGBColor = RGBColor(40, 40, 40);
+pub(super) const SIMULATED: RGBColor = PALETTE[4];
+pub(super) const FITTED: RGBColor = PALETTE[2];
+
+/// The colour of a series by its label (see [`ON`]); `k`: its place among the others.
+pub(super) fn colour_for(label: &str, k: usize) -> RGBColor {
+    match label {
+        "ON" | "true ON" => ON,
+        "OFF" | "true OFF" => OFF,
+        "recording" | "all events" => RECORDING,
+        "ideal model" => SIMULATED,
+        "fitted model" => FITTED,
+        _ => [PALETTE[3], PALETTE[5], PALETTE[6], PALETTE[7]][k % 4],
+    }
+}
 
 /// The viridis colour map at `v` in [0, 1] (its eight anchor colours, linearly blended).
 pub(super) fn viridis(v: f64) -> RGBColor {
@@ -111,9 +151,11 @@ pub(super) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
 ) -> Result<(), String> {
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .legend_area_size(px(30))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font((FONT, font_size))
+        .label_font((FONT, px(font_size)))
         .draw()
         .map_err(|e| e.to_string())
 }

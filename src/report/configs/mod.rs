@@ -4,16 +4,55 @@
 //! - ESIM (Rebecq et al., CoRL 2018) flagfile, one `--flag=value` a line; what ESIM cannot
 //!   express is said in `#` comments: its threshold noise is redrawn at every event rather
 //!   than frozen per pixel, and it has no bandwidth, leak or shot noise;
-//! - an esim_config_generator `camera_params` object (Stoffregen et al. 2020's scene
-//!   generator), covering every given fit with margin for training: ON and OFF thresholds
-//!   are drawn as `C`, `C * N(1, ct_diff_sigma)`;
-//! - v2e (Hu, Liu & Delbruck, CVPR workshops 2021) command-line arguments;
+//! - a whole esim_config_generator configuration ([`generator`]);
+//! - v2e as a shell script that runs as it is, and as JSON ([`v2e`]);
 //! - ctcal's own PARAMS.toml, which `ctcal simulate` reads back unchanged.
 //!
-//! Several fits combine into one configuration by the median of each parameter.
+//! Several fits (of one sensor) combine into one configuration by the median of each
+//! parameter. A parameter the fits do not identify is marked in a comment beside it: its
+//! value is the start value the fit simulated, not a measurement.
+
+pub mod files;
+pub mod generator;
+pub mod v2e;
+
+pub use generator::{EsimGeneratorCamera, esim_generator};
 
 use crate::sim::PixelParams;
-use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// What a configuration needs besides the parameters.
+#[derive(Clone, Debug, Default)]
+pub struct Setup {
+    /// The APS exposure to simulate (the recording's, where known), milliseconds.
+    pub exposure_ms: Option<f64>,
+    pub seed: u64,
+    /// The sensor, (width, height) in pixels, where known.
+    pub sensor: Option<(u32, u32)>,
+    /// Parameters (PARAMS.toml keys) the fits do not identify, with why.
+    pub not_identified: BTreeMap<String, String>,
+}
+
+/// One note per parameter the fits do not identify.
+pub fn not_identified_notes(setup: &Setup) -> Vec<String> {
+    setup
+        .not_identified
+        .iter()
+        .map(|(key, why)| {
+            format!(
+                "NOT IDENTIFIED: {key} is the start value the fit simulated, not a measurement ({why})"
+            )
+        })
+        .collect()
+}
+
+/// The notes as `#` comment lines.
+fn comments(notes: &[String]) -> String {
+    notes
+        .iter()
+        .map(|n| format!("# {}\n", crate::report::caveats::one_line(n)))
+        .collect()
+}
 
 /// The configuration formats.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,14 +60,16 @@ pub enum ConfigFormat {
     Esim,
     EsimGenerator,
     V2e,
+    V2eJson,
     Ctcal,
 }
 
 impl ConfigFormat {
-    pub const ALL: [ConfigFormat; 4] = [
+    pub const ALL: [ConfigFormat; 5] = [
         ConfigFormat::Esim,
         ConfigFormat::EsimGenerator,
         ConfigFormat::V2e,
+        ConfigFormat::V2eJson,
         ConfigFormat::Ctcal,
     ];
 
@@ -38,6 +79,7 @@ impl ConfigFormat {
             ConfigFormat::Esim => "esim",
             ConfigFormat::EsimGenerator => "esim-generator",
             ConfigFormat::V2e => "v2e",
+            ConfigFormat::V2eJson => "v2e-json",
             ConfigFormat::Ctcal => "ctcal",
         }
     }
@@ -47,7 +89,8 @@ impl ConfigFormat {
         match self {
             ConfigFormat::Esim => "esim.flagfile",
             ConfigFormat::EsimGenerator => "esim_config_generator.json",
-            ConfigFormat::V2e => "v2e_args.txt",
+            ConfigFormat::V2e => "v2e_args.sh",
+            ConfigFormat::V2eJson => "v2e_args.json",
             ConfigFormat::Ctcal => "params.toml",
         }
     }
@@ -128,12 +171,22 @@ pub fn combine(fits: &[PixelParams]) -> Option<PixelParams> {
     Some(out)
 }
 
-/// An ESIM flagfile. `exposure_ms`: the APS exposure to simulate (the recording's, where
-/// known).
-pub fn esim_flagfile(p: &PixelParams, exposure_ms: Option<f64>, seed: u64) -> String {
+/// An ESIM flagfile.
+pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
+    let (exposure_ms, seed) = (setup.exposure_ms, setup.seed);
     let mut lines = vec![
         "# ESIM flagfile written by ctcal from a fit of the simulator to a recording".to_string(),
     ];
+    if let Some((w, h)) = setup.sensor {
+        lines.push(format!(
+            "# the fitted sensor is {w}x{h}: give ESIM a camera of that size (its calibration file)"
+        ));
+    }
+    lines.extend(
+        comments(&not_identified_notes(setup))
+            .lines()
+            .map(str::to_string),
+    );
     let sigma = p.ct_sigma.unwrap_or(0.0);
     lines.push(format!("--contrast_threshold_pos={:.6}", p.ct_on));
     lines.push(format!("--contrast_threshold_neg={:.6}", p.ct_off));
@@ -202,128 +255,49 @@ pub fn esim_flagfile(p: &PixelParams, exposure_ms: Option<f64>, seed: u64) -> St
     lines.join("\n") + "\n"
 }
 
-/// esim_config_generator's `camera_params`, covering `fits`.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct EsimGeneratorCamera {
-    pub contrast_threshold_mean: f64,
-    pub ct_diff_sigma: f64,
-    #[serde(rename = "min_C")]
-    pub min_c: f64,
-    #[serde(rename = "max_C")]
-    pub max_c: f64,
-    pub hard_c_t_sigmas: f64,
-    pub refractory_period_ns: i64,
-    pub sim_framerate: u32,
-}
-
-#[derive(Serialize)]
-struct EsimGenerator {
-    /// Marks the file as ctcal's (a later run may replace it).
-    ctcal_version: &'static str,
-    camera_params: EsimGeneratorCamera,
-    ctcal_notes: Vec<String>,
-}
-
-/// The esim_config_generator JSON for `fits`: the mean threshold, a spread of ON against
-/// OFF that covers every fit's ratio (at least the paper's 0.1), bounds 20 % beyond the
-/// lowest and highest fitted thresholds, the median fitted mismatch and refractory period.
-pub fn esim_generator(fits: &[PixelParams]) -> Option<String> {
-    if fits.is_empty() {
-        return None;
-    }
-    let thresholds: Vec<f64> = fits.iter().flat_map(|p| [p.ct_on, p.ct_off]).collect();
-    let mean = thresholds.iter().sum::<f64>() / thresholds.len() as f64;
-    let ratio_spread = fits
-        .iter()
-        .map(|p| (p.ct_off / p.ct_on).ln().abs())
-        .fold(0.0, f64::max);
-    let lo = thresholds.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = thresholds.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let combined = combine(fits)?;
-    let camera = EsimGeneratorCamera {
-        contrast_threshold_mean: mean,
-        ct_diff_sigma: ratio_spread.max(0.1),
-        min_c: (lo / 1.2 * 1e4).round() / 1e4,
-        max_c: (hi * 1.2 * 1e4).round() / 1e4,
-        hard_c_t_sigmas: combined.ct_sigma.unwrap_or(1e-4),
-        refractory_period_ns: (combined.refractory_s.unwrap_or(0.0) * 1e9).round() as i64,
-        sim_framerate: 100,
-    };
-    let notes = vec![
-        format!(
-            "from {} fit(s): thresholds {lo:.3} to {hi:.3}; ON and OFF differ by up to {:.0} %",
-            fits.len(),
-            100.0 * (ratio_spread.exp() - 1.0)
-        ),
-        "hard_c_t_sigmas is ESIM's per-event threshold noise; ctcal fitted a frozen per-pixel mismatch of that size".into(),
-        "sim_framerate is the generator's default; raise it for fast motion".into(),
-    ];
-    serde_json::to_string_pretty(&EsimGenerator {
-        ctcal_version: env!("CARGO_PKG_VERSION"),
-        camera_params: camera,
-        ctcal_notes: notes,
-    })
-    .ok()
-    .map(|s| s + "\n")
-}
-
-/// v2e command-line arguments (absent effects switched off explicitly).
-pub fn v2e_args(p: &PixelParams, seed: u64) -> String {
-    let args = [
-        format!("--pos_thres {:.6}", p.ct_on),
-        format!("--neg_thres {:.6}", p.ct_off),
-        format!("--sigma_thres {:.6}", p.ct_sigma.unwrap_or(0.0)),
-        format!("--cutoff_hz {}", p.cutoff_hz.unwrap_or(0.0)),
-        format!("--leak_rate_hz {}", p.leak_rate_hz.unwrap_or(0.0)),
-        format!(
-            "--shot_noise_rate_hz {}",
-            p.shot_noise_rate_hz.unwrap_or(0.0)
-        ),
-        format!("--refractory_period {}", p.refractory_s.unwrap_or(0.0)),
-        "--leak_jitter_fraction 0.1".to_string(),
-        format!("--noise_rate_cov_decades {}", p.leak_spread_decades()),
-        format!("--dvs_emulator_seed {seed}"),
-    ];
-    let mut text = String::from(
-        "# v2e arguments written by ctcal from a fit of the simulator to a recording\n",
-    );
-    if p.hot_pixel_fraction.is_some() || p.timestamp_jitter_s.is_some() {
-        text.push_str("# v2e has no hot pixels or timestamp jitter; ctcal simulate has both\n");
-    }
-    text.push_str(&args.join(" \\\n"));
-    text.push('\n');
-    text
-}
-
 /// ctcal's PARAMS.toml (read back by `ctcal simulate --params`).
-pub fn ctcal_params(p: &PixelParams, seed: u64) -> String {
+pub fn ctcal_params(p: &PixelParams, setup: &Setup) -> String {
     let mut p = p.clone();
-    p.seed = Some(seed);
+    p.seed = Some(setup.seed);
+    let mut notes = Vec::new();
+    if let Some((w, h)) = setup.sensor {
+        notes.push(format!(
+            "the fitted sensor is {w}x{h} (ctcal simulate --sensor {w}x{h})"
+        ));
+    }
+    notes.extend(not_identified_notes(setup));
     format!(
-        "# ctcal PARAMS.toml written from a fit of the simulator to a recording\n{}",
+        "# ctcal PARAMS.toml written from a fit of the simulator to a recording\n{}{}",
+        comments(&notes),
         p.to_toml()
     )
 }
 
 /// The configuration of `format` for `fits` (combined by median where the format takes
 /// one parameter set).
-pub fn render(
-    format: ConfigFormat,
-    fits: &[PixelParams],
-    exposure_ms: Option<f64>,
-    seed: u64,
-) -> Option<String> {
+pub fn render(format: ConfigFormat, fits: &[PixelParams], setup: &Setup) -> Option<String> {
     match format {
-        ConfigFormat::EsimGenerator => esim_generator(fits),
-        ConfigFormat::Esim => combine(fits).map(|p| esim_flagfile(&p, exposure_ms, seed)),
-        ConfigFormat::V2e => combine(fits).map(|p| v2e_args(&p, seed)),
-        ConfigFormat::Ctcal => combine(fits).map(|p| ctcal_params(&p, seed)),
+        ConfigFormat::EsimGenerator => esim_generator(fits, setup),
+        ConfigFormat::Esim => combine(fits).map(|p| esim_flagfile(&p, setup)),
+        ConfigFormat::V2e => combine(fits).map(|p| v2e::script(&p, setup)),
+        ConfigFormat::V2eJson => combine(fits).map(|p| v2e::json(&p, setup)),
+        ConfigFormat::Ctcal => combine(fits).map(|p| ctcal_params(&p, setup)),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A 4 ms exposure, seed 7, a 240x180 sensor whose ON threshold is not identified.
+    fn setup() -> Setup {
+        Setup {
+            exposure_ms: Some(4.0),
+            seed: 7,
+            sensor: Some((240, 180)),
+            not_identified: [("ct_on".to_string(), "a static scene".to_string())].into(),
+        }
+    }
 
     fn fitted() -> PixelParams {
         PixelParams {
@@ -337,7 +311,7 @@ mod tests {
 
     #[test]
     fn esim_uses_its_names_and_units() {
-        let text = esim_flagfile(&fitted(), Some(4.0), 7);
+        let text = esim_flagfile(&fitted(), &setup());
         for line in [
             "--contrast_threshold_pos=0.350000",
             "--contrast_threshold_neg=0.450000",
@@ -367,7 +341,8 @@ mod tests {
         assert_eq!(c.cutoff_hz, Some(300.0));
         // two of three fits have shot noise (median of 1, 0, 1)
         assert_eq!(c.shot_noise_rate_hz, Some(1.0));
-        let generator = esim_generator(&[PixelParams::ideal(0.2, 0.3), fitted()]).unwrap();
+        let generator =
+            esim_generator(&[PixelParams::ideal(0.2, 0.3), fitted()], &setup()).unwrap();
         let v: serde_json::Value = serde_json::from_str(&generator).unwrap();
         let camera = &v["camera_params"];
         assert!((camera["contrast_threshold_mean"].as_f64().unwrap() - 0.325).abs() < 1e-12);
@@ -378,7 +353,7 @@ mod tests {
 
     #[test]
     fn ctcal_params_read_back_unchanged() {
-        let text = ctcal_params(&fitted(), 3);
+        let text = ctcal_params(&fitted(), &Setup { seed: 3, ..setup() });
         let back = PixelParams::from_toml(&text, "params.toml").unwrap();
         let mut expected = fitted();
         expected.seed = Some(3);
@@ -386,13 +361,14 @@ mod tests {
     }
 
     /// Every format of one hand-made fit (thresholds 0.35/0.45, mismatch 0.03, refractory
-    /// 0.5 ms, 300 Hz bandwidth, 1 Hz shot noise, 4 ms exposure), as a reviewer reads it.
+    /// 0.5 ms, 300 Hz bandwidth, 1 Hz shot noise, 4 ms exposure, 240x180, ON threshold not
+    /// identified), as a reviewer reads it.
     #[test]
     fn every_format_of_a_fit() {
         let mut with_leak = fitted();
         with_leak.leak_rate_hz = Some(0.1);
         for format in ConfigFormat::ALL {
-            let text = render(format, &[with_leak.clone()], Some(4.0), 7).unwrap();
+            let text = render(format, &[with_leak.clone()], &setup()).unwrap();
             insta::assert_snapshot!(format.name(), text);
         }
     }

@@ -1,0 +1,48 @@
+//! What qualifies a number of the report, gathered where the page and `report.md` show it:
+//! a method's "not determinable" values (`why`) and assumptions (extrapolations among
+//! them), the fit's parameters the recording does not identify and its assumptions, what
+//! reading the recording warned of, and outputs that could not be made.
+
+use super::model::SequenceReport;
+use crate::estimate::CtEstimate;
+use crate::fit::FitResult;
+
+/// The caveats of one method's estimate, each as one line.
+pub fn of_estimate(e: &CtEstimate) -> Vec<String> {
+    let mut out: Vec<String> = e
+        .why
+        .iter()
+        .map(|(key, why)| format!("{key} not determinable: {why}"))
+        .collect();
+    out.extend(e.assumptions.iter().cloned());
+    out
+}
+
+/// The caveats of a fit: the parameters it does not identify, then its assumptions.
+pub fn of_fit(f: &FitResult) -> Vec<String> {
+    let mut out: Vec<String> = f
+        .why
+        .iter()
+        .map(|(key, why)| format!("{key} not identified: {why}"))
+        .collect();
+    out.extend(f.assumptions.iter().cloned());
+    out
+}
+
+/// The caveats of a sequence as a whole: what reading it warned of, and its plots that
+/// could not be drawn.
+pub fn of_sequence(s: &SequenceReport) -> Vec<String> {
+    let mut out = s.warnings.clone();
+    out.extend(
+        s.outputs
+            .plots_not_drawn
+            .iter()
+            .map(|e| format!("plot not drawn: {e}")),
+    );
+    out
+}
+
+/// One line of a caveat (Markdown list items and HTML list items are one line).
+pub fn one_line(text: &str) -> String {
+    text.split_whitespace().collect::<Vec<_>>().join(" ")
+}

@@ -1,0 +1,107 @@
+//! v2e (Hu, Liu & Delbruck, CVPR workshops 2021) configurations: a shell script that runs
+//! v2e with the fitted parameters and the sensor size as it is (`sh v2e_args.sh -i IN ...`,
+//! v2e's own input and output arguments appended), and the same arguments as JSON.
+
+use super::{Setup, not_identified_notes};
+use crate::sim::PixelParams;
+use serde_json::json;
+
+/// v2e's arguments as (flag without `--`, value); absent effects switched off explicitly.
+pub fn arguments(p: &PixelParams, setup: &Setup) -> Vec<(&'static str, f64)> {
+    let mut args = vec![
+        ("pos_thres", p.ct_on),
+        ("neg_thres", p.ct_off),
+        ("sigma_thres", p.ct_sigma.unwrap_or(0.0)),
+        ("cutoff_hz", p.cutoff_hz.unwrap_or(0.0)),
+        ("leak_rate_hz", p.leak_rate_hz.unwrap_or(0.0)),
+        ("shot_noise_rate_hz", p.shot_noise_rate_hz.unwrap_or(0.0)),
+        ("refractory_period", p.refractory_s.unwrap_or(0.0)),
+        ("leak_jitter_fraction", 0.1),
+        ("noise_rate_cov_decades", p.leak_spread_decades()),
+        ("dvs_emulator_seed", setup.seed as f64),
+    ];
+    if let Some((w, h)) = setup.sensor {
+        args.push(("output_width", w as f64));
+        args.push(("output_height", h as f64));
+    }
+    args
+}
+
+/// A value as v2e reads it: whole numbers without a decimal point, the rest to six
+/// significant places.
+fn value(v: f64) -> String {
+    if v == v.trunc() && v.abs() < 1e15 {
+        format!("{v:.0}")
+    } else {
+        format!("{v:.6}")
+    }
+}
+
+/// The notes every v2e form carries.
+fn notes(p: &PixelParams, setup: &Setup) -> Vec<String> {
+    let mut notes = Vec::new();
+    if p.hot_pixel_fraction.is_some() || p.timestamp_jitter_s.is_some() {
+        notes.push("v2e has no hot pixels or timestamp jitter; ctcal simulate has both".into());
+    }
+    if setup.sensor.is_none() {
+        notes.push("the sensor size is not known: add --output_width and --output_height".into());
+    }
+    notes.extend(not_identified_notes(setup));
+    notes
+}
+
+/// `v2e_args.sh`: runs v2e (or `$V2E`) with the arguments, then the caller's.
+pub fn script(p: &PixelParams, setup: &Setup) -> String {
+    let mut text = String::from(
+        "#!/bin/sh\n# v2e with the parameters ctcal fitted to a recording. Run it as it is, with v2e's\n# input and output arguments after it:\n#   sh v2e_args.sh -i video.mp4 --output_folder out\n# (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)\n",
+    );
+    for note in notes(p, setup) {
+        text.push_str(&format!("# {}\n", super::super::caveats::one_line(&note)));
+    }
+    text.push_str("exec \"${V2E:-v2e}\" \\\n");
+    for (flag, v) in arguments(p, setup) {
+        text.push_str(&format!("  --{flag} {} \\\n", value(v)));
+    }
+    text.push_str("  \"$@\"\n");
+    text
+}
+
+/// `v2e_args.json`, `ctcal_version` first (how ctcal knows a file it may replace).
+#[derive(serde::Serialize)]
+struct V2eJson {
+    ctcal_version: &'static str,
+    program: &'static str,
+    arguments: serde_json::Map<String, serde_json::Value>,
+    argv: Vec<String>,
+    not_identified: std::collections::BTreeMap<String, String>,
+    notes: Vec<String>,
+}
+
+/// `v2e_args.json`: the arguments by name (numbers), as an argument list, and the notes.
+pub fn json(p: &PixelParams, setup: &Setup) -> String {
+    let args = arguments(p, setup);
+    let by_name: serde_json::Map<String, serde_json::Value> = args
+        .iter()
+        .map(|(flag, v)| {
+            let v = if v.fract() == 0.0 && v.abs() < 1e15 {
+                json!(*v as i64)
+            } else {
+                json!(v)
+            };
+            (flag.to_string(), v)
+        })
+        .collect();
+    let argv: Vec<String> = args
+        .iter()
+        .flat_map(|(flag, v)| [format!("--{flag}"), value(*v)])
+        .collect();
+    let doc = V2eJson {
+        ctcal_version: env!("CARGO_PKG_VERSION"),
+        program: "v2e",
+        arguments: by_name,
+        argv,
+        not_identified: setup.not_identified.clone(),
+        notes: notes(p, setup),
+    };
+    serde_json::to_string_pretty(&doc).expect("JSON of numbers and strings") + "\n"
+}
