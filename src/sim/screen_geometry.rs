@@ -21,6 +21,9 @@ use super::display::DisplayModel;
 use nalgebra::Matrix3;
 use serde::{Deserialize, Serialize};
 
+/// A point in continuous pixel coordinates.
+pub type Point = (f64, f64);
+
 /// A plane-to-plane projective map, row-major 3 x 3, acting on `(x, y, 1)`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Homography(pub [[f64; 3]; 3]);
@@ -169,7 +172,7 @@ impl ScreenGeometry {
     }
 
     /// A [`Self::to_stimulus`] for many points (the inverse computed once).
-    pub fn inverse_map(&self) -> Option<impl Fn((f64, f64)) -> Option<(f64, f64)> + '_> {
+    pub fn inverse_map(&self) -> Option<impl Fn(Point) -> Option<Point> + '_> {
         let inverse = self.homography.inverse()?;
         Some(move |p: (f64, f64)| {
             let u = self.undistort(p)?;

@@ -20,10 +20,7 @@ fn normalising(points: impl Iterator<Item = (f64, f64)> + Clone) -> Matrix3<f64>
     let (cx, cy) = points
         .clone()
         .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
-    let mean = points
-        .map(|p| (p.0 - cx).hypot(p.1 - cy))
-        .sum::<f64>()
-        / n;
+    let mean = points.map(|p| (p.0 - cx).hypot(p.1 - cy)).sum::<f64>() / n;
     let s = if mean > 1e-12 {
         std::f64::consts::SQRT_2 / mean
     } else {
@@ -249,11 +246,7 @@ mod tests {
     use super::*;
 
     fn truth() -> Homography {
-        Homography([
-            [0.82, 0.07, 31.0],
-            [-0.04, 0.95, 12.0],
-            [9e-4, -4e-4, 1.0],
-        ])
+        Homography([[0.82, 0.07, 31.0], [-0.04, 0.95, 12.0], [9e-4, -4e-4, 1.0]])
     }
 
     fn template() -> ScreenGeometry {
@@ -280,7 +273,9 @@ mod tests {
             }
         }
         // collinear points determine nothing
-        let line: Vec<Pair> = (0..5).map(|i| ((i as f64, i as f64), (i as f64, 0.0))).collect();
+        let line: Vec<Pair> = (0..5)
+            .map(|i| ((i as f64, i as f64), (i as f64, 0.0)))
+            .collect();
         assert!(dlt(&line).is_none());
     }
 
@@ -302,7 +297,10 @@ mod tests {
         assert_eq!(fit.geometry.k1, 0.0, "no distortion in the data");
         assert!(fit.rms_px < 0.3, "{}", fit.rms_px);
         for s in grid() {
-            let (a, b) = (h.apply(s.0, s.1).unwrap(), fit.geometry.to_sensor(s).unwrap());
+            let (a, b) = (
+                h.apply(s.0, s.1).unwrap(),
+                fit.geometry.to_sensor(s).unwrap(),
+            );
             assert!((a.0 - b.0).hypot(a.1 - b.1) < 0.3, "{s:?}");
         }
     }
