@@ -1,7 +1,7 @@
 //! The screen as `estimate screen` uses it: registered ([`super::register`]), snapped to
-//! the 1:1 mapping where a stimulus of the sensor's size registers within a quarter pixel
-//! of it (resampling an exact 1:1 mapping would only blur it), and described for the
-//! results.
+//! the 1:1 mapping where a stimulus of the sensor's size registers within 0.35 px
+//! of it wherever it was measured (the matched points; resampling an exact 1:1 mapping
+//! would only blur it), and described for the results.
 
 use super::register::{self, Inputs, Registration};
 use crate::sim::DisplayParams;
@@ -10,7 +10,7 @@ use serde_json::{Value, json};
 use std::sync::Arc;
 
 /// Corner displacement below which a same-size registration is taken as 1:1, pixels.
-const SNAP_PX: f64 = 0.25;
+const SNAP_PX: f64 = 0.35;
 
 /// Where the screen is, as the simulation uses it.
 pub struct Located {
@@ -29,7 +29,7 @@ impl Located {
     pub fn new(registration: Registration) -> Self {
         let g = &registration.geometry;
         let identity = ScreenGeometry::identity(g.stimulus, g.sensor);
-        let change = register::corner_change(g, &identity);
+        let change = register::support_change(g, &identity, &registration.support);
         if g.stimulus == g.sensor && change < SNAP_PX {
             let on_screen = vec![true; g.sensor.0 * g.sensor.1];
             return Self {
@@ -94,7 +94,7 @@ impl Located {
         );
         match self.snapped {
             Some(change) => format!(
-                "{found}; its corners lie within {change:.2} px of the 1:1 mapping, so screen pixels are taken to map 1:1 onto sensor pixels"
+                "{found}; wherever it was measured it lies within {change:.2} px of the 1:1 mapping, so screen pixels are taken to map 1:1 onto sensor pixels"
             ),
             None => format!(
                 "{found}; a homography{} maps the stimulus onto the sensor, the light of each sensor pixel is the screen's over its footprint, and the {} pixels that do not see only the screen are left out",

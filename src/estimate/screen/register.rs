@@ -49,6 +49,8 @@ pub struct Registration {
     /// The coarse search's correlation.
     pub coarse_score: f64,
     pub iterations: usize,
+    /// The stimulus points of the correspondences kept (where the geometry is measured).
+    pub support: Vec<(f64, f64)>,
 }
 
 /// The events' images of the stimulus windows.
@@ -86,12 +88,28 @@ pub fn corner_change(a: &ScreenGeometry, b: &ScreenGeometry) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The largest distance between where `a` and `b` put the stimulus points `support`.
+pub fn support_change(a: &ScreenGeometry, b: &ScreenGeometry, support: &[(f64, f64)]) -> f64 {
+    support
+        .iter()
+        .map(|&s| match (a.to_sensor(s), b.to_sensor(s)) {
+            (Some(p), Some(q)) => (p.0 - q.0).hypot(p.1 - q.1),
+            _ => f64::INFINITY,
+        })
+        .fold(0.0, f64::max)
+}
+
+/// A fit and the correspondences it kept.
+struct Robust {
+    fit: dlt::GeometryFit,
+    p_value: Option<f64>,
+    outliers: usize,
+    support: Vec<(f64, f64)>,
+}
+
 /// The robust fit: all pairs, then only those within three robust standard deviations
 /// (at least 0.75 px) of the fit, twice.
-fn robust_fit(
-    template: &ScreenGeometry,
-    pairs: &[Pair],
-) -> Option<(dlt::GeometryFit, Option<f64>, usize)> {
+fn robust_fit(template: &ScreenGeometry, pairs: &[Pair]) -> Option<Robust> {
     let mut kept: Vec<Pair> = pairs.to_vec();
     let mut result = dlt::fit(template, &kept)?;
     for _ in 0..2 {
@@ -120,7 +138,13 @@ fn robust_fit(
         result = dlt::fit(template, &kept)?;
     }
     let outliers = pairs.len() - kept.len();
-    Some((result.0, result.1, outliers))
+    let support = kept.iter().map(|p| p.0).collect();
+    Some(Robust {
+        fit: result.0,
+        p_value: result.1,
+        outliers,
+        support,
+    })
 }
 
 fn median(values: &mut [f64]) -> f64 {
@@ -150,17 +174,23 @@ pub fn refine(
                 pairs.len()
             ));
         }
-        let (fit, p_value, outliers) = robust_fit(&g, &pairs)
+        let Robust {
+            fit,
+            p_value,
+            outliers,
+            support,
+        } = robust_fit(&g, &pairs)
             .ok_or("the matched points do not determine a homography (too few consistent ones)")?;
         let change = corner_change(&g, &fit.geometry);
         g = fit.geometry.clone();
-        last = Some((fit, p_value, outliers, pairs.len(), iteration));
+        last = Some((fit, p_value, outliers, pairs.len(), iteration, support));
         if change < 0.02 {
             break;
         }
         radius = ((2.0 * change).ceil() as usize + 2).clamp(3, first_radius);
     }
-    let (fit, p_value, outliers, count, iterations) = last.expect("at least one iteration");
+    let (fit, p_value, outliers, count, iterations, support) =
+        last.expect("at least one iteration");
     let mut norms: Vec<f64> = fit.residuals.iter().map(|r| r.0.hypot(r.1)).collect();
     let registration = Registration {
         warp: Arc::new(ScreenWarp::new(&fit.geometry)),
@@ -172,6 +202,7 @@ pub fn refine(
         k1_p_value: p_value,
         coarse_score: f64::NAN,
         iterations,
+        support,
     };
     if registration.rms_px > MAX_RMS_PX {
         return Err(format!(
