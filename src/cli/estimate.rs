@@ -467,6 +467,17 @@ fn present(
     common: &CommonArgs,
     policy: &ctcal::io::write::OutputPolicy,
 ) -> anyhow::Result<()> {
+    let with_biases;
+    let biases = loaded.recording.biases();
+    let estimate = match &biases {
+        Some(b) => {
+            let mut e = estimate.clone();
+            e.extra.insert("biases".into(), serde_json::to_value(b)?);
+            with_biases = e;
+            &with_biases
+        }
+        None => estimate,
+    };
     let target = common.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
         emit_json(estimate, target, policy)?;
@@ -509,6 +520,7 @@ fn present(
             value("ct_off", estimate.ct_off, estimate.ct_off_ci95),
         ),
         ("ct".into(), value("ct", estimate.ct, estimate.ct_ci95)),
+        output::biases_row(biases.as_ref()),
     ];
     if let (Some(s), Some(ci)) = (estimate.ct_sigma, estimate.ct_sigma_ci95) {
         rows.push((

@@ -102,6 +102,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     spinner.finish_and_clear();
     let mut result = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
     result.assumptions.extend(loaded.notes.iter().cloned());
+    result.biases = loaded.recording.biases();
     let target = common.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
         emit_json(&result, target, &policy)?;
@@ -113,10 +114,13 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
 }
 
 fn print_human(r: &FitResult) -> std::io::Result<()> {
-    let mut rows = vec![(
-        "thresholds".to_string(),
-        format!("ON {:.4}, OFF {:.4}", r.params.ct_on, r.params.ct_off),
-    )];
+    let mut rows = vec![
+        (
+            "thresholds".to_string(),
+            format!("ON {:.4}, OFF {:.4}", r.params.ct_on, r.params.ct_off),
+        ),
+        output::biases_row(r.biases.as_ref()),
+    ];
     for (key, u) in &r.uncertainties {
         if key.starts_with("ct_o") {
             continue;

@@ -35,6 +35,9 @@ struct Info {
     timestamps_backwards: u64,
     frames: usize,
     file_bytes: u64,
+    /// Sensor biases saved in or beside the recording.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    biases: Option<ctcal::io::Biases>,
 }
 
 pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
@@ -82,6 +85,7 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
         file_bytes: std::fs::metadata(recording.event_file())
             .map(|m| m.len())
             .unwrap_or(0),
+        biases: recording.biases(),
     };
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
@@ -115,6 +119,7 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
                 info.timestamps_backwards.to_string(),
             ),
             ("frames".into(), info.frames.to_string()),
+            output::biases_row(info.biases.as_ref()),
         ])?;
         if !info.topics.is_empty() {
             print_topics(&info.topics)?;

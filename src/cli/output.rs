@@ -89,3 +89,20 @@ pub fn seconds(s: f64) -> String {
         format!("{s:.6} s")
     }
 }
+
+/// The table row of a recording's biases.
+pub fn biases_row(biases: Option<&ctcal::io::Biases>) -> (String, String) {
+    let text = match biases {
+        Some(b) => format!(
+            "{} (from {})",
+            b.values
+                .iter()
+                .map(|(name, value)| format!("{name} {value}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            b.source.display()
+        ),
+        None => "none found in or beside the recording".into(),
+    };
+    ("biases".into(), text)
+}

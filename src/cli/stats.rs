@@ -70,7 +70,8 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
     for note in &recording.notes {
         warn(global, note);
     }
-    let stats = compute(&recording, args, global)?;
+    let mut stats = compute(&recording, args, global)?;
+    stats.biases = recording.biases();
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
         emit_json(
@@ -283,6 +284,7 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
             },
         ),
         ("hot pixels".into(), s.hot_pixels.len().to_string()),
+        output::biases_row(s.biases.as_ref()),
     ];
     for h in s.hot_pixels.iter().take(10) {
         rows.push((

@@ -191,6 +191,10 @@ impl Serialize for FittedParams {
 /// The result of `ctcal fit` (the JSON keys of `../shared/CLI.md`, and more).
 #[derive(Clone, Debug, Serialize)]
 pub struct FitResult {
+    /// Sensor biases saved in or beside the recording (filled by the caller that knows the
+    /// files; absent when none are found). No model ties them to the parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub biases: Option<crate::io::Biases>,
     /// The fitted model (PARAMS.toml keys; `null` where not identified).
     pub params: FittedParams,
     /// Per parameter of the model: whether the data identify it.

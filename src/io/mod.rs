@@ -8,6 +8,7 @@
 
 pub mod aedat4;
 pub mod bag;
+pub mod biases;
 mod blocks;
 pub mod blosc;
 pub mod dat;
@@ -28,6 +29,7 @@ mod recording;
 pub mod text;
 pub mod write;
 
+pub use biases::Biases;
 pub use detect::detect;
 pub use error::InputError;
 pub use frame_list::FrameList;

@@ -293,6 +293,12 @@ impl Recording {
         })
     }
 
+    /// The sensor biases saved in or beside the recording ([`super::biases`]).
+    pub fn biases(&self) -> Option<super::Biases> {
+        let prophesee = matches!(self.format, Format::Evt2 | Format::Evt3 | Format::Dat);
+        super::biases::find(self.event_file(), prophesee)
+    }
+
     /// The file holding the events (`events.txt` for IJRR folders).
     pub fn event_file(&self) -> &Path {
         match &self.source {

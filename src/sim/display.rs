@@ -9,7 +9,8 @@
 //! - time: sample and hold at `refresh_hz` (no LCD response time or PWM flicker), see
 //!   [`super::source::DisplaySource`].
 //!
-//! Screen pixels map 1:1 onto sensor pixels.
+//! Screen pixels map 1:1 onto sensor pixels, unless a [`super::screen_geometry`] warp puts the
+//! screen at an angle.
 
 use super::params::DisplayParams;
 
@@ -75,7 +76,13 @@ impl DisplayModel {
 
     /// Camera DN of a screen frame (W x H), blurred.
     pub fn camera_dn(&self, screen: &[f32], width: usize, height: usize) -> Vec<f32> {
-        let lit: Vec<f32> = screen
+        self.blur(self.lit(screen), width, height)
+    }
+
+    /// Camera DN of each screen pixel, before the optics (for a screen seen at an angle,
+    /// [`super::screen_geometry`] resamples these onto the sensor before [`Self::blur`]).
+    pub fn lit(&self, screen: &[f32]) -> Vec<f32> {
+        screen
             .iter()
             .map(|&dn| {
                 // whole screen DN (every 8-bit stimulus) read from the table; the cast
@@ -87,7 +94,11 @@ impl DisplayModel {
                     self.luminance_dn(dn)
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    /// The optical blur of a camera-DN image (W x H).
+    pub fn blur(&self, lit: Vec<f32>, width: usize, height: usize) -> Vec<f32> {
         if self.kernel.len() == 1 {
             return lit;
         }

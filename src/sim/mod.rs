@@ -16,6 +16,7 @@ pub mod pixel;
 pub mod rng;
 mod row;
 pub mod scene;
+pub mod screen_geometry;
 pub mod simulator;
 pub mod source;
 

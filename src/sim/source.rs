@@ -5,6 +5,7 @@
 use super::SimError;
 use super::display::DisplayModel;
 use super::pixel::Transition;
+use super::screen_geometry::{self, ScreenWarp};
 use crate::events::{Frame, TimeUs};
 
 /// One intensity sample.
@@ -187,10 +188,12 @@ impl<F: FnMut(usize) -> Result<Frame, SimError>> FrameSource for LoadedFrames<F>
 }
 
 /// A display showing another source's frames: at every refresh it shows the latest frame
-/// (sample and hold), through its gamma, black level, white level and optical blur.
+/// (sample and hold), through its gamma, black level, white level and optical blur; seen
+/// at an angle when it has a [`ScreenWarp`] ([`Self::seen_through`]).
 pub struct DisplaySource<S> {
     inner: S,
     model: DisplayModel,
+    warp: Option<std::sync::Arc<ScreenWarp>>,
     shown: Option<Vec<f32>>,
     pending: Option<Sample>,
     refresh: u64,
@@ -205,6 +208,7 @@ impl<S: FrameSource> DisplaySource<S> {
         Self {
             inner,
             model,
+            warp: None,
             shown: None,
             pending: None,
             refresh: 0,
@@ -212,6 +216,12 @@ impl<S: FrameSource> DisplaySource<S> {
             offset_us,
             done: false,
         }
+    }
+
+    /// The screen seen through `warp` (stimulus-sized frames in, sensor-sized samples out).
+    pub fn seen_through(mut self, warp: std::sync::Arc<ScreenWarp>) -> Self {
+        self.warp = Some(warp);
+        self
     }
 
     fn refresh_time(&self, k: u64) -> TimeUs {
@@ -222,7 +232,10 @@ impl<S: FrameSource> DisplaySource<S> {
 
 impl<S: FrameSource> FrameSource for DisplaySource<S> {
     fn size(&self) -> (usize, usize) {
-        self.inner.size()
+        match &self.warp {
+            Some(warp) => warp.sensor_size(),
+            None => self.inner.size(),
+        }
     }
 
     fn next_frame(&mut self) -> Result<Option<Sample>, SimError> {
@@ -247,7 +260,19 @@ impl<S: FrameSource> FrameSource for DisplaySource<S> {
             }
             let (w, h) = self.inner.size();
             let p = self.pending.take().expect("checked");
-            self.shown = Some(self.model.camera_dn(&p.dn, w, h));
+            self.shown = Some(match &self.warp {
+                Some(warp) if warp.stimulus_size() == (w, h) => {
+                    screen_geometry::camera_dn(&self.model, warp, &p.dn)
+                }
+                Some(warp) => {
+                    return Err(SimError::Invalid(format!(
+                        "the screen geometry is for a {}x{} stimulus, the frames are {w}x{h}",
+                        warp.stimulus_size().0,
+                        warp.stimulus_size().1
+                    )));
+                }
+                None => self.model.camera_dn(&p.dn, w, h),
+            });
             changed = true;
             self.pending = self.inner.next_frame()?;
         }

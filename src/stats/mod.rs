@@ -105,6 +105,10 @@ pub struct IntervalSummary {
 /// Statistics of one event sequence (the `ctcal stats` JSON).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SequenceStats {
+    /// Sensor biases saved in or beside the recording (filled by the caller that knows the
+    /// files; absent when none are found).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub biases: Option<crate::io::Biases>,
     pub width: u16,
     pub height: u16,
     pub sensor_source: String,
@@ -394,6 +398,7 @@ impl StatsAccumulator {
             background_rate(&unsupported, area_w, &hot, duration_s, &keep, kept_pixels);
         let off = self.events - self.on;
         Some(SequenceStats {
+            biases: None,
             width: sensor.width,
             height: sensor.height,
             sensor_source: sensor_source.to_string(),

@@ -290,6 +290,11 @@ fn screen_recovers_the_threshold_through_the_display_and_reports_the_naive_one()
             "{display}"
         );
         assert!(display["time_offset_s"].as_f64().unwrap().abs() < 0.002);
+        // the screen is found in the events, and found to map 1:1
+        let r = &e["registration"];
+        assert_eq!(r["one_to_one"], true, "{r}");
+        assert!(r["error_rms_px"].as_f64().unwrap() < 0.5, "{r}");
+        assert!(r["points"].as_u64().unwrap() > 100, "{r}");
         assert!(
             e["display_explains"].as_str().unwrap().contains("naive")
                 || e["display_explains"]

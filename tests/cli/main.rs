@@ -1,6 +1,7 @@
 //! ctcal's integration tests: one binary (as ripgrep does), driving the `ctcal` command and
 //! the library over the shared real recordings and simulator-oracle cases.
 
+mod biases;
 mod common;
 mod convert;
 mod coverage;

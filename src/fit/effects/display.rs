@@ -33,7 +33,7 @@ pub fn evidence(c: &Context) -> Evidence {
     if let Some(grid) = c.timestamp_grid_us.filter(|&g| g >= GRID_HIDES_DISPLAY_US) {
         return Evidence::none(
             Effect::Display,
-            &format!(
+            format!(
                 "the timestamps lie on a {grid} us grid (a simulator's frames): the event-rate spectrum shows the grid's lines, not a display's"
             ),
         );

@@ -126,6 +126,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         })
         .collect();
     FitResult {
+        biases: None,
         why: not_identified.clone(),
         identified,
         params: FittedParams {

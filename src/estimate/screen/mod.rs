@@ -25,18 +25,30 @@
 //!    the counts cannot separate from `C`, so it comes from the screen model, and full refits
 //!    with it 30 % dimmer and 40 % brighter are the systematic error.
 
+mod coarse;
+pub mod dlt;
+mod images;
+pub mod located;
+mod matching;
+pub mod register;
+#[cfg(test)]
+mod tests;
+
 use super::interval::Measured;
 use super::resim::{Cells, Counts, Intervals, log_ratio};
 use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::sim::display::DisplayModel;
 use crate::sim::pixel::Transition;
+use crate::sim::screen_geometry::ScreenWarp;
 use crate::sim::source::{DisplaySource, MemoryFrames};
 use crate::sim::{DisplayParams, PixelMaps, PixelParams};
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
 use argmin::solver::brent::BrentRoot;
 use argmin::solver::neldermead::NelderMead;
+use located::Located;
 use nalgebra::DVector;
+use register::Registration;
 use serde_json::json;
 
 /// Side of the counting tiles, pixels: small enough to keep each region's own transitions,
@@ -129,6 +141,8 @@ struct Setup<'a> {
     real: Counts,
     offset_us: TimeUs,
     refresh_hz: f64,
+    /// The screen seen at an angle (`None`: 1:1).
+    warp: Option<std::sync::Arc<ScreenWarp>>,
     evaluations: std::sync::atomic::AtomicUsize,
 }
 
@@ -144,6 +158,23 @@ impl Setup<'_> {
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let bug = |e: crate::sim::SimError| {
             EstimateError::new(format!("screen simulation: {e}"), "report this as a bug")
+        };
+        // the naive simulation of a screen seen at an angle: the stimulus values as the
+        // camera's, resampled onto the sensor
+        let identity;
+        let display = match (display, &self.warp) {
+            (None, Some(_)) => {
+                identity = DisplayParams {
+                    refresh_hz: self.refresh_hz,
+                    gamma: 1.0,
+                    black_level: 0.0,
+                    white_dn: 255.0,
+                    blur_px: None,
+                    time_offset_s: None,
+                };
+                Some(&identity)
+            }
+            (display, _) => display,
         };
         let frames = match display {
             None => MemoryFrames::new(&self.shifted, Transition::Hold),
@@ -173,6 +204,9 @@ impl Setup<'_> {
                 d.refresh_hz = self.refresh_hz;
                 d.time_offset_s = Some(self.offset_us as f64 * 1e-6);
                 let mut source = DisplaySource::new(frames, DisplayModel::new(&d));
+                if let Some(warp) = &self.warp {
+                    source = source.seen_through(warp.clone());
+                }
                 crate::sim::run(
                     &mut source,
                     &params,
@@ -225,7 +259,7 @@ impl Setup<'_> {
                 let Some((lo, hi)) = bracket else {
                     return Err(EstimateError::new(
                         "the simulated stimulus makes too few or too many events for every threshold tried",
-                        "check that the stimulus matches the recording (--stimulus) and that the screen fills the camera's view 1:1",
+                        "check that the stimulus is the one the recording shows",
                     ));
                 };
                 let result = Executor::new(problem, BrentRoot::new(lo, hi, 0.002 * current))
@@ -332,13 +366,6 @@ fn log_variation(stimulus: &[Frame], display: Option<&DisplayParams>) -> f64 {
 
 /// Estimates the thresholds from a recording of `input.stimulus` on a screen.
 pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, EstimateError> {
-    let (w, h) = (input.stimulus[0].width, input.stimulus[0].height);
-    if (w as u16, h as u16) != (input.sensor.width, input.sensor.height) {
-        return Err(EstimateError::new(
-            format!("the stimulus is {w}x{h} but the sensor is {}", input.sensor),
-            "screen pixels must map 1:1 onto sensor pixels: play a stimulus of the sensor's size (`ctcal calib checkerboard --width W --height H`)",
-        ));
-    }
     let refresh_hz = match input.refresh_hz.or_else(|| stimulus_rate(input.stimulus)) {
         Some(r) if r.is_finite() && r > 0.0 => r,
         _ => {
@@ -362,9 +389,31 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     let times: Vec<TimeUs> = (0..=count)
         .map(|k| offset_us + input.stimulus[0].t + ((k as f64 - 0.5) * period).round() as TimeUs)
         .collect();
-    let (excluded, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
-    // each small region's count over the whole stimulus: the mapping is 1:1, so a region's
-    // count is the response to the transitions it saw, which pins the display's curve
+    let (hot_mask, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
+    progress("finding the screen on the sensor", 0.05);
+    let sensor = (input.sensor.width as usize, input.sensor.height as usize);
+    let inputs = register::Inputs {
+        events: input.events,
+        sensor,
+        excluded: &hot_mask,
+        stimulus: input.stimulus,
+        offset_us,
+        refresh_hz,
+    };
+    let mut screen_model = input.screen.clone();
+    screen_model.refresh_hz = refresh_hz;
+    let mut located = match Located::find(&inputs, &screen_model) {
+        Ok(located) => located,
+        Err(reason) => return Ok(unregistered(&reason)),
+    };
+    let excluded: Vec<bool> = hot_mask
+        .iter()
+        .zip(&located.on_screen)
+        .map(|(&hot, &on)| hot || !on)
+        .collect();
+    // each small region's count over the whole stimulus: through the known geometry, a
+    // region's count is the response to the transitions it saw, which pins the display's
+    // curve
     let intervals = times.len() - 1;
     let cells = Cells::with_layout(
         Intervals::all(times),
@@ -389,6 +438,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         real,
         offset_us,
         refresh_hz,
+        warp: located.warp.clone(),
         evaluations: std::sync::atomic::AtomicUsize::new(0),
     };
     progress("naive estimate (no display model)", 0.1);
@@ -434,6 +484,18 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         .clone()
         .unwrap_or_else(|| start.clone());
     let display = joint.display(&best);
+    progress(
+        "refining the screen's position through the fitted display",
+        0.75,
+    );
+    let reregistered = reregister(&inputs, &display, &mut located);
+    let setup = match reregistered {
+        Some(warp) => Setup {
+            warp: Some(warp),
+            ..setup
+        },
+        None => setup,
+    };
     progress("refining the thresholds", 0.8);
     let fitted = setup.thresholds((best[0].exp(), best[1].exp()), Some(&display))?;
     // the counts fix gamma / C (transitions between grey levels) and the log contrast of
@@ -522,8 +584,9 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         1.0
     };
     estimate.assumptions.splice(0..0, [
+        located.assumption(),
         format!(
-            "screen pixels map 1:1 onto sensor pixels; the stimulus clock starts {:.6} s into the recording (found from the event bursts at its refreshes)",
+            "the stimulus clock starts {:.6} s into the recording (found from the event bursts at its refreshes)",
             offset_us as f64 * 1e-6
         ),
         format!(
@@ -564,6 +627,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         }),
     );
     estimate.extra.insert("naive_ct".into(), json!(naive_ct));
+    estimate.extra.insert("registration".into(), located.json());
     estimate.extra.insert(
         "display_explains".into(),
         json!(format!(
@@ -577,4 +641,40 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     );
     progress("done", 1.0);
     Ok(estimate)
+}
+
+/// The result when the screen is not found: nothing determinable, and why.
+fn unregistered(reason: &str) -> CtEstimate {
+    let why = format!("the screen could not be found on the sensor: {reason}");
+    let mut estimate = CtEstimate::not_determinable("screen", &why);
+    estimate
+        .extra
+        .insert("registration".into(), json!({ "error": reason }));
+    estimate
+}
+
+/// The screen registered again through the fitted display (the joint refinement of
+/// geometry and display); the new warp when the screen's corners moved more than 0.05 px.
+fn reregister(
+    inputs: &register::Inputs,
+    display: &DisplayParams,
+    located: &mut Located,
+) -> Option<std::sync::Arc<ScreenWarp>> {
+    located.warp.as_ref()?;
+    let (real, bounds) = register::event_images(inputs);
+    let start = located.registration.geometry.clone();
+    let again =
+        register::refine(&real, &bounds, inputs.stimulus, display, start.clone(), 3).ok()?;
+    let change = register::corner_change(&start, &again.geometry);
+    located.refined_change_px = Some(change);
+    if change <= 0.05 {
+        return None;
+    }
+    let coarse_score = located.registration.coarse_score;
+    located.registration = Registration {
+        coarse_score,
+        ..again
+    };
+    located.warp = Some(located.registration.warp.clone());
+    located.warp.clone()
 }
