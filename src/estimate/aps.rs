@@ -85,6 +85,9 @@ pub struct ApsResult {
     pub maps: ThresholdMaps,
 }
 
+/// The fewest usable frame intervals the frame-based thresholds rest on.
+const MIN_USED_INTERVALS: usize = 3;
+
 /// The support window of the re-simulation counts: a few pixel-crossing times of the
 /// recording's typical motion (10-100 ms).
 fn support_window_us(frames: &PreparedFrames) -> TimeUs {
@@ -190,6 +193,15 @@ pub fn estimate(
         ));
     }
     let used = frames.intervals.iter().filter(|i| i.used).count();
+    if used < MIN_USED_INTERVALS {
+        return Err(EstimateError::new(
+            format!(
+                "only {used} of {} frame intervals can be used (the flow between the frames fails: motion too fast for the frame rate, or frames too dark or blurred); thresholds from frames need {MIN_USED_INTERVALS} at least, or they rest on a single stretch of motion whose flow nothing checks",
+                frames.intervals.len()
+            ),
+            "use a recording (or a part, --start/--end) with more frames per unit of motion; without usable frames estimate with the eppps or screen method",
+        ));
+    }
     let exposure = input
         .frames
         .iter()
@@ -408,7 +420,13 @@ pub fn estimate(
         .filter(|i| !i.used)
         .cloned()
         .collect();
-    sigma_result(&mut estimate, &mut assumptions, sigma, sigma_bias, &full.timing);
+    sigma_result(
+        &mut estimate,
+        &mut assumptions,
+        sigma,
+        sigma_bias,
+        &full.timing,
+    );
     estimate.assumptions = assumptions;
     estimate.estimators = estimators;
     let maps = &full.timing.maps;

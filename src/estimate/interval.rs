@@ -130,6 +130,14 @@ pub fn combine(estimates: &[&Measured]) -> Option<(f64, f64)> {
         if birge > 1.0 {
             error *= birge;
         }
+        // methods measuring the same quantity differ by their systematics at least: half
+        // their range stays in the error (so the interval spans about the range)
+        let (lo, hi) = usable
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), m| {
+                (lo.min(m.value), hi.max(m.value))
+            });
+        error = error.max(0.5 * (hi - lo));
     }
     Some((value, error))
 }

@@ -590,8 +590,15 @@ fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
         "--out",
         work.path().join("sim").to_str().unwrap(),
     ]);
+    // every parameter the fit identified (thresholds always here), as simulated
     for key in ["ct_on", "ct_off", "ct_sigma", "shot_noise_rate_hz"] {
-        let fitted = fit["params"][key].as_f64().unwrap();
+        let Some(fitted) = fit["params"][key].as_f64() else {
+            assert!(
+                !key.starts_with("ct_on") && !key.starts_with("ct_off"),
+                "{key}"
+            );
+            continue;
+        };
         let simulated = sim["params"][key]
             .as_f64()
             .unwrap_or_else(|| panic!("{key} in {sim:#}"));

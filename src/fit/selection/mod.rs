@@ -320,34 +320,10 @@ fn next_effect(candidates: Vec<effects::Evidence>, forced: bool) -> Option<effec
     })
 }
 
-/// The hot pixels of the fit blocks that stay hot on the selection blocks (a defect
-/// persists; a busy patch of scene does not): there each still fires above its busiest
-/// neighbour by three Poisson deviations, at a quarter of its fit rate or more. Each with
-/// its rate and ON share in the fit run.
+/// The hot pixels of the fit blocks (robust z-score against the busiest neighbour), each
+/// with its rate and ON share in the fit run.
 fn hot_trains(context: &Context, fit_events: &EventChunk) -> (Vec<HotPixel>, Vec<HotTrain>) {
-    let g = context.geometry;
-    let judging = g.judging();
-    let counts = context.real.pixels_of(g, judging);
-    let seconds = g.duration_of(judging);
-    let (w, h) = (g.sensor.width as usize, g.sensor.height as usize);
-    let persists = |p: &HotPixel| {
-        let (x, y) = (p.x as usize, p.y as usize);
-        let mut neighbours = 0u32;
-        for ny in y.saturating_sub(1)..(y + 2).min(h) {
-            for nx in x.saturating_sub(1)..(x + 2).min(w) {
-                if (nx, ny) != (x, y) {
-                    neighbours = neighbours.max(counts[ny * w + nx]);
-                }
-            }
-        }
-        let own = counts[y * w + x] as f64;
-        own > neighbours as f64 + 3.0 * (neighbours as f64 + 1.0).sqrt()
-            && own >= 0.25 * p.rate_hz * seconds
-    };
-    let hot: Vec<HotPixel> = effects::hot_pixels::find(context)
-        .into_iter()
-        .filter(persists)
-        .collect();
+    let hot = effects::hot_pixels::find(context);
     let trains = hot
         .iter()
         .map(|h| {
