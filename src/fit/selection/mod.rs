@@ -356,11 +356,7 @@ fn refit_together(
     steps: &mut Vec<Step>,
     progress: Progress,
 ) -> Result<(), FitError> {
-    let searched: Vec<Effect> = added
-        .iter()
-        .map(|a| a.effect)
-        .filter(|e| e.parameter().is_some())
-        .collect();
+    let searched = searched_together(added);
     if searched.len() < 2 {
         return Ok(());
     }
@@ -386,11 +382,7 @@ fn prune_added(
     added: &mut Vec<AddedEffect>,
     steps: &mut Vec<Step>,
 ) -> Result<(), FitError> {
-    let searched: Vec<Effect> = added
-        .iter()
-        .map(|a| a.effect)
-        .filter(|e| e.parameter().is_some())
-        .collect();
+    let searched = searched_together(added);
     if searched.len() < 2 {
         return Ok(());
     }
@@ -402,6 +394,15 @@ fn prune_added(
         steps.push(step);
     }
     Ok(())
+}
+
+/// The added effects with a searched parameter, in the order they were added.
+fn searched_together(added: &[AddedEffect]) -> Vec<Effect> {
+    added
+        .iter()
+        .map(|a| a.effect)
+        .filter(|e| e.parameter().is_some())
+        .collect()
 }
 
 /// The evidence context of the current state (fit blocks).
