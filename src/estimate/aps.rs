@@ -199,7 +199,7 @@ pub fn estimate(
                 "only {used} of {} frame intervals can be used (the flow between the frames fails: motion too fast for the frame rate, or frames too dark or blurred); thresholds from frames need {MIN_USED_INTERVALS} at least, or they rest on a single stretch of motion whose flow nothing checks",
                 frames.intervals.len()
             ),
-            "use a recording (or a part, --start/--end) with more frames per unit of motion; without usable frames estimate with the eppps or screen method",
+            "use a recording, or a part of one, with more frames per unit of motion; without usable frames estimate with the eppps or screen method",
         ));
     }
     let exposure = input
