@@ -456,15 +456,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         screen.black_level.max(1e-4).ln(),
         screen.blur_px.unwrap_or(0.7).max(0.1).ln(),
     ]);
-    let simplex: Vec<DVector<f64>> = (0..6)
-        .map(|k| {
-            let mut v = start.clone();
-            if k > 0 {
-                v[k - 1] += [0.15, 0.15, 0.2, 0.5, 0.3][k - 1];
-            }
-            v
-        })
-        .collect();
+    let simplex = simplex_around(&start, [0.15, 0.15, 0.2, 0.5, 0.3]);
     let solver = NelderMead::new(simplex)
         .with_sd_tolerance(2e-3)
         .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))?;
@@ -515,15 +507,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         from[0] = best[0];
         from[1] = best[1];
         from[4] = best[4];
-        let simplex: Vec<DVector<f64>> = (0..6)
-            .map(|k| {
-                let mut v = from.clone();
-                if k > 0 {
-                    v[k - 1] += [0.1, 0.1, 0.15, 0.4, 0.1][k - 1];
-                }
-                v
-            })
-            .collect();
+        let simplex = simplex_around(&from, [0.1, 0.1, 0.15, 0.4, 0.1]);
         let solver = NelderMead::new(simplex).with_sd_tolerance(5e-3).ok()?;
         let found = Executor::new(problem, solver)
             .configure(|s| s.max_iters(60))
@@ -677,4 +661,17 @@ fn reregister(
     };
     located.warp = Some(located.registration.warp.clone());
     located.warp.clone()
+}
+
+/// A Nelder-Mead start simplex: `start` and, for each coordinate, `start` moved by its step.
+fn simplex_around(start: &DVector<f64>, steps: [f64; 5]) -> Vec<DVector<f64>> {
+    (0..=steps.len())
+        .map(|k| {
+            let mut v = start.clone();
+            if k > 0 {
+                v[k - 1] += steps[k - 1];
+            }
+            v
+        })
+        .collect()
 }
