@@ -42,6 +42,21 @@ struct Fits {
     seed: Option<u64>,
     /// The sensor (`WxH`) of each fit, where a report says it, with the sequence's name.
     sensors: Vec<(String, String)>,
+    /// Parameters a fit does not identify, with why (its `why`).
+    not_identified: std::collections::BTreeMap<String, String>,
+}
+
+impl Fits {
+    /// Keeps what the fit `json` says it does not identify.
+    fn note_unidentified(&mut self, json: &serde_json::Value) {
+        if let Some(why) = json.get("why").and_then(|w| w.as_object()) {
+            for (key, reason) in why {
+                if let Some(reason) = reason.as_str() {
+                    self.not_identified.insert(key.clone(), reason.to_string());
+                }
+            }
+        }
+    }
 }
 
 /// Refuses fits of different sensors: a configuration describes one camera.
@@ -186,6 +201,10 @@ fn validate_fit_json(fit: &serde_json::Value, file: &str, prefix: &str) -> Resul
             continue;
         };
         let path = format!("params.{key}");
+        // a parameter the fit says it does not identify is null, with its reason
+        if value.is_null() && fit["why"][key.as_str()].is_string() {
+            continue;
+        }
         let Some(v) = value.as_f64() else {
             return Err(bad(
                 &path,
@@ -276,6 +295,7 @@ fn gather(inputs: &[PathBuf]) -> anyhow::Result<(Fits, Option<(u32, u32)>)> {
                     )?;
                     fits.params.push(p);
                     fits.exposures_us.push(exposure);
+                    fits.note_unidentified(fit);
                     let (w, h) = (&s["stats"]["width"], &s["stats"]["height"]);
                     if let (Some(w), Some(h)) = (w.as_u64(), h.as_u64()) {
                         fits.sensors.push((format!("{w}x{h}"), name.to_string()));
@@ -291,6 +311,7 @@ fn gather(inputs: &[PathBuf]) -> anyhow::Result<(Fits, Option<(u32, u32)>)> {
             }
         } else {
             let (p, exposure) = fit_params(&json, &results.display().to_string(), "")?;
+            fits.note_unidentified(&json);
             fits.params.push(p);
             fits.exposures_us.push(exposure);
         }
@@ -312,7 +333,7 @@ pub fn run(args: &ConfigArgs, global: &Global) -> anyhow::Result<()> {
         exposure_ms,
         seed,
         sensor,
-        not_identified: Default::default(),
+        not_identified: fits.not_identified.clone(),
     };
     let text = configs::render(args.format, &fits.params, &setup).ok_or_else(|| {
         BadInput("no fits given\n  fix: give `ctcal fit` JSON files or a report folder".into())

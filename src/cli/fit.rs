@@ -28,6 +28,94 @@ pub struct FitArgs {
     /// Exposure time of the frames, where the file does not say.
     #[arg(long, value_name = "S")]
     pub exposure_s: Option<f64>,
+    /// Leave the recording's grey frames out and fit from the events alone (as for a
+    /// sensor without frames).
+    #[arg(long)]
+    pub no_frames: bool,
+    /// For a fit without frames: take the absolute thresholds from this `estimate --json`
+    /// result (e.g. `estimate screen` on the same recording) instead of running eppps.
+    #[arg(long, value_name = "ESTIMATE.json")]
+    pub thresholds_from: Option<std::path::PathBuf>,
+}
+
+/// Reads the thresholds of an `estimate --json` result.
+fn thresholds_from(path: &std::path::Path) -> Result<ctcal::estimate::CtEstimate, BadInput> {
+    let bad = |what: String| {
+        BadInput(format!(
+            "{}: {what}\n  fix: give the JSON that `ctcal estimate METHOD INPUT --json FILE` wrote",
+            path.display()
+        ))
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot be read: {e}")))?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| bad(format!("is not JSON: {e}")))?;
+    let method = match value.get("method").and_then(|m| m.as_str()) {
+        Some("screen") => "screen",
+        Some("aps") => "aps",
+        Some("eppps") => "eppps",
+        Some("combined") => "combined",
+        other => {
+            return Err(bad(format!(
+                "`method` is {other:?}, not one of screen, aps, eppps"
+            )));
+        }
+    };
+    let number = |key: &str| -> Result<Option<f64>, BadInput> {
+        match value.get(key) {
+            None | Some(serde_json::Value::Null) => Ok(None),
+            Some(v) => match v.as_f64() {
+                Some(x) if x.is_finite() && x > 0.0 && x < 100.0 => Ok(Some(x)),
+                _ => Err(bad(format!("`{key}` is {v}, not a positive threshold"))),
+            },
+        }
+    };
+    let interval = |key: &str| -> Option<ctcal::estimate::Interval> {
+        let v = value.get(key)?.as_array()?;
+        (v.len() == 2).then(|| [v[0].as_f64(), v[1].as_f64()])
+    };
+    let (ct_on, ct_off) = (number("ct_on")?, number("ct_off")?);
+    if ct_on.is_none() && ct_off.is_none() {
+        return Err(bad(
+            "holds no thresholds (`ct_on` and `ct_off` are null)".into()
+        ));
+    }
+    let strings = |key: &str| -> Vec<String> {
+        value
+            .get(key)
+            .and_then(|v| v.as_array())
+            .map(|a| {
+                a.iter()
+                    .filter_map(|s| s.as_str().map(String::from))
+                    .collect()
+            })
+            .unwrap_or_default()
+    };
+    let why = value
+        .get("why")
+        .and_then(|w| w.as_object())
+        .map(|w| {
+            w.iter()
+                .filter_map(|(k, v)| Some((k.clone(), v.as_str()?.to_string())))
+                .collect()
+        })
+        .unwrap_or_default();
+    Ok(ctcal::estimate::CtEstimate {
+        method,
+        ct_on,
+        ct_off,
+        ct: ct_on.zip(ct_off).map(|(a, b)| 0.5 * (a + b)),
+        ct_on_ci95: interval("ct_on_ci95"),
+        ct_off_ci95: interval("ct_off_ci95"),
+        ct_ci95: interval("ct_ci95"),
+        why,
+        intervals_used: Vec::new(),
+        assumptions: strings("assumptions"),
+        ct_sigma: None,
+        ct_sigma_ci95: None,
+        estimators: Vec::new(),
+        intervals_dropped: Vec::new(),
+        extra: serde_json::Map::new(),
+    })
 }
 
 /// Parses `--effects`.
@@ -73,7 +161,16 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     }
     let (log_map, log_name) = common.log_map()?;
     let policy = global.outputs([common.input.input.as_path()]);
-    let loaded = common.load(Some(args.max_frames), true, global)?;
+    let thresholds = args
+        .thresholds_from
+        .as_deref()
+        .map(thresholds_from)
+        .transpose()?;
+    let loaded = if args.no_frames {
+        common.load(None, false, global)?
+    } else {
+        common.load(Some(args.max_frames), true, global)?
+    };
     let path = loaded.recording.path.clone();
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
@@ -87,6 +184,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
             exposure_us: args.exposure_s.map(|s| (s * 1e6).round() as i64),
             ..ApsOptions::default()
         },
+        thresholds,
         ..FitOptions::default()
     };
     let result = ctcal::fit::fit(
@@ -114,13 +212,53 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
 }
 
 fn print_human(r: &FitResult) -> std::io::Result<()> {
+    let threshold = |key: &str, v: f64| {
+        r.why
+            .get(key)
+            .map_or(format!("{v:.4}"), |why| format!("not determinable ({why})"))
+    };
     let mut rows = vec![
         (
             "thresholds".to_string(),
-            format!("ON {:.4}, OFF {:.4}", r.params.ct_on, r.params.ct_off),
+            format!(
+                "ON {}, OFF {}",
+                threshold("ct_on", r.params.ct_on),
+                threshold("ct_off", r.params.ct_off)
+            ),
         ),
         output::biases_row(r.biases.as_ref()),
     ];
+    if let Some(e) = &r.events_only {
+        rows.push(("thresholds from".into(), e.thresholds_source.clone()));
+        if let Some(ratio) = &e.ct_ratio {
+            rows.push((
+                "Cp/Cn (ON/OFF balance)".into(),
+                format!(
+                    "{:.3} (+- {:.3})",
+                    ratio.value,
+                    ratio.standard_error.unwrap_or(f64::NAN)
+                ),
+            ));
+        }
+        let rate = |u: &Option<ctcal::fit::Uncertain>| {
+            u.as_ref()
+                .map_or("-".to_string(), |u| format!("{:.4}", u.value))
+        };
+        rows.push((
+            "isolated events (Hz/px)".into(),
+            format!(
+                "ON {}, OFF {} (fit blocks); test blocks ON {}, OFF {}",
+                rate(&e.noise_on_hz),
+                rate(&e.noise_off_hz),
+                e.noise_on_test_hz.map_or("-".into(), |v| format!("{v:.4}")),
+                e.noise_off_test_hz
+                    .map_or("-".into(), |v| format!("{v:.4}"))
+            ),
+        ));
+    }
+    for (key, why) in r.why.iter().filter(|(k, _)| !k.starts_with("ct_o")) {
+        rows.push((key.clone(), format!("not identified: {why}")));
+    }
     for (key, u) in &r.uncertainties {
         if key.starts_with("ct_o") {
             continue;

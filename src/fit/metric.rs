@@ -32,6 +32,9 @@ pub struct Components {
     pub polarity: f64,
     pub active: f64,
     pub dispersion: f64,
+    /// The named hot pixels' rates (fit without frames only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hot_pixels: Option<f64>,
     pub total: f64,
 }
 
@@ -182,6 +185,7 @@ pub fn distance(
         polarity,
         active,
         dispersion,
+        hot_pixels: None,
         total,
     }
 }

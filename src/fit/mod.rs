@@ -19,6 +19,7 @@
 //! every effect of the pixel model (Lichtsteiner et al. 2008; v2e, Hu et al. 2021).
 
 pub mod effects;
+pub mod events_only;
 pub mod metric;
 pub mod observe;
 pub mod residuals;
@@ -63,6 +64,9 @@ pub struct FitOptions {
     pub aps: crate::estimate::aps::ApsOptions,
     /// Thresholds used where a static scene cannot measure them.
     pub default_threshold: f64,
+    /// Absolute thresholds measured elsewhere (e.g. `estimate screen` on this recording)
+    /// for a fit without frames; without them it runs `estimate eppps` on its fit run.
+    pub thresholds: Option<crate::estimate::CtEstimate>,
     pub seed: u64,
 }
 
@@ -74,6 +78,7 @@ impl Default for FitOptions {
             blocks: 10,
             aps: crate::estimate::aps::ApsOptions::default(),
             default_threshold: 0.3,
+            thresholds: None,
             seed: 2020,
         }
     }
@@ -214,9 +219,12 @@ pub struct FitResult {
     pub steps: Vec<Step>,
     /// Hot pixels named (simulated where they are as their own event trains).
     pub hot_pixels_masked: Vec<HotPixel>,
-    /// Residuals of the ideal model and of the final one (fit blocks).
-    pub residuals_before: Residuals,
-    pub residuals_after: Residuals,
+    /// Residuals of the ideal model and of the final one (fit blocks; a fit without
+    /// frames simulates no scene and has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_before: Option<Residuals>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_after: Option<Residuals>,
     pub assumptions: Vec<String>,
     pub holdout: Holdout,
     pub simulations: usize,
@@ -224,6 +232,10 @@ pub struct FitResult {
     /// configurations.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub frame_exposure_us: Option<crate::TimeUs>,
+    /// What a fit without frames measured beyond the parameters (where the thresholds
+    /// come from, the noise rates, the interval edge, the threshold ratio).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub events_only: Option<events_only::EventsOnly>,
 }
 
 /// How the data were split.

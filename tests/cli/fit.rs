@@ -271,11 +271,6 @@ fn effect_choices_and_bad_input() {
         e.contains("`glare` is not an effect") && e.contains("shot_noise"),
         "{e}"
     );
-    let e = bad_input(&["fit", real("evk4_faery_evt3.raw").to_str().unwrap()]);
-    assert!(
-        e.contains("evk4_faery_evt3.raw") && e.contains("grey frames") && e.contains("fix:"),
-        "{e}"
-    );
     let e = bad_input(&[
         "fit",
         oracle("a_ideal_texture").to_str().unwrap(),

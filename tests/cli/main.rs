@@ -9,6 +9,7 @@ mod datasets;
 mod errors;
 mod estimate;
 mod fit;
+mod fit_events_only;
 mod limits;
 mod peers;
 mod readers;

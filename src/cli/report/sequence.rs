@@ -265,11 +265,6 @@ fn fit_of(loaded: &Loaded, args: &ReportArgs) -> (Option<FitResult>, Option<Stri
     let quiet = |_: &str, _: f64| {};
     if args.no_fit {
         (None, Some("left out (--no-fit)".to_string()))
-    } else if loaded.frames.len() < 2 {
-        (
-            None,
-            Some("the fit simulates grey frames; the recording has none".to_string()),
-        )
     } else {
         match ctcal::fit::fit(
             &FitInput {

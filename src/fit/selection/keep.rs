@@ -40,7 +40,6 @@ pub fn judge(
     let subset = g.judging();
     let before = simulation.distance(current, subset, kept_pixels);
     let after = simulation.distance(candidate, subset, kept_pixels);
-    let gain = before.total - after.total;
     let judging_blocks = (0..g.blocks).filter(|&b| g.in_subset(b, subset)).count();
     let relative_falls: Vec<f64> = g
         .blocks_of(Role::Fit)
@@ -55,35 +54,56 @@ pub fn judge(
             (was > 0.0).then(|| (was - now) / was)
         })
         .collect();
+    let Decision {
+        chance,
+        kept,
+        reason,
+    } = decide(before.total, after.total, &relative_falls, judging_blocks);
+    Verdict {
+        before,
+        after,
+        chance,
+        kept,
+        reason,
+    }
+}
+
+/// A keep decision from the distances alone.
+pub struct Decision {
+    pub chance: Option<f64>,
+    pub kept: bool,
+    pub reason: String,
+}
+
+/// Keeps a candidate whose distance on the `judging_blocks` falls from `before` to `after`
+/// by more than chance: twice the standard deviation of the per-block `relative_falls` (fit
+/// blocks) over the square root of the judging blocks, and at least [`PARSIMONY`]; with
+/// fewer than three relative falls, [`UNMEASURED_CHANCE`] stands in.
+pub fn decide(before: f64, after: f64, relative_falls: &[f64], judging_blocks: usize) -> Decision {
+    let gain = before - after;
     let chance = (relative_falls.len() >= 3)
-        .then(|| sample_std_dev(&relative_falls))
+        .then(|| sample_std_dev(relative_falls))
         .flatten()
-        .map(|s| 2.0 * s / (judging_blocks.max(1) as f64).sqrt() * before.total);
+        .map(|s| 2.0 * s / (judging_blocks.max(1) as f64).sqrt() * before);
     let floor = match chance {
-        Some(c) => c.max(PARSIMONY * before.total),
-        None => UNMEASURED_CHANCE * before.total,
+        Some(c) => c.max(PARSIMONY * before),
+        None => UNMEASURED_CHANCE * before,
     };
     let kept = gain > floor;
-    let change = -100.0 * gain / before.total.max(1e-12);
+    let change = -100.0 * gain / before.max(1e-12);
     let reason = if kept {
         format!(
-            "error on the selection blocks {:.4} -> {:.4} ({change:+.1} %; chance {})",
-            before.total,
-            after.total,
+            "error on the selection blocks {before:.4} -> {after:.4} ({change:+.1} %; chance {})",
             describe(chance)
         )
     } else {
         format!(
-            "error on the selection blocks {:.4} -> {:.4} ({change:+.1} %): needs a fall of {floor:.4} (chance {}, at least {:.0} %)",
-            before.total,
-            after.total,
+            "error on the selection blocks {before:.4} -> {after:.4} ({change:+.1} %): needs a fall of {floor:.4} (chance {}, at least {:.0} %)",
             describe(chance),
             100.0 * PARSIMONY
         )
     };
-    Verdict {
-        before,
-        after,
+    Decision {
         chance,
         kept,
         reason,

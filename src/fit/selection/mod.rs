@@ -15,7 +15,7 @@
 //! the chance level it had to beat, kept or not and why.
 
 mod finish;
-mod keep;
+pub(in crate::fit) mod keep;
 mod start;
 mod steps;
 
@@ -71,7 +71,9 @@ pub fn fit(
     options: &FitOptions,
     progress: Progress,
 ) -> Result<FitResult, FitError> {
-    start::check_frames(input)?;
+    if input.frames.len() < 2 {
+        return super::events_only::fit(input, options, progress);
+    }
     progress("frames: selection and optical flow", 0.0);
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);

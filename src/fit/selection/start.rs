@@ -2,7 +2,7 @@
 //! the starting thresholds, measured by `estimate aps` on the fit run alone so that nothing
 //! the loop is judged on has shaped its start.
 
-use super::super::{FitError, FitInput, FitOptions, Step};
+use super::super::{FitInput, FitOptions, Step};
 use crate::estimate::aps::{self, ApsInput};
 use crate::estimate::{CtEstimate, Interval};
 use crate::events::{EventChunk, Frame, TimeUs};
@@ -146,17 +146,6 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
             "the starting point; refitted with every effect".into(),
         ),
     }
-}
-
-/// Refuses a recording without frames (the fit simulates them).
-pub fn check_frames(input: &FitInput) -> Result<(), FitError> {
-    if input.frames.len() < 2 {
-        return Err(FitError::new(
-            "the fit simulates the recording from its grey frames; it has none",
-            "fit a recording with APS frames (IJRR folder, event_utils/MVSEC HDF5, AEDAT4 with frames, ROS bag with images); for event-only recordings estimate the thresholds with the eppps or screen method and read background rate, hot pixels and intervals from the statistics",
-        ));
-    }
-    Ok(())
 }
 
 #[cfg(test)]

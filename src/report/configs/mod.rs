@@ -40,7 +40,7 @@ pub fn not_identified_notes(setup: &Setup) -> Vec<String> {
         .iter()
         .map(|(key, why)| {
             format!(
-                "NOT IDENTIFIED: {key} is the start value the fit simulated, not a measurement ({why})"
+                "NOT IDENTIFIED: {key}: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement ({why})"
             )
         })
         .collect()

@@ -263,7 +263,11 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
             },
         ));
     }
-    if let Some(f) = &s.fit {
+    if let Some((f, residuals_before, residuals_after)) = s
+        .fit
+        .as_ref()
+        .and_then(|f| Some((f, f.residuals_before.as_ref()?, f.residuals_after.as_ref()?)))
+    {
         // bins with too few events to say anything are left out
         let points = |bins: &[crate::fit::residuals::Bin]| -> Vec<(f64, f64)> {
             bins.iter()
@@ -273,11 +277,11 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
         };
         let mut intensity = vec![(
             "ideal model".to_string(),
-            points(&f.residuals_before.by_intensity),
+            points(&residuals_before.by_intensity),
         )];
         let mut change = vec![(
             "ideal model".to_string(),
-            points(&f.residuals_before.by_rate_of_change),
+            points(&residuals_before.by_rate_of_change),
         )];
         for step in f.steps.iter().filter(|st| st.kept) {
             if let Some(after) = &step.residuals_after {
@@ -321,7 +325,7 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
                     .collect::<Vec<_>>(),
             )
         };
-        let (before, after) = (&f.residuals_before.intervals, &f.residuals_after.intervals);
+        let (before, after) = (&residuals_before.intervals, &residuals_after.intervals);
         plots.push(render(
             name("intervals"),
             &format!(

@@ -1,0 +1,332 @@
+//! What each block of a recording without frames says about the pixel's noise, measured
+//! once so that every model is compared on the same numbers:
+//!
+//! - **isolated events at quiet pixels**, per polarity and per support window
+//!   ([`SUPPORT_WINDOWS_US`]): events without a neighbour event within ±window (the
+//!   background-activity filter of Delbruck 2008, [`crate::stats::support`]), at pixels whose
+//!   neighbourhood leaves them uncovered at least half the time, over the seconds each pixel
+//!   was uncovered. Noise is Poisson and independent of the neighbours, so isolated events
+//!   over uncovered time is its rate whatever the window (the time a neighbour's event would
+//!   have hidden a noise event is taken out exactly, as the union of the ±window spans); the
+//!   scene's own events, isolated under a short window when it moves slowly, are not, and
+//!   fall away as the window grows ([`choose_window`]);
+//! - **supported events** per polarity (the scene's own events, for the ON/OFF balance);
+//! - **same-pixel intervals** (any polarity), for the refractory period;
+//! - **each named hot pixel's events**.
+//!
+//! Hot pixels' events are taken out before the rest is measured (they would cover their
+//! neighbours' time).
+
+use crate::events::{EventChunk, Sensor, TimeUs};
+
+/// The support windows: the first is `ctcal stats`'s (an edge crossing a pixel faster than
+/// 100 px/s gives its neighbours events well within it); the longer ones take in slower
+/// scenes.
+pub const SUPPORT_WINDOWS_US: [TimeUs; 4] = [10_000, 30_000, 100_000, 300_000];
+/// A pixel is quiet in a block when its neighbours leave it uncovered this share of the time.
+pub const QUIET_SHARE: f64 = 0.5;
+
+/// The measurements of one block.
+#[derive(Clone, Debug, Default)]
+pub struct BlockMeasure {
+    pub seconds: f64,
+    /// Isolated events at quiet pixels, per support window.
+    pub isolated: Vec<Isolated>,
+    /// Supported events, ON and OFF (kept pixels).
+    pub signal_on: u64,
+    pub signal_off: u64,
+    /// Same-pixel intervals ending in this block, µs (kept pixels).
+    pub intervals: Vec<u32>,
+    /// Events of each named hot pixel (the order of the list).
+    pub hot_events: Vec<u64>,
+    /// Events per kept pixel per second, hot pixels left out.
+    pub pixel_rate_hz: f64,
+}
+
+/// Isolated events at quiet pixels under one support window.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Isolated {
+    pub on: u64,
+    pub off: u64,
+    /// Pixel-seconds the quiet pixels were uncovered.
+    pub pixel_seconds: f64,
+}
+
+impl BlockMeasure {
+    /// Isolated events under window `k` over `blocks`.
+    pub fn isolated(blocks: &[&BlockMeasure], k: usize) -> Isolated {
+        blocks.iter().fold(Isolated::default(), |a, b| Isolated {
+            on: a.on + b.isolated[k].on,
+            off: a.off + b.isolated[k].off,
+            pixel_seconds: a.pixel_seconds + b.isolated[k].pixel_seconds,
+        })
+    }
+
+    /// The isolated-event rate of one polarity under window `k` (Hz per pixel) and its
+    /// Poisson standard error, `None` without uncovered time.
+    pub fn isolated_rate(blocks: &[&BlockMeasure], k: usize, on: bool) -> Option<(f64, f64)> {
+        let i = Self::isolated(blocks, k);
+        let n = if on { i.on } else { i.off };
+        (i.pixel_seconds > 0.0).then(|| {
+            (
+                n as f64 / i.pixel_seconds,
+                (n.max(1) as f64).sqrt() / i.pixel_seconds,
+            )
+        })
+    }
+}
+
+/// The support window the noise is measured under: the shortest after which a longer one
+/// no longer lowers the rate significantly (the scene's slow events are supported by then)
+/// while keeping a fifth of the shortest window's quiet time. `still_falling` when the rate
+/// was still falling where the quiet time ran out: the rate is then an upper bound.
+pub fn choose_window(fit: &[&BlockMeasure]) -> (usize, bool) {
+    let total = |k: usize| {
+        let i = BlockMeasure::isolated(fit, k);
+        (i.pixel_seconds > 0.0).then(|| {
+            let n = (i.on + i.off) as f64;
+            (
+                n / i.pixel_seconds,
+                n.max(1.0).sqrt() / i.pixel_seconds,
+                i.pixel_seconds,
+            )
+        })
+    };
+    let Some((mut rate, mut se, first)) = total(0) else {
+        return (0, false);
+    };
+    let mut chosen = 0;
+    for k in 1..SUPPORT_WINDOWS_US.len() {
+        let Some((r, s, exposure)) = total(k) else {
+            return (chosen, true);
+        };
+        let falls = r < rate - 2.0 * (s * s + se * se).sqrt();
+        if !falls {
+            return (chosen, false);
+        }
+        if exposure < 0.2 * first {
+            return (chosen, true);
+        }
+        (chosen, rate, se) = (k, r, s);
+    }
+    (chosen, false)
+}
+
+/// The recording, split for measuring.
+pub struct Measuring<'a> {
+    pub events: &'a EventChunk,
+    pub sensor: Sensor,
+    /// Pixels left out (the user's mask).
+    pub excluded: &'a [bool],
+    /// Named hot pixels (x, y).
+    pub hot: &'a [(u16, u16)],
+}
+
+/// Measures every block (`spans`, in time order).
+pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
+    let (w, h) = (m.sensor.width as usize, m.sensor.height as usize);
+    let mut hot_index = vec![u32::MAX; w * h];
+    for (k, &(x, y)) in m.hot.iter().enumerate() {
+        hot_index[y as usize * w + x as usize] = k as u32;
+    }
+    let kept: Vec<bool> = (0..w * h)
+        .map(|p| !m.excluded[p] && hot_index[p] == u32::MAX)
+        .collect();
+    let mut clean = EventChunk::with_capacity(m.events.len());
+    let mut hot_events = vec![Vec::new(); spans.len()];
+    for (b, span) in spans.iter().enumerate() {
+        let mut counts = vec![0u64; m.hot.len()];
+        let from = m.events.t.partition_point(|&t| t < span.0);
+        let to = m.events.t.partition_point(|&t| t < span.1);
+        for i in from..to {
+            let p = m.events.y[i] as usize * w + m.events.x[i] as usize;
+            if hot_index[p] != u32::MAX {
+                counts[hot_index[p] as usize] += 1;
+            } else if kept[p] {
+                clean.push(m.events.t[i], m.events.x[i], m.events.y[i], m.events.on[i]);
+            }
+        }
+        hot_events[b] = counts;
+    }
+    let kept_pixels = kept.iter().filter(|&&k| k).count().max(1);
+    let ranges: Vec<std::ops::Range<usize>> = spans
+        .iter()
+        .map(|span| {
+            clean.t.partition_point(|&t| t < span.0)..clean.t.partition_point(|&t| t < span.1)
+        })
+        .collect();
+    let mut blocks: Vec<BlockMeasure> = spans
+        .iter()
+        .zip(hot_events)
+        .zip(&ranges)
+        .map(|((&span, hot_events), range)| {
+            let seconds = (span.1 - span.0) as f64 * 1e-6;
+            BlockMeasure {
+                seconds,
+                hot_events,
+                pixel_rate_hz: range.len() as f64 / (kept_pixels as f64 * seconds),
+                ..BlockMeasure::default()
+            }
+        })
+        .collect();
+    let mut last = vec![TimeUs::MIN; w * h];
+    for (b, range) in blocks.iter_mut().zip(&ranges) {
+        b.intervals = intervals(&clean, range.clone(), w, &mut last);
+    }
+    for window in SUPPORT_WINDOWS_US {
+        let support = crate::stats::support::supported_two_sided(&clean, m.sensor, window);
+        for (b, &span) in blocks.iter_mut().zip(spans) {
+            let (isolated, signal) = isolated(&clean, &support, span, window, m.sensor, &kept);
+            b.isolated.push(isolated);
+            if window == SUPPORT_WINDOWS_US[0] {
+                (b.signal_on, b.signal_off) = signal;
+            }
+        }
+    }
+    blocks
+}
+
+/// Same-pixel intervals (µs) of the events `range`; `last` carries each pixel's previous
+/// event across blocks.
+fn intervals(
+    clean: &EventChunk,
+    range: std::ops::Range<usize>,
+    width: usize,
+    last: &mut [TimeUs],
+) -> Vec<u32> {
+    let mut out = Vec::new();
+    for i in range {
+        let p = clean.y[i] as usize * width + clean.x[i] as usize;
+        if last[p] != TimeUs::MIN {
+            out.push((clean.t[i] - last[p]).clamp(0, u32::MAX as TimeUs) as u32);
+        }
+        last[p] = clean.t[i];
+    }
+    out
+}
+
+/// Isolated events at quiet pixels of the clean events (hot and masked pixels out) in
+/// `span` under `window`, and the supported (ON, OFF) counts. Neighbour events up to a
+/// window outside the span cover it too (they support events inside it).
+fn isolated(
+    clean: &EventChunk,
+    support: &[bool],
+    span: (TimeUs, TimeUs),
+    window: TimeUs,
+    sensor: Sensor,
+    kept: &[bool],
+) -> (Isolated, (u64, u64)) {
+    let (w, h) = (sensor.width as usize, sensor.height as usize);
+    let mut until = vec![span.0; w * h];
+    let mut covered = vec![0 as TimeUs; w * h];
+    let mut alone = vec![[0u32; 2]; w * h];
+    let mut signal = (0u64, 0u64);
+    let from = clean.t.partition_point(|&t| t < span.0 - window);
+    let to = clean.t.partition_point(|&t| t < span.1 + window);
+    #[allow(clippy::needless_range_loop)] // five columns of one event share the index
+    for i in from..to {
+        let (t, x, y, on) = (
+            clean.t[i],
+            clean.x[i] as usize,
+            clean.y[i] as usize,
+            clean.on[i],
+        );
+        let p = y * w + x;
+        if (span.0..span.1).contains(&t) {
+            match (support[i], on) {
+                (true, true) => signal.0 += 1,
+                (true, false) => signal.1 += 1,
+                (false, _) => alone[p][on as usize] += 1,
+            }
+        }
+        let (lo, hi) = ((t - window).max(span.0), (t + window).min(span.1));
+        for ny in y.saturating_sub(1)..(y + 2).min(h) {
+            for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                let n = ny * w + nx;
+                if n == p {
+                    continue;
+                }
+                let start = lo.max(until[n]);
+                if hi > start {
+                    covered[n] += hi - start;
+                    until[n] = hi;
+                }
+            }
+        }
+    }
+    let span_us = span.1 - span.0;
+    let mut out = Isolated::default();
+    for p in (0..w * h).filter(|&p| kept[p]) {
+        let uncovered = span_us - covered[p].min(span_us);
+        if uncovered as f64 >= QUIET_SHARE * span_us as f64 {
+            out.on += alone[p][1] as u64;
+            out.off += alone[p][0] as u64;
+            out.pixel_seconds += uncovered as f64 * 1e-6;
+        }
+    }
+    (out, signal)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// Poisson noise at 2 Hz ON and 1 Hz OFF everywhere, plus a bright square where every
+    /// pixel fires every 2 ms (covered all the time): the isolated rate is the noise rate.
+    #[test]
+    fn isolated_events_over_uncovered_time_is_the_noise_rate() {
+        let sensor = Sensor::new(40, 30);
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(5);
+        let mut all = Vec::new();
+        let seconds = 20.0;
+        for y in 0..30u16 {
+            for x in 0..40u16 {
+                for (rate, on) in [(2.0, true), (1.0, false)] {
+                    let mut t = 0.0;
+                    loop {
+                        t += -(1.0 - rng.random::<f64>()).ln() / rate;
+                        if t >= seconds {
+                            break;
+                        }
+                        all.push(((t * 1e6) as TimeUs, x, y, on));
+                    }
+                }
+                if x < 10 && y < 10 {
+                    for k in 0..(seconds * 500.0) as i64 {
+                        all.push((k * 2000 + 7, x, y, k % 2 == 0));
+                    }
+                }
+            }
+        }
+        all.sort_unstable();
+        let mut events = EventChunk::default();
+        for (t, x, y, on) in all {
+            events.push(t, x, y, on);
+        }
+        let excluded = vec![false; sensor.pixels()];
+        let blocks = measure(
+            &Measuring {
+                events: &events,
+                sensor,
+                excluded: &excluded,
+                hot: &[(39, 29)],
+            },
+            &[(0, 10_000_000), (10_000_000, 20_000_000)],
+        );
+        let refs: Vec<&BlockMeasure> = blocks.iter().collect();
+        assert_eq!(choose_window(&refs), (0, false));
+        let (on, on_se) = BlockMeasure::isolated_rate(&refs, 0, true).unwrap();
+        let (off, off_se) = BlockMeasure::isolated_rate(&refs, 0, false).unwrap();
+        // ~1090 quiet pixels x 20 s: 2 Hz +- 0.01, 1 Hz +- 0.007
+        assert!((on - 2.0).abs() < 4.0 * on_se, "{on} +- {on_se}");
+        assert!((off - 1.0).abs() < 4.0 * off_se, "{off} +- {off_se}");
+        assert!(on_se < 0.02);
+        // the hot pixel's own events are counted apart
+        let hot: u64 = blocks.iter().map(|b| b.hot_events[0]).sum();
+        assert!((hot as f64 - 60.0).abs() < 4.0 * 60f64.sqrt(), "{hot}");
+        // the square's events are supported: 100 pixels x 500 Hz
+        let signal: u64 = blocks.iter().map(|b| b.signal_on + b.signal_off).sum();
+        assert!(signal >= 100 * 10_000, "{signal}");
+    }
+}

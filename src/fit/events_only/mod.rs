@@ -1,0 +1,298 @@
+//! The fit of a recording without grey frames (Prophesee EVK3/EVK4/Gen4.1, DVXplorer, a
+//! DAVIS recording without APS): everything the events alone identify, measured on the fit
+//! blocks and checked on held-out blocks like the frame-based fit.
+//!
+//! - **Hot pixels**, named: far above their neighbours' counts
+//!   ([`crate::stats::hot_pixels`]), each with its rate and ON share.
+//! - **Shot noise and leak**: isolated events (no neighbour within ±10 ms) over the time
+//!   their pixel was not covered by a neighbour's event ([`measure`]). Shot noise is
+//!   symmetric in polarity (v2e, Hu et al. 2021), leak fires ON only (the reference drifts),
+//!   so the OFF rate gives the shot noise and the ON excess the leak.
+//! - **Refractory period**: the lower edge of the same-pixel intervals ([`refractory`]).
+//! - **Cp/Cn**: the ON/OFF balance of the scene's own (supported) events. Where brightness
+//!   returns over the recording, `N_on * Cp = N_off * Cn`, so `Cp / Cn = N_off / N_on`.
+//! - **Absolute thresholds**: from a method that measures them (`estimate screen` on an
+//!   on-screen recording), else `estimate eppps` with its natural-image prior on the fit
+//!   run, and said which.
+//!
+//! Mismatch, photoreceptor bandwidth, timestamp jitter and the brightness dependence of
+//! shot noise need the brightness each pixel saw or a known stimulus: not identified.
+//! Each effect enters a noise model ([`model`]) and is kept when the model's distance to
+//! the selection blocks falls by more than measured chance ([`steps`]); the test blocks
+//! give `error_before` (ideal pixel) and `error_after`.
+
+mod blocks;
+mod candidates;
+mod measure;
+mod model;
+pub mod refractory;
+mod result;
+mod steps;
+
+use super::effects::hot_pixels::HotTrain;
+use super::observe::Role;
+use super::{FitError, FitInput, FitOptions, FitResult, Uncertain};
+use crate::estimate::eppps::{EpppsInput, EpppsOptions};
+use crate::estimate::{CtEstimate, Interval, Progress};
+use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
+use crate::stats::robust::sample_std_dev;
+use blocks::Blocks;
+use measure::{BlockMeasure, Measuring};
+use model::Reference;
+use serde::Serialize;
+use steps::Judging;
+
+/// The shortest recording the blocks can be cut from.
+pub const MIN_SPAN_US: i64 = 20_000;
+/// Events a fit without frames needs at least.
+pub const MIN_EVENTS: usize = 1_000;
+
+/// What a fit without frames measured beyond the model's parameters.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct EventsOnly {
+    /// Where the absolute thresholds come from.
+    pub thresholds_source: String,
+    pub ct_on_ci95: Option<Interval>,
+    pub ct_off_ci95: Option<Interval>,
+    /// Cp / Cn from the ON/OFF balance of the scene's events (fit blocks), with its
+    /// standard error over the fit blocks; `None` with the reason.
+    pub ct_ratio: Option<Uncertain>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ct_ratio_why: Option<String>,
+    /// Isolated-event rates at quiet pixels, per pixel per second, on the fit blocks and
+    /// (checked) on the test blocks.
+    pub noise_on_hz: Option<Uncertain>,
+    pub noise_off_hz: Option<Uncertain>,
+    pub noise_on_test_hz: Option<f64>,
+    /// The rates may include the scene's own slow events: upper bounds.
+    pub noise_upper_bound: bool,
+    pub noise_off_test_hz: Option<f64>,
+    /// Pixel-seconds of quiet, uncovered time the rates rest on (fit blocks), and the
+    /// support window that leaves the scene's own events out.
+    pub quiet_pixel_seconds: f64,
+    pub support_window_ms: f64,
+    /// The timestamps' common step, µs.
+    pub timestamp_step_us: u32,
+    /// The lower edge of the same-pixel intervals (fit blocks), µs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub interval_edge: Option<IntervalEdge>,
+}
+
+/// The refractory edge as reported.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct IntervalEdge {
+    pub edge_us: f64,
+    pub range_us: [f64; 2],
+    pub found: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub not_refractory: Option<String>,
+    pub below: usize,
+    pub above: usize,
+    pub intervals: usize,
+}
+
+/// What the fit blocks measured.
+pub(super) struct FitRun {
+    hot: Vec<HotPixel>,
+    trains: Vec<HotTrain>,
+    /// Isolated-event rates (OFF, ON) under the chosen support window.
+    noise: [Option<(f64, f64)>; 2],
+    window: usize,
+    /// The rate was still falling with the window where quiet time ran out: an upper bound.
+    noise_still_falling: bool,
+    edge: Option<refractory::Edge>,
+    /// The timestamps' common step, µs (1: no grid).
+    timestamp_step_us: u32,
+    /// OFF/ON of supported events and its standard error over the fit blocks.
+    balance: Option<(f64, f64)>,
+    quiet_pixel_seconds: f64,
+}
+
+/// Fits the pixel model to a recording without frames.
+pub fn fit(
+    input: &FitInput,
+    options: &FitOptions,
+    progress: Progress,
+) -> Result<FitResult, FitError> {
+    let events = input.events;
+    check(events)?;
+    let blocks = Blocks::split(events, options.blocks, options.holdout);
+    progress("hot pixels", 0.05);
+    let (hot, trains) = hot_pixels(input, &blocks);
+    progress("noise, intervals and balance per block", 0.15);
+    let named: Vec<(u16, u16)> = hot.iter().map(|h| (h.x, h.y)).collect();
+    let measures = measure::measure(
+        &Measuring {
+            events,
+            sensor: input.sensor,
+            excluded: input.excluded,
+            hot: &named,
+        },
+        &blocks.spans,
+    );
+    let judging = Judging {
+        measures: &measures,
+        role: &blocks.role,
+        reference: Reference {
+            edge_us: None,
+            window: 0,
+        },
+    };
+    let step = refractory::timestamp_step(events);
+    let run = fit_run(&judging, hot, trains, step);
+    let judging = Judging {
+        reference: Reference {
+            edge_us: run.edge.as_ref().map(|e| e.edge_us),
+            window: run.window,
+        },
+        ..judging
+    };
+    progress("absolute thresholds", 0.3);
+    let thresholds = thresholds(input, options, &blocks);
+    progress("the loop", 0.9);
+    let (steps, model) = candidates::run_loop(&judging, &run);
+    Ok(result::result(result::Parts {
+        input,
+        options,
+        blocks: &blocks,
+        judging: &judging,
+        run,
+        thresholds,
+        steps,
+        model,
+    }))
+}
+
+fn check(events: &crate::events::EventChunk) -> Result<(), FitError> {
+    if events.len() < MIN_EVENTS {
+        return Err(FitError::new(
+            format!(
+                "{} events: too few to measure noise, intervals and balance (a fit without frames needs {MIN_EVENTS})",
+                events.len()
+            ),
+            "use a longer part of the recording",
+        ));
+    }
+    let span = events.t[events.len() - 1] - events.t[0];
+    if span < MIN_SPAN_US {
+        return Err(FitError::new(
+            format!(
+                "the events span {:.1} ms: too short to cut into fit, selection and test blocks (needs {} ms)",
+                span as f64 / 1e3,
+                MIN_SPAN_US / 1000
+            ),
+            "use a longer part of the recording",
+        ));
+    }
+    Ok(())
+}
+
+/// Hot pixels of the fit run, with their rates and ON shares there.
+fn hot_pixels(input: &FitInput, blocks: &Blocks) -> (Vec<HotPixel>, Vec<HotTrain>) {
+    let (w, h) = (input.sensor.width as usize, input.sensor.height as usize);
+    let end = blocks.fit_end();
+    let fit_to = input.events.t.partition_point(|&t| t < end);
+    let mut counts = vec![0u32; w * h];
+    let mut on = vec![0u32; w * h];
+    for i in 0..fit_to {
+        let p = input.events.y[i] as usize * w + input.events.x[i] as usize;
+        if !input.excluded[p] {
+            counts[p] += 1;
+            on[p] += input.events.on[i] as u32;
+        }
+    }
+    let seconds = blocks.seconds(&blocks.of(Role::Fit));
+    let hot = find_hot_pixels(&counts, w, h, seconds);
+    let trains = hot
+        .iter()
+        .map(|p| {
+            let k = p.y as usize * w + p.x as usize;
+            HotTrain {
+                x: p.x,
+                y: p.y,
+                rate_hz: counts[k] as f64 / seconds,
+                on_share: on[k] as f64 / counts[k].max(1) as f64,
+            }
+        })
+        .collect();
+    (hot, trains)
+}
+
+/// Everything measured on the fit blocks.
+fn fit_run(
+    judging: &Judging,
+    hot: Vec<HotPixel>,
+    trains: Vec<HotTrain>,
+    timestamp_step_us: u32,
+) -> FitRun {
+    let fit = judging.of(Role::Fit);
+    let mut intervals: Vec<u32> = fit
+        .iter()
+        .flat_map(|b| b.intervals.iter().copied())
+        .collect();
+    let edge = refractory::edge(&mut intervals, timestamp_step_us);
+    let (window, noise_still_falling) = measure::choose_window(&fit);
+    let ratio = |b: &[&BlockMeasure]| {
+        let (on, off) = b.iter().fold((0u64, 0u64), |(a, c), m| {
+            (a + m.signal_on, c + m.signal_off)
+        });
+        (on >= 20 && off >= 20).then(|| off as f64 / on as f64)
+    };
+    // the balance's standard error: jackknife over the fit blocks (each block's own
+    // brightness history moves it, which Poisson counting alone would not show)
+    let balance = ratio(&fit).map(|all| {
+        let n = fit.len();
+        let leave_one_out: Vec<f64> = (0..n)
+            .filter_map(|k| {
+                let rest: Vec<&BlockMeasure> = (0..n).filter(|&j| j != k).map(|j| fit[j]).collect();
+                ratio(&rest)
+            })
+            .collect();
+        let se = (leave_one_out.len() >= 3)
+            .then(|| sample_std_dev(&leave_one_out))
+            .flatten()
+            .map_or(f64::INFINITY, |s| s * (n as f64 - 1.0) / (n as f64).sqrt());
+        (all, se)
+    });
+    FitRun {
+        hot,
+        trains,
+        noise: [
+            BlockMeasure::isolated_rate(&fit, window, false),
+            BlockMeasure::isolated_rate(&fit, window, true),
+        ],
+        window,
+        noise_still_falling,
+        edge,
+        timestamp_step_us,
+        balance,
+        quiet_pixel_seconds: BlockMeasure::isolated(&fit, window).pixel_seconds,
+    }
+}
+
+/// The absolute thresholds: given (a method that measured them), else eppps with its
+/// prior on the fit run; `Err` with the reason when neither gives them.
+fn thresholds(
+    input: &FitInput,
+    options: &FitOptions,
+    blocks: &Blocks,
+) -> Result<CtEstimate, String> {
+    if let Some(given) = &options.thresholds {
+        return Ok(given.clone());
+    }
+    let fit_events = input.events.between(input.events.t[0], blocks.fit_end());
+    crate::estimate::eppps::estimate(
+        &EpppsInput {
+            sensor: input.sensor,
+            events: &fit_events,
+            frames: None,
+            excluded: input.excluded,
+        },
+        &EpppsOptions {
+            seed: options.seed,
+            ..EpppsOptions::default()
+        },
+        &|_, _| {},
+    )
+    .map_err(|e| format!("estimate eppps on the fit run: {}", e.problem))
+}

@@ -1,0 +1,411 @@
+//! The result of a fit without frames: the model's parameters (null where the events do
+//! not identify them, with why), the noise measured, the loop's steps, the test-block
+//! errors and every assumption.
+
+use super::blocks::Blocks;
+use super::candidates::{on_excess, symmetric_rate};
+use super::measure::{BlockMeasure, SUPPORT_WINDOWS_US};
+use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, distance};
+use super::steps::Judging;
+use super::{EventsOnly, FitRun, IntervalEdge};
+use crate::estimate::CtEstimate;
+use crate::fit::effects::Effect;
+use crate::fit::observe::Role;
+use crate::fit::selection::keep::PARSIMONY;
+use crate::fit::{
+    AddedEffect, FitInput, FitOptions, FitResult, FittedParams, Holdout, Step, Uncertain,
+};
+use crate::sim::PixelParams;
+use crate::stats::robust::median;
+use std::collections::BTreeMap;
+
+/// Why mismatch, bandwidth and jitter are not identified without frames.
+const NEEDS_BRIGHTNESS: [(&str, &str); 3] = [
+    (
+        "ct_sigma",
+        "per-pixel threshold mismatch shows in how many events each pixel gives for the brightness change it saw: that needs grey frames or a known stimulus (estimate screen)",
+    ),
+    (
+        "cutoff_hz",
+        "the photoreceptor bandwidth shows in how events lag brightness changes of known speed and intensity: that needs grey frames or a known stimulus",
+    ),
+    (
+        "timestamp_jitter_s",
+        "timestamp jitter shows against a stimulus of known timing: that needs a screen recording or frames",
+    ),
+];
+
+/// Everything the result is made from.
+pub(super) struct Parts<'a> {
+    pub input: &'a FitInput<'a>,
+    pub options: &'a FitOptions,
+    pub blocks: &'a Blocks,
+    pub judging: &'a Judging<'a>,
+    pub run: FitRun,
+    pub thresholds: Result<CtEstimate, String>,
+    pub steps: Vec<Step>,
+    pub model: NoiseModel,
+}
+
+pub(super) fn result(parts: Parts) -> FitResult {
+    let Parts {
+        input,
+        options,
+        blocks,
+        judging,
+        run,
+        thresholds,
+        steps,
+        model,
+    } = parts;
+    let kept = |name: &str| steps.iter().any(|s| s.effect == name && s.kept);
+    let mut why = BTreeMap::new();
+    let mut uncertainties = BTreeMap::new();
+    let (on, off) = absolute(&thresholds, &mut why, &mut uncertainties);
+    let mut params = PixelParams::ideal(on, off);
+    for (key, reason) in NEEDS_BRIGHTNESS {
+        why.insert(key.to_string(), reason.to_string());
+    }
+    noise_params(&run, &kept, &mut params, &mut why, &mut uncertainties);
+    refractory_param(
+        &run,
+        kept("refractory"),
+        &mut params,
+        &mut why,
+        &mut uncertainties,
+    );
+    let hot = if kept("hot_pixels") {
+        run.hot.clone()
+    } else {
+        Vec::new()
+    };
+    if !hot.is_empty() {
+        let pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
+        params.hot_pixel_fraction = Some(hot.len() as f64 / pixels as f64);
+        params.hot_pixel_rate_hz =
+            median(&run.trains.iter().map(|t| t.rate_hz).collect::<Vec<_>>());
+    }
+    let test = judging.of(Role::Test);
+    let before = distance(&NoiseModel::ideal(), &test, judging.reference);
+    let after = distance(&model, &test, judging.reference);
+    let mut identified: BTreeMap<String, bool> = serde_json::to_value(&params)
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
+        .map(|(k, _)| (k, true))
+        .collect();
+    for key in why.keys() {
+        identified.insert(key.clone(), false);
+    }
+    let events_only = details(&run, &thresholds, judging, kept("thresholds"));
+    let assumptions = assumptions(&run, &thresholds, blocks, judging, options);
+    FitResult {
+        biases: None,
+        params: FittedParams {
+            model: params,
+            not_identified: why.clone(),
+        },
+        identified,
+        why,
+        uncertainties,
+        effects_added: added(&steps),
+        error_metric: ERROR_METRIC,
+        error_before: before.total,
+        error_after: after.total,
+        components_before: before,
+        components_after: after,
+        steps,
+        hot_pixels_masked: hot,
+        residuals_before: None,
+        residuals_after: None,
+        assumptions,
+        holdout: holdout(blocks, options),
+        simulations: 0,
+        frame_exposure_us: None,
+        events_only: Some(events_only),
+    }
+}
+
+/// The absolute thresholds and their standard errors (from the 95 % interval), or not
+/// identified with the reason (the model then holds NaN, `null` in JSON).
+fn absolute(
+    thresholds: &Result<CtEstimate, String>,
+    why: &mut BTreeMap<String, String>,
+    uncertainties: &mut BTreeMap<String, Uncertain>,
+) -> (f64, f64) {
+    let mut value =
+        |key: &str, v: Option<f64>, ci: Option<crate::estimate::Interval>| match (thresholds, v) {
+            (Ok(_), Some(v)) => {
+                let se = match ci {
+                    Some([Some(lo), Some(hi)]) => Some((hi - lo) / (2.0 * 1.96)),
+                    _ => None,
+                };
+                uncertainties.insert(
+                    key.to_string(),
+                    Uncertain {
+                        value: v,
+                        standard_error: se,
+                    },
+                );
+                v
+            }
+            (Ok(e), None) => {
+                why.insert(
+                    key.to_string(),
+                    e.why
+                        .get(key)
+                        .cloned()
+                        .unwrap_or_else(|| format!("{} determined no value", e.method)),
+                );
+                f64::NAN
+            }
+            (Err(reason), _) => {
+                why.insert(key.to_string(), reason.clone());
+                f64::NAN
+            }
+        };
+    let (on, off, on_ci, off_ci) = match thresholds {
+        Ok(e) => (e.ct_on, e.ct_off, e.ct_on_ci95, e.ct_off_ci95),
+        Err(_) => (None, None, None, None),
+    };
+    (value("ct_on", on, on_ci), value("ct_off", off, off_ci))
+}
+
+/// Shot noise and leak: their values where kept, else not identified with an upper
+/// bound (absent when even the bound is below the floor at which rates are told apart).
+fn noise_params(
+    run: &FitRun,
+    kept: &dyn Fn(&str) -> bool,
+    params: &mut PixelParams,
+    why: &mut BTreeMap<String, String>,
+    uncertainties: &mut BTreeMap<String, Uncertain>,
+) {
+    if let Some((rate, se)) = symmetric_rate(run) {
+        if kept("shot_noise") {
+            params.shot_noise_rate_hz = Some(2.0 * rate);
+            uncertainties.insert(
+                "shot_noise_rate_hz".into(),
+                Uncertain {
+                    value: 2.0 * rate,
+                    standard_error: Some(2.0 * se),
+                },
+            );
+            why.insert(
+                "shot_noise_bright_factor".into(),
+                "how the noise rate depends on brightness needs each pixel's intensity (grey frames); the rate given is the one at the recording's brightness".into(),
+            );
+        } else if 2.0 * (rate + 2.0 * se) > RATE_FLOOR_HZ {
+            why.insert(
+                "shot_noise_rate_hz".into(),
+                format!(
+                    "not told apart from none: at most {:.4} Hz (2 standard errors)",
+                    2.0 * (rate + 2.0 * se)
+                ),
+            );
+        }
+    }
+    if let Some((excess, se)) = on_excess(run) {
+        if kept("leak") {
+            params.leak_rate_hz = Some(excess);
+            uncertainties.insert(
+                "leak_rate_hz".into(),
+                Uncertain {
+                    value: excess,
+                    standard_error: Some(se),
+                },
+            );
+        } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
+            why.insert(
+                "leak_rate_hz".into(),
+                format!(
+                    "the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, is not told apart from none: at most {:.4} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden)",
+                    excess.max(0.0) + 2.0 * se
+                ),
+            );
+        }
+    }
+}
+
+fn refractory_param(
+    run: &FitRun,
+    kept: bool,
+    params: &mut PixelParams,
+    why: &mut BTreeMap<String, String>,
+    uncertainties: &mut BTreeMap<String, Uncertain>,
+) {
+    match &run.edge {
+        Some(edge) if kept => {
+            params.refractory_s = Some(edge.edge_us * 1e-6);
+            uncertainties.insert(
+                "refractory_s".into(),
+                Uncertain {
+                    value: edge.edge_us * 1e-6,
+                    standard_error: Some((edge.range_us[1] - edge.range_us[0]) * 1e-6 / 4.0),
+                },
+            );
+        }
+        Some(edge) => {
+            let reason = match &edge.not_refractory {
+                Some(why) => format!(
+                    "{why}; a refractory period, if any, is at most {:.0} us",
+                    edge.edge_us
+                ),
+                None if edge.found => format!(
+                    "an edge at {:.0} us that the selection blocks did not confirm",
+                    edge.edge_us
+                ),
+                None => format!(
+                    "no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most {:.0} us",
+                    edge.edge_us
+                ),
+            };
+            why.insert("refractory_s".into(), reason);
+        }
+        None => {
+            why.insert(
+                "refractory_s".into(),
+                "too few same-pixel intervals on the fit blocks to see their short end".into(),
+            );
+        }
+    }
+}
+
+fn added(steps: &[Step]) -> Vec<AddedEffect> {
+    steps
+        .iter()
+        .filter(|s| s.kept)
+        .filter_map(|s| {
+            Some(AddedEffect {
+                effect: Effect::parse(&s.effect)?,
+                evidence: s.evidence.clone(),
+                error_after: s.error_after?,
+            })
+        })
+        .collect()
+}
+
+fn details(
+    run: &FitRun,
+    thresholds: &Result<CtEstimate, String>,
+    judging: &Judging,
+    ratio_confirmed: bool,
+) -> EventsOnly {
+    let test = judging.of(Role::Test);
+    let rate = |r: Option<(f64, f64)>| {
+        r.map(|(value, se)| Uncertain {
+            value,
+            standard_error: Some(se),
+        })
+    };
+    let (ct_ratio, ct_ratio_why) = match run.balance {
+        Some((b, se)) if se.is_finite() && ratio_confirmed => (Some(Uncertain { value: b, standard_error: Some(se) }), None),
+        Some((b, se)) if se.is_finite() => (None, Some(format!("the fit blocks' balance OFF/ON = {b:.3} +- {se:.3} did not hold on the selection blocks: the scene's brightness does not return over the recording, so the balance is not the threshold ratio"))),
+        Some(_) => (None, Some("under three fit blocks with events of both polarities: the balance's spread cannot be measured".to_string())),
+        None => (None, Some("too few supported events of one polarity on the fit blocks".to_string())),
+    };
+    EventsOnly {
+        thresholds_source: match thresholds {
+            Ok(e) if e.method == "eppps" => "estimate eppps on the fit run: events per pixel of travel against calibration scenes drawn from its natural-image prior (the prior's spread is in the interval); not a measurement of this sensor's thresholds".into(),
+            Ok(e) => format!("estimate {} (given)", e.method),
+            Err(reason) => format!("none: {reason}"),
+        },
+        ct_on_ci95: thresholds.as_ref().ok().and_then(|e| e.ct_on_ci95),
+        ct_off_ci95: thresholds.as_ref().ok().and_then(|e| e.ct_off_ci95),
+        ct_ratio,
+        ct_ratio_why,
+        noise_on_hz: rate(run.noise[1]),
+        noise_off_hz: rate(run.noise[0]),
+        noise_on_test_hz: BlockMeasure::isolated_rate(&test, run.window, true).map(|r| r.0),
+        noise_upper_bound: run.noise_still_falling,
+        noise_off_test_hz: BlockMeasure::isolated_rate(&test, run.window, false).map(|r| r.0),
+        quiet_pixel_seconds: run.quiet_pixel_seconds,
+        support_window_ms: SUPPORT_WINDOWS_US[run.window] as f64 / 1e3,
+        timestamp_step_us: run.timestamp_step_us,
+        interval_edge: run.edge.as_ref().map(|e| IntervalEdge {
+            edge_us: e.edge_us,
+            range_us: e.range_us,
+            found: e.found,
+            not_refractory: e.not_refractory.clone(),
+            below: e.below,
+            above: e.above,
+            intervals: e.intervals,
+        }),
+    }
+}
+
+fn assumptions(
+    run: &FitRun,
+    thresholds: &Result<CtEstimate, String>,
+    blocks: &Blocks,
+    judging: &Judging,
+    options: &FitOptions,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    if let Ok(e) = thresholds {
+        out.push(format!(
+            "absolute thresholds from estimate {}, marked as such; its assumptions:",
+            e.method
+        ));
+        out.extend(
+            e.assumptions
+                .iter()
+                .map(|a| format!("  {} : {a}", e.method)),
+        );
+    }
+    let seconds = |r| blocks.seconds(&blocks.of(r));
+    out.extend([
+        "no grey frames: the scene is not simulated; the pixel's own effects are measured from the events and checked as a noise model on held-out blocks".to_string(),
+        format!(
+            "isolated events: no neighbour event within +-{} ms (the shortest of {:?} ms after which a longer window no longer lowers the rate: the scene's slow events are supported by then); their rate counts only the time no neighbour event covered, at pixels left uncovered at least {:.0} % of a block",
+            SUPPORT_WINDOWS_US[run.window] / 1000,
+            SUPPORT_WINDOWS_US.map(|w| w / 1000),
+            100.0 * super::measure::QUIET_SHARE
+        ),
+        "shot noise fires ON and OFF equally and leak ON only (v2e, Hu et al. 2021): the OFF rate gives the shot noise (ON + OFF = twice it), the ON excess the leak".to_string(),
+        "noise rates are those at the recording's brightness: v2e and ctcal give shot_noise_rate_hz as the dark rate, falling to 0.25 of it at full white; without frames the brightness is unknown, so the dark rate lies between 1 and 4 times the value given".to_string(),
+        "Cp/Cn from the ON/OFF balance of supported events assumes brightness at each pixel returns over the fit blocks (net log change zero); the jackknife over fit blocks carries how far it does not".to_string(),
+        format!(
+            "time in {} blocks over the events' span: fit {:.2} s (the first {:.0} %), selection {:.2} s (judges each effect), test {:.2} s (error_before and error_after only)",
+            blocks.count(),
+            seconds(Role::Fit),
+            100.0 * (1.0 - options.holdout),
+            seconds(Role::Selection),
+            seconds(Role::Test)
+        ),
+        format!(
+            "an effect is kept when its error on the selection blocks falls by more than twice the chance spread of the per-block relative fall (fit blocks, over sqrt of the selection blocks), and by at least {:.0} %",
+            100.0 * PARSIMONY
+        ),
+    ]);
+    if run.noise_still_falling {
+        out.push(format!(
+            "the isolated-event rate was still falling as the support window grew ({} ms) when the scene's events left too little quiet time: part of the isolated events are the scene's own slow events, so the shot-noise (and leak) rates are upper bounds",
+            SUPPORT_WINDOWS_US[run.window] / 1000
+        ));
+    }
+    if judging.reference.edge_us.is_none() {
+        out.push("too few same-pixel intervals for the interval component of the distance".into());
+    }
+    out
+}
+
+fn holdout(blocks: &Blocks, options: &FitOptions) -> Holdout {
+    let selection = blocks.of(Role::Selection);
+    let test = blocks.of(Role::Test);
+    let mut held: Vec<usize> = selection.iter().chain(&test).copied().collect();
+    held.sort_unstable();
+    Holdout {
+        fraction: options.holdout,
+        blocks: blocks.count(),
+        fit_seconds: blocks.seconds(&blocks.of(Role::Fit)),
+        held_out_seconds: blocks.seconds(&held),
+        selection_seconds: blocks.seconds(&selection),
+        test_seconds: blocks.seconds(&test),
+        guard_seconds: 0.0,
+        held_out_blocks: held,
+        selection_blocks: selection,
+        test_blocks: test,
+    }
+}

@@ -1,0 +1,153 @@
+//! `ctcal fit` without grey frames: v2e oracle cases with their frames withheld against
+//! their known parameters, and the shared events-only recordings end to end (fit, config).
+
+use crate::common::{ctcal, json, oracle, oracle_params, real};
+
+fn fit_without_frames(case: &str) -> serde_json::Value {
+    json(&["fit", oracle(case).to_str().unwrap(), "--no-frames"])
+}
+
+#[test]
+fn hot_pixels_are_named_exactly_without_frames() {
+    let fit = fit_without_frames("dev_hot_pixels");
+    let truth = &oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"];
+    let mut named: Vec<(u64, u64)> = fit["hot_pixels_masked"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+        .collect();
+    let mut injected: Vec<(u64, u64)> = truth
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+        .collect();
+    named.sort_unstable();
+    injected.sort_unstable();
+    assert_eq!(named, injected);
+    // the uniform background activity (0.03 Hz a pixel): within a factor 2 or an upper bound
+    let rate = fit["params"]["shot_noise_rate_hz"].as_f64();
+    if let Some(rate) = rate {
+        assert!((0.015..=0.06 * 1.2).contains(&rate), "{rate}");
+    }
+    // what the events cannot show is said so
+    for key in ["ct_sigma", "cutoff_hz", "timestamp_jitter_s"] {
+        assert!(fit["params"][key].is_null(), "{key}");
+        assert_eq!(fit["identified"][key], false, "{key}");
+        assert!(fit["why"][key].as_str().unwrap().contains("needs"), "{key}");
+    }
+    assert!(
+        fit["events_only"]["thresholds_source"]
+            .as_str()
+            .unwrap()
+            .contains("prior")
+    );
+}
+
+#[test]
+fn refractory_period_is_found_from_the_intervals_within_30_percent() {
+    let fit = fit_without_frames("dev_refractory");
+    let truth = oracle_params("dev_refractory")["emulator_args"]["refractory_period_s"]
+        .as_f64()
+        .unwrap();
+    let found = fit["params"]["refractory_s"].as_f64().expect("identified");
+    assert!((found / truth - 1.0).abs() < 0.3, "{found} for {truth}");
+    assert!(fit["error_after"].as_f64().unwrap() < 0.5 * fit["error_before"].as_f64().unwrap());
+}
+
+#[test]
+fn shot_noise_of_a_static_scene_within_a_factor_2_and_no_refractory_from_a_timestamp_grid() {
+    let fit = fit_without_frames("c_noisy_static");
+    let truth = oracle_params("c_noisy_static")["emulator_args"]["shot_noise_rate_hz"]
+        .as_f64()
+        .unwrap();
+    let rate = fit["params"]["shot_noise_rate_hz"]
+        .as_f64()
+        .expect("identified");
+    assert!(
+        (truth / 2.0..=truth * 2.0).contains(&rate),
+        "{rate} for {truth}"
+    );
+    // v2e stamps this case's events on a 4 ms grid: a gap of one step is not a refractory period
+    assert_eq!(fit["events_only"]["timestamp_step_us"], 4000);
+    assert!(fit["params"]["refractory_s"].is_null());
+    assert!(
+        fit["why"]["refractory_s"]
+            .as_str()
+            .unwrap()
+            .contains("grid")
+    );
+    // a static scene: no absolute thresholds, and why
+    assert!(fit["params"]["ct_on"].is_null());
+    assert!(fit["why"]["ct_on"].as_str().unwrap().contains("eppps"));
+}
+
+#[test]
+fn leak_fires_on_only_and_is_told_from_shot_noise() {
+    let fit = fit_without_frames("c_leak_static");
+    let steps = fit["steps"].as_array().unwrap();
+    let kept = |name: &str| {
+        steps
+            .iter()
+            .any(|s| s["effect"] == name && s["kept"] == true)
+    };
+    assert!(kept("leak") && !kept("shot_noise"), "{steps:?}");
+    let on = fit["events_only"]["noise_on_test_hz"].as_f64().unwrap();
+    assert!((0.5..=2.0).contains(&on), "{on}");
+    assert_eq!(fit["events_only"]["noise_off_test_hz"], 0.0);
+}
+
+#[test]
+fn events_only_recordings_fit_and_configure_end_to_end() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, sensor) in [
+        ("evk4_faery_evt3.raw", (1280, 720)),
+        ("dvxplorer_tonic.aedat4", (320, 240)),
+    ] {
+        let fit_path = dir.path().join(format!("{name}.json"));
+        let status = ctcal()
+            .args(["fit", real(name).to_str().unwrap(), "--json"])
+            .arg(&fit_path)
+            .output()
+            .unwrap();
+        assert!(
+            status.status.success(),
+            "{}",
+            String::from_utf8_lossy(&status.stderr)
+        );
+        let fit: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&fit_path).unwrap()).unwrap();
+        let kept: Vec<&str> = fit["effects_added"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e["effect"].as_str().unwrap())
+            .collect();
+        assert!(
+            kept.contains(&"hot_pixels") && kept.contains(&"shot_noise"),
+            "{name}: {kept:?}"
+        );
+        assert!(fit["error_after"].as_f64().unwrap() < fit["error_before"].as_f64().unwrap());
+        assert!(fit["params"]["ct_on"].as_f64().unwrap() > 0.0);
+        assert!(fit["params"]["ct_sigma"].is_null());
+        let output = ctcal()
+            .args(["config"])
+            .arg(&fit_path)
+            .args(["--format", "v2e"])
+            .output()
+            .unwrap();
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        let config = String::from_utf8(output.stdout).unwrap();
+        assert!(config.contains("--shot_noise_rate_hz"), "{config}");
+        assert!(
+            config.contains("not identified") || config.contains("ct_sigma"),
+            "{config}"
+        );
+        let _ = sensor;
+    }
+}
