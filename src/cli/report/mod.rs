@@ -4,6 +4,7 @@
 //! per-pixel data dropped. A recording that fails is listed with its error and the others
 //! are still reported (exit code 1); when every one fails, nothing is written.
 
+mod from_results;
 mod inputs;
 mod progress;
 
@@ -21,6 +22,10 @@ pub struct ReportArgs {
     /// dataset named after the folder, split by sensor where the folder mixes sensors).
     #[arg(value_name = "INPUT")]
     pub inputs: Vec<PathBuf>,
+    /// Build the report from reports made elsewhere: their folders (or their results.json),
+    /// each sequence with its files taken as it is, merged into one report (same seed).
+    #[arg(long = "from-results", value_name = "DIR", num_args = 1.., conflicts_with_all = ["inputs", "datasets"])]
+    pub from_results: Vec<PathBuf>,
     /// Recordings of a named dataset: NAME=INPUT (repeatable; INPUT may be a folder of
     /// recordings).
     #[arg(long = "dataset", value_name = "NAME=INPUT")]
@@ -105,6 +110,9 @@ fn options(args: &ReportArgs, global: &Global) -> anyhow::Result<pipeline::Optio
 }
 
 pub fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
+    if !args.from_results.is_empty() {
+        return from_results::run(args, global);
+    }
     super::load::check_window(args.start, args.end)?;
     if args.max_frames < 2 {
         return Err(BadInput("--max-frames must be at least 2".into()).into());

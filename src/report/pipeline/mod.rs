@@ -3,10 +3,12 @@
 //! sequence merged into one [`Report`] ([`merge`]). [`run`] does the whole of it on this
 //! machine's threads; a caller that spreads the recordings over other machines calls
 //! [`process`] there and [`merge`] where the results meet, with the sequences carried as
-//! their `results.json` entries. Progress and warnings go to the caller's
+//! their `results.json` entries ([`decode`]). Progress and warnings go to the caller's
 //! [`Observer`]; the library prints nothing and writes nothing (files are returned, or handed
 //! to the caller's writer as soon as a sequence is done).
 
+pub mod decode;
+pub mod gather;
 pub mod inputs;
 pub mod sequence;
 
