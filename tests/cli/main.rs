@@ -9,6 +9,7 @@ mod datasets;
 mod errors;
 mod estimate;
 mod fit;
+mod from_results;
 mod limits;
 mod peers;
 mod readers;

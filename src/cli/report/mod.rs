@@ -167,7 +167,7 @@ fn finish(
     report: &Report,
     staged: ctcal::io::write::StagedFolder,
 ) -> anyhow::Result<()> {
-    for f in ctcal::report::render_summary(&report) {
+    for f in ctcal::report::render_summary(report) {
         staged.write(&f.path, &f.bytes)?;
     }
     staged.commit()?;
