@@ -326,7 +326,7 @@ fn fit(
     let open = open_options(format, sensor)?;
     let result = py
         .detach(|| -> Result<_, String> {
-            let loaded = load(&path, &open, start, end, max_frames, false, roi, mask)?;
+            let loaded = load(&path, &open, start, end, max_frames, true, roi, mask)?;
             let mut f = ctcal::fit::fit(
                 &ctcal::fit::FitInput {
                     sensor: loaded.sensor,

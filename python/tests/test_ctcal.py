@@ -128,6 +128,11 @@ def test_estimate_equals_the_command(method: str) -> None:
     assert ctcal.estimate(path, method) == cli("estimate", method, str(path))
 
 
+def test_fit_equals_the_command() -> None:
+    path = REAL / "ijrr_slider_depth_50k"
+    assert ctcal.fit(path) == cli("fit", str(path))
+
+
 def test_errors_carry_the_commands_message() -> None:
     missing = REAL / "no_such_recording.aedat4"
     with pytest.raises(ctcal.CtcalError) as raised:
