@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import json
 import os
-import sys
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -280,8 +279,14 @@ def report(
     protected = paths + [p for _, p in named]
     if opts.get("screen") is not None:
         protected.append(os.fspath(opts["screen"]))
-    command_line = ["ctcal.report"] + [str(a) for a in sys.argv[:1]]
     out = _path(out)
+    # what made it, in the command's terms (the page and results.json show it)
+    command_line = ["ctcal.report", *paths]
+    for name, p in named:
+        command_line += ["--dataset", f"{name}={p}"]
+    command_line += ["--out", out]
+    if client is not None:
+        command_line += ["--client", type(client).__name__]
     if client is None:
         text = _ctcal.report_local(out, items, options, command_line, protected)
     else:

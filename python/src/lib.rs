@@ -353,9 +353,11 @@ fn fit(
 /// `fit`, `screen` (a TOML file), `roi`, `mask`, `force`).
 fn report_options(text: &str) -> PyResult<Options> {
     let v: serde_json::Value = serde_json::from_str(text).map_err(err)?;
-    let mut o = Options::default();
-    o.start_s = v["start"].as_f64();
-    o.end_s = v["end"].as_f64();
+    let mut o = Options {
+        start_s: v["start"].as_f64(),
+        end_s: v["end"].as_f64(),
+        ..Options::default()
+    };
     if let Some(n) = v["max_frames"].as_u64() {
         o.max_frames = n as usize;
     }
@@ -422,6 +424,13 @@ fn report_inputs(
     Ok(inputs.iter().map(to_tuple).collect())
 }
 
+/// What [`report_sequence`] hands back: done or not, the sequence's JSON or the error's
+/// message, and the files (path in the report, bytes).
+type SequenceOutcome<'py> = (bool, String, Vec<(String, Bound<'py, PyBytes>)>);
+
+/// A [`SequenceOutcome`] as it comes back to the merge.
+type Outcome = (bool, String, Vec<(String, Vec<u8>)>);
+
 /// One recording of a report, as one task of a cluster runs it: `(True, sequence JSON,
 /// files)` or `(False, error message, [])`; files are (path in the report, bytes).
 #[pyfunction]
@@ -429,10 +438,11 @@ fn report_sequence<'py>(
     py: Python<'py>,
     input: InputTuple,
     options: &str,
-) -> PyResult<(bool, String, Vec<(String, Bound<'py, PyBytes>)>)> {
+) -> PyResult<SequenceOutcome<'py>> {
     let options = report_options(options)?;
     let input = from_tuple(input);
-    let outcome = py.detach(|| pipeline::process(&input, &options, &|_, _| {}));
+    let outcome =
+        py.detach(|| pipeline::process(&input, &options, &|_, _| {}).map_err(|e| e.to_string()));
     match outcome {
         Ok(processed) => Ok((
             true,
@@ -443,7 +453,7 @@ fn report_sequence<'py>(
                 .map(|f| (f.path.clone(), PyBytes::new(py, &f.bytes)))
                 .collect(),
         )),
-        Err(e) => Ok((false, e.to_string(), Vec::new())),
+        Err(message) => Ok((false, message, Vec::new())),
     }
 }
 
@@ -456,7 +466,7 @@ fn report_merge(
     py: Python<'_>,
     out: PathBuf,
     inputs: Vec<InputTuple>,
-    outcomes: Vec<(bool, String, Vec<(String, Vec<u8>)>)>,
+    outcomes: Vec<Outcome>,
     options: &str,
     command_line: Vec<String>,
     protected: Vec<PathBuf>,

@@ -173,12 +173,9 @@ def two_recordings() -> list:
     return [REAL / "ijrr_slider_depth_50k", REAL / "ijrr_shapes_rotation_chunk"]
 
 
-#: Keys that differ between two runs of the same report: how long each stage took, and how
-#: it was asked for.
-VARIABLE = ("seconds", "command_line")
-
-
 def comparable(results: dict) -> dict:
+    """The results without what differs between two runs of one report: how it was asked
+    for, how long each stage took, and the paths as given."""
     results = json.loads(json.dumps(results))
     results.pop("command_line")
     for s in results["sequences"]:
