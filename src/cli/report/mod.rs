@@ -3,6 +3,10 @@
 //! Sequences are processed in parallel; each is written as soon as it is done and its
 //! per-pixel data dropped. A recording that fails is listed with its error and the others
 //! are still reported (exit code 1); when every one fails, nothing is written.
+//!
+//! The work is the library's report pipeline (`ctcal::report::pipeline`): this module turns
+//! the command line into its options, shows its progress, words its errors with the
+//! command's flags and writes the folder; `--from-results` merges reports made elsewhere.
 
 mod from_results;
 mod inputs;
