@@ -219,6 +219,20 @@ def test_a_local_cluster_report_equals_the_command(
     assert files_of(out) == files_of(cli_report)
 
 
+def test_worker_processes_report_as_the_command(
+    tmp_path: Path, two_recordings: list, cli_report: Path
+) -> None:
+    """Tasks in other processes: the sequences travel as their JSON and files (pickled),
+    as they would from other machines."""
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+    ) as cluster, distributed.Client(cluster) as client:
+        got = ctcal.report(two_recordings, tmp_path / "report", client=client)
+    assert comparable(got) == comparable(json.loads((cli_report / "results.json").read_text()))
+    assert files_of(tmp_path / "report") == files_of(cli_report)
+
+
 def test_a_report_on_this_machine_equals_the_command(
     tmp_path: Path, two_recordings: list, cli_report: Path
 ) -> None:
