@@ -34,3 +34,4 @@ pub use io::{Format, InputError, OpenOptions, Recording};
 pub mod sim;
 pub mod stats;
 pub mod synthetic;
+pub mod window;

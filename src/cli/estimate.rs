@@ -5,12 +5,16 @@ use super::{BadInput, Global, InputArgs, JsonTarget, SelectionArgs, emit_json, o
 use clap::{Args, Subcommand, ValueEnum};
 use ctcal::estimate::CtEstimate;
 use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
+use ctcal::estimate::eppps;
 use ctcal::estimate::timing::ThresholdMaps;
-use ctcal::estimate::{eppps, screen};
 use ctcal::sim::DisplayParams;
 use ctcal::sim::LogResponse;
 use ctcal::sim::log_response::LogMap;
 use std::path::{Path, PathBuf};
+
+/// `estimate eppps` and `estimate screen` of a loaded recording, and the built-in screen
+/// model, as the report uses them.
+pub(super) use ctcal::window::{default_screen, eppps_of, screen_of};
 
 #[derive(Subcommand, Debug)]
 pub enum EstimateCommand {
@@ -213,50 +217,6 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
     present(&estimate, &loaded, common, &policy)
 }
 
-/// `estimate eppps` of a loaded recording (its frames, where loaded, give the dynamics).
-pub(super) fn eppps_of(
-    loaded: &Loaded,
-    options: &ApsOptions,
-    eppps_options: eppps::EpppsOptions,
-    progress: ctcal::estimate::Progress,
-) -> Result<CtEstimate, ctcal::estimate::EstimateError> {
-    let excluded = &loaded.excluded;
-    let mut notes = loaded.notes.clone();
-    // frames, when there are and they are wanted, prepared as for `aps`
-    let prepared = if loaded.frames.len() >= 2 {
-        let input = ApsInput {
-            sensor: loaded.sensor,
-            events: &loaded.events,
-            frames: &loaded.frames,
-            excluded,
-        };
-        match aps::prepare(&input, excluded, options) {
-            Ok(p) => {
-                notes.extend(p.assumptions.iter().cloned());
-                Some(p.frames)
-            }
-            Err(e) => {
-                notes.push(format!("frames not used for the dynamics: {}", e.problem));
-                None
-            }
-        }
-    } else {
-        None
-    };
-    let mut estimate = eppps::estimate(
-        &eppps::EpppsInput {
-            sensor: loaded.sensor,
-            events: &loaded.events,
-            frames: prepared.as_ref(),
-            excluded,
-        },
-        &eppps_options,
-        progress,
-    )?;
-    estimate.assumptions.extend(notes);
-    Ok(estimate)
-}
-
 fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
     let common = &args.common;
     if let Some(r) = args.refresh_hz
@@ -311,38 +271,6 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
     spinner.finish_and_clear();
     let estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
     present(&estimate, &loaded, common, &policy)
-}
-
-/// `estimate screen` of a loaded recording and the stimulus it showed.
-pub(super) fn screen_of(
-    loaded: &Loaded,
-    stimulus: &[ctcal::Frame],
-    screen: DisplayParams,
-    refresh_hz: Option<f64>,
-    progress: ctcal::estimate::Progress,
-) -> Result<CtEstimate, ctcal::estimate::EstimateError> {
-    let mut estimate = screen::estimate(
-        &screen::ScreenInput {
-            sensor: loaded.sensor,
-            events: &loaded.events,
-            stimulus,
-            screen,
-            refresh_hz,
-            excluded: &loaded.excluded,
-        },
-        progress,
-    )?;
-    estimate.assumptions.extend(loaded.notes.iter().cloned());
-    Ok(estimate)
-}
-
-/// The screen model `estimate screen` starts from without `--screen`.
-const DEFAULT_SCREEN: &str = include_str!("../../calib/screens/lcd_60hz_srgb.toml");
-
-/// The built-in screen model (a typical 60 Hz LCD).
-pub(super) fn default_screen() -> DisplayParams {
-    DisplayParams::from_toml(DEFAULT_SCREEN, "the built-in 60 Hz LCD model")
-        .expect("the built-in screen model is valid")
 }
 
 /// A spinner on stderr showing the stage (hidden when quiet).

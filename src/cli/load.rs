@@ -1,39 +1,10 @@
-//! Reading a recording for the estimators and the fit: the events of a time window in
-//! memory, and the grey frames of that window (at most `max_frames`, evenly spread).
+//! Reading a recording for the estimators and the fit (`ctcal::window`), with its warnings
+//! and reading progress on stderr and its errors worded with the command's flags.
 
 use super::{BadInput, Global, InputArgs, SelectionArgs, progress_bar, warn};
-use ctcal::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
-use ctcal::{InputError, Recording};
-
-/// The most events an estimate holds in memory (about 1.3 GB).
-const MAX_EVENTS: usize = 100_000_000;
-
-/// A time window of a recording, in memory.
-pub struct Loaded {
-    pub recording: Recording,
-    pub sensor: Sensor,
-    pub sensor_source: String,
-    pub events: EventChunk,
-    pub frames: Vec<Frame>,
-    /// Frames in the window before thinning to `max_frames`.
-    pub frames_available: usize,
-    /// The pixels `--roi` / `--mask` keep.
-    pub selection: ctcal::selection::PixelSelection,
-    /// One flag per pixel: left out by `--roi` / `--mask` (what the estimators take).
-    pub excluded: Vec<bool>,
-    pub notes: Vec<String>,
-}
-
-/// What to read.
-pub struct Window {
-    /// Seconds after the first event.
-    pub start_s: Option<f64>,
-    pub end_s: Option<f64>,
-    /// Read frames at all, and at most how many.
-    pub frames: Option<usize>,
-    /// Keep only the events between the first and last frame kept.
-    pub events_between_frames: bool,
-}
+use ctcal::window::{LoadError, LoadObserver};
+pub use ctcal::window::{Loaded, Window};
+use std::cell::OnceCell;
 
 /// Checks `--start`/`--end` as `stats` does.
 pub fn check_window(start: Option<f64>, end: Option<f64>) -> Result<(), BadInput> {
@@ -54,6 +25,64 @@ pub fn check_window(start: Option<f64>, end: Option<f64>) -> Result<(), BadInput
     Ok(())
 }
 
+/// A load's error with the fix in the command's flags: an input error as it is (its exit
+/// code follows it), the others as bad input.
+pub fn hinted(error: LoadError) -> anyhow::Error {
+    let text = match error {
+        LoadError::Input(e) => return e.into(),
+        LoadError::Window(text) => text,
+        LoadError::TooManyEvents { path, max } => format!(
+            "{}: more than {max} events in the selected time window\n  fix: select a shorter part of the recording with --start/--end (seconds from the first event)",
+            path.display()
+        ),
+        LoadError::FrameSize {
+            path,
+            frames: (w, h),
+            sensor,
+        } => format!(
+            "{}: the frames are {w}x{h} but the sensor is {sensor}\n  fix: pass --sensor {w}x{h} if the frames show the whole sensor",
+            path.display()
+        ),
+        LoadError::OverBudget {
+            path,
+            sensor,
+            reach: (max_x, max_y),
+        } => format!(
+            "{}: the {sensor} sensor has {} pixels; the estimators keep several maps of one value per pixel, more than the budget of {} pixels\n  fix: pass --sensor WxH with the camera's real size (the events reach x = {max_x}, y = {max_y}), or --force to use the memory anyway",
+            path.display(),
+            sensor.pixels(),
+            ctcal::stats::PIXEL_BUDGET,
+        ),
+        LoadError::SelectionOverBudget { path, sensor } => format!(
+            "{}: a pixel selection (--roi, --mask, --exclude-hot-pixels) of the {sensor} sensor keeps one flag per pixel ({} pixels), more than the budget of {} pixels\n  fix: pass --sensor WxH with the camera's real size, or --force to use the memory anyway",
+            path.display(),
+            sensor.pixels(),
+            ctcal::stats::PIXEL_BUDGET,
+        ),
+        LoadError::Selection { path, problem, fix } => {
+            format!("{}: {problem}\n  fix: {fix}", path.display())
+        }
+    };
+    BadInput(text).into()
+}
+
+/// Warnings on stderr and a progress bar over the events read.
+struct Stderr<'a> {
+    global: &'a Global,
+    bar: OnceCell<indicatif::ProgressBar>,
+}
+
+impl LoadObserver for Stderr<'_> {
+    fn warn(&self, message: &str) {
+        warn(self.global, message);
+    }
+    fn reading(&self, done: u64, total: u64) {
+        self.bar
+            .get_or_init(|| progress_bar(self.global, total, "reading events"))
+            .set_position(done);
+    }
+}
+
 /// Reads `input` for an estimate, and the pixels `selection` keeps.
 pub fn load(
     input: &InputArgs,
@@ -62,127 +91,20 @@ pub fn load(
     global: &Global,
 ) -> anyhow::Result<Loaded> {
     check_window(window.start_s, window.end_s)?;
-    let recording = Recording::open(&input.input, &input.open_options())?;
-    for note in &recording.notes {
-        warn(global, note);
-    }
-    // the first event fixes the clock of --start/--end
-    let first = recording.first_event_time()?;
-    let to_us = |s: f64| first + (s * 1e6).round() as TimeUs;
-    let (mut from, mut to) = (
-        window.start_s.map_or(TimeUs::MIN, to_us),
-        window.end_s.map_or(TimeUs::MAX, to_us),
+    let observer = Stderr {
+        global,
+        bar: OnceCell::new(),
+    };
+    let loaded = ctcal::window::load(
+        &input.input,
+        &input.open_options(),
+        window,
+        &selection.spec(),
+        global.force,
+        &observer,
     );
-    let mut notes = Vec::new();
-    let mut frames = Vec::new();
-    let mut frames_available = 0;
-    if let Some(max_frames) = window.frames {
-        let times = recording.frame_times()?;
-        let inside: Vec<usize> = (0..times.len())
-            .filter(|&i| times[i] >= from && times[i] <= to)
-            .collect();
-        frames_available = inside.len();
-        let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
-        let keep: std::collections::BTreeSet<usize> =
-            inside.iter().step_by(stride).copied().collect();
-        if stride > 1 {
-            notes.push(format!(
-                "every {stride}th of the {} frames used ({} frames; --max-frames sets the limit)",
-                inside.len(),
-                keep.len()
-            ));
-        }
-        frames = recording.frames_where(|i, _| keep.contains(&i))?;
-        if window.events_between_frames && frames.len() >= 2 {
-            from = from.max(frames[0].t);
-            to = to.min(frames[frames.len() - 1].t);
-        }
+    if let Some(bar) = observer.bar.get() {
+        bar.finish_and_clear();
     }
-    let mut stream = recording.events_between(from, to)?;
-    for note in &stream.notes {
-        warn(global, note);
-    }
-    let bar = progress_bar(global, stream.progress().total, "reading events");
-    let mut events = EventChunk::default();
-    while stream.next_chunk()?.is_some() {
-        let chunk = stream.current_chunk();
-        let lo = chunk.t.partition_point(|&t| t < from);
-        let hi = chunk.t.partition_point(|&t| t <= to);
-        for i in lo..hi.max(lo) {
-            events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
-        }
-        let past_window = chunk.t.last().is_some_and(|&t| t > to);
-        if events.len() > MAX_EVENTS {
-            return Err(BadInput(format!(
-                "{}: more than {MAX_EVENTS} events in the selected time window\n  fix: select a shorter part of the recording with --start/--end (seconds from the first event)",
-                recording.path.display()
-            ))
-            .into());
-        }
-        bar.set_position(stream.progress().done);
-        if past_window {
-            break;
-        }
-    }
-    bar.finish_and_clear();
-    if events.is_empty() {
-        return Err(InputError::EmptyWindow {
-            path: recording.path.clone(),
-            detail: format!(
-                "{:.6} s .. {:.6} s",
-                us_to_s(from.max(first) - first),
-                if to == TimeUs::MAX {
-                    f64::INFINITY
-                } else {
-                    us_to_s(to - first)
-                }
-            ),
-        }
-        .into());
-    }
-    let resolved = recording.resolve_sensor(events.max_coordinates());
-    if let Some(w) = &resolved.warning {
-        warn(global, w);
-    }
-    if let Some(f) = frames.first()
-        && (f.width as u16, f.height as u16) != (resolved.sensor.width, resolved.sensor.height)
-    {
-        return Err(BadInput(format!(
-            "{}: the frames are {}x{} but the sensor is {}\n  fix: pass --sensor {}x{} if the frames show the whole sensor",
-            recording.path.display(),
-            f.width,
-            f.height,
-            resolved.sensor,
-            f.width,
-            f.height
-        ))
-        .into());
-    }
-    // the estimators keep several maps of one value per pixel
-    let sensor = resolved.sensor;
-    if sensor.pixels() > ctcal::stats::PIXEL_BUDGET && !global.force {
-        let (max_x, max_y) = events.max_coordinates().unwrap_or((0, 0));
-        return Err(BadInput(format!(
-            "{}: the {sensor} sensor has {} pixels; the estimators keep several maps of one value per pixel, more than the budget of {} pixels\n  fix: pass --sensor WxH with the camera's real size (the events reach x = {max_x}, y = {max_y}), or --force to use the memory anyway",
-            recording.path.display(),
-            sensor.pixels(),
-            ctcal::stats::PIXEL_BUDGET,
-        ))
-        .into());
-    }
-    let kept = selection.build(sensor, &recording.path, global.force)?;
-    if !kept.is_all() {
-        notes.push(format!("pixels: {}", kept.description()));
-    }
-    Ok(Loaded {
-        excluded: kept.excluded(),
-        selection: kept,
-        sensor: resolved.sensor,
-        sensor_source: resolved.source,
-        recording,
-        events,
-        frames,
-        frames_available,
-        notes,
-    })
+    loaded.map_err(hinted)
 }

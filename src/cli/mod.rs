@@ -110,6 +110,14 @@ impl SelectionArgs {
         self.roi.is_some() || self.mask.is_some() || self.exclude_hot_pixels
     }
 
+    /// The region and mask, as the library takes them.
+    pub fn spec(&self) -> ctcal::window::SelectionSpec {
+        ctcal::window::SelectionSpec {
+            roi: self.roi,
+            mask: self.mask.clone(),
+        }
+    }
+
     /// The region and mask for `sensor` (hot pixels are left out by the caller, who finds
     /// them); `input` names the recording in errors. A selection holds a flag per pixel: a
     /// sensor over the pixel budget is refused unless `force`. A selection that keeps no
@@ -120,34 +128,9 @@ impl SelectionArgs {
         input: &Path,
         force: bool,
     ) -> anyhow::Result<ctcal::selection::PixelSelection> {
-        let budget = ctcal::stats::PIXEL_BUDGET;
-        if sensor.pixels() > budget && !force {
-            return Err(BadInput(format!(
-                "{}: a pixel selection (--roi, --mask, --exclude-hot-pixels) of the {sensor} sensor keeps one flag per pixel ({} pixels), more than the budget of {budget} pixels\n  fix: pass --sensor WxH with the camera's real size, or --force to use the memory anyway",
-                input.display(),
-                sensor.pixels()
-            ))
-            .into());
-        }
-        let fail = |e: ctcal::selection::SelectionError| {
-            BadInput(format!(
-                "{}: {}\n  fix: {}",
-                input.display(),
-                e.problem,
-                e.fix
-            ))
-        };
-        let mut selection = ctcal::selection::PixelSelection::all(sensor);
-        if let Some(roi) = self.roi {
-            selection = selection.roi(roi).map_err(fail)?;
-        }
-        if let Some(path) = &self.mask {
-            let mask = ctcal::io::mask::read_mask(path, sensor)?;
-            selection = selection
-                .mask(&mask, &path.display().to_string())
-                .map_err(fail)?;
-        }
-        Ok(selection)
+        self.spec()
+            .build(sensor, input, force)
+            .map_err(load::hinted)
     }
 }
 

@@ -20,6 +20,7 @@ pub mod frame_list;
 pub mod h5;
 mod h5_direct;
 pub mod ijrr;
+pub mod info;
 pub mod mask;
 pub mod npy;
 pub mod order;

@@ -23,6 +23,7 @@ mod markdown;
 pub mod masks;
 pub mod model;
 mod page;
+pub mod pipeline;
 pub mod plots;
 pub mod presets;
 pub mod tables;

@@ -10,6 +10,7 @@ mod errors;
 mod estimate;
 mod fit;
 mod fit_events_only;
+mod from_results;
 mod limits;
 mod peers;
 mod readers;

@@ -127,22 +127,27 @@ fn the_sample_report_has_every_part() {
         let bytes = std::fs::read(dir.join(format!("{png}.png"))).unwrap();
         assert_eq!(&bytes[1..4], b"PNG", "{png}");
     }
-    // the texture has frames and was fitted: every format of configuration; the on-screen
-    // recording has no frames, so no fit and no configuration of its own
-    for name in [
-        "esim.flagfile",
-        "esim_config_generator.json",
-        "v2e_args.sh",
-        "v2e_args.json",
-        "params.toml",
-    ] {
-        assert!(all.contains(&format!("configs/texture_davis240c/{name}")));
+    // both recordings are fitted (the on-screen one has no frames: from its events alone):
+    // every format of configuration for each, and one combined generator file per sensor
+    for sequence in ["texture_davis240c", "screen_checkerboard"] {
+        for name in [
+            "esim.flagfile",
+            "esim_config_generator.json",
+            "v2e_args.sh",
+            "v2e_args.json",
+            "params.toml",
+        ] {
+            assert!(
+                all.contains(&format!("configs/{sequence}/{name}")),
+                "{sequence}/{name}"
+            );
+        }
     }
-    assert!(all.contains(&"configs/esim_config_generator.json".to_string()));
-    assert!(
-        !all.iter()
-            .any(|f| f.starts_with("configs/screen_checkerboard"))
-    );
+    for sensor in ["240x180", "120x90"] {
+        assert!(all.contains(&format!(
+            "configs/sensors/{sensor}/esim_config_generator.json"
+        )));
+    }
 
     // how it was made, and from what
     let r = results();
@@ -168,10 +173,12 @@ fn the_sample_report_has_every_part() {
             );
         }
     }
+    // the on-screen recording has no frames: fitted from its events alone, and said so
     let screen = sequence(&r, "screen_checkerboard");
-    assert!(screen["fit"].is_null());
-    let why = screen["fit_not_applied"].as_str().unwrap();
-    assert!(why.contains("grey frames"), "{why}");
+    assert!(screen["fit_not_applied"].is_null());
+    let fit = &screen["fit"];
+    assert!(fit["events_only"]["thresholds_source"].is_string());
+    assert!(fit["params"]["ct_sigma"].is_null() && fit["why"]["ct_sigma"].is_string());
 
     // the Markdown report shows every PNG and every table
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
@@ -328,7 +335,8 @@ fn tables_agree_across_formats_and_are_stable() {
         "texture_davis240c/v2e_args.sh",
         "texture_davis240c/v2e_args.json",
         "texture_davis240c/params.toml",
-        "esim_config_generator.json",
+        "sensors/240x180/esim_config_generator.json",
+        "screen_checkerboard/v2e_args.sh",
     ] {
         let text = std::fs::read_to_string(configs.join(name)).unwrap();
         insta::assert_snapshot!(name.replace('/', "__"), text);
@@ -450,7 +458,18 @@ fn the_html_report_renders_in_a_browser() {
         "no plot colours on the page: {coloured} pixels"
     );
     let tables: Vec<&str> = result.lines().filter(|l| l.starts_with("table ")).collect();
-    assert_eq!(tables.len(), TABLES.len(), "{result}");
+    // datasets, statistics and thresholds once; the fitted model and the loop per fit
+    let fitted = results()["sequences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|s| !s["fit"].is_null())
+        .count();
+    assert_eq!(
+        fitted, 2,
+        "both samples are fitted (the screen one from events alone)"
+    );
+    assert_eq!(tables.len(), TABLES.len() - 2 + 2 * fitted, "{result}");
     for line in tables {
         let rows: usize = line.split(' ').nth(1).unwrap().parse().unwrap();
         assert!(rows >= 2, "{line}: a header and rows");
@@ -469,7 +488,16 @@ fn config_reads_a_report_or_a_fit_and_round_trips_through_the_simulator() {
         );
         String::from_utf8(output.stdout).unwrap()
     };
-    let report_arg = report.to_str().unwrap();
+    // one sensor's fit: the texture alone (the sample's two sequences are two sensors, which
+    // a configuration does not combine)
+    let texture_only = tempfile::tempdir().unwrap();
+    let mut r = results();
+    r["sequences"]
+        .as_array_mut()
+        .unwrap()
+        .retain(|s| s["name"] == "texture_davis240c");
+    std::fs::write(texture_only.path().join("results.json"), r.to_string()).unwrap();
+    let report_arg = texture_only.path().to_str().unwrap();
     // one sequence fitted: the report's own files, whichever way asked
     let v2e = run(&["config", report_arg, "--format", "v2e"]);
     assert_eq!(

@@ -274,7 +274,8 @@ fn config_refuses_to_combine_sensors() {
     std::fs::write(dir.join("results.json"), r.to_string()).unwrap();
     let e = bad_input(&["config", dir.to_str().unwrap(), "--format", "v2e"]);
     assert!(
-        e.contains("2 sensors")
+        e.contains("3 sensors")
+            && e.contains("120x90: screen_checkerboard")
             && e.contains("240x180: texture_davis240c")
             && e.contains("346x260: texture_davis346")
             && e.contains("fix:"),

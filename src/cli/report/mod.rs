@@ -3,20 +3,21 @@
 //! Sequences are processed in parallel; each is written as soon as it is done and its
 //! per-pixel data dropped. A recording that fails is listed with its error and the others
 //! are still reported (exit code 1); when every one fails, nothing is written.
+//!
+//! The work is the library's report pipeline (`ctcal::report::pipeline`): this module turns
+//! the command line into its options, shows its progress, words its errors with the
+//! command's flags and writes the folder; `--from-results` merges reports made elsewhere.
 
+mod from_results;
 mod inputs;
 mod progress;
-mod sequence;
 
-use super::estimate::default_screen;
 use super::{BadInput, Global, SelectionArgs, output, warn};
 use clap::Args;
-use ctcal::report::grouping::{Origin, dataset_names, file_stem};
-use ctcal::report::model::{FailedSequence, Report, SequenceReport};
+use ctcal::report::model::Report;
+use ctcal::report::pipeline::{self, Input, SequenceError};
 use ctcal::sim::DisplayParams;
-use inputs::Input;
 use progress::Progress;
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 #[derive(Args, Debug)]
@@ -25,6 +26,10 @@ pub struct ReportArgs {
     /// dataset named after the folder, split by sensor where the folder mixes sensors).
     #[arg(value_name = "INPUT")]
     pub inputs: Vec<PathBuf>,
+    /// Build the report from reports made elsewhere: their folders (or their results.json),
+    /// each sequence with its files taken as it is, merged into one report (same seed).
+    #[arg(long = "from-results", value_name = "DIR", num_args = 1.., conflicts_with_all = ["inputs", "datasets"])]
+    pub from_results: Vec<PathBuf>,
     /// Recordings of a named dataset: NAME=INPUT (repeatable; INPUT may be a folder of
     /// recordings).
     #[arg(long = "dataset", value_name = "NAME=INPUT")]
@@ -60,60 +65,13 @@ pub struct ReportArgs {
 #[error("{0}")]
 pub struct SomeFailed(pub String);
 
-/// The message of a panic.
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "no message".into())
-}
-
-/// One recording computed, rendered and written (its per-pixel data dropped after): the
-/// sequence, or the error that stopped it. Only a failure to write ends the report.
-fn one(
-    input: &Input,
-    args: &ReportArgs,
-    screen: &DisplayParams,
-    global: &Global,
-    progress: &Progress,
-    staged: &ctcal::io::write::StagedFolder,
-) -> anyhow::Result<Result<SequenceReport, anyhow::Error>> {
-    let computed = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        sequence::sequence(input, args, screen, global, progress)
-    }));
-    let (mut s, pixels) = match computed {
-        Ok(Ok(done)) => done,
-        Ok(Err(e)) => {
-            progress.finished(&input.name, "failed");
-            return Ok(Err(e));
-        }
-        Err(payload) => {
-            progress.finished(&input.name, "failed");
-            return Ok(Err(anyhow::anyhow!(
-                "ctcal failed on it (a bug; please report it with this recording): {}",
-                panic_message(payload.as_ref())
-            )));
-        }
-    };
-    let files = ctcal::report::render_sequence(&mut s, &pixels, args.seed);
-    drop(pixels);
-    for f in files {
-        staged.write(&f.path, &f.bytes)?;
-    }
-    progress.finished(&input.name, "written");
-    Ok(Ok(s))
-}
-
-/// Names each sequence's dataset: the user's name, else its folder's, split by sensor.
-fn name_datasets(sequences: &mut [SequenceReport], origins: &[Origin]) {
-    let keyed: Vec<(Origin, String)> = origins
-        .iter()
-        .cloned()
-        .zip(sequences.iter().map(|s| s.sensor()))
-        .collect();
-    for (s, name) in sequences.iter_mut().zip(dataset_names(&keyed)) {
-        s.dataset = file_stem(&name);
+/// A recording's error with the fix in the command's flags (its exit code follows it).
+fn hinted(error: SequenceError) -> anyhow::Error {
+    match error {
+        SequenceError::Load(e) => super::load::hinted(e),
+        SequenceError::Input(e) => e.into(),
+        SequenceError::NoEvents(_) => BadInput(error.to_string()).into(),
+        SequenceError::Panic(_) => anyhow::anyhow!("{error}"),
     }
 }
 
@@ -137,11 +95,28 @@ fn screen_of(args: &ReportArgs) -> anyhow::Result<DisplayParams> {
                 .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
             DisplayParams::from_toml(&text, &path.display().to_string())?
         }
-        None => default_screen(),
+        None => ctcal::window::default_screen(),
+    })
+}
+
+/// The pipeline's options of the command line.
+fn options(args: &ReportArgs, global: &Global) -> anyhow::Result<pipeline::Options> {
+    Ok(pipeline::Options {
+        start_s: args.start,
+        end_s: args.end,
+        max_frames: args.max_frames,
+        screen: screen_of(args)?,
+        seed: args.seed,
+        fit_left_out: args.no_fit.then(|| "left out (--no-fit)".to_string()),
+        selection: args.selection.spec(),
+        force: global.force,
     })
 }
 
 pub fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
+    if !args.from_results.is_empty() {
+        return from_results::run(args, global);
+    }
     super::load::check_window(args.start, args.end)?;
     if args.max_frames < 2 {
         return Err(BadInput("--max-frames must be at least 2".into()).into());
@@ -150,64 +125,57 @@ pub fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
     let policy = global.outputs(protected(args, &inputs));
     // refuse a bad output before the work
     policy.check_folder(&args.out)?;
-    let screen = screen_of(args)?;
+    let options = options(args, global)?;
     let staged = policy.folder(&args.out)?;
     let progress = Progress::new(global, inputs.len());
-    let (presets, outcomes) = rayon::join(
-        || ctcal::report::presets::simulate(args.seed),
-        || {
-            inputs
-                .par_iter()
-                .map(|input| one(input, args, &screen, global, &progress, &staged))
-                .collect::<anyhow::Result<Vec<_>>>()
-        },
-    );
+    let outcomes = pipeline::run(
+        &inputs,
+        &options,
+        &|name, event| progress.event(name, event),
+        &|f| staged.write(&f.path, &f.bytes),
+    )?;
     progress.clear();
-    let mut sequences = Vec::new();
-    let mut origins = Vec::new();
-    let mut failed = Vec::new();
+    let mut merged = Vec::new();
     let mut first_error = None;
-    for (input, outcome) in inputs.iter().zip(outcomes?) {
-        match outcome {
-            Ok(s) => {
-                sequences.push(s);
-                origins.push(input.origin.clone());
-            }
-            Err(e) => {
-                failed.push(FailedSequence {
-                    name: input.name.clone(),
-                    path: input.path.display().to_string(),
-                    error: format!("{e:#}"),
-                });
-                first_error.get_or_insert(e);
-            }
-        }
+    let mut any = false;
+    for (input, outcome) in inputs.iter().zip(outcomes.sequences) {
+        let outcome = outcome.map_err(hinted).map_err(|e| {
+            let message = format!("{e:#}");
+            first_error.get_or_insert(e);
+            message
+        });
+        any |= outcome.is_ok();
+        merged.push((input.clone(), outcome));
     }
-    if sequences.is_empty()
-        && let Some(e) = first_error
-    {
+    if !any && let Some(e) = first_error {
         // nothing to report: the error as it is (the staged folder is removed)
         return Err(e);
     }
-    name_datasets(&mut sequences, &origins);
-    let report = Report {
-        ctcal_version: env!("CARGO_PKG_VERSION"),
+    let report = pipeline::merge(
+        merged,
+        outcomes.presets?,
+        args.seed,
         // the program as `ctcal`, wherever it was run from
-        command_line: std::iter::once("ctcal".to_string())
+        std::iter::once("ctcal".to_string())
             .chain(std::env::args().skip(1))
             .collect(),
-        seed: args.seed,
-        datasets: ctcal::report::model::datasets(&sequences),
-        sequences,
-        presets: presets?,
-        presets_scene: ctcal::report::presets::DESCRIPTION.into(),
-        failed,
-    };
-    for f in ctcal::report::render_summary(&report) {
+    );
+    finish(args, global, &report, staged)
+}
+
+/// The summary written beside the sequences, the folder committed, and what was made
+/// told; some recordings failed: exit code 1.
+fn finish(
+    args: &ReportArgs,
+    global: &Global,
+    report: &Report,
+    staged: ctcal::io::write::StagedFolder,
+) -> anyhow::Result<()> {
+    for f in ctcal::report::render_summary(report) {
         staged.write(&f.path, &f.bytes)?;
     }
     staged.commit()?;
-    tell(args, global, &report)?;
+    tell(args, global, report)?;
     if report.failed.is_empty() {
         Ok(())
     } else {

@@ -1,19 +1,15 @@
-//! One recording of `ctcal report`: read it, compute its statistics, every applicable
-//! threshold estimate and the fit; what it is made of (its files' hashes, the truth it says
-//! it was made with).
+//! One recording of a report: read it, compute its statistics, every applicable threshold
+//! estimate and the fit; what it is made of (its files' hashes, the truth it says it was
+//! made with).
 
-use super::super::BadInput;
-use super::super::estimate::{eppps_of, screen_of};
-use super::super::load::{Loaded, Window, load};
-use super::super::{Global, InputArgs};
-use super::ReportArgs;
 use super::inputs::Input;
-use super::progress::Progress;
-use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
-use ctcal::fit::{FitInput, FitOptions, FitResult};
-use ctcal::report::model::{InputFile, MethodResult, PixelData, PixelMaps, SequenceReport, Truth};
-use ctcal::sim::{DisplayParams, PixelParams};
-use ctcal::stats::{StatsAccumulator, StatsOptions};
+use super::{Event, Observer, Options, SequenceError, Stage};
+use crate::estimate::aps::{self, ApsInput, ApsOptions};
+use crate::fit::{FitInput, FitOptions, FitResult};
+use crate::report::model::{InputFile, MethodResult, PixelData, PixelMaps, SequenceReport, Truth};
+use crate::sim::PixelParams;
+use crate::stats::{StatsAccumulator, StatsOptions};
+use crate::window::{Loaded, Window, load};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -64,7 +60,7 @@ fn input_files(loaded: &Loaded) -> Vec<InputFile> {
 fn truth(path: &Path) -> Option<Truth> {
     let folder = if path.is_dir() { path } else { path.parent()? };
     let read = |name: &str| -> Option<serde_json::Value> {
-        let text = ctcal::files::read_small_text(&folder.join(name), 16 << 20).ok()?;
+        let text = crate::files::read_small_text(&folder.join(name), 16 << 20).ok()?;
         serde_json::from_str(&text).ok()
     };
     if let Some(sim) = read("simulation.json")
@@ -72,7 +68,7 @@ fn truth(path: &Path) -> Option<Truth> {
     {
         return Some(Truth {
             source: "simulation.json (ctcal simulate)".into(),
-            params: ctcal::report::configs::numeric_params(&params)
+            params: crate::report::configs::numeric_params(&params)
                 .into_iter()
                 .collect(),
         });
@@ -101,54 +97,69 @@ fn truth(path: &Path) -> Option<Truth> {
     })
 }
 
-/// Everything reported of one recording.
-pub(super) fn sequence(
+/// The warnings of reading a recording, passed on as the sequence's events.
+struct Warnings<'a> {
+    name: &'a str,
+    progress: &'a Observer<'a>,
+}
+
+impl crate::window::LoadObserver for Warnings<'_> {
+    fn warn(&self, message: &str) {
+        (self.progress)(self.name, Event::Warning(message));
+    }
+}
+
+/// Everything reported of one recording, and its per-pixel data; `progress` hears of each
+/// stage done and of what reading the recording warned of.
+pub fn sequence(
     input: &Input,
-    args: &ReportArgs,
-    screen: &DisplayParams,
-    global: &Global,
-    progress: &Progress,
-) -> anyhow::Result<(SequenceReport, PixelData)> {
+    options: &Options,
+    progress: &Observer,
+) -> Result<(SequenceReport, PixelData), SequenceError> {
     let mut seconds = BTreeMap::new();
     let mut clock = Instant::now();
     let mut lap = |name: &str, seconds: &mut BTreeMap<String, f64>| {
         seconds.insert(name.to_string(), clock.elapsed().as_secs_f64());
         clock = Instant::now();
     };
-    let input_args = InputArgs {
-        input: input.path.clone(),
-        format: None,
-        sensor: None,
-        topic: None,
-        image_topic: None,
-        side: None,
-    };
     let loaded = load(
-        &input_args,
+        &input.path,
+        &Default::default(),
         &Window {
-            start_s: args.start,
-            end_s: args.end,
-            frames: Some(args.max_frames),
+            start_s: options.start_s,
+            end_s: options.end_s,
+            frames: Some(options.max_frames),
             events_between_frames: false,
         },
-        &args.selection,
-        global,
+        &options.selection,
+        options.force,
+        &Warnings {
+            name: &input.name,
+            progress,
+        },
     )?;
     let inputs = input_files(&loaded);
     lap("reading", &mut seconds);
-    progress.stage(&input.name, "reading");
+    progress(&input.name, Event::Done(Stage::Reading));
 
     let (stats, pixel_counts) = statistics(&loaded, &input.path)?;
     lap("statistics", &mut seconds);
-    progress.stage(&input.name, "statistics");
+    progress(&input.name, Event::Done(Stage::Statistics));
 
-    let (methods, maps) = estimates(&loaded, args, screen)?;
+    let (methods, maps) = estimates(&loaded, options)?;
     lap("estimates", &mut seconds);
-    progress.stage(&input.name, "estimates");
+    progress(&input.name, Event::Done(Stage::Estimates));
 
-    let (fit, fit_not_applied) = fit_of(&loaded, args);
+    // an on-screen recording's thresholds come from the screen method (measured through
+    // the display model), not from eppps's prior, where a fit has no frames to measure them
+    let screen = methods
+        .iter()
+        .find(|m| m.method == "screen")
+        .and_then(|m| m.estimate.as_ref())
+        .filter(|e| e.ct_on.is_some() || e.ct_off.is_some());
+    let (fit, fit_not_applied) = fit_of(&loaded, options, screen);
     lap("fit", &mut seconds);
-    progress.stage(&input.name, "fit");
+    progress(&input.name, Event::Done(Stage::Fit));
     let report = SequenceReport {
         name: input.name.clone(),
         // named once every sequence's sensor is known (see `grouping`)
@@ -177,11 +188,10 @@ pub(super) fn sequence(
 /// Every applicable threshold estimate of a recording, and the per-pixel maps of `aps`.
 fn estimates(
     loaded: &Loaded,
-    args: &ReportArgs,
-    screen: &DisplayParams,
-) -> anyhow::Result<(Vec<MethodResult>, Option<PixelMaps>)> {
+    options: &Options,
+) -> Result<(Vec<MethodResult>, Option<PixelMaps>), SequenceError> {
     let quiet = |_: &str, _: f64| {};
-    let options = ApsOptions::default();
+    let aps_options = ApsOptions::default();
     let mut methods = Vec::new();
     let mut maps = None;
     if loaded.frames.len() >= 2 {
@@ -192,7 +202,7 @@ fn estimates(
                 frames: &loaded.frames,
                 excluded: &loaded.excluded,
             },
-            &options,
+            &aps_options,
             &quiet,
         ) {
             Ok(mut result) => {
@@ -225,11 +235,11 @@ fn estimates(
             not_applied: Some("the recording has no grey frames".into()),
         });
     }
-    let eppps = eppps_of(
+    let eppps = crate::window::eppps_of(
         loaded,
-        &options,
-        ctcal::estimate::eppps::EpppsOptions {
-            seed: args.seed,
+        &aps_options,
+        crate::estimate::eppps::EpppsOptions {
+            seed: options.seed,
             ..Default::default()
         },
         &quiet,
@@ -242,7 +252,8 @@ fn estimates(
     match loaded.recording.stimulus()? {
         Some(list) if list.len() >= 2 => {
             let frames = list.load_all()?;
-            let found = screen_of(loaded, &frames, screen.clone(), None, &quiet);
+            let found =
+                crate::window::screen_of(loaded, &frames, options.screen.clone(), None, &quiet);
             methods.push(MethodResult {
                 method: "screen",
                 not_applied: found.as_ref().err().map(|e| e.to_string()),
@@ -261,12 +272,16 @@ fn estimates(
 }
 
 /// The fit of a recording, or why there is none.
-fn fit_of(loaded: &Loaded, args: &ReportArgs) -> (Option<FitResult>, Option<String>) {
+fn fit_of(
+    loaded: &Loaded,
+    options: &Options,
+    screen: Option<&crate::estimate::CtEstimate>,
+) -> (Option<FitResult>, Option<String>) {
     let quiet = |_: &str, _: f64| {};
-    if args.no_fit {
-        (None, Some("left out (--no-fit)".to_string()))
+    if let Some(why) = &options.fit_left_out {
+        (None, Some(why.clone()))
     } else {
-        match ctcal::fit::fit(
+        match crate::fit::fit(
             &FitInput {
                 sensor: loaded.sensor,
                 events: &loaded.events,
@@ -274,7 +289,8 @@ fn fit_of(loaded: &Loaded, args: &ReportArgs) -> (Option<FitResult>, Option<Stri
                 excluded: &loaded.excluded,
             },
             &FitOptions {
-                seed: args.seed,
+                seed: options.seed,
+                thresholds: screen.cloned(),
                 ..FitOptions::default()
             },
             &quiet,
@@ -292,7 +308,7 @@ fn fit_of(loaded: &Loaded, args: &ReportArgs) -> (Option<FitResult>, Option<Stri
 fn statistics(
     loaded: &Loaded,
     path: &Path,
-) -> anyhow::Result<(ctcal::stats::SequenceStats, Vec<u32>)> {
+) -> Result<(crate::stats::SequenceStats, Vec<u32>), SequenceError> {
     let selection = loaded.selection.clone();
     let mut accumulator = StatsAccumulator::new(
         StatsOptions {
@@ -308,12 +324,7 @@ fn statistics(
             &loaded.sensor_source,
             &loaded.recording.frame_times()?,
         )
-        .ok_or_else(|| {
-            BadInput(format!(
-                "{}: no events in the selected pixels",
-                path.display()
-            ))
-        })?;
+        .ok_or_else(|| SequenceError::NoEvents(path.to_path_buf()))?;
     let width = loaded.sensor.width as usize;
     let mut pixel_counts = vec![0u32; loaded.sensor.pixels()];
     for i in 0..loaded.events.len() {

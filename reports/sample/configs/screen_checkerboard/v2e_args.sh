@@ -1,0 +1,25 @@
+#!/bin/sh
+# v2e with the parameters ctcal fitted to a recording. Run it as it is, with v2e's
+# input and output arguments after it:
+#   sh v2e_args.sh -i video.mp4 --output_folder out
+# (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)
+# NOT IDENTIFIED: ct_sigma: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (per-pixel threshold mismatch shows in how many events each pixel gives for the brightness change it saw: that needs grey frames or a known stimulus (estimate screen))
+# NOT IDENTIFIED: cutoff_hz: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (the photoreceptor bandwidth shows in how events lag brightness changes of known speed and intensity: that needs grey frames or a known stimulus)
+# NOT IDENTIFIED: leak_rate_hz: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (the ON excess of isolated events, 0.0023 +- 0.0013 Hz, is not told apart from none: at most 0.0048 Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden))
+# NOT IDENTIFIED: refractory_s: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most 1 us)
+# NOT IDENTIFIED: shot_noise_rate_hz: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (not told apart from none: at most 0.0023 Hz (2 standard errors))
+# NOT IDENTIFIED: timestamp_jitter_s: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (timestamp jitter shows against a stimulus of known timing: that needs a screen recording or frames)
+exec "${V2E:-v2e}" \
+  --pos_thres 0.310205 \
+  --neg_thres 0.309809 \
+  --sigma_thres 0 \
+  --cutoff_hz 0 \
+  --leak_rate_hz 0 \
+  --shot_noise_rate_hz 0 \
+  --refractory_period 0 \
+  --leak_jitter_fraction 0.100000 \
+  --noise_rate_cov_decades 0.100000 \
+  --dvs_emulator_seed 2020 \
+  --output_width 120 \
+  --output_height 90 \
+  "$@"
