@@ -913,11 +913,18 @@ fn config(text: &str, format: &str) -> PyResult<String> {
         [first, rest @ ..] if rest.iter().all(|e| e == first) => first.map(|e| e as f64 / 1e3),
         _ => None,
     };
+    // what the fits say they do not identify, as `ctcal config` marks it
+    let not_identified = fits
+        .iter()
+        .filter_map(|f| f.get("why").and_then(|w| w.as_object()))
+        .flat_map(|w| w.iter())
+        .filter_map(|(k, v)| Some((k.clone(), v.as_str()?.to_string())))
+        .collect();
     let setup = configs::Setup {
         exposure_ms,
         seed: seed.unwrap_or(2020),
         sensor,
-        not_identified: Default::default(),
+        not_identified,
     };
     configs::render(format, &params, &setup).ok_or_else(|| err("no fits given"))
 }

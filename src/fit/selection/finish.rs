@@ -102,6 +102,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         .extend(threshold_uncertainty(simulation, &state.model));
     let mut params = state.model.params.clone();
     params.seed = None;
+    // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml
+    // takes (1e-6 of white: < 3e-4 log units at DN 1); only pixels at DN 0 differ
+    if params.log_eps == Some(0.0) {
+        params.log_eps = Some(1e-6);
+    }
     if !state.hot.is_empty() {
         let kept_pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
         let rates: Vec<f64> = state.hot.iter().map(|h| h.rate_hz).collect();

@@ -85,10 +85,7 @@ pub fn fit(
     assumptions.extend(start.assumptions.iter().cloned());
     let start_params = PixelParams {
         log_response: Some(frames.log_map.response()),
-        // a pure ln(DN) response (offset 0) is written with the smallest offset a
-        // PARAMS.toml takes: 1e-6 of white changes ln(DN / 255) by < 3e-4 at DN 1, and keeps
-        // DN 0 finite
-        log_eps: Some(frames.log_map.eps().max(1e-6)),
+        log_eps: Some(frames.log_map.eps()),
         ..start.params.clone()
     };
 
