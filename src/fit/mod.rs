@@ -159,6 +159,50 @@ pub struct Step {
     pub residuals_after: Option<StepResiduals>,
 }
 
+impl Step {
+    /// A step with its evidence, not yet judged (nothing fitted, not kept).
+    pub fn untried(effect: String, evidence: String, score: f64) -> Self {
+        Self {
+            effect,
+            evidence,
+            score,
+            parameters: BTreeMap::new(),
+            error_before: None,
+            error_after: None,
+            components_after: None,
+            chance: None,
+            kept: false,
+            reason: String::new(),
+            simulations: 0,
+            residuals_before: None,
+            residuals_after: None,
+        }
+    }
+}
+
+/// Per parameter the model sets (log response aside): whether the data identify it (not in
+/// `not_identified`); the not-identified ones are listed too, as `false`.
+pub fn identified(
+    params: &PixelParams,
+    not_identified: &BTreeMap<String, String>,
+) -> BTreeMap<String, bool> {
+    let mut out: BTreeMap<String, bool> = serde_json::to_value(params)
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
+        .map(|(k, _)| {
+            let known = !not_identified.contains_key(&k);
+            (k, known)
+        })
+        .collect();
+    for key in not_identified.keys() {
+        out.insert(key.clone(), false);
+    }
+    out
+}
+
 /// The fitted model, and which of its parameters the data do not identify: in JSON those
 /// are `null` (the model simulated needs a value; a reader must not take it for a result).
 #[derive(Clone, Debug, PartialEq)]

@@ -88,17 +88,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
     let test = judging.of(Role::Test);
     let before = distance(&NoiseModel::ideal(), &test, judging.reference);
     let after = distance(&model, &test, judging.reference);
-    let mut identified: BTreeMap<String, bool> = serde_json::to_value(&params)
-        .ok()
-        .and_then(|v| v.as_object().cloned())
-        .unwrap_or_default()
-        .into_iter()
-        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
-        .map(|(k, _)| (k, true))
-        .collect();
-    for key in why.keys() {
-        identified.insert(key.clone(), false);
-    }
+    let identified = crate::fit::identified(&params, &why);
     let events_only = details(&run, &thresholds, judging, kept("thresholds"));
     let assumptions = assumptions(&run, &thresholds, blocks, judging, options);
     FitResult {

@@ -42,21 +42,12 @@ impl Judging<'_> {
 
     /// Tries `candidate` against `current`: the step, and the model kept.
     pub fn try_step(&self, current: &NoiseModel, candidate: Candidate) -> (Step, NoiseModel) {
-        let mut step = Step {
-            effect: candidate.name.to_string(),
-            evidence: candidate.evidence,
-            score: candidate.score,
-            parameters: candidate.parameters,
-            error_before: None,
-            error_after: None,
-            components_after: None,
-            chance: None,
-            kept: false,
-            reason: String::new(),
-            simulations: 0,
-            residuals_before: None,
-            residuals_after: None,
-        };
+        let mut step = Step::untried(
+            candidate.name.to_string(),
+            candidate.evidence,
+            candidate.score,
+        );
+        step.parameters = candidate.parameters;
         if !candidate.relevant {
             step.reason = "the fit blocks do not call for it".into();
             return (step, current.clone());

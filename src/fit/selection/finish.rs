@@ -119,17 +119,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         state.uncertainty.remove("ct_off");
     }
     assumptions.extend(split_assumptions(simulation, options));
-    let identified = serde_json::to_value(&params)
-        .ok()
-        .and_then(|v| v.as_object().cloned())
-        .unwrap_or_default()
-        .into_iter()
-        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
-        .map(|(k, _)| {
-            let known = !not_identified.contains_key(&k);
-            (k, known)
-        })
-        .collect();
+    let identified = super::super::identified(&params, &not_identified);
     FitResult {
         biases: None,
         why: not_identified.clone(),

@@ -13,24 +13,6 @@ use super::keep::{Verdict, judge};
 use crate::stats::hot_pixels::HotPixel;
 use std::collections::BTreeMap;
 
-fn empty_step(effect: String, evidence: String, score: f64) -> Step {
-    Step {
-        effect,
-        evidence,
-        score,
-        parameters: BTreeMap::new(),
-        error_before: None,
-        error_after: None,
-        components_after: None,
-        chance: None,
-        kept: false,
-        reason: String::new(),
-        simulations: 0,
-        residuals_before: None,
-        residuals_after: None,
-    }
-}
-
 fn thresholds_of(model: &Simulated) -> BTreeMap<String, f64> {
     BTreeMap::from([
         ("ct_on".to_string(), model.params.ct_on),
@@ -67,7 +49,7 @@ pub fn try_effect(
 ) -> Result<Step, FitError> {
     let effect = evidence.effect;
     let count_before = simulation.count.get();
-    let mut step = empty_step(effect.name().into(), evidence.text.clone(), evidence.score);
+    let mut step = Step::untried(effect.name().into(), evidence.text.clone(), evidence.score);
     step.residuals_before = Some(fit_residuals(simulation, &state.model));
     let (candidate, uncertain) = match effect {
         Effect::Display => {
@@ -215,7 +197,7 @@ pub fn refit(
         &searched.model.observed,
         &state.kept,
     );
-    let mut step = empty_step(
+    let mut step = Step::untried(
         format!("{} (refit)", effect.name()),
         format!("{key} was {current:.6} when the effect was added"),
         0.0,
@@ -263,7 +245,7 @@ pub fn prune(
         &state.model.observed,
         &state.kept,
     );
-    let mut step = empty_step(
+    let mut step = Step::untried(
         format!("{} (still needed?)", effect.name()),
         format!("the model without {key} (thresholds profiled again) against the model with it"),
         0.0,
@@ -290,7 +272,7 @@ pub fn prune(
 
 /// The record of an effect the residuals did not call for.
 pub fn untried(evidence: &effects::Evidence) -> Step {
-    let mut step = empty_step(
+    let mut step = Step::untried(
         evidence.effect.name().into(),
         evidence.text.clone(),
         evidence.score,
