@@ -855,78 +855,10 @@ fn config(text: &str, format: &str) -> PyResult<String> {
         ))
     })?;
     let json: serde_json::Value = serde_json::from_str(text).map_err(err)?;
-    let (fits, seed, sensors): (Vec<&serde_json::Value>, Option<u64>, Vec<(u64, u64)>) =
-        match json.get("sequences").and_then(|s| s.as_array()) {
-            Some(sequences) => {
-                let fitted: Vec<&serde_json::Value> = sequences
-                    .iter()
-                    .filter(|s| s.get("fit").is_some())
-                    .collect();
-                (
-                    fitted.iter().map(|s| &s["fit"]).collect(),
-                    json.get("seed").and_then(|s| s.as_u64()),
-                    fitted
-                        .iter()
-                        .filter_map(|s| {
-                            Some((
-                                s["stats"]["width"].as_u64()?,
-                                s["stats"]["height"].as_u64()?,
-                            ))
-                        })
-                        .collect(),
-                )
-            }
-            None => (vec![&json], None, Vec::new()),
-        };
-    let mut params = Vec::new();
-    let mut exposures = Vec::new();
-    for fit in &fits {
-        for key in ["ct_on", "ct_off"] {
-            if fit["params"].get(key).is_some_and(|v| v.is_null()) {
-                let why = fit["why"][key].as_str().unwrap_or("no reason given");
-                return Err(err(format!(
-                    "`params.{key}` is null: the recording does not identify it ({why})\n  fix: configure from a fit of a recording that shows the thresholds"
-                )));
-            }
-        }
-        let p: PixelParams = serde_json::from_value(fit["params"].clone()).map_err(err)?;
-        params.push(p);
-        exposures.push(fit.get("frame_exposure_us").and_then(|v| v.as_i64()));
-    }
-    if params.is_empty() {
-        return Err(err(
-            "no fitted sequence\n  fix: give a fit result or a report with fits",
-        ));
-    }
-    let sensor = match sensors.as_slice() {
-        [] => None,
-        [first, rest @ ..] if rest.iter().all(|s| s == first) => {
-            Some((first.0 as u32, first.1 as u32))
-        }
-        _ => {
-            return Err(err(
-                "the fits are of different sensors\n  fix: configure each sensor's fits apart",
-            ));
-        }
-    };
-    let exposure_ms = match exposures.as_slice() {
-        [first, rest @ ..] if rest.iter().all(|e| e == first) => first.map(|e| e as f64 / 1e3),
-        _ => None,
-    };
-    // what the fits say they do not identify, as `ctcal config` marks it
-    let not_identified = fits
-        .iter()
-        .filter_map(|f| f.get("why").and_then(|w| w.as_object()))
-        .flat_map(|w| w.iter())
-        .filter_map(|(k, v)| Some((k.clone(), v.as_str()?.to_string())))
-        .collect();
-    let setup = configs::Setup {
-        exposure_ms,
-        seed: seed.unwrap_or(2020),
-        sensor,
-        not_identified,
-    };
-    configs::render(format, &params, &setup).ok_or_else(|| err("no fits given"))
+    let mut fits = configs::source::FitSet::default();
+    fits.add("the fit JSON", &json).map_err(err)?;
+    let setup = fits.setup("the fit JSON", None).map_err(err)?;
+    configs::render(format, &fits.params, &setup).ok_or_else(|| err("no fits given"))
 }
 
 #[pymodule]

@@ -14,6 +14,7 @@
 
 pub mod files;
 pub mod generator;
+pub mod source;
 pub mod v2e;
 
 pub use generator::{EsimGeneratorCamera, esim_generator};
