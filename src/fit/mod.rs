@@ -261,6 +261,9 @@ pub struct FitResult {
     pub components_before: Components,
     pub components_after: Components,
     pub steps: Vec<Step>,
+    /// Pairs of effects the recording does not separate: the kept one and a look-alike
+    /// that explains it as well within chance, with what data would separate them.
+    pub ambiguities: Vec<Ambiguity>,
     /// Hot pixels named (simulated where they are as their own event trains).
     pub hot_pixels_masked: Vec<HotPixel>,
     /// Residuals of the ideal model and of the final one (fit blocks; a fit without
@@ -299,4 +302,4 @@ pub struct Holdout {
     pub guard_seconds: f64,
 }
 
-pub use selection::fit;
+pub use selection::{Ambiguity, fit};

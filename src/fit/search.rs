@@ -44,6 +44,38 @@ pub struct Simulation<'a> {
     pub hot_events: EventChunk,
 }
 
+/// Secant steps of the threshold profile after its first simulation.
+const PROFILE_STEPS: usize = 4;
+
+fn threshold_of(p: &PixelParams, polarity: usize) -> f64 {
+    if polarity == 1 { p.ct_on } else { p.ct_off }
+}
+
+fn set_threshold(p: &mut PixelParams, polarity: usize, value: f64) {
+    if polarity == 1 {
+        p.ct_on = value;
+    } else {
+        p.ct_off = value;
+    }
+}
+
+/// The next threshold of a profile from its tried `(ln C, median log ratio)` points: a
+/// secant step in `ln C`. Counts scale about as `1 / C`, so the slope starts at -1 and a
+/// measured slope is held within [-2, -0.5]: the median of integer-count ratios moves in
+/// steps, and a flat stretch between two close tries would otherwise throw the step far.
+fn secant_step(history: &[(f64, f64)]) -> f64 {
+    let &(x1, y1) = history.last().expect("a profile step follows a try");
+    let slope = match history {
+        [.., (x0, y0), _] if (x1 - x0).abs() > 1e-6 => ((y1 - y0) / (x1 - x0)).clamp(-2.0, -0.5),
+        _ => -1.0,
+    };
+    let c = x1.exp();
+    (x1 - y1 / slope)
+        .exp()
+        .clamp(c / 2.0, c * 2.0)
+        .clamp(0.02, 5.0)
+}
+
 /// A simulated model: its parameters (thresholds profiled) and statistics.
 #[derive(Clone)]
 pub struct Simulated {
@@ -89,14 +121,14 @@ impl Simulation<'_> {
                 observed,
             });
         }
-        // per polarity (OFF, ON): the last two (ln C, median log ratio)
+        // per polarity (OFF, ON): every (ln C, median log ratio) tried
         let mut history: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
-        for _ in 0..4 {
+        for round in 0..=PROFILE_STEPS {
             let medians = median_ratios(&self.real, &observed, self.geometry, Subset::Fit);
             let mut moved = false;
             for pol in 0..2 {
                 let Some(m) = medians[pol] else { continue };
-                let c = if pol == 1 { p.ct_on } else { p.ct_off };
+                let c = threshold_of(&p, pol);
                 if !(c.is_finite() && c > 0.0) {
                     return Err(EstimateError::new(
                         format!("the threshold profile reached {c} (it must stay positive)"),
@@ -104,25 +136,10 @@ impl Simulation<'_> {
                     ));
                 }
                 history[pol].push((c.ln(), m));
-                if m.abs() < 0.003 {
+                if m.abs() < 0.003 || round == PROFILE_STEPS {
                     continue;
                 }
-                // slope of the ratio in ln C: -1 to start (counts ~ 1 / C), then measured
-                let slope = match history[pol].as_slice() {
-                    [.., (x0, y0), (x1, y1)] if (x1 - x0).abs() > 1e-6 => {
-                        ((y1 - y0) / (x1 - x0)).clamp(-3.0, -0.2)
-                    }
-                    _ => -1.0,
-                };
-                let next = (c.ln() - m / slope)
-                    .exp()
-                    .clamp(c / 2.0, c * 2.0)
-                    .clamp(0.02, 5.0);
-                if pol == 1 {
-                    p.ct_on = next;
-                } else {
-                    p.ct_off = next;
-                }
+                set_threshold(&mut p, pol, secant_step(&history[pol]));
                 moved = true;
             }
             if !moved {
@@ -130,8 +147,19 @@ impl Simulation<'_> {
             }
             observed = self.observe(&p, masked)?;
         }
+        // the median ratio is a step function of C (counts are integers): a secant step
+        // can overshoot, so the profile ends at the tried threshold closest to balance
+        let mut best = p.clone();
+        for (pol, tried) in history.iter().enumerate() {
+            if let Some(&(ln_c, _)) = tried.iter().min_by(|a, b| a.1.abs().total_cmp(&b.1.abs())) {
+                set_threshold(&mut best, pol, ln_c.exp());
+            }
+        }
+        if best.ct_on != p.ct_on || best.ct_off != p.ct_off {
+            observed = self.observe(&best, masked)?;
+        }
         Ok(Simulated {
-            params: p,
+            params: best,
             observed,
         })
     }

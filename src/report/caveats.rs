@@ -25,6 +25,12 @@ pub fn of_fit(f: &FitResult) -> Vec<String> {
         .iter()
         .map(|(key, why)| format!("{key} not identified: {why}"))
         .collect();
+    out.extend(f.ambiguities.iter().map(|a| {
+        format!(
+            "{} or {}: not separated by this recording (selection error {:.4} with {}, {:.4} with {} = {:.4} instead); {}",
+            a.kept, a.alternative, a.error_kept, a.kept, a.error_alternative, a.parameter, a.value, a.separated_by
+        )
+    }));
     out.extend(f.assumptions.iter().cloned());
     out
 }

@@ -38,6 +38,7 @@ fn check_contract(f: &serde_json::Value) {
         "error_metric",
         "error_before",
         "error_after",
+        "ambiguities",
         "steps",
     ] {
         assert!(f.get(key).is_some(), "missing {key}");
@@ -86,11 +87,17 @@ fn check_contract(f: &serde_json::Value) {
 fn bandwidth_is_added_where_pixels_are_slow_and_only_there() {
     let f = fit(&oracle("d_bw_middim_texture"), &[]);
     check_contract(&f);
-    assert!(
-        added(&f).contains(&"bandwidth".to_string()),
-        "{:?}",
-        added(&f)
-    );
+    // the greedy loop tries a refractory period first (both drop events of fast changes);
+    // once bandwidth is in, the refractory period is removed, and bandwidth beats it as
+    // its look-alike beyond chance, so no ambiguity is named
+    assert_eq!(added(&f), ["bandwidth"]);
+    let steps = f["steps"].as_array().unwrap();
+    let swap = steps
+        .iter()
+        .find(|s| s["effect"] == "refractory in place of bandwidth?")
+        .expect("bandwidth compared with its look-alike");
+    assert_eq!(swap["kept"], false, "{swap:#}");
+    assert_eq!(f["ambiguities"], serde_json::json!([]));
     for key in ["ct_on", "ct_off"] {
         let v = param(&f, key).unwrap();
         assert!((v / 0.3 - 1.0).abs() < 0.10, "{key} {v}");
@@ -315,12 +322,76 @@ fn simulated_recording(params: &PixelParams, seed: u64) -> (ctcal::EventChunk, V
     (events, frames)
 }
 
-proptest! {
-    #![proptest_config(ProptestConfig { cases: 3, failure_persistence: None, ..ProptestConfig::default() })]
+/// The fit of a recording made with known parameters recovers them: the thresholds within
+/// 10 %, shot noise (when made) added at its rate within 50 %, and no effect the recording
+/// was not made with.
+fn fit_recovers(ct_on: f64, asymmetry: f64, noise: f64, seed: u64) -> Result<(), TestCaseError> {
+    let mut params = PixelParams::ideal(ct_on, ct_on * asymmetry);
+    if noise > 0.0 {
+        params.shot_noise_rate_hz = Some(noise);
+    }
+    params.seed = Some(seed);
+    let (events, frames) = simulated_recording(&params, seed);
+    let sensor = ctcal::Sensor::new(160, 120);
+    let excluded = vec![false; sensor.pixels()];
+    let result = ctcal::fit::fit(
+        &FitInput {
+            sensor,
+            events: &events,
+            frames: &frames,
+            excluded: &excluded,
+        },
+        &FitOptions {
+            effects: EffectChoice::Auto,
+            ..FitOptions::default()
+        },
+        &|_, _| {},
+    )
+    .unwrap();
+    let added: Vec<&str> = result
+        .effects_added
+        .iter()
+        .map(|e| e.effect.name())
+        .collect();
+    prop_assert!(
+        (result.params.ct_on / params.ct_on - 1.0).abs() < 0.1,
+        "ON {} vs {}",
+        result.params.ct_on,
+        params.ct_on
+    );
+    prop_assert!(
+        (result.params.ct_off / params.ct_off - 1.0).abs() < 0.1,
+        "OFF {} vs {}",
+        result.params.ct_off,
+        params.ct_off
+    );
+    if noise > 0.0 {
+        prop_assert!(added.contains(&"shot_noise"), "{added:?}");
+        let rate = result.params.shot_noise_rate_hz.unwrap();
+        prop_assert!(
+            (rate / noise - 1.0).abs() < 0.5,
+            "shot noise {rate} vs {noise}"
+        );
+    }
+    prop_assert!(
+        added.iter().all(|e| *e == "shot_noise" || *e == "leak"),
+        "{added:?}"
+    );
+    Ok(())
+}
 
-    /// The fit of a recording made with known parameters recovers them: the thresholds
-    /// within 10 %, shot noise (when made) added at its rate within 50 %, and no effect the
-    /// recording was not made with.
+proptest! {
+    // a fixed generator seed: CI runs the same cases every time (change it here to explore
+    // others); case (0.218, 0.997, 0.78, 331) once stopped the threshold profile
+    // on an overshoot and gave shot noise 0.29 Hz
+    #![proptest_config(ProptestConfig {
+        cases: 3,
+        failure_persistence: None,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(331),
+        ..ProptestConfig::default()
+    })]
+
+    /// [`fit_recovers`] on random parameters.
     #[test]
     fn a_fit_recovers_the_parameters_of_a_simulated_recording(
         ct_on in 0.2f64..0.5,
@@ -328,27 +399,19 @@ proptest! {
         noise in prop_oneof![Just(0.0f64), 0.5f64..2.0],
         seed in 1u64..1000,
     ) {
-        let mut params = PixelParams::ideal(ct_on, ct_on * asymmetry);
-        if noise > 0.0 {
-            params.shot_noise_rate_hz = Some(noise);
-        }
-        params.seed = Some(seed);
-        let (events, frames) = simulated_recording(&params, seed);
-        let sensor = ctcal::Sensor::new(160, 120);
-        let excluded = vec![false; sensor.pixels()];
-        let result = ctcal::fit::fit(
-            &FitInput { sensor, events: &events, frames: &frames, excluded: &excluded },
-            &FitOptions { effects: EffectChoice::Auto, ..FitOptions::default() },
-            &|_, _| {},
-        ).unwrap();
-        let added: Vec<&str> = result.effects_added.iter().map(|e| e.effect.name()).collect();
-        prop_assert!((result.params.ct_on / params.ct_on - 1.0).abs() < 0.1, "ON {} vs {}", result.params.ct_on, params.ct_on);
-        prop_assert!((result.params.ct_off / params.ct_off - 1.0).abs() < 0.1, "OFF {} vs {}", result.params.ct_off, params.ct_off);
-        if noise > 0.0 {
-            prop_assert!(added.contains(&"shot_noise"), "{added:?}");
-            let rate = result.params.shot_noise_rate_hz.unwrap();
-            prop_assert!((rate / noise - 1.0).abs() < 0.5, "shot noise {rate} vs {noise}");
-        }
-        prop_assert!(added.iter().all(|e| *e == "shot_noise" || *e == "leak"), "{added:?}");
+        fit_recovers(ct_on, asymmetry, noise, seed)?;
     }
+}
+
+/// The case that once stopped the threshold profile on an overshoot (shot noise 0.29 Hz
+/// for a true 0.78 Hz): low thresholds, strong noise.
+#[test]
+fn a_fit_recovers_strong_shot_noise_at_low_thresholds() {
+    fit_recovers(
+        0.21787868029451585,
+        0.9972102660351376,
+        0.7815150007348058,
+        331,
+    )
+    .unwrap();
 }

@@ -107,6 +107,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
         components_before: before,
         components_after: after,
         steps,
+        ambiguities: Vec::new(),
         hot_pixels_masked: hot,
         residuals_before: None,
         residuals_after: None,

@@ -7,13 +7,19 @@
 //! 3. the loop: from the ideal model, every effect's evidence read from the fit blocks'
 //!    residuals; the strongest tried (its parameter searched with the thresholds on the fit
 //!    blocks) and kept only if the selection error falls by more than chance ([`keep`]);
-//! 4. each searched parameter refitted with all the others in place ([`steps::refit`]);
-//! 5. the error before (ideal model) and after (final model) on the test blocks, which
+//! 4. each searched parameter refitted with all the others in place ([`steps::refit`]),
+//!    then each tested for whether it is still needed, the others searched again
+//!    ([`steps::prune`]);
+//! 5. each kept effect against its look-alikes ([`alternatives`]): replaced where one wins,
+//!    named beside it where the data do not separate them;
+//! 6. the error before (ideal model) and after (final model) on the test blocks, which
 //!    neither fitted nor chose anything.
 //!
 //! Every step is recorded: the effect, its evidence, the selection error before and after,
 //! the chance level it had to beat, kept or not and why.
 
+mod alternatives;
+pub use alternatives::Ambiguity;
 mod finish;
 pub(in crate::fit) mod keep;
 mod start;
@@ -149,6 +155,19 @@ pub fn fit(
         progress,
     )?;
     prune_added(&simulation, &mut state, &loop_run, &mut added, &mut steps)?;
+    let ambiguities = if matches!(options.effects, EffectChoice::List(_)) {
+        Vec::new()
+    } else {
+        progress("effects that look alike", 0.95);
+        alternatives::compare(
+            &simulation,
+            &mut state,
+            known,
+            &mut added,
+            &mut steps,
+            (fixed, noise),
+        )?
+    };
     if !matches!(options.effects, EffectChoice::List(_)) {
         let context = context_of(&state, &simulation, known);
         for &effect in planned(options).iter() {
@@ -166,6 +185,7 @@ pub fn fit(
             residuals_before,
             added,
             steps,
+            ambiguities,
             assumptions,
             fixed,
             options,
@@ -388,8 +408,13 @@ fn prune_added(
     if searched.len() < 2 {
         return Ok(());
     }
-    for effect in searched {
-        let step = steps::prune(simulation, state, effect, run.fixed)?;
+    for &effect in &searched {
+        let others: Vec<Effect> = searched
+            .iter()
+            .copied()
+            .filter(|&e| e != effect && added.iter().any(|a| a.effect == e))
+            .collect();
+        let step = steps::prune(simulation, state, effect, &others, run.fixed, run.noise)?;
         if !step.kept {
             added.retain(|a| a.effect != effect);
         }

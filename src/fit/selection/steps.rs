@@ -224,21 +224,25 @@ pub fn refit(
 }
 
 /// Tests whether a kept effect is still needed once the others are in (backward
-/// elimination): the model without it, thresholds profiled again, against the model with
-/// it on the selection blocks. The effect is removed when the model with it no longer wins
-/// by more than chance (an effect added early can stand in for one added later: a
-/// refractory period for a slow photoreceptor). The step is `kept` when the effect stays.
+/// elimination): the best model without it (thresholds profiled again, and each of the
+/// `others`' parameters searched again, since an effect added early takes over part of what
+/// a later one explains: threshold mismatch disperses counts as strong shot noise does, a
+/// refractory period drops events as a slow photoreceptor does) against the model with it
+/// on the selection blocks. The effect is removed when the model with it no longer wins by
+/// more than chance. The step is `kept` when the effect stays.
 pub fn prune(
     simulation: &Simulation,
     state: &mut State,
     effect: Effect,
+    others: &[Effect],
     fixed: bool,
+    noise: f64,
 ) -> Result<Step, FitError> {
     let key = effect.parameter().expect("a searched effect");
     let count_before = simulation.count.get();
     let mut reduced = state.model.params.clone();
     effect.clear(&mut reduced);
-    let without = simulation.profile(&reduced, &state.masked, fixed)?;
+    let (without, refitted) = best_without(simulation, state, &reduced, others, fixed, noise)?;
     let verdict = judge(
         simulation,
         &without.observed,
@@ -247,10 +251,18 @@ pub fn prune(
     );
     let mut step = Step::untried(
         format!("{} (still needed?)", effect.name()),
-        format!("the model without {key} (thresholds profiled again) against the model with it"),
+        format!(
+            "the model without {key} (thresholds profiled again{}) against the model with it",
+            refitted
+                .iter()
+                .map(|(k, u, _)| format!(", {k} searched again: {:.6}", u.value))
+                .collect::<String>()
+        ),
         0.0,
     );
     step.parameters = thresholds_of(&without);
+    step.parameters
+        .extend(refitted.iter().map(|(k, u, _)| (k.clone(), u.value)));
     step.simulations = simulation.count.get() - count_before;
     let stays = verdict.kept;
     record(&mut step, verdict);
@@ -266,8 +278,54 @@ pub fn prune(
         state.model = without;
         state.uncertainty.remove(key);
         state.at_bound.remove(key);
+        for (key, uncertain, bound) in refitted {
+            state.set_uncertain(key, uncertain, bound);
+        }
     }
     Ok(step)
+}
+
+/// A parameter searched again: its key, value with standard error, and the range bound it
+/// reached.
+type Refitted = (String, Uncertain, Option<f64>);
+
+/// The model `reduced` with its thresholds profiled and each of `others`' parameters
+/// searched again (kept where the search lowers the error on the fit blocks), and the
+/// parameters that moved.
+fn best_without(
+    simulation: &Simulation,
+    state: &State,
+    reduced: &crate::sim::PixelParams,
+    others: &[Effect],
+    fixed: bool,
+    noise: f64,
+) -> Result<(Simulated, Vec<Refitted>), FitError> {
+    let mut best = simulation.profile(reduced, &state.masked, fixed)?;
+    let mut error = simulation
+        .distance(&best.observed, Subset::Fit, &state.kept)
+        .total;
+    let mut refitted = Vec::new();
+    for &other in others {
+        let (Some(key), Some(current)) = (other.parameter(), other.value(&best.params)) else {
+            continue;
+        };
+        let searched = search(
+            simulation,
+            &best.params,
+            other,
+            other.range(current),
+            &state.masked,
+            &state.kept,
+            fixed,
+            noise,
+        )?;
+        if searched.fit_error < error {
+            error = searched.fit_error;
+            refitted.push(uncertain_of(key, &searched));
+            best = searched.model;
+        }
+    }
+    Ok((best, refitted))
 }
 
 /// The record of an effect the residuals did not call for.

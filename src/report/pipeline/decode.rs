@@ -15,7 +15,9 @@ use crate::estimate::{CtEstimate, EstimatorReport};
 use crate::fit::events_only::{EventsOnly, IntervalEdge};
 use crate::fit::metric::Components;
 use crate::fit::residuals::{BackgroundBin, Bin, IntervalDistributions, Residuals, Spectrum};
-use crate::fit::{AddedEffect, FitResult, FittedParams, Holdout, Step, StepResiduals, Uncertain};
+use crate::fit::{
+    AddedEffect, Ambiguity, FitResult, FittedParams, Holdout, Step, StepResiduals, Uncertain,
+};
 use crate::report::model::{
     InputFile, MethodResult, PlotEntry, PresetLevel, SequenceOutputs, SequenceReport, Truth,
 };
@@ -271,7 +273,7 @@ structs! {
     FrameRatePoint { frame_step, frame_interval_s, value }
     IntervalInfo { t_start_s, t_end_s, used, reason, motion_px }
     FitResult { biases, params, identified, why, uncertainties, effects_added, error_metric,
-        error_before, error_after, components_before, components_after, steps,
+        error_before, error_after, components_before, components_after, steps, ambiguities,
         hot_pixels_masked, residuals_before, residuals_after, assumptions, holdout,
         simulations, frame_exposure_us, events_only }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
@@ -280,6 +282,8 @@ structs! {
     IntervalEdge { edge_us, range_us, found, not_refractory, below, above, intervals }
     Uncertain { value, standard_error }
     AddedEffect { effect, evidence, error_after }
+    Ambiguity { kept, alternative, parameter, value, error_kept, error_alternative, chance,
+        separated_by }
     StepResiduals { by_intensity, by_rate_of_change }
     Step { effect, evidence, score, parameters, error_before, error_after, components_after,
         chance, kept, reason, simulations, residuals_before, residuals_after }

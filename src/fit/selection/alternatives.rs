@@ -1,0 +1,254 @@
+//! Effects the data may not tell apart. Forward selection adds the effect whose signature
+//! the residuals show most strongly, but some effects leave nearly the same trace in event
+//! counts: a refractory period and a slow photoreceptor both drop events of fast changes
+//! (both are in v2e's pixel model, Hu, Liu & Delbruck, CVPRW 2021), threshold mismatch and shot noise both disperse
+//! per-pixel counts, leak and shot noise both add isolated events. For each kept effect
+//! with such a look-alike the model lacks, the model with the look-alike in its place
+//! (parameter searched from its evidence against the model without the kept effect) is
+//! judged against the fitted one on the selection blocks, both ways, with the measured
+//! chance of [`super::keep`]:
+//!
+//! - the look-alike wins beyond chance: it replaces the kept effect (the greedy order chose
+//!   wrongly);
+//! - neither wins: the fit keeps its effect and reports the pair as not separated, with
+//!   what data would separate them.
+
+use super::super::effects::{self, Context, Effect};
+use super::super::search::{Simulated, Simulation, search};
+use super::super::{AddedEffect, FitError, Step};
+use super::keep::judge;
+use super::{Known, State, context_of};
+use crate::fit::Uncertain;
+use serde::Serialize;
+
+/// Two effects that explain the recording equally well within chance.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Ambiguity {
+    /// The effect the fit kept.
+    pub kept: String,
+    /// The look-alike that explains the data as well in its place.
+    pub alternative: String,
+    /// The look-alike's parameter (PARAMS.toml key) and its fitted value in that model.
+    pub parameter: String,
+    pub value: f64,
+    /// Selection-block errors of the fitted model and of the model with the look-alike.
+    pub error_kept: f64,
+    pub error_alternative: f64,
+    /// The fall of the selection error chance alone would give, where measurable.
+    pub chance: Option<f64>,
+    /// What recording would tell the two apart.
+    pub separated_by: String,
+}
+
+const REFRACTORY_OR_BANDWIDTH: &str = "a refractory period drops events of fast changes at every brightness, a slow photoreceptor only in dim light: the same motion recorded at another brightness separates them";
+const MISMATCH_OR_SHOT_NOISE: &str = "threshold mismatch scales each pixel's events with the motion it sees, shot noise adds events where nothing moves: a stretch of the same scene held still separates them";
+const LEAK_OR_SHOT_NOISE: &str = "leak adds ON events only, shot noise both polarities: the polarity of the events of a still scene separates them";
+
+/// (kept effect, look-alike, what separates them).
+const LOOK_ALIKES: [(Effect, Effect, &str); 6] = [
+    (
+        Effect::Refractory,
+        Effect::Bandwidth,
+        REFRACTORY_OR_BANDWIDTH,
+    ),
+    (
+        Effect::Bandwidth,
+        Effect::Refractory,
+        REFRACTORY_OR_BANDWIDTH,
+    ),
+    (Effect::Mismatch, Effect::ShotNoise, MISMATCH_OR_SHOT_NOISE),
+    (Effect::ShotNoise, Effect::Mismatch, MISMATCH_OR_SHOT_NOISE),
+    (Effect::Leak, Effect::ShotNoise, LEAK_OR_SHOT_NOISE),
+    (Effect::ShotNoise, Effect::Leak, LEAK_OR_SHOT_NOISE),
+];
+
+/// Where a look-alike's search starts when its evidence gives no start: a middle value of
+/// the range event cameras show (DAVIS and Prophesee datasheets; v2e's defaults), searched
+/// over a factor of 5 (3 for mismatch) either side.
+fn typical_start(effect: Effect) -> f64 {
+    match effect {
+        Effect::Mismatch => 0.05,
+        Effect::Refractory => 1e-3,
+        Effect::Bandwidth => 300.0,
+        _ => 0.1,
+    }
+}
+
+/// What the selection blocks say about a kept effect and one look-alike.
+struct Comparison {
+    alternative: Simulated,
+    value: f64,
+    uncertain: Uncertain,
+    at_bound: Option<f64>,
+    step: Step,
+    /// The look-alike wins beyond chance.
+    replaces: bool,
+    /// Neither wins beyond chance.
+    ambiguous: bool,
+}
+
+/// Compares each kept effect with its look-alikes; replaces it where a look-alike wins,
+/// and returns the pairs the data do not separate. Steps record every comparison.
+pub fn compare(
+    simulation: &Simulation,
+    state: &mut State,
+    known: Known,
+    added: &mut [AddedEffect],
+    steps: &mut Vec<Step>,
+    (fixed, noise): (bool, f64),
+) -> Result<Vec<Ambiguity>, FitError> {
+    let mut found = Vec::new();
+    for (kept, other, separated_by) in LOOK_ALIKES {
+        let in_model = |e: Effect| added.iter().any(|a| a.effect == e);
+        if !in_model(kept) || in_model(other) {
+            continue;
+        }
+        let count_before = simulation.count.get();
+        let c = compare_one(simulation, state, known, kept, other, (fixed, noise))?;
+        let mut step = c.step;
+        step.simulations = simulation.count.get() - count_before;
+        if c.replaces {
+            let key = kept.parameter().expect("a searched effect");
+            state.uncertainty.remove(key);
+            state.at_bound.remove(key);
+            state.model = c.alternative;
+            state.set_uncertain(
+                other.parameter().expect("a searched effect").into(),
+                c.uncertain,
+                c.at_bound,
+            );
+            if let Some(a) = added.iter_mut().find(|a| a.effect == kept) {
+                *a = AddedEffect {
+                    effect: other,
+                    evidence: step.evidence.clone(),
+                    error_after: step.error_after.unwrap_or(a.error_after),
+                };
+            }
+        } else if c.ambiguous {
+            found.push(Ambiguity {
+                kept: kept.name().into(),
+                alternative: other.name().into(),
+                parameter: other.parameter().unwrap_or_default().into(),
+                value: c.value,
+                error_kept: step.error_before.unwrap_or(f64::NAN),
+                error_alternative: step.error_after.unwrap_or(f64::NAN),
+                chance: step.chance,
+                separated_by: separated_by.into(),
+            });
+        }
+        steps.push(step);
+    }
+    Ok(found)
+}
+
+/// The model with `other` in place of `kept`, judged against the fitted one both ways.
+fn compare_one(
+    simulation: &Simulation,
+    state: &State,
+    known: Known,
+    kept: Effect,
+    other: Effect,
+    (fixed, noise): (bool, f64),
+) -> Result<Comparison, FitError> {
+    let mut reduced = state.model.params.clone();
+    kept.clear(&mut reduced);
+    let without = simulation.profile(&reduced, &state.masked, fixed)?;
+    let context = Context {
+        sim: &without.observed,
+        model: &without.params,
+        ..context_of(state, simulation, known)
+    };
+    let evidence = effects::evidence(other, &context);
+    let start = evidence.start.unwrap_or_else(|| typical_start(other));
+    let searched = search(
+        simulation,
+        &without.params,
+        other,
+        other.range(start),
+        &state.masked,
+        &state.kept,
+        fixed,
+        noise,
+    )?;
+    let key = other.parameter().expect("a searched effect");
+    let wins = judge(
+        simulation,
+        &state.model.observed,
+        &searched.model.observed,
+        &state.kept,
+    );
+    let loses = judge(
+        simulation,
+        &searched.model.observed,
+        &state.model.observed,
+        &state.kept,
+    );
+    let (replaces, ambiguous) = (wins.kept, !wins.kept && !loses.kept);
+    let mut step = Step::untried(
+        format!("{} in place of {}?", other.name(), kept.name()),
+        format!(
+            "the model without {} and with {key} searched ({}) against the fitted one",
+            kept.name(),
+            evidence.text
+        ),
+        evidence.score,
+    );
+    step.parameters.insert(key.into(), searched.value);
+    step.error_before = Some(wins.before.total);
+    step.error_after = Some(wins.after.total);
+    step.components_after = Some(wins.after);
+    step.chance = wins.chance;
+    step.kept = replaces;
+    step.reason = if replaces {
+        format!("replaces {}: {}", kept.name(), wins.reason)
+    } else if ambiguous {
+        format!(
+            "not separated: either explains the recording within chance ({}); {} stays, both are named",
+            wins.reason,
+            kept.name()
+        )
+    } else {
+        format!(
+            "{} explains the recording better: {}",
+            kept.name(),
+            loses.reason
+        )
+    };
+    Ok(Comparison {
+        value: searched.value,
+        uncertain: Uncertain {
+            value: searched.value,
+            standard_error: searched.standard_error,
+        },
+        at_bound: searched.at_bound,
+        alternative: searched.model,
+        step,
+        replaces,
+        ambiguous,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn look_alikes_go_both_ways_with_one_explanation() {
+        for (kept, other, text) in LOOK_ALIKES {
+            assert!(
+                LOOK_ALIKES.contains(&(other, kept, text)),
+                "{kept} -> {other} has no way back"
+            );
+            assert!(kept.parameter().is_some() && other.parameter().is_some());
+        }
+    }
+
+    #[test]
+    fn typical_starts_lie_inside_the_searched_ranges() {
+        for (_, other, _) in LOOK_ALIKES {
+            let start = typical_start(other);
+            let (lo, hi) = other.range(start);
+            assert!(lo < start && start < hi, "{other}: {start} in [{lo}, {hi}]");
+        }
+    }
+}
