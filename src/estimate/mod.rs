@@ -210,6 +210,23 @@ impl CtEstimate {
         estimate
     }
 
+    /// Withdraws the thresholds (and the spread) a method measured but cannot stand by, for
+    /// `reason`: each becomes not determinable; the estimators' own values stay under
+    /// `estimators` for inspection.
+    pub fn withhold(&mut self, reason: &str) {
+        for key in ["ct_on", "ct_off", "ct", "ct_sigma"] {
+            self.why.insert(key.into(), reason.to_string());
+        }
+        self.ct_on = None;
+        self.ct_on_ci95 = None;
+        self.ct_off = None;
+        self.ct_off_ci95 = None;
+        self.ct = None;
+        self.ct_ci95 = None;
+        self.ct_sigma = None;
+        self.ct_sigma_ci95 = None;
+    }
+
     /// An estimate that determined nothing, for `reason`.
     pub fn not_determinable(method: &'static str, reason: &str) -> Self {
         let mut estimate = Self::empty(method);

@@ -23,10 +23,14 @@ const APS_COVERAGE_BOUNDS: [(&str, f64); 3] =
 /// it. When this test was written: of 7 determinable each (one refused, too few events
 /// between frames) Cp 3/7, Cn 2/7, ct_sigma 4/7. Since aps refuses thresholds resting on
 /// fewer than 3 usable frame intervals, case-9000 (one usable interval, 0.07 for a true
-/// 0.85) is refused too: of 6, Cp 2/6 (case-9006 is still confidently wrong, 0.11 for
-/// 0.76, and open), Cn 2/6; ct_sigma 2/5 (one more not resolved: null with an upper
-/// bound, which the study counts as not reported).
-const APS_COVERED_TODAY: [(&str, usize); 3] = [("ct_on", 2), ("ct_off", 2), ("ct_sigma", 2)];
+/// 0.85) is refused too. Since aps withholds what its re-simulation cannot confirm (the
+/// counts of ideal pixels on these frames match the recording's at no threshold), the
+/// event timing's values of case-9006 (0.11 for 0.76, noise three quarters of the events)
+/// and case-9007 (ON 0.24 for 0.47) are not determinable: of 4, Cp 2/4, Cn 2/4, ct_sigma
+/// 1/4 (case-9007's spread, withheld with its thresholds, had been covered). The misses
+/// left: case-9003 (dim, 10 DN: both methods agree on 0.58 for 0.78, a log response
+/// question) and case-9008 (0.91 for 0.63).
+const APS_COVERED_TODAY: [(&str, usize); 3] = [("ct_on", 2), ("ct_off", 2), ("ct_sigma", 1)];
 
 fn cases() -> Vec<CaseSpec> {
     (FIRST_SEED..)
