@@ -24,6 +24,7 @@ pub mod estimate;
 pub mod events;
 pub mod files;
 pub mod fit;
+pub mod hint;
 pub mod io;
 pub mod report;
 pub mod selection;

@@ -5,6 +5,7 @@
 //! all of its neighbours (a moving edge does not stop at the border of a region).
 
 use crate::events::Sensor;
+use crate::hint::{Hint, Text};
 use serde::Serialize;
 
 /// A rectangle of pixels `x0 <= x < x1`, `y0 <= y < y1` (the upper bounds excluded, as in
@@ -47,8 +48,8 @@ impl std::fmt::Display for Roi {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{problem}\n  fix: {fix}")]
 pub struct SelectionError {
-    pub problem: String,
-    pub fix: String,
+    pub problem: Text,
+    pub fix: Text,
 }
 
 /// The kept pixels of a sensor.
@@ -76,14 +77,15 @@ impl PixelSelection {
         let s = self.sensor;
         if roi.x1 > s.width || roi.y1 > s.height {
             return Err(SelectionError {
-                problem: format!(
-                    "--roi {roi} reaches beyond the {s} sensor (x < {}, y < {})",
+                problem: Text::default().name(Hint::Roi(roi)).words(format!(
+                    " reaches beyond the {s} sensor (x < {}, y < {})",
                     s.width, s.height
-                ),
+                )),
                 fix: format!(
                     "give X0,Y0,X1,Y1 with X1 <= {} and Y1 <= {} (X1 and Y1 are excluded)",
                     s.width, s.height
-                ),
+                )
+                .into(),
             });
         }
         for y in 0..s.height {
@@ -109,8 +111,9 @@ impl PixelSelection {
                     mask.len(),
                     self.sensor,
                     self.keep.len()
-                ),
-                fix: format!("give a mask of {} (H x W)", self.sensor),
+                )
+                .into(),
+                fix: format!("give a mask of {} (H x W)", self.sensor).into(),
             });
         }
         for (k, &m) in self.keep.iter_mut().zip(mask) {
@@ -127,7 +130,7 @@ impl PixelSelection {
                 format!("the mask {source} keeps no pixel (every value is zero)")
             };
             return Err(SelectionError {
-                problem,
+                problem: problem.into(),
                 fix: "give a mask with non-zero values at the pixels to keep (zero = leave out)"
                     .into(),
             });
@@ -227,18 +230,18 @@ mod tests {
         let sensor = Sensor::new(240, 180);
         assert!(Roi::parse("0,0,240").unwrap_err().contains("four"));
         assert!(Roi::parse("5,5,5,10").unwrap_err().contains("empty"));
-        let e = PixelSelection::all(sensor)
-            .roi(Roi::parse("0,0,241,180").unwrap())
-            .unwrap_err();
+        let roi = Roi::parse("0,0,241,180").unwrap();
+        let e = PixelSelection::all(sensor).roi(roi).unwrap_err();
+        assert_eq!(e.problem.hints().collect::<Vec<_>>(), [&Hint::Roi(roi)]);
         assert!(
-            e.problem.contains("240x180") && e.fix.contains("X1 <= 240"),
+            e.problem.to_string().contains("240x180") && e.fix.to_string().contains("X1 <= 240"),
             "{e}"
         );
         let e = PixelSelection::all(sensor)
             .mask(&[true; 10], "m.npy")
             .unwrap_err();
         assert!(
-            e.problem.contains("10 values") && e.fix.contains("240x180"),
+            e.problem.to_string().contains("10 values") && e.fix.to_string().contains("240x180"),
             "{e}"
         );
         // a mask that keeps nothing, alone or inside a region
@@ -246,7 +249,8 @@ mod tests {
             .mask(&[false; 12], "zero.png")
             .unwrap_err();
         assert!(
-            e.problem.contains("zero.png keeps no pixel") && e.fix.contains("non-zero"),
+            e.problem.to_string().contains("zero.png keeps no pixel")
+                && e.fix.to_string().contains("non-zero"),
             "{e}"
         );
         let mut corner = [false; 12];
@@ -258,6 +262,7 @@ mod tests {
             .unwrap_err();
         assert!(
             e.problem
+                .to_string()
                 .contains("corner.npy keeps no pixel inside the region x 2..4"),
             "{e}"
         );

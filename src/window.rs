@@ -7,6 +7,7 @@
 use crate::estimate::aps::{self, ApsInput, ApsOptions};
 use crate::estimate::{CtEstimate, EstimateError, eppps, screen};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
+use crate::hint::Text;
 use crate::selection::{PixelSelection, Roi};
 use crate::sim::DisplayParams;
 use crate::{InputError, OpenOptions, Recording};
@@ -80,8 +81,8 @@ pub enum LoadError {
     #[error("{}: {problem}\n  fix: {fix}", path.display())]
     Selection {
         path: PathBuf,
-        problem: String,
-        fix: String,
+        problem: Text,
+        fix: Text,
     },
 }
 
@@ -141,8 +142,9 @@ impl SelectionSpec {
 
 /// Where a load reports what it warns of and how far it has read.
 pub trait LoadObserver {
-    /// A warning about the recording (sensor size guessed, an index rebuilt, ...).
-    fn warn(&self, _message: &str) {}
+    /// A warning about the recording (sensor size guessed, an index rebuilt, ...), which
+    /// may name options.
+    fn warn(&self, _message: &Text) {}
     /// `done` of `total` units of the event stream read.
     fn reading(&self, _done: u64, _total: u64) {}
 }
@@ -165,7 +167,7 @@ pub fn load(
     check_window(window.start_s, window.end_s)?;
     let recording = Recording::open(path, open)?;
     for note in &recording.notes {
-        observer.warn(note);
+        observer.warn(&note.as_str().into());
     }
     // the first event fixes the clock of start/end
     let first = recording.first_event_time()?;
@@ -201,7 +203,7 @@ pub fn load(
     }
     let mut stream = recording.events_between(from, to)?;
     for note in &stream.notes {
-        observer.warn(note);
+        observer.warn(&note.as_str().into());
     }
     let mut events = EventChunk::default();
     while stream.next_chunk()?.is_some() {

@@ -97,7 +97,7 @@ pub fn run(args: &ConvertArgs, global: &Global) -> anyhow::Result<()> {
     };
     let resolved = recording.resolve_sensor(max_coordinates);
     if let Some(w) = &resolved.warning {
-        warn(global, w);
+        warn(global, &super::flags::render(w));
     }
     let mut writer = match to {
         OutputFormat::Ijrr => {

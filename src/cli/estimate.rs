@@ -164,6 +164,15 @@ pub struct ApsArgs {
     pub frame_offset_dn: Option<f64>,
 }
 
+/// An estimate's error for `path`, its fix in the command's flags.
+pub(super) fn estimate_failed(path: &Path, error: &ctcal::estimate::EstimateError) -> BadInput {
+    BadInput(format!(
+        "{}: {}",
+        path.display(),
+        super::flags::render(&error.message())
+    ))
+}
+
 pub fn run(command: &EstimateCommand, global: &Global) -> anyhow::Result<()> {
     match command {
         EstimateCommand::Aps(args) => run_aps(args, global),
@@ -208,7 +217,7 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
         &progress,
     );
     spinner.finish_and_clear();
-    let mut estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    let mut estimate = result.map_err(|e| estimate_failed(&path, &e))?;
     if args.ignore_frames {
         estimate
             .assumptions
@@ -269,7 +278,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
     let result = screen_of(&loaded, &frames, screen, args.refresh_hz, &progress);
     spinner.finish_and_clear();
-    let estimate = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    let estimate = result.map_err(|e| estimate_failed(&path, &e))?;
     present(&estimate, &loaded, common, &policy)
 }
 
@@ -352,7 +361,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
         &|stage, _| spinner.set_message(stage.to_string()),
     );
     spinner.finish_and_clear();
-    let mut result = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    let mut result = result.map_err(|e| estimate_failed(&path, &e))?;
     result
         .estimate
         .assumptions

@@ -1,7 +1,7 @@
 //! `ctcal fit`: every simulator parameter fitted to a recording, effects added where the
 //! residuals call for them and the held-out error falls (see `ctcal::fit`).
 
-use super::estimate::{CommonArgs, stage_spinner};
+use super::estimate::{CommonArgs, estimate_failed, stage_spinner};
 use super::{BadInput, Global, JsonTarget, emit_json, output};
 use clap::Args;
 use ctcal::estimate::aps::ApsOptions;
@@ -198,7 +198,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
         &progress,
     );
     spinner.finish_and_clear();
-    let mut result = result.map_err(|e| BadInput(format!("{}: {e}", path.display())))?;
+    let mut result = result.map_err(|e| estimate_failed(&path, &e))?;
     result.assumptions.extend(loaded.notes.iter().cloned());
     result.biases = loaded.recording.biases();
     let target = common.json.as_deref().map(JsonTarget::parse);

@@ -34,7 +34,7 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
         ctcal::io::info::info(&recording, stream, &|done, _| bar.set_position(done))?;
     bar.finish_and_clear();
     if let Some(w) = &warning {
-        warn(global, w);
+        warn(global, &super::flags::render(w));
     }
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {

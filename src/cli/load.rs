@@ -59,9 +59,11 @@ pub fn hinted(error: LoadError) -> anyhow::Error {
             sensor.pixels(),
             ctcal::stats::PIXEL_BUDGET,
         ),
-        LoadError::Selection { path, problem, fix } => {
-            format!("{}: {problem}\n  fix: {fix}", path.display())
-        }
+        LoadError::Selection { path, problem, fix } => format!(
+            "{}: {}",
+            path.display(),
+            super::flags::render(&problem.fixed_by(&fix))
+        ),
     };
     BadInput(text).into()
 }
@@ -73,8 +75,8 @@ struct Stderr<'a> {
 }
 
 impl LoadObserver for Stderr<'_> {
-    fn warn(&self, message: &str) {
-        warn(self.global, message);
+    fn warn(&self, message: &ctcal::hint::Text) {
+        warn(self.global, &super::flags::render(message));
     }
     fn reading(&self, done: u64, total: u64) {
         self.bar

@@ -6,6 +6,7 @@ mod config;
 mod convert;
 mod estimate;
 mod fit;
+mod flags;
 mod info;
 mod load;
 mod output;
@@ -204,7 +205,7 @@ pub fn run() -> i32 {
         // the reader of stdout went away (`ctcal stats ... | head`): nothing is wrong
         Err(error) if is_broken_pipe(&error) => 0,
         Err(error) => {
-            eprintln!("error: {error:#}");
+            eprintln!("error: {}", flags::message(&error));
             exit_code(&error)
         }
     }

@@ -112,7 +112,7 @@ fn compute(
             while stream.next_chunk()?.is_some() {}
             let resolved = recording.resolve_sensor(stream.max_coordinates());
             if let Some(w) = &resolved.warning {
-                warn(global, w);
+                warn(global, &super::flags::render(w));
             }
             resolved.sensor
         }
@@ -181,7 +181,7 @@ fn pass(
     }
     let resolved = recording.resolve_sensor(max_coordinates);
     if let Some(w) = &resolved.warning {
-        warn(global, w);
+        warn(global, &super::flags::render(w));
     }
     let frame_times = recording.frame_times()?;
     let window = |flag: &str, value: Option<f64>| value.map(|v| format!("{flag} {v} s"));

@@ -66,13 +66,26 @@ pub fn run_method(options: &RunOptions, method: Method, input: &Path) -> (Outcom
     (outcome, started.elapsed().as_secs_f64())
 }
 
+/// The options of every run: the JSON on stdout, no progress or warnings, `threads` worker
+/// threads (the binary's options, by name).
+fn output_options(threads: usize) -> Vec<String> {
+    let threads = threads.to_string();
+    [
+        ("json", Some("-")),
+        ("quiet", None),
+        ("threads", Some(threads.as_str())),
+    ]
+    .into_iter()
+    .flat_map(|(name, value)| std::iter::once(format!("--{name}")).chain(value.map(String::from)))
+    .collect()
+}
+
 fn run(options: &RunOptions, method: Method, input: &Path) -> std::io::Result<Outcome> {
     let capture = |stream: &str| input.with_extension(format!("{}.{stream}", method.name()));
     let (stdout_path, stderr_path) = (capture("stdout"), capture("stderr"));
     let mut child = Command::new(&options.binary)
         .args(method.args(input))
-        .args(["--json", "-", "--quiet", "--threads"])
-        .arg(options.threads.to_string())
+        .args(output_options(options.threads))
         .env("HDF5_USE_FILE_LOCKING", "FALSE")
         .stdin(Stdio::null())
         .stdout(std::fs::File::create(&stdout_path)?)

@@ -22,6 +22,7 @@ use super::{
     CtEstimate, Determinable, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid,
 };
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
+use crate::hint::{Hint, Text};
 use crate::sim::PixelParams;
 use crate::sim::log_response::LogMap;
 use serde_json::json;
@@ -123,7 +124,9 @@ fn run_pass(
         .ok_or_else(|| {
             EstimateError::new(
                 "too few events between consecutive frames to measure thresholds (fewer than 10 pixels with a sample of each polarity)",
-                "use a longer or busier part of the recording (--start/--end), or `ctcal estimate eppps`",
+                Text::from("use a longer or busier part of the recording")
+                    .aside(Hint::TimeWindow)
+                    .words(", or `ctcal estimate eppps`"),
             )
         })?;
     let (cp, cn, sigma) = start.unwrap_or((
@@ -189,7 +192,9 @@ pub fn estimate(
             format!(
                 "the frames show a static scene (log intensity changes by {change:.4} per pixel per second): nothing crosses a threshold, so the events are noise and do not measure thresholds"
             ),
-            "use a part of the recording where the scene moves (--start/--end); measure the noise with `ctcal fit` or `ctcal stats`",
+            Text::from("use a part of the recording where the scene moves")
+                .aside(Hint::TimeWindow)
+                .words("; measure the noise with `ctcal fit` or `ctcal stats`"),
         ));
     }
     let used = frames.intervals.iter().filter(|i| i.used).count();
@@ -214,7 +219,7 @@ pub fn estimate(
         frames.intervals.len(),
         match exposure {
             Some(e) => format!("exposure {:.3} ms, treated as instantaneous (motion during it blurs frames slightly)", e as f64 / 1e3),
-            None => "exposure unknown (give --exposure-s); frames treated as instantaneous".into(),
+            None => "exposure unknown (give the frame exposure where it is known); frames treated as instantaneous".into(),
         }
     ));
     assumptions.push("between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity up to the offset b (no gamma: a gamma scales every log change alike, so it cannot be told from the thresholds by events and frames; frames encoded with gamma g give thresholds 1/g times the true ones)".into());
@@ -509,7 +514,7 @@ pub fn prepare(
         Some(shift) => {
             frames.shift_times((shift * 1e6).round() as TimeUs);
             assumptions.push(format!(
-                "frame times shifted by {:.3} ms (--frame-time-offset-s)",
+                "frame times shifted by {:.3} ms (the frame time offset given)",
                 shift * 1e3
             ));
             None
@@ -525,7 +530,7 @@ pub fn prepare(
             if let Some(a) = &found {
                 frames.shift_times((a.shift_s * 1e6).round() as TimeUs);
                 assumptions.push(format!(
-                    "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); --frame-time-offset-s overrides",
+                    "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); a frame time offset given overrides it",
                     a.shift_s * 1e3,
                     a.precision_s * 1e3,
                     a.spread_unshifted,

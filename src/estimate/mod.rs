@@ -23,26 +23,39 @@ pub mod screen;
 pub mod timing;
 
 use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::hint::Text;
 use interval::{FrameRatePoint, Measured};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// An estimate cannot be made from this input: what is missing and what to do.
-#[derive(Debug, Clone, thiserror::Error)]
-#[error("{problem}\n  fix: {fix}")]
+#[derive(Debug, Clone)]
 pub struct EstimateError {
     pub problem: String,
-    pub fix: String,
+    pub fix: Text,
 }
 
 impl EstimateError {
-    pub fn new(problem: impl Into<String>, fix: impl Into<String>) -> Self {
+    pub fn new(problem: impl Into<String>, fix: impl Into<Text>) -> Self {
         Self {
             problem: problem.into(),
             fix: fix.into(),
         }
     }
+
+    /// The problem and its fix.
+    pub fn message(&self) -> Text {
+        Text::from(self.problem.as_str()).fixed_by(&self.fix)
+    }
 }
+
+impl std::fmt::Display for EstimateError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.message().fmt(f)
+    }
+}
+
+impl std::error::Error for EstimateError {}
 
 /// One estimator's result inside a [`CtEstimate`].
 #[derive(Clone, Debug, Serialize)]

@@ -9,6 +9,7 @@ use super::error::{FIX_TRUNCATED, InputError};
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Sensor};
+use crate::hint::{Hint, Text};
 use std::path::{Path, PathBuf};
 
 /// Streaming DAT decoder.
@@ -42,7 +43,9 @@ impl DatDecoder {
                 path,
                 format!("byte offset {}", data_offset + 1),
                 format!("event size {size} bytes (type 0x{kind:02x}); CD events take 8"),
-                "this is not a Prophesee CD .dat file; pass --format to read it as another format",
+                Text::from("this is not a Prophesee CD .dat file; ")
+                    .act(Hint::Format(None))
+                    .words(" to read it as another format"),
             ));
         }
         reader.consume(2);

@@ -5,6 +5,7 @@
 use super::error::InputError;
 use super::prophesee::PropheseeHeader;
 use super::{Format, aedat4, bag, h5, text};
+use crate::hint::{Hint, Text};
 use std::io::Read;
 use std::path::Path;
 
@@ -88,7 +89,9 @@ pub fn detect(path: &Path) -> Result<Format, InputError> {
             None => Err(InputError::unknown(
                 path,
                 "a Prophesee header without an `evt` line",
-                "pass --format evt2, evt3 or dat to say which it is",
+                Text::default()
+                    .act(Hint::Format(None))
+                    .words(" evt2, evt3 or dat to say which it is"),
             )),
         };
     }
@@ -99,7 +102,7 @@ pub fn detect(path: &Path) -> Result<Format, InputError> {
     Err(InputError::unknown(
         path,
         format!("first bytes {} match no known signature", first.join(" ")),
-        super::error::FIX_UNKNOWN_FORMAT,
+        super::error::fix_unknown_format(),
     ))
 }
 

@@ -24,6 +24,7 @@ use super::h5_direct::{DirectColumn, DirectError, ElementKind};
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TimeUs};
+use crate::hint::{Hint, Text};
 use hdf5::types::TypeDescriptor;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -166,9 +167,9 @@ fn layout_of(path: &Path, file: &hdf5::File, side: Side) -> Result<Layout, Input
                 }
             ),
             match others.first() {
-                Some(other) => format!("pass --side {other}"),
+                Some(other) => Text::default().act(Hint::Side(other.clone())),
                 None => "the file holds no MVSEC events (davis/left/events or davis/right/events)"
-                    .to_string(),
+                    .into(),
             },
         ));
     }
@@ -790,7 +791,9 @@ pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
                     claimed: format!(
                         " the file claims (sensor_resolution = ({h}, {w}), in either order)"
                     ),
-                    fix: "pass --sensor WxH with the real sensor size".into(),
+                    fix: Text::default()
+                        .act(Hint::Sensor(None))
+                        .words(" with the real sensor size"),
                 });
             }
         }

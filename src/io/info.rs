@@ -37,7 +37,7 @@ pub fn info(
     recording: &Recording,
     mut stream: super::EventStream,
     progress: &dyn Fn(u64, u64),
-) -> Result<(Info, Option<String>), InputError> {
+) -> Result<(Info, Option<crate::hint::Text>), InputError> {
     stream.allow_unsorted = true;
     let (mut first, mut last, mut on) = (i64::MAX, i64::MIN, 0u64);
     while let Some(chunk) = stream.next_chunk()? {

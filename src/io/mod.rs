@@ -38,6 +38,7 @@ pub use order::OrderCheck;
 pub use recording::{EventStream, OpenOptions, Recording, ResolvedSensor};
 
 use crate::events::{EventChunk, MAX_SENSOR_SIDE, Sensor};
+use crate::hint::{Hint, Text};
 use serde::Serialize;
 use std::path::Path;
 
@@ -140,8 +141,10 @@ pub(crate) fn outside_sensor(
         height,
         claimed: String::new(),
         fix: match sensor {
-            Some(_) => "if the sensor is larger than the file says, pass --sensor WxH; otherwise the file is damaged".into(),
-            None => format!("the file does not state its sensor and ctcal infers at most {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE}: if the sensor really is that large, pass --sensor WxH; otherwise the file is damaged"),
-        },
+            Some(_) => Text::from("if the sensor is larger than the file says, "),
+            None => Text::from(format!("the file does not state its sensor and ctcal infers at most {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE}: if the sensor really is that large, ")),
+        }
+        .act(Hint::Sensor(None))
+        .words("; otherwise the file is damaged"),
     }
 }

@@ -10,8 +10,12 @@ use super::{
 use crate::events::{
     CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TIME_LIMIT_US, TimeUs,
 };
+use crate::hint::{Hint, Text};
 use crate::sensors;
 use std::path::{Path, PathBuf};
+
+/// The [`Recording::sensor_source`] of a sensor size the caller gave ([`OpenOptions::sensor`]).
+pub const GIVEN_SENSOR: &str = "given";
 
 /// Options for opening a recording.
 #[derive(Clone, Debug, Default)]
@@ -44,8 +48,8 @@ enum Source {
 pub struct Recording {
     pub path: PathBuf,
     pub format: Format,
-    /// The sensor size known before reading events (from `--sensor`, the file's metadata or
-    /// its frames); `None` when it must be inferred from the coordinates.
+    /// The sensor size known before reading events (given in [`OpenOptions`], from the file's
+    /// metadata or its frames); `None` when it must be inferred from the coordinates.
     pub sensor: Option<Sensor>,
     /// Where [`Self::sensor`] comes from.
     pub sensor_source: Option<String>,
@@ -60,7 +64,7 @@ pub struct ResolvedSensor {
     pub sensor: Sensor,
     pub source: String,
     /// Set when the size was guessed from the coordinates.
-    pub warning: Option<String>,
+    pub warning: Option<Text>,
 }
 
 impl Recording {
@@ -83,8 +87,12 @@ impl Recording {
                     Ok(found) if found != forced => {
                         return Err(InputError::invalid(
                             path,
-                            format!("--format {forced} does not fit: the content is {found}"),
-                            "drop --format (ctcal detects the format from the content), or give the right one",
+                            Text::default()
+                                .name(Hint::Format(Some(forced)))
+                                .words(format!(" does not fit: the content is {found}")),
+                            Text::from("drop ")
+                                .name(Hint::Format(None))
+                                .words(" (ctcal detects the format from the content), or give the right one"),
                         ));
                     }
                     _ => forced,
@@ -181,10 +189,12 @@ impl Recording {
         };
         let (sensor, sensor_source) = match (options.sensor, file_sensor) {
             (Some(s), Some((claimed, _))) if s != claimed => {
-                notes.push(format!("--sensor {s} overrides the file's {claimed}"));
-                (Some(s), Some("--sensor".to_string()))
+                notes.push(format!(
+                    "the sensor size given ({s}) overrides the file's {claimed}"
+                ));
+                (Some(s), Some(GIVEN_SENSOR.to_string()))
             }
-            (Some(s), _) => (Some(s), Some("--sensor".to_string())),
+            (Some(s), _) => (Some(s), Some(GIVEN_SENSOR.to_string())),
             (None, Some((s, origin))) => {
                 if !s.is_plausible() {
                     return Err(InputError::invalid(
@@ -192,9 +202,11 @@ impl Recording {
                         format!(
                             "{origin} says the sensor is {s}, larger than {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE} (more than any sensor sold)"
                         ),
-                        format!(
-                            "if the header is damaged, pass --sensor WxH with the camera's real size; if the sensor really is {s}, pass --sensor {s} (statistics then keep per-pixel state only for the area the events reach)"
-                        ),
+                        Text::from("if the header is damaged, ")
+                            .act(Hint::Sensor(None))
+                            .words(format!(" with the camera's real size; if the sensor really is {s}, "))
+                            .act(Hint::Sensor(Some(s)))
+                            .words(" (statistics then keep per-pixel state only for the area the events reach)"),
                     ));
                 }
                 (Some(s), Some(origin))
@@ -337,22 +349,29 @@ impl Recording {
             Some(preset) => ResolvedSensor {
                 sensor: preset.sensor(),
                 source: format!("inferred: {} ({})", preset.name, preset.sensor()),
-                warning: Some(format!(
-                    "{}: the file does not state the sensor size; using {} ({}), the smallest known sensor containing every event (x up to {max_x}, y up to {max_y}); pass --sensor WxH if that is wrong",
-                    self.path.display(),
-                    preset.name,
-                    preset.sensor()
-                )),
+                warning: Some(
+                    Text::from(format!(
+                        "{}: the file does not state the sensor size; using {} ({}), the smallest known sensor containing every event (x up to {max_x}, y up to {max_y}); ",
+                        self.path.display(),
+                        preset.name,
+                        preset.sensor()
+                    ))
+                    .act(Hint::Sensor(None))
+                    .words(" if that is wrong"),
+                ),
             },
             None => {
                 let sensor = Sensor::new(max_x.saturating_add(1), max_y.saturating_add(1));
                 ResolvedSensor {
                     sensor,
                     source: format!("inferred: {sensor} from the coordinates"),
-                    warning: Some(format!(
-                        "{}: the file does not state the sensor size and no known sensor contains x up to {max_x}, y up to {max_y}; using {sensor}; pass --sensor WxH",
-                        self.path.display()
-                    )),
+                    warning: Some(
+                        Text::from(format!(
+                            "{}: the file does not state the sensor size and no known sensor contains x up to {max_x}, y up to {max_y}; using {sensor}; ",
+                            self.path.display()
+                        ))
+                        .act(Hint::Sensor(None)),
+                    ),
                 }
             }
         }

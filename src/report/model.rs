@@ -241,7 +241,7 @@ pub fn sensors(sequences: &[&SequenceReport]) -> Vec<(String, usize)> {
 fn mixed_sensors_warning(sensors: &[(String, usize)]) -> Option<String> {
     (sensors.len() > 1).then(|| {
         format!(
-            "this dataset mixes sensors ({}): its means and spreads pool different cameras, and no simulator configuration is combined across them; name one dataset per sensor with --dataset NAME=INPUT",
+            "this dataset mixes sensors ({}): its means and spreads pool different cameras, and no simulator configuration is combined across them; name one dataset per sensor",
             sensors
                 .iter()
                 .map(|(s, n)| format!("{s}: {n} sequence{}", if *n == 1 { "" } else { "s" }))

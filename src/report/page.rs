@@ -163,7 +163,7 @@ fn files_html(s: &SequenceReport) -> String {
     if !s.outputs.masks.is_empty() {
         let links: Vec<String> = s.outputs.masks.iter().map(|p| link(p)).collect();
         out.push_str(&format!(
-            "<p class=\"note\">Hot-pixel mask (0 = hot, for <code>--mask</code>): {}</p>\n",
+            "<p class=\"note\">Hot-pixel mask (0 = hot; give it as the pixel mask to leave the hot pixels out): {}</p>\n",
             links.join(" &middot; ")
         ));
     }

@@ -1,13 +1,14 @@
 //! Work limits of a simulation, estimated before it starts: a scene with a typo (1e9 Hz, a
 //! 100,000-pixel-wide sensor, a year of duration) is refused with the estimate and the key
-//! to change, instead of running for hours or asking for tens of gigabytes. `--force` runs
-//! it anyway.
+//! to change, instead of running for hours or asking for tens of gigabytes. Forcing runs it
+//! anyway.
 //!
 //! The cost of a simulation is its pixel updates (samples x pixels; the simulator runs
 //! about 2-7e8 of them per second and core, README `benches/`) and its memory (about 150
 //! bytes of state and frame buffers per pixel).
 
 use super::SimError;
+use crate::hint::{Hint, Text};
 
 /// The largest sensor side ctcal simulates or infers (more than any sensor sold).
 pub const MAX_SIDE: usize = 4096;
@@ -17,6 +18,13 @@ pub const MAX_PIXEL_UPDATES: f64 = 2e10;
 pub const MAX_MEMORY_BYTES: f64 = 4e9;
 /// Simulator state and frame buffers per pixel, bytes (an upper estimate).
 const BYTES_PER_PIXEL: f64 = 150.0;
+
+/// The fix `fix`, or forcing the work (`then` says what forcing does).
+fn or_force(fix: &str, then: &str) -> Text {
+    Text::from(format!("{fix}, or "))
+        .act(Hint::Force)
+        .words(then)
+}
 
 /// The estimated work of one simulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -50,21 +58,27 @@ impl Work {
         }
         let updates = self.pixel_updates();
         if updates.is_nan() || updates > MAX_PIXEL_UPDATES {
-            return Err(SimError::Invalid(format!(
-                "{what}: {:.3e} samples of {:.0} pixels make {updates:.2e} pixel updates, over the budget of {MAX_PIXEL_UPDATES:.0e} (about {:.0} minutes on 2 cores)\n  fix: {fix}, or pass --force to run it anyway",
-                self.samples,
-                self.pixels,
-                updates / 4e8 / 60.0
-            )));
+            return Err(SimError::OverBudget {
+                problem: format!(
+                    "{what}: {:.3e} samples of {:.0} pixels make {updates:.2e} pixel updates, over the budget of {MAX_PIXEL_UPDATES:.0e} (about {:.0} minutes on 2 cores)",
+                    self.samples,
+                    self.pixels,
+                    updates / 4e8 / 60.0
+                ),
+                fix: or_force(fix, " to run it anyway"),
+            });
         }
         let memory = self.memory_bytes();
         if memory.is_nan() || memory > MAX_MEMORY_BYTES {
-            return Err(SimError::Invalid(format!(
-                "{what}: {:.0} pixels need about {:.1} GB of simulator state, over the budget of {:.0} GB\n  fix: simulate a smaller sensor, or pass --force",
-                self.pixels,
-                memory / 1e9,
-                MAX_MEMORY_BYTES / 1e9
-            )));
+            return Err(SimError::OverBudget {
+                problem: format!(
+                    "{what}: {:.0} pixels need about {:.1} GB of simulator state, over the budget of {:.0} GB",
+                    self.pixels,
+                    memory / 1e9,
+                    MAX_MEMORY_BYTES / 1e9
+                ),
+                fix: or_force("simulate a smaller sensor", ""),
+            });
         }
         Ok(())
     }
@@ -154,16 +168,30 @@ impl EffectWork {
                 .iter()
                 .max_by(|a, b| a.1.total_cmp(&b.1))
                 .map_or("the noise rates", |(key, _)| key);
-            return Err(SimError::Invalid(format!(
-                "{what}: the noise effects would make about {events:.2e} events ({parts}), {per_sample:.2e} per input sample; the budget is {MAX_NOISE_EVENTS:.0e} events, {MAX_EVENTS_PER_SAMPLE:.0e} per sample (about 20 bytes each in memory, more on disk)\n  fix: lower {largest} (rates are per pixel per second), simulate a shorter span or a smaller sensor, or pass --force to run it anyway"
-            )));
+            return Err(SimError::OverBudget {
+                problem: format!(
+                    "{what}: the noise effects would make about {events:.2e} events ({parts}), {per_sample:.2e} per input sample; the budget is {MAX_NOISE_EVENTS:.0e} events, {MAX_EVENTS_PER_SAMPLE:.0e} per sample (about 20 bytes each in memory, more on disk)"
+                ),
+                fix: or_force(
+                    &format!(
+                        "lower {largest} (rates are per pixel per second), simulate a shorter span or a smaller sensor"
+                    ),
+                    " to run it anyway",
+                ),
+            });
         }
         if self.blur_taps.is_nan() || self.blur_taps > MAX_BLUR_TAPS {
-            return Err(SimError::Invalid(format!(
-                "{what}: the display blur (display.blur_px) takes {:.2e} multiply-adds, over the budget of {MAX_BLUR_TAPS:.0e} (about {:.0} minutes on 2 cores)\n  fix: lower display.blur_px (a sigma in pixels; optics blur a few pixels), or pass --force to run it anyway",
-                self.blur_taps,
-                self.blur_taps / 4e8 / 60.0
-            )));
+            return Err(SimError::OverBudget {
+                problem: format!(
+                    "{what}: the display blur (display.blur_px) takes {:.2e} multiply-adds, over the budget of {MAX_BLUR_TAPS:.0e} (about {:.0} minutes on 2 cores)",
+                    self.blur_taps,
+                    self.blur_taps / 4e8 / 60.0
+                ),
+                fix: or_force(
+                    "lower display.blur_px (a sigma in pixels; optics blur a few pixels)",
+                    " to run it anyway",
+                ),
+            });
         }
         Ok(())
     }
@@ -172,6 +200,11 @@ impl EffectWork {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Whether forcing is among the fixes of `e`.
+    fn forcing_fixes(e: &SimError) -> bool {
+        e.message().hints().any(|h| *h == Hint::Force)
+    }
 
     #[test]
     fn noise_and_blur_are_budgeted_from_the_parameters() {
@@ -185,10 +218,11 @@ mod tests {
         p.leak_rate_hz = Some(1e9);
         let e = EffectWork::new(&p, &work, 1.0, 501.0)
             .check("p.toml", false)
-            .unwrap_err()
-            .to_string();
+            .unwrap_err();
+        assert!(forcing_fixes(&e), "{e}");
+        let e = e.to_string();
         assert!(
-            e.contains("p.toml") && e.contains("lower leak_rate_hz") && e.contains("--force"),
+            e.contains("p.toml") && e.contains("lower leak_rate_hz"),
             "{e}"
         );
         assert!(
@@ -232,8 +266,10 @@ mod tests {
         assert!(Work::new(1001.0, 240, 180).check("s", "f", false).is_ok());
         // a typo: 1e9 Hz for a second
         let e = Work::new(1e9, 240, 180).check("scene.toml", "lower render_hz", false);
-        let e = e.unwrap_err().to_string();
-        assert!(e.contains("scene.toml") && e.contains("render_hz") && e.contains("--force"));
+        let e = e.unwrap_err();
+        assert!(forcing_fixes(&e), "{e}");
+        let e = e.to_string();
+        assert!(e.contains("scene.toml") && e.contains("render_hz"));
         assert!(Work::new(1e9, 240, 180).check("s", "f", true).is_ok());
         assert!(
             Work::new(f64::NAN, 240, 180)

@@ -26,6 +26,7 @@ pub use simulator::{PixelMaps, Simulator};
 pub use source::{FrameSource, Sample};
 
 use crate::events::{EventChunk, TimeUs};
+use crate::hint::Text;
 use std::path::{Path, PathBuf};
 
 /// What can go wrong in a simulation. Every variant is something the user can fix (a
@@ -43,6 +44,9 @@ pub enum SimError {
     Params(#[from] ParamsError),
     #[error("{0}")]
     Invalid(String),
+    /// Work beyond a budget ([`budget`]); the fix names the option that allows it.
+    #[error("{}", over_budget(problem, fix))]
+    OverBudget { problem: String, fix: Text },
     /// An error of the frame source or event sink the caller supplied (a reader, a writer).
     #[error("{0}")]
     Source(Box<dyn std::error::Error + Send + Sync>),
@@ -66,6 +70,18 @@ impl SimError {
     pub fn source(error: impl std::error::Error + Send + Sync + 'static) -> Self {
         SimError::Source(Box::new(error))
     }
+
+    /// The message, its fix naming options as hints.
+    pub fn message(&self) -> Text {
+        match self {
+            SimError::OverBudget { problem, fix } => over_budget(problem, fix),
+            other => other.to_string().into(),
+        }
+    }
+}
+
+fn over_budget(problem: &str, fix: &Text) -> Text {
+    Text::from(problem).fixed_by(fix)
 }
 
 /// Counts of a finished simulation.

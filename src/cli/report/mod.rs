@@ -140,7 +140,7 @@ pub fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
     let mut any = false;
     for (input, outcome) in inputs.iter().zip(outcomes.sequences) {
         let outcome = outcome.map_err(hinted).map_err(|e| {
-            let message = format!("{e:#}");
+            let message = super::flags::message(&e);
             first_error.get_or_insert(e);
             message
         });

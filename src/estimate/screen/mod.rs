@@ -38,6 +38,7 @@ use super::interval::Measured;
 use super::resim::{Cells, Counts, Intervals, log_ratio};
 use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
+use crate::hint::{Hint, Text};
 use crate::sim::display::DisplayModel;
 use crate::sim::pixel::Transition;
 use crate::sim::screen_geometry::ScreenWarp;
@@ -371,7 +372,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         _ => {
             return Err(EstimateError::new(
                 "the stimulus does not give its refresh rate (fewer than two frames)",
-                "pass --refresh-hz",
+                Text::default().act(Hint::RefreshHz),
             ));
         }
     };
@@ -379,7 +380,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     let offset_us = align(input.events, input.stimulus).ok_or_else(|| {
         EstimateError::new(
             "the events do not line up with the stimulus's changes",
-            "check that this recording shows this stimulus (--stimulus DIR)",
+            Text::from("check that this recording shows this stimulus").aside(Hint::Stimulus),
         )
     })?;
     // cells: tiles x refresh intervals, each interval starting half a refresh before the
@@ -574,7 +575,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             offset_us as f64 * 1e-6
         ),
         format!(
-            "the display: sample-and-hold at {refresh_hz:.3} Hz; gamma, black level and optical blur ({:.2} px) fitted; white imaged at {:.0} camera DN, from the screen model (the counts cannot tell it from the threshold: refits with white 30 % dimmer and 40 % brighter are in the intervals; give --screen with the measured display)",
+            "the display: sample-and-hold at {refresh_hz:.3} Hz; gamma, black level and optical blur ({:.2} px) fitted; white imaged at {:.0} camera DN, from the screen model (the counts cannot tell it from the threshold: refits with white 30 % dimmer and 40 % brighter are in the intervals; give the measured display as the screen model)",
             display.blur_px.unwrap_or(0.0),
             display.white_dn
         ),

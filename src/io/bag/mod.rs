@@ -31,6 +31,7 @@ use super::error::{FIX_TRUNCATED, InputError};
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TimeUs};
+use crate::hint::{Hint, Text};
 use reader::{Item, MessageReader};
 use records::{RecordFile, op};
 use serde::Serialize;
@@ -61,7 +62,7 @@ pub struct TopicChoice {
 pub struct BagInfo {
     pub topics: Vec<Topic>,
     /// The events topic, or why none could be chosen (problem, fix).
-    pub events_topic: Result<String, (String, String)>,
+    pub events_topic: Result<String, (String, Text)>,
     pub image_topic: Option<String>,
     /// The sensor the first event message states (width, height).
     pub sensor: Option<Sensor>,
@@ -196,8 +197,8 @@ fn choose(
     topics: &[Topic],
     message_type: &str,
     wanted: Option<&str>,
-    option: &str,
-) -> Result<String, (String, String)> {
+    option: Hint,
+) -> Result<String, (String, Text)> {
     if let Some(name) = wanted {
         return match topics.iter().find(|t| t.name == name) {
             Some(t) if t.message_type == message_type => Ok(t.name.clone()),
@@ -206,17 +207,15 @@ fn choose(
                     "topic {name} carries {}, not {message_type}",
                     t.message_type
                 ),
-                format!(
-                    "choose a {message_type} topic with {option}: {}",
-                    listing(topics)
-                ),
+                Text::from(format!("choose a {message_type} topic"))
+                    .aside(option)
+                    .words(format!(": {}", listing(topics))),
             )),
             None => Err((
                 format!("the bag has no topic {name}"),
-                format!(
-                    "choose one of its topics with {option}: {}",
-                    listing(topics)
-                ),
+                Text::from("choose one of its topics")
+                    .aside(option)
+                    .words(format!(": {}", listing(topics))),
             )),
         };
     }
@@ -236,7 +235,7 @@ fn choose(
                 several.len(),
                 several.iter().map(|t| t.name.as_str()).collect::<Vec<_>>().join(", ")
             ),
-            format!("choose one with {option} NAME"),
+            Text::default().act(option),
         )),
     }
 }
@@ -279,13 +278,13 @@ pub fn probe(path: &Path, choice: &TopicChoice) -> Result<BagInfo, InputError> {
         &topics,
         messages::EVENT_ARRAY,
         choice.events.as_deref(),
-        "--topic",
+        Hint::Topic,
     );
     let image_topic = match choose(
         &topics,
         messages::IMAGE,
         choice.images.as_deref(),
-        "--image-topic",
+        Hint::ImageTopic,
     ) {
         Ok(t) => Some(t),
         Err((problem, fix)) if choice.images.is_some() => {
@@ -310,7 +309,7 @@ pub fn probe(path: &Path, choice: &TopicChoice) -> Result<BagInfo, InputError> {
             });
             if beside.is_none() && images.len() > 1 {
                 notes.push(format!(
-                    "{} image topics and none beside the events topic: frames not read (choose with --image-topic)",
+                    "{} image topics and none beside the events topic: frames not read (name the image topic to read them)",
                     images.len()
                 ));
             }
@@ -809,7 +808,7 @@ mod tests {
             topic("/davis/left/image_raw", messages::IMAGE),
             topic("/davis/right/events", messages::EVENT_ARRAY),
         ];
-        let (problem, fix) = choose(&stereo, messages::EVENT_ARRAY, None, "--topic").unwrap_err();
+        let (problem, fix) = choose(&stereo, messages::EVENT_ARRAY, None, Hint::Topic).unwrap_err();
         assert!(
             problem.contains("2 dvs_msgs/EventArray topics"),
             "{problem}"
@@ -818,30 +817,30 @@ mod tests {
             problem.contains("/davis/left/events, /davis/right/events"),
             "{problem}"
         );
-        assert_eq!(fix, "choose one with --topic NAME");
+        assert_eq!(fix, Text::default().act(Hint::Topic));
         assert_eq!(
             choose(
                 &stereo,
                 messages::EVENT_ARRAY,
                 Some("/davis/right/events"),
-                "--topic"
+                Hint::Topic
             ),
             Ok("/davis/right/events".to_string())
         );
         assert_eq!(
-            choose(&stereo[..2], messages::EVENT_ARRAY, None, "--topic"),
+            choose(&stereo[..2], messages::EVENT_ARRAY, None, Hint::Topic),
             Ok("/davis/left/events".to_string())
         );
         let (problem, _) = choose(
             &stereo,
             messages::EVENT_ARRAY,
             Some("/davis/left/image_raw"),
-            "--topic",
+            Hint::Topic,
         )
         .unwrap_err();
         assert!(problem.contains("carries sensor_msgs/Image"), "{problem}");
         let (problem, _) =
-            choose(&stereo[1..2], messages::EVENT_ARRAY, None, "--topic").unwrap_err();
+            choose(&stereo[1..2], messages::EVENT_ARRAY, None, Hint::Topic).unwrap_err();
         assert!(
             problem.contains("no dvs_msgs/EventArray topic"),
             "{problem}"

@@ -7,6 +7,7 @@
 
 use super::{OutputPolicy, Staged};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
+use crate::hint::{Hint, Text};
 use crate::io::error::InputError;
 use std::collections::BTreeMap;
 use std::io::{Seek, SeekFrom, Write};
@@ -252,7 +253,7 @@ impl BagWriter {
                 return Err(InputError::invalid(
                     &self.staged.shown,
                     format!("events must be time-sorted (event {i} at {t} us)"),
-                    "sort the events first (--sort)",
+                    Text::from("sort the events first").aside(Hint::Sort),
                 ));
             }
             self.last_t = t;

@@ -17,6 +17,7 @@
 //!   device or FIFO (`/dev/null`, a pipe) is written in place, never renamed over; sockets,
 //!   block devices and folders where a file is expected are refused.
 
+use crate::hint::{Hint, Text};
 use crate::io::error::InputError;
 use std::collections::BTreeSet;
 use std::path::{Component, Path, PathBuf};
@@ -31,7 +32,12 @@ const SIGNATURES: [&[u8]; 3] = [
     b"% integrator_name ctcal",
 ];
 
-const FORCE_FIX: &str = "choose a new path, or pass --force to replace only the files ctcal writes";
+/// The fix for an output that would replace what ctcal did not write.
+fn force_fix(new: &str) -> Text {
+    Text::from(format!("choose a new {new}, or "))
+        .act(Hint::Force)
+        .words(" to replace only the files ctcal writes")
+}
 
 /// The rules for one command's outputs: whether `--force` was given, and the inputs that no
 /// output may overwrite.
@@ -93,10 +99,12 @@ impl OutputPolicy {
                 continue;
             }
             let fix = match relation {
-                Relation::Inside => {
-                    "write the output outside the input folder, or pass --force to write there anyway"
+                Relation::Inside => Text::from("write the output outside the input folder, or ")
+                    .act(Hint::Force)
+                    .words(" to write there anyway"),
+                _ => {
+                    "choose an output path that is neither the input nor a folder holding it".into()
                 }
-                _ => "choose an output path that is neither the input nor a folder holding it",
             };
             return Err(InputError::invalid(
                 shown,
@@ -165,7 +173,7 @@ impl OutputPolicy {
                             return Err(InputError::invalid(
                                 path,
                                 "exists and was not written by ctcal",
-                                FORCE_FIX,
+                                force_fix("path"),
                             ));
                         }
                     }
@@ -255,7 +263,7 @@ impl OutputPolicy {
         Err(InputError::invalid(
             shown,
             format!("is an existing folder that ctcal did not create (it holds {list})"),
-            "choose a new folder, or pass --force to replace only the files ctcal writes",
+            force_fix("folder"),
         ))
     }
 }
@@ -594,7 +602,7 @@ impl StagedFolder {
                     return Err(InputError::invalid(
                         &self.shown,
                         format!("holds {}, which ctcal did not write there", clash.display()),
-                        FORCE_FIX,
+                        force_fix("path"),
                     ));
                 }
                 for file in &written {
@@ -720,11 +728,13 @@ mod tests {
         let out = dir.path().join("out");
         std::fs::create_dir(&out).unwrap();
         std::fs::write(out.join("notes.md"), "mine").unwrap();
-        let e = OutputPolicy::default()
-            .folder(&out)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("did not create") && e.contains("notes.md") && e.contains("--force"));
+        let e = OutputPolicy::default().folder(&out).unwrap_err();
+        let InputError::Invalid { fix, .. } = &e else {
+            panic!("{e}")
+        };
+        assert_eq!(fix.hints().collect::<Vec<_>>(), [&Hint::Force]);
+        let e = e.to_string();
+        assert!(e.contains("did not create") && e.contains("notes.md"));
         folder_output(&OutputPolicy::new(true), &out, &[("x.txt", "1")]);
         assert_eq!(
             std::fs::read_to_string(out.join("notes.md")).unwrap(),

@@ -7,6 +7,7 @@
 
 use super::OutputPolicy;
 use crate::events::EventChunk;
+use crate::hint::{Hint, Text};
 use crate::io::error::InputError;
 use std::path::Path;
 
@@ -25,7 +26,7 @@ pub fn write_dsec(
         return Err(InputError::invalid(
             target,
             "DSEC files hold time-sorted events, at least one",
-            "sort the events first (--sort)",
+            Text::from("sort the events first").aside(Hint::Sort),
         ));
     }
     let t_offset = events.t[0];

@@ -6,6 +6,7 @@
 
 use super::{OutputPolicy, Staged};
 use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::hint::{Hint, Text};
 use crate::io::error::InputError;
 use std::io::Write;
 use std::path::Path;
@@ -75,7 +76,7 @@ impl Evt3Writer {
                 return Err(InputError::invalid(
                     &self.staged.shown,
                     format!("EVT3 needs non-negative, time-sorted events (event {i} at {t} us)"),
-                    "sort the events first (--sort)",
+                    Text::from("sort the events first").aside(Hint::Sort),
                 ));
             }
             self.last_t = t;

@@ -3,6 +3,8 @@
 
 use super::{OutputPolicy, Staged};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
+use crate::hint::{Hint, Text};
+use crate::io::Format;
 use crate::io::error::InputError;
 use std::path::Path;
 
@@ -81,7 +83,7 @@ impl H5Writer {
                     "the {} sensor does not fit event_utils' int16 coordinates",
                     self.sensor
                 ),
-                "write an IJRR folder instead (--to ijrr)",
+                Text::from("write an IJRR folder instead").aside(Hint::WriteAs(Format::Ijrr)),
             ));
         }
         let start = self.written;

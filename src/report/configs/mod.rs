@@ -172,6 +172,11 @@ pub fn combine(fits: &[PixelParams]) -> Option<PixelParams> {
     Some(out)
 }
 
+/// A line of an ESIM flagfile: ESIM's flag `name` set to `value`.
+fn esim_flag(name: &str, value: impl std::fmt::Display) -> String {
+    format!("--{name}={value}")
+}
+
 /// An ESIM flagfile.
 pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
     let (exposure_ms, seed) = (setup.exposure_ms, setup.seed);
@@ -189,18 +194,30 @@ pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
             .map(str::to_string),
     );
     let sigma = p.ct_sigma.unwrap_or(0.0);
-    lines.push(format!("--contrast_threshold_pos={:.6}", p.ct_on));
-    lines.push(format!("--contrast_threshold_neg={:.6}", p.ct_off));
+    lines.push(esim_flag(
+        "contrast_threshold_pos",
+        format!("{:.6}", p.ct_on),
+    ));
+    lines.push(esim_flag(
+        "contrast_threshold_neg",
+        format!("{:.6}", p.ct_off),
+    ));
     if sigma > 0.0 {
         lines.push(format!(
             "# the fitted mismatch ({sigma:.4}) is frozen per pixel; ESIM redraws its threshold noise at every event"
         ));
     }
-    lines.push(format!("--contrast_threshold_sigma_pos={sigma:.6}"));
-    lines.push(format!("--contrast_threshold_sigma_neg={sigma:.6}"));
-    lines.push(format!(
-        "--refractory_period_ns={}",
-        (p.refractory_s.unwrap_or(0.0) * 1e9).round() as i64
+    lines.push(esim_flag(
+        "contrast_threshold_sigma_pos",
+        format!("{sigma:.6}"),
+    ));
+    lines.push(esim_flag(
+        "contrast_threshold_sigma_neg",
+        format!("{sigma:.6}"),
+    ));
+    lines.push(esim_flag(
+        "refractory_period_ns",
+        (p.refractory_s.unwrap_or(0.0) * 1e9).round() as i64,
     ));
     let eps = p.log_eps();
     match p.log_response() {
@@ -209,16 +226,16 @@ pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
             "# fitted with the lin-log response (ln DN above 20 DN, linear below); ESIM takes log(I + eps), I in [0, 1]: eps {eps} is the nearest"
         )),
     }
-    lines.push(format!("--log_eps={eps}"));
-    lines.push("--use_log_image=true".to_string());
+    lines.push(esim_flag("log_eps", eps));
+    lines.push(esim_flag("use_log_image", true));
     match exposure_ms {
-        Some(e) => lines.push(format!("--exposure_time_ms={e:.3}")),
+        Some(e) => lines.push(esim_flag("exposure_time_ms", format!("{e:.3}"))),
         None => {
             lines.push("# the recording does not state its frame exposure".to_string());
-            lines.push("--exposure_time_ms=0.0".to_string());
+            lines.push(esim_flag("exposure_time_ms", "0.0"));
         }
     }
-    lines.push(format!("--random_seed={seed}"));
+    lines.push(esim_flag("random_seed", seed));
     let missing: Vec<String> = [
         (
             "photoreceptor bandwidth",
@@ -263,7 +280,7 @@ pub fn ctcal_params(p: &PixelParams, setup: &Setup) -> String {
     let mut notes = Vec::new();
     if let Some((w, h)) = setup.sensor {
         notes.push(format!(
-            "the fitted sensor is {w}x{h} (ctcal simulate --sensor {w}x{h})"
+            "the fitted sensor is {w}x{h}: simulate a sensor of that size"
         ));
     }
     notes.extend(not_identified_notes(setup));
@@ -313,16 +330,17 @@ mod tests {
     #[test]
     fn esim_uses_its_names_and_units() {
         let text = esim_flagfile(&fitted(), &setup());
-        for line in [
-            "--contrast_threshold_pos=0.350000",
-            "--contrast_threshold_neg=0.450000",
-            "--contrast_threshold_sigma_pos=0.030000",
-            "--refractory_period_ns=500000",
-            "--log_eps=0.001",
-            "--use_log_image=true",
-            "--exposure_time_ms=4.000",
-            "--random_seed=7",
+        for (name, value) in [
+            ("contrast_threshold_pos", "0.350000"),
+            ("contrast_threshold_neg", "0.450000"),
+            ("contrast_threshold_sigma_pos", "0.030000"),
+            ("refractory_period_ns", "500000"),
+            ("log_eps", "0.001"),
+            ("use_log_image", "true"),
+            ("exposure_time_ms", "4.000"),
+            ("random_seed", "7"),
         ] {
+            let line = format!("--{name}={value}");
             assert!(text.lines().any(|l| l == line), "{line} in\n{text}");
         }
         assert!(text.contains(

@@ -27,6 +27,11 @@ pub fn arguments(p: &PixelParams, setup: &Setup) -> Vec<(&'static str, f64)> {
     args
 }
 
+/// v2e's flag of the argument `name`.
+fn flag(name: &str) -> String {
+    format!("--{name}")
+}
+
 /// A value as v2e reads it: whole numbers without a decimal point, the rest to six
 /// significant places.
 fn value(v: f64) -> String {
@@ -44,7 +49,11 @@ fn notes(p: &PixelParams, setup: &Setup) -> Vec<String> {
         notes.push("v2e has no hot pixels or timestamp jitter; ctcal simulate has both".into());
     }
     if setup.sensor.is_none() {
-        notes.push("the sensor size is not known: add --output_width and --output_height".into());
+        notes.push(format!(
+            "the sensor size is not known: add {} and {}",
+            flag("output_width"),
+            flag("output_height")
+        ));
     }
     notes.extend(not_identified_notes(setup));
     notes
@@ -52,15 +61,16 @@ fn notes(p: &PixelParams, setup: &Setup) -> Vec<String> {
 
 /// `v2e_args.sh`: runs v2e (or `$V2E`) with the arguments, then the caller's.
 pub fn script(p: &PixelParams, setup: &Setup) -> String {
-    let mut text = String::from(
-        "#!/bin/sh\n# v2e with the parameters ctcal fitted to a recording. Run it as it is, with v2e's\n# input and output arguments after it:\n#   sh v2e_args.sh -i video.mp4 --output_folder out\n# (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)\n",
+    let mut text = format!(
+        "#!/bin/sh\n# v2e with the parameters ctcal fitted to a recording. Run it as it is, with v2e's\n# input and output arguments after it:\n#   sh v2e_args.sh -i video.mp4 {} out\n# (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)\n",
+        flag("output_folder")
     );
     for note in notes(p, setup) {
         text.push_str(&format!("# {}\n", super::super::caveats::one_line(&note)));
     }
     text.push_str("exec \"${V2E:-v2e}\" \\\n");
-    for (flag, v) in arguments(p, setup) {
-        text.push_str(&format!("  --{flag} {} \\\n", value(v)));
+    for (name, v) in arguments(p, setup) {
+        text.push_str(&format!("  {} {} \\\n", flag(name), value(v)));
     }
     text.push_str("  \"$@\"\n");
     text
@@ -82,18 +92,18 @@ pub fn json(p: &PixelParams, setup: &Setup) -> String {
     let args = arguments(p, setup);
     let by_name: serde_json::Map<String, serde_json::Value> = args
         .iter()
-        .map(|(flag, v)| {
+        .map(|(name, v)| {
             let v = if v.fract() == 0.0 && v.abs() < 1e15 {
                 json!(*v as i64)
             } else {
                 json!(v)
             };
-            (flag.to_string(), v)
+            (name.to_string(), v)
         })
         .collect();
     let argv: Vec<String> = args
         .iter()
-        .flat_map(|(flag, v)| [format!("--{flag}"), value(*v)])
+        .flat_map(|(name, v)| [flag(name), value(*v)])
         .collect();
     let doc = V2eJson {
         ctcal_version: env!("CARGO_PKG_VERSION"),

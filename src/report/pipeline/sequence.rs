@@ -104,8 +104,8 @@ struct Warnings<'a> {
 }
 
 impl crate::window::LoadObserver for Warnings<'_> {
-    fn warn(&self, message: &str) {
-        (self.progress)(self.name, Event::Warning(message));
+    fn warn(&self, message: &crate::hint::Text) {
+        (self.progress)(self.name, Event::Warning(&message.to_string()));
     }
 }
 
