@@ -116,9 +116,10 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         params.hot_pixel_rate_hz = median(&rates);
     }
     let not_identified = not_identified(&state, fixed);
-    if fixed {
-        state.uncertainty.remove("ct_on");
-        state.uncertainty.remove("ct_off");
+    for k in ["ct_on", "ct_off"] {
+        if not_identified.contains_key(k) {
+            state.uncertainty.remove(k);
+        }
     }
     assumptions.extend(split_assumptions(simulation, options));
     let identified = super::super::identified(&params, &not_identified);
@@ -163,6 +164,22 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
                 k.to_string(),
                 "the recording does not show the thresholds (a static scene, or frames that explain almost none of its events): the model simulated them at a start value".to_string(),
             );
+        }
+    }
+    if !fixed {
+        for k in ["ct_on", "ct_off"] {
+            if state
+                .uncertainty
+                .get(k)
+                .is_none_or(|u| u.standard_error.is_none())
+            {
+                why.insert(
+                    k.to_string(),
+                    format!(
+                        "the fit blocks have too few events of this polarity to fix {k} (fewer than 3 count cells with 5 events): the model kept the value its search started from, not a measurement"
+                    ),
+                );
+            }
         }
     }
     for (key, bound) in &state.at_bound {

@@ -288,3 +288,57 @@ fn fit_params(
         fit.get("frame_exposure_us").and_then(|v| v.as_i64()),
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn fit(ct_on: f64) -> serde_json::Value {
+        json!({"params": {"ct_on": ct_on, "ct_off": 0.3}, "frame_exposure_us": 2000})
+    }
+
+    #[test]
+    fn a_report_gives_its_fits_seed_sensor_and_common_exposure() {
+        let report = json!({"seed": 7, "sequences": [
+            {"name": "a", "fit": fit(0.25), "stats": {"width": 240, "height": 180}},
+            {"name": "b", "stats": {"width": 240, "height": 180}},
+            {"name": "c", "fit": fit(0.35), "stats": {"width": 240, "height": 180}},
+        ]});
+        let mut fits = FitSet::default();
+        fits.add("results.json", &report).unwrap();
+        assert_eq!(fits.params.len(), 2);
+        let setup = fits.setup("results.json", None).unwrap();
+        assert_eq!(
+            (setup.seed, setup.sensor, setup.exposure_ms),
+            (7, Some((240, 180)), Some(2.0))
+        );
+        assert_eq!(fits.setup("results.json", Some(3)).unwrap().seed, 3);
+    }
+
+    #[test]
+    fn refusals_name_the_file_the_json_path_and_the_fix() {
+        let mut fits = FitSet::default();
+        let e = fits.add("f.json", &fit(1e9)).unwrap_err().0;
+        assert!(
+            e.contains("f.json") && e.contains("`params.ct_on`") && e.contains("fix:"),
+            "{e}"
+        );
+        let unidentified =
+            json!({"params": {"ct_on": null, "ct_off": 0.3}, "why": {"ct_on": "a static scene"}});
+        let e = fits.add("g.json", &unidentified).unwrap_err().0;
+        assert!(
+            e.contains("a static scene") && e.contains("does not identify"),
+            "{e}"
+        );
+        let mixed = json!({"sequences": [
+            {"name": "a", "fit": fit(0.25), "stats": {"width": 240, "height": 180}},
+            {"name": "b", "fit": fit(0.25), "stats": {"width": 346, "height": 260}},
+        ]});
+        fits.add("r.json", &mixed).unwrap();
+        let e = fits.setup("r.json", None).unwrap_err().0;
+        assert!(e.contains("2 sensors") && e.contains("346x260: b"), "{e}");
+        let e = FitSet::default().setup("none", None).unwrap_err().0;
+        assert!(e.contains("no fitted sequence"), "{e}");
+    }
+}
