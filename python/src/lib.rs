@@ -61,11 +61,45 @@ fn open_options(format: Option<&str>, sensor: Option<&str>) -> PyResult<OpenOpti
     })
 }
 
+/// Events as Python receives them: t (int64 us), x, y (uint16), p (uint8, 1 = ON).
+type EventArrays<'py> = (
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray1<u16>>,
+    Bound<'py, PyArray1<u16>>,
+    Bound<'py, PyArray1<u8>>,
+);
+
+/// Events gathered column by column, for [`EventArrays`].
+#[derive(Default)]
+struct EventColumns {
+    t: Vec<i64>,
+    x: Vec<u16>,
+    y: Vec<u16>,
+    p: Vec<u8>,
+}
+
+impl EventColumns {
+    fn extend(&mut self, chunk: &ctcal::EventChunk, range: std::ops::Range<usize>) {
+        self.t.extend_from_slice(&chunk.t[range.clone()]);
+        self.x.extend_from_slice(&chunk.x[range.clone()]);
+        self.y.extend_from_slice(&chunk.y[range.clone()]);
+        self.p.extend(chunk.on[range].iter().map(|&on| on as u8));
+    }
+
+    fn into_numpy(self, py: Python<'_>) -> EventArrays<'_> {
+        (
+            PyArray1::from_vec(py, self.t),
+            PyArray1::from_vec(py, self.x),
+            PyArray1::from_vec(py, self.y),
+            PyArray1::from_vec(py, self.p),
+        )
+    }
+}
+
 /// The events of `path` (between `start` and `end` seconds after the first event) as
 /// four arrays: t (int64 us), x, y (uint16), p (uint8, 1 = ON).
 #[pyfunction]
 #[pyo3(signature = (path, start=None, end=None, format=None, sensor=None))]
-#[allow(clippy::type_complexity)]
 fn read<'py>(
     py: Python<'py>,
     path: PathBuf,
@@ -73,14 +107,9 @@ fn read<'py>(
     end: Option<f64>,
     format: Option<&str>,
     sensor: Option<&str>,
-) -> PyResult<(
-    Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyArray1<u16>>,
-    Bound<'py, PyArray1<u16>>,
-    Bound<'py, PyArray1<u8>>,
-)> {
+) -> PyResult<EventArrays<'py>> {
     let open = open_options(format, sensor)?;
-    let (t, x, y, p) = py
+    let columns = py
         .detach(|| -> Result<_, String> {
             ctcal::window::check_window(start, end).map_err(|e| e.to_string())?;
             let recording = Recording::open(&path, &open).map_err(|e| e.to_string())?;
@@ -90,27 +119,19 @@ fn read<'py>(
             let mut stream = recording
                 .events_between(from, to)
                 .map_err(|e| e.to_string())?;
-            let (mut t, mut x, mut y, mut p) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let mut columns = EventColumns::default();
             while let Some(chunk) = stream.next_chunk().map_err(|e| e.to_string())? {
                 let lo = chunk.t.partition_point(|&v| v < from);
                 let hi = chunk.t.partition_point(|&v| v <= to).max(lo);
-                t.extend_from_slice(&chunk.t[lo..hi]);
-                x.extend_from_slice(&chunk.x[lo..hi]);
-                y.extend_from_slice(&chunk.y[lo..hi]);
-                p.extend(chunk.on[lo..hi].iter().map(|&on| on as u8));
+                columns.extend(chunk, lo..hi);
                 if chunk.t.last().is_some_and(|&v| v > to) {
                     break;
                 }
             }
-            Ok((t, x, y, p))
+            Ok(columns)
         })
         .map_err(err)?;
-    Ok((
-        PyArray1::from_vec(py, t),
-        PyArray1::from_vec(py, x),
-        PyArray1::from_vec(py, y),
-        PyArray1::from_vec(py, p),
-    ))
+    Ok(columns.into_numpy(py))
 }
 
 /// The grey frames of `path`: their times (int64 us), every frame's pixels one after the
@@ -775,7 +796,6 @@ fn toml_of(value: &serde_json::Value) -> Result<String, String> {
 /// Events of frames (uint8, `n` frames of `h` x `w`, at `times` us) through the pixel model
 /// `params` (PARAMS.toml text or a params dict's JSON): t, x, y, p arrays.
 #[pyfunction]
-#[allow(clippy::type_complexity)]
 fn simulate<'py>(
     py: Python<'py>,
     pixels: PyReadonlyArray1<'py, u8>,
@@ -784,12 +804,7 @@ fn simulate<'py>(
     w: usize,
     times: PyReadonlyArray1<'py, i64>,
     params: &str,
-) -> PyResult<(
-    Bound<'py, PyArray1<i64>>,
-    Bound<'py, PyArray1<u16>>,
-    Bound<'py, PyArray1<u16>>,
-    Bound<'py, PyArray1<u8>>,
-)> {
+) -> PyResult<EventArrays<'py>> {
     let pixels = pixels.as_slice()?;
     let times = times.as_slice()?;
     if times.len() != n || pixels.len() != n * h * w {
@@ -814,35 +829,27 @@ fn simulate<'py>(
         })
         .collect();
     let params = params_of(params).map_err(err)?;
-    let (t, x, y, p) = py
+    let columns = py
         .detach(|| -> Result<_, ctcal::sim::SimError> {
             // as `ctcal simulate --frames` replays its frames
             let mut source = ctcal::sim::source::LoadedFrames::new(frames.len(), (w, h), |i| {
                 Ok(frames[i].clone())
             });
-            let (mut t, mut x, mut y, mut p) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            let mut columns = EventColumns::default();
             ctcal::sim::run::<ctcal::sim::SimError>(
                 &mut source,
                 &params,
                 ctcal::sim::PixelMaps::default(),
                 |chunk| {
-                    t.extend_from_slice(&chunk.t);
-                    x.extend_from_slice(&chunk.x);
-                    y.extend_from_slice(&chunk.y);
-                    p.extend(chunk.on.iter().map(|&on| on as u8));
+                    columns.extend(chunk, 0..chunk.t.len());
                     Ok(())
                 },
                 |_| {},
             )?;
-            Ok((t, x, y, p))
+            Ok(columns)
         })
         .map_err(err)?;
-    Ok((
-        PyArray1::from_vec(py, t),
-        PyArray1::from_vec(py, x),
-        PyArray1::from_vec(py, y),
-        PyArray1::from_vec(py, p),
-    ))
+    Ok(columns.into_numpy(py))
 }
 
 /// `ctcal config --format FORMAT` of a fit's JSON or a report's `results.json` text.
