@@ -283,6 +283,15 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
                 .join(", ")
         },
     ));
+    for a in &r.ambiguities {
+        rows.push((
+            "not separated".into(),
+            format!(
+                "{} or {} ({} {:.6} in its place): {}",
+                a.kept, a.alternative, a.parameter, a.value, a.separated_by
+            ),
+        ));
+    }
     rows.push((
         "held-out error".into(),
         format!(
