@@ -18,21 +18,37 @@
 //! Time is integer microseconds throughout; seconds appear only at the edges (text files,
 //! JSON keys ending `_s`). The library never prints: it returns values and errors, and the
 //! `ctcal` binary presents them.
+//!
+//! ## Layout
+//!
+//! This package is the `ctcal` binary (`src/main.rs`, `src/cli/`) and this facade, which
+//! re-exports the workspace's library crates under the paths of the single crate they
+//! were split from (`ctcal::sim`, `ctcal::io`, `ctcal::report`, ...), plus the coverage
+//! study ([`coverage`]), which runs the binary. Arrows point down:
+//!
+//! - `ctcal-core`: events, simulator, statistics, estimators, fit (no other ctcal crate);
+//! - `ctcal-io`: readers, writers, the loading of a window of a recording (on core);
+//! - `ctcal-report`: tables, plots, pages, configurations and the report pipeline (on
+//!   core, and on io for the pipeline's reading);
+//! - `ctcal` (this package): the command line and the coverage study, on all three.
+
+pub use ctcal_core::*;
+pub use ctcal_io as io;
+pub use ctcal_io::window;
+pub use ctcal_io::{Format, InputError, OpenOptions, Recording};
+pub use ctcal_report as report;
 
 pub mod coverage;
-pub mod estimate;
-pub mod events;
-pub mod files;
-pub mod fit;
-pub mod hint;
-pub mod io;
-pub mod report;
-pub mod selection;
-pub mod sensors;
 
-pub use events::{CHUNK_EVENTS, Event, EventChunk, Frame, Sensor, TimeUs};
-pub use io::{Format, InputError, OpenOptions, Recording};
-pub mod sim;
-pub mod stats;
-pub mod synthetic;
-pub mod window;
+/// The pixel simulator ([`ctcal_core::sim`]), with the writing of a peer simulator's case
+/// as an IJRR folder ([`ctcal_io::peers::write_case`]) under its old path.
+pub mod sim {
+    pub use ctcal_core::sim::*;
+
+    /// Other simulators' pixel models ([`ctcal_core::sim::peers`]), with
+    /// [`write_case`] from the IO crate.
+    pub mod peers {
+        pub use ctcal_core::sim::peers::*;
+        pub use ctcal_io::peers::write_case;
+    }
+}

@@ -1,0 +1,221 @@
+//! On-screen cases simulated through [`crate::sim::screen_geometry`]: the screen seen at an
+//! angle, shifted, scaled and partly off the sensor; the registration must put the
+//! stimulus's corners within 1 px of the truth and the thresholds' intervals must hold the
+//! thresholds simulated.
+
+use super::*;
+use crate::sim::scene::stimulus::StimulusSpec;
+use crate::sim::screen_geometry::{Homography, ScreenGeometry};
+use std::sync::Arc;
+
+const SENSOR: (usize, usize) = (160, 120);
+const TRUTH: (f64, f64) = (0.25, 0.35);
+
+fn display() -> DisplayParams {
+    DisplayParams::from_toml(
+        include_str!("../../../../../calib/screens/lcd_75hz_gamma2.toml"),
+        "lcd_75hz_gamma2",
+    )
+    .unwrap()
+}
+
+fn spec() -> StimulusSpec {
+    StimulusSpec {
+        width: 160,
+        height: 120,
+        square_px: 12.0,
+        squares: [6, 4],
+        ..StimulusSpec::default()
+    }
+}
+
+fn stimulus() -> Vec<Frame> {
+    let spec = spec();
+    (0..spec.frame_count()).map(|k| spec.render(k)).collect()
+}
+
+/// The largest distance between where `truth` and `found` put the checkerboard's corners
+/// (every square corner, at every 5th refresh) that the sensor sees.
+fn board_error(truth: &ScreenGeometry, found: &ScreenGeometry) -> f64 {
+    let spec = spec();
+    let mut worst: f64 = 0.0;
+    for k in (0..spec.frame_count()).step_by(5) {
+        let (bx, by) = spec.board_corner(k as f64 / spec.refresh_hz);
+        for i in 0..=spec.squares[0] {
+            for j in 0..=spec.squares[1] {
+                let s = (
+                    bx + i as f64 * spec.square_px,
+                    by + j as f64 * spec.square_px,
+                );
+                let (Some(p), Some(q)) = (truth.to_sensor(s), found.to_sensor(s)) else {
+                    continue;
+                };
+                if p.0 >= 0.0 && p.1 >= 0.0 && p.0 <= SENSOR.0 as f64 && p.1 <= SENSOR.1 as f64 {
+                    worst = worst.max((p.0 - q.0).hypot(p.1 - q.1));
+                }
+            }
+        }
+    }
+    worst
+}
+
+/// The events of `stimulus` on a screen at `geometry`, through the display, ideal pixels.
+fn record(geometry: &ScreenGeometry, stimulus: &[Frame]) -> EventChunk {
+    let warp = Arc::new(ScreenWarp::new(geometry));
+    let frames = MemoryFrames::new(stimulus, Transition::Hold).unwrap();
+    let mut source = DisplaySource::new(frames, DisplayModel::new(&display())).seen_through(warp);
+    let mut events = EventChunk::default();
+    let params = PixelParams::ideal(TRUTH.0, TRUTH.1);
+    crate::sim::run(
+        &mut source,
+        &params,
+        PixelMaps::default(),
+        |chunk: &EventChunk| -> Result<(), crate::sim::SimError> {
+            events.extend_from(chunk);
+            Ok(())
+        },
+        |_| {},
+    )
+    .unwrap();
+    events.sort_by_time();
+    events
+}
+
+fn geometry(h: [[f64; 3]; 3], k1: f64) -> ScreenGeometry {
+    ScreenGeometry {
+        homography: Homography(h),
+        k1,
+        stimulus: (160, 120),
+        sensor: SENSOR,
+    }
+}
+
+/// The geometry the results hold.
+fn recovered(e: &CtEstimate) -> ScreenGeometry {
+    let r = &e.extra["registration"];
+    let h: [[f64; 3]; 3] = serde_json::from_value(r["homography"].clone()).unwrap();
+    geometry(h, r["k1"].as_f64().unwrap())
+}
+
+fn run(truth: &ScreenGeometry) -> (CtEstimate, f64) {
+    let stimulus = stimulus();
+    let events = record(truth, &stimulus);
+    let excluded = vec![false; SENSOR.0 * SENSOR.1];
+    let input = ScreenInput {
+        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
+        events: &events,
+        stimulus: &stimulus,
+        screen: display(),
+        refresh_hz: None,
+        excluded: &excluded,
+    };
+    let started = std::time::Instant::now();
+    let e = estimate(&input, &|_, _| {}).unwrap();
+    (e, started.elapsed().as_secs_f64())
+}
+
+/// `outer`: the largest error allowed at the stimulus's own corners (extrapolated beyond
+/// the board's path; a fitted distortion coefficient trades off with perspective there).
+fn check(name: &str, truth: ScreenGeometry, outer_limit: f64) {
+    let (e, seconds) = run(&truth);
+    let found = recovered(&e);
+    let error = board_error(&truth, &found);
+    let outer = register::corner_change(&truth, &found);
+    let r = &e.extra["registration"];
+    eprintln!(
+        "{name}: checkerboard corners within {error:.3} px (the screen's corners {outer:.3} px), k1 {:.4}, reprojection {:.3} px RMS over {} points; ct_on {:?} {:?}, ct_off {:?} {:?}; {seconds:.1} s",
+        found.k1, r["error_rms_px"], r["points"], e.ct_on, e.ct_on_ci95, e.ct_off, e.ct_off_ci95
+    );
+    assert!(error < 1.0, "{name}: board corners {error} px off");
+    assert!(outer < outer_limit, "{name}: screen corners {outer} px off");
+    for (value, ci, truth) in [
+        (e.ct_on, e.ct_on_ci95, TRUTH.0),
+        (e.ct_off, e.ct_off_ci95, TRUTH.1),
+    ] {
+        let value = value.unwrap_or_else(|| panic!("{name}: {:?}", e.why));
+        let [lo, hi] = ci.unwrap();
+        assert!(
+            lo.is_none_or(|lo| lo <= truth) && hi.is_none_or(|hi| truth <= hi),
+            "{name}: {value} [{lo:?}, {hi:?}] misses {truth}"
+        );
+        assert!(
+            (value / truth - 1.0).abs() < 0.15,
+            "{name}: {value} vs {truth}"
+        );
+    }
+}
+
+#[test]
+fn a_screen_seen_at_an_angle_is_registered() {
+    check(
+        "angle",
+        geometry(
+            [[0.8, 0.07, 18.0], [-0.05, 0.78, 20.0], [6e-4, 3e-4, 1.0]],
+            0.0,
+        ),
+        1.0,
+    );
+}
+
+#[test]
+fn a_shifted_screen_with_lens_distortion_is_registered() {
+    check(
+        "shifted",
+        geometry([[1.0, 0.0, 7.3], [0.0, 1.0, -5.6], [0.0, 0.0, 1.0]], -0.06),
+        3.0,
+    );
+}
+
+#[test]
+fn a_smaller_screen_is_registered() {
+    check(
+        "scaled",
+        geometry([[0.68, 0.0, 27.0], [0.0, 0.68, 19.5], [0.0, 0.0, 1.0]], 0.0),
+        1.0,
+    );
+}
+
+#[test]
+fn a_screen_partly_off_the_sensor_is_registered() {
+    check(
+        "partly off",
+        geometry(
+            [[1.3, 0.03, -38.0], [-0.02, 1.3, -12.0], [0.0, 0.0, 1.0]],
+            0.0,
+        ),
+        1.0,
+    );
+}
+
+#[test]
+fn events_without_the_stimulus_are_not_registered() {
+    let stimulus = stimulus();
+    // events at every refresh, at pixels that follow no stimulus
+    let mut events = EventChunk::default();
+    let mut state = 12345u64;
+    for frame in &stimulus {
+        for _ in 0..400 {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let x = ((state >> 33) % SENSOR.0 as u64) as u16;
+            let y = ((state >> 17) % SENSOR.1 as u64) as u16;
+            events.push(frame.t + 100 + (state % 2000) as i64, x, y, state & 1 == 0);
+        }
+    }
+    events.sort_by_time();
+    let excluded = vec![false; SENSOR.0 * SENSOR.1];
+    let input = ScreenInput {
+        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
+        events: &events,
+        stimulus: &stimulus,
+        screen: display(),
+        refresh_hz: None,
+        excluded: &excluded,
+    };
+    let e = estimate(&input, &|_, _| {}).unwrap();
+    assert!(e.ct.is_none());
+    let why = &e.why["ct"];
+    assert!(why.contains("could not be found"), "{why}");
+    assert!(e.extra["registration"]["error"].is_string());
+}

@@ -1,0 +1,305 @@
+//! Fitting the simulator to a recording, and closing the loop: start from the ideal pixel
+//! with the estimated thresholds, look at where the model is still wrong, trace that
+//! residual to the effect whose signature it carries ([`effects`]), add the effect, fit its
+//! parameter with the thresholds, and keep it only if the error on held-out data falls;
+//! repeat until nothing helps.
+//!
+//! - The recording's grey frames, upsampled along the optical flow, are simulated with the
+//!   candidate model ([`search`]), and the simulation is compared with the recording
+//!   statistic by statistic ([`observe`]) under one sim-to-real distance ([`metric`]).
+//! - Time is cut into blocks: the first ones fit, the rest is held out as a selection run
+//!   (an effect is kept only if its error there falls by more than measured chance) and a
+//!   test run (the final error, touched once) ([`selection`]).
+//! - Thresholds start from `estimate aps` on the fit run (event timing and re-simulation);
+//!   in a static scene (no change in the frames) they cannot be measured: a start value,
+//!   reported as not identified.
+//!
+//! The approach is that of Stoffregen et al. (ECCV 2020), who matched simulator settings
+//! to datasets by hand through events per pixel per second, made automatic and extended to
+//! every effect of the pixel model (Lichtsteiner et al. 2008; v2e, Hu et al. 2021).
+
+pub mod effects;
+pub mod events_only;
+pub mod metric;
+pub mod observe;
+pub mod residuals;
+pub mod search;
+pub mod selection;
+
+use crate::estimate::EstimateError;
+use crate::events::{EventChunk, Frame, Sensor};
+use crate::sim::PixelParams;
+use crate::stats::hot_pixels::HotPixel;
+use effects::Effect;
+use metric::Components;
+use residuals::{Bin, Residuals};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// A fit cannot be made from this input: what is missing and what to do.
+pub type FitError = EstimateError;
+
+/// Which effects the fit considers.
+#[derive(Clone, Debug, PartialEq)]
+pub enum EffectChoice {
+    /// Every effect, each tried when its residual signature calls for it.
+    Auto,
+    /// None: the ideal pixel with fitted thresholds.
+    None,
+    /// These, in this order, each tried whatever the evidence (and kept only if the
+    /// held-out error falls).
+    List(Vec<Effect>),
+}
+
+/// Settings of a fit.
+#[derive(Clone, Debug)]
+pub struct FitOptions {
+    pub effects: EffectChoice,
+    /// Fraction of the frames' span held out of the fit (the later part: selection, then
+    /// test).
+    pub holdout: f64,
+    /// Number of time blocks.
+    pub blocks: usize,
+    /// The estimator's settings (log response, frame options) for the starting thresholds.
+    pub aps: crate::estimate::aps::ApsOptions,
+    /// Thresholds used where a static scene cannot measure them.
+    pub default_threshold: f64,
+    /// Absolute thresholds measured elsewhere (e.g. `estimate screen` on this recording)
+    /// for a fit without frames; without them it runs `estimate eppps` on its fit run.
+    pub thresholds: Option<crate::estimate::CtEstimate>,
+    pub seed: u64,
+}
+
+impl Default for FitOptions {
+    fn default() -> Self {
+        Self {
+            effects: EffectChoice::Auto,
+            holdout: 0.4,
+            blocks: 10,
+            aps: crate::estimate::aps::ApsOptions::default(),
+            default_threshold: 0.3,
+            thresholds: None,
+            seed: 2020,
+        }
+    }
+}
+
+/// What a fit reads.
+pub struct FitInput<'a> {
+    pub sensor: Sensor,
+    /// Time-sorted events.
+    pub events: &'a EventChunk,
+    /// Grey frames (time-sorted, the sensor's size).
+    pub frames: &'a [Frame],
+    /// Pixels left out (region of interest, mask).
+    pub excluded: &'a [bool],
+}
+
+/// A parameter with its standard error.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Uncertain {
+    pub value: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub standard_error: Option<f64>,
+}
+
+/// An effect the loop added.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct AddedEffect {
+    pub effect: Effect,
+    pub evidence: String,
+    /// Held-out error after adding it.
+    pub error_after: f64,
+}
+
+/// The residuals a step changed, before and after (for the report's plots).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct StepResiduals {
+    pub by_intensity: Vec<Bin>,
+    pub by_rate_of_change: Vec<Bin>,
+}
+
+impl From<&Residuals> for StepResiduals {
+    fn from(r: &Residuals) -> Self {
+        Self {
+            by_intensity: r.by_intensity.clone(),
+            by_rate_of_change: r.by_rate_of_change.clone(),
+        }
+    }
+}
+
+/// One step of the loop: an effect tried (or a parameter left out), and why it was kept
+/// or not.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Step {
+    /// The effect's name (or `thresholds`).
+    pub effect: String,
+    pub evidence: String,
+    /// The evidence in standard errors.
+    pub score: f64,
+    /// The parameters fitted in this step.
+    pub parameters: BTreeMap<String, f64>,
+    /// Error of the model before and with the effect on the selection blocks.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_before: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub error_after: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub components_after: Option<Components>,
+    /// The fall of the selection error chance alone would give (twice its measured
+    /// standard error), where measurable.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub chance: Option<f64>,
+    pub kept: bool,
+    pub reason: String,
+    pub simulations: usize,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_before: Option<StepResiduals>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_after: Option<StepResiduals>,
+}
+
+impl Step {
+    /// A step with its evidence, not yet judged (nothing fitted, not kept).
+    pub fn untried(effect: String, evidence: String, score: f64) -> Self {
+        Self {
+            effect,
+            evidence,
+            score,
+            parameters: BTreeMap::new(),
+            error_before: None,
+            error_after: None,
+            components_after: None,
+            chance: None,
+            kept: false,
+            reason: String::new(),
+            simulations: 0,
+            residuals_before: None,
+            residuals_after: None,
+        }
+    }
+}
+
+/// Per parameter the model sets (log response aside): whether the data identify it (not in
+/// `not_identified`); the not-identified ones are listed too, as `false`.
+pub fn identified(
+    params: &PixelParams,
+    not_identified: &BTreeMap<String, String>,
+) -> BTreeMap<String, bool> {
+    let mut out: BTreeMap<String, bool> = serde_json::to_value(params)
+        .ok()
+        .and_then(|v| v.as_object().cloned())
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(k, v)| !v.is_null() && k != "log_response" && k != "log_eps")
+        .map(|(k, _)| {
+            let known = !not_identified.contains_key(&k);
+            (k, known)
+        })
+        .collect();
+    for key in not_identified.keys() {
+        out.insert(key.clone(), false);
+    }
+    out
+}
+
+/// The fitted model, and which of its parameters the data do not identify: in JSON those
+/// are `null` (the model simulated needs a value; a reader must not take it for a result).
+#[derive(Clone, Debug, PartialEq)]
+pub struct FittedParams {
+    pub model: PixelParams,
+    /// Parameter (PARAMS.toml key) -> why the data do not identify it.
+    pub not_identified: BTreeMap<String, String>,
+}
+
+impl std::ops::Deref for FittedParams {
+    type Target = PixelParams;
+    fn deref(&self) -> &PixelParams {
+        &self.model
+    }
+}
+
+impl std::ops::DerefMut for FittedParams {
+    fn deref_mut(&mut self) -> &mut PixelParams {
+        &mut self.model
+    }
+}
+
+impl Serialize for FittedParams {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut value = serde_json::to_value(&self.model).map_err(serde::ser::Error::custom)?;
+        if let Some(map) = value.as_object_mut() {
+            for key in self.not_identified.keys() {
+                map.insert(key.clone(), serde_json::Value::Null);
+            }
+        }
+        value.serialize(serializer)
+    }
+}
+
+/// The result of `ctcal fit` (the JSON keys of `../shared/CLI.md`, and more).
+#[derive(Clone, Debug, Serialize)]
+pub struct FitResult {
+    /// Sensor biases saved in or beside the recording (filled by the caller that knows the
+    /// files; absent when none are found). No model ties them to the parameters.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub biases: Option<crate::biases::Biases>,
+    /// The fitted model (PARAMS.toml keys; `null` where not identified).
+    pub params: FittedParams,
+    /// Per parameter of the model: whether the data identify it.
+    pub identified: BTreeMap<String, bool>,
+    /// Why a parameter is not identified (`null` in `params`).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub why: BTreeMap<String, String>,
+    pub uncertainties: BTreeMap<String, Uncertain>,
+    pub effects_added: Vec<AddedEffect>,
+    pub error_metric: &'static str,
+    /// Error of the ideal model (fitted thresholds) and of the final model on the test
+    /// blocks (which neither fitted nor chose anything).
+    pub error_before: f64,
+    pub error_after: f64,
+    pub components_before: Components,
+    pub components_after: Components,
+    pub steps: Vec<Step>,
+    /// Pairs of effects the recording does not separate: the kept one and a look-alike
+    /// that explains it as well within chance, with what data would separate them.
+    pub ambiguities: Vec<Ambiguity>,
+    /// Hot pixels named (simulated where they are as their own event trains).
+    pub hot_pixels_masked: Vec<HotPixel>,
+    /// Residuals of the ideal model and of the final one (fit blocks; a fit without
+    /// frames simulates no scene and has none).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_before: Option<Residuals>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub residuals_after: Option<Residuals>,
+    pub assumptions: Vec<String>,
+    pub holdout: Holdout,
+    pub simulations: usize,
+    /// Exposure of the grey frames (the file's, else `--exposure-s`), for the simulator
+    /// configurations.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub frame_exposure_us: Option<crate::TimeUs>,
+    /// What a fit without frames measured beyond the parameters (where the thresholds
+    /// come from, the noise rates, the interval edge, the threshold ratio).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub events_only: Option<events_only::EventsOnly>,
+}
+
+/// How the data were split.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Holdout {
+    pub fraction: f64,
+    pub blocks: usize,
+    /// Selection and test blocks together.
+    pub held_out_blocks: Vec<usize>,
+    pub selection_blocks: Vec<usize>,
+    pub test_blocks: Vec<usize>,
+    pub fit_seconds: f64,
+    pub held_out_seconds: f64,
+    pub selection_seconds: f64,
+    pub test_seconds: f64,
+    /// Frame intervals left out between runs of different roles.
+    pub guard_seconds: f64,
+}
+
+pub use selection::{Ambiguity, fit};

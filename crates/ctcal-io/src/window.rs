@@ -1,0 +1,357 @@
+//! A time window of a recording in memory, as the estimators, the fit and the report take
+//! it: the events of the window, its grey frames (at most a given number, evenly spread),
+//! the sensor and the pixels a region or mask keeps. Warnings and reading progress go to
+//! the caller's callbacks; errors are typed ([`LoadError`]) and name no command-line flag,
+//! so that the `ctcal` binary and the Python package each word the fix in their own terms.
+
+use crate::estimate::aps::{self, ApsInput, ApsOptions};
+use crate::estimate::{CtEstimate, EstimateError, eppps, screen};
+use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
+use crate::hint::Text;
+use crate::selection::{PixelSelection, Roi};
+use crate::sim::DisplayParams;
+use crate::{InputError, OpenOptions, Recording};
+use std::path::{Path, PathBuf};
+
+/// The most events a window holds in memory (about 1.3 GB).
+pub const MAX_EVENTS: usize = 100_000_000;
+
+/// A time window of a recording, in memory.
+pub struct Loaded {
+    pub recording: Recording,
+    pub sensor: Sensor,
+    pub sensor_source: String,
+    pub events: EventChunk,
+    pub frames: Vec<Frame>,
+    /// Frames in the window before thinning to the frame limit.
+    pub frames_available: usize,
+    /// The pixels the region / mask keep.
+    pub selection: PixelSelection,
+    /// One flag per pixel: left out by the region / mask (what the estimators take).
+    pub excluded: Vec<bool>,
+    pub notes: Vec<String>,
+}
+
+/// What to read.
+#[derive(Clone, Debug, Default)]
+pub struct Window {
+    /// Seconds after the first event.
+    pub start_s: Option<f64>,
+    pub end_s: Option<f64>,
+    /// Read frames at all, and at most how many.
+    pub frames: Option<usize>,
+    /// Keep only the events between the first and last frame kept.
+    pub events_between_frames: bool,
+}
+
+/// Which pixels to keep: a region and a mask file (hot pixels are left out by the caller,
+/// who finds them).
+#[derive(Clone, Debug, Default)]
+pub struct SelectionSpec {
+    pub roi: Option<Roi>,
+    /// A PNG or `.npy` array of the sensor's size (H x W), non-zero = keep.
+    pub mask: Option<PathBuf>,
+}
+
+/// Why a window could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error(transparent)]
+    Input(#[from] InputError),
+    /// A start or end that is not a time of the recording.
+    #[error("{0}")]
+    Window(String),
+    #[error("{}: more than {max} events in the selected time window\n  fix: select a shorter part of the recording (start/end, seconds from the first event)", path.display())]
+    TooManyEvents { path: PathBuf, max: usize },
+    #[error("{}: the frames are {}x{} but the sensor is {sensor}\n  fix: give the sensor size {}x{} if the frames show the whole sensor", path.display(), frames.0, frames.1, frames.0, frames.1)]
+    FrameSize {
+        path: PathBuf,
+        frames: (usize, usize),
+        sensor: Sensor,
+    },
+    #[error("{}: the {sensor} sensor has {} pixels; the estimators keep several maps of one value per pixel, more than the budget of {} pixels\n  fix: give the camera's real sensor size (the events reach x = {}, y = {}), or force to use the memory anyway", path.display(), sensor.pixels(), crate::stats::PIXEL_BUDGET, reach.0, reach.1)]
+    OverBudget {
+        path: PathBuf,
+        sensor: Sensor,
+        /// The largest x and y of the events.
+        reach: (u16, u16),
+    },
+    #[error("{}: a pixel selection of the {sensor} sensor keeps one flag per pixel ({} pixels), more than the budget of {} pixels\n  fix: give the camera's real sensor size, or force to use the memory anyway", path.display(), sensor.pixels(), crate::stats::PIXEL_BUDGET)]
+    SelectionOverBudget { path: PathBuf, sensor: Sensor },
+    #[error("{}: {problem}\n  fix: {fix}", path.display())]
+    Selection {
+        path: PathBuf,
+        problem: Text,
+        fix: Text,
+    },
+}
+
+/// Checks a window's start and end (seconds from the first event).
+pub fn check_window(start: Option<f64>, end: Option<f64>) -> Result<(), LoadError> {
+    for (name, value) in [("start", start), ("end", end)] {
+        if let Some(v) = value
+            && !(v.is_finite() && (0.0..=1e12).contains(&v))
+        {
+            return Err(LoadError::Window(format!(
+                "{name} {v} must be a number of seconds from the first event, between 0 and 1e12"
+            )));
+        }
+    }
+    if let (Some(s), Some(e)) = (start, end)
+        && e <= s
+    {
+        return Err(LoadError::Window(format!("end {e} is not after start {s}")));
+    }
+    Ok(())
+}
+
+impl SelectionSpec {
+    /// The region and mask for `sensor`; `input` names the recording in errors. A
+    /// selection holds a flag per pixel: a sensor over the pixel budget is refused unless
+    /// `force`. A selection that keeps no pixel is an error naming what emptied it.
+    pub fn build(
+        &self,
+        sensor: Sensor,
+        input: &Path,
+        force: bool,
+    ) -> Result<PixelSelection, LoadError> {
+        if sensor.pixels() > crate::stats::PIXEL_BUDGET && !force {
+            return Err(LoadError::SelectionOverBudget {
+                path: input.to_path_buf(),
+                sensor,
+            });
+        }
+        let fail = |e: crate::selection::SelectionError| LoadError::Selection {
+            path: input.to_path_buf(),
+            problem: e.problem,
+            fix: e.fix,
+        };
+        let mut selection = PixelSelection::all(sensor);
+        if let Some(roi) = self.roi {
+            selection = selection.roi(roi).map_err(fail)?;
+        }
+        if let Some(path) = &self.mask {
+            let mask = crate::mask::read_mask(path, sensor)?;
+            selection = selection
+                .mask(&mask, &path.display().to_string())
+                .map_err(fail)?;
+        }
+        Ok(selection)
+    }
+}
+
+/// Where a load reports what it warns of and how far it has read.
+pub trait LoadObserver {
+    /// A warning about the recording (sensor size guessed, an index rebuilt, ...), which
+    /// may name options.
+    fn warn(&self, _message: &Text) {}
+    /// `done` of `total` units of the event stream read.
+    fn reading(&self, _done: u64, _total: u64) {}
+}
+
+/// An observer that ignores everything.
+pub struct Silent;
+impl LoadObserver for Silent {}
+
+/// Reads the window of the recording at `path`, and the pixels `selection` keeps. More
+/// than [`MAX_EVENTS`] events, or a sensor over the pixel budget, is refused unless `force`
+/// (the pixel budget only).
+pub fn load(
+    path: &Path,
+    open: &OpenOptions,
+    window: &Window,
+    selection: &SelectionSpec,
+    force: bool,
+    observer: &dyn LoadObserver,
+) -> Result<Loaded, LoadError> {
+    check_window(window.start_s, window.end_s)?;
+    let recording = Recording::open(path, open)?;
+    for note in &recording.notes {
+        observer.warn(&note.as_str().into());
+    }
+    // the first event fixes the clock of start/end
+    let first = recording.first_event_time()?;
+    let to_us = |s: f64| first + (s * 1e6).round() as TimeUs;
+    let (mut from, mut to) = (
+        window.start_s.map_or(TimeUs::MIN, to_us),
+        window.end_s.map_or(TimeUs::MAX, to_us),
+    );
+    let mut notes = Vec::new();
+    let mut frames = Vec::new();
+    let mut frames_available = 0;
+    if let Some(max_frames) = window.frames {
+        let times = recording.frame_times()?;
+        let inside: Vec<usize> = (0..times.len())
+            .filter(|&i| times[i] >= from && times[i] <= to)
+            .collect();
+        frames_available = inside.len();
+        let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
+        let keep: std::collections::BTreeSet<usize> =
+            inside.iter().step_by(stride).copied().collect();
+        if stride > 1 {
+            notes.push(format!(
+                "every {stride}th of the {} frames used ({} frames; the frame limit is {max_frames})",
+                inside.len(),
+                keep.len()
+            ));
+        }
+        frames = recording.frames_where(|i, _| keep.contains(&i))?;
+        if window.events_between_frames && frames.len() >= 2 {
+            from = from.max(frames[0].t);
+            to = to.min(frames[frames.len() - 1].t);
+        }
+    }
+    let mut stream = recording.events_between(from, to)?;
+    for note in &stream.notes {
+        observer.warn(&note.as_str().into());
+    }
+    let mut events = EventChunk::default();
+    while stream.next_chunk()?.is_some() {
+        let chunk = stream.current_chunk();
+        let lo = chunk.t.partition_point(|&t| t < from);
+        let hi = chunk.t.partition_point(|&t| t <= to);
+        for i in lo..hi.max(lo) {
+            events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
+        }
+        let past_window = chunk.t.last().is_some_and(|&t| t > to);
+        if events.len() > MAX_EVENTS {
+            return Err(LoadError::TooManyEvents {
+                path: recording.path.clone(),
+                max: MAX_EVENTS,
+            });
+        }
+        let progress = stream.progress();
+        observer.reading(progress.done, progress.total);
+        if past_window {
+            break;
+        }
+    }
+    if events.is_empty() {
+        return Err(InputError::EmptyWindow {
+            path: recording.path.clone(),
+            detail: format!(
+                "{:.6} s .. {:.6} s",
+                us_to_s(from.max(first) - first),
+                if to == TimeUs::MAX {
+                    f64::INFINITY
+                } else {
+                    us_to_s(to - first)
+                }
+            ),
+        }
+        .into());
+    }
+    let resolved = recording.resolve_sensor(events.max_coordinates());
+    if let Some(w) = &resolved.warning {
+        observer.warn(w);
+    }
+    if let Some(f) = frames.first()
+        && (f.width as u16, f.height as u16) != (resolved.sensor.width, resolved.sensor.height)
+    {
+        return Err(LoadError::FrameSize {
+            path: recording.path.clone(),
+            frames: (f.width as usize, f.height as usize),
+            sensor: resolved.sensor,
+        });
+    }
+    // the estimators keep several maps of one value per pixel
+    let sensor = resolved.sensor;
+    if sensor.pixels() > crate::stats::PIXEL_BUDGET && !force {
+        return Err(LoadError::OverBudget {
+            path: recording.path.clone(),
+            sensor,
+            reach: events.max_coordinates().unwrap_or((0, 0)),
+        });
+    }
+    let kept = selection.build(sensor, &recording.path, force)?;
+    if !kept.is_all() {
+        notes.push(format!("pixels: {}", kept.description()));
+    }
+    Ok(Loaded {
+        excluded: kept.excluded(),
+        selection: kept,
+        sensor: resolved.sensor,
+        sensor_source: resolved.source,
+        recording,
+        events,
+        frames,
+        frames_available,
+        notes,
+    })
+}
+
+/// The `eppps` estimate of a window: its frames, where there are and they prepare as for
+/// `aps`, give the scene's dynamics.
+pub fn eppps_of(
+    loaded: &Loaded,
+    options: &ApsOptions,
+    eppps_options: eppps::EpppsOptions,
+    progress: crate::estimate::Progress,
+) -> Result<CtEstimate, EstimateError> {
+    let excluded = &loaded.excluded;
+    let mut notes = loaded.notes.clone();
+    // frames, when there are and they are wanted, prepared as for `aps`
+    let prepared = if loaded.frames.len() >= 2 {
+        let input = ApsInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            frames: &loaded.frames,
+            excluded,
+        };
+        match aps::prepare(&input, excluded, options) {
+            Ok(p) => {
+                notes.extend(p.assumptions.iter().cloned());
+                Some(p.frames)
+            }
+            Err(e) => {
+                notes.push(format!("frames not used for the dynamics: {}", e.problem));
+                None
+            }
+        }
+    } else {
+        None
+    };
+    let mut estimate = eppps::estimate(
+        &eppps::EpppsInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            frames: prepared.as_ref(),
+            excluded,
+        },
+        &eppps_options,
+        progress,
+    )?;
+    estimate.assumptions.extend(notes);
+    Ok(estimate)
+}
+
+/// The `screen` estimate of a window recorded while `stimulus` played on `screen`.
+pub fn screen_of(
+    loaded: &Loaded,
+    stimulus: &[Frame],
+    screen: DisplayParams,
+    refresh_hz: Option<f64>,
+    progress: crate::estimate::Progress,
+) -> Result<CtEstimate, EstimateError> {
+    let mut estimate = screen::estimate(
+        &screen::ScreenInput {
+            sensor: loaded.sensor,
+            events: &loaded.events,
+            stimulus,
+            screen,
+            refresh_hz,
+            excluded: &loaded.excluded,
+        },
+        progress,
+    )?;
+    estimate.assumptions.extend(loaded.notes.iter().cloned());
+    Ok(estimate)
+}
+
+/// The built-in screen model (a typical 60 Hz LCD), for recordings of an on-screen
+/// stimulus when no model is given.
+pub fn default_screen() -> DisplayParams {
+    const DEFAULT_SCREEN: &str = include_str!("../../../calib/screens/lcd_60hz_srgb.toml");
+    DisplayParams::from_toml(DEFAULT_SCREEN, "the built-in 60 Hz LCD model")
+        .expect("the built-in screen model is valid")
+}

@@ -1,0 +1,337 @@
+//! One recording of a report: read it, compute its statistics, every applicable threshold
+//! estimate and the fit; what it is made of (its files' hashes, the truth it says it was
+//! made with).
+
+use super::inputs::Input;
+use super::{Event, Observer, Options, SequenceError, Stage};
+use crate::estimate::aps::{self, ApsInput, ApsOptions};
+use crate::fit::{FitInput, FitOptions, FitResult};
+use crate::model::{InputFile, MethodResult, PixelData, PixelMaps, SequenceReport, Truth};
+use crate::sim::PixelParams;
+use crate::stats::{StatsAccumulator, StatsOptions};
+use crate::window::{Loaded, Window, load};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+/// SHA-256 and size of a file.
+fn hash(path: &Path) -> Option<InputFile> {
+    use std::io::Read;
+    let mut file = std::fs::File::open(path).ok()?;
+    let mut hasher = Sha256::new();
+    let mut buffer = vec![0u8; 1 << 20];
+    let mut bytes = 0u64;
+    loop {
+        let n = file.read(&mut buffer).ok()?;
+        if n == 0 {
+            break;
+        }
+        hasher.update(&buffer[..n]);
+        bytes += n as u64;
+    }
+    Some(InputFile {
+        path: path.display().to_string(),
+        bytes,
+        sha256: hasher
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect(),
+    })
+}
+
+/// The files a recording is read from.
+fn input_files(loaded: &Loaded) -> Vec<InputFile> {
+    let recording = &loaded.recording;
+    let mut paths = vec![recording.event_file().to_path_buf()];
+    if recording.path.is_dir() {
+        for index in ["images.txt", "stimulus.txt"] {
+            let p = recording.path.join(index);
+            if p.is_file() {
+                paths.push(p);
+            }
+        }
+    }
+    paths.iter().filter_map(|p| hash(p)).collect()
+}
+
+/// The parameters a recording says it was made with.
+fn truth(path: &Path) -> Option<Truth> {
+    let folder = if path.is_dir() { path } else { path.parent()? };
+    let read = |name: &str| -> Option<serde_json::Value> {
+        let text = crate::files::read_small_text(&folder.join(name), 16 << 20).ok()?;
+        serde_json::from_str(&text).ok()
+    };
+    if let Some(sim) = read("simulation.json")
+        && let Ok(params) = serde_json::from_value::<PixelParams>(sim["params"].clone())
+    {
+        return Some(Truth {
+            source: "simulation.json (ctcal simulate)".into(),
+            params: crate::configs::numeric_params(&params)
+                .into_iter()
+                .collect(),
+        });
+    }
+    let oracle = read("params.json")?;
+    let args = oracle.get("emulator_args")?;
+    let mut params = BTreeMap::new();
+    for (from, to) in [
+        ("pos_thres", "ct_on"),
+        ("neg_thres", "ct_off"),
+        ("sigma_thres", "ct_sigma"),
+        ("cutoff_hz", "cutoff_hz"),
+        ("leak_rate_hz", "leak_rate_hz"),
+        ("shot_noise_rate_hz", "shot_noise_rate_hz"),
+        ("refractory_period_s", "refractory_s"),
+    ] {
+        if let Some(v) = args.get(from).and_then(|v| v.as_f64())
+            && (v > 0.0 || from.ends_with("thres"))
+        {
+            params.insert(to.to_string(), v);
+        }
+    }
+    Some(Truth {
+        source: "params.json (v2e emulator arguments)".into(),
+        params,
+    })
+}
+
+/// The warnings of reading a recording, passed on as the sequence's events.
+struct Warnings<'a> {
+    name: &'a str,
+    progress: &'a Observer<'a>,
+}
+
+impl crate::window::LoadObserver for Warnings<'_> {
+    fn warn(&self, message: &crate::hint::Text) {
+        (self.progress)(self.name, Event::Warning(&message.to_string()));
+    }
+}
+
+/// Everything reported of one recording, and its per-pixel data; `progress` hears of each
+/// stage done and of what reading the recording warned of.
+pub fn sequence(
+    input: &Input,
+    options: &Options,
+    progress: &Observer,
+) -> Result<(SequenceReport, PixelData), SequenceError> {
+    let mut seconds = BTreeMap::new();
+    let mut clock = Instant::now();
+    let mut lap = |name: &str, seconds: &mut BTreeMap<String, f64>| {
+        seconds.insert(name.to_string(), clock.elapsed().as_secs_f64());
+        clock = Instant::now();
+    };
+    let loaded = load(
+        &input.path,
+        &Default::default(),
+        &Window {
+            start_s: options.start_s,
+            end_s: options.end_s,
+            frames: Some(options.max_frames),
+            events_between_frames: false,
+        },
+        &options.selection,
+        options.force,
+        &Warnings {
+            name: &input.name,
+            progress,
+        },
+    )?;
+    let inputs = input_files(&loaded);
+    lap("reading", &mut seconds);
+    progress(&input.name, Event::Done(Stage::Reading));
+
+    let (stats, pixel_counts) = statistics(&loaded, &input.path)?;
+    lap("statistics", &mut seconds);
+    progress(&input.name, Event::Done(Stage::Statistics));
+
+    let (methods, maps) = estimates(&loaded, options)?;
+    lap("estimates", &mut seconds);
+    progress(&input.name, Event::Done(Stage::Estimates));
+
+    // an on-screen recording's thresholds come from the screen method (measured through
+    // the display model), not from eppps's prior, where a fit has no frames to measure them
+    let screen = methods
+        .iter()
+        .find(|m| m.method == "screen")
+        .and_then(|m| m.estimate.as_ref())
+        .filter(|e| e.ct_on.is_some() || e.ct_off.is_some());
+    let (fit, fit_not_applied) = fit_of(&loaded, options, screen);
+    lap("fit", &mut seconds);
+    progress(&input.name, Event::Done(Stage::Fit));
+    let report = SequenceReport {
+        name: input.name.clone(),
+        // named once every sequence's sensor is known (see `grouping`)
+        dataset: String::new(),
+        format: match loaded.recording.layout() {
+            Some(layout) => format!("{} ({layout})", loaded.recording.format),
+            None => loaded.recording.format.to_string(),
+        },
+        inputs,
+        stats,
+        methods,
+        fit,
+        fit_not_applied,
+        truth: truth(&loaded.recording.path),
+        warnings: loaded.notes.clone(),
+        outputs: Default::default(),
+        seconds,
+    };
+    let pixels = PixelData {
+        counts: pixel_counts,
+        maps,
+    };
+    Ok((report, pixels))
+}
+
+/// Every applicable threshold estimate of a recording, and the per-pixel maps of `aps`.
+fn estimates(
+    loaded: &Loaded,
+    options: &Options,
+) -> Result<(Vec<MethodResult>, Option<PixelMaps>), SequenceError> {
+    let quiet = |_: &str, _: f64| {};
+    let aps_options = ApsOptions::default();
+    let mut methods = Vec::new();
+    let mut maps = None;
+    if loaded.frames.len() >= 2 {
+        match aps::estimate(
+            &ApsInput {
+                sensor: loaded.sensor,
+                events: &loaded.events,
+                frames: &loaded.frames,
+                excluded: &loaded.excluded,
+            },
+            &aps_options,
+            &quiet,
+        ) {
+            Ok(mut result) => {
+                result
+                    .estimate
+                    .assumptions
+                    .extend(loaded.notes.iter().cloned());
+                maps = Some(PixelMaps {
+                    width: result.maps.width,
+                    height: result.maps.height,
+                    ct_on: result.maps.ct_on,
+                    ct_off: result.maps.ct_off,
+                });
+                methods.push(MethodResult {
+                    method: "aps",
+                    estimate: Some(result.estimate),
+                    not_applied: None,
+                });
+            }
+            Err(e) => methods.push(MethodResult {
+                method: "aps",
+                estimate: None,
+                not_applied: Some(e.to_string()),
+            }),
+        }
+    } else {
+        methods.push(MethodResult {
+            method: "aps",
+            estimate: None,
+            not_applied: Some("the recording has no grey frames".into()),
+        });
+    }
+    let eppps = crate::window::eppps_of(
+        loaded,
+        &aps_options,
+        crate::estimate::eppps::EpppsOptions {
+            seed: options.seed,
+            ..Default::default()
+        },
+        &quiet,
+    );
+    methods.push(MethodResult {
+        method: "eppps",
+        not_applied: eppps.as_ref().err().map(|e| e.to_string()),
+        estimate: eppps.ok(),
+    });
+    match loaded.recording.stimulus()? {
+        Some(list) if list.len() >= 2 => {
+            let frames = list.load_all()?;
+            let found =
+                crate::window::screen_of(loaded, &frames, options.screen.clone(), None, &quiet);
+            methods.push(MethodResult {
+                method: "screen",
+                not_applied: found.as_ref().err().map(|e| e.to_string()),
+                estimate: found.ok(),
+            });
+        }
+        _ => methods.push(MethodResult {
+            method: "screen",
+            estimate: None,
+            not_applied: Some(
+                "the recording has no stimulus.txt (not an on-screen recording)".into(),
+            ),
+        }),
+    }
+    Ok((methods, maps))
+}
+
+/// The fit of a recording, or why there is none.
+fn fit_of(
+    loaded: &Loaded,
+    options: &Options,
+    screen: Option<&crate::estimate::CtEstimate>,
+) -> (Option<FitResult>, Option<String>) {
+    let quiet = |_: &str, _: f64| {};
+    if let Some(why) = &options.fit_left_out {
+        (None, Some(why.clone()))
+    } else {
+        match crate::fit::fit(
+            &FitInput {
+                sensor: loaded.sensor,
+                events: &loaded.events,
+                frames: &loaded.frames,
+                excluded: &loaded.excluded,
+            },
+            &FitOptions {
+                seed: options.seed,
+                thresholds: screen.cloned(),
+                ..FitOptions::default()
+            },
+            &quiet,
+        ) {
+            Ok(mut f) => {
+                f.assumptions.extend(loaded.notes.iter().cloned());
+                (Some(f), None)
+            }
+            Err(e) => (None, Some(e.to_string())),
+        }
+    }
+}
+
+/// The statistics of the events in memory, and the events of each kept pixel.
+fn statistics(
+    loaded: &Loaded,
+    path: &Path,
+) -> Result<(crate::stats::SequenceStats, Vec<u32>), SequenceError> {
+    let selection = loaded.selection.clone();
+    let mut accumulator = StatsAccumulator::new(
+        StatsOptions {
+            selection: (!selection.is_all()).then_some(selection),
+            ..StatsOptions::default()
+        },
+        Some(loaded.sensor),
+    );
+    accumulator.add(&loaded.events);
+    let stats = accumulator
+        .finish(
+            loaded.sensor,
+            &loaded.sensor_source,
+            &loaded.recording.frame_times()?,
+        )
+        .ok_or_else(|| SequenceError::NoEvents(path.to_path_buf()))?;
+    let width = loaded.sensor.width as usize;
+    let mut pixel_counts = vec![0u32; loaded.sensor.pixels()];
+    for i in 0..loaded.events.len() {
+        let p = loaded.events.y[i] as usize * width + loaded.events.x[i] as usize;
+        if !loaded.excluded[p] {
+            pixel_counts[p] += 1;
+        }
+    }
+    Ok((stats, pixel_counts))
+}
