@@ -4,13 +4,14 @@
 //! (`ctcal/__init__.py`) turns into dicts. Every error is a `CtcalError` (a `ValueError`)
 //! carrying the library's message.
 
-use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
-use ctcal::report::grouping::Origin;
-use ctcal::report::pipeline::{self, Input, Options};
-use ctcal::sim::PixelParams;
-use ctcal::stats::{StatsAccumulator, StatsOptions};
-use ctcal::window::{Loaded, SelectionSpec, Window};
-use ctcal::{OpenOptions, Recording, Sensor};
+use ctcal_core::Sensor;
+use ctcal_core::estimate::aps::{self, ApsInput, ApsOptions};
+use ctcal_core::sim::PixelParams;
+use ctcal_core::stats::{StatsAccumulator, StatsOptions};
+use ctcal_io::window::{Loaded, SelectionSpec, Window};
+use ctcal_io::{OpenOptions, Recording};
+use ctcal_report::grouping::Origin;
+use ctcal_report::pipeline::{self, Input, Options};
 use numpy::{PyArray1, PyReadonlyArray1};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
@@ -79,7 +80,7 @@ struct EventColumns {
 }
 
 impl EventColumns {
-    fn extend(&mut self, chunk: &ctcal::EventChunk, range: std::ops::Range<usize>) {
+    fn extend(&mut self, chunk: &ctcal_core::EventChunk, range: std::ops::Range<usize>) {
         self.t.extend_from_slice(&chunk.t[range.clone()]);
         self.x.extend_from_slice(&chunk.x[range.clone()]);
         self.y.extend_from_slice(&chunk.y[range.clone()]);
@@ -111,7 +112,7 @@ fn read<'py>(
     let open = open_options(format, sensor)?;
     let columns = py
         .detach(|| -> Result<_, String> {
-            ctcal::window::check_window(start, end).map_err(|e| e.to_string())?;
+            ctcal_io::window::check_window(start, end).map_err(|e| e.to_string())?;
             let recording = Recording::open(&path, &open).map_err(|e| e.to_string())?;
             let first = recording.first_event_time().map_err(|e| e.to_string())?;
             let to_us = |s: f64| first + (s * 1e6).round() as i64;
@@ -152,7 +153,7 @@ fn read_frames<'py>(
 )> {
     let open = open_options(format, sensor)?;
     let (times, pixels, h, w) = py
-        .detach(|| -> Result<_, ctcal::InputError> {
+        .detach(|| -> Result<_, ctcal_io::InputError> {
             let recording = Recording::open(&path, &open)?;
             let frames = recording.frames_where(|_, _| true)?;
             let (w, h) = frames
@@ -186,10 +187,10 @@ fn info(
 ) -> PyResult<String> {
     let open = open_options(format, sensor)?;
     let info = py
-        .detach(|| -> Result<_, ctcal::InputError> {
+        .detach(|| -> Result<_, ctcal_io::InputError> {
             let recording = Recording::open(&path, &open)?;
             let stream = recording.events()?;
-            Ok(ctcal::io::info::info(&recording, stream, &|_, _| {})?.0)
+            Ok(ctcal_io::info::info(&recording, stream, &|_, _| {})?.0)
         })
         .map_err(err)?;
     json(&info)
@@ -208,10 +209,10 @@ fn load(
     mask: Option<PathBuf>,
 ) -> Result<Loaded, String> {
     let roi = roi
-        .map(ctcal::selection::Roi::parse)
+        .map(ctcal_core::selection::Roi::parse)
         .transpose()
         .map_err(|e| e.to_string())?;
-    ctcal::window::load(
+    ctcal_io::window::load(
         path,
         open,
         &Window {
@@ -222,7 +223,7 @@ fn load(
         },
         &SelectionSpec { roi, mask },
         false,
-        &ctcal::window::Silent,
+        &ctcal_io::window::Silent,
     )
     .map_err(|e| e.to_string())
 }
@@ -253,7 +254,7 @@ fn estimate(
         .detach(|| -> Result<_, String> {
             let aps_method = method == "aps";
             let loaded = load(&path, &open, start, end, max_frames, aps_method, roi, mask)?;
-            let named = |e: ctcal::estimate::EstimateError| format!("{}: {e}", path.display());
+            let named = |e: ctcal_core::estimate::EstimateError| format!("{}: {e}", path.display());
             let mut estimate = match method.as_str() {
                 "aps" => {
                     if loaded.frames.len() < 2 {
@@ -280,10 +281,10 @@ fn estimate(
                         .extend(loaded.notes.iter().cloned());
                     result.estimate
                 }
-                "eppps" => ctcal::window::eppps_of(
+                "eppps" => ctcal_io::window::eppps_of(
                     &loaded,
                     &ApsOptions::default(),
-                    ctcal::estimate::eppps::EpppsOptions {
+                    ctcal_core::estimate::eppps::EpppsOptions {
                         seed,
                         ..Default::default()
                     },
@@ -292,7 +293,7 @@ fn estimate(
                 .map_err(named)?,
                 "screen" => {
                     let list = match &stimulus {
-                        Some(dir) => Some(ctcal::io::FrameList::read(dir).map_err(|e| e.to_string())?),
+                        Some(dir) => Some(ctcal_io::FrameList::read(dir).map_err(|e| e.to_string())?),
                         None => loaded.recording.stimulus().map_err(|e| e.to_string())?,
                     };
                     let Some(list) = list else {
@@ -302,10 +303,10 @@ fn estimate(
                         ));
                     };
                     let frames = list.load_all().map_err(|e| e.to_string())?;
-                    ctcal::window::screen_of(
+                    ctcal_io::window::screen_of(
                         &loaded,
                         &frames,
-                        ctcal::window::default_screen(),
+                        ctcal_io::window::default_screen(),
                         None,
                         &quiet,
                     )
@@ -348,14 +349,14 @@ fn fit(
     let result = py
         .detach(|| -> Result<_, String> {
             let loaded = load(&path, &open, start, end, max_frames, true, roi, mask)?;
-            let mut f = ctcal::fit::fit(
-                &ctcal::fit::FitInput {
+            let mut f = ctcal_core::fit::fit(
+                &ctcal_core::fit::FitInput {
                     sensor: loaded.sensor,
                     events: &loaded.events,
                     frames: &loaded.frames,
                     excluded: &loaded.excluded,
                 },
-                &ctcal::fit::FitOptions {
+                &ctcal_core::fit::FitOptions {
                     seed,
                     ..Default::default()
                 },
@@ -390,15 +391,15 @@ fn report_options(text: &str) -> PyResult<Options> {
     }
     if let Some(path) = v["screen"].as_str() {
         let path = Path::new(path);
-        let text = ctcal::files::read_small_text(path, 1 << 20)
-            .map_err(|e| err(ctcal::InputError::not_a_file(path, e)))?;
-        o.screen = ctcal::sim::DisplayParams::from_toml(&text, &path.display().to_string())
+        let text = ctcal_core::files::read_small_text(path, 1 << 20)
+            .map_err(|e| err(ctcal_io::InputError::not_a_file(path, e)))?;
+        o.screen = ctcal_core::sim::DisplayParams::from_toml(&text, &path.display().to_string())
             .map_err(err)?;
     }
     o.selection = SelectionSpec {
         roi: v["roi"]
             .as_str()
-            .map(ctcal::selection::Roi::parse)
+            .map(ctcal_core::selection::Roi::parse)
             .transpose()
             .map_err(err)?,
         mask: v["mask"].as_str().map(PathBuf::from),
@@ -517,13 +518,13 @@ fn report_merge(
         {
             return Err(e);
         }
-        let presets = ctcal::report::presets::simulate(options.seed).map_err(|e| e.to_string())?;
+        let presets = ctcal_report::presets::simulate(options.seed).map_err(|e| e.to_string())?;
         let report = pipeline::merge(merged, presets, options.seed, command_line);
         let staged = policy.folder(&out).map_err(|e| e.to_string())?;
         for (path, bytes) in &files {
             staged.write(path, bytes).map_err(|e| e.to_string())?;
         }
-        for f in ctcal::report::render_summary(&report) {
+        for f in ctcal_report::render_summary(&report) {
             staged.write(&f.path, &f.bytes).map_err(|e| e.to_string())?;
         }
         staged.commit().map_err(|e| e.to_string())?;
@@ -537,8 +538,8 @@ fn output_policy(
     force: bool,
     protected: &[PathBuf],
     inputs: &[Input],
-) -> ctcal::io::write::OutputPolicy {
-    ctcal::io::write::OutputPolicy::new(force).protect_all(
+) -> ctcal_io::write::OutputPolicy {
+    ctcal_io::write::OutputPolicy::new(force).protect_all(
         protected
             .iter()
             .map(PathBuf::as_path)
@@ -583,7 +584,7 @@ fn report_local(
         }
         let presets = outcomes.presets.map_err(|e| e.to_string())?;
         let report = pipeline::merge(merged, presets, options.seed, command_line);
-        for f in ctcal::report::render_summary(&report) {
+        for f in ctcal_report::render_summary(&report) {
             staged.write(&f.path, &f.bytes).map_err(|e| e.to_string())?;
         }
         staged.commit().map_err(|e| e.to_string())?;
@@ -611,7 +612,7 @@ fn stats(
     let stats = py
         .detach(|| -> Result<_, String> {
             check_seconds(window_s, support_window_s)?;
-            ctcal::window::check_window(start, end).map_err(|e| e.to_string())?;
+            ctcal_io::window::check_window(start, end).map_err(|e| e.to_string())?;
             let recording = Recording::open(&path, &open).map_err(|e| e.to_string())?;
             let windowed = start.is_some() || end.is_some();
             let origin = if windowed {
@@ -626,7 +627,7 @@ fn stats(
                     window_s,
                     support_window_s,
                     origin_us: origin,
-                    max_pixels: Some(ctcal::stats::PIXEL_BUDGET),
+                    max_pixels: Some(ctcal_core::stats::PIXEL_BUDGET),
                     ..StatsOptions::default()
                 },
                 recording.sensor,
@@ -642,7 +643,7 @@ fn stats(
             }
             .map_err(|e| e.to_string())?;
             let read_ahead = rayon_threads() > 1;
-            ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, _| {
+            ctcal_io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, _| {
                 accumulator.add(chunk)
             })
             .map_err(|e| e.to_string())?;
@@ -653,7 +654,7 @@ fn stats(
                     over.max_x,
                     over.max_y,
                     over.pixels,
-                    ctcal::stats::PIXEL_BUDGET
+                    ctcal_core::stats::PIXEL_BUDGET
                 ));
             }
             let resolved = recording.resolve_sensor(stream.max_coordinates());
@@ -707,7 +708,7 @@ fn stats_events(
     if x.len() != t.len() || y.len() != t.len() || p.len() != t.len() {
         return Err(err("t, x, y and p must have one value per event"));
     }
-    let mut events = ctcal::EventChunk::default();
+    let mut events = ctcal_core::EventChunk::default();
     for i in 0..t.len() {
         events.push(t[i], x[i], y[i], p[i] != 0);
     }
@@ -734,7 +735,7 @@ fn stats_events(
                 StatsOptions {
                     window_s,
                     support_window_s,
-                    max_pixels: Some(ctcal::stats::PIXEL_BUDGET),
+                    max_pixels: Some(ctcal_core::stats::PIXEL_BUDGET),
                     ..StatsOptions::default()
                 },
                 Some(sensor),
@@ -819,8 +820,8 @@ fn simulate<'py>(
     if times.windows(2).any(|p| p[1] <= p[0]) {
         return Err(err("the frame times must increase"));
     }
-    let frames: Vec<ctcal::Frame> = (0..n)
-        .map(|i| ctcal::Frame {
+    let frames: Vec<ctcal_core::Frame> = (0..n)
+        .map(|i| ctcal_core::Frame {
             t: times[i],
             width: w as u32,
             height: h as u32,
@@ -830,16 +831,17 @@ fn simulate<'py>(
         .collect();
     let params = params_of(params).map_err(err)?;
     let columns = py
-        .detach(|| -> Result<_, ctcal::sim::SimError> {
+        .detach(|| -> Result<_, ctcal_core::sim::SimError> {
             // as `ctcal simulate --frames` replays its frames
-            let mut source = ctcal::sim::source::LoadedFrames::new(frames.len(), (w, h), |i| {
-                Ok(frames[i].clone())
-            });
+            let mut source =
+                ctcal_core::sim::source::LoadedFrames::new(frames.len(), (w, h), |i| {
+                    Ok(frames[i].clone())
+                });
             let mut columns = EventColumns::default();
-            ctcal::sim::run::<ctcal::sim::SimError>(
+            ctcal_core::sim::run::<ctcal_core::sim::SimError>(
                 &mut source,
                 &params,
-                ctcal::sim::PixelMaps::default(),
+                ctcal_core::sim::PixelMaps::default(),
                 |chunk| {
                     columns.extend(chunk, 0..chunk.t.len());
                     Ok(())
@@ -855,7 +857,7 @@ fn simulate<'py>(
 /// `ctcal config --format FORMAT` of a fit's JSON or a report's `results.json` text.
 #[pyfunction]
 fn config(text: &str, format: &str) -> PyResult<String> {
-    use ctcal::report::configs::{self, ConfigFormat};
+    use ctcal_report::configs::{self, ConfigFormat};
     let format = ConfigFormat::parse(format).ok_or_else(|| {
         err(format!(
             "unknown format `{format}`\n  fix: esim, esim-generator, v2e or ctcal"
