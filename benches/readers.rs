@@ -58,7 +58,7 @@ fn readers(c: &mut Criterion) {
         .build()
         .unwrap();
     group.bench_function("ijrr_text", |b| b.iter(|| one.install(|| decode(&text))));
-    // lines split between two threads (`src/io/ijrr/split.rs`)
+    // lines split between two threads (`crates/ctcal-io/src/ijrr/split.rs`)
     let two = rayon::ThreadPoolBuilder::new()
         .num_threads(2)
         .build()
