@@ -265,8 +265,11 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
         }
         rows.push((
             key.clone(),
-            match u.standard_error {
-                Some(se) => format!("{:.6} (+- {se:.2e})", u.value),
+            match u.interval() {
+                Some([lo, hi]) => {
+                    let side = |b: Option<f64>| b.map_or("open".to_string(), |b| format!("{b:.6}"));
+                    format!("{:.6} (95 %: {} to {})", u.value, side(lo), side(hi))
+                }
                 None => format!("{:.6}", u.value),
             },
         ));

@@ -140,18 +140,13 @@ pub fn thresholds(sequences: &[&SequenceReport]) -> Table {
             }
         }
         if let Some(f) = &q.fit {
-            let ci = |key: &str, value: f64| {
-                f.uncertainties
-                    .get(key)
-                    .and_then(|u| u.standard_error)
-                    .map(|se| (value - 1.96 * se, value + 1.96 * se))
-            };
             // thresholds the recording does not identify are empty, not start values
             let fitted = q.fitted_thresholds();
             let (on, off) = (fitted.map(|t| t.0), fitted.map(|t| t.1));
             let side = |key: &str, v: Option<f64>, upper: bool| {
-                v.and_then(|v| ci(key, v))
-                    .map(|c| if upper { c.1 } else { c.0 })
+                v.and(f.uncertainties.get(key))
+                    .and_then(|u| u.interval())
+                    .and_then(|c| c[usize::from(upper)])
             };
             rows.push((
                 q.name.clone(),
@@ -192,28 +187,34 @@ pub fn thresholds(sequences: &[&SequenceReport]) -> Table {
 
 /// One row per sequence and fitted parameter.
 pub fn fitted_parameters(sequences: &[&SequenceReport]) -> Table {
-    // (sequence, parameter, value, standard error, truth)
-    type Row = (String, String, Option<f64>, Option<f64>, Option<f64>);
+    // (sequence, parameter, [value, standard error, ci95 lo, ci95 hi, truth])
+    type Row = (String, String, [Option<f64>; 5]);
     let mut rows: Vec<Row> = Vec::new();
     for q in sequences {
         let Some(f) = &q.fit else { continue };
         for (key, value) in super::configs::numeric_params(&f.params) {
-            let se = f.uncertainties.get(&key).and_then(|u| u.standard_error);
+            let uncertain = f.uncertainties.get(&key);
+            let se = uncertain.and_then(|u| u.standard_error);
+            let ci = uncertain.and_then(|u| u.interval()).unwrap_or([None, None]);
             let truth = q.truth.as_ref().and_then(|t| t.params.get(&key).copied());
             // not identified: no value (the reason is beside the table)
             let value = (!f.params.not_identified.contains_key(&key)).then_some(value);
-            rows.push((q.name.clone(), key, value, se, truth));
+            let ci = if value.is_some() { ci } else { [None, None] };
+            rows.push((q.name.clone(), key, [value, se, ci[0], ci[1], truth]));
         }
     }
+    let column = |k: usize| -> Vec<Option<f64>> { rows.iter().map(|r| r.2[k]).collect() };
     table(
         "fitted_parameters",
-        "Fitted simulator parameters (PARAMS.toml keys) with standard errors and the truth",
+        "Fitted simulator parameters (PARAMS.toml keys) with standard errors, 95 % intervals (empty side: not bounded by the data) and the truth",
         vec![
             strings("sequence", rows.iter().map(|r| r.0.clone()).collect()),
             strings("parameter", rows.iter().map(|r| r.1.clone()).collect()),
-            floats("value", rows.iter().map(|r| r.2).collect()),
-            floats("standard_error", rows.iter().map(|r| r.3).collect()),
-            floats("truth", rows.iter().map(|r| r.4).collect()),
+            floats("value", column(0)),
+            floats("standard_error", column(1)),
+            floats("ci95_lo", column(2)),
+            floats("ci95_hi", column(3)),
+            floats("truth", column(4)),
         ],
     )
 }

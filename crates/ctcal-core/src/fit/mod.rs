@@ -95,12 +95,57 @@ pub struct FitInput<'a> {
     pub excluded: &'a [bool],
 }
 
-/// A parameter with its standard error.
+/// A parameter with its standard error and 95 % interval.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Uncertain {
     pub value: f64,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub standard_error: Option<f64>,
+    /// 95 % interval `[lo, hi]`; an open side (`null`) is one the data do not bound (the
+    /// fit error stays within chance out to the end of the searched range).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ci95: Option<crate::estimate::Interval>,
+}
+
+impl Uncertain {
+    /// A parameter that cannot be negative (a threshold, a rate, a time): its interval is
+    /// log-normal, `value * exp(+-1.96 se / value)`, as the searches work in the
+    /// logarithm of the parameter (and a symmetric interval would cross zero when the
+    /// standard error is large).
+    pub fn positive(value: f64, standard_error: Option<f64>) -> Self {
+        let ci95 = standard_error
+            .filter(|se| se.is_finite() && *se >= 0.0 && value > 0.0)
+            .map(|se| {
+                let spread = (crate::estimate::interval::z95() * se / value).exp();
+                [Some(value / spread), Some(value * spread)]
+            });
+        Self {
+            value,
+            standard_error,
+            ci95,
+        }
+    }
+
+    /// The 95 % interval: `ci95`, else `value +- 1.96 standard_error`, else none.
+    pub fn interval(&self) -> Option<crate::estimate::Interval> {
+        self.ci95.or_else(|| {
+            let half = crate::estimate::interval::z95() * self.standard_error?;
+            Some([Some(self.value - half), Some(self.value + half)])
+        })
+    }
+
+    /// A value with an interval measured otherwise (a profile, a count).
+    pub fn with_interval(
+        value: f64,
+        standard_error: Option<f64>,
+        ci95: crate::estimate::Interval,
+    ) -> Self {
+        Self {
+            value,
+            standard_error,
+            ci95: Some(ci95),
+        }
+    }
 }
 
 /// An effect the loop added.

@@ -17,7 +17,7 @@
 
 use super::metric::{Components, distance, median_ratios};
 use super::observe::{Geometry, Observed, Subset};
-use crate::estimate::{EstimateError, quantise, resim};
+use crate::estimate::{EstimateError, Interval, quantise, resim};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::{PixelParams, Sample};
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
@@ -164,6 +164,30 @@ impl Simulation<'_> {
         })
     }
 
+    /// The largest value `effect`'s parameter can take in this recording, read from the
+    /// recording itself. A refractory period cannot be longer than the recording's
+    /// shortest same-pixel intervals (a change inside the period is delayed to its end or
+    /// dropped, so no interval is shorter): the upper edge of the interval bin where the
+    /// fit blocks' interval distribution passes 1 % (the share a jittered or noisy
+    /// timestamp may fall below it; with under 100 intervals, the shortest one's bin);
+    /// without any interval, the fit blocks' duration. `None`: no limit for this effect.
+    pub fn upper_limit(&self, effect: super::effects::Effect) -> Option<f64> {
+        use super::observe::{INTERVAL_BINS, interval_bin_start};
+        if effect != super::effects::Effect::Refractory {
+            return None;
+        }
+        let counts = self.real.intervals_of(self.geometry, Subset::Fit);
+        let total: f64 = counts.iter().map(|&c| c as f64).sum();
+        if total == 0.0 {
+            return Some(self.geometry.duration_of(Subset::Fit));
+        }
+        let mut cumulative = 0.0;
+        (0..INTERVAL_BINS - 1).find_map(|k| {
+            cumulative += counts[k] as f64;
+            (cumulative >= 0.01 * total).then(|| interval_bin_start(k + 1))
+        })
+    }
+
     /// The distance of `observed` from the recording over `subset`.
     pub fn distance(&self, observed: &Observed, subset: Subset, kept: &[bool]) -> Components {
         distance(&self.real, observed, self.geometry, subset, kept)
@@ -251,6 +275,52 @@ pub struct Searched {
     /// The value sits at an end of the searched range: a bound, not a measurement.
     pub at_bound: Option<f64>,
     pub evaluations: Vec<Evaluation>,
+    /// How much the fit error moves by chance (the scale of `standard_error`).
+    pub noise: f64,
+}
+
+impl Searched {
+    /// The value with its standard error and 95 % interval: log-normal from the curvature
+    /// (`value * exp(+-1.96 sigma(ln value))`), else the profile of the evaluated values
+    /// ([`profile_interval`]).
+    pub fn uncertain(&self) -> super::Uncertain {
+        match self.standard_error {
+            Some(se) => super::Uncertain::positive(self.value, Some(se)),
+            None if self.at_bound.is_none() => super::Uncertain::with_interval(
+                self.value,
+                None,
+                profile_interval(&self.evaluations, self.value, self.noise),
+            ),
+            None => super::Uncertain::positive(self.value, None),
+        }
+    }
+}
+
+/// A 95 % interval read off the evaluated points of a search, for when no parabola fits
+/// (flat or one-sided errors): on each side, the nearest evaluated value whose fit error
+/// exceeds the minimum by `1.96^2 noise` (the rise a parabola with standard error
+/// `sigma` has at 1.96 sigma, see [`curvature_error`]); a side where every evaluated value
+/// stays within that rise is open (`None`): the data do not bound it within the range
+/// searched.
+pub fn profile_interval(evaluations: &[Evaluation], value: f64, noise: f64) -> Interval {
+    let Some(minimum) = evaluations.iter().map(|e| e.fit_error).reduce(f64::min) else {
+        return [None, None];
+    };
+    let rise = crate::estimate::interval::z95().powi(2) * noise.max(0.0);
+    let beyond = |e: &&Evaluation| e.fit_error > minimum + rise;
+    let lo = evaluations
+        .iter()
+        .filter(|e| e.value < value)
+        .filter(beyond)
+        .map(|e| e.value)
+        .reduce(f64::max);
+    let hi = evaluations
+        .iter()
+        .filter(|e| e.value > value)
+        .filter(beyond)
+        .map(|e| e.value)
+        .reduce(f64::min);
+    [lo, hi]
 }
 
 /// Searches `effect`'s parameter over `range` (Brent in its logarithm) on top of `base`.
@@ -265,7 +335,7 @@ pub fn search(
     fixed_thresholds: bool,
     noise: f64,
 ) -> Result<Searched, EstimateError> {
-    let range = valid_range(range);
+    let range = within_limit(valid_range(range), simulation.upper_limit(effect));
     let problem = Search {
         simulation,
         effect,
@@ -314,6 +384,7 @@ pub fn search(
         model,
         fit_error,
         evaluations,
+        noise,
     })
 }
 
@@ -327,6 +398,14 @@ fn valid_range((lo, hi): (f64, f64)) -> (f64, f64) {
         2.0 * lo
     };
     (lo, hi)
+}
+
+/// `range` with its upper end at most `limit` (the lower end kept a factor 4 below it).
+fn within_limit((lo, hi): (f64, f64), limit: Option<f64>) -> (f64, f64) {
+    match limit {
+        Some(limit) if limit > 0.0 && hi > limit => (lo.min(limit / 4.0), limit),
+        _ => (lo, hi),
+    }
 }
 
 /// The standard error of a searched value: a parabola `e(x) = a (x - x0)^2 + b` through
@@ -366,6 +445,41 @@ pub fn curvature_error(evaluations: &[Evaluation], value: f64, noise: f64) -> Op
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn evaluation(value: f64, fit_error: f64) -> Evaluation {
+        Evaluation {
+            value,
+            fit_error,
+            ct_on: 0.3,
+            ct_off: 0.3,
+        }
+    }
+
+    #[test]
+    fn a_profile_interval_ends_where_the_error_rises_past_chance_and_stays_open_where_it_does_not()
+    {
+        // minimum 1.0 at 2; a rise of 3.84 x 0.01 = 0.0384 is the 95 % line
+        let tried = [
+            evaluation(0.5, 1.0 + 0.01),
+            evaluation(1.0, 1.0 + 0.05),
+            evaluation(1.5, 1.0 + 0.02),
+            evaluation(2.0, 1.0),
+            evaluation(3.0, 1.0 + 0.03),
+            evaluation(4.0, 1.0 + 0.2),
+            evaluation(8.0, 1.0 + 0.5),
+        ];
+        assert_eq!(profile_interval(&tried, 2.0, 0.01), [Some(1.0), Some(4.0)]);
+        // nothing below 2 rises by 0.0384 when chance is twice as large: open below
+        assert_eq!(profile_interval(&tried, 2.0, 0.02), [None, Some(4.0)]);
+        assert_eq!(profile_interval(&[], 2.0, 0.01), [None, None]);
+    }
+
+    #[test]
+    fn a_range_is_cut_at_the_limit_the_recording_sets() {
+        assert_eq!(within_limit((0.2, 5.0), Some(0.001)), (0.00025, 0.001));
+        assert_eq!(within_limit((1e-5, 5e-4), Some(0.001)), (1e-5, 5e-4));
+        assert_eq!(within_limit((0.2, 5.0), None), (0.2, 5.0));
+    }
 
     #[test]
     fn curvature_gives_the_width_of_a_parabola() {

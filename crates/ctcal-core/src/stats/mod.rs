@@ -18,6 +18,7 @@
 //! [`PIXEL_BUDGET`] pixels unless [`StatsOptions::max_pixels`] says otherwise: a sensor
 //! claimed (or given) far larger than its events costs only what the events need.
 
+pub mod binomial;
 pub mod hot_pixels;
 pub mod intervals;
 mod kernel;

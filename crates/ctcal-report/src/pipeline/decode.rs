@@ -280,7 +280,7 @@ structs! {
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,
         quiet_pixel_seconds, support_window_ms, timestamp_step_us, interval_edge }
     IntervalEdge { edge_us, range_us, found, not_refractory, below, above, intervals }
-    Uncertain { value, standard_error }
+    Uncertain { value, standard_error, ci95 }
     AddedEffect { effect, evidence, error_after }
     Ambiguity { kept, alternative, parameter, value, error_kept, error_alternative, chance,
         separated_by }

@@ -97,7 +97,17 @@ impl Figure for Calibration {
             .map_err(err)?
             .label(format!("estimate CT {:.3}", self.estimate))
             .legend(|(x, y)| Circle::new((x + px(10) as i32, y), px(5), RECORDING.filled()));
-        draw_legend(&mut chart, 14)?;
+        let curve: Vec<(f64, f64)> = self
+            .curve
+            .iter()
+            .map(|p| (p.ct, p.events_per_pixel_per_second))
+            .collect();
+        let data = [
+            curve,
+            vec![(0.07, self.recording), (2.2, self.recording)],
+            vec![(self.estimate, self.recording)],
+        ];
+        draw_legend(&mut chart, 14, &data)?;
         Ok(())
     }
 

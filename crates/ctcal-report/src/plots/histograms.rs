@@ -80,7 +80,18 @@ impl Figure for Histograms {
                     )
                 });
         }
-        draw_legend(&mut chart, 14)?;
+        // each bar as its top edge
+        let tops: Vec<Vec<(f64, f64)>> = counts
+            .iter()
+            .map(|series| {
+                series
+                    .iter()
+                    .enumerate()
+                    .flat_map(|(i, &c)| [(i as f64 * width, c), ((i + 1) as f64 * width, c)])
+                    .collect()
+            })
+            .collect();
+        draw_legend(&mut chart, 14, &tops)?;
         Ok(())
     }
 

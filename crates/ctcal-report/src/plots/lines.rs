@@ -70,6 +70,7 @@ impl Figure for Lines {
                         .draw_series(LineSeries::new([(x0, 0.0), (x1, 0.0)], BLACK.mix(0.4)))
                         .map_err(err)?;
                 }
+                let mut drawn = Vec::new();
                 for (k, (label, series)) in self.series.iter().enumerate() {
                     let colour = colour_for(label, k);
                     let valid: Vec<(f64, f64)> = series
@@ -96,9 +97,10 @@ impl Figure for Lines {
                                 .map(|&p| Circle::new(p, px(3), colour.filled())),
                         )
                         .map_err(err)?;
+                    drawn.push(valid);
                 }
                 if self.series.len() > 1 {
-                    draw_legend(&mut chart, 13)?;
+                    draw_legend(&mut chart, 13, &drawn)?;
                 }
             }};
         }

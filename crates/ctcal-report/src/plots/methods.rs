@@ -70,7 +70,10 @@ impl Figure for Methods {
             .label_style((FONT, px(14)))
             .draw()
             .map_err(err)?;
+        let mut drawn: Vec<Vec<(f64, f64)>> = Vec::new();
         if let Some((on, off)) = self.truth {
+            drawn.push(vec![(-0.5, on), (n - 0.5, on)]);
+            drawn.push(vec![(-0.5, off), (n - 0.5, off)]);
             for (value, colour, label) in
                 [(on, PALETTE[0], "true ON"), (off, PALETTE[1], "true OFF")]
             {
@@ -105,6 +108,10 @@ impl Figure for Methods {
                 .collect();
             // an open side runs to the axis, drawn thinner
             let (bottom, top) = (0.0, hi);
+            for (x, v, ci) in &points {
+                let [lo, up] = ci.unwrap_or([Some(*v), Some(*v)]);
+                drawn.push(vec![(*x, lo.unwrap_or(bottom)), (*x, up.unwrap_or(top))]);
+            }
             chart
                 .draw_series(points.iter().filter_map(|(x, v, ci)| {
                     let [lo, up] = (*ci)?;
@@ -139,7 +146,7 @@ impl Figure for Methods {
                 .label(label)
                 .legend(move |(x, y)| Circle::new((x + px(10) as i32, y), px(5), colour.filled()));
         }
-        draw_legend(&mut chart, 14)?;
+        draw_legend(&mut chart, 14, &drawn)?;
         Ok(())
     }
 

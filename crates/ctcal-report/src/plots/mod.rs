@@ -162,12 +162,7 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
         })
         .collect();
     if let Some(f) = &s.fit {
-        let ci = |key: &str, v: f64| {
-            f.uncertainties
-                .get(key)
-                .and_then(|u| u.standard_error)
-                .map(|se| [Some(v - 1.96 * se), Some(v + 1.96 * se)])
-        };
+        let ci = |key: &str, _: f64| f.uncertainties.get(key).and_then(|u| u.interval());
         if let Some((on, off)) = s.fitted_thresholds() {
             rows.push(MethodRow {
                 method: "fit".into(),

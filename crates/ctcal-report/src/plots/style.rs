@@ -144,18 +144,129 @@ pub(super) fn log_range(values: impl Iterator<Item = f64>) -> std::ops::Range<f6
     (lo / 2.0)..(hi * 2.0)
 }
 
-/// The legend box every figure uses: translucent white over the plot, black border.
+/// The legend box every figure uses: translucent white, black border, in the corner of the
+/// plot that the fewest of `data` cross ([`emptiest_corner`]): each polyline of `data` in
+/// the chart's own coordinates (a single point is a polyline of one).
 pub(super) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
     font_size: u32,
+    data: &[Vec<CT::From>],
 ) -> Result<(), String> {
+    let pixels: Vec<Vec<(i32, i32)>> = data
+        .iter()
+        .map(|line| {
+            line.iter()
+                .map(|p| chart.as_coord_spec().translate(p))
+                .collect()
+        })
+        .collect();
+    let (x, y) = chart.plotting_area().get_pixel_range();
+    let position = emptiest_corner(&pixels, (x.start, x.end), (y.start, y.end));
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(position)
         .legend_area_size(px(30))
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font((FONT, px(font_size)))
         .draw()
         .map_err(|e| e.to_string())
+}
+
+/// Where a legend hides the least: of the four corner boxes (45 % of the plot's width, 35 %
+/// of its height, about a legend's size), the one the fewest samples of `lines` fall in
+/// (pixel coordinates; each segment sampled every 4 px); the upper right on ties.
+fn emptiest_corner(
+    lines: &[Vec<(i32, i32)>],
+    (x0, x1): (i32, i32),
+    (y0, y1): (i32, i32),
+) -> SeriesLabelPosition {
+    let (w, h) = (f64::from(x1 - x0), f64::from(y1 - y0));
+    // (right, upper) of upper right, upper left, lower right, lower left
+    let corners = [(true, true), (false, true), (true, false), (false, false)];
+    let mut counts = [0usize; 4];
+    let mut visit = |x: f64, y: f64| {
+        for (k, &(right, upper)) in corners.iter().enumerate() {
+            let in_x = if right {
+                x >= f64::from(x0) + 0.55 * w
+            } else {
+                x <= f64::from(x0) + 0.45 * w
+            };
+            let in_y = if upper {
+                y <= f64::from(y0) + 0.35 * h
+            } else {
+                y >= f64::from(y1) - 0.35 * h
+            };
+            counts[k] += usize::from(in_x && in_y);
+        }
+    };
+    for line in lines {
+        if let [only] = line.as_slice() {
+            visit(f64::from(only.0), f64::from(only.1));
+        }
+        for pair in line.windows(2) {
+            let (a, b) = (pair[0], pair[1]);
+            let length = f64::from(b.0 - a.0).hypot(f64::from(b.1 - a.1));
+            let steps = ((length / 4.0).ceil() as usize).clamp(1, 2000);
+            for i in 0..=steps {
+                let f = i as f64 / steps as f64;
+                visit(
+                    f64::from(a.0) + f * f64::from(b.0 - a.0),
+                    f64::from(a.1) + f * f64::from(b.1 - a.1),
+                );
+            }
+        }
+    }
+    match (0..4).min_by_key(|&k| counts[k]).unwrap_or(0) {
+        1 => SeriesLabelPosition::UpperLeft,
+        2 => SeriesLabelPosition::LowerRight,
+        3 => SeriesLabelPosition::LowerLeft,
+        _ => SeriesLabelPosition::UpperRight,
+    }
+}
+
+#[cfg(test)]
+mod legend_tests {
+    use super::*;
+
+    fn name(p: SeriesLabelPosition) -> &'static str {
+        match p {
+            SeriesLabelPosition::UpperRight => "upper right",
+            SeriesLabelPosition::UpperLeft => "upper left",
+            SeriesLabelPosition::LowerRight => "lower right",
+            SeriesLabelPosition::LowerLeft => "lower left",
+            _ => "other",
+        }
+    }
+
+    #[test]
+    fn a_legend_goes_where_the_data_are_not() {
+        // a falling curve (upper left to lower right) leaves the upper right and lower left
+        // empty: upper right wins the tie
+        let falling = vec![vec![(0, 0), (1000, 800)]];
+        assert_eq!(
+            name(emptiest_corner(&falling, (0, 1000), (0, 800))),
+            "upper right"
+        );
+        // a rising curve crosses the upper right: the upper left is empty
+        let rising = vec![vec![(0, 800), (1000, 0)]];
+        assert_eq!(
+            name(emptiest_corner(&rising, (0, 1000), (0, 800))),
+            "upper left"
+        );
+        // a horizontal line near the top and a point cloud at the lower left
+        let mixed = vec![
+            vec![(0, 100), (1000, 100)],
+            vec![(100, 700)],
+            vec![(120, 650)],
+        ];
+        assert_eq!(
+            name(emptiest_corner(&mixed, (0, 1000), (0, 800))),
+            "lower right"
+        );
+        assert_eq!(
+            name(emptiest_corner(&[], (0, 1000), (0, 800))),
+            "upper right"
+        );
+    }
 }

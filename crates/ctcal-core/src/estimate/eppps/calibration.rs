@@ -19,6 +19,7 @@ pub const MAX_SCAN_PX: f64 = 100.0;
 /// Blocks of scans through `image` with the recording's travel and directions (sampled
 /// together, per counted tile), placed so that burn-in and counted part stay inside.
 pub fn prior_blocks(image: &LogImage, rates: &RecordingRates, seed: u64) -> Vec<Block> {
+    let seconds_per_px = 1.0 / rates.speed_median_px_s.max(1e-3);
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
     let n = rates.travels.len();
     let side = TILE_PX as f64;
@@ -49,6 +50,7 @@ pub fn prior_blocks(image: &LogImage, rates: &RecordingRates, seed: u64) -> Vec<
                     dx,
                     dy,
                     length,
+                    seconds_per_px,
                 },
             }
         })
@@ -92,6 +94,14 @@ fn burn_in(frames: &PreparedFrames, k: usize, x: usize, y: usize) -> Profile {
     let (dx, dy) = (u as f64 / norm, v as f64 / norm);
     let burn = (BURN_IN_PX / STEP_PX).round() as usize;
     let frame = &frames.dn[k];
+    // the burn-in passes at the first interval's speed
+    let steps = ((u.hypot(v) as f64 / STEP_PX).ceil()).clamp(1.0, 4000.0);
+    let (t0, t1) = (
+        frames.times[k] as f64 * 1e-6,
+        frames.times[k + 1] as f64 * 1e-6,
+    );
+    let dt = (t1 - t0) / steps;
+    let times_s = (0..burn).map(|i| t0 - (burn - i) as f64 * dt).collect();
     // the content that passed the pixel before the frame: at fraction a < 0 of the
     // interval it saw the frame at (x, y) - a (u, v), downstream along the flow
     let values = (0..burn)
@@ -103,6 +113,7 @@ fn burn_in(frames: &PreparedFrames, k: usize, x: usize, y: usize) -> Profile {
         .collect();
     Profile {
         values,
+        times_s,
         burn,
         length: 0.0,
     }
@@ -119,6 +130,7 @@ fn extend(profile: &mut Profile, frames: &PreparedFrames, k: usize, x: usize, y:
         let t = t.min(t1 - 1);
         if let Some(level) = frames.log_at(x as u16, y as u16, t) {
             profile.values.push(level);
+            profile.times_s.push(t as f64 * 1e-6);
         }
     }
     profile.length += travel;

@@ -59,11 +59,15 @@ pub struct Scan {
     pub dx: f64,
     pub dy: f64,
     pub length: f64,
+    /// Time the scene takes to move one pixel past the scan, seconds.
+    pub seconds_per_px: f64,
 }
 
 /// A scan's log-intensity profile: `burn` samples of burn-in, then the counted part.
 pub struct Profile {
     pub values: Vec<f32>,
+    /// The time of each sample, seconds (any origin).
+    pub times_s: Vec<f64>,
     pub burn: usize,
     /// Counted length, pixels.
     pub length: f64,
@@ -79,38 +83,158 @@ pub fn profile(image: &LogImage, scan: &Scan) -> Profile {
             image.sample(scan.x + s * scan.dx, scan.y + s * scan.dy)
         })
         .collect();
+    let times_s = (0..=burn + counted)
+        .map(|i| i as f64 * STEP_PX * scan.seconds_per_px)
+        .collect();
     Profile {
         values,
+        times_s,
         burn,
         length: scan.length,
     }
 }
 
-/// ON and OFF events of an ideal pixel of threshold `c` along `profile`, counted after its
-/// burn-in; the memorised level starts at the first sample and moves by one threshold per
-/// event.
-pub fn count(profile: &Profile, c: f32) -> (u32, u32) {
+/// ON and OFF events of an ideal pixel of thresholds `c_on`, `c_off` along `profile`,
+/// counted after its burn-in; the memorised level starts at the first sample and moves by
+/// one threshold per event. The two thresholds interact: the memorised level is a play
+/// operator of width `c_on + c_off` on the profile, so a pixel's ON count depends on its OFF
+/// threshold wherever the profile turns.
+pub fn count(profile: &Profile, c_on: f32, c_off: f32) -> (u32, u32) {
     let mut reference = profile.values[0];
     let (mut on, mut off) = (0u32, 0u32);
     for (i, &level) in profile.values.iter().enumerate() {
         let counted = i > profile.burn;
-        while level - reference >= c {
-            reference += c;
+        while level - reference >= c_on {
+            reference += c_on;
             on += counted as u32;
         }
-        while reference - level >= c {
-            reference -= c;
+        while reference - level >= c_off {
+            reference -= c_off;
             off += counted as u32;
         }
     }
     (on, off)
 }
 
-/// One point of a calibration curve: at threshold `ct`, ON and OFF events per pixel of
-/// travel over the scans that fired, and the share of scans that fired.
+/// The pixel the scans simulate besides its ON threshold: its OFF threshold as a multiple
+/// of the ON one, and its refractory period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ScanPixel {
+    /// OFF threshold / ON threshold.
+    pub ratio: f64,
+    /// Refractory period, seconds (0: none).
+    pub refractory_s: f64,
+}
+
+impl ScanPixel {
+    pub const SYMMETRIC: ScanPixel = ScanPixel {
+        ratio: 1.0,
+        refractory_s: 0.0,
+    };
+
+    /// ON and OFF events along `profile` at ON threshold `c`.
+    fn count(&self, profile: &Profile, c: f64) -> (u32, u32) {
+        let (c_on, c_off) = (c as f32, (c * self.ratio) as f32);
+        if self.refractory_s > 0.0 {
+            count_refractory(profile, c_on, c_off, self.refractory_s)
+        } else {
+            count(profile, c_on, c_off)
+        }
+    }
+}
+
+/// [`count`] for a pixel with a refractory period (the simulator's and v2e's semantics,
+/// [`crate::sim::effects::refractory`]): after an event the pixel cannot fire for
+/// `refractory_s`; a crossing inside the period stays pending and fires when it ends if the
+/// level is then still a threshold away, one event per period. Between samples the level
+/// is interpolated linearly in time, so crossings are timed within a sample.
+pub fn count_refractory(profile: &Profile, c_on: f32, c_off: f32, refractory_s: f64) -> (u32, u32) {
+    let (v, t) = (&profile.values, &profile.times_s);
+    let mut reference = v[0];
+    let mut ready = f64::NEG_INFINITY;
+    let (mut on, mut off) = (0u32, 0u32);
+    for i in 1..v.len().min(t.len()) {
+        let (t0, t1, v0, v1) = (t[i - 1], t[i], v[i - 1], v[i]);
+        let counted = (i > profile.burn) as u32;
+        let level_at = |s: f64| {
+            if t1 > t0 {
+                v0 + (v1 - v0) * ((s - t0) / (t1 - t0)) as f32
+            } else {
+                v1
+            }
+        };
+        let mut from = t0;
+        loop {
+            let start = from.max(ready);
+            if start > t1 {
+                break;
+            }
+            let level = level_at(start);
+            let fired = if level - reference >= c_on {
+                Some((start, true))
+            } else if reference - level >= c_off {
+                Some((start, false))
+            } else {
+                // the next crossing later in this stretch, if the level gets there
+                let up = v1 > level;
+                let target = if up {
+                    reference + c_on
+                } else {
+                    reference - c_off
+                };
+                let reached = if up { v1 >= target } else { v1 <= target };
+                (reached && v1 != level && t1 > start).then(|| {
+                    let f = f64::from((target - level) / (v1 - level));
+                    (start + f * (t1 - start), up)
+                })
+            };
+            let Some((at, up)) = fired else { break };
+            if up {
+                reference += c_on;
+                on += counted;
+            } else {
+                reference -= c_off;
+                off += counted;
+            }
+            ready = at + refractory_s;
+            from = at;
+        }
+    }
+    (on, off)
+}
+
+/// Which polarity a calibration curve is read for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    On,
+    Off,
+}
+
+impl Side {
+    /// Events of this polarity per pixel of travel at a curve point.
+    pub fn rate(self, p: &CurvePoint) -> f64 {
+        match self {
+            Side::On => p.on_per_px,
+            Side::Off => p.off_per_px,
+        }
+    }
+
+    /// This polarity's threshold at a curve point.
+    pub fn threshold(self, p: &CurvePoint) -> f64 {
+        match self {
+            Side::On => p.ct,
+            Side::Off => p.ct_off,
+        }
+    }
+}
+
+/// One point of a calibration curve: at ON threshold `ct` and OFF threshold `ct_off`, ON and
+/// OFF events per pixel of travel over the scans that fired, and the share of scans that
+/// fired.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
 pub struct CurvePoint {
     pub ct: f64,
+    pub ct_off: f64,
     pub on_per_px: f64,
     pub off_per_px: f64,
     pub active_fraction: f64,
@@ -118,15 +242,20 @@ pub struct CurvePoint {
     pub events_per_scan: f64,
 }
 
-/// The calibration curve of `profiles` at every threshold of `grid`: per pixel of the
-/// travel of the scans that fired (`fired_only`, as the recording's pixels are counted
-/// without frames) or of all scans.
-pub fn curve(profiles: &[Profile], grid: &[f64], fired_only: bool) -> Vec<CurvePoint> {
+/// The calibration curve of `profiles` at every ON threshold of `grid` for `pixel`: per
+/// pixel of the travel of the scans that fired (`fired_only`, as the recording's pixels are
+/// counted without frames) or of all scans.
+pub fn curve(
+    profiles: &[Profile],
+    grid: &[f64],
+    fired_only: bool,
+    pixel: ScanPixel,
+) -> Vec<CurvePoint> {
     grid.par_iter()
         .map(|&ct| {
             let (mut on, mut off, mut travel, mut active) = (0u64, 0u64, 0.0f64, 0usize);
             for p in profiles {
-                let (a, b) = count(p, ct as f32);
+                let (a, b) = pixel.count(p, ct);
                 active += (a + b > 0) as usize;
                 if a + b > 0 || !fired_only {
                     on += a as u64;
@@ -137,6 +266,7 @@ pub fn curve(profiles: &[Profile], grid: &[f64], fired_only: bool) -> Vec<CurveP
             let travel = travel.max(1e-9);
             CurvePoint {
                 ct,
+                ct_off: ct * pixel.ratio,
                 on_per_px: on as f64 / travel,
                 off_per_px: off as f64 / travel,
                 active_fraction: active as f64 / profiles.len().max(1) as f64,
@@ -154,8 +284,8 @@ pub struct Block {
     pub corner: Scan,
 }
 
-/// ON and OFF events of a block's pixels at each threshold of `grid`.
-fn block_counts(image: &LogImage, block: &Block, grid: &[f64]) -> Vec<[u32; 2]> {
+/// ON and OFF events of a block's pixels at each ON threshold of `grid`.
+fn block_counts(image: &LogImage, block: &Block, grid: &[f64], pixel: ScanPixel) -> Vec<[u32; 2]> {
     let mut out = vec![[0u32; 2]; grid.len()];
     for j in 0..TILE_PX {
         for i in 0..TILE_PX {
@@ -166,7 +296,7 @@ fn block_counts(image: &LogImage, block: &Block, grid: &[f64]) -> Vec<[u32; 2]> 
             };
             let p = profile(image, &scan);
             for (slot, &c) in out.iter_mut().zip(grid) {
-                let (on, off) = count(&p, c as f32);
+                let (on, off) = pixel.count(&p, c);
                 slot[0] += on;
                 slot[1] += off;
             }
@@ -175,12 +305,18 @@ fn block_counts(image: &LogImage, block: &Block, grid: &[f64]) -> Vec<[u32; 2]> 
     out
 }
 
-/// The calibration curve of `blocks` through `image`: per threshold, events per pixel of
-/// travel over the blocks where any pixel fired (as the recording's tiles are counted).
-pub fn block_curve(image: &LogImage, blocks: &[Block], grid: &[f64]) -> Vec<CurvePoint> {
+/// The calibration curve of `blocks` through `image` for `pixel`: per ON threshold, events
+/// per pixel of travel over the blocks where any pixel fired (as the recording's tiles are
+/// counted).
+pub fn block_curve(
+    image: &LogImage,
+    blocks: &[Block],
+    grid: &[f64],
+    pixel: ScanPixel,
+) -> Vec<CurvePoint> {
     let counts: Vec<Vec<[u32; 2]>> = blocks
         .par_iter()
-        .map(|b| block_counts(image, b, grid))
+        .map(|b| block_counts(image, b, grid, pixel))
         .collect();
     let pixels = (TILE_PX * TILE_PX) as f64;
     (0..grid.len())
@@ -197,6 +333,7 @@ pub fn block_curve(image: &LogImage, blocks: &[Block], grid: &[f64]) -> Vec<Curv
             let travel = travel.max(1e-9);
             CurvePoint {
                 ct: grid[k],
+                ct_off: grid[k] * pixel.ratio,
                 on_per_px: on as f64 / travel,
                 off_per_px: off as f64 / travel,
                 active_fraction: active as f64 / blocks.len().max(1) as f64,
@@ -206,27 +343,29 @@ pub fn block_curve(image: &LogImage, blocks: &[Block], grid: &[f64]) -> Vec<Curv
         .collect()
 }
 
-/// The threshold at which a curve's `rate` (falling with the threshold) reaches `target`,
-/// interpolated in log-log between grid points; `None` outside the curve.
-pub fn invert(curve: &[CurvePoint], rate: impl Fn(&CurvePoint) -> f64, target: f64) -> Option<f64> {
+/// The threshold of `side` at which its rate (falling with the threshold) reaches
+/// `target`, interpolated in log-log between grid points; `None` outside the curve.
+pub fn invert(curve: &[CurvePoint], side: Side, target: f64) -> Option<f64> {
     curve.windows(2).find_map(|w| {
-        let (r0, r1) = (rate(&w[0]), rate(&w[1]));
+        let (r0, r1) = (side.rate(&w[0]), side.rate(&w[1]));
+        let (c0, c1) = (side.threshold(&w[0]), side.threshold(&w[1]));
         (r0 >= target && target >= r1 && r1 > 0.0 && r0 > r1).then(|| {
             let f = (target.ln() - r0.ln()) / (r1.ln() - r0.ln());
-            (w[0].ct.ln() + f * (w[1].ct.ln() - w[0].ct.ln())).exp()
+            (c0.ln() + f * (c1.ln() - c0.ln())).exp()
         })
     })
 }
 
-/// The local slope `d ln rate / d ln ct` of a curve at `ct` (for turning an error of the
-/// rate into an error of the threshold); -1 where it cannot be measured.
-pub fn log_slope(curve: &[CurvePoint], rate: impl Fn(&CurvePoint) -> f64, ct: f64) -> f64 {
+/// The local slope `d ln rate / d ln threshold` of `side` at threshold `ct` (for turning an
+/// error of the rate into an error of the threshold); -1 where it cannot be measured.
+pub fn log_slope(curve: &[CurvePoint], side: Side, ct: f64) -> f64 {
     curve
         .windows(2)
-        .find(|w| w[0].ct <= ct && ct <= w[1].ct)
+        .find(|w| side.threshold(&w[0]) <= ct && ct <= side.threshold(&w[1]))
         .and_then(|w| {
-            let (r0, r1) = (rate(&w[0]), rate(&w[1]));
-            (r0 > 0.0 && r1 > 0.0).then(|| (r1.ln() - r0.ln()) / (w[1].ct.ln() - w[0].ct.ln()))
+            let (r0, r1) = (side.rate(&w[0]), side.rate(&w[1]));
+            let (c0, c1) = (side.threshold(&w[0]), side.threshold(&w[1]));
+            (r0 > 0.0 && r1 > 0.0).then(|| (r1.ln() - r0.ln()) / (c1.ln() - c0.ln()))
         })
         .filter(|s| s.is_finite() && *s < 0.0)
         .unwrap_or(-1.0)
@@ -255,9 +394,10 @@ mod tests {
             dx: 1.0,
             dy: 0.0,
             length: 40.0,
+            seconds_per_px: 0.01,
         };
         let p = profile(&image, &scan);
-        let (on, off) = count(&p, 0.3);
+        let (on, off) = count(&p, 0.3, 0.3);
         assert_eq!(off, 0);
         assert!(on == 6 || on == 7, "{on}");
         // against the ramp: OFF
@@ -266,7 +406,7 @@ mod tests {
             x: 120.0,
             ..scan
         };
-        assert_eq!(count(&profile(&image, &back), 0.3).0, 0);
+        assert_eq!(count(&profile(&image, &back), 0.3, 0.3).0, 0);
     }
 
     #[test]
@@ -282,19 +422,64 @@ mod tests {
                         dx: 1.0,
                         dy: 0.0,
                         length: 100.0,
+                        seconds_per_px: 0.01,
                     },
                 )
             })
             .collect();
         let grid = threshold_grid();
-        let c = curve(&profiles, &grid, true);
+        let c = curve(&profiles, &grid, true, ScanPixel::SYMMETRIC);
         // 0.05 per pixel: 0.05 / C events per pixel of travel
-        let ct = invert(&c, |p| p.on_per_px, 0.05 / 0.25).unwrap();
+        let ct = invert(&c, Side::On, 0.05 / 0.25).unwrap();
         assert!((ct - 0.25).abs() < 0.01, "{ct}");
-        let slope = log_slope(&c, |p| p.on_per_px, 0.25);
+        let slope = log_slope(&c, Side::On, 0.25);
         // counts are whole events (17 at 0.3 for 16.7), so the slope between grid points is
         // about -1 within that rounding
         assert!((slope + 1.0).abs() < 0.2, "{slope}");
         assert!((grid[0] - 0.03).abs() < 1e-12 && (grid[24] - 3.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_pixel_s_on_count_depends_on_its_off_threshold_where_the_profile_turns() {
+        // a triangle wave between 0.05 and 1.1: with thresholds 0.2 / 0.2 the memorised level
+        // swings 0.2 <-> 1.0, 4 ON events per rise; with an OFF threshold of 0.6 it falls
+        // only to 0.4 (one OFF event of 0.6), so each rise makes 3 ON events (0.6, 0.8, 1.0)
+        let values: Vec<f32> = (0..4000)
+            .map(|i| {
+                let phase = (i % 200) as f32 / 100.0;
+                0.05 + 1.05 * if phase < 1.0 { phase } else { 2.0 - phase }
+            })
+            .collect();
+        let p = Profile {
+            times_s: (0..values.len()).map(|i| i as f64 * 1e-3).collect(),
+            values,
+            burn: 400,
+            length: 900.0,
+        };
+        let (on_sym, off_sym) = count(&p, 0.2, 0.2);
+        let (on_wide, off_wide) = count(&p, 0.2, 0.6);
+        // 18 rises and falls after the burn-in
+        assert_eq!((on_sym, off_sym), (72, 72));
+        assert_eq!((on_wide, off_wide), (54, 18));
+    }
+
+    #[test]
+    fn a_refractory_pixel_fires_at_most_once_per_period_and_keeps_the_change_pending() {
+        // a ramp of 0.05 per ms: a 0.1 threshold is crossed every 2 ms
+        let values: Vec<f32> = (0..=100).map(|i| 0.05 * i as f32).collect();
+        let p = Profile {
+            times_s: (0..=100).map(|i| i as f64 * 1e-3).collect(),
+            values,
+            burn: 0,
+            length: 25.0,
+        };
+        let ideal = count(&p, 0.1, 0.1);
+        assert_eq!(count_refractory(&p, 0.1, 0.1, 0.0), ideal);
+        // 1 ms < 2 ms between crossings: nothing lost, nothing delayed past the end
+        assert_eq!(count_refractory(&p, 0.1, 0.1, 1e-3), ideal);
+        // 5 ms: one event per 5 ms over the 100 ms ramp (the first at 2 ms)
+        let (on, off) = count_refractory(&p, 0.1, 0.1, 5e-3);
+        assert_eq!((on, off), (20, 0));
+        assert!(ideal.0 >= 49, "{ideal:?}");
     }
 }

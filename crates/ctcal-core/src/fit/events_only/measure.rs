@@ -171,7 +171,7 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
         .collect();
     let mut last = vec![TimeUs::MIN; w * h];
     for (b, range) in blocks.iter_mut().zip(&ranges) {
-        b.intervals = intervals(&clean, range.clone(), w, &mut last);
+        b.intervals = super::refractory::intervals(&clean, range.clone(), w, &mut last);
     }
     for window in SUPPORT_WINDOWS_US {
         let support = crate::stats::support::supported_two_sided(&clean, m.sensor, window);
@@ -184,25 +184,6 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
         }
     }
     blocks
-}
-
-/// Same-pixel intervals (µs) of the events `range`; `last` carries each pixel's previous
-/// event across blocks.
-fn intervals(
-    clean: &EventChunk,
-    range: std::ops::Range<usize>,
-    width: usize,
-    last: &mut [TimeUs],
-) -> Vec<u32> {
-    let mut out = Vec::new();
-    for i in range {
-        let p = clean.y[i] as usize * width + clean.x[i] as usize;
-        if last[p] != TimeUs::MIN {
-            out.push((clean.t[i] - last[p]).clamp(0, u32::MAX as TimeUs) as u32);
-        }
-        last[p] = clean.t[i];
-    }
-    out
 }
 
 /// Isolated events at quiet pixels of the clean events (hot and masked pixels out) in

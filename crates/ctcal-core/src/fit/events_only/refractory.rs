@@ -43,6 +43,25 @@ pub struct Edge {
     pub intervals: usize,
 }
 
+/// Same-pixel intervals (µs) of the events `range`; `last` carries each pixel's previous
+/// event across blocks.
+pub fn intervals(
+    clean: &crate::events::EventChunk,
+    range: std::ops::Range<usize>,
+    width: usize,
+    last: &mut [crate::events::TimeUs],
+) -> Vec<u32> {
+    let mut out = Vec::new();
+    for i in range {
+        let p = clean.y[i] as usize * width + clean.x[i] as usize;
+        if last[p] != crate::events::TimeUs::MIN {
+            out.push((clean.t[i] - last[p]).clamp(0, u32::MAX as crate::events::TimeUs) as u32);
+        }
+        last[p] = clean.t[i];
+    }
+    out
+}
+
 /// The common step of the timestamps (µs; 1 when they are not on a coarser grid): the
 /// greatest common divisor of the first 100,000 differences between distinct timestamps.
 pub fn timestamp_step(events: &crate::events::EventChunk) -> u32 {

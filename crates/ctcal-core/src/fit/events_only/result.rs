@@ -133,13 +133,11 @@ fn absolute(
                     Some([Some(lo), Some(hi)]) => Some((hi - lo) / (2.0 * 1.96)),
                     _ => None,
                 };
-                uncertainties.insert(
-                    key.to_string(),
-                    Uncertain {
-                        value: v,
-                        standard_error: se,
-                    },
-                );
+                let uncertain = match ci {
+                    Some(ci) => Uncertain::with_interval(v, se, ci),
+                    None => Uncertain::positive(v, se),
+                };
+                uncertainties.insert(key.to_string(), uncertain);
                 v
             }
             (Ok(e), None) => {
@@ -178,10 +176,7 @@ fn noise_params(
             params.shot_noise_rate_hz = Some(2.0 * rate);
             uncertainties.insert(
                 "shot_noise_rate_hz".into(),
-                Uncertain {
-                    value: 2.0 * rate,
-                    standard_error: Some(2.0 * se),
-                },
+                Uncertain::positive(2.0 * rate, Some(2.0 * se)),
             );
             why.insert(
                 "shot_noise_bright_factor".into(),
@@ -200,13 +195,7 @@ fn noise_params(
     if let Some((excess, se)) = on_excess(run) {
         if kept("leak") {
             params.leak_rate_hz = Some(excess);
-            uncertainties.insert(
-                "leak_rate_hz".into(),
-                Uncertain {
-                    value: excess,
-                    standard_error: Some(se),
-                },
-            );
+            uncertainties.insert("leak_rate_hz".into(), Uncertain::positive(excess, Some(se)));
         } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
             why.insert(
                 "leak_rate_hz".into(),
@@ -231,10 +220,11 @@ fn refractory_param(
             params.refractory_s = Some(edge.edge_us * 1e-6);
             uncertainties.insert(
                 "refractory_s".into(),
-                Uncertain {
-                    value: edge.edge_us * 1e-6,
-                    standard_error: Some((edge.range_us[1] - edge.range_us[0]) * 1e-6 / 4.0),
-                },
+                Uncertain::with_interval(
+                    edge.edge_us * 1e-6,
+                    Some((edge.range_us[1] - edge.range_us[0]) * 1e-6 / 4.0),
+                    [Some(edge.range_us[0] * 1e-6), Some(edge.range_us[1] * 1e-6)],
+                ),
             );
         }
         Some(edge) => {
@@ -284,14 +274,9 @@ fn details(
     ratio_confirmed: bool,
 ) -> EventsOnly {
     let test = judging.of(Role::Test);
-    let rate = |r: Option<(f64, f64)>| {
-        r.map(|(value, se)| Uncertain {
-            value,
-            standard_error: Some(se),
-        })
-    };
+    let rate = |r: Option<(f64, f64)>| r.map(|(value, se)| Uncertain::positive(value, Some(se)));
     let (ct_ratio, ct_ratio_why) = match run.balance {
-        Some((b, se)) if se.is_finite() && ratio_confirmed => (Some(Uncertain { value: b, standard_error: Some(se) }), None),
+        Some((b, se)) if se.is_finite() && ratio_confirmed => (Some(Uncertain::positive(b, Some(se))), None),
         Some((b, se)) if se.is_finite() => (None, Some(format!("the fit blocks' balance OFF/ON = {b:.3} +- {se:.3} did not hold on the selection blocks: the scene's brightness does not return over the recording, so the balance is not the threshold ratio"))),
         Some(_) => (None, Some("under three fit blocks with events of both polarities: the balance's spread cannot be measured".to_string())),
         None => (None, Some("too few supported events of one polarity on the fit blocks".to_string())),

@@ -216,10 +216,7 @@ fn compare_one(
     };
     Ok(Comparison {
         value: searched.value,
-        uncertain: Uncertain {
-            value: searched.value,
-            standard_error: searched.standard_error,
-        },
+        uncertain: searched.uncertain(),
         at_bound: searched.at_bound,
         alternative: searched.model,
         step,

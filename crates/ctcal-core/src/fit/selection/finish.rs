@@ -10,6 +10,8 @@ use super::super::{
 };
 use super::State;
 use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
+use crate::stats::binomial::{median_interval95, wilson95};
+use crate::stats::hot_pixels::HotPixel;
 use crate::stats::robust::{mad_sigma, median};
 use std::collections::BTreeMap;
 
@@ -40,19 +42,41 @@ pub fn threshold_uncertainty(
     BTreeMap::from([
         (
             "ct_on".to_string(),
-            Uncertain {
-                value: p.ct_on,
-                standard_error: se(1, p.ct_on),
-            },
+            Uncertain::positive(p.ct_on, se(1, p.ct_on)),
         ),
         (
             "ct_off".to_string(),
-            Uncertain {
-                value: p.ct_off,
-                standard_error: se(0, p.ct_off),
-            },
+            Uncertain::positive(p.ct_off, se(0, p.ct_off)),
         ),
     ])
+}
+
+/// The named hot pixels as a simulator takes them: their fraction of the kept pixels with
+/// its Wilson interval (counting only: pixels too weak to stand out from their
+/// neighbours are not counted), and their median rate with the order-statistic interval of
+/// a median, or under six pixels the range of their rates widened by each rate's Poisson
+/// error (1.96 / sqrt(events)).
+pub fn hot_pixel_uncertainty(hot: &[HotPixel], kept_pixels: usize) -> (Uncertain, Uncertain) {
+    let n = hot.len();
+    let fraction = n as f64 / kept_pixels as f64;
+    let (lo, hi) = wilson95(n, kept_pixels).unwrap_or((0.0, 1.0));
+    let rates: Vec<f64> = hot.iter().map(|h| h.rate_hz).collect();
+    let rate = median(&rates).unwrap_or(0.0);
+    let (rate_lo, rate_hi) = median_interval95(&rates).unwrap_or_else(|| {
+        let poisson = |h: &HotPixel, side: f64| {
+            h.rate_hz * (1.0 + side * 1.96 / (h.events.max(1) as f64).sqrt()).max(0.0)
+        };
+        (
+            hot.iter()
+                .map(|h| poisson(h, -1.0))
+                .fold(f64::INFINITY, f64::min),
+            hot.iter().map(|h| poisson(h, 1.0)).fold(0.0, f64::max),
+        )
+    });
+    (
+        Uncertain::with_interval(fraction, None, [Some(lo), Some(hi)]),
+        Uncertain::with_interval(rate, None, [Some(rate_lo), Some(rate_hi)]),
+    )
 }
 
 /// Says so when the ideal model already makes more isolated events than the recording: the
@@ -111,9 +135,13 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     }
     if !state.hot.is_empty() {
         let kept_pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
-        let rates: Vec<f64> = state.hot.iter().map(|h| h.rate_hz).collect();
-        params.hot_pixel_fraction = Some(state.hot.len() as f64 / kept_pixels as f64);
-        params.hot_pixel_rate_hz = median(&rates);
+        let (fraction, rate) = hot_pixel_uncertainty(&state.hot, kept_pixels);
+        params.hot_pixel_fraction = Some(fraction.value);
+        params.hot_pixel_rate_hz = Some(rate.value);
+        state
+            .uncertainty
+            .insert("hot_pixel_fraction".into(), fraction);
+        state.uncertainty.insert("hot_pixel_rate_hz".into(), rate);
     }
     let not_identified = not_identified(&state, fixed);
     for k in ["ct_on", "ct_off"] {
@@ -155,6 +183,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     }
 }
 
+/// The widest 95 % interval (hi / lo) a measured parameter may have: a standard error of
+/// its logarithm of 1 (a factor e either side at one sigma, e^(2 x 1.96) = 50 across the
+/// interval). Wider, the value is a model setting the data do not pin down.
+pub const UNMEASURED_SPAN: f64 = 50.0;
+
 /// Parameters the data do not identify, and why.
 fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
     let mut why = BTreeMap::new();
@@ -180,6 +213,19 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
                     ),
                 );
             }
+        }
+    }
+    for (key, u) in &state.uncertainty {
+        if let Some([Some(lo), Some(hi)]) = u.ci95
+            && lo > 0.0
+            && hi / lo > UNMEASURED_SPAN
+        {
+            why.entry(key.clone()).or_insert_with(|| {
+                format!(
+                    "its 95 % interval, {lo:.4e} to {hi:.4e}, spans more than a factor {UNMEASURED_SPAN:.0}: the fit error changes by no more than chance over that range, so the recording does not measure it (the model keeps the effect at {:.4e})",
+                    u.value
+                )
+            });
         }
     }
     for (key, bound) in &state.at_bound {

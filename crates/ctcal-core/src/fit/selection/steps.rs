@@ -135,14 +135,7 @@ pub fn try_effect(
 
 /// The searched value with its standard error, or the bound it sits at.
 fn uncertain_of(key: &str, searched: &Searched) -> (String, Uncertain, Option<f64>) {
-    (
-        key.to_string(),
-        Uncertain {
-            value: searched.value,
-            standard_error: searched.standard_error,
-        },
-        searched.at_bound,
-    )
+    (key.to_string(), searched.uncertain(), searched.at_bound)
 }
 
 fn finish_step(

@@ -1,0 +1,93 @@
+//! Intervals from counting: a binomial proportion (Wilson, JASA 1927: a score interval
+//! that stays inside [0, 1] and behaves at 0 and n) and the distribution-free interval of
+//! a median from its order statistics (the number of values below the median is
+//! Binomial(n, 1/2); Conover, *Practical Nonparametric Statistics*, 3rd ed., sec. 3.2).
+
+use crate::estimate::interval::z95;
+
+/// The 95 % Wilson interval of `successes` out of `trials` (`None` for no trials).
+pub fn wilson95(successes: usize, trials: usize) -> Option<(f64, f64)> {
+    if trials == 0 {
+        return None;
+    }
+    let n = trials as f64;
+    let p = successes as f64 / n;
+    let z = z95();
+    let z2 = z * z;
+    let denominator = 1.0 + z2 / n;
+    let centre = (p + z2 / (2.0 * n)) / denominator;
+    let half = z * (p * (1.0 - p) / n + z2 / (4.0 * n * n)).sqrt() / denominator;
+    // at 0 and n the bound is exactly 0 (1); rounding would leave it a hair away
+    let lo = if successes == 0 {
+        0.0
+    } else {
+        (centre - half).max(0.0)
+    };
+    let hi = if successes >= trials {
+        1.0
+    } else {
+        (centre + half).min(1.0)
+    };
+    Some((lo, hi))
+}
+
+/// The distribution-free 95 % interval of the median of `values`: `[x_(k), x_(n+1-k)]`
+/// with the largest `k` for which `P(Binomial(n, 1/2) < k) <= 0.025`. `None` under six
+/// values (even `[min, max]` then holds the median with less than 95 %).
+pub fn median_interval95(values: &[f64]) -> Option<(f64, f64)> {
+    let n = values.len();
+    if n < 6 {
+        return None;
+    }
+    let mut sorted = values.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    // P(B < k) for B ~ Binomial(n, 1/2), summed in logs (n can be large)
+    let ln_half_n = -(n as f64) * std::f64::consts::LN_2;
+    let mut ln_choose = 0.0; // ln C(n, 0)
+    let mut below = 0.0; // P(B < k)
+    let mut k = 0;
+    loop {
+        let p_k = (ln_choose + ln_half_n).exp();
+        if below + p_k > 0.025 {
+            break;
+        }
+        below += p_k;
+        k += 1;
+        ln_choose += ((n - k + 1) as f64).ln() - (k as f64).ln();
+    }
+    // k values lie below the interval with probability <= 0.025: it starts at x_(k)
+    let k = k.max(1);
+    Some((sorted[k - 1], sorted[n - k]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wilson_matches_the_textbook_values() {
+        // 19 of 20: 0.764-0.991 (Newcombe 1998, Table I style)
+        let (lo, hi) = wilson95(19, 20).unwrap();
+        assert!(
+            (lo - 0.7639).abs() < 1e-3 && (hi - 0.9911).abs() < 1e-3,
+            "{lo} {hi}"
+        );
+        let (lo, hi) = wilson95(0, 10).unwrap();
+        assert_eq!(lo, 0.0);
+        assert!((hi - 0.2775).abs() < 1e-3, "{hi}");
+        assert_eq!(wilson95(0, 0), None);
+    }
+
+    #[test]
+    fn the_median_interval_takes_the_order_statistics_of_the_tables() {
+        let values: Vec<f64> = (1..=20).map(f64::from).collect();
+        // n = 20: P(B <= 5) = 0.0207, P(B <= 6) = 0.0577 -> [x_(6), x_(15)]
+        assert_eq!(median_interval95(&values), Some((6.0, 15.0)));
+        // n = 6: P(B = 0) = 0.0156 -> [min, max]
+        assert_eq!(
+            median_interval95(&[3.0, 1.0, 2.0, 6.0, 5.0, 4.0]),
+            Some((1.0, 6.0))
+        );
+        assert_eq!(median_interval95(&[1.0, 2.0, 3.0, 4.0, 5.0]), None);
+    }
+}
