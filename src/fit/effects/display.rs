@@ -12,10 +12,10 @@ use super::{Context, Effect, Evidence};
 use crate::fit::residuals::power_spectrum;
 
 /// The frequency and normalised power of the recording's strongest line, and the model's
-/// power there.
+/// power there, over the context's blocks.
 pub fn line(c: &Context) -> Option<(f64, f64, f64)> {
-    let (f, real) = power_spectrum(&c.real.timeline);
-    let (_, sim) = power_spectrum(&c.sim.timeline);
+    let (f, real) = power_spectrum(c.real.timeline_of(c.geometry, c.subset));
+    let (_, sim) = power_spectrum(c.sim.timeline_of(c.geometry, c.subset));
     let (k, &power) = real
         .iter()
         .enumerate()

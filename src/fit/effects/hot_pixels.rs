@@ -19,11 +19,12 @@ pub fn find(c: &Context) -> Vec<HotPixel> {
     let g = c.geometry;
     let (w, h) = (g.sensor.width as usize, g.sensor.height as usize);
     let duration = g.duration_of(c.subset);
+    // both on the same pixels: those compared
     let mut real = c.real.pixels_of(c.geometry, c.subset);
-    let sim = c.sim.pixels_of(c.geometry, c.subset);
-    for (k, r) in c.kept.iter().zip(real.iter_mut()) {
+    let mut sim = c.sim.pixels_of(c.geometry, c.subset);
+    for ((k, r), s) in c.kept.iter().zip(real.iter_mut()).zip(sim.iter_mut()) {
         if !k {
-            *r = 0;
+            (*r, *s) = (0, 0);
         }
     }
     let simulated = find_hot_pixels(&sim, w, h, duration);
