@@ -258,6 +258,15 @@ impl Geometry {
         }
     }
 
+    /// The first and last time of `subset`'s frame intervals (`None`: it has none). Each
+    /// role's blocks are contiguous in time, so this is where its events fall.
+    pub fn time_range_of(&self, subset: Subset) -> Option<(TimeUs, TimeUs)> {
+        (0..self.interval_block.len())
+            .filter(|&k| self.interval_block[k].is_some_and(|b| self.in_subset(b, subset)))
+            .map(|k| (self.times[k], self.times[k + 1]))
+            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    }
+
     /// Pixel-seconds of intensity bin `bin` over `subset`.
     pub fn exposure_of(&self, bin: usize, subset: Subset) -> f64 {
         (0..self.blocks)
@@ -457,6 +466,16 @@ impl Observed {
         sum_blocks(&self.intervals, INTERVAL_BINS, self.blocks, |b| {
             g.in_subset(b, subset)
         })
+    }
+
+    /// The event-rate timeline over `subset`'s time range ([`Geometry::time_range_of`]).
+    pub fn timeline_of(&self, g: &Geometry, subset: Subset) -> &[u32] {
+        let Some((a, b)) = g.time_range_of(subset) else {
+            return &[];
+        };
+        let bin = |t: TimeUs| (((t - g.span.0) / TIMELINE_BIN_US).max(0) as usize);
+        let to = (bin(b) + 1).min(self.timeline.len());
+        &self.timeline[bin(a).min(to)..to]
     }
 
     /// ON and OFF events over `subset`.

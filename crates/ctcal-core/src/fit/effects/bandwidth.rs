@@ -95,4 +95,115 @@ mod tests {
         assert!(se > 0.0 && se < 0.01, "{se}");
         assert!((spread - 3.8).abs() < 1e-9);
     }
+
+    use crate::estimate::frames::PreparedFrames;
+    use crate::events::{EventChunk, TimeUs};
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{self, Fixture, THRESHOLD, chunk};
+    use std::f64::consts::SQRT_2;
+
+    /// Intensities (DN) of the scene's rows of cells: the centres of intensity bins 2 to 5.
+    const INTENSITY: [f64; 4] = [20.0 * SQRT_2, 40.0 * SQRT_2, 80.0 * SQRT_2, 201.99];
+    /// Change rates (log units per second) of its columns of cells: the centres of change
+    /// bins 1 to 6.
+    const CHANGE: [f64; 6] = [
+        0.25 * SQRT_2,
+        0.5 * SQRT_2,
+        SQRT_2,
+        2.0 * SQRT_2,
+        4.0 * SQRT_2,
+        8.0 * SQRT_2,
+    ];
+    /// Frame interval, seconds, and the recording's length.
+    const DT: f64 = 0.02;
+    const SECONDS: f64 = 4.0;
+
+    /// A 24 x 16 scene of 4 x 4-pixel cells, one per intensity (rows) and change rate
+    /// (columns): each cell's value goes up and down by `change * DT` in log every frame
+    /// (50 frames a second), so that the frames show that change rate.
+    fn scene() -> PreparedFrames {
+        fixture::frames(24, 16, &fixture::frame_times(SECONDS, DT), |x, y, k| {
+            (INTENSITY[y / 4] * (CHANGE[x / 4] * DT * (k % 2) as f64).exp()) as f32
+        })
+    }
+
+    /// Events of the scene: every pixel of a cell crosses a threshold of 0.2 at the same
+    /// instants, `change / 0.2` times a second (ON while its value rises, OFF while it
+    /// falls), so that each event has its neighbours' support. `kept(intensity, change)`
+    /// is the share of a cell's events that fire (the others are evenly left out).
+    fn events(kept: impl Fn(f64, f64) -> f64) -> EventChunk {
+        let mut out = Vec::new();
+        for (row, &intensity) in INTENSITY.iter().enumerate() {
+            for (column, &change) in CHANGE.iter().enumerate() {
+                let period = THRESHOLD / change;
+                let share = kept(intensity, change);
+                let mut n = 0usize;
+                loop {
+                    let t = (n as f64 + 0.5) * period;
+                    if t >= SECONDS {
+                        break;
+                    }
+                    let fires = ((n + 1) as f64 * share).floor() > (n as f64 * share).floor();
+                    n += 1;
+                    if !fires {
+                        continue;
+                    }
+                    let on = ((t / DT) as usize).is_multiple_of(2);
+                    for y in 4 * row..4 * row + 4 {
+                        for x in 4 * column..4 * column + 4 {
+                            out.push(((t * 1e6) as TimeUs, x as u16, y as u16, on));
+                        }
+                    }
+                }
+            }
+        }
+        chunk(out)
+    }
+
+    /// A first-order low-pass with cutoff `cutoff_hz * (DN + 20) / 275` (v2e's): a texture
+    /// of 0.5 log units peak to peak changing at `change` log units per second varies at
+    /// `change` Hz, whose amplitude (and so its threshold crossings) the filter scales by
+    /// `1 / sqrt(1 + (f / fc)^2)`.
+    fn low_pass(cutoff_hz: f64) -> impl Fn(f64, f64) -> f64 {
+        move |intensity, change| {
+            let fc = cutoff_hz * (intensity + 20.0) / 275.0;
+            1.0 / (1.0 + (change / fc).powi(2)).sqrt()
+        }
+    }
+
+    #[test]
+    fn a_20_hz_cutoff_calls_for_bandwidth_and_starts_at_the_fixed_100_hz() {
+        let model = events(|_, _| 1.0);
+        let recording = events(low_pass(20.0));
+        let f = Fixture::new(&scene(), &recording, &model);
+        let e = evidence(&f.context());
+        // nearly every event kept in the slowest, brightest cell, 30 % in the fastest,
+        // darkest: a slope of about 0.25 in about 9.5 standard errors
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        assert!(e.score > 8.0 && e.score < 11.0, "{e:?}");
+        // the search starts at 100 Hz whatever the evidence and spans 2 to 5000 Hz
+        assert_eq!(e.start, Some(100.0));
+        let (lo, hi) = crate::fit::effects::Effect::Bandwidth.range(100.0);
+        assert!(lo < 20.0 && 20.0 < hi);
+    }
+
+    #[test]
+    fn the_model_as_the_recording_does_not_call_for_bandwidth() {
+        let recording = events(low_pass(20.0));
+        let f = Fixture::new(&scene(), &recording, &recording);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert_eq!(e.score, 0.0);
+    }
+
+    #[test]
+    fn a_deficit_alike_in_every_cell_does_not_call_for_bandwidth() {
+        // thresholds 40 % higher than the model's: 1 event in 1.4 everywhere
+        let model = events(|_, _| 1.0);
+        let recording = events(|_, _| 1.0 / 1.4);
+        let f = Fixture::new(&scene(), &recording, &model);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+    }
 }

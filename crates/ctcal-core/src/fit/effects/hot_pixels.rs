@@ -19,11 +19,12 @@ pub fn find(c: &Context) -> Vec<HotPixel> {
     let g = c.geometry;
     let (w, h) = (g.sensor.width as usize, g.sensor.height as usize);
     let duration = g.duration_of(c.subset);
+    // both on the same pixels: those compared
     let mut real = c.real.pixels_of(c.geometry, c.subset);
-    let sim = c.sim.pixels_of(c.geometry, c.subset);
-    for (k, r) in c.kept.iter().zip(real.iter_mut()) {
+    let mut sim = c.sim.pixels_of(c.geometry, c.subset);
+    for ((k, r), s) in c.kept.iter().zip(real.iter_mut()).zip(sim.iter_mut()) {
         if !k {
-            *r = 0;
+            (*r, *s) = (0, 0);
         }
     }
     let simulated = find_hot_pixels(&sim, w, h, duration);
@@ -121,5 +122,67 @@ mod tests {
         assert!(e.t.iter().all(|&t| (1_000_000..3_000_000).contains(&t)));
         // the same events every time
         assert_eq!(events(&trains, (1_000_000, 3_000_000), 9), e);
+    }
+
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{Fixture, chunk, poisson_times, rng, static_frames};
+
+    type Events = Vec<(TimeUs, u16, u16, bool)>;
+
+    /// A 16 x 12 static scene for 2 s whose pixels fire at 5 Hz each (about 10 events).
+    fn quiet() -> Events {
+        let mut rng = rng(71);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                for t in poisson_times(&mut rng, 5.0, 0.0, 2.0) {
+                    events.push((t, x, y, rng.random::<bool>()));
+                }
+            }
+        }
+        events
+    }
+
+    /// Pixel (9, 6) firing at 500 Hz besides.
+    fn with_hot_pixel() -> Events {
+        let mut rng = rng(72);
+        let mut events = quiet();
+        for t in poisson_times(&mut rng, 500.0, 0.0, 2.0) {
+            events.push((t, 9, 6, rng.random::<bool>()));
+        }
+        events
+    }
+
+    #[test]
+    fn one_pixel_at_500_hz_among_quiet_neighbours_is_found_at_its_rate_and_calls_for_hot_pixels() {
+        let (model, recording) = (chunk(quiet()), chunk(with_hot_pixel()));
+        let f = Fixture::new(&static_frames(16, 12, 2.0, 100.0), &recording, &model);
+        let hot = find(&f.context());
+        assert_eq!(hot.len(), 1, "{hot:?}");
+        assert_eq!((hot[0].x, hot[0].y), (9, 6));
+        // about 1000 events in 2 s, Poisson: 500 +- 16 Hz
+        assert!((hot[0].rate_hz - 500.0).abs() < 50.0, "{:?}", hot[0]);
+        let e = evidence(&f.context());
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        assert_eq!(e.score, hot[0].z);
+    }
+
+    #[test]
+    fn a_hot_pixel_the_model_has_too_does_not_call_for_hot_pixels() {
+        let recording = chunk(with_hot_pixel());
+        let f = Fixture::new(&static_frames(16, 12, 2.0, 100.0), &recording, &recording);
+        assert!(find(&f.context()).is_empty());
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+    }
+
+    #[test]
+    fn a_hot_pixel_that_is_not_kept_is_not_found() {
+        let (model, recording) = (chunk(quiet()), chunk(with_hot_pixel()));
+        let mut f = Fixture::new(&static_frames(16, 12, 2.0, 100.0), &recording, &model);
+        f.kept[6 * 16 + 9] = false;
+        assert!(find(&f.context()).is_empty());
+        assert!(!evidence(&f.context()).calls_for());
     }
 }

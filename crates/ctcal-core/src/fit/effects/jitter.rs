@@ -42,3 +42,72 @@ pub fn evidence(c: &Context) -> Evidence {
         start: Some(100e-6),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::{EventChunk, TimeUs};
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{Fixture, chunk, rng, static_frames};
+    use rand::RngExt;
+
+    /// A 16 x 12 static scene for 1 s. The model: every pixel fires bursts of 4 events
+    /// 300 us apart every 50 ms (an edge crossing several thresholds), so no same-pixel
+    /// interval is shorter than 300 us. The recording: the same events with Gaussian
+    /// timestamp jitter of `jitter_us` standard deviation, re-sorted.
+    fn model_and_jittered(jitter_us: f64) -> (EventChunk, EventChunk) {
+        let mut rng = rng(51);
+        let (mut model, mut recording) = (Vec::new(), Vec::new());
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                let phase = 1_000 + (rng.random::<f64>() * 45_000.0) as TimeUs;
+                for burst in 0..19 {
+                    for k in 0..4 {
+                        let t = phase + burst * 50_000 + k * 300;
+                        let (u1, u2) = (1.0 - rng.random::<f64>(), rng.random::<f64>());
+                        let z = (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos();
+                        let on = burst % 2 == 0;
+                        model.push((t, x, y, on));
+                        recording.push((t + (z * jitter_us).round() as TimeUs, x, y, on));
+                    }
+                }
+            }
+        }
+        (chunk(model), chunk(recording))
+    }
+
+    #[test]
+    fn a_hundred_us_of_jitter_makes_intervals_below_50_us_and_calls_for_jitter() {
+        let (model, recording) = model_and_jittered(100.0);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &model);
+        let e = evidence(&f.context());
+        // about 2 % of the recording's intervals below 42 us (the bins below 50 us), none of
+        // the model's
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        let start = e.start.unwrap();
+        assert!(start > 100e-6 / 2.0 && start < 100e-6 * 2.0, "{start}");
+    }
+
+    #[test]
+    fn the_model_as_the_recording_does_not_call_for_jitter() {
+        let (_, recording) = model_and_jittered(100.0);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &recording);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert_eq!(e.score, 0.0);
+    }
+
+    #[test]
+    fn stamps_on_a_grid_do_not_call_for_jitter() {
+        let (model, recording) = model_and_jittered(100.0);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &model);
+        let context = Context {
+            timestamp_grid_us: Some(50),
+            ..f.context()
+        };
+        let e = evidence(&context);
+        assert!(!e.calls_for(), "{e:?}");
+        assert_eq!(e.score, 0.0);
+    }
+}

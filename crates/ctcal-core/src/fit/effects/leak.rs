@@ -36,3 +36,98 @@ pub fn evidence(c: &Context) -> Evidence {
         start: Some((rate / 0.9).max(1e-3)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::TimeUs;
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{Fixture, chunk, poisson_times, rng, static_frames};
+    use rand::RngExt;
+
+    type Events = Vec<(TimeUs, u16, u16, bool)>;
+
+    /// A 16 x 12 static scene at 100 DN for 10 s whose pixels fire isolated events of both
+    /// polarities at 0.05 Hz each (the model).
+    fn noise_floor() -> Events {
+        let mut rng = rng(21);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                for t in poisson_times(&mut rng, 0.05, 0.0, 10.0) {
+                    events.push((t, x, y, rng.random::<bool>()));
+                }
+            }
+        }
+        events
+    }
+
+    /// A leak of `rate_hz`: every pixel fires an ON event once per period, at a random
+    /// phase.
+    fn leak(rate_hz: f64) -> Events {
+        let mut rng = rng(22);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                let mut t = rng.random::<f64>() / rate_hz;
+                while t < 10.0 {
+                    events.push(((t * 1e6) as TimeUs, x, y, true));
+                    t += 1.0 / rate_hz;
+                }
+            }
+        }
+        events
+    }
+
+    /// Isolated events of both polarities at `rate_hz` (ON and OFF together) per pixel.
+    fn balanced_noise(rate_hz: f64) -> Events {
+        let mut rng = rng(23);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                for t in poisson_times(&mut rng, rate_hz, 0.0, 10.0) {
+                    events.push((t, x, y, rng.random::<bool>()));
+                }
+            }
+        }
+        events
+    }
+
+    fn with(mut base: Events, extra: Events) -> Events {
+        base.extend(extra);
+        base
+    }
+
+    #[test]
+    fn isolated_on_events_at_a_fifth_of_a_hertz_call_for_leak_starting_near_that_rate() {
+        let model = chunk(noise_floor());
+        let recording = chunk(with(noise_floor(), leak(0.2)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, 100.0), &recording, &model);
+        let e = evidence(&f.context());
+        // 384 leak events against a floor of about 96 events in each set
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        let start = e.start.unwrap();
+        assert!(start > 0.2 / 2.0 && start < 0.2 * 2.0, "{start}");
+    }
+
+    #[test]
+    fn the_model_as_the_recording_does_not_call_for_leak() {
+        let recording = chunk(with(noise_floor(), leak(0.2)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, 100.0), &recording, &recording);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert_eq!(e.score, 0.0);
+    }
+
+    #[test]
+    fn an_excess_of_both_polarities_is_shot_noise_and_does_not_call_for_leak() {
+        let model = chunk(noise_floor());
+        let recording = chunk(with(noise_floor(), balanced_noise(0.4)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, 100.0), &recording, &model);
+        let e = evidence(&f.context());
+        // about 384 ON and 384 OFF events more: the ON excess is the OFF excess
+        assert!(!e.calls_for(), "{e:?}");
+        assert!(e.score.abs() < 3.0, "{e:?}");
+    }
+}

@@ -52,3 +52,94 @@ pub fn evidence(c: &Context) -> Evidence {
         ),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::EventChunk;
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{Fixture, chunk, poisson_times, rng, static_frames};
+    use rand::RngExt;
+
+    /// One 16 x 16 tile, static at 100 DN for 2 s. The model: every pixel fires at 500 Hz
+    /// (about 1000 events each, Poisson). The recording: the same arrivals thinned to
+    /// `500 / (1 + sigma z)` Hz at each pixel (threshold `theta (1 + sigma z)`, z standard
+    /// normal, clamped to 4), so that `sigma = 0` gives the model's events.
+    fn model_and_mismatched(sigma: f64) -> (EventChunk, EventChunk) {
+        let mut rng = rng(41);
+        let top = 500.0 / (1.0 - 4.0 * sigma);
+        let (mut model, mut recording) = (Vec::new(), Vec::new());
+        for y in 0..16u16 {
+            for x in 0..16u16 {
+                let (u1, u2) = (1.0 - rng.random::<f64>(), rng.random::<f64>());
+                let z =
+                    ((-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()).clamp(-4.0, 4.0);
+                let rate = 500.0 / (1.0 + sigma * z);
+                for (i, t) in poisson_times(&mut rng, top, 0.0, 2.0)
+                    .into_iter()
+                    .enumerate()
+                {
+                    let u = rng.random::<f64>() * top;
+                    let on = i % 2 == 0;
+                    if u < 500.0 {
+                        model.push((t, x, y, on));
+                    }
+                    if u < rate {
+                        recording.push((t, x, y, on));
+                    }
+                }
+            }
+        }
+        (chunk(model), chunk(recording))
+    }
+
+    #[test]
+    fn thresholds_spread_by_three_percent_make_counts_more_dispersed_and_call_for_mismatch() {
+        let (model, recording) = model_and_mismatched(0.03);
+        let f = Fixture::new(&static_frames(16, 16, 2.0, 100.0), &recording, &model);
+        let e = evidence(&f.context());
+        // dispersion about 1 + 0.03^2 * 1000 = 1.9 against 1: ln 1.9 / 0.02 = 32
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        let start = e.start.unwrap();
+        assert!(start > 0.03 / 1.5 && start < 0.03 * 1.5, "{start}");
+    }
+
+    #[test]
+    fn the_model_as_the_recording_does_not_call_for_mismatch() {
+        let (model, same) = model_and_mismatched(0.0);
+        assert_eq!(model, same);
+        let f = Fixture::new(&static_frames(16, 16, 2.0, 100.0), &same, &model);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert!(e.score.abs() < 1e-9, "{e:?}");
+    }
+
+    #[test]
+    fn a_measured_spread_whose_interval_excludes_zero_calls_for_mismatch_and_starts_at_it() {
+        // counts alike: only the estimators' measurement calls for it
+        let (model, _) = model_and_mismatched(0.0);
+        let f = Fixture::new(&static_frames(16, 16, 2.0, 100.0), &model, &model);
+        let context = Context {
+            mismatch_estimate: Some((0.04, [0.03, 0.05])),
+            ..f.context()
+        };
+        let e = evidence(&context);
+        // standard error 0.02 / 3.92 = 0.0051: 7.8 standard errors
+        assert!(e.calls_for(), "{e:?}");
+        assert!((e.score - 0.04 / (0.02 / 3.92)).abs() < 1e-9, "{e:?}");
+        assert_eq!(e.start, Some(0.04));
+    }
+
+    #[test]
+    fn a_measured_spread_whose_interval_reaches_zero_does_not_call_for_mismatch() {
+        let (model, recording) = model_and_mismatched(0.03);
+        let f = Fixture::new(&static_frames(16, 16, 2.0, 100.0), &recording, &model);
+        let context = Context {
+            mismatch_estimate: Some((0.006, [0.0, 0.012])),
+            ..f.context()
+        };
+        // the measurement takes precedence over the dispersion of counts
+        assert!(!evidence(&context).calls_for());
+    }
+}

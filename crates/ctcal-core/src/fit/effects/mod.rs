@@ -16,6 +16,8 @@
 
 pub mod bandwidth;
 pub mod display;
+#[cfg(test)]
+mod fixture;
 pub mod hot_pixels;
 pub mod jitter;
 pub mod leak;

@@ -53,3 +53,68 @@ pub fn evidence(c: &Context) -> Evidence {
         start: Some(edge),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::{EventChunk, TimeUs};
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{Fixture, chunk, poisson_times, rng, static_frames};
+
+    /// Every pixel of a 16 x 12 static scene fires at 200 Hz for 1 s (the model); the
+    /// recording is the same changes through a refractory period of `period_s`: a change
+    /// inside it fires when it ends (the pile-up).
+    fn model_and_refractory(period_s: f64) -> (EventChunk, EventChunk) {
+        let mut rng = rng(11);
+        let (mut model, mut recording) = (Vec::new(), Vec::new());
+        let period = (period_s * 1e6) as TimeUs;
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                let mut free = TimeUs::MIN;
+                for (i, t) in poisson_times(&mut rng, 200.0, 0.0, 1.0)
+                    .into_iter()
+                    .enumerate()
+                {
+                    let on = i % 2 == 0;
+                    model.push((t, x, y, on));
+                    let fired = t.max(free);
+                    recording.push((fired, x, y, on));
+                    free = fired + period;
+                }
+            }
+        }
+        (chunk(model), chunk(recording))
+    }
+
+    #[test]
+    fn a_two_ms_gap_with_a_pile_up_calls_for_refractory_and_starts_near_two_ms() {
+        let (model, recording) = model_and_refractory(2e-3);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &model);
+        let e = evidence(&f.context());
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        let start = e.start.unwrap();
+        // the lower edge of the interval bin holding 2 ms (1.78 ms)
+        assert!(start > 2e-3 / 1.5 && start < 2e-3 * 1.5, "{start}");
+    }
+
+    #[test]
+    fn a_half_ms_refractory_period_starts_near_half_a_ms() {
+        let (model, recording) = model_and_refractory(0.5e-3);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &model);
+        let e = evidence(&f.context());
+        assert!(e.calls_for(), "{e:?}");
+        let start = e.start.unwrap();
+        assert!(start > 0.5e-3 / 1.5 && start < 0.5e-3 * 1.5, "{start}");
+    }
+
+    #[test]
+    fn a_model_with_the_recordings_intervals_does_not_call_for_refractory() {
+        let (_, recording) = model_and_refractory(2e-3);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &recording);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert_eq!(e.score, 0.0);
+        assert_eq!(e.start, None);
+    }
+}

@@ -46,3 +46,102 @@ pub fn evidence(c: &Context) -> Evidence {
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::TimeUs;
+    use crate::fit::effects::EVIDENCE_THRESHOLD;
+    use crate::fit::effects::fixture::{Fixture, chunk, poisson_times, rng, static_frames};
+    use rand::RngExt;
+
+    type Events = Vec<(TimeUs, u16, u16, bool)>;
+
+    /// The scene: 16 x 12 pixels, static at 100 DN, for 10 s.
+    const DN: f32 = 100.0;
+
+    /// Isolated ON events at 0.05 Hz per pixel (a leak both sets share).
+    fn leak_floor() -> Events {
+        let mut rng = rng(31);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                for t in poisson_times(&mut rng, 0.05, 0.0, 10.0) {
+                    events.push((t, x, y, true));
+                }
+            }
+        }
+        events
+    }
+
+    /// Shot noise of dark rate `rate_hz` (the simulator's `shot_noise_rate_hz`): at 100 DN
+    /// each pixel fires at `rate_hz` times the brightness factor (0.67), each event ON or
+    /// OFF alike.
+    fn shot_noise(rate_hz: f64) -> Events {
+        let observed = rate_hz * brightness_factor(DN, 0.25) as f64;
+        let mut rng = rng(32);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                for t in poisson_times(&mut rng, observed, 0.0, 10.0) {
+                    events.push((t, x, y, rng.random::<bool>()));
+                }
+            }
+        }
+        events
+    }
+
+    /// ON events once every 5 s at every pixel (a leak of 0.2 Hz).
+    fn on_only() -> Events {
+        let mut rng = rng(33);
+        let mut events = Vec::new();
+        for y in 0..12u16 {
+            for x in 0..16u16 {
+                let mut t = 5.0 * rng.random::<f64>();
+                while t < 10.0 {
+                    events.push(((t * 1e6) as TimeUs, x, y, true));
+                    t += 5.0;
+                }
+            }
+        }
+        events
+    }
+
+    fn with(mut base: Events, extra: Events) -> Events {
+        base.extend(extra);
+        base
+    }
+
+    #[test]
+    fn isolated_events_of_both_polarities_call_for_shot_noise_starting_near_the_dark_rate() {
+        let model = chunk(leak_floor());
+        let recording = chunk(with(leak_floor(), shot_noise(0.5)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, DN), &recording, &model);
+        let e = evidence(&f.context());
+        // about 320 ON and 320 OFF events more than the model
+        assert!(e.calls_for(), "{e:?}");
+        assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
+        let start = e.start.unwrap();
+        assert!(start > 0.5 / 2.0 && start < 0.5 * 2.0, "{start}");
+    }
+
+    #[test]
+    fn the_model_as_the_recording_does_not_call_for_shot_noise() {
+        let recording = chunk(with(leak_floor(), shot_noise(0.5)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, DN), &recording, &recording);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert_eq!(e.score, 0.0);
+    }
+
+    #[test]
+    fn an_excess_of_on_events_only_is_leak_and_does_not_call_for_shot_noise() {
+        let model = chunk(leak_floor());
+        let recording = chunk(with(leak_floor(), on_only()));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, DN), &recording, &model);
+        let e = evidence(&f.context());
+        // 384 ON events more, no OFF excess: the smaller excess is nil
+        assert!(!e.calls_for(), "{e:?}");
+        assert!(e.score.abs() < 1e-9, "{e:?}");
+    }
+}
