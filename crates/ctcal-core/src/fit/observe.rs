@@ -473,7 +473,7 @@ impl Observed {
         let Some((a, b)) = g.time_range_of(subset) else {
             return &[];
         };
-        let bin = |t: TimeUs| (((t - g.span.0) / TIMELINE_BIN_US).max(0) as usize);
+        let bin = |t: TimeUs| ((t - g.span.0) / TIMELINE_BIN_US).max(0) as usize;
         let to = (bin(b) + 1).min(self.timeline.len());
         &self.timeline[bin(a).min(to)..to]
     }
