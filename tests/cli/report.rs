@@ -191,7 +191,7 @@ fn the_sample_report_has_every_part() {
         "| dataset | sequences | event rate (events/px/s) |",
         "| sequence | dataset | sensor | events | duration (s) |",
         "| sequence | method | ct on (ln) | ct on lo (ln) | ct on hi (ln) |",
-        "| sequence | parameter | value | standard error | truth |",
+        "| sequence | parameter | value | standard error | 95 % low | 95 % high | truth |",
         "| sequence | effect | evidence | error before | error after | kept | reason |",
     ] {
         assert!(md.contains(header), "{header} in report.md");

@@ -39,6 +39,8 @@ pub fn header(name: &str) -> String {
         ("on", true) => "ON rate",
         ("off", true) => "OFF rate",
         ("on", false) => "ON",
+        ("ci95_lo", _) => "95 % low",
+        ("ci95_hi", _) => "95 % high",
         (other, _) => other,
     };
     format!("{}{unit}", stem.replace('_', " "))
@@ -132,6 +134,7 @@ mod tests {
         assert_eq!(header("sequence"), "sequence");
         assert_eq!(header("events"), "events");
         assert_eq!(header("on_fraction"), "ON (fraction)");
+        assert_eq!(header("ci95_lo"), "95 % low");
     }
 
     #[test]
