@@ -28,15 +28,23 @@
 //!
 //! - `ctcal-core`: events, simulator, statistics, estimators, fit (no other ctcal crate);
 //! - `ctcal-io`: readers, writers, the loading of a window of a recording (on core);
-//! - `ctcal-report`: tables, plots, pages, configurations and the report pipeline (on
-//!   core, and on io for the pipeline's reading);
-//! - `ctcal` (this package): the command line and the coverage study, on all three.
+//! - `ctcal-report`: tables, plots, pages and configurations of what was computed (on
+//!   core; it reads no recording);
+//! - `ctcal-pipeline`: the report pipeline, each recording read through io, analysed by
+//!   core and rendered by report (on all three);
+//! - `ctcal` (this package): the command line and the coverage study, on all four.
 
 pub use ctcal_core::*;
 pub use ctcal_io as io;
 pub use ctcal_io::window;
 pub use ctcal_io::{Format, InputError, OpenOptions, Recording};
-pub use ctcal_report as report;
+
+/// The report ([`ctcal_report`]) with its pipeline ([`ctcal_pipeline`]) under the path they
+/// had in one crate, `ctcal::report::pipeline`.
+pub mod report {
+    pub use ctcal_pipeline as pipeline;
+    pub use ctcal_report::*;
+}
 
 pub mod coverage;
 

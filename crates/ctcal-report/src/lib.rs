@@ -17,9 +17,9 @@
 //! per-pixel data can be dropped; the summary ([`render_summary`]) needs only the model.
 //! Rendering returns files as bytes; the binary writes them (the library does no I/O).
 //!
-//! Arrows point down: this crate depends on `ctcal-core` (what it renders, and the
-//! simulator its configurations and presets use) and, for its [`pipeline`] alone, on
-//! `ctcal-io` (which loads each recording's window); never on the command line.
+//! Arrows point down: this crate depends on `ctcal-core` alone (what it renders, and the
+//! simulator its configurations and presets use); it reads no recording (the pipeline that
+//! computes a report, `ctcal-pipeline`, reads them through `ctcal-io` and renders here).
 
 pub mod caveats;
 pub mod configs;
@@ -29,15 +29,13 @@ mod markdown;
 pub mod masks;
 pub mod model;
 mod page;
-pub mod pipeline;
 pub mod plots;
 pub mod presets;
 pub mod tables;
 
-// the core modules and the window loader by their old paths (`crate::sim`, ...), as when
-// this was a module of one crate
-use ctcal_core::{biases, estimate, files, fit, hint, sim, stats};
-use ctcal_io::window;
+// the core modules by their old paths (`crate::sim`, ...), as when this was a module of
+// one crate
+use ctcal_core::{estimate, fit, sim, stats};
 
 use model::{PixelData, PlotEntry, Report, SequenceReport};
 

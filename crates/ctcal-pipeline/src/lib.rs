@@ -1,4 +1,6 @@
-//! The report pipeline: each recording read, measured, estimated, fitted and rendered on
+//! # ctcal-pipeline: the report pipeline
+//!
+//! Each recording read, measured, estimated, fitted and rendered on
 //! its own ([`process`], a failure or a panic isolated to its recording), then every
 //! sequence merged into one [`Report`] ([`merge`]). [`run`] does the whole of it on this
 //! machine's threads; a caller that spreads the recordings over other machines calls
@@ -6,19 +8,29 @@
 //! their `results.json` entries ([`decode`]). Progress and warnings go to the caller's
 //! [`Observer`]; the library prints nothing and writes nothing (files are returned, or handed
 //! to the caller's writer as soon as a sequence is done).
+//!
+//! Arrows point down: this crate joins the three below it, `ctcal-io` (each recording's
+//! window), `ctcal-core` (statistics, estimators, fit) and `ctcal-report` (rendering), so
+//! that none of them needs another's layer: the report renders what it is given and reads
+//! no file.
 
 pub mod decode;
 pub mod gather;
 pub mod inputs;
 pub mod sequence;
 
-use super::OutputFile;
-use super::grouping::{Origin, dataset_names, file_stem};
-use super::model::{FailedSequence, PresetLevel, Report, SequenceReport};
+// the core modules, the window loader and the report's modules by the paths they had when
+// this was a module of the report (`crate::sim`, `crate::model`, ...)
+use ctcal_core::{biases, estimate, files, fit, hint, sim, stats};
+use ctcal_io::window;
+use ctcal_report::{OutputFile, configs, grouping, model, presets};
+
 use crate::sim::{DisplayParams, SimError};
 use crate::window::{LoadError, SelectionSpec};
 use ctcal_io::InputError;
+use grouping::{Origin, dataset_names, file_stem};
 pub use inputs::{Input, InputsError};
+use model::{FailedSequence, PresetLevel, Report, SequenceReport};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -157,7 +169,7 @@ pub fn process(
         Ok(Err(e)) => return Err(e),
         Err(payload) => return Err(SequenceError::Panic(panic_message(payload.as_ref()))),
     };
-    let files = super::render_sequence(&mut report, &pixels, options.seed);
+    let files = ctcal_report::render_sequence(&mut report, &pixels, options.seed);
     Ok(Processed { report, files })
 }
 
@@ -193,7 +205,7 @@ pub fn run<E: Send>(
         }
     };
     let (presets, sequences) = rayon::join(
-        || super::presets::simulate(options.seed),
+        || presets::simulate(options.seed),
         || inputs.par_iter().map(one).collect::<Result<Vec<_>, E>>(),
     );
     Ok(Outcomes {
@@ -216,7 +228,7 @@ fn name_datasets(sequences: &mut [SequenceReport], origins: &[Origin]) {
 
 /// The sequences merged into one report: each input's sequence, or the message of the
 /// error that stopped it (listed under `failed`), with the presets, the seed and the
-/// command line that made it. The summary is rendered of it by [`super::render_summary`].
+/// command line that made it. The summary is rendered of it by [`ctcal_report::render_summary`].
 pub fn merge(
     outcomes: Vec<(Input, Result<SequenceReport, String>)>,
     presets: Vec<PresetLevel>,
@@ -244,10 +256,10 @@ pub fn merge(
         ctcal_version: env!("CARGO_PKG_VERSION"),
         command_line,
         seed,
-        datasets: super::model::datasets(&sequences),
+        datasets: model::datasets(&sequences),
         sequences,
         presets,
-        presets_scene: super::presets::DESCRIPTION.into(),
+        presets_scene: presets::DESCRIPTION.into(),
         failed,
     }
 }
