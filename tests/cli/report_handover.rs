@@ -431,3 +431,66 @@ fn the_hot_pixel_mask_reads_back_with_mask() {
         assert_eq!(masked["hot_pixels"].as_array().unwrap().len(), 0);
     }
 }
+
+/// Two recordings of one sensor at different bias settings (a Prophesee `.bias` file beside
+/// each): the report carries each recording's biases in `results.json` and tabulates the
+/// thresholds and noise beside the bias that differs (measured pairs, issue 16).
+#[test]
+fn recordings_of_one_sensor_at_different_biases_are_tabulated_beside_them() {
+    let work = tempfile::tempdir().unwrap();
+    let source = crate::common::real("gen3_faery_evt2.raw");
+    for (name, diff_on) in [("low", 370), ("high", 400)] {
+        std::fs::copy(&source, work.path().join(format!("{name}.raw"))).unwrap();
+        std::fs::write(
+            work.path().join(format!("{name}.bias")),
+            format!("299 % bias_diff\n228 % bias_diff_off\n{diff_on} % bias_diff_on\n"),
+        )
+        .unwrap();
+    }
+    let out = work.path().join("report");
+    let output = ctcal()
+        .arg("report")
+        .arg(work.path().join("low.raw"))
+        .arg(work.path().join("high.raw"))
+        .args(["--no-fit", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let r = read_json(&out.join("results.json"));
+    let diff_on: Vec<i64> = r["sequences"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            s["stats"]["biases"]["values"]["bias_diff_on"]
+                .as_i64()
+                .unwrap()
+        })
+        .collect();
+    assert_eq!(diff_on, [370, 400]);
+    let csv = std::fs::read_to_string(out.join("tables/bias_sweep.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    assert!(
+        header.starts_with("sequence,sensor,bias_diff_on,ct_on,ct_off,"),
+        "{header}"
+    );
+    // only the bias that differs is a column
+    assert!(!header.contains("bias_diff_off"), "{header}");
+    let rows: Vec<&str> = lines.collect();
+    assert_eq!(rows.len(), 2, "{csv}");
+    assert!(
+        rows[0].starts_with("low_raw,640x480,370") && rows[1].starts_with("high_raw,640x480,400"),
+        "{csv}"
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("beside the biases that differ") && md.contains("| bias diff on |"),
+        "{md}"
+    );
+}

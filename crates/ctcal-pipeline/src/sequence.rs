@@ -142,7 +142,9 @@ pub fn sequence(
     lap("reading", &mut seconds);
     progress(&input.name, Event::Done(Stage::Reading));
 
-    let (stats, pixel_counts) = statistics(&loaded, &input.path)?;
+    let (mut stats, pixel_counts) = statistics(&loaded, &input.path)?;
+    // the sensor biases saved in or beside the recording (as `ctcal stats` shows them)
+    stats.biases = loaded.recording.biases();
     lap("statistics", &mut seconds);
     progress(&input.name, Event::Done(Stage::Statistics));
 

@@ -21,6 +21,7 @@
 //! simulator its configurations and presets use); it reads no recording (the pipeline that
 //! computes a report, `ctcal-pipeline`, reads them through `ctcal-io` and renders here).
 
+pub mod bias_sweep;
 pub mod caveats;
 pub mod configs;
 pub mod display;

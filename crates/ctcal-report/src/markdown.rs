@@ -52,6 +52,9 @@ fn summary_tables(v: &Summary, out: &mut String) {
     out.push_str("## Datasets\n\n");
     out.push_str(&table("datasets"));
     out.push('\n');
+    if let Some(t) = v.table("bias_sweep") {
+        out.push_str(&format!("{}\n\n{}\n", t.caption, display::markdown(t)));
+    }
     for d in &v.report.datasets {
         let notes: Vec<String> = d
             .warnings

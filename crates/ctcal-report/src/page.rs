@@ -238,6 +238,13 @@ fn failed_html(report: &Report) -> String {
 
 fn datasets_html(v: &Summary) -> String {
     let mut out = v.table("datasets").map(table_html).unwrap_or_default();
+    if let Some(t) = v.table("bias_sweep") {
+        out.push_str(&format!(
+            "<p class=\"note\">{}</p>\n",
+            escape_html(t.caption)
+        ));
+        out.push_str(&table_html(t));
+    }
     for d in &v.report.datasets {
         let notes: Vec<String> = d
             .warnings

@@ -20,7 +20,7 @@ pub struct Table {
 }
 
 /// A column of optional floats.
-fn floats(name: &str, values: Vec<Option<f64>>) -> Column {
+pub(crate) fn floats(name: &str, values: Vec<Option<f64>>) -> Column {
     Column::new(name.into(), values)
 }
 
@@ -29,11 +29,11 @@ fn counts(name: &str, values: Vec<Option<u64>>) -> Column {
     Column::new(name.into(), values)
 }
 
-fn strings(name: &str, values: Vec<String>) -> Column {
+pub(crate) fn strings(name: &str, values: Vec<String>) -> Column {
     Column::new(name.into(), values)
 }
 
-fn table(name: &'static str, caption: &'static str, columns: Vec<Column>) -> Table {
+pub(crate) fn table(name: &'static str, caption: &'static str, columns: Vec<Column>) -> Table {
     let frame = DataFrame::new_infer_height(columns).expect("columns of one length");
     Table {
         name,
@@ -468,13 +468,15 @@ pub fn markdown(t: &Table) -> String {
 /// Every table of a report.
 pub fn all(report: &Report) -> Vec<Table> {
     let sequences: Vec<&SequenceReport> = report.sequences.iter().collect();
-    vec![
+    let mut out = vec![
         statistics(&sequences),
         thresholds(&sequences),
         fitted_parameters(&sequences),
         fit_steps(&sequences),
         datasets(report),
-    ]
+    ];
+    out.extend(super::bias_sweep::bias_sweep(&sequences));
+    out
 }
 
 /// The per-sequence tables of one sequence (for its Parquet files).
