@@ -18,6 +18,7 @@ pub mod aedat4;
 pub mod bag;
 pub mod biases;
 mod blocks;
+#[cfg(feature = "hdf5")]
 pub mod blosc;
 pub mod dat;
 mod detect;
@@ -26,7 +27,6 @@ pub mod evt2;
 pub mod evt3;
 pub mod frame_list;
 pub mod h5;
-mod h5_direct;
 pub mod ijrr;
 pub mod info;
 pub mod mask;

@@ -34,11 +34,18 @@ pub struct OpenOptions {
 #[derive(Clone, Debug)]
 enum Source {
     Ijrr(ijrr::IjrrFiles),
+    #[cfg(feature = "hdf5")]
     H5(h5::H5Info),
     Aedat4(aedat4::Aedat4Header),
-    Evt2 { data_offset: u64 },
-    Evt3 { data_offset: u64 },
-    Dat { data_offset: u64 },
+    Evt2 {
+        data_offset: u64,
+    },
+    Evt3 {
+        data_offset: u64,
+    },
+    Dat {
+        data_offset: u64,
+    },
     Bag(bag::BagInfo),
 }
 
@@ -147,6 +154,15 @@ impl Recording {
                 });
                 (Source::Bag(info), sensor)
             }
+            #[cfg(not(feature = "hdf5"))]
+            Format::H5 => {
+                return Err(InputError::hdf5(
+                    path,
+                    "this build of ctcal-io reads no HDF5 (built without its feature `hdf5`)",
+                    "build ctcal-io with its default feature `hdf5` (libhdf5-dev installed), or convert the file to another format with a full ctcal build",
+                ));
+            }
+            #[cfg(feature = "hdf5")]
             Format::H5 => {
                 let info = h5::probe(path, options.side.unwrap_or_default())?;
                 let sensor = info.sensor.map(|s| {
@@ -231,6 +247,7 @@ impl Recording {
     /// The time of the first event (a seek and one value for indexed layouts, the first
     /// chunk otherwise).
     pub fn first_event_time(&self) -> Result<TimeUs, InputError> {
+        #[cfg(feature = "hdf5")]
         if let Source::H5(info) = &self.source
             && let Some(t) = h5::first_time(&self.path, info)?
         {
@@ -248,22 +265,35 @@ impl Recording {
     /// with the file's own index where it has one (DSEC, MVSEC), else from the start; the
     /// caller trims to the window. An empty window is not an error here.
     pub fn events_between(&self, from: TimeUs, to: TimeUs) -> Result<EventStream, InputError> {
-        let (rows, note) = match &self.source {
-            Source::H5(info) => match h5::index_window(&self.path, info, from, to)? {
-                Some((rows, note)) => (Some(rows), note),
-                None => (None, None),
-            },
-            _ => (None, None),
-        };
+        let (rows, note) = self.indexed_rows(from, to)?;
         let mut stream = self.stream(rows)?;
         stream.allow_empty = true;
         stream.notes.extend(note);
         Ok(stream)
     }
 
+    /// The rows holding times `from..=to` where the file has an index (DSEC, MVSEC), and
+    /// a note on how they were found; none (read from the start) otherwise.
+    #[cfg_attr(not(feature = "hdf5"), allow(unused_variables))]
+    fn indexed_rows(
+        &self,
+        from: TimeUs,
+        to: TimeUs,
+    ) -> Result<(Option<std::ops::Range<usize>>, Option<String>), InputError> {
+        #[cfg(feature = "hdf5")]
+        if let Source::H5(info) = &self.source
+            && let Some((rows, note)) = h5::index_window(&self.path, info, from, to)?
+        {
+            return Ok((Some(rows), note));
+        }
+        Ok((None, None))
+    }
+
+    #[cfg_attr(not(feature = "hdf5"), allow(unused_variables))]
     fn stream(&self, rows: Option<std::ops::Range<usize>>) -> Result<EventStream, InputError> {
         let decoder: Box<dyn EventDecoder> = match &self.source {
             Source::Ijrr(files) => Box::new(ijrr::IjrrDecoder::open(&files.events, self.sensor)?),
+            #[cfg(feature = "hdf5")]
             Source::H5(info) => Box::new(h5::H5Decoder::open_rows(
                 &self.path,
                 info,
@@ -384,6 +414,7 @@ impl Recording {
                 Some(images) => FrameList::read(images)?.load_all(),
                 None => Ok(Vec::new()),
             },
+            #[cfg(feature = "hdf5")]
             Source::H5(info) => h5::read_frames(&self.path, info),
             Source::Aedat4(header) => aedat4::read_frames(&self.path, header),
             Source::Bag(info) => bag::frames_where(&self.path, info, |_, _| true),
@@ -426,6 +457,7 @@ impl Recording {
                 }
                 None => Ok(Vec::new()),
             },
+            #[cfg(feature = "hdf5")]
             Source::H5(info) => Ok(h5::read_frames(&self.path, info)?
                 .into_iter()
                 .enumerate()
@@ -445,6 +477,7 @@ impl Recording {
                 Some(images) => Ok(FrameList::read(images)?.times()),
                 None => Ok(Vec::new()),
             },
+            #[cfg(feature = "hdf5")]
             Source::H5(info) => h5::read_frame_times(&self.path, info),
             Source::Aedat4(header) => aedat4::read_frame_times(&self.path, header),
             Source::Bag(info) => bag::frame_times(&self.path, info),
@@ -455,6 +488,7 @@ impl Recording {
     /// The HDF5 layout (event_utils, v2e, MVSEC, DSEC), for HDF5 files.
     pub fn layout(&self) -> Option<&'static str> {
         match &self.source {
+            #[cfg(feature = "hdf5")]
             Source::H5(info) => Some(info.layout.name()),
             _ => None,
         }

@@ -479,6 +479,10 @@ pub fn written_by_ctcal(path: &Path) -> bool {
         return false;
     }
     if head.starts_with(crate::h5::SIGNATURE) {
+        // without libhdf5 the attribute cannot be read: not known to be ctcal's, so kept
+        #[cfg(not(feature = "hdf5"))]
+        return false;
+        #[cfg(feature = "hdf5")]
         return hdf5::File::open(path)
             .map(|f| f.attr("ctcal_version").is_ok())
             .unwrap_or(false);

@@ -1,18 +1,22 @@
-//! Writers: IJRR folders ([`ijrr`]), event_utils HDF5 files ([`h5`]), Prophesee EVT3
-//! ([`evt3`]), ROS1 bags ([`bag`]) and the DSEC HDF5 layout ([`dsec`]). Every writer works in a temporary sibling and moves it into place at the end,
+//! Writers: IJRR folders ([`ijrr`]), event_utils HDF5 files (`h5`), Prophesee EVT3
+//! ([`evt3`]), ROS1 bags ([`bag`]) and the DSEC HDF5 layout (`dsec`; both HDF5 writers with
+//! the feature `hdf5`). Every writer works in a temporary sibling and moves it into place at the end,
 //! so a failure never leaves a half-written output under the requested name; where ctcal may
 //! write at all is decided by [`destination`].
 
 pub mod bag;
 pub mod destination;
+#[cfg(feature = "hdf5")]
 pub mod dsec;
 pub mod evt3;
+#[cfg(feature = "hdf5")]
 pub mod h5;
 pub mod ijrr;
 
 pub use bag::{BagCompression, BagWriter};
 pub use destination::{OutputPolicy, Staged, StagedFolder};
 pub use evt3::Evt3Writer;
+#[cfg(feature = "hdf5")]
 pub use h5::H5Writer;
 pub use ijrr::IjrrWriter;
 

@@ -1,102 +1,22 @@
-//! HDF5 event files in the layouts researchers meet most:
-//!
-//! - event_utils / event_cnn_minimal (Stoffregen et al. 2020): `events/ts` (float64 seconds;
-//!   integer timestamps, which some writers store, are read as microseconds),
-//!   `events/xs`, `events/ys` (integers), `events/ps` (bool or 0/1 or -1/1), frames as
-//!   `images/image%09d` with a `timestamp` attribute in seconds, and a root attribute
-//!   `sensor_resolution` = (H, W). Writers disagree on that order, so the claim is checked
-//!   against the coordinates and swapped when only the swapped reading contains them;
-//! - v2e: `events` N x 4 unsigned `[t_us, x, y, p]`, frames in `frame` (N, H, W) with
-//!   `frame_ts` in microseconds;
-//! - MVSEC (Zhu et al., RA-L 2018): `davis/left/events` (or `davis/right`) N x 4 float64
-//!   `[x, y, t, p]` with `t` in seconds since the epoch and `p` -1/1, grey frames in
-//!   `davis/left/image_raw` (M, H, W) with `image_raw_ts` in seconds;
-//! - DSEC (Gehrig et al., RA-L 2021): `events/x`, `events/y`, `events/t` (microseconds after
-//!   the scalar `t_offset`, also microseconds), `events/p` (0/1), compressed with the Blosc
-//!   filter (id 32001, zstd inside), which ctcal decodes itself (no HDF5 plugin needed).
-//!   Times are reported as `t + t_offset`, the file's own clock.
-//!
-//! Read through `hdf5-metno` (libhdf5) in chunks of `CHUNK_EVENTS` rows; compressed 1-D
-//! columns by direct chunk access on all cores ([`super::h5_direct`]).
+//! Reading the HDF5 layouts of [`super`] through `hdf5-metno` (libhdf5), in chunks of
+//! `CHUNK_EVENTS` rows; compressed 1-D columns by direct chunk access on all cores
+//! ([`super::direct`]).
 
-use super::error::InputError;
-use super::h5_direct::{DirectColumn, DirectError, ElementKind};
-use super::order::OrderCheck;
-use super::{EventDecoder, Progress};
+use super::direct::{DirectColumn, DirectError, ElementKind};
+use super::{H5Info, Layout, Side};
+use crate::error::InputError;
 use crate::events::{CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TimeUs};
 use crate::hint::{Hint, Text};
+use crate::order::OrderCheck;
+use crate::{EventDecoder, Progress};
 use hdf5::types::TypeDescriptor;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
-
-/// HDF5 signature at the start of a file.
-pub const SIGNATURE: &[u8] = b"\x89HDF\r\n\x1a\n";
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Layout {
-    EventUtils,
-    V2e,
-    Mvsec(Side),
-    Dsec,
-}
-
-impl Layout {
-    /// The layout's name, for `info`.
-    pub fn name(self) -> &'static str {
-        match self {
-            Layout::EventUtils => "event_utils",
-            Layout::V2e => "v2e",
-            Layout::Mvsec(_) => "MVSEC",
-            Layout::Dsec => "DSEC",
-        }
-    }
-}
-
-/// Which camera of a stereo MVSEC file.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Side {
-    #[default]
-    Left,
-    Right,
-}
-
 impl Side {
-    pub fn name(self) -> &'static str {
-        match self {
-            Side::Left => "left",
-            Side::Right => "right",
-        }
-    }
-
     /// The MVSEC group of this camera.
     fn group(self) -> String {
         format!("davis/{}", self.name())
     }
-}
-
-impl std::str::FromStr for Side {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s.to_ascii_lowercase().as_str() {
-            "left" => Ok(Side::Left),
-            "right" => Ok(Side::Right),
-            _ => Err(format!("`{s}` is not a side (left or right)")),
-        }
-    }
-}
-
-/// What an HDF5 event file holds, checked against its data.
-#[derive(Clone, Debug)]
-pub struct H5Info {
-    pub layout: Layout,
-    pub events: usize,
-    /// The sensor after checking the file's claim against the coordinates.
-    pub sensor: Option<Sensor>,
-    /// How the sensor is known (or why the claim was changed).
-    pub sensor_note: Option<String>,
-    pub frame_count: usize,
-    /// Remarks for the user (e.g. times stored with less than microsecond precision).
-    pub notes: Vec<String>,
 }
 
 fn h5_error(path: &Path, what: &str, e: hdf5::Error) -> InputError {
@@ -191,7 +111,7 @@ fn layout_of(path: &Path, file: &hdf5::File, side: Side) -> Result<Layout, Input
 }
 
 /// One 1-D column of an event_utils file: read by direct chunk access and parallel
-/// inflation where the layout allows ([`super::h5_direct`]), through libhdf5 otherwise.
+/// inflation where the layout allows ([`super::direct`]), through libhdf5 otherwise.
 /// Results go into caller buffers, which are reused from chunk to chunk.
 struct Column {
     name: String,
@@ -1537,11 +1457,11 @@ impl EventDecoder for H5Decoder {
                     "coordinates must be whole pixel numbers; the file is damaged or was written from floating-point data: rewrite it with integer x and y",
                 ));
             }
-            if !(x >= 0 && y >= 0 && super::within(self.sensor, x as u32, y as u32))
+            if !(x >= 0 && y >= 0 && crate::within(self.sensor, x as u32, y as u32))
                 || x > u32::MAX as i64
                 || y > u32::MAX as i64
             {
-                return Err(super::outside_sensor(
+                return Err(crate::outside_sensor(
                     &self.path,
                     format!("event index {index} ({}, {})", names.x, names.y),
                     x,

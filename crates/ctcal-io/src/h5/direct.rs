@@ -194,7 +194,7 @@ impl DirectColumn {
             data = match stage {
                 Stage::Deflate => inflate(&data, chunk_bytes).ok_or("does not inflate")?,
                 Stage::Shuffle => unshuffle(&data, self.element_size),
-                Stage::Blosc => super::blosc::decompress(&data, chunk_bytes)?,
+                Stage::Blosc => crate::blosc::decompress(&data, chunk_bytes)?,
             };
         }
         if data.len() == chunk_bytes {
