@@ -2,7 +2,7 @@
 //! its own terms ("give the sensor size WxH", `ctcal::hint`); the command names the flag
 //! ("pass --sensor WxH").
 
-use ctcal::hint::{Hint, Text};
+use ctcal::hint::{Analysis, Hint, Text};
 
 /// The flag that sets `hint`'s option, with its value.
 pub fn flag(hint: &Hint) -> String {
@@ -21,6 +21,9 @@ pub fn flag(hint: &Hint) -> String {
         Hint::RefreshHz => "--refresh-hz HZ".into(),
         Hint::Stimulus => "--stimulus DIR".into(),
         Hint::Roi(roi) => format!("--roi {roi}"),
+        Hint::Analysis(Analysis::Eppps) => "`ctcal estimate eppps` (no frames needed)".into(),
+        Hint::Analysis(Analysis::Fit) => "`ctcal fit`".into(),
+        Hint::Analysis(Analysis::Stats) => "`ctcal stats`".into(),
     }
 }
 

@@ -39,6 +39,30 @@ pub enum Hint {
     Stimulus,
     /// A region of interest.
     Roi(Roi),
+    /// Another analysis that answers where this one cannot.
+    Analysis(Analysis),
+}
+
+/// The analyses a fix can point to (the binary names their commands).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Analysis {
+    /// The threshold estimate from events alone (events per pixel per second).
+    Eppps,
+    /// The fit of the pixel model with its noise.
+    Fit,
+    /// The event statistics.
+    Stats,
+}
+
+impl Analysis {
+    /// The analysis as a noun.
+    pub fn name(self) -> &'static str {
+        match self {
+            Analysis::Eppps => "the events-only estimate (eppps), which needs no frames",
+            Analysis::Fit => "the fit",
+            Analysis::Stats => "the statistics",
+        }
+    }
 }
 
 impl Hint {
@@ -59,6 +83,7 @@ impl Hint {
             Hint::RefreshHz => "the display's refresh rate (Hz)".into(),
             Hint::Stimulus => "the stimulus folder".into(),
             Hint::Roi(roi) => format!("the region {roi}"),
+            Hint::Analysis(analysis) => analysis.name().into(),
         }
     }
 

@@ -22,7 +22,7 @@ use super::{
     CtEstimate, Determinable, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid,
 };
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
-use crate::hint::{Hint, Text};
+use crate::hint::{Analysis, Hint, Text};
 use crate::sim::PixelParams;
 use crate::sim::log_response::LogMap;
 use serde_json::json;
@@ -126,7 +126,8 @@ fn run_pass(
                 "too few events between consecutive frames to measure thresholds (fewer than 10 pixels with a sample of each polarity)",
                 Text::from("use a longer or busier part of the recording")
                     .aside(Hint::TimeWindow)
-                    .words(", or `ctcal estimate eppps`"),
+                    .words(", or use ")
+                    .name(Hint::Analysis(Analysis::Eppps)),
             )
         })?;
     let (cp, cn, sigma) = start.unwrap_or((
@@ -194,7 +195,10 @@ pub fn estimate(
             ),
             Text::from("use a part of the recording where the scene moves")
                 .aside(Hint::TimeWindow)
-                .words("; measure the noise with `ctcal fit` or `ctcal stats`"),
+                .words("; measure the noise with ")
+                .name(Hint::Analysis(Analysis::Fit))
+                .words(" or ")
+                .name(Hint::Analysis(Analysis::Stats)),
         ));
     }
     let used = frames.intervals.iter().filter(|i| i.used).count();

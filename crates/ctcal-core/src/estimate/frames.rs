@@ -21,6 +21,7 @@ use super::EstimateError;
 use super::flow::{FlowField, FlowOptions, dense_flow, interpolate};
 use super::image::Image;
 use crate::events::{Frame, TimeUs, us_to_s};
+use crate::hint::{Analysis, Hint, Text};
 use crate::sim::log_response::LogMap;
 use crate::sim::pixel::Transition;
 use crate::sim::{FrameSource, Sample, SimError};
@@ -100,7 +101,7 @@ impl PreparedFrames {
                     "needs at least two grey frames; the recording has {}",
                     frames.len()
                 ),
-                "use `ctcal estimate eppps`, which needs no frames",
+                Text::from("use ").name(Hint::Analysis(Analysis::Eppps)),
             ));
         }
         let (width, height) = (frames[0].width as usize, frames[0].height as usize);
@@ -194,7 +195,8 @@ impl PreparedFrames {
                     prepared.intervals.len(),
                     reasons.join("; ")
                 ),
-                "record with a fixed exposure and moderate motion, or use `ctcal estimate eppps`",
+                Text::from("record with a fixed exposure and moderate motion, or use ")
+                    .name(Hint::Analysis(Analysis::Eppps)),
             ));
         }
         Ok(prepared)
