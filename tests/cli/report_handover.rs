@@ -493,4 +493,23 @@ fn recordings_of_one_sensor_at_different_biases_are_tabulated_beside_them() {
         md.contains("beside the biases that differ") && md.contains("| bias diff on |"),
         "{md}"
     );
+    // and plotted against the bias: one point per recording, the same file twice gives the
+    // same background rate at both settings
+    assert!(md.contains("](plots/bias_sweep_bias_diff_on.png)"), "{md}");
+    assert!(out.join("plots/bias_sweep_bias_diff_on.svg").is_file());
+    let plot = std::fs::read_to_string(out.join("plots/bias_sweep_bias_diff_on.csv")).unwrap();
+    let background: Vec<(f64, f64)> = plot
+        .lines()
+        .filter_map(|l| l.strip_prefix("background rate,background,"))
+        .map(|l| {
+            let (x, y) = l.split_once(',').unwrap();
+            (x.parse().unwrap(), y.parse().unwrap())
+        })
+        .collect();
+    assert_eq!(background.len(), 2, "{plot}");
+    assert_eq!((background[0].0, background[1].0), (370.0, 400.0), "{plot}");
+    assert!(
+        background[0].1 > 0.0 && background[0].1 == background[1].1,
+        "{plot}"
+    );
 }

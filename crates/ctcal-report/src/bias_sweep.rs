@@ -33,14 +33,59 @@ pub fn differing<'a>(
     out
 }
 
+/// The recordings that carry biases, with their biases.
+fn with_biases<'a>(
+    sequences: &[&'a SequenceReport],
+) -> Vec<(&'a SequenceReport, &'a BTreeMap<String, i64>)> {
+    sequences
+        .iter()
+        .filter_map(|s| Some((*s, &s.stats.biases.as_ref()?.values)))
+        .collect()
+}
+
+/// One recording in a sweep of one bias.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepPoint {
+    pub sequence: String,
+    pub sensor: String,
+    /// The bias's value in this recording.
+    pub value: i64,
+    /// The best thresholds (ON, OFF) and the method they come from, where measured.
+    pub thresholds: Option<(f64, f64, &'static str)>,
+    pub background_rate_hz: f64,
+}
+
+/// For each bias that differs between recordings of one sensor, the recordings that set it,
+/// by sensor and value.
+pub fn sweeps(sequences: &[&SequenceReport]) -> Vec<(String, Vec<SweepPoint>)> {
+    let with = with_biases(sequences);
+    let names = differing(with.iter().map(|(s, b)| (s.sensor(), *b)));
+    names
+        .into_iter()
+        .map(|name| {
+            let mut points: Vec<SweepPoint> = with
+                .iter()
+                .filter_map(|(s, b)| {
+                    Some(SweepPoint {
+                        sequence: s.name.clone(),
+                        sensor: s.sensor(),
+                        value: *b.get(&name)?,
+                        thresholds: s.best_thresholds(),
+                        background_rate_hz: s.stats.background_rate_hz,
+                    })
+                })
+                .collect();
+            points.sort_by(|a, b| (&a.sensor, a.value).cmp(&(&b.sensor, b.value)));
+            (name, points)
+        })
+        .collect()
+}
+
 /// The bias sweep table: one row per recording that carries biases, with each differing
 /// bias, the best thresholds (and the method they come from) and the background rate;
 /// `None` when no bias differs between recordings of one sensor.
 pub fn bias_sweep(sequences: &[&SequenceReport]) -> Option<Table> {
-    let with: Vec<(&SequenceReport, &BTreeMap<String, i64>)> = sequences
-        .iter()
-        .filter_map(|s| Some((*s, &s.stats.biases.as_ref()?.values)))
-        .collect();
+    let with = with_biases(sequences);
     let names = differing(with.iter().map(|(s, b)| (s.sensor(), *b)));
     if names.is_empty() {
         return None;

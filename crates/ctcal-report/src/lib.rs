@@ -125,10 +125,20 @@ pub fn render_summary(report: &Report) -> Vec<OutputFile> {
     if let Ok(p) = &fig2 {
         files.extend(plot_files(p));
     }
-    let fig2 = fig2.map(|p| PlotEntry {
+    let entry = |p: plots::Plot| PlotEntry {
         name: p.name,
         title: p.title,
-    });
+    };
+    let fig2 = fig2.map(entry);
+    let bias_plots: Vec<Result<PlotEntry, String>> = plots::bias_sweeps(report)
+        .into_iter()
+        .map(|p| {
+            if let Ok(p) = &p {
+                files.extend(plot_files(p));
+            }
+            p.map(entry)
+        })
+        .collect();
     let combined = configs::files::combined(report);
     let combined_paths: Vec<String> = combined.iter().map(|(p, _)| p.clone()).collect();
     files.extend(combined.into_iter().map(|(path, text)| file(path, text)));
@@ -136,6 +146,7 @@ pub fn render_summary(report: &Report) -> Vec<OutputFile> {
         report,
         tables: &all_tables,
         fig2: &fig2,
+        bias_plots: &bias_plots,
         combined_configs: &combined_paths,
     };
     files.push(file("index.html", page::html(&view)));

@@ -55,6 +55,12 @@ fn summary_tables(v: &Summary, out: &mut String) {
     if let Some(t) = v.table("bias_sweep") {
         out.push_str(&format!("{}\n\n{}\n", t.caption, display::markdown(t)));
     }
+    for plot in v.bias_plots {
+        match plot {
+            Ok(p) => out.push_str(&format!("\n![{}](plots/{}.png)\n\n", p.title, p.name)),
+            Err(e) => bullets(out, &[format!("plot not drawn: {e}")]),
+        }
+    }
     for d in &v.report.datasets {
         let notes: Vec<String> = d
             .warnings

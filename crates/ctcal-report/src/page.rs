@@ -14,6 +14,8 @@ pub(super) struct Summary<'a> {
     pub report: &'a Report,
     pub tables: &'a [Table],
     pub fig2: &'a Result<PlotEntry, String>,
+    /// Thresholds and noise against each bias that differs (none when nothing differs).
+    pub bias_plots: &'a [Result<PlotEntry, String>],
     /// Configurations combined over datasets or sensors.
     pub combined_configs: &'a [String],
 }
@@ -244,6 +246,12 @@ fn datasets_html(v: &Summary) -> String {
             escape_html(t.caption)
         ));
         out.push_str(&table_html(t));
+    }
+    for plot in v.bias_plots {
+        match plot {
+            Ok(p) => out.push_str(&figure(p)),
+            Err(e) => out.push_str(&list(&[format!("plot not drawn: {e}")], "caveats")),
+        }
     }
     for d in &v.report.datasets {
         let notes: Vec<String> = d

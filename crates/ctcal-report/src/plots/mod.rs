@@ -2,6 +2,8 @@
 //! ([`Figure`]), with the data behind each as CSV. Text uses DejaVu Sans from the `dejavu`
 //! crate (registered once; the machine's fonts are never looked up).
 //!
+//! - beside the biases that differ between recordings of one sensor: thresholds and
+//!   background rate against each bias value (measured pairs, no model);
 //! - the paper's Fig. 2: each sequence's events per pixel per second as a dot per dataset,
 //!   beside the calibration scene simulated at the fixed presets CT 0.2 to 1.5;
 //! - per sequence: the e/pix/s-versus-CT calibration curve with the recording marked; the
@@ -10,6 +12,7 @@
 //!   hot pixels; the fit's residuals by intensity and by rate of change for the ideal model
 //!   and after each effect; the same-pixel interval distributions, real against simulated.
 
+mod bias;
 mod calibration;
 mod fig2;
 mod heat;
@@ -106,6 +109,24 @@ pub fn fig2(report: &Report) -> Result<Plot, String> {
         "Events per pixel per second by dataset, beside the simulated presets (Stoffregen et al. 2020, Fig. 2)",
         &Fig2 { report },
     )
+}
+
+/// One figure per bias that differs between recordings of one sensor: the best thresholds
+/// and the background rate against the bias value.
+pub fn bias_sweeps(report: &Report) -> Vec<Result<Plot, String>> {
+    let sequences: Vec<&SequenceReport> = report.sequences.iter().collect();
+    crate::bias_sweep::sweeps(&sequences)
+        .iter()
+        .map(|(bias, points)| {
+            render(
+                format!("bias_sweep_{bias}"),
+                &format!(
+                    "Thresholds and background rate against {bias}, one point per recording (measured pairs, joined in order; no bias model)"
+                ),
+                &bias::sweep(bias, points),
+            )
+        })
+        .collect()
 }
 
 /// Series of a distribution cut to the range where some series has a non-zero share (the
