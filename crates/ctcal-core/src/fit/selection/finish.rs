@@ -103,6 +103,8 @@ pub struct Parts<'a> {
     pub ambiguities: Vec<super::Ambiguity>,
     pub assumptions: Vec<String>,
     pub fixed: bool,
+    /// The starting thresholds as measured (the intervals widen where the fit disagrees).
+    pub start: Option<super::agreement::Measured>,
     pub options: &'a FitOptions,
     pub input: &'a FitInput<'a>,
 }
@@ -118,6 +120,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         ambiguities,
         mut assumptions,
         fixed,
+        start,
         options,
         input,
     } = parts;
@@ -126,6 +129,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     state
         .uncertainty
         .extend(threshold_uncertainty(simulation, &state.model));
+    if let Some(start) = &start
+        && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
+    {
+        assumptions.push(note);
+    }
     let mut params = state.model.params.clone();
     params.seed = None;
     // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml

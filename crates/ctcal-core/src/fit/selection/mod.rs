@@ -18,6 +18,7 @@
 //! Every step is recorded: the effect, its evidence, the selection error before and after,
 //! the chance level it had to beat, kept or not and why.
 
+mod agreement;
 mod alternatives;
 pub use alternatives::Ambiguity;
 mod finish;
@@ -188,6 +189,7 @@ pub fn fit(
             ambiguities,
             assumptions,
             fixed,
+            start: start.measured,
             options,
             input,
         },

@@ -55,6 +55,9 @@ pub struct Start {
     pub params: PixelParams,
     pub fixed: bool,
     pub mismatch: Option<(f64, [f64; 2])>,
+    /// The thresholds as `estimate aps` measured them, with their intervals (none for a
+    /// start value).
+    pub measured: Option<super::agreement::Measured>,
     pub step: Step,
     pub assumptions: Vec<String>,
 }
@@ -91,6 +94,7 @@ pub fn thresholds(
         params: PixelParams::ideal(default, default),
         fixed,
         mismatch: None,
+        measured: None,
         assumptions: vec![format!(
             "thresholds start at {default} (a start value, not a measurement): {reason}"
         )],
@@ -134,6 +138,10 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
         params: PixelParams::ideal(on, off),
         fixed: false,
         mismatch: e.ct_sigma.zip(e.ct_sigma_ci95),
+        measured: Some([
+            (on, e.ct_on_ci95.unwrap_or([None, None])),
+            (off, e.ct_off_ci95.unwrap_or([None, None])),
+        ]),
         assumptions: Vec::new(),
         step: step(
             format!(
