@@ -174,7 +174,14 @@ pub fn estimate(
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<TimingEstimate> {
-    let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
+    let pairs = collect(
+        events,
+        frames,
+        0,
+        sensor,
+        excluded,
+        options.support_window_us,
+    );
     let pixels = sensor.pixels();
     let (log_map, offset) = choose_response(&pairs, frames, options);
     let fit = |b: f32| {
@@ -559,17 +566,26 @@ fn maps(sensor: Sensor, on: &[(f64, u32)], off: &[(f64, u32)]) -> ThresholdMaps 
     }
 }
 
-/// How consistently the frames explain the events: the mean over polarities of the robust
-/// relative spread of the samples around their mode, at the frames' own offset (smallest
-/// when the frames' times are aligned with the events'). `None` with too few samples.
+/// How consistently the frames, their times moved by `shift`, explain the events: the mean
+/// over polarities of the robust relative spread of the samples around their mode, at the
+/// frames' own offset (smallest when the frames' times are aligned with the events').
+/// `None` with too few samples.
 pub fn spread(
     events: &EventChunk,
     frames: &PreparedFrames,
+    shift: TimeUs,
     sensor: Sensor,
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<f64> {
-    let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
+    let pairs = collect(
+        events,
+        frames,
+        shift,
+        sensor,
+        excluded,
+        options.support_window_us,
+    );
     let values = model::values(&pairs, &frames.log_map, frames.offset);
     let mut total = 0.0;
     for on in [true, false] {
