@@ -11,6 +11,7 @@
 use super::frames::PreparedFrames;
 use super::timing::{TimingOptions, spread};
 use crate::events::{EventChunk, Sensor, TimeUs};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// The alignment found.
@@ -25,7 +26,8 @@ pub struct Alignment {
     pub spread_aligned: f64,
 }
 
-/// Finds the frame-time shift of `frames` (their times are restored before returning).
+/// Finds the frame-time shift of `frames` (the grid's shifts are tried on every thread,
+/// each reading the frames at shifted times; the frames' times are as they were).
 pub fn align(
     events: &EventChunk,
     frames: &mut PreparedFrames,
@@ -39,14 +41,15 @@ pub fn align(
     }
     const STEPS: i64 = 4;
     let step = quarter / STEPS;
-    let mut evaluate = |shift: TimeUs| {
-        frames.shift_times(shift);
-        let value = spread(events, frames, sensor, excluded, options);
-        frames.shift_times(-shift);
-        value
-    };
-    let grid: Vec<(TimeUs, f64)> = (-STEPS..=STEPS)
-        .filter_map(|k| Some((k * step, evaluate(k * step)?)))
+    let evaluate = |shift: TimeUs| spread(events, frames, shift, sensor, excluded, options);
+    let tried: Vec<(TimeUs, Option<f64>)> = (-STEPS..=STEPS)
+        .into_par_iter()
+        .map(|k| (k * step, evaluate(k * step)))
+        .collect();
+    frames.replay_shifts(tried.iter().map(|t| t.0));
+    let grid: Vec<(TimeUs, f64)> = tried
+        .into_iter()
+        .filter_map(|(shift, value)| Some((shift, value?)))
         .collect();
     let unshifted = grid.iter().find(|(s, _)| *s == 0)?.1;
     let best = grid
@@ -71,7 +74,9 @@ pub fn align(
         (grid[best].0 as f64, 0.0)
     };
     let shift = shift.round() as TimeUs;
-    let aligned = evaluate(shift).unwrap_or(grid[best].1);
+    let aligned = spread(events, frames, shift, sensor, excluded, options);
+    frames.replay_shifts([shift]);
+    let aligned = aligned.unwrap_or(grid[best].1);
     // the shift at which the spread rises by 2 %: y = a (x - x*)^2 / 2 ... a = curvature
     let precision_us = if curvature > 0.0 {
         (2.0 * 0.02 * aligned / curvature).sqrt()

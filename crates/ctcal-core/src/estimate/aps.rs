@@ -23,8 +23,8 @@ use super::{
 };
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
 use crate::hint::{Analysis, Hint, Text};
-use crate::sim::PixelParams;
 use crate::sim::log_response::LogMap;
+use crate::sim::{PixelParams, Sample};
 use serde_json::json;
 
 /// Settings of `estimate aps`.
@@ -113,10 +113,13 @@ struct Pass {
     interval_s: f64,
 }
 
+/// The timing and re-simulation estimates of `frames`, with `runs` their frames upsampled
+/// along the flow ([`PreparedFrames::upsample_runs`]).
 fn run_pass(
     input: &ApsInput,
     excluded: &[bool],
     frames: &PreparedFrames,
+    runs: &[Vec<Sample>],
     options: &ApsOptions,
     start: Option<(f64, f64, f64)>,
 ) -> Result<Pass, EstimateError> {
@@ -143,9 +146,8 @@ fn run_pass(
         input.events,
     );
     let real = cells.count(input.events);
-    let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
     let resim = Resimulation {
-        runs: &runs,
+        runs,
         width: frames.width,
         height: frames.height,
         cells: &cells,
@@ -229,7 +231,13 @@ pub fn estimate(
     assumptions.push("between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity up to the offset b (no gamma: a gamma scales every log change alike, so it cannot be told from the thresholds by events and frames; frames encoded with gamma g give thresholds 1/g times the true ones)".into());
 
     progress("event timing and re-simulation", 0.2);
-    let full = run_pass(input, &excluded, &frames, options, None)?;
+    // the full frames upsampled once: for their pass and the self-calibration's simulation
+    let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    let full = run_pass(input, &excluded, &frames, &runs, options, None)?;
+    let sigma = 0.5 * (full.timing.on.sigma + full.timing.off.sigma);
+    let grid = timestamp_grid(input.events);
+    let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
+    drop(runs);
     // the alignment's precision as a systematic error of event timing
     let alignment_systematic = match &alignment {
         Some(a) if a.precision_s > 0.0 => {
@@ -271,7 +279,8 @@ pub fn estimate(
                     0.5 * (full.timing.on.sigma + full.timing.off.sigma),
                 )
             });
-            run_pass(input, &excluded, &f, options, start)
+            let runs = f.upsample_runs(0.5, options.max_upsampled_bytes);
+            run_pass(input, &excluded, &f, &runs, options, start)
                 .ok()
                 .map(|p| (step, p))
         })
@@ -292,8 +301,6 @@ pub fn estimate(
 
     // self-calibration of the timing estimator on a simulation of the same frames
     progress("self-calibration on a simulation of the frames", 0.8);
-    let sigma = 0.5 * (full.timing.on.sigma + full.timing.off.sigma);
-    let grid = timestamp_grid(input.events);
     if let Some((period, _)) = grid {
         assumptions.push(format!(
             "timestamps are quantised to {period} us (events share stamps: a simulator's frames); the self-calibration simulation is quantised alike"
@@ -302,16 +309,18 @@ pub fn estimate(
     let shift = alignment
         .as_ref()
         .map_or(0, |a| (a.shift_s * 1e6).round() as TimeUs);
-    let calibration = self_calibrate(
-        input,
-        &excluded,
-        &mut frames,
-        options,
-        &full.timing,
-        sigma,
-        grid,
-        (shift, alignment.is_some()),
-    );
+    let calibration = calibration_events.and_then(|simulated| {
+        self_calibrate(
+            input,
+            &excluded,
+            &mut frames,
+            options,
+            &full.timing,
+            sigma,
+            simulated,
+            (shift, alignment.is_some()),
+        )
+    });
 
     // event timing: corrected value, statistical and systematic errors
     let timing_series_on = series(&|p| Some(p.timing.on.ct));
@@ -668,11 +677,31 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
     }
 }
 
-/// The timing estimator's bias, found by running the same pipeline on a simulation of the
-/// same frames with the thresholds `timing` found (and `sigma`), stamped on the recording's
-/// timestamp grid: the simulation sees the frames where the alignment put them, the
-/// estimator starts from the file's frame times and aligns again (when the recording was
-/// aligned), as it did on the real events. Returns (ON bias, OFF bias, sigma bias);
+/// The events of the self-calibration: `runs` (the frames upsampled along the flow)
+/// simulated with the model the timing found (and `sigma`), stamped on the recording's
+/// timestamp grid. `None` when the simulation fails.
+fn calibration_events(
+    runs: &[Vec<Sample>],
+    frames: &PreparedFrames,
+    options: &ApsOptions,
+    timing: &TimingEstimate,
+    sigma: f64,
+    grid: Option<(TimeUs, TimeUs)>,
+) -> Option<EventChunk> {
+    let mut params = measured_model(timing, sigma);
+    params.seed = Some(options.seed);
+    let mut simulated = super::resim::simulate(runs, frames.width, frames.height, &params).ok()?;
+    if let Some(grid) = grid {
+        quantise(&mut simulated, grid);
+    }
+    Some(simulated)
+}
+
+/// The timing estimator's bias, found by running the same pipeline on `simulated`, a
+/// simulation of the same frames with the thresholds `timing` found
+/// ([`calibration_events`]): the simulation sees the frames where the alignment put them,
+/// the estimator starts from the file's frame times and aligns again (when the recording
+/// was aligned), as it did on the real events. Returns (ON bias, OFF bias, sigma bias);
 /// `frames` are left as they were.
 #[allow(clippy::too_many_arguments)]
 fn self_calibrate(
@@ -682,17 +711,9 @@ fn self_calibrate(
     options: &ApsOptions,
     timing: &TimingEstimate,
     sigma: f64,
-    grid: Option<(TimeUs, TimeUs)>,
+    simulated: EventChunk,
     (shift, realign): (TimeUs, bool),
 ) -> Option<(f64, f64, f64)> {
-    let mut params = measured_model(timing, sigma);
-    params.seed = Some(options.seed);
-    let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
-    let mut simulated = super::resim::simulate(&runs, frames.width, frames.height, &params).ok()?;
-    drop(runs);
-    if let Some(grid) = grid {
-        quantise(&mut simulated, grid);
-    }
     // back to the file's frame times, then the same alignment as for the real events
     frames.shift_times(-shift);
     let again_shift = if realign {

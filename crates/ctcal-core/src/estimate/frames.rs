@@ -210,41 +210,40 @@ impl PreparedFrames {
             return None;
         }
         let width = self.width;
-        let mut flows = Vec::new();
-        let mut intervals = Vec::new();
-        for pair in keep.windows(2) {
-            let (a, b) = (pair[0], pair[1]);
-            let mut info = IntervalInfo {
-                t_start_s: us_to_s(self.times[a]),
-                t_end_s: us_to_s(self.times[b]),
-                used: false,
-                reason: None,
-                motion_px: 0.0,
-            };
-            if !(a..b).all(|k| self.intervals[k].used) {
-                info.reason = Some("spans an interval that is not used".into());
-                flows.push(None);
-                intervals.push(info);
-                continue;
-            }
-            let log = |k: usize| {
-                Image::new(
-                    width,
-                    self.height,
-                    self.dn[k].data.iter().map(|&v| self.log(v)).collect(),
-                )
-            };
-            let flow = dense_flow(&log(a), &log(b), &options.flow);
-            let mut magnitudes = flow.magnitudes();
-            magnitudes.sort_by(f32::total_cmp);
-            info.motion_px = magnitudes[(magnitudes.len() - 1) * 95 / 100] as f64;
-            info.used = info.motion_px <= options.max_motion_px;
-            if !info.used {
-                info.reason = Some("motion too large".into());
-            }
-            flows.push(info.used.then_some(flow));
-            intervals.push(info);
-        }
+        // each interval's flow on its own thread, kept in order
+        let (flows, intervals): (Vec<Option<FlowField>>, Vec<IntervalInfo>) = keep
+            .par_windows(2)
+            .map(|pair| {
+                let (a, b) = (pair[0], pair[1]);
+                let mut info = IntervalInfo {
+                    t_start_s: us_to_s(self.times[a]),
+                    t_end_s: us_to_s(self.times[b]),
+                    used: false,
+                    reason: None,
+                    motion_px: 0.0,
+                };
+                if !(a..b).all(|k| self.intervals[k].used) {
+                    info.reason = Some("spans an interval that is not used".into());
+                    return (None, info);
+                }
+                let log = |k: usize| {
+                    Image::new(
+                        width,
+                        self.height,
+                        self.dn[k].data.iter().map(|&v| self.log(v)).collect(),
+                    )
+                };
+                let flow = dense_flow(&log(a), &log(b), &options.flow);
+                let mut magnitudes = flow.magnitudes();
+                magnitudes.sort_by(f32::total_cmp);
+                info.motion_px = magnitudes[(magnitudes.len() - 1) * 95 / 100] as f64;
+                info.used = info.motion_px <= options.max_motion_px;
+                if !info.used {
+                    info.reason = Some("motion too large".into());
+                }
+                (info.used.then_some(flow), info)
+            })
+            .unzip();
         if !intervals.iter().any(|i| i.used) {
             return None;
         }
@@ -269,6 +268,18 @@ impl PreparedFrames {
         for i in &mut self.intervals {
             i.t_start_s += us_to_s(shift);
             i.t_end_s += us_to_s(shift);
+        }
+    }
+
+    /// What shifting the frames by each of `shifts` and back leaves: the frame times as
+    /// they were, the intervals' times in seconds off by rounding (a float sum and
+    /// difference do not cancel exactly). The alignment search once shifted the frames
+    /// themselves; it now reads them at shifted times and replays the shifts here, so that
+    /// every result stays the same to the bit.
+    pub fn replay_shifts(&mut self, shifts: impl IntoIterator<Item = TimeUs>) {
+        for shift in shifts {
+            self.shift_times(shift);
+            self.shift_times(-shift);
         }
     }
 

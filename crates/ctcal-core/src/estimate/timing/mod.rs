@@ -18,6 +18,7 @@
 //! mean_p(s^2 / n_p)`, `s^2` the pooled within-pixel variance of the samples.
 
 pub mod model;
+pub mod pixels;
 pub mod samples;
 
 use crate::estimate::frames::PreparedFrames;
@@ -25,6 +26,8 @@ use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::sim::LogResponse;
 use crate::sim::log_response::LogMap;
 use model::{Coefficients, fit_at, offset_interval, offset_root, resampled_weights};
+use pixels::{PixelSlots, pixel_sums};
+use rayon::prelude::*;
 use samples::{Pair, collect};
 use serde::Serialize;
 
@@ -171,7 +174,14 @@ pub fn estimate(
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<TimingEstimate> {
-    let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
+    let pairs = collect(
+        events,
+        frames,
+        0,
+        sensor,
+        excluded,
+        options.support_window_us,
+    );
     let pixels = sensor.pixels();
     let (log_map, offset) = choose_response(&pairs, frames, options);
     let fit = |b: f32| {
@@ -188,7 +198,7 @@ pub fn estimate(
     // the thresholds across the offset's interval
     let (lo, hi) = offset.systematic_range;
     let ends: Vec<Coefficients> = [lo, hi]
-        .iter()
+        .par_iter()
         .filter(|&&b| b != offset.offset_dn)
         .filter_map(|&b| fit(b).map(|f| f.0))
         .collect();
@@ -198,9 +208,16 @@ pub fn estimate(
             .fold(0.0, f64::max)
             / 1.96
     };
-    let boot = bootstrap(&pairs, &values, &weights, pixels, options);
-    let on = polarity(&pairs, &values, &weights, &coefficients, true, sensor)?;
-    let off = polarity(&pairs, &values, &weights, &coefficients, false, sensor)?;
+    let slots = PixelSlots::new(&pairs);
+    let fitted = Fitted {
+        pairs: &pairs,
+        slots: &slots,
+        values: &values,
+        weights: &weights,
+    };
+    let boot = bootstrap(&fitted, pixels, options);
+    let on = polarity(&fitted, &coefficients, true, sensor)?;
+    let off = polarity(&fitted, &coefficients, false, sensor)?;
     let median_dn = median_level(&pairs);
     let cutoff = coefficients.cutoff_hz(median_dn, offset.offset_dn as f64);
     let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
@@ -252,21 +269,28 @@ fn choose_response(
     {
         candidates.push(LogMap::new(LogResponse::Eps, 0.0));
     }
+    // each candidate's offset and score on its own thread, then chosen in order
+    let scored: Vec<(LogMap, Offset, f64)> = candidates
+        .into_par_iter()
+        .map(|map| {
+            let fit = |b: f32| {
+                fit_at(
+                    pairs,
+                    &map,
+                    b,
+                    options.mode_window,
+                    pixels,
+                    options.fit_leak,
+                )
+            };
+            let offset = find_offset(pairs, frames, options, &fit);
+            let score =
+                fit(offset.offset_dn).map_or(f64::INFINITY, |(c, v, w)| scatter(pairs, &c, &v, &w));
+            (map, offset, score)
+        })
+        .collect();
     let mut best: Option<(LogMap, Offset, f64)> = None;
-    for (k, map) in candidates.into_iter().enumerate() {
-        let fit = |b: f32| {
-            fit_at(
-                pairs,
-                &map,
-                b,
-                options.mode_window,
-                pixels,
-                options.fit_leak,
-            )
-        };
-        let offset = find_offset(pairs, frames, options, &fit);
-        let score =
-            fit(offset.offset_dn).map_or(f64::INFINITY, |(c, v, w)| scatter(pairs, &c, &v, &w));
+    for (k, (map, offset, score)) in scored.into_iter().enumerate() {
         let margin = if k == 0 { 1.0 } else { 0.98 };
         if best.as_ref().is_none_or(|b| score < margin * b.2) {
             best = Some((map, offset, score));
@@ -275,6 +299,9 @@ fn choose_response(
     let (map, offset, _) = best.expect("one candidate at least");
     (map, offset)
 }
+
+/// The whole fit at one offset ([`fit_at`] with the response and options fixed).
+type Fit<'a> = dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)> + Sync + 'a;
 
 /// Weighted mean absolute residual of the kept pairs over the mean threshold.
 fn scatter(pairs: &[Pair], c: &Coefficients, v: &model::Values, w: &[f64]) -> f64 {
@@ -295,7 +322,7 @@ fn find_offset(
     pairs: &[Pair],
     frames: &PreparedFrames,
     options: &TimingOptions,
-    fit: &dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)>,
+    fit: &Fit<'_>,
 ) -> Offset {
     if !options.fit_offset {
         return Offset {
@@ -334,12 +361,10 @@ fn find_offset(
         return not_determined;
     };
     let pixels = frames.width * frames.height;
-    let slopes: Vec<f64> = (0..40)
-        .filter_map(|k| {
-            let w = resampled_weights(pairs, &weights, pixels, 500 + k);
-            model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.level_slope)
-        })
-        .collect();
+    let slopes: Vec<f64> = in_order(40, |k| {
+        let w = resampled_weights(pairs, &weights, pixels, 500 + k as u64);
+        model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.level_slope)
+    });
     let bound = 1.96 * std_dev(&slopes);
     let ci95 = offset_interval(&slope, root, bound, range);
     if !(OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(&root) {
@@ -372,16 +397,14 @@ fn lag_strength(
     pairs: &[Pair],
     frames: &PreparedFrames,
     options: &TimingOptions,
-    fit: &dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)>,
+    fit: &Fit<'_>,
 ) -> Option<(f64, f64)> {
     let (c, values, weights) = fit(frames.offset)?;
     let pixels = frames.width * frames.height;
-    let lags: Vec<f64> = (0..30)
-        .filter_map(|k| {
-            let w = resampled_weights(pairs, &weights, pixels, 900 + k);
-            model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.lag)
-        })
-        .collect();
+    let lags: Vec<f64> = in_order(30, |k| {
+        let w = resampled_weights(pairs, &weights, pixels, 900 + k as u64);
+        model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.lag)
+    });
     let wsum: f64 = weights.iter().sum();
     let rms = (values
         .lag
@@ -407,32 +430,40 @@ struct Bootstrap {
     lag: f64,
 }
 
-fn bootstrap(
-    pairs: &[Pair],
-    values: &model::Values,
-    weights: &[f64],
-    pixels: usize,
-    options: &TimingOptions,
-) -> Bootstrap {
-    let mut draws: Vec<[f64; 6]> = Vec::with_capacity(options.bootstrap);
+/// The pairs at the fitted offset: their values and weights, and their pixels' slots.
+struct Fitted<'a> {
+    pairs: &'a [Pair],
+    slots: &'a PixelSlots,
+    values: &'a model::Values,
+    weights: &'a [f64],
+}
+
+/// The bootstrap draws, each from its own seed (`11 + k`), run on every thread and kept in
+/// draw order: the same draws whatever the thread count.
+fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstrap {
+    let Fitted {
+        pairs,
+        slots,
+        values,
+        weights,
+    } = *fitted;
     let median_dn = median_level(pairs);
-    for k in 0..options.bootstrap {
+    let draw = |k: usize| -> Option<[f64; 6]> {
         let w = resampled_weights(pairs, weights, pixels, 11 + k as u64);
-        let Some(c) = model::fit(pairs, values, &w, options.fit_leak) else {
-            continue;
-        };
+        let c = model::fit(pairs, values, &w, options.fit_leak)?;
         let sigma = |on: bool| {
-            pixel_sums(pairs, values, &w, &c, on).map_or(0.0, |s| mean_and_sigma(&s.0).1)
+            pixel_sums(pairs, slots, values, &w, &c, on).map_or(0.0, |s| mean_and_sigma(&s.0).1)
         };
-        draws.push([
+        Some([
             c.c_on,
             c.c_off,
             sigma(true),
             sigma(false),
             c.drift + c.drift_per_dn * median_dn,
             c.lag,
-        ]);
-    }
+        ])
+    };
+    let draws: Vec<[f64; 6]> = in_order(options.bootstrap, draw);
     let sd = |k: usize| std_dev(&draws.iter().map(|d| d[k]).collect::<Vec<_>>());
     Bootstrap {
         on: sd(0),
@@ -442,6 +473,12 @@ fn bootstrap(
         drift: sd(4),
         lag: sd(5),
     }
+}
+
+/// `draw(k)` for `k` in `0..n` on every thread, the results that exist in the order of `k`.
+fn in_order<T: Send>(n: usize, draw: impl Fn(usize) -> Option<T> + Sync + Send) -> Vec<T> {
+    let all: Vec<Option<T>> = (0..n).into_par_iter().map(draw).collect();
+    all.into_iter().flatten().collect()
 }
 
 /// The median DN of the pairs' middles.
@@ -454,52 +491,20 @@ fn median_level(pairs: &[Pair]) -> f64 {
     *levels.select_nth_unstable_by(mid, f32::total_cmp).1 as f64
 }
 
-/// Per-pixel (sum, count, sum of squares) of the corrected kept samples of one polarity,
-/// with every pixel drawn `weight * n` times (1 when the weights are the fit's own), and the
-/// pixel of each entry.
-type PixelSums = (Vec<(f64, u32, f64)>, Vec<usize>);
-
-fn pixel_sums(
-    pairs: &[Pair],
-    values: &model::Values,
-    weight: &[f64],
-    c: &Coefficients,
-    on: bool,
-) -> Option<PixelSums> {
-    let mut by_pixel: std::collections::BTreeMap<u32, (f64, u32, f64, f64)> = Default::default();
-    for (i, p) in pairs.iter().enumerate() {
-        if p.on != on || weight[i] <= 0.0 {
-            continue;
-        }
-        let v = c.corrected(p, values, i);
-        let e = by_pixel.entry(p.pixel).or_default();
-        e.0 += v;
-        e.1 += 1;
-        e.2 += v * v;
-        e.3 += weight[i];
-    }
-    let mut sums = Vec::new();
-    let mut which = Vec::new();
-    for (pixel, (s, n, sq, w)) in by_pixel {
-        // a pixel drawn m times weighs m (its pairs' weights sum to m)
-        for _ in 0..(w.round() as usize).max(1) {
-            sums.push((s, n, sq));
-            which.push(pixel as usize);
-        }
-    }
-    (sums.len() >= 10).then_some((sums, which))
-}
-
 /// One polarity's estimate and its per-pixel sums.
 fn polarity(
-    pairs: &[Pair],
-    values: &model::Values,
-    weight: &[f64],
+    fitted: &Fitted,
     c: &Coefficients,
     on: bool,
     sensor: Sensor,
 ) -> Option<(PolarityEstimate, Vec<(f64, u32)>)> {
-    let (sums, which) = pixel_sums(pairs, values, weight, c, on)?;
+    let Fitted {
+        pairs,
+        slots,
+        values,
+        weights: weight,
+    } = *fitted;
+    let (sums, which) = pixel_sums(pairs, slots, values, weight, c, on)?;
     let (_, sigma) = mean_and_sigma(&sums);
     let ct = if on { c.c_on } else { c.c_off };
     let own: Vec<(usize, f64)> = pairs
@@ -561,17 +566,26 @@ fn maps(sensor: Sensor, on: &[(f64, u32)], off: &[(f64, u32)]) -> ThresholdMaps 
     }
 }
 
-/// How consistently the frames explain the events: the mean over polarities of the robust
-/// relative spread of the samples around their mode, at the frames' own offset (smallest
-/// when the frames' times are aligned with the events'). `None` with too few samples.
+/// How consistently the frames, their times moved by `shift`, explain the events: the mean
+/// over polarities of the robust relative spread of the samples around their mode, at the
+/// frames' own offset (smallest when the frames' times are aligned with the events').
+/// `None` with too few samples.
 pub fn spread(
     events: &EventChunk,
     frames: &PreparedFrames,
+    shift: TimeUs,
     sensor: Sensor,
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<f64> {
-    let pairs = collect(events, frames, sensor, excluded, options.support_window_us);
+    let pairs = collect(
+        events,
+        frames,
+        shift,
+        sensor,
+        excluded,
+        options.support_window_us,
+    );
     let values = model::values(&pairs, &frames.log_map, frames.offset);
     let mut total = 0.0;
     for on in [true, false] {

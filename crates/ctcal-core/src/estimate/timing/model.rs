@@ -162,32 +162,9 @@ pub fn fit(pairs: &[Pair], v: &Values, weight: &[f64], leak: bool) -> Option<Coe
     }
     let mean_level = v.level.iter().zip(weight).map(|(l, w)| l * w).sum::<f64>() / wsum;
     let k = if leak { 6 } else { 4 };
-    let mut xtx = nalgebra::DMatrix::<f64>::zeros(k, k);
-    let mut xty = nalgebra::DVector::<f64>::zeros(k);
-    for (i, p) in pairs.iter().enumerate() {
-        let w = weight[i];
-        if w <= 0.0 {
-            continue;
-        }
-        let s = if p.on { -1.0 } else { 1.0 };
-        let dt = p.dt as f64;
-        let dn = 0.5 * (p.dn0 + p.dn1) as f64;
-        let mut row = vec![
-            p.on as u8 as f64,
-            (!p.on) as u8 as f64,
-            v.level[i] - mean_level,
-            v.lag[i],
-        ];
-        if leak {
-            row.extend([s * dt, s * dt * dn]);
-        }
-        for a in 0..k {
-            xty[a] += w * row[a] * v.y[i];
-            for b in 0..k {
-                xtx[(a, b)] += w * row[a] * row[b];
-            }
-        }
-    }
+    let (sums, sums_y) = normal_sums(pairs, v, weight, mean_level, k);
+    let mut xtx = nalgebra::DMatrix::<f64>::from_fn(k, k, |a, b| sums[a][b]);
+    let mut xty = nalgebra::DVector::<f64>::from_fn(k, |a, _| sums_y[a]);
     // a term the pairs carry no information on (no lag where every pair is a steady ramp,
     // no level spread) is left out: its coefficient 0
     let largest = (0..k).map(|a| xtx[(a, a)]).fold(0.0, f64::max);
@@ -210,6 +187,44 @@ pub fn fit(pairs: &[Pair], v: &Values, weight: &[f64], leak: bool) -> Option<Coe
         drift: if leak { beta[4] } else { 0.0 },
         drift_per_dn: if leak { beta[5] } else { 0.0 },
     })
+}
+
+/// The sums of the normal equations over the pairs with positive `weight`, `X^T W X` and
+/// `X^T W y`, for the first `k` columns of the model. Fixed-size arrays, summed pair by
+/// pair in order (the same sums, to the bit, as any other layout summing in that order).
+fn normal_sums(
+    pairs: &[Pair],
+    v: &Values,
+    weight: &[f64],
+    mean_level: f64,
+    k: usize,
+) -> ([[f64; 6]; 6], [f64; 6]) {
+    let mut xtx = [[0.0; 6]; 6];
+    let mut xty = [0.0; 6];
+    for (i, p) in pairs.iter().enumerate() {
+        let w = weight[i];
+        if w <= 0.0 {
+            continue;
+        }
+        let s = if p.on { -1.0 } else { 1.0 };
+        let dt = p.dt as f64;
+        let dn = 0.5 * (p.dn0 + p.dn1) as f64;
+        let row = [
+            p.on as u8 as f64,
+            (!p.on) as u8 as f64,
+            v.level[i] - mean_level,
+            v.lag[i],
+            s * dt,
+            s * dt * dn,
+        ];
+        for a in 0..k {
+            xty[a] += w * row[a] * v.y[i];
+            for b in 0..k {
+                xtx[a][b] += w * row[a] * row[b];
+            }
+        }
+    }
+    (xtx, xty)
 }
 
 /// The whole fit at offset `b`: values, kept pairs, weights and coefficients.
@@ -253,10 +268,10 @@ pub fn resampled_weights(pairs: &[Pair], weight: &[f64], pixels: usize, seed: u6
 }
 
 /// The offset's interval: where the level slope is within `z` of its standard error of
-/// zero, by bisection on each side of `centre` within `[lo, hi]`; a side that reaches its
-/// bound is `None` (the data do not bound the offset there).
+/// zero, by bisection on each side of `centre` within `[lo, hi]` (the two sides at once);
+/// a side that reaches its bound is `None` (the data do not bound the offset there).
 pub fn offset_interval(
-    slope: &dyn Fn(f32) -> Option<f64>,
+    slope: &(dyn Fn(f32) -> Option<f64> + Sync),
     centre: f32,
     bound: f64,
     (lo, hi): (f32, f32),
@@ -277,7 +292,8 @@ pub fn offset_interval(
         }
         Some(0.5 * (inside + out))
     };
-    [side(lo), side(hi)]
+    let (below, above) = rayon::join(|| side(lo), || side(hi));
+    [below, above]
 }
 
 /// The offset where the level slope crosses zero, by bisection within `[lo, hi]` (the

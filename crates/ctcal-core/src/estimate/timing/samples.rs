@@ -27,7 +27,8 @@ pub struct Pair {
 /// Half the span over which a rate of change is measured, microseconds.
 const HALF_SPAN_US: TimeUs = 1000;
 
-/// DN just before and after `t` along the flow (one-sided at the ends of a used interval).
+/// DN just before and after `t` along the flow (one-sided at the ends of a used interval);
+/// `t` on the frames' own clock.
 fn around(frames: &PreparedFrames, x: u16, y: u16, t: TimeUs) -> Option<(f32, f32)> {
     let before = frames
         .dn_at(x, y, t - HALF_SPAN_US)
@@ -38,11 +39,14 @@ fn around(frames: &PreparedFrames, x: u16, y: u16, t: TimeUs) -> Option<(f32, f3
     Some((before, after))
 }
 
-/// Every usable pair of `events` (time-sorted) against `frames`: both events in used
+/// Every usable pair of `events` (time-sorted) against `frames` with their times moved by
+/// `shift` (an event at `t` is read at `t - shift` on the frames' own clock, exactly what
+/// frames whose times were shifted give, without changing them): both events in used
 /// intervals at a reliable pixel, and supported when `support_window_us` is set.
 pub fn collect(
     events: &EventChunk,
     frames: &PreparedFrames,
+    shift: TimeUs,
     sensor: Sensor,
     excluded: &[bool],
     support_window_us: Option<TimeUs>,
@@ -59,12 +63,12 @@ pub fn collect(
         if excluded[pixel] {
             continue;
         }
-        let dn = match frames.dn_at(x, y, t) {
+        let dn = match frames.dn_at(x, y, t - shift) {
             Some(dn) if support.as_ref().is_none_or(|s| s[i]) => dn,
             _ => f32::NAN,
         };
         let near = if dn.is_finite() {
-            around(frames, x, y, t).unwrap_or((dn, dn))
+            around(frames, x, y, t - shift).unwrap_or((dn, dn))
         } else {
             (dn, dn)
         };
