@@ -634,16 +634,28 @@ fn sigma_result(
         estimate.ct_sigma = Some(value);
         estimate.ct_sigma_ci95 = Some([measure.ci95[0].max(0.0), measure.ci95[1]]);
     } else {
+        let upper = measure.ci95[1].max(unresolved_upper_bound(timing));
         estimate.ct_sigma = None;
-        estimate.ct_sigma_ci95 = Some([0.0, measure.ci95[1].max(0.0)]);
+        estimate.ct_sigma_ci95 = Some([0.0, upper]);
         estimate.why.insert(
             "ct_sigma".into(),
             format!(
-                "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors; 95 % upper bound {:.4}",
-                measure.ci95[1].max(0.0)
+                "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
             ),
         );
     }
+}
+
+/// The 95 % upper bound of a spread the data do not resolve, found where it is bounded: in
+/// the excess variance (between-pixel variance less estimation noise, which the bootstrap
+/// follows through zero), `sqrt(max(v, 0) + 1.96 se(v))`. With few samples per pixel
+/// the estimation noise is large and so is the bound; the spread of `sigma` itself (zero in
+/// most draws there) would give a bound near zero that the data do not support.
+fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
+    let v = 0.5 * (timing.on.excess_variance + timing.off.excess_variance);
+    let se = 0.5
+        * (timing.on.excess_variance_standard_error + timing.off.excess_variance_standard_error);
+    (v.max(0.0) + super::interval::z95() * se).sqrt()
 }
 
 /// The offset, in words for the assumptions.

@@ -75,6 +75,14 @@ pub struct PolarityEstimate {
     /// Frozen mismatch, estimation noise removed.
     pub sigma: f64,
     pub sigma_standard_error: f64,
+    /// The between-pixel variance of the per-pixel thresholds less their estimation noise,
+    /// unclipped (negative where the noise explains the whole spread): `sigma` squared
+    /// where positive. Its bootstrap standard error bounds a spread that is not resolved
+    /// (the bootstrap of `sigma` itself collapses at zero).
+    #[serde(skip)]
+    pub excess_variance: f64,
+    #[serde(skip)]
+    pub excess_variance_standard_error: f64,
     /// Samples kept, and pixels with at least one.
     pub samples: usize,
     pub pixels: usize,
@@ -227,12 +235,14 @@ pub fn estimate(
             standard_error: boot.on,
             offset_systematic: shift(|c| c.c_on),
             sigma_standard_error: boot.sigma_on,
+            excess_variance_standard_error: boot.excess_on,
             ..on.0
         },
         off: PolarityEstimate {
             standard_error: boot.off,
             offset_systematic: shift(|c| c.c_off),
             sigma_standard_error: boot.sigma_off,
+            excess_variance_standard_error: boot.excess_off,
             ..off.0
         },
         maps: maps(sensor, &on.1, &off.1),
@@ -426,6 +436,8 @@ struct Bootstrap {
     off: f64,
     sigma_on: f64,
     sigma_off: f64,
+    excess_on: f64,
+    excess_off: f64,
     drift: f64,
     lag: f64,
 }
@@ -448,28 +460,33 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
         weights,
     } = *fitted;
     let median_dn = median_level(pairs);
-    let draw = |k: usize| -> Option<[f64; 6]> {
+    let draw = |k: usize| -> Option<[f64; 8]> {
         let w = resampled_weights(pairs, weights, pixels, 11 + k as u64);
         let c = model::fit(pairs, values, &w, options.fit_leak)?;
-        let sigma = |on: bool| {
-            pixel_sums(pairs, slots, values, &w, &c, on).map_or(0.0, |s| mean_and_sigma(&s.0).1)
+        let excess = |on: bool| {
+            pixel_sums(pairs, slots, values, &w, &c, on).map_or(0.0, |s| mean_and_excess(&s.0).1)
         };
+        let (on, off) = (excess(true), excess(false));
         Some([
             c.c_on,
             c.c_off,
-            sigma(true),
-            sigma(false),
+            sigma_of(on),
+            sigma_of(off),
             c.drift + c.drift_per_dn * median_dn,
             c.lag,
+            on,
+            off,
         ])
     };
-    let draws: Vec<[f64; 6]> = in_order(options.bootstrap, draw);
+    let draws: Vec<[f64; 8]> = in_order(options.bootstrap, draw);
     let sd = |k: usize| std_dev(&draws.iter().map(|d| d[k]).collect::<Vec<_>>());
     Bootstrap {
         on: sd(0),
         off: sd(1),
         sigma_on: sd(2),
         sigma_off: sd(3),
+        excess_on: sd(6),
+        excess_off: sd(7),
         drift: sd(4),
         lag: sd(5),
     }
@@ -505,7 +522,7 @@ fn polarity(
         weights: weight,
     } = *fitted;
     let (sums, which) = pixel_sums(pairs, slots, values, weight, c, on)?;
-    let (_, sigma) = mean_and_sigma(&sums);
+    let (_, excess) = mean_and_excess(&sums);
     let ct = if on { c.c_on } else { c.c_off };
     let own: Vec<(usize, f64)> = pairs
         .iter()
@@ -534,8 +551,10 @@ fn polarity(
             ct,
             standard_error: 0.0,
             offset_systematic: 0.0,
-            sigma,
+            sigma: sigma_of(excess),
             sigma_standard_error: 0.0,
+            excess_variance: excess,
+            excess_variance_standard_error: 0.0,
             samples: kept.len(),
             pixels: sums.len(),
             rejected: own.len() - kept.len(),
@@ -614,9 +633,23 @@ pub fn spread(
     Some(total)
 }
 
+/// The frozen spread of an excess variance (zero where the noise explains it all).
+fn sigma_of(excess_variance: f64) -> f64 {
+    excess_variance.max(0.0).sqrt()
+}
+
 /// The mean of per-pixel thresholds and the frozen spread with estimation noise removed,
 /// from per-pixel (sum, count, sum of squares).
+#[cfg(test)]
 fn mean_and_sigma(pixels: &[(f64, u32, f64)]) -> (f64, f64) {
+    let (mean, excess) = mean_and_excess(pixels);
+    (mean, sigma_of(excess))
+}
+
+/// The mean of per-pixel thresholds and their between-pixel variance less the estimation
+/// noise of each pixel's mean (the pooled within-pixel variance over its sample count),
+/// unclipped, from per-pixel (sum, count, sum of squares).
+fn mean_and_excess(pixels: &[(f64, u32, f64)]) -> (f64, f64) {
     let n = pixels.len() as f64;
     let means: Vec<f64> = pixels.iter().map(|&(s, c, _)| s / c as f64).collect();
     let mean = means.iter().sum::<f64>() / n;
@@ -635,7 +668,7 @@ fn mean_and_sigma(pixels: &[(f64, u32, f64)]) -> (f64, f64) {
         .map(|&(_, c, _)| pooled / c as f64)
         .sum::<f64>()
         / n;
-    (mean, (between - noise).max(0.0).sqrt())
+    (mean, between - noise)
 }
 
 fn std_dev(values: &[f64]) -> f64 {
@@ -672,6 +705,27 @@ mod tests {
             .collect();
         let (_, sigma) = mean_and_sigma(&shifted);
         assert!((sigma - 0.03).abs() < 0.004, "{sigma}");
+    }
+
+    /// One or two samples per pixel, each off by +-0.1, no real spread: the pixel means
+    /// spread less than their noise predicts in about half of such draws, and the excess is
+    /// then negative (kept, so a bootstrap can follow it through zero), not clipped.
+    #[test]
+    fn the_excess_variance_is_not_clipped_at_zero() {
+        let sample = |i: usize| if i.is_multiple_of(2) { 0.4 } else { 0.2 };
+        // pixels with two samples: both the same side (+-0.1) or one each (0)
+        let mut pixels: Vec<(f64, u32, f64)> = (0..400)
+            .map(|i| {
+                let (a, b) = (sample(i), sample(i / 2));
+                (a + b, 2, a * a + b * b)
+            })
+            .collect();
+        // and single samples whose spread is smaller than the pooled noise predicts
+        pixels.extend((0..400).map(|_| (0.3, 1, 0.09)));
+        let (mean, excess) = mean_and_excess(&pixels);
+        assert!((mean - 0.3).abs() < 1e-9, "{mean}");
+        assert!(excess < -0.001, "{excess}");
+        assert_eq!(mean_and_sigma(&pixels).1, 0.0);
     }
 
     #[test]
