@@ -44,7 +44,10 @@ fn recording() -> (EventChunk, Vec<Frame>) {
                 t,
                 width: WIDTH as u32,
                 height: HEIGHT as u32,
-                pixels: dn.iter().map(|&v| v.round().clamp(0.0, 255.0) as u8).collect(),
+                pixels: dn
+                    .iter()
+                    .map(|&v| v.round().clamp(0.0, 255.0) as u8)
+                    .collect(),
                 exposure_us: None,
             });
         }
