@@ -116,7 +116,7 @@ mod tests {
         let (sums, which) = pixel_sums(&pairs, &slots, &values, &weight, &c, true).unwrap();
         let mut expected: Vec<usize> = (0..24)
             .filter(|k| k % 4 != 1)
-            .map(|k| [7, 3, 40, 12][k % 4] + (k / 4) * 100)
+            .map(|k: usize| [7, 3, 40, 12][k % 4] + (k / 4) * 100)
             .collect();
         expected.sort_unstable();
         expected.insert(0, 7);
