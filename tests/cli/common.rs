@@ -50,6 +50,17 @@ pub fn json(args: &[&str]) -> serde_json::Value {
     serde_json::from_slice(&output.stdout).expect("stdout is JSON")
 }
 
+/// The output of a command that must have succeeded (its stderr in the failure message).
+pub fn succeeded(output: std::io::Result<std::process::Output>) -> std::process::Output {
+    let output = output.expect("runs");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    output
+}
+
 /// Runs ctcal expecting exit code 2; returns stderr.
 pub fn bad_input(args: &[&str]) -> String {
     let output = ctcal().args(args).output().expect("runs");

@@ -1,7 +1,7 @@
 //! `ctcal fit` without grey frames: v2e oracle cases with their frames withheld against
 //! their known parameters, and the shared events-only recordings end to end (fit, config).
 
-use crate::common::{ctcal, json, oracle, oracle_params, real};
+use crate::common::{ctcal, json, oracle, oracle_params, real, succeeded};
 
 fn fit_without_frames(case: &str) -> serde_json::Value {
     json(&["fit", oracle(case).to_str().unwrap(), "--no-frames"])
@@ -106,15 +106,11 @@ fn events_only_recordings_fit_and_configure_end_to_end() {
         ("dvxplorer_tonic.aedat4", (320, 240)),
     ] {
         let fit_path = dir.path().join(format!("{name}.json"));
-        let status = ctcal()
-            .args(["fit", real(name).to_str().unwrap(), "--json"])
-            .arg(&fit_path)
-            .output()
-            .unwrap();
-        assert!(
-            status.status.success(),
-            "{}",
-            String::from_utf8_lossy(&status.stderr)
+        succeeded(
+            ctcal()
+                .args(["fit", real(name).to_str().unwrap(), "--json"])
+                .arg(&fit_path)
+                .output(),
         );
         let fit: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(&fit_path).unwrap()).unwrap();
@@ -131,16 +127,12 @@ fn events_only_recordings_fit_and_configure_end_to_end() {
         assert!(fit["error_after"].as_f64().unwrap() < fit["error_before"].as_f64().unwrap());
         assert!(fit["params"]["ct_on"].as_f64().unwrap() > 0.0);
         assert!(fit["params"]["ct_sigma"].is_null());
-        let output = ctcal()
-            .args(["config"])
-            .arg(&fit_path)
-            .args(["--format", "v2e"])
-            .output()
-            .unwrap();
-        assert!(
-            output.status.success(),
-            "{}",
-            String::from_utf8_lossy(&output.stderr)
+        let output = succeeded(
+            ctcal()
+                .args(["config"])
+                .arg(&fit_path)
+                .args(["--format", "v2e"])
+                .output(),
         );
         let config = String::from_utf8(output.stdout).unwrap();
         assert!(config.contains("--shot_noise_rate_hz"), "{config}");

@@ -3,7 +3,7 @@
 //! and never combines sensors, writes configurations a shell runs as they are, and exports
 //! the hot-pixel masks in the form `--mask` reads.
 
-use crate::common::{bad_input, ctcal, json, oracle};
+use crate::common::{bad_input, ctcal, json, oracle, succeeded};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -325,16 +325,12 @@ fn the_v2e_script_runs_as_it_is_and_matches_its_json() {
         .unwrap();
     assert!(syntax.success(), "bash -n {}", script.display());
     let work = tempfile::tempdir().unwrap();
-    let output = std::process::Command::new("sh")
-        .arg(&script)
-        .args(["-i", "my video.mp4"])
-        .env("V2E", stub(work.path()))
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+    let output = succeeded(
+        std::process::Command::new("sh")
+            .arg(&script)
+            .args(["-i", "my video.mp4"])
+            .env("V2E", stub(work.path()))
+            .output(),
     );
     let argv: Vec<String> = String::from_utf8(output.stdout)
         .unwrap()
@@ -448,18 +444,14 @@ fn recordings_of_one_sensor_at_different_biases_are_tabulated_beside_them() {
         .unwrap();
     }
     let out = work.path().join("report");
-    let output = ctcal()
-        .arg("report")
-        .arg(work.path().join("low.raw"))
-        .arg(work.path().join("high.raw"))
-        .args(["--no-fit", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
+    succeeded(
+        ctcal()
+            .arg("report")
+            .arg(work.path().join("low.raw"))
+            .arg(work.path().join("high.raw"))
+            .args(["--no-fit", "--out"])
+            .arg(&out)
+            .output(),
     );
     let r = read_json(&out.join("results.json"));
     let diff_on: Vec<i64> = r["sequences"]
