@@ -59,7 +59,7 @@ fn timing_estimator(c: &mut Criterion) {
     let (events, frames) = recording();
     let log_map = LogMap::new(LogResponse::V2e, 0.001);
     let prepared =
-        PreparedFrames::new(&frames, &events.t, log_map, &FrameOptions::default()).unwrap();
+        PreparedFrames::new(&frames, &events.t, &[], log_map, &FrameOptions::default()).unwrap();
     let sensor = Sensor::new(WIDTH as u16, HEIGHT as u16);
     let excluded = vec![false; sensor.pixels()];
     let options = TimingOptions {

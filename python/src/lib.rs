@@ -270,6 +270,7 @@ fn estimate(
                             events: &loaded.events,
                             frames: &loaded.frames,
                             excluded: &loaded.excluded,
+                            unread: &loaded.unread,
                         },
                         &ApsOptions::default(),
                         &quiet,
@@ -355,6 +356,7 @@ fn fit(
                     events: &loaded.events,
                     frames: &loaded.frames,
                     excluded: &loaded.excluded,
+                    unread: &loaded.unread,
                 },
                 &ctcal_core::fit::FitOptions {
                     seed,

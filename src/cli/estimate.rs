@@ -151,7 +151,9 @@ pub struct ApsArgs {
     /// Exposure time of the frames, where the file does not say.
     #[arg(long, value_name = "S")]
     pub exposure_s: Option<f64>,
-    /// Use at most this many frames (evenly spread over the window).
+    /// Use at most this many frames: a window with more is measured on blocks of 20
+    /// consecutive frames, one in each equal part of it, each where its part has the most
+    /// events (only their frames and events are read).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
     /// Seconds to add to the frames' times (default: found where the events agree best with
@@ -356,6 +358,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
             events: &loaded.events,
             frames: &loaded.frames,
             excluded: &excluded,
+            unread: &loaded.unread,
         },
         &options,
         &|stage, _| spinner.set_message(stage.to_string()),

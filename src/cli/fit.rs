@@ -22,7 +22,9 @@ pub struct FitArgs {
     /// each effect, the second measures the final error.
     #[arg(long, value_name = "FRACTION", default_value_t = 0.4)]
     pub holdout: f64,
-    /// Use at most this many frames (evenly spread over the window).
+    /// Use at most this many frames: a window with more is measured on blocks of 20
+    /// consecutive frames, one in each equal part of it, each where its part has the most
+    /// events (only their frames and events are read).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
     /// Exposure time of the frames, where the file does not say.
@@ -193,6 +195,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
             events: &loaded.events,
             frames: &loaded.frames,
             excluded: &loaded.excluded,
+            unread: &loaded.unread,
         },
         &options,
         &progress,

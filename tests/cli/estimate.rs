@@ -482,3 +482,78 @@ fn aps_refuses_a_static_scene_whose_events_are_noise() {
     ]);
     assert!(e.contains("static scene") && e.contains("ctcal fit"), "{e}");
 }
+
+/// A recording with more frames than the estimator takes is measured on blocks of
+/// consecutive frames (not every k-th frame, whose flow would no longer hold): 75 frames
+/// at 25 Hz and a limit of 60 give three blocks of 20, one in each third, only their events
+/// read; the intervals between blocks are named as not read, the between-block spread is in
+/// the interval, and the thresholds still hold the truth.
+#[test]
+fn a_long_recording_is_measured_on_blocks_of_consecutive_frames() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let text = std::fs::read_to_string("calib/scenes/sample_texture_davis240c.toml").unwrap();
+    std::fs::write(&scene, text.replace("duration_s = 0.6", "duration_s = 3.0")).unwrap();
+    let rec = dir.path().join("rec");
+    succeeded(
+        ctcal()
+            .args(["simulate", "--params", "calib/params/ideal.toml", "--quiet"])
+            .args([
+                "--scene",
+                scene.to_str().unwrap(),
+                "--out",
+                rec.to_str().unwrap(),
+            ])
+            .output(),
+    );
+    let r = json(&[
+        "estimate",
+        "aps",
+        rec.to_str().unwrap(),
+        "--max-frames",
+        "60",
+    ]);
+    let assumptions: Vec<&str> = r["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| a.as_str().unwrap())
+        .collect();
+    assert!(
+        assumptions
+            .iter()
+            .any(|a| a.starts_with("measured on 3 blocks of consecutive frames (60 of 75 frames")),
+        "{assumptions:#?}"
+    );
+    assert!(
+        assumptions
+            .iter()
+            .any(|a| a.starts_with("read in blocks of frames")),
+        "{assumptions:#?}"
+    );
+    let dropped = r["intervals_dropped"].as_array().unwrap();
+    let between = dropped
+        .iter()
+        .filter(|d| {
+            d["reason"]
+                .as_str()
+                .unwrap()
+                .starts_with("between two blocks")
+        })
+        .count();
+    assert_eq!(between, 2, "{dropped:#?}");
+    // 19 intervals a block; none spans a gap
+    let used = r["intervals_used"].as_array().unwrap();
+    assert!(used.len() <= 57 && used.len() >= 50, "{}", used.len());
+    assert!(
+        used.iter()
+            .all(|i| i[1].as_f64().unwrap() - i[0].as_f64().unwrap() < 0.05),
+        "{used:?}"
+    );
+    for polarity in ["ct_on", "ct_off"] {
+        let (lo, hi) = interval(&r[format!("{polarity}_ci95").as_str()]);
+        assert!(lo < 0.3 && 0.3 < hi, "{polarity}: [{lo}, {hi}]");
+        let value = r[polarity].as_f64().unwrap();
+        assert!((value - 0.3).abs() < 0.03, "{polarity} {value}");
+    }
+}

@@ -340,6 +340,7 @@ fn fit_recovers(ct_on: f64, asymmetry: f64, noise: f64, seed: u64) -> Result<(),
             events: &events,
             frames: &frames,
             excluded: &excluded,
+            unread: &[],
         },
         &FitOptions {
             effects: EffectChoice::Auto,

@@ -7,6 +7,7 @@
 use crate::estimate::aps::{self, ApsInput, ApsOptions};
 use crate::estimate::{CtEstimate, EstimateError, eppps, screen};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
+use crate::frame_blocks;
 use crate::hint::Text;
 use crate::selection::{PixelSelection, Roi};
 use crate::sim::DisplayParams;
@@ -25,6 +26,9 @@ pub struct Loaded {
     pub frames: Vec<Frame>,
     /// Frames in the window before thinning to the frame limit.
     pub frames_available: usize,
+    /// Spans between the blocks of frames read (see [`frame_blocks`]) whose events were not
+    /// read: a pixel's change across one is unknown. Empty when the window was read whole.
+    pub unread: Vec<(TimeUs, TimeUs)>,
     /// The pixels the region / mask keep.
     pub selection: PixelSelection,
     /// One flag per pixel: left out by the region / mask (what the estimators take).
@@ -179,28 +183,53 @@ pub fn load(
     let mut notes = Vec::new();
     let mut frames = Vec::new();
     let mut frames_available = 0;
+    let mut blocks = None;
     if let Some(max_frames) = window.frames {
         let times = recording.frame_times()?;
         let inside: Vec<usize> = (0..times.len())
             .filter(|&i| times[i] >= from && times[i] <= to)
             .collect();
         frames_available = inside.len();
-        let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
-        let keep: std::collections::BTreeSet<usize> =
-            inside.iter().step_by(stride).copied().collect();
-        if stride > 1 {
-            notes.push(format!(
-                "every {stride}th of the {} frames used ({} frames; the frame limit is {max_frames})",
-                inside.len(),
-                keep.len()
-            ));
-        }
+        let inside_times: Vec<TimeUs> = inside.iter().map(|&i| times[i]).collect();
+        let plan = frame_blocks::plan(&inside_times, max_frames);
+        let keep: std::collections::BTreeSet<usize> = match plan {
+            frame_blocks::Plan::Blocks { step } if window.events_between_frames => {
+                let counts = interval_counts(&recording, &inside_times, observer)?;
+                let thinned: Vec<usize> = (0..inside.len()).step_by(step).collect();
+                let chosen =
+                    frame_blocks::choose(&frame_blocks::thinned_counts(&counts, step), max_frames);
+                let times_of: Vec<TimeUs> = thinned.iter().map(|&k| inside_times[k]).collect();
+                notes.push(blocks_note(&chosen, &times_of, (step, inside.len()), first));
+                blocks = Some(
+                    chosen
+                        .iter()
+                        .map(|&(a, b)| (times_of[a], times_of[b]))
+                        .collect::<Vec<_>>(),
+                );
+                chosen
+                    .iter()
+                    .flat_map(|&(a, b)| thinned[a..=b].iter().map(|&k| inside[k]))
+                    .collect()
+            }
+            frame_blocks::Plan::All => inside.iter().copied().collect(),
+            frame_blocks::Plan::Stride(_) | frame_blocks::Plan::Blocks { .. } => {
+                let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
+                notes.push(format!(
+                    "every {stride}th of the {} frames used ({} frames; the frame limit is {max_frames})",
+                    inside.len(),
+                    inside.len().div_ceil(stride)
+                ));
+                inside.iter().step_by(stride).copied().collect()
+            }
+        };
         frames = recording.frames_where(|i, _| keep.contains(&i))?;
         if window.events_between_frames && frames.len() >= 2 {
             from = from.max(frames[0].t);
             to = to.min(frames[frames.len() - 1].t);
         }
     }
+    let blocks = blocks.unwrap_or_default();
+    let unread: Vec<(TimeUs, TimeUs)> = blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
     let mut stream = recording.events_between(from, to)?;
     for note in &stream.notes {
         observer.warn(&note.as_str().into());
@@ -211,7 +240,9 @@ pub fn load(
         let lo = chunk.t.partition_point(|&t| t < from);
         let hi = chunk.t.partition_point(|&t| t <= to);
         for i in lo..hi.max(lo) {
-            events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
+            if !in_unread(&unread, chunk.t[i]) {
+                events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
+            }
         }
         let past_window = chunk.t.last().is_some_and(|&t| t > to);
         if events.len() > MAX_EVENTS {
@@ -276,8 +307,84 @@ pub fn load(
         events,
         frames,
         frames_available,
+        unread,
         notes,
     })
+}
+
+/// Whether `t` lies strictly inside one of the `unread` spans (time-sorted).
+fn in_unread(unread: &[(TimeUs, TimeUs)], t: TimeUs) -> bool {
+    let k = unread.partition_point(|&(_, end)| end <= t);
+    unread.get(k).is_some_and(|&(start, _)| t > start)
+}
+
+/// The events between each pair of neighbouring `times` (sorted), counted in one pass over
+/// the events of their span (none kept).
+fn interval_counts(
+    recording: &Recording,
+    times: &[TimeUs],
+    observer: &dyn LoadObserver,
+) -> Result<Vec<u64>, LoadError> {
+    let mut counts = vec![0u64; times.len().saturating_sub(1)];
+    let (from, to) = (times[0], times[times.len() - 1]);
+    let mut stream = recording.events_between(from, to)?;
+    let mut k = 0;
+    while stream.next_chunk()?.is_some() {
+        let chunk = stream.current_chunk();
+        for &t in &chunk.t {
+            if t < from || t >= to {
+                continue;
+            }
+            while times[k + 1] <= t {
+                k += 1;
+            }
+            counts[k] += 1;
+        }
+        let progress = stream.progress();
+        observer.reading(progress.done, progress.total);
+        if chunk.t.last().is_some_and(|&t| t >= to) {
+            break;
+        }
+    }
+    Ok(counts)
+}
+
+/// What the blocks' choice says in `assumptions`: `chosen` ranges of `times` (the frames
+/// thinned to every `step`-th of `all`).
+fn blocks_note(
+    chosen: &[(usize, usize)],
+    times: &[TimeUs],
+    (step, all): (usize, usize),
+    first: TimeUs,
+) -> String {
+    let used: usize = chosen.iter().map(|&(a, b)| b - a + 1).sum();
+    let read: TimeUs = chosen.iter().map(|&(a, b)| times[b] - times[a]).sum();
+    let total = times[times.len() - 1] - times[0];
+    let spans: Vec<String> = chosen
+        .iter()
+        .map(|&(a, b)| {
+            format!(
+                "{:.2}-{:.2} s",
+                us_to_s(times[a] - first),
+                us_to_s(times[b] - first)
+            )
+        })
+        .collect();
+    let thinning = if step > 1 {
+        format!(
+            ", every {step}th frame (frames at most {} ms apart)",
+            frame_blocks::MAX_SPACING_US / 1000
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        "measured on {} blocks of consecutive frames{thinning} ({used} of {all} frames, {:.1} % of the frames' time span: {}): every frame thinned evenly to the frame limit would lie more than {} ms apart, too far for the optical flow; one block in each equal part of the recording, each where its part holds the most events (an interval's events counted up to the 75th percentile of the intervals with events); only these blocks' frames and events were kept, the rest of the recording is not measured",
+        chosen.len(),
+        100.0 * read as f64 / total.max(1) as f64,
+        spans.join(", "),
+        frame_blocks::MAX_SPACING_US / 1000
+    )
 }
 
 /// The `eppps` estimate of a window: its frames, where there are and they prepare as for
@@ -297,6 +404,7 @@ pub fn eppps_of(
             events: &loaded.events,
             frames: &loaded.frames,
             excluded,
+            unread: &loaded.unread,
         };
         match aps::prepare(&input, excluded, options) {
             Ok(p) => {
@@ -354,4 +462,20 @@ pub fn default_screen() -> DisplayParams {
     const DEFAULT_SCREEN: &str = include_str!("../../../calib/screens/lcd_60hz_srgb.toml");
     DisplayParams::from_toml(DEFAULT_SCREEN, "the built-in 60 Hz LCD model")
         .expect("the built-in screen model is valid")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn only_times_strictly_between_blocks_are_unread() {
+        let unread = [(100, 200), (300, 400)];
+        let read: Vec<TimeUs> = [0, 100, 150, 200, 250, 300, 399, 400, 500]
+            .into_iter()
+            .filter(|&t| !in_unread(&unread, t))
+            .collect();
+        assert_eq!(read, vec![0, 100, 200, 250, 300, 400, 500]);
+        assert!(!in_unread(&[], 7));
+    }
 }

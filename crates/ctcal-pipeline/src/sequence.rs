@@ -122,15 +122,16 @@ pub fn sequence(
         seconds.insert(name.to_string(), clock.elapsed().as_secs_f64());
         clock = Instant::now();
     };
+    let window = Window {
+        start_s: options.start_s,
+        end_s: options.end_s,
+        frames: Some(options.max_frames),
+        events_between_frames: false,
+    };
     let loaded = load(
         &input.path,
         &Default::default(),
-        &Window {
-            start_s: options.start_s,
-            end_s: options.end_s,
-            frames: Some(options.max_frames),
-            events_between_frames: false,
-        },
+        &window,
         &options.selection,
         options.force,
         &Warnings {
@@ -138,6 +139,30 @@ pub fn sequence(
             progress,
         },
     )?;
+    // frames thinned to the limit: the frame-based methods read blocks of consecutive
+    // frames instead (see `ctcal_io::frame_blocks`), whose optical flow still holds
+    let blocks = (loaded.frames_available > options.max_frames)
+        .then(|| {
+            load(
+                &input.path,
+                &Default::default(),
+                &Window {
+                    events_between_frames: true,
+                    ..window.clone()
+                },
+                &options.selection,
+                options.force,
+                &crate::window::Silent,
+            )
+        })
+        .map(|read| {
+            read.map_err(|e| format!("the blocks of consecutive frames could not be read: {e}"))
+        });
+    let framed = match &blocks {
+        None => Ok(&loaded),
+        Some(Ok(read)) => Ok(read),
+        Some(Err(why)) => Err(why.clone()),
+    };
     let inputs = input_files(&loaded);
     lap("reading", &mut seconds);
     progress(&input.name, Event::Done(Stage::Reading));
@@ -148,7 +173,7 @@ pub fn sequence(
     lap("statistics", &mut seconds);
     progress(&input.name, Event::Done(Stage::Statistics));
 
-    let (methods, maps) = estimates(&loaded, options)?;
+    let (methods, maps) = estimates(&loaded, framed.clone(), options)?;
     lap("estimates", &mut seconds);
     progress(&input.name, Event::Done(Stage::Estimates));
 
@@ -159,7 +184,10 @@ pub fn sequence(
         .find(|m| m.method == "screen")
         .and_then(|m| m.estimate.as_ref())
         .filter(|e| e.ct_on.is_some() || e.ct_off.is_some());
-    let (fit, fit_not_applied) = fit_of(&loaded, options, screen);
+    let (fit, fit_not_applied) = match framed {
+        Ok(framed) => fit_of(framed, options, screen),
+        Err(why) => (None, Some(why.clone())),
+    };
     lap("fit", &mut seconds);
     progress(&input.name, Event::Done(Stage::Fit));
     let report = SequenceReport {
@@ -187,22 +215,34 @@ pub fn sequence(
     Ok((report, pixels))
 }
 
-/// Every applicable threshold estimate of a recording, and the per-pixel maps of `aps`.
+/// Every applicable threshold estimate of a recording, and the per-pixel maps of `aps`
+/// (from `framed`: the window read in blocks of consecutive frames where it has more frames
+/// than the limit, else `loaded` itself; or why the blocks could not be read).
 fn estimates(
     loaded: &Loaded,
+    framed: Result<&Loaded, String>,
     options: &Options,
 ) -> Result<(Vec<MethodResult>, Option<PixelMaps>), SequenceError> {
     let quiet = |_: &str, _: f64| {};
     let aps_options = ApsOptions::default();
     let mut methods = Vec::new();
     let mut maps = None;
-    if loaded.frames.len() >= 2 {
+    if let Err(why) = &framed {
+        methods.push(MethodResult {
+            method: "aps",
+            estimate: None,
+            not_applied: Some(why.clone()),
+        });
+    } else if let Ok(framed) = framed
+        && framed.frames.len() >= 2
+    {
         match aps::estimate(
             &ApsInput {
-                sensor: loaded.sensor,
-                events: &loaded.events,
-                frames: &loaded.frames,
-                excluded: &loaded.excluded,
+                sensor: framed.sensor,
+                events: &framed.events,
+                frames: &framed.frames,
+                excluded: &framed.excluded,
+                unread: &framed.unread,
             },
             &aps_options,
             &quiet,
@@ -211,7 +251,7 @@ fn estimates(
                 result
                     .estimate
                     .assumptions
-                    .extend(loaded.notes.iter().cloned());
+                    .extend(framed.notes.iter().cloned());
                 maps = Some(PixelMaps {
                     width: result.maps.width,
                     height: result.maps.height,
@@ -289,6 +329,7 @@ fn fit_of(
                 events: &loaded.events,
                 frames: &loaded.frames,
                 excluded: &loaded.excluded,
+                unread: &loaded.unread,
             },
             &FitOptions {
                 seed: options.seed,

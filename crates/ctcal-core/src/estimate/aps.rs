@@ -78,6 +78,9 @@ pub struct ApsInput<'a> {
     pub frames: &'a [Frame],
     /// Pixels to leave out (outside a region of interest, masked).
     pub excluded: &'a [bool],
+    /// Spans between blocks of frames read from a longer recording whose events were not
+    /// read (empty: read whole). See [`PreparedFrames::unread`].
+    pub unread: &'a [(TimeUs, TimeUs)],
 }
 
 /// The estimate and the per-pixel maps.
@@ -329,6 +332,15 @@ pub fn estimate(
         assumptions.push("the self-calibration (a simulation of these frames with the measured model) could not be run: the event timing's thresholds and spread are not corrected for the method's own bias, and no bias is in their intervals".into());
     }
     let (bias_on, bias_off, sigma_bias) = calibration.map_or((0.0, 0.0, 0.0), |c| c);
+    if let (Some(on), Some(off)) = (
+        full.timing.on.between_blocks_standard_error,
+        full.timing.off.between_blocks_standard_error,
+    ) {
+        assumptions.push(format!(
+            "read in blocks of frames: the event timing's statistical error adds to the bootstrap over pixels the spread between the blocks in quadrature (weighted delete-one-block jackknife, scaled by t(0.975, blocks - 1) / 1.96: ON {on:.4}, OFF {off:.4}; together: ON {:.4}, OFF {:.4}), so that thresholds that change over the recording widen the interval; the parts not read are not measured",
+            full.timing.on.standard_error, full.timing.off.standard_error
+        ));
+    }
     let timing_measure = |estimate: f64,
                           se: f64,
                           bias: f64,
@@ -520,6 +532,7 @@ pub fn prepare(
     let mut frames = PreparedFrames::new(
         input.frames,
         &input.events.t,
+        input.unread,
         options.log_map,
         &options.frames,
     )?;

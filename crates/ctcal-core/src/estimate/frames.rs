@@ -28,6 +28,16 @@ use crate::sim::{FrameSource, Sample, SimError};
 use rayon::prelude::*;
 use serde::Serialize;
 
+/// The block of frames read that event time `t` falls in, given the `unread` spans between
+/// blocks (time-sorted): the number of spans that end by `t`.
+#[inline]
+pub fn read_block(unread: &[(TimeUs, TimeUs)], t: TimeUs) -> usize {
+    if unread.is_empty() {
+        return 0;
+    }
+    unread.partition_point(|&(_, end)| end <= t)
+}
+
 /// Limits of frame selection.
 #[derive(Clone, Debug)]
 pub struct FrameOptions {
@@ -84,14 +94,19 @@ pub struct PreparedFrames {
     /// The offsets the thresholds' systematic error spans (the offset's 95 % interval, or
     /// its prior range where the data do not bound it).
     pub offset_range: (f32, f32),
+    /// Event-time spans between blocks of frames read from a longer recording whose events
+    /// were not read (time-sorted; empty when the recording was read whole): a pixel's
+    /// change across one is unknown.
+    pub unread: Vec<(TimeUs, TimeUs)>,
 }
 
 impl PreparedFrames {
     /// Prepares `frames` (time-sorted, one size); `event_times` (sorted) decide which
-    /// intervals hold events.
+    /// intervals hold events; an interval across one of the `unread` spans is not used.
     pub fn new(
         frames: &[Frame],
         event_times: &[TimeUs],
+        unread: &[(TimeUs, TimeUs)],
         log_map: LogMap,
         options: &FrameOptions,
     ) -> Result<Self, EstimateError> {
@@ -132,6 +147,11 @@ impl PreparedFrames {
                     reason: None,
                     motion_px: 0.0,
                 };
+                if unread.iter().any(|&(a, b)| a < t1 && b > t0) {
+                    info.reason =
+                        Some("between two blocks of frames read: its events were not read".into());
+                    return (None, info);
+                }
                 let problem = frame_problems[k]
                     .as_ref()
                     .map(|p| format!("frame at {:.6} s: {p}", us_to_s(t0)))
@@ -181,6 +201,7 @@ impl PreparedFrames {
             log_map,
             offset: 0.0,
             offset_range: (0.0, 0.0),
+            unread: unread.to_vec(),
         };
         if !prepared.intervals.iter().any(|i| i.used) {
             let reasons: Vec<String> = prepared
@@ -257,6 +278,7 @@ impl PreparedFrames {
             log_map: self.log_map,
             offset: self.offset,
             offset_range: self.offset_range,
+            unread: self.unread.clone(),
         })
     }
 
@@ -281,6 +303,13 @@ impl PreparedFrames {
             self.shift_times(shift);
             self.shift_times(-shift);
         }
+    }
+
+    /// The block of frames read that event time `t` falls in (0 when the recording was read
+    /// whole): the number of unread spans that end by `t`.
+    #[inline]
+    pub fn read_block(&self, t: TimeUs) -> usize {
+        read_block(&self.unread, t)
     }
 
     /// The median frame interval, microseconds.

@@ -27,7 +27,7 @@ pub mod search;
 pub mod selection;
 
 use crate::estimate::EstimateError;
-use crate::events::{EventChunk, Frame, Sensor};
+use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::sim::PixelParams;
 use crate::stats::hot_pixels::HotPixel;
 use effects::Effect;
@@ -93,6 +93,9 @@ pub struct FitInput<'a> {
     pub frames: &'a [Frame],
     /// Pixels left out (region of interest, mask).
     pub excluded: &'a [bool],
+    /// Spans between blocks of frames read from a longer recording whose events were not
+    /// read (empty: read whole).
+    pub unread: &'a [(TimeUs, TimeUs)],
 }
 
 /// A parameter with its standard error and 95 % interval.

@@ -18,7 +18,7 @@
 //! some blocks are held out of the fit ([`Subset`]) to judge each added effect on data the
 //! fit has not seen.
 
-use crate::estimate::frames::PreparedFrames;
+use crate::estimate::frames::{PreparedFrames, read_block};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::stats::support::supported;
 
@@ -134,6 +134,8 @@ pub struct Geometry {
     pub exposure: Vec<[f64; INTENSITY_BINS]>,
     /// First and last time of the used intervals.
     pub span: (TimeUs, TimeUs),
+    /// Spans between blocks of frames read whose events were not read.
+    unread: Vec<(TimeUs, TimeUs)>,
     /// Representative DN of each intensity bin (geometric middle).
     pub intensity_centres: [f64; INTENSITY_BINS],
     /// Representative change rate of each change bin (log units per second).
@@ -232,6 +234,7 @@ impl Geometry {
             change_centres,
             sensor,
             times: frames.times.clone(),
+            unread: frames.unread.clone(),
             interval_block,
             blocks,
             role,
@@ -418,7 +421,10 @@ impl Observed {
             let pol = events.on[i] as usize;
             o.pixel_counts[block * pixels + p] += 1;
             o.polarity[block][pol] += 1;
-            if previous != TimeUs::MIN {
+            // a same-pixel interval across a span whose events were not read is unknown
+            if previous != TimeUs::MIN
+                && read_block(&g.unread, previous) == read_block(&g.unread, t)
+            {
                 o.intervals[block * INTERVAL_BINS + interval_bin((t - previous) as f64 * 1e-6)] +=
                     1;
             }

@@ -68,8 +68,14 @@ impl Default for TimingOptions {
 pub struct PolarityEstimate {
     /// Mean over pixels of each pixel's threshold.
     pub ct: f64,
-    /// Standard error of `ct` (bootstrap over pixels).
+    /// Standard error of `ct`: the bootstrap over pixels, with the spread between the blocks
+    /// of frames read (see [`between_blocks`]) added in quadrature where there are blocks
+    /// (pixels and blocks are crossed: neither resampling sees the other's variation).
     pub standard_error: f64,
+    /// The between-blocks standard error where the recording was read in blocks of frames
+    /// (delete-one-block jackknife, scaled to a 95 % interval of `+-1.96` of it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub between_blocks_standard_error: Option<f64>,
     /// How far `ct` moves across the offset's 95 % interval (half the range), a systematic.
     pub offset_systematic: f64,
     /// Frozen mismatch, estimation noise removed.
@@ -224,6 +230,8 @@ pub fn estimate(
         weights: &weights,
     };
     let boot = bootstrap(&fitted, pixels, options);
+    let blocks = between_blocks(&fitted, options.fit_leak);
+    let combined = |boot: f64, block: Option<f64>| block.map_or(boot, |b| b.hypot(boot));
     let on = polarity(&fitted, &coefficients, true, sensor)?;
     let off = polarity(&fitted, &coefficients, false, sensor)?;
     let median_dn = median_level(&pairs);
@@ -232,14 +240,16 @@ pub fn estimate(
     Some(TimingEstimate {
         log_map,
         on: PolarityEstimate {
-            standard_error: boot.on,
+            standard_error: combined(boot.on, blocks.map(|b| b[0])),
+            between_blocks_standard_error: blocks.map(|b| b[0]),
             offset_systematic: shift(|c| c.c_on),
             sigma_standard_error: boot.sigma_on,
             excess_variance_standard_error: boot.excess_on,
             ..on.0
         },
         off: PolarityEstimate {
-            standard_error: boot.off,
+            standard_error: combined(boot.off, blocks.map(|b| b[1])),
+            between_blocks_standard_error: blocks.map(|b| b[1]),
             offset_systematic: shift(|c| c.c_off),
             sigma_standard_error: boot.sigma_off,
             excess_variance_standard_error: boot.excess_off,
@@ -492,6 +502,116 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
     }
 }
 
+/// The thresholds' standard error between the blocks of frames read from a longer
+/// recording (ON, OFF; `None` when it was read whole, in fewer than three blocks with
+/// samples, or a block's leave-one-out fit fails): the delete-one-block jackknife for
+/// blocks of unequal size (the delete-m_j jackknife, Busing, Meijer & van der Leeden,
+/// *Statistics and Computing* 9, 1999; Künsch 1989 for blocks of a series), each block
+/// sized by its pairs' weight. It sees what the bootstrap over pixels cannot: thresholds
+/// that change over the recording (with brightness, temperature, bias drift) and the scene
+/// each block happens to show. With few blocks the jackknife's own error is large, so it is
+/// scaled by `t(0.975, B - 1) / 1.96` (2.57 / 1.96 for six blocks) to give a 95 % interval
+/// as `+-1.96` of it.
+fn between_blocks(fitted: &Fitted, fit_leak: bool) -> Option<[f64; 2]> {
+    let Fitted {
+        pairs,
+        values,
+        weights,
+        ..
+    } = *fitted;
+    let mut sizes: std::collections::BTreeMap<u16, f64> = Default::default();
+    for (p, &w) in pairs.iter().zip(weights.iter()) {
+        if w > 0.0 {
+            *sizes.entry(p.block).or_default() += w;
+        }
+    }
+    if sizes.len() < 3 {
+        return None;
+    }
+    let whole = model::fit(pairs, values, weights, fit_leak)?;
+    let left_out = |block: u16| -> Option<[f64; 2]> {
+        let w: Vec<f64> = pairs
+            .iter()
+            .zip(weights.iter())
+            .map(|(p, &w)| if p.block == block { 0.0 } else { w })
+            .collect();
+        let c = model::fit(pairs, values, &w, fit_leak)?;
+        Some([c.c_on, c.c_off])
+    };
+    let blocks: Vec<(u16, f64)> = sizes.into_iter().collect();
+    let fits: Vec<[f64; 2]> = blocks
+        .par_iter()
+        .map(|&(b, _)| left_out(b))
+        .collect::<Option<_>>()?;
+    let sizes: Vec<f64> = blocks.iter().map(|b| b.1).collect();
+    let scale = {
+        use statrs::distribution::{ContinuousCDF, StudentsT};
+        StudentsT::new(0.0, 1.0, (blocks.len() - 1) as f64)
+            .map_or(1.0, |t| t.inverse_cdf(0.975) / 1.96)
+    };
+    let whole = [whole.c_on, whole.c_off];
+    let se = |k: usize| {
+        weighted_jackknife_se(
+            whole[k],
+            &fits.iter().map(|f| f[k]).collect::<Vec<_>>(),
+            &sizes,
+        ) * scale
+    };
+    Some([se(0), se(1)])
+}
+
+/// The delete-m_j jackknife's standard error (Busing et al. 1999, eq. 6-8): `whole` the
+/// estimate on all blocks, `left_out[j]` without block `j`, `sizes[j]` block `j`'s size.
+/// With equal sizes it is the ordinary delete-one jackknife,
+/// `sqrt((g - 1) / g * sum (left_out - mean)^2)`.
+fn weighted_jackknife_se(whole: f64, left_out: &[f64], sizes: &[f64]) -> f64 {
+    let g = left_out.len() as f64;
+    let n: f64 = sizes.iter().sum();
+    let h: Vec<f64> = sizes.iter().map(|&m| n / m).collect();
+    let corrected = g * whole
+        - left_out
+            .iter()
+            .zip(sizes)
+            .map(|(&t, &m)| (1.0 - m / n) * t)
+            .sum::<f64>();
+    let variance = left_out
+        .iter()
+        .zip(&h)
+        .map(|(&t, &h)| {
+            let pseudo = h * whole - (h - 1.0) * t;
+            (pseudo - corrected).powi(2) / (h - 1.0)
+        })
+        .sum::<f64>()
+        / g;
+    variance.max(0.0).sqrt()
+}
+
+#[cfg(test)]
+mod jackknife_tests {
+    use super::weighted_jackknife_se;
+
+    #[test]
+    fn equal_blocks_give_the_ordinary_jackknife() {
+        // the mean of 4 equal blocks with means 1, 2, 3, 6: whole 3, left out 11/3, 10/3,
+        // 3, 2; ordinary jackknife sqrt(3/4 * sum (t - 3)^2) = sqrt(3/4 * 14/9)
+        let left_out = [11.0 / 3.0, 10.0 / 3.0, 3.0, 2.0];
+        let se = weighted_jackknife_se(3.0, &left_out, &[5.0; 4]);
+        assert!((se - (0.75f64 * 14.0 / 9.0).sqrt()).abs() < 1e-12, "{se}");
+        // which is the standard error of a mean of 4 block means, sd / sqrt(4)
+        let sd = ((4.0 + 1.0 + 0.0 + 9.0) / 3.0f64).sqrt();
+        assert!((se - sd / 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn unequal_blocks_weigh_the_larger_more() {
+        // a weighted mean over blocks of sizes 1, 1, 2 with block means 0, 0, 4: whole 2;
+        // its standard error by the delta method is larger than with the big block split
+        let left_out = [8.0 / 3.0, 8.0 / 3.0, 0.0];
+        let se = weighted_jackknife_se(2.0, &left_out, &[1.0, 1.0, 2.0]);
+        assert!(se.is_finite() && se > 1.0 && se < 3.0, "{se}");
+    }
+}
+
 /// `draw(k)` for `k` in `0..n` on every thread, the results that exist in the order of `k`.
 fn in_order<T: Send>(n: usize, draw: impl Fn(usize) -> Option<T> + Sync + Send) -> Vec<T> {
     let all: Vec<Option<T>> = (0..n).into_par_iter().map(draw).collect();
@@ -550,6 +670,7 @@ fn polarity(
         PolarityEstimate {
             ct,
             standard_error: 0.0,
+            between_blocks_standard_error: None,
             offset_systematic: 0.0,
             sigma: sigma_of(excess),
             sigma_standard_error: 0.0,

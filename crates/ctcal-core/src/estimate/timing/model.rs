@@ -349,6 +349,7 @@ mod tests {
                 // a steady ramp through both events: no lag
                 around: [a as f32, a as f32, b as f32, b as f32],
                 span: 0.002,
+                block: 0,
             });
         }
         out

@@ -82,6 +82,7 @@ mod tests {
             dt: 0.01,
             around: [100.0, 100.0, dn1, dn1],
             span: 0.002,
+            block: 0,
         }
     }
 

@@ -22,6 +22,9 @@ pub struct Pair {
     /// `[before first, after first, before second, after second]`, and `2 h` in seconds.
     pub around: [f32; 4],
     pub span: f32,
+    /// The block of frames read that the pair lies in (0 when the recording was read
+    /// whole; see [`PreparedFrames::unread`]).
+    pub block: u16,
 }
 
 /// Half the span over which a rate of change is measured, microseconds.
@@ -73,7 +76,9 @@ pub fn collect(
             (dn, dn)
         };
         let (before, t_before, near_before) = previous[pixel];
-        if before.is_finite() && dn.is_finite() {
+        let block = frames.read_block(t);
+        // a pixel's change across a span whose events were not read is unknown
+        if before.is_finite() && dn.is_finite() && frames.read_block(t_before) == block {
             pairs.push(Pair {
                 pixel: pixel as u32,
                 on: events.on[i],
@@ -82,6 +87,7 @@ pub fn collect(
                 dt: ((t - t_before) as f64 * 1e-6) as f32,
                 around: [near_before.0, near_before.1, near.0, near.1],
                 span: (2 * HALF_SPAN_US) as f32 * 1e-6,
+                block: u16::try_from(block).unwrap_or(u16::MAX),
             });
         }
         previous[pixel] = (dn, t, near);

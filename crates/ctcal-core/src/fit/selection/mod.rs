@@ -222,6 +222,7 @@ fn prepare_frames(
         events: input.events,
         frames: input.frames,
         excluded: input.excluded,
+        unread: input.unread,
     };
     let prepared = aps::prepare(&all, input.excluded, &fixed)?;
     Ok((prepared.frames, found.assumptions))

@@ -45,6 +45,7 @@ impl FitRun {
             events: &self.events,
             frames: &self.frames,
             excluded: input.excluded,
+            unread: input.unread,
         }
     }
 }
