@@ -52,10 +52,10 @@ pub struct SimulateArgs {
     pub json: Option<PathBuf>,
 }
 
-/// What was simulated and what came out (`simulation.json` in an IJRR output folder).
+/// What was simulated and what came out (`simulation.json` in an IJRR output folder,
+/// stamped with ctcal's version as every JSON output).
 #[derive(Serialize)]
 struct Provenance {
-    ctcal_version: &'static str,
     width: usize,
     height: usize,
     input_samples: u64,
@@ -300,7 +300,6 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     let wall_s = started.elapsed().as_secs_f64();
     let duration_s = (summary.t_last_sample_us - summary.t_first_sample_us) as f64 * 1e-6;
     let result = Provenance {
-        ctcal_version: env!("CARGO_PKG_VERSION"),
         width,
         height,
         input_samples: summary.samples,
@@ -322,10 +321,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     };
     match writer {
         Writer::Ijrr(mut w) => {
-            w.add_file(
-                "simulation.json",
-                serde_json::to_string_pretty(&result)?.as_bytes(),
-            )?;
+            w.add_file("simulation.json", output::json_text(&result)?.as_bytes())?;
             w.finish()?
         }
         Writer::H5(w) => w.finish()?,

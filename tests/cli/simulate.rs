@@ -598,3 +598,22 @@ fn multi_object_scene_with_user_textures_and_hdf5_output() {
     );
     assert!(read_events(&first.out) == read_events(&again.out));
 }
+
+/// The `--json` summary on stdout names ctcal's version once (the provenance it flattens
+/// carries its own stamp for `simulation.json`), and `simulation.json` keeps its stamp.
+#[test]
+fn the_json_summary_names_the_version_once() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let output = succeeded(
+        ctcal()
+            .args(["simulate", "--params", "calib/params/ideal.toml"])
+            .args(["--scene", "calib/scenes/sample_texture_davis240c.toml"])
+            .args(["--out", out.to_str().unwrap(), "--json", "-", "--quiet"])
+            .output(),
+    );
+    let text = String::from_utf8(output.stdout).unwrap();
+    assert_eq!(text.matches("\"ctcal_version\"").count(), 1, "{text}");
+    let provenance = std::fs::read_to_string(out.join("simulation.json")).unwrap();
+    assert_eq!(provenance.matches("\"ctcal_version\"").count(), 1);
+}
