@@ -243,12 +243,14 @@ pub fn simulate(
     params: &PixelParams,
 ) -> Result<EventChunk, EstimateError> {
     let mut all = EventChunk::default();
-    for run in runs {
+    // each run an independent stretch of time: its own draw of the noise
+    for (k, run) in runs.iter().enumerate() {
         let mut source = ReplaySamples::new(run, width, height);
-        crate::sim::run::<crate::sim::SimError>(
+        crate::sim::run_noise_stream::<crate::sim::SimError>(
             &mut source,
             params,
             PixelMaps::default(),
+            k as u64,
             |chunk| {
                 all.extend_from(chunk);
                 Ok(())
@@ -425,4 +427,74 @@ pub fn fit(
         cells,
         simulations: resim.evaluations.get(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::simulate;
+    use crate::sim::{PixelParams, Sample, Transition};
+
+    /// `n` samples 10 ms apart of a 16 x 16 sensor at `dn(k, pixel)`.
+    fn run(n: usize, dn: impl Fn(usize, usize) -> f32) -> Vec<Sample> {
+        (0..n)
+            .map(|k| Sample {
+                t: k as i64 * 10_000,
+                dn: (0..256).map(|p| dn(k, p)).collect(),
+                transition: Transition::Linear,
+            })
+            .collect()
+    }
+
+    type Event = (i64, u16, u16, bool);
+
+    fn events_of(chunk: &crate::events::EventChunk) -> Vec<Event> {
+        (0..chunk.len())
+            .map(|i| (chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]))
+            .collect()
+    }
+
+    #[test]
+    fn runs_of_a_recording_draw_their_own_noise_over_frozen_thresholds() {
+        // shot noise on a static scene: two runs of the same length, the second 1 s later
+        let mut params = PixelParams::ideal(0.3, 0.3);
+        params.shot_noise_rate_hz = Some(20.0);
+        params.ct_sigma = Some(0.05);
+        let static_run = |offset: i64| {
+            let mut r = run(101, |_, _| 80.0);
+            r.iter_mut().for_each(|s| s.t += offset);
+            r
+        };
+        let two = simulate(&[static_run(0), static_run(2_000_000)], 16, 16, &params).unwrap();
+        let one = simulate(&[static_run(0)], 16, 16, &params).unwrap();
+        let all = events_of(&two);
+        let (first, second): (Vec<&Event>, Vec<&Event>) = all.iter().partition(|e| e.0 < 2_000_000);
+        // the first run is the simulation of that run alone, event for event
+        assert_eq!(
+            first.into_iter().copied().collect::<Vec<_>>(),
+            events_of(&one)
+        );
+        // the second's noise is not the first's shifted by 2 s
+        let shifted: Vec<_> = second
+            .iter()
+            .map(|e| (e.0 - 2_000_000, e.1, e.2, e.3))
+            .collect();
+        assert!(shifted.len() > 100, "{} noise events", shifted.len());
+        assert_ne!(shifted, events_of(&one));
+
+        // without random updates both runs fire alike: the thresholds are frozen
+        params.shot_noise_rate_hz = None;
+        let ramp = |offset: i64| {
+            let mut r = run(101, |k, p| 40.0 + k as f32 * (1.0 + (p % 7) as f32 * 0.1));
+            r.iter_mut().for_each(|s| s.t += offset);
+            r
+        };
+        let two = events_of(&simulate(&[ramp(0), ramp(2_000_000)], 16, 16, &params).unwrap());
+        let (first, second): (Vec<&Event>, Vec<&Event>) = two.iter().partition(|e| e.0 < 2_000_000);
+        let shifted: Vec<_> = second
+            .iter()
+            .map(|e| (e.0 - 2_000_000, e.1, e.2, e.3))
+            .collect();
+        assert!(first.len() > 1000);
+        assert_eq!(first.into_iter().copied().collect::<Vec<_>>(), shifted);
+    }
 }

@@ -101,11 +101,24 @@ pub fn run<E: From<SimError>>(
     source: &mut dyn FrameSource,
     params: &PixelParams,
     maps: PixelMaps,
+    sink: impl FnMut(&EventChunk) -> Result<(), E>,
+    progress: impl FnMut(u64),
+) -> Result<SimSummary, E> {
+    run_noise_stream(source, params, maps, 0, sink, progress)
+}
+
+/// [`run`] with the `noise_stream`-th draw of the pixels' random updates (see
+/// [`Simulator::noise_stream`]): the runs of one recording each take their own.
+pub fn run_noise_stream<E: From<SimError>>(
+    source: &mut dyn FrameSource,
+    params: &PixelParams,
+    maps: PixelMaps,
+    noise_stream: u64,
     mut sink: impl FnMut(&EventChunk) -> Result<(), E>,
     mut progress: impl FnMut(u64),
 ) -> Result<SimSummary, E> {
     let (width, height) = source.size();
-    let mut simulator = Simulator::new(params, width, height, maps);
+    let mut simulator = Simulator::new(params, width, height, maps).noise_stream(noise_stream);
     let mut summary = SimSummary::default();
     let count = |chunk: &EventChunk, summary: &mut SimSummary| {
         summary.events += chunk.len() as u64;

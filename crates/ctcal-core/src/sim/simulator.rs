@@ -42,6 +42,10 @@ pub struct Simulator {
     out: EventChunk,
     log_frame: Vec<f32>,
     seed: u64,
+    /// Which draw of the pixels' random updates (shot noise, temporal threshold noise,
+    /// hot-pixel trains, jitter) this simulation takes; the frozen draws (thresholds, leak
+    /// factors, which pixels are hot) do not depend on it. See [`Self::noise_stream`].
+    noise_stream: u64,
     params: PixelParams,
     maps: PixelMaps,
 }
@@ -92,9 +96,27 @@ impl Simulator {
             out: EventChunk::default(),
             log_frame: vec![0.0; width * height],
             seed: params.seed(),
+            noise_stream: 0,
             params: params.clone(),
             maps,
         }
+    }
+
+    /// The same sensor (thresholds, leak factors, hot pixels) with the `k`-th independent
+    /// draw of its random updates: separate runs of one recording (blocks of frames, runs
+    /// between dropped intervals) are independent stretches of time, whose noise must not
+    /// repeat from run to run. Stream 0 is the draw of a simulation that sets none.
+    pub fn noise_stream(mut self, k: u64) -> Self {
+        self.noise_stream = k;
+        if let Some((_, rng)) = &mut self.jitter {
+            *rng = generator(self.seed, Stream::Jitter, k);
+        }
+        self
+    }
+
+    /// The index of a row's (or the noise set-up's) generator in the noise stream.
+    fn noise_index(&self, index: u64) -> u64 {
+        index ^ self.noise_stream.rotate_left(32)
     }
 
     pub fn width(&self) -> usize {
@@ -146,7 +168,7 @@ impl Simulator {
             }
             (None, false) => vec![1.0; n],
         };
-        let mut noise_rng = generator(self.seed, Stream::Rows, u64::MAX);
+        let mut noise_rng = generator(self.seed, Stream::Rows, self.noise_index(u64::MAX));
         let noise_rate = params.shot_noise_rate_hz();
         let mut hot_next = vec![f64::INFINITY; n];
         if let Some((fraction, _)) = params.hot_pixels() {
@@ -209,7 +231,7 @@ impl Simulator {
                     busy: vec![0; width],
                     filter_end: vec![0.0; width],
                     cold,
-                    rng: generator(self.seed, Stream::Rows, y as u64),
+                    rng: generator(self.seed, Stream::Rows, self.noise_index(y as u64)),
                     events: Vec::new(),
                 }
             })
