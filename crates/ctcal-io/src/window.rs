@@ -181,82 +181,21 @@ pub fn load(
         window.end_s.map_or(TimeUs::MAX, to_us),
     );
     let mut notes = Vec::new();
-    let mut frames = Vec::new();
-    let mut frames_available = 0;
-    let mut blocks = None;
-    if let Some(max_frames) = window.frames {
-        let times = recording.frame_times()?;
-        let inside: Vec<usize> = (0..times.len())
-            .filter(|&i| times[i] >= from && times[i] <= to)
-            .collect();
-        frames_available = inside.len();
-        let inside_times: Vec<TimeUs> = inside.iter().map(|&i| times[i]).collect();
-        let plan = frame_blocks::plan(&inside_times, max_frames);
-        let keep: std::collections::BTreeSet<usize> = match plan {
-            frame_blocks::Plan::Blocks { step } if window.events_between_frames => {
-                let counts = interval_counts(&recording, &inside_times, observer)?;
-                let thinned: Vec<usize> = (0..inside.len()).step_by(step).collect();
-                let chosen =
-                    frame_blocks::choose(&frame_blocks::thinned_counts(&counts, step), max_frames);
-                let times_of: Vec<TimeUs> = thinned.iter().map(|&k| inside_times[k]).collect();
-                notes.push(blocks_note(&chosen, &times_of, (step, inside.len()), first));
-                blocks = Some(
-                    chosen
-                        .iter()
-                        .map(|&(a, b)| (times_of[a], times_of[b]))
-                        .collect::<Vec<_>>(),
-                );
-                chosen
-                    .iter()
-                    .flat_map(|&(a, b)| thinned[a..=b].iter().map(|&k| inside[k]))
-                    .collect()
-            }
-            frame_blocks::Plan::All => inside.iter().copied().collect(),
-            frame_blocks::Plan::Stride(_) | frame_blocks::Plan::Blocks { .. } => {
-                let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
-                notes.push(format!(
-                    "every {stride}th of the {} frames used ({} frames; the frame limit is {max_frames})",
-                    inside.len(),
-                    inside.len().div_ceil(stride)
-                ));
-                inside.iter().step_by(stride).copied().collect()
-            }
-        };
-        frames = recording.frames_where(|i, _| keep.contains(&i))?;
-        if window.events_between_frames && frames.len() >= 2 {
-            from = from.max(frames[0].t);
-            to = to.min(frames[frames.len() - 1].t);
+    let chosen = match window.frames {
+        Some(max_frames) => {
+            choose_frames(&recording, window, max_frames, (from, to), first, observer)?
         }
+        None => ChosenFrames::default(),
+    };
+    notes.extend(chosen.note.iter().cloned());
+    let frames = chosen.frames;
+    if window.events_between_frames && frames.len() >= 2 {
+        from = from.max(frames[0].t);
+        to = to.min(frames[frames.len() - 1].t);
     }
-    let blocks = blocks.unwrap_or_default();
-    let unread: Vec<(TimeUs, TimeUs)> = blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
-    let mut stream = recording.events_between(from, to)?;
-    for note in &stream.notes {
-        observer.warn(&note.as_str().into());
-    }
-    let mut events = EventChunk::default();
-    while stream.next_chunk()?.is_some() {
-        let chunk = stream.current_chunk();
-        let lo = chunk.t.partition_point(|&t| t < from);
-        let hi = chunk.t.partition_point(|&t| t <= to);
-        for i in lo..hi.max(lo) {
-            if !in_unread(&unread, chunk.t[i]) {
-                events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
-            }
-        }
-        let past_window = chunk.t.last().is_some_and(|&t| t > to);
-        if events.len() > MAX_EVENTS {
-            return Err(LoadError::TooManyEvents {
-                path: recording.path.clone(),
-                max: MAX_EVENTS,
-            });
-        }
-        let progress = stream.progress();
-        observer.reading(progress.done, progress.total);
-        if past_window {
-            break;
-        }
-    }
+    let unread: Vec<(TimeUs, TimeUs)> =
+        chosen.blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
+    let events = read_events(&recording, (from, to), &unread, observer)?;
     if events.is_empty() {
         return Err(InputError::EmptyWindow {
             path: recording.path.clone(),
@@ -306,10 +245,114 @@ pub fn load(
         recording,
         events,
         frames,
-        frames_available,
+        frames_available: chosen.available,
         unread,
         notes,
     })
+}
+
+/// The frames a window reads: all of them, every k-th, or blocks of consecutive frames
+/// ([`frame_blocks`]).
+#[derive(Default)]
+struct ChosenFrames {
+    frames: Vec<Frame>,
+    /// Frames in the window before the choice.
+    available: usize,
+    /// First and last frame time of each block (empty unless read in blocks).
+    blocks: Vec<(TimeUs, TimeUs)>,
+    /// What the choice says in `assumptions`.
+    note: Option<String>,
+}
+
+/// At most `max_frames` of the frames in `[from, to]`, evenly thinned or in blocks (the
+/// latter only where the window keeps just the events between its frames).
+fn choose_frames(
+    recording: &Recording,
+    window: &Window,
+    max_frames: usize,
+    (from, to): (TimeUs, TimeUs),
+    first: TimeUs,
+    observer: &dyn LoadObserver,
+) -> Result<ChosenFrames, LoadError> {
+    let times = recording.frame_times()?;
+    let inside: Vec<usize> = (0..times.len())
+        .filter(|&i| times[i] >= from && times[i] <= to)
+        .collect();
+    let inside_times: Vec<TimeUs> = inside.iter().map(|&i| times[i]).collect();
+    let mut chosen = ChosenFrames {
+        available: inside.len(),
+        ..Default::default()
+    };
+    let keep: std::collections::BTreeSet<usize> = match frame_blocks::plan(
+        &inside_times,
+        max_frames,
+    ) {
+        frame_blocks::Plan::Blocks { step } if window.events_between_frames => {
+            let counts = interval_counts(recording, &inside_times, observer)?;
+            let thinned: Vec<usize> = (0..inside.len()).step_by(step).collect();
+            let blocks =
+                frame_blocks::choose(&frame_blocks::thinned_counts(&counts, step), max_frames);
+            let times_of: Vec<TimeUs> = thinned.iter().map(|&k| inside_times[k]).collect();
+            chosen.note = Some(blocks_note(&blocks, &times_of, (step, inside.len()), first));
+            chosen.blocks = blocks
+                .iter()
+                .map(|&(a, b)| (times_of[a], times_of[b]))
+                .collect();
+            blocks
+                .iter()
+                .flat_map(|&(a, b)| thinned[a..=b].iter().map(|&k| inside[k]))
+                .collect()
+        }
+        frame_blocks::Plan::All => inside.iter().copied().collect(),
+        frame_blocks::Plan::Stride(_) | frame_blocks::Plan::Blocks { .. } => {
+            let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
+            chosen.note = Some(format!(
+                "every {stride}th of the {} frames used ({} frames; the frame limit is {max_frames})",
+                inside.len(),
+                inside.len().div_ceil(stride)
+            ));
+            inside.iter().step_by(stride).copied().collect()
+        }
+    };
+    chosen.frames = recording.frames_where(|i, _| keep.contains(&i))?;
+    Ok(chosen)
+}
+
+/// The events in `[from, to]` outside the `unread` spans, at most [`MAX_EVENTS`].
+fn read_events(
+    recording: &Recording,
+    (from, to): (TimeUs, TimeUs),
+    unread: &[(TimeUs, TimeUs)],
+    observer: &dyn LoadObserver,
+) -> Result<EventChunk, LoadError> {
+    let mut stream = recording.events_between(from, to)?;
+    for note in &stream.notes {
+        observer.warn(&note.as_str().into());
+    }
+    let mut events = EventChunk::default();
+    while stream.next_chunk()?.is_some() {
+        let chunk = stream.current_chunk();
+        let lo = chunk.t.partition_point(|&t| t < from);
+        let hi = chunk.t.partition_point(|&t| t <= to);
+        for i in lo..hi.max(lo) {
+            if !in_unread(unread, chunk.t[i]) {
+                events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
+            }
+        }
+        let past_window = chunk.t.last().is_some_and(|&t| t > to);
+        if events.len() > MAX_EVENTS {
+            return Err(LoadError::TooManyEvents {
+                path: recording.path.clone(),
+                max: MAX_EVENTS,
+            });
+        }
+        let progress = stream.progress();
+        observer.reading(progress.done, progress.total);
+        if past_window {
+            break;
+        }
+    }
+    Ok(events)
 }
 
 /// Whether `t` lies strictly inside one of the `unread` spans (time-sorted).
