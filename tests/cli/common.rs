@@ -110,3 +110,13 @@ pub fn oracle_params(case: &str) -> serde_json::Value {
     let text = std::fs::read_to_string(oracle(case).join("params.json")).expect("params.json");
     serde_json::from_str(&text).expect("valid JSON")
 }
+
+/// The strings of a JSON array (panics where it is not one of strings).
+pub fn strings(value: &serde_json::Value) -> Vec<&str> {
+    value
+        .as_array()
+        .expect("a JSON array")
+        .iter()
+        .map(|a| a.as_str().expect("a string"))
+        .collect()
+}

@@ -513,12 +513,7 @@ fn a_long_recording_is_measured_on_blocks_of_consecutive_frames() {
         "--max-frames",
         "60",
     ]);
-    let assumptions: Vec<&str> = r["assumptions"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a.as_str().unwrap())
-        .collect();
+    let assumptions = strings(&r["assumptions"]);
     assert!(
         assumptions
             .iter()

@@ -63,12 +63,7 @@ fn a_report_rebuilt_from_its_results_is_the_same_report() {
     assert_eq!(comparable(&out), comparable(sample_report()));
     assert_eq!(files(&out), files(sample_report()));
     let command = results(&out)["command_line"].clone();
-    let command: Vec<&str> = command
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a.as_str().unwrap())
-        .collect();
+    let command = crate::common::strings(&command);
     assert!(
         command
             .windows(2)

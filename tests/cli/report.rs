@@ -153,12 +153,7 @@ fn the_sample_report_has_every_part() {
     let r = results();
     assert_eq!(r["ctcal_version"], env!("CARGO_PKG_VERSION"));
     assert_eq!(r["seed"], 2020);
-    let command: Vec<&str> = r["command_line"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|a| a.as_str().unwrap())
-        .collect();
+    let command = crate::common::strings(&r["command_line"]);
     assert_eq!(command[0], "ctcal");
     assert!(command.windows(2).any(|w| w == ["report", "data_samples"]));
     for s in r["sequences"].as_array().unwrap() {
