@@ -136,7 +136,7 @@ impl Plan<'_> {
             if i >= self.args.cases {
                 return;
             }
-            let case = CaseSpec::draw(self.args.seed + i);
+            let case = CaseSpec::draw_from(self.args.seed + i, &self.args.generators.0);
             let todo = self.todo(&case);
             if todo.is_empty() {
                 continue;

@@ -17,7 +17,7 @@ mod jobs;
 mod report;
 
 use clap::Parser;
-use ctcal::coverage::Method;
+use ctcal::coverage::{Generator, Method};
 use std::path::PathBuf;
 
 #[derive(Parser, Debug)]
@@ -59,6 +59,25 @@ pub struct Args {
     /// The ctcal binary (default target/release/ctcal).
     #[arg(long)]
     pub ctcal: Option<PathBuf>,
+    /// Simulators that make the cases, comma-separated, one chosen at random per case:
+    /// ctcal, esim, voltmeter, iebcs (`ctcal::sim::peers`).
+    #[arg(long, default_value = "ctcal", value_parser = parse_generators)]
+    pub generators: Generators,
+}
+
+/// The `--generators` list.
+#[derive(Clone, Debug)]
+pub struct Generators(pub Vec<Generator>);
+
+fn parse_generators(list: &str) -> Result<Generators, String> {
+    list.split(',')
+        .map(|name| {
+            Generator::named(name.trim()).ok_or_else(|| {
+                format!("unknown generator `{name}` (ctcal, esim, voltmeter, iebcs)")
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()
+        .map(Generators)
 }
 
 fn parse_methods(list: &str) -> anyhow::Result<Vec<Method>> {

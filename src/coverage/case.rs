@@ -3,6 +3,7 @@
 //! `write_case(&serde_json::from_str(json)?, dir)`.
 
 use crate::sim::PixelParams;
+use crate::sim::peers::Peer;
 use crate::sim::scene::SceneSpec;
 use crate::sim::scene::stimulus::StimulusSpec;
 use serde::{Deserialize, Serialize};
@@ -22,25 +23,48 @@ pub struct CaseSpec {
     /// The drawn mean brightness, camera DN (nominal for multi-object scenes).
     pub brightness_dn: f64,
     pub recording: RecordingSpec,
+    /// The peer simulator's own parameters when `generator` is a peer (ESIM, DVS-Voltmeter,
+    /// IEBCS); `params` then holds only the thresholds in ctcal's terms (and the display).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub peer: Option<Peer>,
 }
 
-/// Which simulator turns the scene into events. Re-implementations of other simulators
-/// (ESIM, DVS-Voltmeter, IEBCS under `ctcal::sim::peers`) become one variant and one arm of
-/// [`crate::coverage::write`]'s match each.
+/// Which simulator turns the scene into events: ctcal's own, or a re-implementation of
+/// another simulator's pixel (`ctcal::sim::peers`), so that a method is checked across
+/// generators and not only against the conventions of the simulator it was built with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Generator {
-    /// ctcal's own pixel model (`ctcal::sim`).
+    /// ctcal's own pixel model (`ctcal::sim`, v2e's conventions).
     Ctcal,
+    /// ESIM (Rebecq et al. 2018): `ln(DN/255 + eps)`, thresholds redrawn per interval.
+    Esim,
+    /// DVS-Voltmeter (Lin et al. 2022): Brownian motion with drift, diffusion noise, leak.
+    Voltmeter,
+    /// IEBCS (Joubert et al. 2021): low-pass, latency and jitter, per-event threshold noise.
+    Iebcs,
 }
 
 impl Generator {
-    pub const ALL: [Generator; 1] = [Generator::Ctcal];
+    pub const ALL: [Generator; 4] = [
+        Generator::Ctcal,
+        Generator::Esim,
+        Generator::Voltmeter,
+        Generator::Iebcs,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Generator::Ctcal => "ctcal",
+            Generator::Esim => "esim",
+            Generator::Voltmeter => "voltmeter",
+            Generator::Iebcs => "iebcs",
         }
+    }
+
+    /// The generator of `name` (as [`Generator::name`] spells it).
+    pub fn named(name: &str) -> Option<Generator> {
+        Self::ALL.into_iter().find(|g| g.name() == name)
     }
 }
 

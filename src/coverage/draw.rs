@@ -7,6 +7,7 @@
 //! 8-200 DN, speed in 10-600 px/s; on-screen cases draw the display.
 
 use super::case::{CaseSpec, Generator, RecordingSpec, SceneFamily};
+use super::draw_peer::draw_peer;
 use super::draw_scene::{Look, draw_scene};
 use crate::sim::scene::stimulus::StimulusSpec;
 use crate::sim::{DisplayParams, LogResponse, PixelParams};
@@ -112,6 +113,10 @@ fn draw_stimulus(rng: &mut impl Rng, look: &Look, refresh_hz: f64) -> StimulusSp
     }
 }
 
+/// Mixed into a case's seed for the stream that chooses its generator and draws a peer's
+/// parameters.
+const GENERATOR_STREAM: u64 = 0x9e37_79b9_7f4a_7c15;
+
 /// Significant digits a drawn number keeps.
 const DIGITS: usize = 6;
 
@@ -146,6 +151,26 @@ impl CaseSpec {
         tidy(Self::draw_exact(seed))
     }
 
+    /// Draws the case of `seed` made by one of `generators`, chosen at random. The scene,
+    /// thresholds and effects are those of [`CaseSpec::draw`] (the generator and the peer's
+    /// own parameters come from streams of their own), so `[Generator::Ctcal]` gives exactly
+    /// [`CaseSpec::draw`]'s case.
+    pub fn draw_from(seed: u64, generators: &[Generator]) -> CaseSpec {
+        let mut case = Self::draw_exact(seed);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed ^ GENERATOR_STREAM);
+        let generator = match generators {
+            [] => Generator::Ctcal,
+            [only] => *only,
+            _ => generators[rng.random_range(0..generators.len())],
+        };
+        if let Some((peer, params)) = draw_peer(&mut rng, generator, &case.params) {
+            case.generator = generator;
+            case.peer = Some(peer);
+            case.params = params;
+        }
+        tidy(case)
+    }
+
     fn draw_exact(seed: u64) -> CaseSpec {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let family = draw_family(&mut rng);
@@ -177,6 +202,7 @@ impl CaseSpec {
             speed_px_s: look.speed_px_s,
             brightness_dn: look.brightness_dn,
             recording,
+            peer: None,
         }
     }
 }
@@ -184,6 +210,7 @@ impl CaseSpec {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sim::peers::Peer;
 
     #[test]
     fn a_case_is_reproducible_from_its_seed_and_its_json() {
@@ -201,6 +228,43 @@ mod tests {
             let json = serde_json::to_string_pretty(&case).unwrap();
             assert_eq!(serde_json::from_str::<CaseSpec>(&json).unwrap(), case);
         }
+    }
+
+    #[test]
+    fn peer_cases_keep_the_scene_and_carry_the_drawn_thresholds() {
+        let all = Generator::ALL;
+        assert_eq!(
+            CaseSpec::draw_from(7, &[Generator::Ctcal]),
+            CaseSpec::draw(7)
+        );
+        let mut seen = std::collections::BTreeSet::new();
+        for seed in 0..40 {
+            let plain = CaseSpec::draw(seed);
+            let case = CaseSpec::draw_from(seed, &all);
+            seen.insert(case.generator);
+            assert_eq!(case.recording, plain.recording);
+            assert_eq!(case.params.display, plain.params.display);
+            assert_eq!(case.peer.is_some(), case.generator != Generator::Ctcal);
+            let json = serde_json::to_string(&case).unwrap();
+            assert_eq!(serde_json::from_str::<CaseSpec>(&json).unwrap(), case);
+            match &case.peer {
+                Some(Peer::Voltmeter(v)) => {
+                    // one threshold, 1 / k1, the mean of the two drawn
+                    let mean = (plain.params.ct_on + plain.params.ct_off) / 2.0;
+                    assert!((case.params.ct_on - mean).abs() < 1e-4 * mean);
+                    assert_eq!(case.params.ct_on, case.params.ct_off);
+                    assert!((5.0..=40.0).contains(&v.k[1]));
+                }
+                Some(_) => {
+                    assert_eq!(
+                        (case.params.ct_on, case.params.ct_off),
+                        (plain.params.ct_on, plain.params.ct_off)
+                    );
+                }
+                None => assert_eq!(case, plain),
+            }
+        }
+        assert_eq!(seen.len(), 4, "{seen:?}");
     }
 
     #[test]

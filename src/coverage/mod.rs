@@ -12,6 +12,7 @@
 
 pub mod case;
 pub mod draw;
+mod draw_peer;
 mod draw_scene;
 pub mod method;
 pub mod record;

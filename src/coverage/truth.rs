@@ -3,6 +3,7 @@
 //! brightness), for tracing a miss to its cause.
 
 use super::case::{CaseSpec, Generator, SceneFamily};
+use crate::sim::peers::Peer;
 use crate::sim::{LogResponse, PixelParams};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -86,16 +87,55 @@ pub fn true_values(params: &PixelParams) -> BTreeMap<String, f64> {
     values
 }
 
+/// The effects and scored values of a peer's case. Only the thresholds are scored: the
+/// peers' threshold noise (redrawn per interval or per event), refractory period (changes
+/// dropped, not delayed), leak (brightness dependent) and noise (diffusion, measured
+/// distributions) are not the parameters ctcal's fit reports, so their values are listed
+/// as effects for the breakdown, not scored.
+fn peer_truth(peer: &Peer) -> (Vec<String>, BTreeMap<String, f64>) {
+    let truth = peer.truth().expect("a case's peer reads no noise files");
+    let effects = [
+        (
+            "threshold_noise",
+            truth.ct_sigma > 0.0 || truth.ct_sigma_off > 0.0,
+        ),
+        ("refractory", truth.refractory.period_s > 0.0),
+        (
+            "leak",
+            truth.leak.on_rate_hz > 0.0 || truth.leak.on_rate_hz_per_dn > 0.0,
+        ),
+        (
+            "noise",
+            truth.noise.on_rate_hz > 0.0 || truth.noise.model != "none",
+        ),
+        ("bandwidth", truth.cutoff.is_some()),
+        ("latency", truth.latency.mean_s > 0.0),
+    ]
+    .into_iter()
+    .filter(|(_, present)| *present)
+    .map(|(name, _)| name.to_string())
+    .collect();
+    let values = [("ct_on", truth.ct_on), ("ct_off", truth.ct_off)]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+    (effects, values)
+}
+
 impl Truth {
     /// The truth of `case` before simulation (the recording's measurements at zero).
     pub fn of(case: &CaseSpec) -> Truth {
         let (width, height) = case.size();
+        let (effects, values) = match &case.peer {
+            Some(peer) => peer_truth(peer),
+            None => (effects_present(&case.params), true_values(&case.params)),
+        };
         Truth {
             case_id: case.id.clone(),
             generator: case.generator,
             family: case.family,
-            effects: effects_present(&case.params),
-            values: true_values(&case.params),
+            effects,
+            values,
             params: case.params.clone(),
             width,
             height,

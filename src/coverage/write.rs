@@ -100,14 +100,30 @@ fn generate(
     input: &mut CameraInput,
     writer: &mut IjrrWriter,
 ) -> Result<SimSummary, SimError> {
-    match case.generator {
-        Generator::Ctcal => crate::sim::run::<SimError>(
+    match (case.generator, &case.peer) {
+        (Generator::Ctcal, _) => crate::sim::run::<SimError>(
             input.source.as_mut(),
             &case.params,
             PixelMaps::default(),
             |events| writer.write_events(events).map_err(SimError::source),
             |_| {},
         ),
+        (_, Some(peer)) => {
+            let events = peer.simulate(input.source.as_mut(), case.seed)?;
+            writer.write_events(&events).map_err(SimError::source)?;
+            Ok(SimSummary {
+                samples: 0,
+                events: events.len() as u64,
+                on_events: events.on.iter().filter(|&&on| on).count() as u64,
+                t_first_sample_us: events.t.first().copied().unwrap_or(0),
+                t_last_sample_us: events.t.last().copied().unwrap_or(0),
+            })
+        }
+        (generator, None) => Err(SimError::Invalid(format!(
+            "{}: a {} case needs the peer's parameters (`peer`)",
+            case.id,
+            generator.name()
+        ))),
     }
 }
 
