@@ -307,7 +307,7 @@ fn estimate(
                     ctcal_io::window::screen_of(
                         &loaded,
                         &frames,
-                        ctcal_io::window::default_screen(),
+                        None,
                         None,
                         &quiet,
                     )

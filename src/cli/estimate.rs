@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 /// `estimate eppps` and `estimate screen` of a loaded recording, and the built-in screen
 /// model, as the report uses them.
-pub(super) use ctcal::window::{default_screen, eppps_of, screen_of};
+pub(super) use ctcal::window::{eppps_of, screen_of};
 
 #[derive(Subcommand, Debug)]
 pub enum EstimateCommand {
@@ -243,9 +243,12 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         Some(path) => {
             let text = ctcal::files::read_small_text(path, 1 << 20)
                 .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
-            DisplayParams::from_toml(&text, &path.display().to_string())?
+            Some(DisplayParams::from_toml(
+                &text,
+                &path.display().to_string(),
+            )?)
         }
-        None => default_screen(),
+        None => None,
     };
     let loaded = common.load(None, false, global)?;
     let path = loaded.recording.path.clone();

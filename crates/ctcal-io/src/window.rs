@@ -476,11 +476,12 @@ pub fn eppps_of(
     Ok(estimate)
 }
 
-/// The `screen` estimate of a window recorded while `stimulus` played on `screen`.
+/// The `screen` estimate of a window recorded while `stimulus` played on `screen` (a
+/// measured screen model; `None`: [`default_screen`], with the gamma of displays in use).
 pub fn screen_of(
     loaded: &Loaded,
     stimulus: &[Frame],
-    screen: DisplayParams,
+    screen: Option<DisplayParams>,
     refresh_hz: Option<f64>,
     progress: crate::estimate::Progress,
 ) -> Result<CtEstimate, EstimateError> {
@@ -489,7 +490,11 @@ pub fn screen_of(
             sensor: loaded.sensor,
             events: &loaded.events,
             stimulus,
-            screen,
+            gamma_prior: match &screen {
+                Some(measured) => screen::GammaPrior::Measured(measured.gamma),
+                None => screen::GammaPrior::Displays,
+            },
+            screen: screen.unwrap_or_else(default_screen),
             refresh_hz,
             excluded: &loaded.excluded,
         },

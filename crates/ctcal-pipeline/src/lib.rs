@@ -43,8 +43,9 @@ pub struct Options {
     pub end_s: Option<f64>,
     /// At most this many grey frames of a recording (evenly spread; at least 2).
     pub max_frames: usize,
-    /// The screen model for recordings of an on-screen stimulus.
-    pub screen: DisplayParams,
+    /// The measured screen model for recordings of an on-screen stimulus (`None`: the
+    /// built-in one, its gamma a prior; see `ctcal_core::estimate::screen::GammaPrior`).
+    pub screen: Option<DisplayParams>,
     /// Seed of every simulation.
     pub seed: u64,
     /// `None`: fit every recording; else leave the fit out, with this reason in the report.
@@ -61,7 +62,7 @@ impl Default for Options {
             start_s: None,
             end_s: None,
             max_frames: 120,
-            screen: crate::window::default_screen(),
+            screen: None,
             seed: 2020,
             fit_left_out: None,
             selection: SelectionSpec::default(),

@@ -89,15 +89,17 @@ fn protected<'a>(args: &'a ReportArgs, inputs: &'a [Input]) -> Vec<&'a Path> {
     protected
 }
 
-fn screen_of(args: &ReportArgs) -> anyhow::Result<DisplayParams> {
-    Ok(match &args.screen {
-        Some(path) => {
-            let text = ctcal::files::read_small_text(path, 1 << 20)
-                .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
-            DisplayParams::from_toml(&text, &path.display().to_string())?
-        }
-        None => ctcal::window::default_screen(),
-    })
+/// The measured screen model of `--screen` (`None`: the built-in one, gamma a prior).
+fn screen_of(args: &ReportArgs) -> anyhow::Result<Option<DisplayParams>> {
+    let Some(path) = &args.screen else {
+        return Ok(None);
+    };
+    let text = ctcal::files::read_small_text(path, 1 << 20)
+        .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
+    Ok(Some(DisplayParams::from_toml(
+        &text,
+        &path.display().to_string(),
+    )?))
 }
 
 /// The pipeline's options of the command line.

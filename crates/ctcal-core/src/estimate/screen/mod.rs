@@ -13,17 +13,20 @@
 //! 2. naive: the stimulus frames simulated directly (no display), thresholds by a Brent root
 //!    of the median count log ratio per region and refresh ([`super::resim`]) -- the paper's
 //!    method, reported as `naive_ct`;
-//! 3. display: thresholds, gamma, black level and the camera DN of white fitted together by
-//!    Nelder-Mead (argmin) on the squared log ratios of every pixel's count over the
-//!    stimulus (the mapping is 1:1, so each pixel's count is its response to the
-//!    transitions it saw, which pins the display's curve), through ctcal's display model
-//!    ([`crate::sim::display`]), starting from a screen model (`--screen`, default a typical
-//!    LCD); then the thresholds refined by the Brent root. Between grey levels a power-law
-//!    display changes log contrast by `gamma ln(DN1/DN2)`, so those counts fix `gamma / C`;
-//!    transitions to black fix their log contrast over `C`, which depends on how bright
-//!    white is imaged (camera DN of white) against the sensor's dark response -- something
-//!    the counts cannot separate from `C`, so it comes from the screen model, and full refits
-//!    with it 30 % dimmer and 40 % brighter are the systematic error.
+//! 3. display: thresholds, black level, optical blur and the camera DN of white fitted
+//!    together by Nelder-Mead (argmin) on the squared log ratios of every region's count
+//!    over the stimulus, through ctcal's display model ([`crate::sim::display`]); then the
+//!    thresholds refined by the Brent root. The stimulus has three levels (black, grey 128,
+//!    white 255): white-grey transitions fix `gamma / C` (a power-law display changes their
+//!    log contrast by `gamma ln(255/128)`), transitions to black fix their log contrast over
+//!    `C`, which depends on how bright white is imaged against the sensor's dark response.
+//!    Gamma and white trade off along a valley the counts cannot resolve (on the coverage
+//!    study's cases a fit of both drifted to gamma 0.9 with white at 30 DN or 2.6 at 255 DN,
+//!    its thresholds from 0.47 to 0.84 for a true 0.72, and a fit of white at a fixed gamma
+//!    ends where its start leads it), so gamma is a prior ([`GammaPrior`]): the fit is made
+//!    at its centre and, from a dim and a bright white, at both ends; the best fit is
+//!    reported, and the spread of the fits that explain the counts as well is in the
+//!    intervals. A measured screen model (`--screen`) fixes white and gamma within +-0.1.
 
 mod coarse;
 pub mod dlt;
@@ -52,6 +55,11 @@ use nalgebra::DVector;
 use register::Registration;
 use serde_json::json;
 
+/// The camera DN of white the fits at the ends of the gamma prior start from: a dim and a
+/// bright exposure of the screen (the fit moves white along a valley whose end it reaches
+/// from where it starts; see [`fit_displays`]).
+const WHITE_STARTS_DN: [f64; 2] = [50.0, 300.0];
+
 /// Side of the counting tiles, pixels: small enough to keep each region's own transitions,
 /// large enough to average the pixels' threshold mismatch.
 const TILE_PX: usize = 4;
@@ -62,12 +70,74 @@ pub struct ScreenInput<'a> {
     pub events: &'a EventChunk,
     /// The stimulus frames, times from 0 at its first refresh.
     pub stimulus: &'a [Frame],
-    /// The screen model to start from (gamma and black level are fitted; white and blur
-    /// are taken from it).
+    /// The screen model to start from (black level, blur and the camera DN of white are
+    /// fitted; gamma is `gamma_prior`'s).
     pub screen: DisplayParams,
+    /// What is known of the display's gamma.
+    pub gamma_prior: GammaPrior,
     /// The refresh rate, when not the stimulus's frame rate.
     pub refresh_hz: Option<f64>,
     pub excluded: &'a [bool],
+}
+
+/// What is known of the display's gamma, which the counts cannot tell from the camera DN of
+/// white (see the module docs): the thresholds are fitted at [`GammaPrior::centre`] and at
+/// both ends of [`GammaPrior::range`], and the spread of the fits that explain the counts
+/// as well as the best, in the prior's standard deviations, is a systematic of the
+/// intervals.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GammaPrior {
+    /// No measured display: gamma 2.2 (sRGB, IEC 61966-2-1) within 1.8-2.6, the span of
+    /// displays in use: 1.8 (Mac OS before 10.6), 2.4 (ITU-R BT.1886), CRTs measured at
+    /// 2.35-2.55 (Poynton, *Digital Video and HD*, 2012) and 2.6 (DCI cinema).
+    Displays,
+    /// The screen model's gamma was measured (a photometer over the grey levels): within
+    /// +-0.1.
+    Measured(f64),
+}
+
+impl GammaPrior {
+    /// sRGB's effective gamma.
+    pub const SRGB: f64 = 2.2;
+
+    pub fn centre(self) -> f64 {
+        match self {
+            GammaPrior::Displays => Self::SRGB,
+            GammaPrior::Measured(g) => g,
+        }
+    }
+
+    pub fn range(self) -> [f64; 2] {
+        match self {
+            GammaPrior::Displays => [1.8, 2.6],
+            GammaPrior::Measured(g) => [g - 0.1, g + 0.1],
+        }
+    }
+
+    /// How many standard deviations the range's ends lie from its centre: a uniform prior
+    /// over the displays in use has sqrt(3) (its standard deviation is the half-range over
+    /// sqrt(3)); a measured gamma's +-0.1 is one.
+    pub fn ends_in_sigmas(self) -> f64 {
+        match self {
+            GammaPrior::Displays => 3f64.sqrt(),
+            GammaPrior::Measured(_) => 1.0,
+        }
+    }
+
+    fn says(self) -> String {
+        let [lo, hi] = self.range();
+        match self {
+            GammaPrior::Displays => format!(
+                "the display's gamma is not measured: {:.1} (sRGB) with {lo:.1}-{hi:.1} (the displays in use: Mac OS 1.8 to BT.1886 2.4, CRTs 2.35-2.55, DCI 2.6), and the camera DN of white, which the counts trade against gamma and the threshold, fitted from {:.0} and {:.0} DN at both ends: the best fit is reported, and the spread of the fits within 1.5x its cost is in the intervals (as a uniform prior's standard deviation); give the measured display as the screen model to narrow them",
+                self.centre(),
+                WHITE_STARTS_DN[0],
+                WHITE_STARTS_DN[1]
+            ),
+            GammaPrior::Measured(g) => format!(
+                "the display's gamma {g:.2} and the camera DN of white from the screen model, taken as measured (gamma +-0.1, one standard deviation, fitted too; the best fit is reported, and the spread of the fits within 1.5x its cost is in the intervals)"
+            ),
+        }
+    }
 }
 
 /// The stimulus's frame rate, Hz.
@@ -302,19 +372,27 @@ impl CostFunction for Root<'_, '_> {
     }
 }
 
-/// Squared log ratios of all cells, for the joint fit: parameters `ln Cp, ln Cn, ln gamma,
-/// ln black_level, ln blur_px` (the camera DN of white stays the screen model's).
+/// Squared log ratios of all cells, for the joint fit: parameters `ln Cp, ln Cn,
+/// ln black_level, ln blur_px` and, unless the screen model's white is measured,
+/// `ln white_dn`, at the display gamma `gamma`.
 struct Joint<'a, 'b> {
     setup: &'b Setup<'a>,
     screen: &'b DisplayParams,
+    gamma: f64,
 }
+
+/// Where a fit's parameters sit in its vector.
+const P_WHITE: usize = 4;
 
 impl Joint<'_, '_> {
     fn display(&self, p: &DVector<f64>) -> DisplayParams {
         let mut d = self.screen.clone();
-        d.gamma = p[2].exp().clamp(0.3, 5.0);
-        d.black_level = p[3].exp().clamp(1e-5, 0.5);
-        d.blur_px = Some(p[4].exp().clamp(0.05, 3.0));
+        d.gamma = self.gamma;
+        d.black_level = p[2].exp().clamp(1e-5, 0.5);
+        d.blur_px = Some(p[3].exp().clamp(0.05, 3.0));
+        if let Some(white) = p.get(P_WHITE) {
+            d.white_dn = white.exp().clamp(2.0, 2000.0);
+        }
         d
     }
 }
@@ -444,39 +522,17 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     };
     progress("naive estimate (no display model)", 0.1);
     let naive = setup.thresholds((0.3, 0.3), None)?;
-    progress("fitting thresholds, gamma and black level", 0.3);
+    progress("fitting thresholds, white and black level", 0.3);
     let screen = &input.screen;
-    let joint = Joint {
+    let prior = input.gamma_prior;
+    let fits = fit_displays(&setup, screen, prior, naive)?;
+    let best = fits.best();
+    let display = Joint {
         setup: &setup,
         screen,
-    };
-    let start = DVector::from_vec(vec![
-        naive.0.ln(),
-        naive.1.ln(),
-        screen.gamma.ln(),
-        screen.black_level.max(1e-4).ln(),
-        screen.blur_px.unwrap_or(0.7).max(0.1).ln(),
-    ]);
-    let simplex = simplex_around(&start, [0.15, 0.15, 0.2, 0.5, 0.3]);
-    let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(2e-3)
-        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))?;
-    let result = Executor::new(
-        Joint {
-            setup: &setup,
-            screen,
-        },
-        solver,
-    )
-    .configure(|s| s.max_iters(140))
-    .run()
-    .map_err(|e| EstimateError::new(format!("display fit: {e}"), "report this as a bug"))?;
-    let best = result
-        .state
-        .best_param
-        .clone()
-        .unwrap_or_else(|| start.clone());
-    let display = joint.display(&best);
+        gamma: best.gamma,
+    }
+    .display(&best.param);
     progress(
         "refining the screen's position through the fitted display",
         0.75,
@@ -490,45 +546,16 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         None => setup,
     };
     progress("refining the thresholds", 0.8);
-    let fitted = setup.thresholds((best[0].exp(), best[1].exp()), Some(&display))?;
-    // the counts fix gamma / C (transitions between grey levels) and the log contrast of
-    // the transitions to black over C, which depends on how bright white is imaged against
-    // the sensor's dark response: the fit is repeated (warm-started) with white 30 % dimmer
-    // and 40 % brighter, and the thresholds' change is in the intervals
-    let refit = |white: f64| -> Option<(f64, f64)> {
-        let mut screen = input.screen.clone();
-        screen.white_dn = (screen.white_dn * white).clamp(10.0, 255.0);
-        let problem = Joint {
-            setup: &setup,
-            screen: &screen,
-        };
-        // from the screen model's gamma and black level (not the fit's), so that a
-        // different balance of white, black and threshold can be found
-        let mut from = start.clone();
-        from[0] = best[0];
-        from[1] = best[1];
-        from[4] = best[4];
-        let simplex = simplex_around(&from, [0.1, 0.1, 0.15, 0.4, 0.1]);
-        let solver = NelderMead::new(simplex).with_sd_tolerance(5e-3).ok()?;
-        let found = Executor::new(problem, solver)
-            .configure(|s| s.max_iters(60))
-            .run()
-            .ok()?
-            .state
-            .best_param?;
-        Some((found[0].exp(), found[1].exp()))
-    };
-    let (dim, bright) = rayon::join(|| refit(0.7), || refit(1.4));
-    let variants: Vec<(f64, f64)> = [dim, bright].into_iter().flatten().collect();
-    let spread = |pick: fn(&(f64, f64)) -> f64| -> f64 {
-        let values: Vec<f64> = variants.iter().chain([&fitted]).map(pick).collect();
-        let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        if values.is_empty() {
-            0.0
-        } else {
-            0.5 * (hi - lo)
-        }
+    let fitted = setup.thresholds((best.param[0].exp(), best.param[1].exp()), Some(&display))?;
+    let variants = fits.compatible();
+    // the fits as good as the best span the prior's effect: their largest change is the
+    // systematic (see `GammaPrior::ends_in_sigmas`)
+    let spread = |pick: fn(&(f64, f64)) -> f64, value: f64| -> f64 {
+        variants
+            .iter()
+            .map(|v| (pick(v) - value).abs())
+            .fold(0.0, f64::max)
+            / prior.ends_in_sigmas()
     };
     let simulated = setup.counts(fitted, Some(&display))?;
     let standard_error = |r: &[u32], s: &[u32], c: f64| {
@@ -550,12 +577,12 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     let on = Measured::new(
         fitted.0,
         standard_error(&setup.real.on, &simulated.on, fitted.0),
-        spread(|v| v.0),
+        spread(|v| v.0, fitted.0),
     );
     let off = Measured::new(
         fitted.1,
         standard_error(&setup.real.off, &simulated.off, fitted.1),
-        spread(|v| v.1),
+        spread(|v| v.1, fitted.1),
     );
     let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
     let naive_ct = 0.5 * (naive.0 + naive.1);
@@ -575,10 +602,13 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             offset_us as f64 * 1e-6
         ),
         format!(
-            "the display: sample-and-hold at {refresh_hz:.3} Hz; gamma, black level and optical blur ({:.2} px) fitted; white imaged at {:.0} camera DN, from the screen model (the counts cannot tell it from the threshold: refits with white 30 % dimmer and 40 % brighter are in the intervals; give the measured display as the screen model)",
+            "the display: sample-and-hold at {refresh_hz:.3} Hz; black level ({:.4}), optical blur ({:.2} px) and the camera DN of white ({:.0}) fitted at gamma {:.2}",
+            display.black_level,
             display.blur_px.unwrap_or(0.0),
-            display.white_dn
+            display.white_dn,
+            display.gamma,
         ),
+        prior.says(),
         "ideal pixels (no mismatch, noise or bandwidth); v2e lin-log response".into(),
     ]);
     if hot > 0 {
@@ -588,7 +618,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     }
     estimate.estimators = vec![EstimatorReport {
         name: "screen_resimulation",
-        description: "the stimulus simulated through the display model (gamma and black level fitted with the thresholds); thresholds whose counts match the recording's in every region and refresh",
+        description: "the stimulus simulated through the display model (white, black level and blur fitted with the thresholds, gamma from its prior); thresholds whose counts match the recording's in every region and refresh",
         ct_on: on,
         ct_off: off,
         frame_rate_series_on: Vec::new(),
@@ -596,7 +626,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         details: json!({
             "naive_ct_on": naive.0,
             "naive_ct_off": naive.1,
-            "assumption_variants": variants,
+            "display_fits": fits.json(),
             "simulations": setup.evaluations.load(std::sync::atomic::Ordering::Relaxed),
         }),
     }];
@@ -664,8 +694,158 @@ fn reregister(
     located.warp.clone()
 }
 
+/// A fit of the display with the thresholds, at one gamma from one start.
+struct DisplayFit {
+    gamma: f64,
+    white_start_dn: f64,
+    param: DVector<f64>,
+    cost: f64,
+}
+
+/// The display fits from every start (see [`fit_displays`]).
+struct DisplayFits(Vec<DisplayFit>);
+
+impl DisplayFits {
+    fn best(&self) -> &DisplayFit {
+        self.0
+            .iter()
+            .min_by(|a, b| a.cost.total_cmp(&b.cost))
+            .expect("at least one fit")
+    }
+
+    /// The thresholds of the other fits whose cost is within [`COMPATIBLE_COST`] of the
+    /// best's.
+    fn compatible(&self) -> Vec<(f64, f64)> {
+        let best = self.best().cost;
+        self.0
+            .iter()
+            .filter(|f| f.cost <= COMPATIBLE_COST * best)
+            .map(|f| (f.param[0].exp(), f.param[1].exp()))
+            .collect()
+    }
+
+    fn json(&self) -> serde_json::Value {
+        let best = self.best().cost;
+        self.0
+            .iter()
+            .map(|f| {
+                json!({
+                    "gamma": f.gamma,
+                    "white_dn_start": f.white_start_dn,
+                    "ct_on": f.param[0].exp(),
+                    "ct_off": f.param[1].exp(),
+                    "white_dn": f.param.get(P_WHITE).map_or(f.white_start_dn, |w| w.exp()),
+                    "black_level": f.param[2].exp(),
+                    "cost": f.cost,
+                    "compatible": f.cost <= COMPATIBLE_COST * best,
+                })
+            })
+            .collect()
+    }
+}
+
+/// Fits whose cost is at most this multiple of the best's are taken as explaining the counts
+/// as well (the residuals are dominated by what ideal pixels lack, not by count noise, so a
+/// likelihood ratio over the cells would call every other fit excluded): on the coverage
+/// study's on-screen cases the fits from starts across the prior that lay near the truth
+/// cost up to 1.3x the best, those stuck far from it 20-30x.
+const COMPATIBLE_COST: f64 = 1.5;
+
+/// The joint fit at the prior's centre from the screen model's white, and at both ends of
+/// the prior from a dim and a bright white ([`WHITE_STARTS_DN`]; from the model's white
+/// when it is measured), two at a time: the counts
+/// do not resolve gamma from the camera DN of white (nor, through the sensor's dark
+/// response, white from the threshold), and each fit ends where its start leads it along
+/// that valley.
+fn fit_displays(
+    setup: &Setup,
+    screen: &DisplayParams,
+    prior: GammaPrior,
+    naive: (f64, f64),
+) -> Result<DisplayFits, EstimateError> {
+    use rayon::prelude::*;
+    let [low, high] = prior.range();
+    let mut starts = vec![(prior.centre(), screen.white_dn)];
+    for gamma in [low, high] {
+        match prior {
+            // a measured screen model's white (the camera DN it is imaged at) is kept
+            GammaPrior::Measured(_) => starts.push((gamma, screen.white_dn)),
+            GammaPrior::Displays => starts.extend(WHITE_STARTS_DN.map(|white| (gamma, white))),
+        }
+    }
+    let fits: Vec<Result<DisplayFit, EstimateError>> = starts
+        .par_iter()
+        .map(|&(gamma, white)| {
+            let mut from = vec![
+                naive.0.ln(),
+                naive.1.ln(),
+                screen.black_level.max(1e-4).ln(),
+                screen.blur_px.unwrap_or(0.7).max(0.1).ln(),
+            ];
+            if prior == GammaPrior::Displays {
+                from.push(white.max(2.0).ln());
+            }
+            let from = DVector::from_vec(from);
+            let (param, cost) = fit_display(setup, screen, gamma, &from, 140)?;
+            Ok(DisplayFit {
+                gamma,
+                white_start_dn: white,
+                param,
+                cost,
+            })
+        })
+        .collect();
+    let mut done = Vec::new();
+    let mut failure = None;
+    for fit in fits {
+        match fit {
+            Ok(fit) if fit.cost.is_finite() => done.push(fit),
+            Ok(_) => {}
+            Err(e) => failure = Some(e),
+        }
+    }
+    match (done.is_empty(), failure) {
+        (true, Some(e)) => Err(e),
+        (true, None) => Err(EstimateError::new(
+            "the display fit found no finite cost from any start",
+            "report this as a bug",
+        )),
+        _ => Ok(DisplayFits(done)),
+    }
+}
+
+/// The joint fit of thresholds, white, black level and blur at display `gamma`, by
+/// Nelder-Mead from `from` (see [`Joint`]).
+fn fit_display(
+    setup: &Setup,
+    screen: &DisplayParams,
+    gamma: f64,
+    from: &DVector<f64>,
+    iterations: u64,
+) -> Result<(DVector<f64>, f64), EstimateError> {
+    let steps = [0.15, 0.15, 0.5, 0.3, 0.5];
+    let simplex = simplex_around(from, &steps[..from.len()]);
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(2e-3)
+        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))?;
+    let problem = Joint {
+        setup,
+        screen,
+        gamma,
+    };
+    let result = Executor::new(problem, solver)
+        .configure(|s| s.max_iters(iterations))
+        .run()
+        .map_err(|e| EstimateError::new(format!("display fit: {e}"), "report this as a bug"))?;
+    let cost = result.state.best_cost;
+    Ok((
+        result.state.best_param.unwrap_or_else(|| from.clone()),
+        cost,
+    ))
+}
+
 /// A Nelder-Mead start simplex: `start` and, for each coordinate, `start` moved by its step.
-fn simplex_around(start: &DVector<f64>, steps: [f64; 5]) -> Vec<DVector<f64>> {
+fn simplex_around(start: &DVector<f64>, steps: &[f64]) -> Vec<DVector<f64>> {
     (0..=steps.len())
         .map(|k| {
             let mut v = start.clone();

@@ -106,6 +106,7 @@ fn run(truth: &ScreenGeometry) -> (CtEstimate, f64) {
         events: &events,
         stimulus: &stimulus,
         screen: display(),
+        gamma_prior: super::GammaPrior::Measured(display().gamma),
         refresh_hz: None,
         excluded: &excluded,
     };
@@ -210,6 +211,7 @@ fn events_without_the_stimulus_are_not_registered() {
         events: &events,
         stimulus: &stimulus,
         screen: display(),
+        gamma_prior: super::GammaPrior::Measured(display().gamma),
         refresh_hz: None,
         excluded: &excluded,
     };
