@@ -395,8 +395,10 @@ fn report_options(text: &str) -> PyResult<Options> {
         let path = Path::new(path);
         let text = ctcal_core::files::read_small_text(path, 1 << 20)
             .map_err(|e| err(ctcal_io::InputError::not_a_file(path, e)))?;
-        o.screen = ctcal_core::sim::DisplayParams::from_toml(&text, &path.display().to_string())
-            .map_err(err)?;
+        o.screen = Some(
+            ctcal_core::sim::DisplayParams::from_toml(&text, &path.display().to_string())
+                .map_err(err)?,
+        );
     }
     o.selection = SelectionSpec {
         roi: v["roi"]

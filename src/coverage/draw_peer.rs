@@ -63,7 +63,12 @@ fn draw_voltmeter(rng: &mut impl Rng, params: &PixelParams) -> voltmeter::Params
         let (lo, hi) = (a[i].min(b[i]), a[i].max(b[i]));
         log_uniform(rng, lo / widen, hi * widen)
     };
-    let (k3, k4, k5, k6) = (around(2, 3.0), around(3, 3.0), around(4, 1.0), around(5, 3.0));
+    let (k3, k4, k5, k6) = (
+        around(2, 3.0),
+        around(3, 3.0),
+        around(4, 1.0),
+        around(5, 3.0),
+    );
     voltmeter::Params {
         camera_type: "drawn".into(),
         k: [
