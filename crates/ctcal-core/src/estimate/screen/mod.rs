@@ -55,9 +55,9 @@ use nalgebra::DVector;
 use register::Registration;
 use serde_json::json;
 
-/// The camera DN of white the fits at the ends of the gamma prior start from: a dim and a
-/// bright exposure of the screen (the fit moves white along a valley whose end it reaches
-/// from where it starts; see [`fit_displays`]).
+/// The camera DN of white the fits start from beside the screen model's: a dim and a bright
+/// exposure of the screen (the fit moves white along a valley whose end it reaches from
+/// where it starts; see [`fit_displays`]).
 const WHITE_STARTS_DN: [f64; 2] = [50.0, 300.0];
 
 /// Side of the counting tiles, pixels: small enough to keep each region's own transitions,
@@ -602,10 +602,14 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             offset_us as f64 * 1e-6
         ),
         format!(
-            "the display: sample-and-hold at {refresh_hz:.3} Hz; black level ({:.4}), optical blur ({:.2} px) and the camera DN of white ({:.0}) fitted at gamma {:.2}",
+            "the display: sample-and-hold at {refresh_hz:.3} Hz; black level ({:.4}) and optical blur ({:.2} px) fitted, the camera DN of white ({:.0}) {}, at gamma {:.2}",
             display.black_level,
             display.blur_px.unwrap_or(0.0),
             display.white_dn,
+            match prior {
+                GammaPrior::Displays => "fitted",
+                GammaPrior::Measured(_) => "the screen model's",
+            },
             display.gamma,
         ),
         prior.says(),
