@@ -114,7 +114,7 @@ fn generate(
             Ok(SimSummary {
                 samples: 0,
                 events: events.len() as u64,
-                on_events: events.on.iter().filter(|&&on| on).count() as u64,
+                on_events: events.on_count() as u64,
                 t_first_sample_us: events.t.first().copied().unwrap_or(0),
                 t_last_sample_us: events.t.last().copied().unwrap_or(0),
             })

@@ -114,6 +114,11 @@ impl EventChunk {
         self.t.is_empty()
     }
 
+    /// How many of the events are ON.
+    pub fn on_count(&self) -> usize {
+        self.on.iter().filter(|&&on| on).count()
+    }
+
     pub fn clear(&mut self) {
         self.t.clear();
         self.x.clear();

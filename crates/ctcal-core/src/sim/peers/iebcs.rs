@@ -610,7 +610,7 @@ mod tests {
         };
         let times: Vec<i64> = (0..=2000).map(|k| k * 1000).collect();
         let events = run(&p, &times, &vec![80.0; times.len()], 4);
-        let on = events.on.iter().filter(|&&on| on).count();
+        let on = events.on_count();
         assert_eq!((on, events.len() - on), (20, 10));
         let gaps: Vec<i64> = events
             .iter()

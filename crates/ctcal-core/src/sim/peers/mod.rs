@@ -309,7 +309,7 @@ pub fn write_case_with<W: CaseWriter>(
         width,
         height,
         events: events.len() as u64,
-        on_events: events.on.iter().filter(|&&on| on).count() as u64,
+        on_events: events.on_count() as u64,
         aps_frames: frames.len(),
     };
     let json = serde_json::to_string_pretty(&case).map_err(SimError::source)?;
