@@ -21,6 +21,7 @@
 pub mod binomial;
 pub mod hot_pixels;
 pub mod intervals;
+pub mod jackknife;
 mod kernel;
 pub mod pixel_grid;
 pub mod robust;

@@ -25,6 +25,7 @@ use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::sim::LogResponse;
 use crate::sim::log_response::LogMap;
+use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
 use model::{Coefficients, fit_at, offset_interval, offset_root, resampled_weights};
 use pixels::{PixelSlots, pixel_sums};
 use rayon::prelude::*;
@@ -544,11 +545,7 @@ fn between_blocks(fitted: &Fitted, fit_leak: bool) -> Option<[f64; 2]> {
         .map(|&(b, _)| left_out(b))
         .collect::<Option<_>>()?;
     let sizes: Vec<f64> = blocks.iter().map(|b| b.1).collect();
-    let scale = {
-        use statrs::distribution::{ContinuousCDF, StudentsT};
-        StudentsT::new(0.0, 1.0, (blocks.len() - 1) as f64)
-            .map_or(1.0, |t| t.inverse_cdf(0.975) / 1.96)
-    };
+    let scale = t95_scale(blocks.len());
     let whole = [whole.c_on, whole.c_off];
     let se = |k: usize| {
         weighted_jackknife_se(
@@ -558,58 +555,6 @@ fn between_blocks(fitted: &Fitted, fit_leak: bool) -> Option<[f64; 2]> {
         ) * scale
     };
     Some([se(0), se(1)])
-}
-
-/// The delete-m_j jackknife's standard error (Busing et al. 1999, eq. 6-8): `whole` the
-/// estimate on all blocks, `left_out[j]` without block `j`, `sizes[j]` block `j`'s size.
-/// With equal sizes it is the ordinary delete-one jackknife,
-/// `sqrt((g - 1) / g * sum (left_out - mean)^2)`.
-fn weighted_jackknife_se(whole: f64, left_out: &[f64], sizes: &[f64]) -> f64 {
-    let g = left_out.len() as f64;
-    let n: f64 = sizes.iter().sum();
-    let h: Vec<f64> = sizes.iter().map(|&m| n / m).collect();
-    let corrected = g * whole
-        - left_out
-            .iter()
-            .zip(sizes)
-            .map(|(&t, &m)| (1.0 - m / n) * t)
-            .sum::<f64>();
-    let variance = left_out
-        .iter()
-        .zip(&h)
-        .map(|(&t, &h)| {
-            let pseudo = h * whole - (h - 1.0) * t;
-            (pseudo - corrected).powi(2) / (h - 1.0)
-        })
-        .sum::<f64>()
-        / g;
-    variance.max(0.0).sqrt()
-}
-
-#[cfg(test)]
-mod jackknife_tests {
-    use super::weighted_jackknife_se;
-
-    #[test]
-    fn equal_blocks_give_the_ordinary_jackknife() {
-        // the mean of 4 equal blocks with means 1, 2, 3, 6: whole 3, left out 11/3, 10/3,
-        // 3, 2; ordinary jackknife sqrt(3/4 * sum (t - 3)^2) = sqrt(3/4 * 14/9)
-        let left_out = [11.0 / 3.0, 10.0 / 3.0, 3.0, 2.0];
-        let se = weighted_jackknife_se(3.0, &left_out, &[5.0; 4]);
-        assert!((se - (0.75f64 * 14.0 / 9.0).sqrt()).abs() < 1e-12, "{se}");
-        // which is the standard error of a mean of 4 block means, sd / sqrt(4)
-        let sd = ((4.0 + 1.0 + 0.0 + 9.0) / 3.0f64).sqrt();
-        assert!((se - sd / 2.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn unequal_blocks_weigh_the_larger_more() {
-        // a weighted mean over blocks of sizes 1, 1, 2 with block means 0, 0, 4: whole 2;
-        // its standard error by the delta method is larger than with the big block split
-        let left_out = [8.0 / 3.0, 8.0 / 3.0, 0.0];
-        let se = weighted_jackknife_se(2.0, &left_out, &[1.0, 1.0, 2.0]);
-        assert!(se.is_finite() && se > 1.0 && se < 3.0, "{se}");
-    }
 }
 
 /// `draw(k)` for `k` in `0..n` on every thread, the results that exist in the order of `k`.
