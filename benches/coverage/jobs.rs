@@ -28,7 +28,7 @@ fn run_case(
         .iter()
         .map(|&method| match &written {
             Ok(truth) => {
-                let (outcome, seconds) = run_method(options, method, &dir);
+                let (outcome, seconds) = run_method(options, method, &dir, case);
                 RunRecord::new(case.clone(), Some(truth.clone()), method, seconds, outcome)
             }
             Err(e) => {

@@ -1,7 +1,7 @@
 //! The methods whose intervals the study scores, how each is called, which cases it
 //! applies to, and which parameters it reports.
 
-use super::case::CaseSpec;
+use super::case::{CaseSpec, RecordingSpec};
 use serde::{Deserialize, Serialize};
 use std::ffi::OsString;
 use std::path::Path;
@@ -58,13 +58,24 @@ impl Method {
         (self == Method::Screen) == case.is_screen()
     }
 
-    /// The command line after `ctcal` (without `--json -`).
-    pub fn args(self, input: &Path) -> Vec<OsString> {
+    /// The command line after `ctcal` (without `--json -`). The methods that read frames
+    /// are told the frames' exposure, as a user who knows the camera's setting would (the
+    /// IJRR text a case is written in has no field for it).
+    pub fn args(self, input: &Path, case: &CaseSpec) -> Vec<OsString> {
         let mut args: Vec<OsString> = match self {
             Method::Fit => vec!["fit".into()],
             estimate => vec!["estimate".into(), estimate.name().into()],
         };
         args.push(input.as_os_str().to_owned());
+        let exposure_s = match &case.recording {
+            RecordingSpec::Scene { scene } => scene.aps.as_ref().map(|a| a.exposure_s),
+            RecordingSpec::Screen { .. } => None,
+        };
+        if let Some(e) = exposure_s.filter(|&e| e > 0.0)
+            && matches!(self, Method::Fit | Method::Aps)
+        {
+            args.extend(["--exposure-s".into(), e.to_string().into()]);
+        }
         args
     }
 

@@ -2,6 +2,7 @@
 //! bounded threads and a time limit; stdout and stderr go to files beside the case (so a
 //! large JSON never blocks a pipe), and the outcome is the parsed JSON or the error.
 
+use super::case::CaseSpec;
 use super::method::Method;
 use super::record::Outcome;
 use std::path::{Path, PathBuf};
@@ -54,9 +55,14 @@ fn failed(exit_code: Option<i32>, timed_out: bool, message: impl Into<String>) -
 }
 
 /// Runs `method` on the case folder `input`; returns the outcome and the wall time.
-pub fn run_method(options: &RunOptions, method: Method, input: &Path) -> (Outcome, f64) {
+pub fn run_method(
+    options: &RunOptions,
+    method: Method,
+    input: &Path,
+    case: &CaseSpec,
+) -> (Outcome, f64) {
     let started = Instant::now();
-    let outcome = run(options, method, input).unwrap_or_else(|e| {
+    let outcome = run(options, method, input, case).unwrap_or_else(|e| {
         failed(
             None,
             false,
@@ -80,11 +86,16 @@ fn output_options(threads: usize) -> Vec<String> {
     .collect()
 }
 
-fn run(options: &RunOptions, method: Method, input: &Path) -> std::io::Result<Outcome> {
+fn run(
+    options: &RunOptions,
+    method: Method,
+    input: &Path,
+    case: &CaseSpec,
+) -> std::io::Result<Outcome> {
     let capture = |stream: &str| input.with_extension(format!("{}.{stream}", method.name()));
     let (stdout_path, stderr_path) = (capture("stdout"), capture("stderr"));
     let mut child = Command::new(&options.binary)
-        .args(method.args(input))
+        .args(method.args(input, case))
         .args(output_options(options.threads))
         .env("HDF5_USE_FILE_LOCKING", "FALSE")
         .stdin(Stdio::null())

@@ -51,7 +51,7 @@ fn run_aps(case: &CaseSpec, dir: &Path) -> RunRecord {
         threads: 2,
         timeout: Duration::from_secs(300),
     };
-    let (outcome, seconds) = run_method(&options, Method::Aps, dir);
+    let (outcome, seconds) = run_method(&options, Method::Aps, dir, case);
     RunRecord::new(case.clone(), Some(truth), Method::Aps, seconds, outcome)
 }
 
