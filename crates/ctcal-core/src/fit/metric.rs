@@ -64,9 +64,14 @@ pub fn cell_ratios(
     g: &Geometry,
     subset: Subset,
 ) -> Vec<(f64, u32, usize)> {
-    let (r, s) = (real.cells_of(g, subset), sim.cells_of(g, subset));
+    ratios_of_cells(&real.cells_of(g, subset), &sim.cells_of(g, subset))
+}
+
+/// The log ratios (simulated over real) of count cells `r` (real) and `s` (simulated),
+/// with the real count and the index of each, over cells with enough events to compare.
+pub fn ratios_of_cells(r: &[u32], s: &[u32]) -> Vec<(f64, u32, usize)> {
     r.iter()
-        .zip(&s)
+        .zip(s)
         .enumerate()
         .filter(|(_, (r, s))| **r + **s >= MIN_CELL_EVENTS)
         .map(|(i, (&r, &s))| (log_ratio(s as f64, r as f64), r, i))
@@ -198,18 +203,19 @@ pub fn median_ratios(
     g: &Geometry,
     subset: Subset,
 ) -> [Option<f64>; 2] {
-    let ratios = cell_ratios(real, sim, g, subset);
+    median_ratios_of(&cell_ratios(real, sim, g, subset))
+}
+
+/// The median of the [`ratios_of_cells`] of each polarity (OFF, ON), over cells with at
+/// least 5 real events.
+pub fn median_ratios_of(ratios: &[(f64, u32, usize)]) -> [Option<f64>; 2] {
     [0, 1].map(|pol| {
-        let mut v: Vec<f64> = ratios
+        let v: Vec<f64> = ratios
             .iter()
             .filter(|(_, r, i)| i % 2 == pol && *r >= 5)
             .map(|c| c.0)
             .collect();
-        if v.is_empty() {
-            return None;
-        }
-        let mid = v.len() / 2;
-        Some(*v.select_nth_unstable_by(mid, f64::total_cmp).1)
+        crate::stats::robust::median(&v)
     })
 }
 

@@ -1,8 +1,8 @@
 //! The fit's result: the final model's error on the test blocks, the thresholds' standard
 //! errors, what the data identify and what they do not, and every assumption with its size.
 
-use super::super::metric::{ERROR_METRIC, cell_ratios};
-use super::super::observe::{Role, Subset};
+use super::super::metric::{ERROR_METRIC, cell_ratios, median_ratios_of, ratios_of_cells};
+use super::super::observe::{Observed, Role, Subset};
 use super::super::residuals::{Residuals, residuals};
 use super::super::search::{Simulated, Simulation};
 use super::super::{
@@ -12,11 +12,21 @@ use super::State;
 use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
 use crate::stats::binomial::{median_interval95, wilson95};
 use crate::stats::hot_pixels::HotPixel;
+use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
 use crate::stats::robust::{mad_sigma, median};
 use std::collections::BTreeMap;
 
-/// Standard errors of the thresholds from the spread of the count-cell log ratios on the
-/// fit blocks (MAD sigma, times 1.2533 for the median's efficiency, over sqrt(cells)).
+/// Standard errors of the thresholds: the larger of two measures of how well the fit
+/// blocks fix them (thresholds are profiled to a zero median count-cell log ratio, and
+/// counts scale about as `1 / C`, so a median log ratio `m` is a threshold off by `e^m`):
+///
+/// - within the cells: the spread of the count-cell log ratios on the fit blocks (MAD
+///   sigma, times 1.2533 for the median's efficiency, over sqrt(cells)), which takes the
+///   cells as independent;
+/// - between the fit blocks: the delete-one-block jackknife of the median log ratio
+///   ([`crate::stats::jackknife`], scaled by `t(0.975, blocks - 1) / 1.96`), which sees
+///   what the first cannot: a model that matches some stretches of the recording and not
+///   others (an effect it lacks acting unevenly, the scene each block shows).
 pub fn threshold_uncertainty(
     simulation: &Simulation,
     model: &Simulated,
@@ -27,16 +37,21 @@ pub fn threshold_uncertainty(
         simulation.geometry,
         Subset::Fit,
     );
+    let between = between_blocks(simulation, model);
     let se = |pol: usize, c: f64| {
         let v: Vec<f64> = ratios
             .iter()
             .filter(|(_, r, i)| i % 2 == pol && *r >= 5)
             .map(|c| c.0)
             .collect();
-        (v.len() >= 3)
+        let within = (v.len() >= 3)
             .then(|| mad_sigma(&v))
             .flatten()
-            .map(|s| c * 1.2533 * s / (v.len() as f64).sqrt())
+            .map(|s| 1.2533 * s / (v.len() as f64).sqrt());
+        match (within, between[pol]) {
+            (Some(w), Some(b)) => Some(c * w.max(b)),
+            (w, b) => w.or(b).map(|s| c * s),
+        }
     };
     let p = &model.params;
     BTreeMap::from([
@@ -49,6 +64,51 @@ pub fn threshold_uncertainty(
             Uncertain::positive(p.ct_off, se(0, p.ct_off)),
         ),
     ])
+}
+
+/// The delete-one-fit-block jackknife standard error of each polarity's median count-cell
+/// log ratio (OFF, ON), each block sized by its real events; `None` under three fit blocks
+/// or where a polarity has no median without some block.
+fn between_blocks(simulation: &Simulation, model: &Simulated) -> [Option<f64>; 2] {
+    let g = simulation.geometry;
+    let blocks = g.blocks_of(Role::Fit);
+    if blocks.len() < 3 {
+        return [None, None];
+    }
+    let cells = |o: &Observed| -> Vec<Vec<u32>> {
+        blocks
+            .iter()
+            .map(|&b| o.cells_of(g, Subset::Block(b)))
+            .collect()
+    };
+    let (real, sim) = (cells(&simulation.real), cells(&model.observed));
+    let without = |per_block: &[Vec<u32>], left_out: Option<usize>| -> Vec<u32> {
+        let mut sum = vec![0u32; per_block[0].len()];
+        for (k, block) in per_block.iter().enumerate() {
+            if Some(k) != left_out {
+                sum.iter_mut().zip(block).for_each(|(s, &c)| *s += c);
+            }
+        }
+        sum
+    };
+    let medians = |left_out: Option<usize>| {
+        median_ratios_of(&ratios_of_cells(
+            &without(&real, left_out),
+            &without(&sim, left_out),
+        ))
+    };
+    let whole = medians(None);
+    let left_out: Vec<[Option<f64>; 2]> = (0..blocks.len()).map(|k| medians(Some(k))).collect();
+    let sizes: Vec<f64> = real
+        .iter()
+        .map(|b| b.iter().map(|&c| c as f64).sum::<f64>().max(1.0))
+        .collect();
+    let scale = t95_scale(blocks.len());
+    [0, 1].map(|pol| {
+        let whole = whole[pol]?;
+        let values: Option<Vec<f64>> = left_out.iter().map(|m| m[pol]).collect();
+        Some(weighted_jackknife_se(whole, &values?, &sizes) * scale)
+    })
 }
 
 /// The named hot pixels as a simulator takes them: their fraction of the kept pixels with
@@ -105,6 +165,9 @@ pub struct Parts<'a> {
     pub fixed: bool,
     /// The starting thresholds as measured (the intervals widen where the fit disagrees).
     pub start: Option<super::agreement::Measured>,
+    /// The thresholds at coarser frame rates and a doubled exposure (their systematics
+    /// join the intervals).
+    pub frame_quality: super::frame_quality::FrameQuality,
     pub options: &'a FitOptions,
     pub input: &'a FitInput<'a>,
 }
@@ -121,6 +184,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         mut assumptions,
         fixed,
         start,
+        frame_quality,
         options,
         input,
     } = parts;
@@ -129,6 +193,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     state
         .uncertainty
         .extend(threshold_uncertainty(simulation, &state.model));
+    assumptions.push("the thresholds' standard errors are the larger of the count cells' spread on the fit blocks (cells taken as independent) and the delete-one-block jackknife of the median cell log ratio over the fit blocks (scaled by t(0.975, blocks - 1) / 1.96): a model that matches some stretches of the recording and not others widens them".into());
+    assumptions.extend(super::frame_quality::widen(
+        &mut state.uncertainty,
+        &frame_quality,
+    ));
     if let Some(start) = &start
         && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
     {

@@ -22,6 +22,7 @@ mod agreement;
 mod alternatives;
 pub use alternatives::Ambiguity;
 mod finish;
+mod frame_quality;
 pub(in crate::fit) mod keep;
 mod start;
 mod steps;
@@ -177,6 +178,22 @@ pub fn fit(
             }
         }
     }
+    progress(
+        "frame checks (every 2nd and 3rd frame, a doubled exposure)",
+        0.96,
+    );
+    let frame_quality = if fixed {
+        frame_quality::FrameQuality::default()
+    } else {
+        let check = frame_quality::Check {
+            frames: &frames,
+            input,
+            options,
+            fit_end: end,
+            masked: &state.masked,
+        };
+        frame_quality::measure(&check, &simulation, &state.model)
+    };
     progress("the final model on the test blocks", 0.97);
     let result = finish::result(
         &simulation,
@@ -190,6 +207,7 @@ pub fn fit(
             assumptions,
             fixed,
             start: start.measured,
+            frame_quality,
             options,
             input,
         },

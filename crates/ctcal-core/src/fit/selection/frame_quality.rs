@@ -1,0 +1,327 @@
+//! The fit's frame-quality checks. The fit re-simulates the recording from its frames
+//! upsampled along the optical flow, and frames lose contrast in two ways a re-simulation
+//! inherits (Stoffregen et al., ECCV 2020, sec. 4: frame quality limits re-simulation):
+//!
+//! - the gap between frames: where the scene moves several pixels from one frame to the
+//!   next, the flow and its interpolation smooth what happens in between. The final
+//!   model's thresholds are profiled again on every 2nd and every 3rd frame, and the
+//!   distance of the full-rate value from the straight line's limit at infinite frame rate,
+//!   plus the scatter about the line ([`crate::estimate::interval::frame_rate_systematic`],
+//!   the same check `estimate aps` makes), is a systematic error of each threshold (the
+//!   motion gate of a usable interval doubles for the coarser frames, so that the same
+//!   intervals are compared where the flow can still follow them);
+//! - the exposure: a frame averages the moving scene over its exposure (motion blur),
+//!   which the simulation takes as an instant. The thresholds are profiled again on frames
+//!   blurred by one more exposure's motion along the flow
+//!   ([`PreparedFrames::motion_blurred`]); a straight line through the two exposures is
+//!   extrapolated to none, and the distance is a second systematic (Richardson's deferred
+//!   approach to the limit, 1911, with one step).
+//!
+//! Both add to the thresholds' standard errors in quadrature. A clean, slow case profiles
+//! the same thresholds in every check and keeps its interval.
+
+use super::super::observe::{Geometry, Observed};
+use super::super::search::{Simulated, Simulation};
+use super::super::{FitInput, FitOptions, Uncertain};
+use crate::estimate::frames::PreparedFrames;
+use crate::estimate::interval::{FrameRatePoint, frame_rate_systematic};
+use crate::events::{EventChunk, TimeUs};
+use rayon::prelude::*;
+use std::cell::Cell;
+use std::collections::BTreeMap;
+
+/// The thresholds each check profiled.
+#[derive(Clone, Debug, Default)]
+pub struct FrameQuality {
+    /// At frame steps 1, 2, 3 (OFF, ON), the full rate first.
+    pub off: Vec<FrameRatePoint>,
+    pub on: Vec<FrameRatePoint>,
+    /// With the exposure's motion blur doubled: (exposure in us, OFF, ON).
+    pub doubled_exposure: Option<(TimeUs, f64, f64)>,
+    /// The frames' exposure is not known (no exposure check).
+    pub exposure_unknown: bool,
+}
+
+/// What the checks read besides the fit's simulation.
+pub struct Check<'a> {
+    pub frames: &'a PreparedFrames,
+    pub input: &'a FitInput<'a>,
+    pub options: &'a FitOptions,
+    pub fit_end: TimeUs,
+    pub masked: &'a [bool],
+}
+
+/// What the checks' simulations share with the fit's (which, counting its runs in a
+/// `Cell`, cannot cross threads itself).
+struct Fine<'a> {
+    events: &'a EventChunk,
+    grid: Option<(TimeUs, TimeUs)>,
+    seed: u64,
+    hot_events: &'a EventChunk,
+}
+
+/// A variant of the fit's frames.
+#[derive(Clone, Copy)]
+enum Variant {
+    /// Every `n`-th frame.
+    Step(usize),
+    /// Blurred by one more exposure of this many microseconds.
+    Blurred(TimeUs),
+}
+
+fn point(frames: &PreparedFrames, step: usize, value: f64) -> FrameRatePoint {
+    FrameRatePoint {
+        frame_step: step,
+        frame_interval_s: frames.median_interval_us() as f64 * 1e-6,
+        value,
+    }
+}
+
+/// The model's thresholds profiled on `variant` of the frames (`None` where too few frame
+/// intervals remain usable, or the profile fails), with the variant's frames and the
+/// simulations run.
+fn profiled_on(
+    check: &Check,
+    fine: &Fine,
+    model: &Simulated,
+    variant: Variant,
+) -> Option<(PreparedFrames, Simulated, usize)> {
+    let frames = match variant {
+        Variant::Step(step) => {
+            // the same intervals, `step` times longer: the motion gate grows with them, up
+            // to twice the fit's (the flow's coarsest pyramid level, a quarter of the
+            // sensor with a 4 px window, follows about 16 px; far beyond, a failing flow
+            // and not the frame rate would move the thresholds)
+            let mut options = check.options.aps.frames.clone();
+            options.max_motion_px *= step.min(2) as f64;
+            check.frames.every(step, &options)?
+        }
+        Variant::Blurred(exposure) => check.frames.motion_blurred(exposure),
+    };
+    let runs = frames.upsample_runs(0.5, check.options.aps.max_upsampled_bytes);
+    let geometry = Geometry::new(
+        &frames,
+        check.input.excluded,
+        check.options.blocks,
+        check.fit_end,
+    );
+    let coarse = Simulation {
+        runs: &runs,
+        width: frames.width,
+        height: frames.height,
+        geometry: &geometry,
+        events: fine.events,
+        real: Observed::new(fine.events, &geometry, check.masked),
+        grid: fine.grid,
+        seed: fine.seed,
+        count: Cell::new(0),
+        hot_events: fine.hot_events.clone(),
+    };
+    let profiled = coarse.profile(&model.params, check.masked, false).ok()?;
+    let count = coarse.count.get();
+    Some((frames, profiled, count))
+}
+
+/// The frames' exposure: the frames' own, else the user's.
+fn exposure_of(check: &Check) -> Option<TimeUs> {
+    check
+        .input
+        .frames
+        .iter()
+        .find_map(|f| f.exposure_us)
+        .or(check.options.aps.exposure_us)
+        .filter(|&e| e > 0)
+}
+
+/// The checks of the final `model` (fitted on `simulation`'s frames); the simulations they
+/// ran are added to the fit's count.
+pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> FrameQuality {
+    let fine = Fine {
+        events: simulation.events,
+        grid: simulation.grid,
+        seed: simulation.seed,
+        hot_events: &simulation.hot_events,
+    };
+    let exposure = exposure_of(check);
+    let mut variants = vec![Variant::Step(2), Variant::Step(3)];
+    variants.extend(exposure.map(Variant::Blurred));
+    let profiled: Vec<(Variant, PreparedFrames, Simulated, usize)> = variants
+        .par_iter()
+        .filter_map(|&v| profiled_on(check, &fine, model, v).map(|(f, s, n)| (v, f, s, n)))
+        .collect();
+    let mut quality = FrameQuality {
+        off: vec![point(check.frames, 1, model.params.ct_off)],
+        on: vec![point(check.frames, 1, model.params.ct_on)],
+        doubled_exposure: None,
+        exposure_unknown: exposure.is_none(),
+    };
+    for (variant, frames, p, count) in profiled {
+        simulation.count.set(simulation.count.get() + count);
+        match variant {
+            Variant::Step(step) => {
+                quality.off.push(point(&frames, step, p.params.ct_off));
+                quality.on.push(point(&frames, step, p.params.ct_on));
+            }
+            Variant::Blurred(e) => {
+                quality.doubled_exposure = Some((e, p.params.ct_off, p.params.ct_on));
+            }
+        }
+    }
+    quality
+}
+
+/// Adds each threshold's frame-rate and exposure systematics to its standard error in
+/// quadrature (the interval log-normal about the fitted value, as the fit's own) and
+/// returns the assumptions that say what was measured.
+pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>, quality: &FrameQuality) -> Vec<String> {
+    if quality.on.is_empty() || quality.off.is_empty() {
+        return Vec::new();
+    }
+    let mut rate_parts = Vec::new();
+    let mut exposure_parts = Vec::new();
+    let polarities = [
+        (
+            "ct_off",
+            "OFF",
+            &quality.off,
+            quality.doubled_exposure.map(|d| d.1),
+        ),
+        (
+            "ct_on",
+            "ON",
+            &quality.on,
+            quality.doubled_exposure.map(|d| d.2),
+        ),
+    ];
+    for (key, name, points, doubled) in polarities {
+        let (limit, rate) = frame_rate_systematic(points);
+        if points.len() >= 2 {
+            let values: Vec<String> = points.iter().map(|p| format!("{:.4}", p.value)).collect();
+            rate_parts.push(format!(
+                "{name} {} (limit {}, systematic {rate:.4})",
+                values.join(" / "),
+                limit.map_or("-".into(), |l| format!("{l:.4}"))
+            ));
+        }
+        let full = points[0].value;
+        // a straight line through exposures e and 2e reaches e = 0 as far below the
+        // full value as the doubled one lies above it
+        let exposure = doubled.map_or(0.0, |d| (d - full).abs());
+        if let Some(d) = doubled {
+            exposure_parts.push(format!(
+                "{name} {full:.4} / {d:.4} (limit {:.4}, systematic {exposure:.4})",
+                2.0 * full - d
+            ));
+        }
+        let Some(u) = uncertainty.get_mut(key) else {
+            continue;
+        };
+        let Some(se) = u.standard_error else { continue };
+        let systematic = rate.hypot(exposure);
+        if systematic > 0.0 && u.value > 0.0 {
+            *u = Uncertain::positive(u.value, Some(se.hypot(systematic)));
+        }
+    }
+    let mut notes = Vec::new();
+    if rate_parts.is_empty() {
+        notes.push("frame-rate check not run: every 2nd and 3rd frame left no interval the optical flow follows, so the gap between frames is not in the thresholds' intervals".into());
+    } else {
+        notes.push(format!(
+            "frame-rate check: the final model's thresholds profiled again on every 2nd and 3rd frame ({}); a straight line in the frame interval is extrapolated to infinite frame rate and the full-rate value's distance from it, plus the scatter about the line, is added to each threshold's standard error in quadrature",
+            rate_parts.join("; ")
+        ));
+    }
+    match quality.doubled_exposure {
+        Some((e, ..)) => notes.push(format!(
+            "exposure check: the thresholds profiled again on frames blurred by one more exposure's motion ({:.3} ms along the optical flow): {}; a straight line through the two exposures is extrapolated to none and the distance is added to each threshold's standard error in quadrature",
+            e as f64 / 1e3,
+            exposure_parts.join("; ")
+        )),
+        None if quality.exposure_unknown => notes.push("exposure check not run: the frames' exposure is not known (give it where it is known), so motion blur within an exposure is not in the thresholds' intervals".into()),
+        None => notes.push("exposure check not run: the blurred frames could not be profiled, so motion blur within an exposure is not in the thresholds' intervals".into()),
+    }
+    notes
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn series_of(values: &[f64]) -> Vec<FrameRatePoint> {
+        values
+            .iter()
+            .enumerate()
+            .map(|(i, &value)| FrameRatePoint {
+                frame_step: i + 1,
+                frame_interval_s: 0.02 * (i + 1) as f64,
+                value,
+            })
+            .collect()
+    }
+
+    fn uncertainty(on: f64, off: f64) -> BTreeMap<String, Uncertain> {
+        BTreeMap::from([
+            ("ct_on".into(), Uncertain::positive(on, Some(0.01 * on))),
+            ("ct_off".into(), Uncertain::positive(off, Some(0.01 * off))),
+        ])
+    }
+
+    fn closed(u: &Uncertain) -> (f64, f64) {
+        let [Some(lo), Some(hi)] = u.interval().expect("an interval") else {
+            panic!("closed")
+        };
+        (lo, hi)
+    }
+
+    #[test]
+    fn a_threshold_that_falls_with_the_frame_rate_widens_by_the_distance_to_the_limit() {
+        // ON read 0.30 / 0.26 / 0.22 at steps 1 / 2 / 3: the limit is 0.34, 0.04 away
+        let quality = FrameQuality {
+            on: series_of(&[0.30, 0.26, 0.22]),
+            off: series_of(&[0.40, 0.40, 0.40]),
+            doubled_exposure: None,
+            exposure_unknown: true,
+        };
+        let mut u = uncertainty(0.30, 0.40);
+        let notes = widen(&mut u, &quality);
+        let on = u["ct_on"].standard_error.unwrap();
+        assert!((on - (0.003f64).hypot(0.04)).abs() < 1e-9, "{on}");
+        let (lo, hi) = closed(&u["ct_on"]);
+        assert!(lo < 0.30 && hi > 0.34, "{lo} {hi}");
+        // OFF did not move: its interval stays as it was
+        assert!((u["ct_off"].standard_error.unwrap() - 0.004).abs() < 1e-12);
+        assert!(
+            notes[0].contains("ON 0.3000 / 0.2600 / 0.2200"),
+            "{notes:?}"
+        );
+        assert!(notes[1].contains("exposure is not known"), "{notes:?}");
+    }
+
+    #[test]
+    fn a_doubled_exposure_that_lowers_a_threshold_widens_it_by_as_much() {
+        // doubling the blur takes ON from 0.30 to 0.27: no blur would read about 0.33
+        let quality = FrameQuality {
+            on: series_of(&[0.30]),
+            off: series_of(&[0.40]),
+            doubled_exposure: Some((5000, 0.40, 0.27)),
+            exposure_unknown: false,
+        };
+        let mut u = uncertainty(0.30, 0.40);
+        let notes = widen(&mut u, &quality);
+        let (_, hi) = closed(&u["ct_on"]);
+        assert!(hi > 0.33 && hi < 0.40, "{hi}");
+        assert!((u["ct_off"].standard_error.unwrap() - 0.004).abs() < 1e-12);
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(
+            notes[0].contains("5.000 ms") && notes[0].contains("limit 0.3300"),
+            "{notes:?}"
+        );
+    }
+
+    #[test]
+    fn thresholds_that_were_not_fitted_are_left_alone() {
+        let mut u = uncertainty(0.30, 0.40);
+        assert!(widen(&mut u, &FrameQuality::default()).is_empty());
+        assert_eq!(u["ct_on"].standard_error, Some(0.003));
+    }
+}
