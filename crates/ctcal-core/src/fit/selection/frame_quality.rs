@@ -311,9 +311,10 @@ mod tests {
         let (_, hi) = closed(&u["ct_on"]);
         assert!(hi > 0.33 && hi < 0.40, "{hi}");
         assert!((u["ct_off"].standard_error.unwrap() - 0.004).abs() < 1e-12);
-        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert_eq!(notes.len(), 2, "{notes:?}");
+        assert!(notes[0].contains("frame-rate check not run"), "{notes:?}");
         assert!(
-            notes[0].contains("5.000 ms") && notes[0].contains("limit 0.3300"),
+            notes[1].contains("5.000 ms") && notes[1].contains("limit 0.3300"),
             "{notes:?}"
         );
     }
