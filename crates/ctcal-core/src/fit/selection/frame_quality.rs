@@ -4,7 +4,8 @@
 //!
 //! - the gap between frames: where the scene moves several pixels from one frame to the
 //!   next, the flow and its interpolation smooth what happens in between. The final
-//!   model's thresholds are profiled again on every 2nd and every 3rd frame, and the
+//!   model's thresholds are profiled again on every frame, every 2nd and every 3rd frame
+//!   (the same profile for each, so that only the frames differ), and the
 //!   distance of the full-rate value from the straight line's limit at infinite frame rate,
 //!   plus the scatter about the line ([`crate::estimate::interval::frame_rate_systematic`],
 //!   the same check `estimate aps` makes), is a systematic error of each threshold (the
@@ -33,10 +34,15 @@ use std::collections::BTreeMap;
 /// The thresholds each check profiled.
 #[derive(Clone, Debug, Default)]
 pub struct FrameQuality {
-    /// At frame steps 1, 2, 3 (OFF, ON), the full rate first.
+    /// At frame steps 1, 2, 3 (OFF, ON), the full rate first. Every point, the full rate's
+    /// too, is profiled by the check from the final model's thresholds: a threshold profile
+    /// ends at the tried value nearest balance, and the median of integer-count ratios
+    /// moves in steps, so the same profile on the same frames is what a changed frame set
+    /// is compared with (not the fit's own value, which may sit a step away).
     pub off: Vec<FrameRatePoint>,
     pub on: Vec<FrameRatePoint>,
-    /// With the exposure's motion blur doubled: (exposure in us, OFF, ON).
+    /// With the exposure's motion blur doubled: (exposure in us, OFF, ON), compared with
+    /// the full-rate points.
     pub doubled_exposure: Option<(TimeUs, f64, f64)>,
     /// The frames' exposure is not known (no exposure check).
     pub exposure_unknown: bool,
@@ -63,30 +69,34 @@ struct Fine<'a> {
 /// A variant of the fit's frames.
 #[derive(Clone, Copy)]
 enum Variant {
+    /// The frames as they are (the reference of the others).
+    Same,
     /// Every `n`-th frame.
     Step(usize),
     /// Blurred by one more exposure of this many microseconds.
     Blurred(TimeUs),
 }
 
-fn point(frames: &PreparedFrames, step: usize, value: f64) -> FrameRatePoint {
+fn point(frame_interval_s: f64, step: usize, value: f64) -> FrameRatePoint {
     FrameRatePoint {
         frame_step: step,
-        frame_interval_s: frames.median_interval_us() as f64 * 1e-6,
+        frame_interval_s,
         value,
     }
 }
 
 /// The model's thresholds profiled on `variant` of the frames (`None` where too few frame
-/// intervals remain usable, or the profile fails), with the variant's frames and the
-/// simulations run.
+/// intervals remain usable, or the profile fails), with the variant's median frame
+/// interval (seconds) and the simulations run.
 fn profiled_on(
     check: &Check,
     fine: &Fine,
     model: &Simulated,
     variant: Variant,
-) -> Option<(PreparedFrames, Simulated, usize)> {
-    let frames = match variant {
+) -> Option<(f64, Simulated, usize)> {
+    let owned;
+    let frames: &PreparedFrames = match variant {
+        Variant::Same => check.frames,
         Variant::Step(step) => {
             // the same intervals, `step` times longer: the motion gate grows with them, up
             // to twice the fit's (the flow's coarsest pyramid level, a quarter of the
@@ -94,13 +104,17 @@ fn profiled_on(
             // and not the frame rate would move the thresholds)
             let mut options = check.options.aps.frames.clone();
             options.max_motion_px *= step.min(2) as f64;
-            check.frames.every(step, &options)?
+            owned = check.frames.every(step, &options)?;
+            &owned
         }
-        Variant::Blurred(exposure) => check.frames.motion_blurred(exposure),
+        Variant::Blurred(exposure) => {
+            owned = check.frames.motion_blurred(exposure);
+            &owned
+        }
     };
     let runs = frames.upsample_runs(0.5, check.options.aps.max_upsampled_bytes);
     let geometry = Geometry::new(
-        &frames,
+        frames,
         check.input.excluded,
         check.options.blocks,
         check.fit_end,
@@ -119,7 +133,8 @@ fn profiled_on(
     };
     let profiled = coarse.profile(&model.params, check.masked, false).ok()?;
     let count = coarse.count.get();
-    Some((frames, profiled, count))
+    let interval_s = frames.median_interval_us() as f64 * 1e-6;
+    Some((interval_s, profiled, count))
 }
 
 /// The frames' exposure: the frames' own, else the user's.
@@ -143,29 +158,34 @@ pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> Fra
         hot_events: &simulation.hot_events,
     };
     let exposure = exposure_of(check);
-    let mut variants = vec![Variant::Step(2), Variant::Step(3)];
+    let mut variants = vec![Variant::Same, Variant::Step(2), Variant::Step(3)];
     variants.extend(exposure.map(Variant::Blurred));
-    let profiled: Vec<(Variant, PreparedFrames, Simulated, usize)> = variants
+    let profiled: Vec<(Variant, f64, Simulated, usize)> = variants
         .par_iter()
-        .filter_map(|&v| profiled_on(check, &fine, model, v).map(|(f, s, n)| (v, f, s, n)))
+        .filter_map(|&v| profiled_on(check, &fine, model, v).map(|(i, s, n)| (v, i, s, n)))
         .collect();
     let mut quality = FrameQuality {
-        off: vec![point(check.frames, 1, model.params.ct_off)],
-        on: vec![point(check.frames, 1, model.params.ct_on)],
-        doubled_exposure: None,
         exposure_unknown: exposure.is_none(),
+        ..FrameQuality::default()
     };
-    for (variant, frames, p, count) in profiled {
+    if !profiled.iter().any(|p| matches!(p.0, Variant::Same)) {
+        return quality;
+    }
+    for (variant, interval_s, p, count) in profiled {
         simulation.count.set(simulation.count.get() + count);
         match variant {
-            Variant::Step(step) => {
-                quality.off.push(point(&frames, step, p.params.ct_off));
-                quality.on.push(point(&frames, step, p.params.ct_on));
+            Variant::Same | Variant::Step(_) => {
+                let step = if let Variant::Step(n) = variant { n } else { 1 };
+                quality.off.push(point(interval_s, step, p.params.ct_off));
+                quality.on.push(point(interval_s, step, p.params.ct_on));
             }
             Variant::Blurred(e) => {
                 quality.doubled_exposure = Some((e, p.params.ct_off, p.params.ct_on));
             }
         }
+    }
+    for series in [&mut quality.off, &mut quality.on] {
+        series.sort_by_key(|p| p.frame_step);
     }
     quality
 }
@@ -227,7 +247,7 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>, quality: &FrameQuali
         notes.push("frame-rate check not run: every 2nd and 3rd frame left no interval the optical flow follows, so the gap between frames is not in the thresholds' intervals".into());
     } else {
         notes.push(format!(
-            "frame-rate check: the final model's thresholds profiled again on every 2nd and 3rd frame ({}); a straight line in the frame interval is extrapolated to infinite frame rate and the full-rate value's distance from it, plus the scatter about the line, is added to each threshold's standard error in quadrature",
+            "frame-rate check: the final model's thresholds profiled again on every frame, every 2nd and every 3rd frame ({}); a straight line in the frame interval is extrapolated to infinite frame rate and the full-rate value's distance from it, plus the scatter about the line, is added to each threshold's standard error in quadrature",
             rate_parts.join("; ")
         ));
     }
