@@ -71,7 +71,7 @@ impl Method {
             RecordingSpec::Scene { scene } => scene.aps.as_ref().map(|a| a.exposure_s),
             RecordingSpec::Screen { .. } => None,
         };
-        if let Some(e) = exposure_s.filter(|&e| e > 0.0)
+        if let Some(e) = exposure_s
             && matches!(self, Method::Fit | Method::Aps)
         {
             args.extend(["--exposure-s".into(), e.to_string().into()]);

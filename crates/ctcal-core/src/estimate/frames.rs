@@ -487,10 +487,12 @@ impl PreparedFrames {
     }
 }
 
-/// Why a frame cannot be used, if it cannot.
+/// Samples of a blurred pixel at most (a path of 32 px; a flow that long is not used).
+const MAX_BLUR_SAMPLES: usize = 64;
+
 /// `image` averaged along `fraction` of `flow` at each pixel (a linear motion blur of
 /// that path, centred on the pixel): one bilinear sample per half pixel of path, at least
-/// one.
+/// one, at most [`MAX_BLUR_SAMPLES`]; a pixel whose flow is not finite is kept.
 fn blurred_along(image: &Image, flow: &FlowField, fraction: f32) -> Image {
     let (w, h) = (image.width, image.height);
     let mut out = Vec::with_capacity(w * h);
@@ -498,7 +500,12 @@ fn blurred_along(image: &Image, flow: &FlowField, fraction: f32) -> Image {
         for x in 0..w {
             let (u, v) = flow.at(x, y);
             let (u, v) = (u * fraction, v * fraction);
-            let samples = ((2.0 * u.hypot(v)).ceil() as usize).max(1);
+            let length = u.hypot(v);
+            if !length.is_finite() {
+                out.push(image.at(x, y));
+                continue;
+            }
+            let samples = ((2.0 * length).ceil() as usize).clamp(1, MAX_BLUR_SAMPLES);
             if samples == 1 {
                 out.push(image.at(x, y));
                 continue;
@@ -514,6 +521,7 @@ fn blurred_along(image: &Image, flow: &FlowField, fraction: f32) -> Image {
     Image::new(w, h, out)
 }
 
+/// Why a frame cannot be used, if it cannot.
 fn frame_problems(dn: &[Image], options: &FrameOptions) -> Vec<Option<String>> {
     let energies: Vec<f64> = dn
         .par_iter()

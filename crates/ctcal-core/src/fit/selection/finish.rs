@@ -48,10 +48,9 @@ pub fn threshold_uncertainty(
             .then(|| mad_sigma(&v))
             .flatten()
             .map(|s| 1.2533 * s / (v.len() as f64).sqrt());
-        match (within, between[pol]) {
-            (Some(w), Some(b)) => Some(c * w.max(b)),
-            (w, b) => w.or(b).map(|s| c * s),
-        }
+        // the cells decide whether a threshold is measured at all (three at least); the
+        // jackknife only widens
+        within.map(|w| c * between[pol].map_or(w, |b| w.max(b)))
     };
     let p = &model.params;
     BTreeMap::from([
@@ -193,7 +192,9 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     state
         .uncertainty
         .extend(threshold_uncertainty(simulation, &state.model));
-    assumptions.push("the thresholds' standard errors are the larger of the count cells' spread on the fit blocks (cells taken as independent) and the delete-one-block jackknife of the median cell log ratio over the fit blocks (scaled by t(0.975, blocks - 1) / 1.96): a model that matches some stretches of the recording and not others widens them".into());
+    if !fixed && g.blocks_of(Role::Fit).len() >= 3 {
+        assumptions.push("the thresholds' standard errors are the larger of the count cells' spread on the fit blocks (cells taken as independent) and the delete-one-block jackknife of the median cell log ratio over the fit blocks (scaled by t(0.975, blocks - 1) / 1.96): a model that matches some stretches of the recording and not others widens them".into());
+    }
     assumptions.extend(super::frame_quality::widen(
         &mut state.uncertainty,
         &frame_quality,

@@ -5,12 +5,11 @@
 //! - the gap between frames: where the scene moves several pixels from one frame to the
 //!   next, the flow and its interpolation smooth what happens in between. The final
 //!   model's thresholds are profiled again on every frame, every 2nd and every 3rd frame
-//!   (the same profile for each, so that only the frames differ), and the
+//!   (the same profile for each, so that only the frames differ; the motion gate of a
+//!   usable interval doubled for the coarser ones, as far as the flow follows), and the
 //!   distance of the full-rate value from the straight line's limit at infinite frame rate,
 //!   plus the scatter about the line ([`crate::estimate::interval::frame_rate_systematic`],
-//!   the same check `estimate aps` makes), is a systematic error of each threshold (the
-//!   motion gate of a usable interval doubles for the coarser frames, so that the same
-//!   intervals are compared where the flow can still follow them);
+//!   the same check `estimate aps` makes), is a systematic error of each threshold;
 //! - the exposure: a frame averages the moving scene over its exposure (motion blur),
 //!   which the simulation takes as an instant. The thresholds are profiled again on frames
 //!   blurred by one more exposure's motion along the flow
@@ -27,6 +26,7 @@ use super::super::{FitInput, FitOptions, Uncertain};
 use crate::estimate::frames::PreparedFrames;
 use crate::estimate::interval::{FrameRatePoint, frame_rate_systematic};
 use crate::events::{EventChunk, TimeUs};
+use crate::sim::Sample;
 use rayon::prelude::*;
 use std::cell::Cell;
 use std::collections::BTreeMap;
@@ -46,6 +46,10 @@ pub struct FrameQuality {
     pub doubled_exposure: Option<(TimeUs, f64, f64)>,
     /// The frames' exposure is not known (no exposure check).
     pub exposure_unknown: bool,
+    /// The frames' exposure is zero (no motion blur, no exposure check).
+    pub instantaneous: bool,
+    /// The thresholds could not be profiled again on the frames as they are (no check).
+    pub not_profiled: bool,
 }
 
 /// What the checks read besides the fit's simulation.
@@ -64,6 +68,11 @@ struct Fine<'a> {
     grid: Option<(TimeUs, TimeUs)>,
     seed: u64,
     hot_events: &'a EventChunk,
+    /// The fit's frames as simulated, their geometry and the recording's statistics on it
+    /// (kept where a check changes only the frames' content, not their times).
+    runs: &'a [Vec<Sample>],
+    geometry: &'a Geometry,
+    real: &'a Observed,
 }
 
 /// A variant of the fit's frames.
@@ -94,38 +103,46 @@ fn profiled_on(
     model: &Simulated,
     variant: Variant,
 ) -> Option<(f64, Simulated, usize)> {
-    let owned;
-    let frames: &PreparedFrames = match variant {
-        Variant::Same => check.frames,
+    let (frames, runs, geometry) = match variant {
+        // the fit's own frames, runs and statistics: only the profile is run again
+        Variant::Same => (None, None, None),
         Variant::Step(step) => {
-            // the same intervals, `step` times longer: the motion gate grows with them, up
-            // to twice the fit's (the flow's coarsest pyramid level, a quarter of the
-            // sensor with a 4 px window, follows about 16 px; far beyond, a failing flow
-            // and not the frame rate would move the thresholds)
+            // the intervals `step` times longer: the motion gate doubles for them (the
+            // flow's coarsest pyramid level, a quarter of the sensor with a 4 px window,
+            // follows about 16 px; far beyond, a failing flow and not the frame rate would
+            // move the thresholds), so the every-3rd-frame check keeps the intervals whose
+            // motion the flow still follows
             let mut options = check.options.aps.frames.clone();
             options.max_motion_px *= step.min(2) as f64;
-            owned = check.frames.every(step, &options)?;
-            &owned
+            let frames = check.frames.every(step, &options)?;
+            let runs = frames.upsample_runs(0.5, check.options.aps.max_upsampled_bytes);
+            let geometry = Geometry::new(
+                &frames,
+                check.input.excluded,
+                check.options.blocks,
+                check.fit_end,
+            );
+            (Some(frames), Some(runs), Some(geometry))
         }
+        // the same frame times, bins and statistics: only the frames' content changes
         Variant::Blurred(exposure) => {
-            owned = check.frames.motion_blurred(exposure);
-            &owned
+            let frames = check.frames.motion_blurred(exposure);
+            let runs = frames.upsample_runs(0.5, check.options.aps.max_upsampled_bytes);
+            (Some(frames), Some(runs), None)
         }
     };
-    let runs = frames.upsample_runs(0.5, check.options.aps.max_upsampled_bytes);
-    let geometry = Geometry::new(
-        frames,
-        check.input.excluded,
-        check.options.blocks,
-        check.fit_end,
-    );
+    let frames = frames.as_ref().unwrap_or(check.frames);
+    let geometry_used = geometry.as_ref().unwrap_or(fine.geometry);
     let coarse = Simulation {
-        runs: &runs,
+        runs: runs.as_deref().unwrap_or(fine.runs),
         width: frames.width,
         height: frames.height,
-        geometry: &geometry,
+        geometry: geometry_used,
         events: fine.events,
-        real: Observed::new(fine.events, &geometry, check.masked),
+        real: match &geometry {
+            Some(g) => Observed::new(fine.events, g, check.masked),
+            None => fine.real.clone(),
+        },
         grid: fine.grid,
         seed: fine.seed,
         count: Cell::new(0),
@@ -145,7 +162,7 @@ fn exposure_of(check: &Check) -> Option<TimeUs> {
         .iter()
         .find_map(|f| f.exposure_us)
         .or(check.options.aps.exposure_us)
-        .filter(|&e| e > 0)
+        .filter(|&e| e >= 0)
 }
 
 /// The checks of the final `model` (fitted on `simulation`'s frames); the simulations they
@@ -156,19 +173,24 @@ pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> Fra
         grid: simulation.grid,
         seed: simulation.seed,
         hot_events: &simulation.hot_events,
+        runs: simulation.runs,
+        geometry: simulation.geometry,
+        real: &simulation.real,
     };
     let exposure = exposure_of(check);
     let mut variants = vec![Variant::Same, Variant::Step(2), Variant::Step(3)];
-    variants.extend(exposure.map(Variant::Blurred));
+    variants.extend(exposure.filter(|&e| e > 0).map(Variant::Blurred));
     let profiled: Vec<(Variant, f64, Simulated, usize)> = variants
         .par_iter()
         .filter_map(|&v| profiled_on(check, &fine, model, v).map(|(i, s, n)| (v, i, s, n)))
         .collect();
     let mut quality = FrameQuality {
         exposure_unknown: exposure.is_none(),
+        instantaneous: exposure == Some(0),
         ..FrameQuality::default()
     };
     if !profiled.iter().any(|p| matches!(p.0, Variant::Same)) {
+        quality.not_profiled = true;
         return quality;
     }
     for (variant, interval_s, p, count) in profiled {
@@ -194,6 +216,9 @@ pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> Fra
 /// quadrature (the interval log-normal about the fitted value, as the fit's own) and
 /// returns the assumptions that say what was measured.
 pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>, quality: &FrameQuality) -> Vec<String> {
+    if quality.not_profiled {
+        return vec!["frame checks not run: the final model's thresholds could not be profiled again on its frames, so neither the gap between frames nor the exposure's motion blur is in the thresholds' intervals".into()];
+    }
     if quality.on.is_empty() || quality.off.is_empty() {
         return Vec::new();
     }
@@ -244,7 +269,7 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>, quality: &FrameQuali
     }
     let mut notes = Vec::new();
     if rate_parts.is_empty() {
-        notes.push("frame-rate check not run: every 2nd and 3rd frame left no interval the optical flow follows, so the gap between frames is not in the thresholds' intervals".into());
+        notes.push("frame-rate check not run: every 2nd and 3rd frame left no interval the optical flow follows (or their thresholds could not be profiled), so the gap between frames is not in the thresholds' intervals".into());
     } else {
         notes.push(format!(
             "frame-rate check: the final model's thresholds profiled again on every frame, every 2nd and every 3rd frame ({}); a straight line in the frame interval is extrapolated to infinite frame rate and the full-rate value's distance from it, plus the scatter about the line, is added to each threshold's standard error in quadrature",
@@ -257,6 +282,7 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>, quality: &FrameQuali
             e as f64 / 1e3,
             exposure_parts.join("; ")
         )),
+        None if quality.instantaneous => notes.push("exposure check not needed: the frames' exposure is 0 (instantaneous frames have no motion blur)".into()),
         None if quality.exposure_unknown => notes.push("exposure check not run: the frames' exposure is not known (give it where it is known), so motion blur within an exposure is not in the thresholds' intervals".into()),
         None => notes.push("exposure check not run: the blurred frames could not be profiled, so motion blur within an exposure is not in the thresholds' intervals".into()),
     }
@@ -301,6 +327,7 @@ mod tests {
             off: series_of(&[0.40, 0.40, 0.40]),
             doubled_exposure: None,
             exposure_unknown: true,
+            ..FrameQuality::default()
         };
         let mut u = uncertainty(0.30, 0.40);
         let notes = widen(&mut u, &quality);
@@ -324,7 +351,7 @@ mod tests {
             on: series_of(&[0.30]),
             off: series_of(&[0.40]),
             doubled_exposure: Some((5000, 0.40, 0.27)),
-            exposure_unknown: false,
+            ..FrameQuality::default()
         };
         let mut u = uncertainty(0.30, 0.40);
         let notes = widen(&mut u, &quality);
@@ -337,6 +364,27 @@ mod tests {
             notes[1].contains("5.000 ms") && notes[1].contains("limit 0.3300"),
             "{notes:?}"
         );
+    }
+
+    #[test]
+    fn instantaneous_frames_need_no_exposure_check_and_a_failed_profile_is_said() {
+        let quality = FrameQuality {
+            on: series_of(&[0.30, 0.30]),
+            off: series_of(&[0.40, 0.40]),
+            instantaneous: true,
+            ..FrameQuality::default()
+        };
+        let mut u = uncertainty(0.30, 0.40);
+        let notes = widen(&mut u, &quality);
+        assert!(notes[1].contains("exposure is 0"), "{notes:?}");
+        assert_eq!(u["ct_on"].standard_error, Some(0.003));
+        let failed = FrameQuality {
+            not_profiled: true,
+            ..FrameQuality::default()
+        };
+        let notes = widen(&mut u, &failed);
+        assert!(notes[0].starts_with("frame checks not run"), "{notes:?}");
+        assert_eq!(u["ct_on"].standard_error, Some(0.003));
     }
 
     #[test]
