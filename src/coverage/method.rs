@@ -74,7 +74,9 @@ impl Method {
         if let Some(e) = exposure_s
             && matches!(self, Method::Fit | Method::Aps)
         {
-            args.extend(["--exposure-s".into(), e.to_string().into()]);
+            // the binary's option, by name (as `run::output_options` names its own)
+            let name = "exposure-s";
+            args.extend([format!("--{name}").into(), e.to_string().into()]);
         }
         args
     }
