@@ -216,11 +216,7 @@ pub fn estimate(
             "use a recording, or a part of one, with more frames per unit of motion; without usable frames estimate with the eppps or screen method",
         ));
     }
-    let exposure = input
-        .frames
-        .iter()
-        .find_map(|f| f.exposure_us)
-        .or(options.exposure_us);
+    let exposure = super::frames::exposure_of(input.frames, options.exposure_us);
     assumptions.push(format!("log response: {}", options.log_response_name));
     assumptions.push(format!(
         "frames: {} of {} intervals used; frame times are exposure midpoints (as the file gives them); {}",

@@ -521,6 +521,11 @@ fn blurred_along(image: &Image, flow: &FlowField, fraction: f32) -> Image {
     Image::new(w, h, out)
 }
 
+/// The frames' exposure: the first the frames carry, else `given` (the user's).
+pub fn exposure_of(frames: &[Frame], given: Option<TimeUs>) -> Option<TimeUs> {
+    frames.iter().find_map(|f| f.exposure_us).or(given)
+}
+
 /// Why a frame cannot be used, if it cannot.
 fn frame_problems(dn: &[Image], options: &FrameOptions) -> Vec<Option<String>> {
     let energies: Vec<f64> = dn

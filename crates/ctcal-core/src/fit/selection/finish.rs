@@ -10,6 +10,7 @@ use super::super::{
 };
 use super::State;
 use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
+use crate::estimate::frames::exposure_of;
 use crate::stats::binomial::{median_interval95, wilson95};
 use crate::stats::hot_pixels::HotPixel;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
@@ -253,11 +254,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         assumptions,
         holdout: holdout(simulation, options),
         simulations: simulation.count.get(),
-        frame_exposure_us: input
-            .frames
-            .iter()
-            .find_map(|f| f.exposure_us)
-            .or(options.aps.exposure_us),
+        frame_exposure_us: exposure_of(input.frames, options.aps.exposure_us),
     }
 }
 

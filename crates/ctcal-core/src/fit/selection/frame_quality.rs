@@ -23,7 +23,7 @@
 use super::super::observe::{Geometry, Observed};
 use super::super::search::{Simulated, Simulation};
 use super::super::{FitInput, FitOptions, Uncertain};
-use crate::estimate::frames::PreparedFrames;
+use crate::estimate::frames::{PreparedFrames, exposure_of};
 use crate::estimate::interval::{FrameRatePoint, frame_rate_systematic};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::Sample;
@@ -154,17 +154,6 @@ fn profiled_on(
     Some((interval_s, profiled, count))
 }
 
-/// The frames' exposure: the frames' own, else the user's.
-fn exposure_of(check: &Check) -> Option<TimeUs> {
-    check
-        .input
-        .frames
-        .iter()
-        .find_map(|f| f.exposure_us)
-        .or(check.options.aps.exposure_us)
-        .filter(|&e| e >= 0)
-}
-
 /// The checks of the final `model` (fitted on `simulation`'s frames); the simulations they
 /// ran are added to the fit's count.
 pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> FrameQuality {
@@ -177,7 +166,8 @@ pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> Fra
         geometry: simulation.geometry,
         real: &simulation.real,
     };
-    let exposure = exposure_of(check);
+    let exposure =
+        exposure_of(check.input.frames, check.options.aps.exposure_us).filter(|&e| e >= 0);
     let mut variants = vec![Variant::Same, Variant::Step(2), Variant::Step(3)];
     variants.extend(exposure.filter(|&e| e > 0).map(Variant::Blurred));
     let profiled: Vec<(Variant, f64, Simulated, usize)> = variants
