@@ -18,7 +18,11 @@
 //!   approach to the limit, 1911, with one step).
 //!
 //! Both add to the thresholds' standard errors in quadrature. A clean, slow case profiles
-//! the same thresholds in every check and keeps its interval.
+//! nearly the same thresholds in every check; what it still adds is the profile's own
+//! step (the median of integer-count ratios is a step function, and a threshold the counts
+//! fix poorly can land a step away under any change of the frames), which these
+//! systematics do not yet tell apart from the frames' (`benches/coverage/`
+//! `fit-frame-checks-2026-11-25/`: slow cases' median half-width 0.18 -> 0.30 in ln).
 
 use super::super::observe::{Geometry, Observed};
 use super::super::search::{Simulated, Simulation};
