@@ -82,9 +82,7 @@ struct Fine<'a> {
 /// A variant of the fit's frames.
 #[derive(Clone, Copy)]
 enum Variant {
-    /// The frames as they are (the reference of the others).
-    Same,
-    /// Every `n`-th frame.
+    /// Every `n`-th frame (1: the frames as they are, the reference of the others).
     Step(usize),
     /// Blurred by one more exposure of this many microseconds.
     Blurred(TimeUs),
@@ -109,7 +107,7 @@ fn profiled_on(
 ) -> Option<(f64, Simulated, usize)> {
     let (frames, runs, geometry) = match variant {
         // the fit's own frames, runs and statistics: only the profile is run again
-        Variant::Same => (None, None, None),
+        Variant::Step(1) => (None, None, None),
         Variant::Step(step) => {
             // the intervals `step` times longer: the motion gate doubles for them (the
             // flow's coarsest pyramid level, a quarter of the sensor with a 4 px window,
@@ -172,7 +170,7 @@ pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> Fra
     };
     let exposure =
         exposure_of(check.input.frames, check.options.aps.exposure_us).filter(|&e| e >= 0);
-    let mut variants = vec![Variant::Same, Variant::Step(2), Variant::Step(3)];
+    let mut variants = vec![Variant::Step(1), Variant::Step(2), Variant::Step(3)];
     variants.extend(exposure.filter(|&e| e > 0).map(Variant::Blurred));
     let profiled: Vec<(Variant, f64, Simulated, usize)> = variants
         .par_iter()
@@ -183,15 +181,14 @@ pub fn measure(check: &Check, simulation: &Simulation, model: &Simulated) -> Fra
         instantaneous: exposure == Some(0),
         ..FrameQuality::default()
     };
-    if !profiled.iter().any(|p| matches!(p.0, Variant::Same)) {
+    if !profiled.iter().any(|p| matches!(p.0, Variant::Step(1))) {
         quality.not_profiled = true;
         return quality;
     }
     for (variant, interval_s, p, count) in profiled {
         simulation.count.set(simulation.count.get() + count);
         match variant {
-            Variant::Same | Variant::Step(_) => {
-                let step = if let Variant::Step(n) = variant { n } else { 1 };
+            Variant::Step(step) => {
                 quality.off.push(point(interval_s, step, p.params.ct_off));
                 quality.on.push(point(interval_s, step, p.params.ct_on));
             }
