@@ -258,6 +258,16 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
                     .map_or("-".into(), |v| format!("{v:.4}"))
             ),
         ));
+        rows.push((
+            "test blocks".into(),
+            match &e.simulated_back_why {
+                None => format!(
+                    "model simulated back over the recorded scene (from parameters alone: {:.4} -> {:.4})",
+                    e.predicted_error_before, e.predicted_error_after
+                ),
+                Some(why) => format!("errors from the model's parameters: {why}"),
+            },
+        ));
     }
     for (key, why) in r.why.iter().filter(|(k, _)| !k.starts_with("ct_o")) {
         rows.push((key.clone(), format!("not identified: {why}")));

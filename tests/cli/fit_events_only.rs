@@ -78,6 +78,20 @@ fn shot_noise_of_a_static_scene_within_a_factor_2_and_no_refractory_from_a_times
             .unwrap()
             .contains("grid")
     );
+    // the fitted noise simulated back onto the test blocks measures what they measure
+    // (0.02 here; twice the rate would give ln 2 = 0.69), the ideal pixel far from it
+    assert!(fit["events_only"]["simulated_back_why"].is_null());
+    let background = |key: &str| fit[key]["background"].as_f64().unwrap();
+    assert!(
+        background("components_after") < 0.1,
+        "{}",
+        background("components_after")
+    );
+    assert!(
+        background("components_before") > 3.0,
+        "{}",
+        background("components_before")
+    );
     // a static scene: no absolute thresholds, and why
     assert!(fit["params"]["ct_on"].is_null());
     assert!(fit["why"]["ct_on"].as_str().unwrap().contains("eppps"));

@@ -19,7 +19,8 @@
 //! shot noise need the brightness each pixel saw or a known stimulus: not identified.
 //! Each effect enters a noise model ([`model`]) and is kept when the model's distance to
 //! the selection blocks falls by more than measured chance ([`steps`]); the test blocks
-//! give `error_before` (ideal pixel) and `error_after`.
+//! give `error_before` (ideal pixel) and `error_after`, both with the model simulated back
+//! onto the test blocks' scene events and measured like the recording ([`simulate_back`]).
 
 mod blocks;
 mod candidates;
@@ -27,6 +28,7 @@ mod measure;
 mod model;
 pub mod refractory;
 mod result;
+mod simulate_back;
 mod steps;
 
 use super::effects::hot_pixels::HotTrain;
@@ -67,6 +69,13 @@ pub struct EventsOnly {
     /// The rates may include the scene's own slow events: upper bounds.
     pub noise_upper_bound: bool,
     pub noise_off_test_hz: Option<f64>,
+    /// The test blocks' distances of the ideal pixel and the final model read from their
+    /// parameters (`error_before`/`error_after` simulate them back, [`simulate_back`]).
+    pub predicted_error_before: f64,
+    pub predicted_error_after: f64,
+    /// Why the models were not simulated back (the errors are then the predicted ones).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulated_back_why: Option<String>,
     /// Pixel-seconds of quiet, uncovered time the rates rest on (fit blocks), and the
     /// support window that leaves the scene's own events out.
     pub quiet_pixel_seconds: f64,
@@ -94,6 +103,8 @@ pub struct IntervalEdge {
 /// What the fit blocks measured.
 pub(super) struct FitRun {
     hot: Vec<HotPixel>,
+    /// The named hot pixels' positions (x, y), in the order of `hot` and `trains`.
+    hot_positions: Vec<(u16, u16)>,
     trains: Vec<HotTrain>,
     /// Isolated-event rates (OFF, ON) under the chosen support window.
     noise: [Option<(f64, f64)>; 2],
@@ -255,6 +266,7 @@ fn fit_run(
         (all, se)
     });
     FitRun {
+        hot_positions: hot.iter().map(|h| (h.x, h.y)).collect(),
         hot,
         trains,
         noise: [

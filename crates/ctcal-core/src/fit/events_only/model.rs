@@ -52,8 +52,46 @@ pub struct Reference {
     pub window: usize,
 }
 
+/// What a model says the blocks measure: the isolated-event rates, the named hot pixels'
+/// rates, the share of short same-pixel intervals and the scene's OFF/ON balance. From
+/// the model's parameters ([`Prediction::of`]) or from the model simulated onto the
+/// blocks and measured ([`super::simulate_back`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Prediction {
+    pub on_hz: f64,
+    pub off_hz: f64,
+    /// `None`: the hot pixels fire like any pixel (the blocks' mean pixel rate).
+    pub hot_rates_hz: Option<Vec<f64>>,
+    /// Same-pixel intervals under the edge, relative to those in [edge, 2 edge).
+    pub short_share: f64,
+    pub balance: f64,
+}
+
+impl Prediction {
+    /// The model's parameters read as measurements: the rates as given, no short
+    /// intervals under a refractory period and a smooth density (share 1) without.
+    pub fn of(model: &NoiseModel) -> Self {
+        Self {
+            on_hz: model.noise_on_hz,
+            off_hz: model.noise_off_hz,
+            hot_rates_hz: model.hot_rates_hz.clone(),
+            short_share: if model.refractory { 0.0 } else { 1.0 },
+            balance: model.balance,
+        }
+    }
+}
+
 /// The distance of `model` to the recording's `blocks`.
 pub fn distance(model: &NoiseModel, blocks: &[&BlockMeasure], reference: Reference) -> Components {
+    compare(&Prediction::of(model), blocks, reference)
+}
+
+/// The distance of a prediction to the recording's `blocks`.
+pub fn compare(
+    predicted: &Prediction,
+    blocks: &[&BlockMeasure],
+    reference: Reference,
+) -> Components {
     let log = |p: f64, m: f64, floor: f64| ((p + floor) / (m + floor)).ln();
     let background = match (
         BlockMeasure::isolated_rate(blocks, reference.window, true),
@@ -62,8 +100,8 @@ pub fn distance(model: &NoiseModel, blocks: &[&BlockMeasure], reference: Referen
         (Some((on, on_se)), Some((off, off_se))) => {
             // rates are told apart down to twice their standard error on these blocks
             let floor = |se: f64| (2.0 * se).clamp(RATE_FLOOR_HZ, BACKGROUND_FLOOR_HZ);
-            let a = log(model.noise_on_hz, on, floor(on_se));
-            let b = log(model.noise_off_hz, off, floor(off_se));
+            let a = log(predicted.on_hz, on, floor(on_se));
+            let b = log(predicted.off_hz, off, floor(off_se));
             ((a * a + b * b) / 2.0).sqrt()
         }
         _ => 0.0,
@@ -79,33 +117,22 @@ pub fn distance(model: &NoiseModel, blocks: &[&BlockMeasure], reference: Referen
         let squares: f64 = (0..hot)
             .map(|k| {
                 let measured = blocks.iter().map(|b| b.hot_events[k]).sum::<u64>() as f64 / seconds;
-                let predicted = model.hot_rates_hz.as_ref().map_or(base, |r| r[k]);
+                let predicted = predicted.hot_rates_hz.as_ref().map_or(base, |r| r[k]);
                 log(predicted, measured, base.max(BACKGROUND_FLOOR_HZ)).powi(2)
             })
             .sum();
         (squares / hot as f64).sqrt()
     });
     let intervals = reference.edge_us.map_or(0.0, |e| {
-        let (mut under, mut above) = (0usize, 0usize);
-        for b in blocks {
-            for &v in &b.intervals {
-                let v = v as f64;
-                if v < e {
-                    under += 1;
-                } else if v < 2.0 * e {
-                    above += 1;
-                }
-            }
-        }
-        let measured = under as f64 / above.max(1) as f64;
-        let predicted = if model.refractory { 0.0 } else { 1.0 };
-        (predicted - measured).abs().min(2.0)
+        (predicted.short_share - short_share(blocks, e))
+            .abs()
+            .min(2.0)
     });
     let (on, off): (u64, u64) = blocks
         .iter()
         .fold((0, 0), |(a, b), m| (a + m.signal_on, b + m.signal_off));
     let polarity = if on > 0 && off > 0 {
-        ((off as f64 / on as f64).ln() - model.balance.ln()).abs()
+        ((off as f64 / on as f64).ln() - predicted.balance.ln()).abs()
     } else {
         0.0
     };
@@ -123,6 +150,22 @@ pub fn distance(model: &NoiseModel, blocks: &[&BlockMeasure], reference: Referen
         total,
         ..Components::default()
     }
+}
+
+/// Same-pixel intervals of `blocks` under `edge_us`, relative to those in [edge, 2 edge).
+pub fn short_share(blocks: &[&BlockMeasure], edge_us: f64) -> f64 {
+    let (mut under, mut above) = (0usize, 0usize);
+    for b in blocks {
+        for &v in &b.intervals {
+            let v = v as f64;
+            if v < edge_us {
+                under += 1;
+            } else if v < 2.0 * edge_us {
+                above += 1;
+            }
+        }
+    }
+    under as f64 / above.max(1) as f64
 }
 
 #[cfg(test)]

@@ -4,12 +4,15 @@
 
 use super::blocks::Blocks;
 use super::candidates::{on_excess, symmetric_rate};
+use super::measure::Measuring;
 use super::measure::{BlockMeasure, SUPPORT_WINDOWS_US};
-use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, distance};
+use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, compare, distance};
+use super::simulate_back::{Replaying, simulated};
 use super::steps::Judging;
 use super::{EventsOnly, FitRun, IntervalEdge};
 use crate::estimate::CtEstimate;
 use crate::fit::effects::Effect;
+use crate::fit::metric::Components;
 use crate::fit::observe::Role;
 use crate::fit::selection::keep::PARSIMONY;
 use crate::fit::{
@@ -85,12 +88,24 @@ pub(super) fn result(parts: Parts) -> FitResult {
         params.hot_pixel_rate_hz =
             median(&run.trains.iter().map(|t| t.rate_hz).collect::<Vec<_>>());
     }
-    let test = judging.of(Role::Test);
-    let before = distance(&NoiseModel::ideal(), &test, judging.reference);
-    let after = distance(&model, &test, judging.reference);
+    let test_errors = test_errors(
+        &parts_for_test(input, blocks, judging, &run, options),
+        &model,
+    );
+    let (before, after) = (test_errors.before.clone(), test_errors.after.clone());
     let identified = crate::fit::identified(&params, &why);
-    let events_only = details(&run, &thresholds, judging, kept("thresholds"));
-    let assumptions = assumptions(&run, &thresholds, blocks, judging, options);
+    let mut events_only = details(&run, &thresholds, judging, kept("thresholds"));
+    events_only.predicted_error_before = test_errors.predicted_before;
+    events_only.predicted_error_after = test_errors.predicted_after;
+    events_only.simulated_back_why = test_errors.why.clone();
+    let mut assumptions = assumptions(&run, &thresholds, blocks, judging, options);
+    assumptions.push(match &test_errors.why {
+        None => format!(
+            "error_before and error_after: the ideal pixel and the final model simulated back onto the test blocks' supported events (the scene as recorded) and measured like the recording (isolated rates, hot pixels); intervals and balance from the model's parameters. Read from the parameters alone they are {:.4} and {:.4}",
+            test_errors.predicted_before, test_errors.predicted_after
+        ),
+        Some(why) => format!("error_before and error_after from the model's parameters, not simulated back: {why}"),
+    });
     FitResult {
         biases: None,
         params: FittedParams {
@@ -116,6 +131,87 @@ pub(super) fn result(parts: Parts) -> FitResult {
         simulations: 0,
         frame_exposure_us: None,
         events_only: Some(events_only),
+    }
+}
+
+/// The test blocks' errors of the ideal pixel and the final model.
+struct TestErrors {
+    before: Components,
+    after: Components,
+    predicted_before: f64,
+    predicted_after: f64,
+    /// Why the models were not simulated back.
+    why: Option<String>,
+}
+
+/// What the test errors are measured on.
+struct TestBlocks<'a> {
+    measuring: Measuring<'a>,
+    spans: Vec<(crate::events::TimeUs, crate::events::TimeUs)>,
+    judging: &'a Judging<'a>,
+    run: &'a FitRun,
+    seed: u64,
+}
+
+fn parts_for_test<'a>(
+    input: &'a FitInput,
+    blocks: &Blocks,
+    judging: &'a Judging<'a>,
+    run: &'a FitRun,
+    options: &FitOptions,
+) -> TestBlocks<'a> {
+    TestBlocks {
+        measuring: Measuring {
+            events: input.events,
+            sensor: input.sensor,
+            excluded: input.excluded,
+            hot: &run.hot_positions,
+        },
+        spans: blocks
+            .of(Role::Test)
+            .iter()
+            .map(|&b| blocks.spans[b])
+            .collect(),
+        judging,
+        run,
+        seed: options.seed,
+    }
+}
+
+/// Both models simulated back onto the test blocks ([`simulated`]); read from their
+/// parameters where that cannot be done.
+fn test_errors(t: &TestBlocks, model: &NoiseModel) -> TestErrors {
+    let test = t.judging.of(Role::Test);
+    let reference = t.judging.reference;
+    let ideal = NoiseModel::ideal();
+    let predicted_before = distance(&ideal, &test, reference);
+    let predicted_after = distance(model, &test, reference);
+    let replaying = Replaying {
+        measuring: &t.measuring,
+        spans: &t.spans,
+        window: t.run.window,
+        trains: &t.run.trains,
+        edge_us: reference.edge_us,
+        seed: t.seed,
+    };
+    let back = |m: &NoiseModel| simulated(&replaying, m).map(|p| compare(&p, &test, reference));
+    let (predicted_before_total, predicted_after_total) =
+        (predicted_before.total, predicted_after.total);
+    match (back(&ideal), back(model)) {
+        (Ok(before), Ok(after)) => TestErrors {
+            before,
+            after,
+            predicted_before: predicted_before_total,
+            predicted_after: predicted_after_total,
+            why: None,
+        },
+        (Err(why), _) | (_, Err(why)) => TestErrors {
+            before: predicted_before,
+            after: predicted_after,
+            predicted_before: predicted_before_total,
+            predicted_after: predicted_after_total,
+            why: Some(why),
+        },
     }
 }
 
@@ -296,6 +392,9 @@ fn details(
         noise_on_test_hz: BlockMeasure::isolated_rate(&test, run.window, true).map(|r| r.0),
         noise_upper_bound: run.noise_still_falling,
         noise_off_test_hz: BlockMeasure::isolated_rate(&test, run.window, false).map(|r| r.0),
+        predicted_error_before: f64::NAN,
+        predicted_error_after: f64::NAN,
+        simulated_back_why: None,
         quiet_pixel_seconds: run.quiet_pixel_seconds,
         support_window_ms: SUPPORT_WINDOWS_US[run.window] as f64 / 1e3,
         timestamp_step_us: run.timestamp_step_us,
