@@ -153,6 +153,14 @@ pub trait LoadObserver {
     fn reading(&self, _done: u64, _total: u64) {}
 }
 
+/// Passes on reading progress, not warnings.
+struct ProgressOnly<'a>(&'a dyn LoadObserver);
+impl LoadObserver for ProgressOnly<'_> {
+    fn reading(&self, done: u64, total: u64) {
+        self.0.reading(done, total);
+    }
+}
+
 /// An observer that ignores everything.
 pub struct Silent;
 impl LoadObserver for Silent {}
@@ -173,49 +181,13 @@ pub fn load(
     for note in &recording.notes {
         observer.warn(&note.as_str().into());
     }
-    // the first event fixes the clock of start/end
-    let first = recording.first_event_time()?;
-    let to_us = |s: f64| first + (s * 1e6).round() as TimeUs;
-    let (mut from, mut to) = (
-        window.start_s.map_or(TimeUs::MIN, to_us),
-        window.end_s.map_or(TimeUs::MAX, to_us),
-    );
-    let mut notes = Vec::new();
-    let chosen = match window.frames {
-        Some(max_frames) => {
-            choose_frames(&recording, window, max_frames, (from, to), first, observer)?
-        }
-        None => ChosenFrames::default(),
-    };
-    notes.extend(chosen.note.iter().cloned());
-    let frames = chosen.frames;
-    if window.events_between_frames && frames.len() >= 2 {
-        from = from.max(frames[0].t);
-        to = to.min(frames[frames.len() - 1].t);
-    }
-    let unread: Vec<(TimeUs, TimeUs)> =
-        chosen.blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
-    let events = read_events(&recording, (from, to), &unread, observer)?;
-    if events.is_empty() {
-        return Err(InputError::EmptyWindow {
-            path: recording.path.clone(),
-            detail: format!(
-                "{:.6} s .. {:.6} s",
-                us_to_s(from.max(first) - first),
-                if to == TimeUs::MAX {
-                    f64::INFINITY
-                } else {
-                    us_to_s(to - first)
-                }
-            ),
-        }
-        .into());
-    }
+    let read = read_window(&recording, Source::Decode, window, observer)?;
+    let events = read.events;
     let resolved = recording.resolve_sensor(events.max_coordinates());
     if let Some(w) = &resolved.warning {
         observer.warn(w);
     }
-    if let Some(f) = frames.first()
+    if let Some(f) = read.chosen.frames.first()
         && (f.width as u16, f.height as u16) != (resolved.sensor.width, resolved.sensor.height)
     {
         return Err(LoadError::FrameSize {
@@ -234,6 +206,7 @@ pub fn load(
         });
     }
     let kept = selection.build(sensor, &recording.path, force)?;
+    let mut notes: Vec<String> = read.chosen.note.iter().cloned().collect();
     if !kept.is_all() {
         notes.push(format!("pixels: {}", kept.description()));
     }
@@ -244,11 +217,145 @@ pub fn load(
         sensor_source: resolved.source,
         recording,
         events,
-        frames,
-        frames_available: chosen.available,
-        unread,
+        frames: read.chosen.frames,
+        frames_available: read.chosen.available,
+        unread: read.unread,
         notes,
     })
+}
+
+/// The same window as `whole` (read whole by [`load`] with `window`), in blocks of
+/// consecutive frames with only the events between them ([`Window::events_between_frames`]),
+/// its events taken from `whole` rather than decoded again: only the chosen frames are read.
+pub fn load_blocks(
+    whole: &Loaded,
+    window: &Window,
+    observer: &dyn LoadObserver,
+) -> Result<Loaded, LoadError> {
+    let window = Window {
+        events_between_frames: true,
+        ..window.clone()
+    };
+    let read = read_window(
+        &whole.recording,
+        Source::Read(&whole.events),
+        &window,
+        observer,
+    )?;
+    let mut notes: Vec<String> = read.chosen.note.iter().cloned().collect();
+    if !whole.selection.is_all() {
+        notes.push(format!("pixels: {}", whole.selection.description()));
+    }
+    Ok(Loaded {
+        recording: whole.recording.clone(),
+        sensor: whole.sensor,
+        sensor_source: whole.sensor_source.clone(),
+        events: read.events,
+        frames: read.chosen.frames,
+        frames_available: read.chosen.available,
+        unread: read.unread,
+        selection: whole.selection.clone(),
+        excluded: whole.excluded.clone(),
+        notes,
+    })
+}
+
+/// Where a window's events come from: decoded from the recording, or already read.
+#[derive(Clone, Copy)]
+enum Source<'a> {
+    Decode,
+    Read(&'a EventChunk),
+}
+
+/// A window's frames and events, before the sensor is resolved.
+struct WindowRead {
+    chosen: ChosenFrames,
+    unread: Vec<(TimeUs, TimeUs)>,
+    events: EventChunk,
+}
+
+/// The frames `window` chooses and the events of its span (outside the spans between
+/// frame blocks), from `source`.
+fn read_window(
+    recording: &Recording,
+    source: Source,
+    window: &Window,
+    observer: &dyn LoadObserver,
+) -> Result<WindowRead, LoadError> {
+    // the first event fixes the clock of start/end
+    let first = recording.first_event_time()?;
+    let to_us = |s: f64| first + (s * 1e6).round() as TimeUs;
+    let (mut from, mut to) = (
+        window.start_s.map_or(TimeUs::MIN, to_us),
+        window.end_s.map_or(TimeUs::MAX, to_us),
+    );
+    let chosen = match window.frames {
+        Some(max_frames) => choose_frames(
+            recording,
+            source,
+            window,
+            max_frames,
+            (from, to),
+            first,
+            observer,
+        )?,
+        None => ChosenFrames::default(),
+    };
+    if window.events_between_frames && chosen.frames.len() >= 2 {
+        from = from.max(chosen.frames[0].t);
+        to = to.min(chosen.frames[chosen.frames.len() - 1].t);
+    }
+    let unread: Vec<(TimeUs, TimeUs)> =
+        chosen.blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
+    let events = read_events(recording, source, (from, to), &unread, observer)?;
+    if events.is_empty() {
+        return Err(InputError::EmptyWindow {
+            path: recording.path.clone(),
+            detail: format!(
+                "{:.6} s .. {:.6} s",
+                us_to_s(from.max(first) - first),
+                if to == TimeUs::MAX {
+                    f64::INFINITY
+                } else {
+                    us_to_s(to - first)
+                }
+            ),
+        }
+        .into());
+    }
+    Ok(WindowRead {
+        chosen,
+        unread,
+        events,
+    })
+}
+
+/// Calls `each` on the chunks of events from `source` that reach into `[from, to]`, in time
+/// order (a chunk may hold events outside it), until one passes `to`.
+fn each_chunk(
+    recording: &Recording,
+    source: Source,
+    (from, to): (TimeUs, TimeUs),
+    observer: &dyn LoadObserver,
+    mut each: impl FnMut(&EventChunk) -> Result<(), LoadError>,
+) -> Result<(), LoadError> {
+    let mut stream = match source {
+        Source::Read(events) => return each(events),
+        Source::Decode => recording.events_between(from, to)?,
+    };
+    for note in &stream.notes {
+        observer.warn(&note.as_str().into());
+    }
+    while stream.next_chunk()?.is_some() {
+        let chunk = stream.current_chunk();
+        each(chunk)?;
+        let progress = stream.progress();
+        observer.reading(progress.done, progress.total);
+        if chunk.t.last().is_some_and(|&t| t > to) {
+            break;
+        }
+    }
+    Ok(())
 }
 
 /// The frames a window reads: all of them, every k-th, or blocks of consecutive frames
@@ -268,6 +375,7 @@ struct ChosenFrames {
 /// latter only where the window keeps just the events between its frames).
 fn choose_frames(
     recording: &Recording,
+    source: Source,
     window: &Window,
     max_frames: usize,
     (from, to): (TimeUs, TimeUs),
@@ -288,7 +396,7 @@ fn choose_frames(
         max_frames,
     ) {
         frame_blocks::Plan::Blocks { step } if window.events_between_frames => {
-            let counts = interval_counts(recording, &inside_times, observer)?;
+            let counts = interval_counts(recording, source, &inside_times, observer)?;
             let thinned: Vec<usize> = (0..inside.len()).step_by(step).collect();
             let blocks =
                 frame_blocks::choose(&frame_blocks::thinned_counts(&counts, step), max_frames);
@@ -321,17 +429,13 @@ fn choose_frames(
 /// The events in `[from, to]` outside the `unread` spans, at most [`MAX_EVENTS`].
 fn read_events(
     recording: &Recording,
+    source: Source,
     (from, to): (TimeUs, TimeUs),
     unread: &[(TimeUs, TimeUs)],
     observer: &dyn LoadObserver,
 ) -> Result<EventChunk, LoadError> {
-    let mut stream = recording.events_between(from, to)?;
-    for note in &stream.notes {
-        observer.warn(&note.as_str().into());
-    }
     let mut events = EventChunk::default();
-    while stream.next_chunk()?.is_some() {
-        let chunk = stream.current_chunk();
+    each_chunk(recording, source, (from, to), observer, |chunk| {
         let lo = chunk.t.partition_point(|&t| t < from);
         let hi = chunk.t.partition_point(|&t| t <= to);
         for i in lo..hi.max(lo) {
@@ -339,19 +443,14 @@ fn read_events(
                 events.push(chunk.t[i], chunk.x[i], chunk.y[i], chunk.on[i]);
             }
         }
-        let past_window = chunk.t.last().is_some_and(|&t| t > to);
         if events.len() > MAX_EVENTS {
             return Err(LoadError::TooManyEvents {
                 path: recording.path.clone(),
                 max: MAX_EVENTS,
             });
         }
-        let progress = stream.progress();
-        observer.reading(progress.done, progress.total);
-        if past_window {
-            break;
-        }
-    }
+        Ok(())
+    })?;
     Ok(events)
 }
 
@@ -365,30 +464,28 @@ fn in_unread(unread: &[(TimeUs, TimeUs)], t: TimeUs) -> bool {
 /// the events of their span (none kept).
 fn interval_counts(
     recording: &Recording,
+    source: Source,
     times: &[TimeUs],
     observer: &dyn LoadObserver,
 ) -> Result<Vec<u64>, LoadError> {
     let mut counts = vec![0u64; times.len().saturating_sub(1)];
     let (from, to) = (times[0], times[times.len() - 1]);
-    let mut stream = recording.events_between(from, to)?;
     let mut k = 0;
-    while stream.next_chunk()?.is_some() {
-        let chunk = stream.current_chunk();
-        for &t in &chunk.t {
-            if t < from || t >= to {
-                continue;
+    // the window's own read warns of the stream's notes
+    let quiet = ProgressOnly(observer);
+    each_chunk(recording, source, (from, to), &quiet, |chunk| {
+        let lo = chunk.t.partition_point(|&t| t < from);
+        for &t in &chunk.t[lo..] {
+            if t >= to {
+                break;
             }
             while times[k + 1] <= t {
                 k += 1;
             }
             counts[k] += 1;
         }
-        let progress = stream.progress();
-        observer.reading(progress.done, progress.total);
-        if chunk.t.last().is_some_and(|&t| t >= to) {
-            break;
-        }
-    }
+        Ok(())
+    })?;
     Ok(counts)
 }
 
@@ -525,5 +622,71 @@ mod tests {
             .collect();
         assert_eq!(read, vec![0, 100, 200, 250, 300, 400, 500]);
         assert!(!in_unread(&[], 7));
+    }
+
+    /// 75 frames at 25 Hz under a limit of 60: three blocks of consecutive frames. Taken from the
+    /// events of the whole window already read, they are the blocks a second decoding reads.
+    #[test]
+    fn blocks_from_the_whole_window_are_the_blocks_decoded_again() {
+        use crate::write::{IjrrWriter, OutputPolicy};
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("rec");
+        let sensor = Sensor::new(16, 12);
+        let mut writer = IjrrWriter::create(&path, sensor, &OutputPolicy::default()).unwrap();
+        let mut events = EventChunk::default();
+        // busier in the middle second, so that the blocks' choice has something to choose
+        for k in 0..30_000i64 {
+            let t = k * 100 + (k % 7) * 3;
+            let busy = (1_000_000..2_000_000).contains(&t) || k % 3 == 0;
+            if busy {
+                events.push(t, (k % 16) as u16, ((k / 16) % 12) as u16, k % 2 == 0);
+            }
+        }
+        writer.write_events(&events).unwrap();
+        for f in 0..75i64 {
+            writer
+                .write_frame(&Frame {
+                    t: 20_000 + f * 40_000,
+                    width: 16,
+                    height: 12,
+                    pixels: vec![(f * 3) as u8; 16 * 12],
+                    exposure_us: None,
+                })
+                .unwrap();
+        }
+        writer.finish().unwrap();
+        let window = Window {
+            start_s: None,
+            end_s: None,
+            frames: Some(60),
+            events_between_frames: false,
+        };
+        let load_with = |between: bool| {
+            load(
+                &path,
+                &OpenOptions::default(),
+                &Window {
+                    events_between_frames: between,
+                    ..window.clone()
+                },
+                &SelectionSpec::default(),
+                false,
+                &Silent,
+            )
+            .unwrap()
+        };
+        let decoded = load_with(true);
+        let whole = load_with(false);
+        let taken = load_blocks(&whole, &window, &Silent).unwrap();
+        assert!(!decoded.unread.is_empty(), "{:?}", decoded.notes);
+        assert_eq!(taken.unread, decoded.unread);
+        assert_eq!(taken.events.t, decoded.events.t);
+        assert_eq!(taken.events.x, decoded.events.x);
+        assert_eq!(taken.events.on, decoded.events.on);
+        let times = |l: &Loaded| l.frames.iter().map(|f| f.t).collect::<Vec<_>>();
+        assert_eq!(times(&taken), times(&decoded));
+        assert_eq!(taken.notes, decoded.notes);
+        assert_eq!(taken.frames_available, 75);
+        assert!(taken.events.len() < whole.events.len());
     }
 }

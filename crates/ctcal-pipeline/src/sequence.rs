@@ -141,20 +141,9 @@ pub fn sequence(
     )?;
     // frames thinned to the limit: the frame-based methods read blocks of consecutive
     // frames instead (see `ctcal_io::frame_blocks`), whose optical flow still holds
+    // (from the events already read: the recording is decoded once)
     let blocks = (loaded.frames_available > options.max_frames)
-        .then(|| {
-            load(
-                &input.path,
-                &Default::default(),
-                &Window {
-                    events_between_frames: true,
-                    ..window.clone()
-                },
-                &options.selection,
-                options.force,
-                &crate::window::Silent,
-            )
-        })
+        .then(|| crate::window::load_blocks(&loaded, &window, &crate::window::Silent))
         .map(|read| {
             read.map_err(|e| format!("the blocks of consecutive frames could not be read: {e}"))
         });
