@@ -1,7 +1,8 @@
 //! Intervals from counting: a binomial proportion (Wilson, JASA 1927: a score interval
 //! that stays inside [0, 1] and behaves at 0 and n) and the distribution-free interval of
 //! a median from its order statistics (the number of values below the median is
-//! Binomial(n, 1/2); Conover, *Practical Nonparametric Statistics*, 3rd ed., sec. 3.2).
+//! Binomial(n, 1/2); Conover, *Practical Nonparametric Statistics*, 3rd ed., sec. 3.2),
+//! and the exact interval of a Poisson mean from one count (Garwood, Biometrika 1936).
 
 use crate::estimate::interval::z95;
 
@@ -29,6 +30,21 @@ pub fn wilson95(successes: usize, trials: usize) -> Option<(f64, f64)> {
         (centre + half).min(1.0)
     };
     Some((lo, hi))
+}
+
+/// Garwood's exact 95 % interval of a Poisson mean from the count `n`:
+/// `[chi2(0.025; 2n) / 2, chi2(0.975; 2n + 2) / 2]` (the lower end 0 for `n = 0`).
+pub fn poisson95(n: usize) -> (f64, f64) {
+    use statrs::distribution::{ChiSquared, ContinuousCDF};
+    let quantile = |freedom: f64, p: f64| {
+        ChiSquared::new(freedom).map_or(f64::NAN, |d| d.inverse_cdf(p)) / 2.0
+    };
+    let lo = if n == 0 {
+        0.0
+    } else {
+        quantile(2.0 * n as f64, 0.025)
+    };
+    (lo, quantile(2.0 * n as f64 + 2.0, 0.975))
 }
 
 /// The distribution-free 95 % interval of the median of `values`: `[x_(k), x_(n+1-k)]`
@@ -76,6 +92,19 @@ mod tests {
         assert_eq!(lo, 0.0);
         assert!((hi - 0.2775).abs() < 1e-3, "{hi}");
         assert_eq!(wilson95(0, 0), None);
+    }
+
+    #[test]
+    fn garwood_intervals_match_the_tables() {
+        // Garwood 1936 / any table of exact Poisson limits: 0 -> [0, 3.689], 10 -> [4.795, 18.39]
+        let (lo, hi) = poisson95(0);
+        assert_eq!(lo, 0.0);
+        assert!((hi - 3.6889).abs() < 1e-3, "{hi}");
+        let (lo, hi) = poisson95(10);
+        assert!(
+            (lo - 4.7954).abs() < 1e-3 && (hi - 18.3904).abs() < 1e-3,
+            "{lo} {hi}"
+        );
     }
 
     #[test]

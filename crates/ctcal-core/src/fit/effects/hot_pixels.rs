@@ -3,7 +3,8 @@
 //!
 //! Signature: pixels far above the count distribution of their neighbours in the
 //! recording but not in the model ([`crate::stats::hot_pixels`], robust z-score against the
-//! busiest 8-neighbour). They are named, and added to the model where they are: each a
+//! busiest 8-neighbour), whose excess falls also where the neighbours are quiet
+//! ([`independent_of_scene`]: a defect fires whatever the scene, a low threshold only on it). They are named, and added to the model where they are: each a
 //! Poisson train at its own rate and polarity share, measured on the fit blocks ([`events`]),
 //! so that model and recording are compared on the same pixels before and after (a
 //! simulator places its hot pixels at random: the fraction and the median rate are reported
@@ -57,6 +58,113 @@ pub fn evidence(c: &Context) -> Evidence {
     }
 }
 
+/// Neighbour events within this time of a pixel's event support it (the scene's edges
+/// cross neighbouring pixels within it at the speeds of the study, > 10 px/s, whatever
+/// their direction).
+pub const SCENE_WINDOW_US: TimeUs = 30_000;
+
+/// The named pixels whose excess is not the scene's: a defective pixel fires whatever its
+/// neighbours do (a Poisson train independent of the scene), so a share of its events
+/// falls where no neighbour fires, as large as the share of time its neighbours leave
+/// uncovered (within [`SCENE_WINDOW_US`]). A pixel that out-fires its neighbours only
+/// while they fire too — a low threshold under mismatch on the scene's own edges — has
+/// none there. A pixel is kept unless its excess over the busiest neighbour, spread over
+/// its uncovered time, predicts at least 10 events without support and fewer than a
+/// quarter of those are seen; where the neighbours cover too much of the time to tell,
+/// it is kept. Returns the kept pixels and the number left out.
+pub fn independent_of_scene(
+    hot: &[HotPixel],
+    events: &EventChunk,
+    sensor: crate::events::Sensor,
+) -> (Vec<HotPixel>, usize) {
+    if hot.is_empty() || events.is_empty() {
+        return (hot.to_vec(), 0);
+    }
+    let w = sensor.width as usize;
+    let span = (events.t[0], events.t[events.len() - 1] + 1);
+    // for each pixel, the named pixels whose neighbourhood it is in (own pixel: usize::MAX tag)
+    let mut watchers: std::collections::HashMap<usize, Vec<(usize, bool)>> =
+        std::collections::HashMap::new();
+    for (k, h) in hot.iter().enumerate() {
+        let (x, y) = (h.x as i64, h.y as i64);
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= sensor.width as i64 || ny >= sensor.height as i64 {
+                    continue;
+                }
+                watchers
+                    .entry(ny as usize * w + nx as usize)
+                    .or_default()
+                    .push((k, dx == 0 && dy == 0));
+            }
+        }
+    }
+    let mut own: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
+    let mut neighbours: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
+    let mut counts: std::collections::HashMap<usize, u64> = std::collections::HashMap::new();
+    for i in 0..events.len() {
+        let p = events.y[i] as usize * w + events.x[i] as usize;
+        if let Some(list) = watchers.get(&p) {
+            *counts.entry(p).or_default() += 1;
+            for &(k, is_own) in list {
+                if is_own {
+                    own[k].push(events.t[i]);
+                } else {
+                    neighbours[k].push(events.t[i]);
+                }
+            }
+        }
+    }
+    let seconds = (span.1 - span.0) as f64 * 1e-6;
+    let mut kept = Vec::new();
+    for (k, h) in hot.iter().enumerate() {
+        let (uncovered, unsupported) = uncovered_and_alone(&own[k], &neighbours[k], span);
+        let busiest = watchers
+            .iter()
+            .filter(|(_, list)| list.contains(&(k, false)))
+            .map(|(p, _)| counts.get(p).copied().unwrap_or(0))
+            .max()
+            .unwrap_or(0);
+        let excess_hz = own[k].len().saturating_sub(busiest as usize) as f64 / seconds;
+        let predicted = excess_hz * uncovered;
+        if predicted < 10.0 || unsupported as f64 >= 0.25 * predicted {
+            kept.push(h.clone());
+        }
+    }
+    let left_out = hot.len() - kept.len();
+    (kept, left_out)
+}
+
+/// Seconds of `span` no neighbour event covers (within [`SCENE_WINDOW_US`]) and the own
+/// events that fall in that time; both lists time-sorted.
+fn uncovered_and_alone(
+    own: &[TimeUs],
+    neighbours: &[TimeUs],
+    span: (TimeUs, TimeUs),
+) -> (f64, usize) {
+    let mut covered: Vec<(TimeUs, TimeUs)> = Vec::new();
+    for &t in neighbours {
+        let (a, b) = (t - SCENE_WINDOW_US, t + SCENE_WINDOW_US);
+        match covered.last_mut() {
+            Some(last) if a <= last.1 => last.1 = last.1.max(b),
+            _ => covered.push((a, b)),
+        }
+    }
+    let inside: TimeUs = covered
+        .iter()
+        .map(|&(a, b)| (b.min(span.1) - a.max(span.0)).max(0))
+        .sum();
+    let alone = own
+        .iter()
+        .filter(|&&t| {
+            let k = covered.partition_point(|&(_, b)| b <= t);
+            covered.get(k).is_none_or(|&(a, _)| t < a)
+        })
+        .count();
+    ((span.1 - span.0 - inside) as f64 * 1e-6, alone)
+}
+
 /// A named hot pixel as the model simulates it.
 #[derive(Clone, Copy, Debug)]
 pub struct HotTrain {
@@ -93,6 +201,52 @@ pub fn events(trains: &[HotTrain], span: (TimeUs, TimeUs), seed: u64) -> EventCh
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A pixel firing a Poisson train at 50 Hz beside quiet neighbours is kept; a pixel
+    /// that fires three events for each of its neighbour's (a low threshold on the
+    /// scene's edges), always within a few ms of it, is left out.
+    #[test]
+    fn a_pixel_that_fires_only_with_its_neighbours_is_not_hot() {
+        let sensor = crate::events::Sensor::new(20, 10);
+        let mut all = Vec::new();
+        let train = events(
+            &[HotTrain {
+                x: 3,
+                y: 3,
+                rate_hz: 50.0,
+                on_share: 0.5,
+            }],
+            (0, 4_000_000),
+            1,
+        );
+        for i in 0..train.len() {
+            all.push((train.t[i], 3u16, 3u16, true));
+        }
+        // the scene: an edge every 200 ms at (12, 5) and its neighbour (13, 5)
+        for k in 0..20i64 {
+            let t = k * 200_000 + 1_000;
+            all.push((t, 13, 5, true));
+            for j in 0..3 {
+                all.push((t + 2_000 * j, 12, 5, true));
+            }
+        }
+        all.sort_unstable();
+        let mut chunk = EventChunk::default();
+        for (t, x, y, on) in all {
+            chunk.push(t, x, y, on);
+        }
+        let named = |x: u16, y: u16, rate_hz: f64| HotPixel {
+            x,
+            y,
+            events: (rate_hz * 4.0) as u64,
+            rate_hz,
+            z: 20.0,
+        };
+        let (kept, left_out) =
+            independent_of_scene(&[named(3, 3, 50.0), named(12, 5, 15.0)], &chunk, sensor);
+        assert_eq!(left_out, 1);
+        assert_eq!((kept[0].x, kept[0].y), (3, 3));
+    }
 
     #[test]
     fn trains_fire_at_their_rate_and_share() {

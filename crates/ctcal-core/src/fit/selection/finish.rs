@@ -11,10 +11,8 @@ use super::super::{
 use super::State;
 use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
 use crate::estimate::frames::exposure_of;
-use crate::stats::binomial::{median_interval95, wilson95};
-use crate::stats::hot_pixels::HotPixel;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
-use crate::stats::robust::{mad_sigma, median};
+use crate::stats::robust::mad_sigma;
 use std::collections::BTreeMap;
 
 /// Standard errors of the thresholds: the larger of two measures of how well the fit
@@ -111,31 +109,44 @@ fn between_blocks(simulation: &Simulation, model: &Simulated) -> [Option<f64>; 2
     })
 }
 
-/// The named hot pixels as a simulator takes them: their fraction of the kept pixels with
-/// its Wilson interval (counting only: pixels too weak to stand out from their
-/// neighbours are not counted), and their median rate with the order-statistic interval of
-/// a median, or under six pixels the range of their rates widened by each rate's Poisson
-/// error (1.96 / sqrt(events)).
-pub fn hot_pixel_uncertainty(hot: &[HotPixel], kept_pixels: usize) -> (Uncertain, Uncertain) {
-    let n = hot.len();
-    let fraction = n as f64 / kept_pixels as f64;
-    let (lo, hi) = wilson95(n, kept_pixels).unwrap_or((0.0, 1.0));
-    let rates: Vec<f64> = hot.iter().map(|h| h.rate_hz).collect();
-    let rate = median(&rates).unwrap_or(0.0);
-    let (rate_lo, rate_hi) = median_interval95(&rates).unwrap_or_else(|| {
-        let poisson = |h: &HotPixel, side: f64| {
-            h.rate_hz * (1.0 + side * 1.96 / (h.events.max(1) as f64).sqrt()).max(0.0)
-        };
-        (
-            hot.iter()
-                .map(|h| poisson(h, -1.0))
-                .fold(f64::INFINITY, f64::min),
-            hot.iter().map(|h| poisson(h, 1.0)).fold(0.0, f64::max),
-        )
+/// The hot pixels reported: the named ones in excess of the final model's own count
+/// outliers ([`super::hot_excess`]), as a simulator takes them (a fraction of the kept
+/// pixels and a median rate); the assumption that says how they were counted.
+fn hot_pixels(
+    simulation: &Simulation,
+    state: &mut State,
+    input: &FitInput,
+    params: &mut crate::sim::PixelParams,
+) -> String {
+    let g = simulation.geometry;
+    let mut model = state.model.observed.pixels_of(g, Subset::Fit);
+    for (count, kept) in model.iter_mut().zip(&state.kept) {
+        if !kept {
+            *count = 0;
+        }
+    }
+    let found = super::hot_excess::excess(&super::hot_excess::Counts {
+        real_named: &state.hot,
+        model: &model,
+        width: g.sensor.width as usize,
+        height: g.sensor.height as usize,
+        duration_s: g.duration_of(Subset::Fit),
+        kept_pixels: input.excluded.iter().filter(|&&e| !e).count(),
     });
-    (
-        Uncertain::with_interval(fraction, None, [Some(lo), Some(hi)]),
-        Uncertain::with_interval(rate, None, [Some(rate_lo), Some(rate_hi)]),
+    params.hot_pixel_fraction = Some(found.fraction.value);
+    params.hot_pixel_rate_hz = found.rate.as_ref().map(|r| r.value);
+    state
+        .uncertainty
+        .insert("hot_pixel_fraction".into(), found.fraction);
+    if let Some(rate) = found.rate {
+        state.uncertainty.insert("hot_pixel_rate_hz".into(), rate);
+    }
+    format!(
+        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms; masked and simulated at their own rates), {} of them in excess of the {} count outliers the final model (mismatch, noise) makes by itself on the same blocks; hot_pixel_fraction and hot_pixel_rate_hz describe those {} (fraction interval: Poisson spread of both counts, Garwood's exact interval when the model makes none; pixels too weak to stand out from their neighbours are not counted)",
+        state.hot.len(),
+        found.hot.len(),
+        found.model_outliers,
+        found.hot.len()
     )
 }
 
@@ -213,14 +224,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         params.log_eps = Some(1e-6);
     }
     if !state.hot.is_empty() {
-        let kept_pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
-        let (fraction, rate) = hot_pixel_uncertainty(&state.hot, kept_pixels);
-        params.hot_pixel_fraction = Some(fraction.value);
-        params.hot_pixel_rate_hz = Some(rate.value);
-        state
-            .uncertainty
-            .insert("hot_pixel_fraction".into(), fraction);
-        state.uncertainty.insert("hot_pixel_rate_hz".into(), rate);
+        assumptions.push(hot_pixels(simulation, &mut state, input, &mut params));
     }
     let not_identified = not_identified(&state, fixed);
     for k in ["ct_on", "ct_off"] {

@@ -23,6 +23,7 @@ mod alternatives;
 pub use alternatives::Ambiguity;
 mod finish;
 mod frame_quality;
+mod hot_excess;
 pub(in crate::fit) mod keep;
 mod start;
 mod steps;
@@ -366,7 +367,11 @@ fn next_effect(candidates: Vec<effects::Evidence>, forced: bool) -> Option<effec
 /// The hot pixels of the fit blocks (robust z-score against the busiest neighbour), each
 /// with its rate and ON share in the fit run.
 fn hot_trains(context: &Context, fit_events: &EventChunk) -> (Vec<HotPixel>, Vec<HotTrain>) {
-    let hot = effects::hot_pixels::find(context);
+    let (hot, _) = effects::hot_pixels::independent_of_scene(
+        &effects::hot_pixels::find(context),
+        fit_events,
+        context.geometry.sensor,
+    );
     let trains = hot
         .iter()
         .map(|h| {
