@@ -118,6 +118,7 @@ fn events_only_recordings_fit_and_configure_end_to_end() {
     for (name, sensor) in [
         ("evk4_faery_evt3.raw", (1280, 720)),
         ("dvxplorer_tonic.aedat4", (320, 240)),
+        ("gen3_faery_evt2.raw", (640, 480)),
     ] {
         let fit_path = dir.path().join(format!("{name}.json"));
         succeeded(
@@ -156,4 +157,36 @@ fn events_only_recordings_fit_and_configure_end_to_end() {
         );
         let _ = sensor;
     }
+}
+
+/// A Gen3 recording (no frames) reported end to end: the per-sequence page gives the fitted
+/// noise, what is not identified and why, the loop's table and the simulated-back test
+/// errors, and its v2e configuration marks what the events do not identify.
+#[test]
+fn an_events_only_recording_is_reported_with_its_noise_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("report");
+    succeeded(
+        ctcal()
+            .arg("report")
+            .arg(real("gen3_faery_evt2.raw"))
+            .arg("--out")
+            .arg(&out)
+            .output(),
+    );
+    let md = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        md.contains("Effects added: **hot_pixels, shot_noise**"),
+        "{md}"
+    );
+    assert!(md.contains("ct_sigma not identified"), "{md}");
+    assert!(md.contains("#### The loop"), "{md}");
+    assert!(md.contains("simulated back onto the test blocks"), "{md}");
+    let results: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("results.json")).unwrap()).unwrap();
+    let fit = &results["sequences"][0]["fit"];
+    assert!(fit["events_only"]["simulated_back_why"].is_null());
+    assert!(fit["error_after"].as_f64().unwrap() < 0.5 * fit["error_before"].as_f64().unwrap());
+    let v2e = std::fs::read_to_string(out.join("configs/gen3_faery_evt2_raw/v2e_args.sh")).unwrap();
+    assert!(v2e.contains("NOT IDENTIFIED"), "{v2e}");
 }
