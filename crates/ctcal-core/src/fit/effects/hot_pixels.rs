@@ -71,17 +71,19 @@ pub const SCENE_WINDOW_US: TimeUs = 30_000;
 /// none there. A pixel is kept unless its excess over the busiest neighbour, spread over
 /// its uncovered time, predicts at least 10 events without support and fewer than a
 /// quarter of those are seen; where the neighbours cover too much of the time to tell,
-/// it is kept. Returns the kept pixels and the number left out.
+/// it is kept. `range`: the events (of `events`) to judge by. Returns the kept pixels and
+/// the number left out.
 pub fn independent_of_scene(
     hot: &[HotPixel],
     events: &EventChunk,
+    range: std::ops::Range<usize>,
     sensor: crate::events::Sensor,
 ) -> (Vec<HotPixel>, usize) {
-    if hot.is_empty() || events.is_empty() {
+    if hot.is_empty() || range.is_empty() {
         return (hot.to_vec(), 0);
     }
     let w = sensor.width as usize;
-    let span = (events.t[0], events.t[events.len() - 1] + 1);
+    let span = (events.t[range.start], events.t[range.end - 1] + 1);
     // for each pixel, the named pixels whose neighbourhood it is in (own pixel: usize::MAX tag)
     let mut watchers: std::collections::HashMap<usize, Vec<(usize, bool)>> =
         std::collections::HashMap::new();
@@ -103,7 +105,7 @@ pub fn independent_of_scene(
     let mut own: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
     let mut neighbours: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
     let mut counts: std::collections::HashMap<usize, u64> = std::collections::HashMap::new();
-    for i in 0..events.len() {
+    for i in range {
         let p = events.y[i] as usize * w + events.x[i] as usize;
         if let Some(list) = watchers.get(&p) {
             *counts.entry(p).or_default() += 1;
@@ -242,8 +244,12 @@ mod tests {
             rate_hz,
             z: 20.0,
         };
-        let (kept, left_out) =
-            independent_of_scene(&[named(3, 3, 50.0), named(12, 5, 15.0)], &chunk, sensor);
+        let (kept, left_out) = independent_of_scene(
+            &[named(3, 3, 50.0), named(12, 5, 15.0)],
+            &chunk,
+            0..chunk.len(),
+            sensor,
+        );
         assert_eq!(left_out, 1);
         assert_eq!((kept[0].x, kept[0].y), (3, 3));
     }

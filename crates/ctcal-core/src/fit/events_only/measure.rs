@@ -122,6 +122,18 @@ pub struct Measuring<'a> {
     pub hot: &'a [(u16, u16)],
 }
 
+impl Measuring<'_> {
+    /// Whether each pixel is measured: not masked, not a named hot pixel.
+    pub fn kept_pixels(&self) -> Vec<bool> {
+        let w = self.sensor.width as usize;
+        let mut kept: Vec<bool> = self.excluded.iter().map(|e| !e).collect();
+        for &(x, y) in self.hot {
+            kept[y as usize * w + x as usize] = false;
+        }
+        kept
+    }
+}
+
 /// Measures every block (`spans`, in time order).
 pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
     let (w, h) = (m.sensor.width as usize, m.sensor.height as usize);
@@ -129,9 +141,7 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
     for (k, &(x, y)) in m.hot.iter().enumerate() {
         hot_index[y as usize * w + x as usize] = k as u32;
     }
-    let kept: Vec<bool> = (0..w * h)
-        .map(|p| !m.excluded[p] && hot_index[p] == u32::MAX)
-        .collect();
+    let kept = m.kept_pixels();
     let mut clean = EventChunk::with_capacity(m.events.len());
     let mut hot_events = vec![Vec::new(); spans.len()];
     for (b, span) in spans.iter().enumerate() {

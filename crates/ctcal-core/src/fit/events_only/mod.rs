@@ -215,10 +215,10 @@ fn hot_pixels(input: &FitInput, blocks: &Blocks) -> (Vec<HotPixel>, Vec<HotTrain
     let seconds = blocks.seconds(&blocks.of(Role::Fit));
     // a pixel out-firing its neighbours only while they fire is the scene's (a low
     // threshold on its edges), not a defect
-    let fit_events = input.events.between(input.events.t[0], end);
     let (hot, _) = crate::fit::effects::hot_pixels::independent_of_scene(
         &find_hot_pixels(&counts, w, h, seconds),
-        &fit_events,
+        input.events,
+        0..fit_to,
         input.sensor,
     );
     let trains = hot

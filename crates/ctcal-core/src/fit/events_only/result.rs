@@ -88,24 +88,25 @@ pub(super) fn result(parts: Parts) -> FitResult {
         params.hot_pixel_rate_hz =
             median(&run.trains.iter().map(|t| t.rate_hz).collect::<Vec<_>>());
     }
-    let test_errors = test_errors(
-        &parts_for_test(input, blocks, judging, &run, options),
-        &model,
-    );
-    let (before, after) = (test_errors.before.clone(), test_errors.after.clone());
+    let TestErrors {
+        before,
+        after,
+        predicted_before,
+        predicted_after,
+        why: not_simulated,
+    } = test_errors(&test_blocks(input, blocks, judging, &run, options), &model);
     let identified = crate::fit::identified(&params, &why);
     let mut events_only = details(&run, &thresholds, judging, kept("thresholds"));
-    events_only.predicted_error_before = test_errors.predicted_before;
-    events_only.predicted_error_after = test_errors.predicted_after;
-    events_only.simulated_back_why = test_errors.why.clone();
+    events_only.predicted_error_before = predicted_before;
+    events_only.predicted_error_after = predicted_after;
     let mut assumptions = assumptions(&run, &thresholds, blocks, judging, options);
-    assumptions.push(match &test_errors.why {
+    assumptions.push(match &not_simulated {
         None => format!(
-            "error_before and error_after: the ideal pixel and the final model simulated back onto the test blocks' supported events (the scene as recorded) and measured like the recording (isolated rates, hot pixels); intervals and balance from the model's parameters. Read from the parameters alone they are {:.4} and {:.4}",
-            test_errors.predicted_before, test_errors.predicted_after
+            "error_before and error_after: the ideal pixel and the final model simulated back onto the test blocks' supported events (the scene as recorded) and measured like the recording (isolated rates, hot pixels); intervals and balance from the model's parameters. Read from the parameters alone they are {predicted_before:.4} and {predicted_after:.4}"
         ),
         Some(why) => format!("error_before and error_after from the model's parameters, not simulated back: {why}"),
     });
+    events_only.simulated_back_why = not_simulated;
     FitResult {
         biases: None,
         params: FittedParams {
@@ -153,7 +154,7 @@ struct TestBlocks<'a> {
     seed: u64,
 }
 
-fn parts_for_test<'a>(
+fn test_blocks<'a>(
     input: &'a FitInput,
     blocks: &Blocks,
     judging: &'a Judging<'a>,

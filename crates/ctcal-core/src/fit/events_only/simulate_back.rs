@@ -90,22 +90,12 @@ fn padded(spans: &[(TimeUs, TimeUs)], events: &EventChunk) -> Vec<(TimeUs, TimeU
     out
 }
 
-/// Whether each pixel is one the noise is measured at (not masked, not named hot).
-fn kept_pixels(m: &Measuring) -> Vec<bool> {
-    let w = m.sensor.width as usize;
-    let mut kept: Vec<bool> = m.excluded.iter().map(|e| !e).collect();
-    for &(x, y) in m.hot {
-        kept[y as usize * w + x as usize] = false;
-    }
-    kept
-}
-
 /// The recording's supported events at kept pixels over `ranges`: the scene as recorded,
 /// its isolated events (noise, leak) and the hot pixels' events out.
 fn scene(r: &Replaying, ranges: &[(TimeUs, TimeUs)]) -> EventChunk {
     let m = r.measuring;
     let w = m.sensor.width as usize;
-    let kept = kept_pixels(m);
+    let kept = m.kept_pixels();
     let mut all = EventChunk::default();
     for &(a, b) in ranges {
         let from = m.events.t.partition_point(|&t| t < a);
@@ -135,7 +125,8 @@ fn noise(
 ) -> Result<EventChunk, String> {
     let m = r.measuring;
     let w = m.sensor.width as usize;
-    let mut pixels: Vec<usize> = kept_pixels(m)
+    let mut pixels: Vec<usize> = m
+        .kept_pixels()
         .iter()
         .enumerate()
         .filter(|(_, k)| **k)

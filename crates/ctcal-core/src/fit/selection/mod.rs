@@ -370,6 +370,7 @@ fn hot_trains(context: &Context, fit_events: &EventChunk) -> (Vec<HotPixel>, Vec
     let (hot, _) = effects::hot_pixels::independent_of_scene(
         &effects::hot_pixels::find(context),
         fit_events,
+        0..fit_events.len(),
         context.geometry.sensor,
     );
     let trains = hot
