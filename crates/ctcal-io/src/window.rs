@@ -206,10 +206,7 @@ pub fn load(
         });
     }
     let kept = selection.build(sensor, &recording.path, force)?;
-    let mut notes: Vec<String> = read.chosen.note.iter().cloned().collect();
-    if !kept.is_all() {
-        notes.push(format!("pixels: {}", kept.description()));
-    }
+    let notes = notes(&read.chosen, &kept);
     Ok(Loaded {
         excluded: kept.excluded(),
         selection: kept,
@@ -242,10 +239,7 @@ pub fn load_blocks(
         &window,
         observer,
     )?;
-    let mut notes: Vec<String> = read.chosen.note.iter().cloned().collect();
-    if !whole.selection.is_all() {
-        notes.push(format!("pixels: {}", whole.selection.description()));
-    }
+    let notes = notes(&read.chosen, &whole.selection);
     Ok(Loaded {
         recording: whole.recording.clone(),
         sensor: whole.sensor,
@@ -258,6 +252,15 @@ pub fn load_blocks(
         excluded: whole.excluded.clone(),
         notes,
     })
+}
+
+/// What a window says in `assumptions`: how its frames were chosen, which pixels it keeps.
+fn notes(chosen: &ChosenFrames, selection: &PixelSelection) -> Vec<String> {
+    let mut notes: Vec<String> = chosen.note.iter().cloned().collect();
+    if !selection.is_all() {
+        notes.push(format!("pixels: {}", selection.description()));
+    }
+    notes
 }
 
 /// Where a window's events come from: decoded from the recording, or already read.

@@ -84,22 +84,13 @@ pub fn independent_of_scene(
     }
     let w = sensor.width as usize;
     let span = (events.t[range.start], events.t[range.end - 1] + 1);
-    // for each pixel, the named pixels whose neighbourhood it is in (own pixel: usize::MAX tag)
+    // for each pixel, the named pixels whose 3 x 3 neighbourhood it is in (and whether it is
+    // their own)
     let mut watchers: std::collections::HashMap<usize, Vec<(usize, bool)>> =
         std::collections::HashMap::new();
     for (k, h) in hot.iter().enumerate() {
-        let (x, y) = (h.x as i64, h.y as i64);
-        for dy in -1..=1 {
-            for dx in -1..=1 {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx < 0 || ny < 0 || nx >= sensor.width as i64 || ny >= sensor.height as i64 {
-                    continue;
-                }
-                watchers
-                    .entry(ny as usize * w + nx as usize)
-                    .or_default()
-                    .push((k, dx == 0 && dy == 0));
-            }
+        for (p, is_own) in neighbourhood(h, sensor) {
+            watchers.entry(p).or_default().push((k, is_own));
         }
     }
     let mut own: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
@@ -122,10 +113,9 @@ pub fn independent_of_scene(
     let mut kept = Vec::new();
     for (k, h) in hot.iter().enumerate() {
         let (uncovered, unsupported) = uncovered_and_alone(&own[k], &neighbours[k], span);
-        let busiest = watchers
-            .iter()
-            .filter(|(_, list)| list.contains(&(k, false)))
-            .map(|(p, _)| counts.get(p).copied().unwrap_or(0))
+        let busiest = neighbourhood(h, sensor)
+            .filter(|&(_, is_own)| !is_own)
+            .map(|(p, _)| counts.get(&p).copied().unwrap_or(0))
             .max()
             .unwrap_or(0);
         let excess_hz = own[k].len().saturating_sub(busiest as usize) as f64 / seconds;
@@ -136,6 +126,19 @@ pub fn independent_of_scene(
     }
     let left_out = hot.len() - kept.len();
     (kept, left_out)
+}
+
+/// The pixels (y * W + x) of the 3 x 3 neighbourhood of `h` on the sensor, each with
+/// whether it is `h` itself.
+fn neighbourhood(
+    h: &HotPixel,
+    sensor: crate::events::Sensor,
+) -> impl Iterator<Item = (usize, bool)> {
+    let (x, y, w) = (h.x as i64, h.y as i64, sensor.width as i64);
+    (-1..=1)
+        .flat_map(move |dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+        .filter(move |&(nx, ny)| nx >= 0 && ny >= 0 && nx < w && ny < sensor.height as i64)
+        .map(move |(nx, ny)| ((ny * w + nx) as usize, (nx, ny) == (x, y)))
 }
 
 /// Seconds of `span` no neighbour event covers (within [`SCENE_WINDOW_US`]) and the own
