@@ -13,6 +13,13 @@
 //! simulation of the same frames with known thresholds (and the recording's own timestamp
 //! grid). The least-squares fit of Wang et al. (ACRA 2019, [`super::lsq`]) cross-checks
 //! the maps and gives a third, timing-free global value.
+//!
+//! Interpolating frames along the flow misses part of the scene's change between them
+//! (occlusions, rotation, fine texture), at any frame rate: event timing fits its samples
+//! against their events' distance from the frames and reads the thresholds at the frames
+//! ([`super::timing::model`]); the re-simulation, whose counts come from the same
+//! interpolated frames, gets back the share the timing found missing, and keeps half that
+//! correction in its interval.
 
 use super::frames::{FrameOptions, PreparedFrames};
 use super::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
@@ -26,6 +33,18 @@ use crate::hint::{Analysis, Hint, Text};
 use crate::sim::log_response::LogMap;
 use crate::sim::{PixelParams, Sample};
 use serde_json::json;
+
+/// A re-simulated threshold with the share of the change the frames' interpolation misses
+/// (the event timing's, [`super::timing::PolarityEstimate::interpolation_share`]) put back:
+/// the value, and the size of the correction. Shares beyond +-50 % are not trusted to be
+/// the interpolation's and are not applied.
+fn interpolation_corrected(value: f64, share: f64) -> (f64, f64) {
+    if !share.is_finite() || share.abs() >= 0.5 {
+        return (value, 0.0);
+    }
+    let corrected = value / (1.0 - share);
+    (corrected, (corrected - value).abs())
+}
 
 /// Settings of `estimate aps`.
 #[derive(Clone, Debug)]
@@ -87,6 +106,10 @@ pub struct ApsInput<'a> {
 pub struct ApsResult {
     pub estimate: CtEstimate,
     pub maps: ThresholdMaps,
+    /// The share of each threshold (ON, OFF) the frames' interpolation took from the event
+    /// timing's samples ([`super::timing::PolarityEstimate::interpolation_share`]): what a
+    /// method matching counts of the interpolated frames misses.
+    pub interpolation_share: [f64; 2],
 }
 
 /// The fewest usable frame intervals the frame-based thresholds rest on.
@@ -387,23 +410,46 @@ pub fn estimate(
     let mut on_estimates = vec![timing_on.clone()];
     let mut off_estimates = vec![timing_off.clone()];
     if let Some(r) = &full.resim {
-        let series_on = series(&|p| p.resim.as_ref().map(|r| r.ct_on));
-        let series_off = series(&|p| p.resim.as_ref().map(|r| r.ct_off));
+        let share = |p: &Pass, on: bool| {
+            let t = if on { &p.timing.on } else { &p.timing.off };
+            t.interpolation_share
+        };
+        let series_on = series(&|p| {
+            p.resim
+                .as_ref()
+                .map(|r| interpolation_corrected(r.ct_on, share(p, true)).0)
+        });
+        let series_off = series(&|p| {
+            p.resim
+                .as_ref()
+                .map(|r| interpolation_corrected(r.ct_off, share(p, false)).0)
+        });
+        let (on_value, on_applied) = interpolation_corrected(r.ct_on, share(&full, true));
+        let (off_value, off_applied) = interpolation_corrected(r.ct_off, share(&full, false));
+        assumptions.push(format!(
+            "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
+            100.0 * share(&full, true),
+            100.0 * share(&full, false),
+            r.ct_on,
+            r.ct_off,
+        ));
         // the offset moves the re-simulation as it moves the timing (the same frames
         // through the same log)
         let on = Measured::new(
-            r.ct_on,
+            on_value,
             r.standard_error_on,
             frame_rate_systematic(&series_on)
                 .1
-                .hypot(full.timing.on.offset_systematic),
+                .hypot(full.timing.on.offset_systematic)
+                .hypot(0.5 * on_applied),
         );
         let off = Measured::new(
-            r.ct_off,
+            off_value,
             r.standard_error_off,
             frame_rate_systematic(&series_off)
                 .1
-                .hypot(full.timing.off.offset_systematic),
+                .hypot(full.timing.off.offset_systematic)
+                .hypot(0.5 * off_applied),
         );
         on_estimates.push(on.clone());
         off_estimates.push(off.clone());
@@ -504,6 +550,10 @@ pub fn estimate(
     progress("done", 1.0);
     Ok(ApsResult {
         estimate,
+        interpolation_share: [
+            full.timing.on.interpolation_share,
+            full.timing.off.interpolation_share,
+        ],
         maps: full.timing.maps,
     })
 }
@@ -672,10 +722,12 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
     let side = |v: Option<f32>| v.map_or("open".to_string(), |v| format!("{v:.1}"));
     match o.source {
         "fitted" => format!(
-            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN is in their intervals",
+            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval and both polarities' offsets: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing) is in their intervals",
             o.offset_dn,
             side(o.ci95[0]),
             side(o.ci95[1]),
+            side(o.by_polarity[0]),
+            side(o.by_polarity[1]),
             o.systematic_range.0,
             o.systematic_range.1
         ),
@@ -754,4 +806,19 @@ fn self_calibrate(
         again.off.ct - timing.off.ct,
         sigma_again - sigma,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::interpolation_corrected;
+
+    #[test]
+    fn the_interpolations_share_is_put_back_into_a_resimulated_threshold() {
+        // counts from frames that show 90 % of the change give 90 % of the threshold
+        let (value, applied) = interpolation_corrected(0.27, 0.1);
+        assert!((value - 0.3).abs() < 1e-12 && (applied - 0.03).abs() < 1e-12);
+        // a share that large is not the interpolation's: left alone
+        assert_eq!(interpolation_corrected(0.27, 0.6), (0.27, 0.0));
+        assert_eq!(interpolation_corrected(0.27, f64::NAN), (0.27, 0.0));
+    }
 }

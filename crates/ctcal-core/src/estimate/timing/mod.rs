@@ -98,6 +98,11 @@ pub struct PolarityEstimate {
     /// Robust relative spread of the kept samples (1.4826 MAD / mode): how consistently the
     /// frames explain the events.
     pub sample_spread: f64,
+    /// The share of `ct` the frames' interpolation took from the kept samples on average
+    /// (the fitted trend with the events' distance from the frames, at the samples' mean
+    /// distance, over `ct`; 0 where the trend was not fitted). Taken out of `ct`, whose
+    /// samples are read at the frames.
+    pub interpolation_share: f64,
 }
 
 /// Per-pixel thresholds (NaN without a sample) and sample counts, row-major.
@@ -118,8 +123,13 @@ pub struct Offset {
     /// Its 95 % interval; a side is `None` where the data do not bound it.
     pub ci95: [Option<f32>; 2],
     /// The offsets the thresholds' systematic error spans: the interval, with the prior
-    /// range ([`OFFSET_PRIOR`]) where the data leave a side open.
+    /// range ([`OFFSET_PRIOR`]) where the data leave a side open, and the offsets the ON and
+    /// the OFF samples each give.
     pub systematic_range: (f32, f32),
+    /// The offset each polarity's samples alone give (ON, OFF; `None` where one does not
+    /// make them independent of brightness). One offset belongs to the frames, so their
+    /// difference is what other brightness-dependent errors do to the fit.
+    pub by_polarity: [Option<f32>; 2],
     /// `fitted`, `given` (by the caller), or `not determined...` (the thresholds do not
     /// become independent of brightness at any offset, or the photoreceptor's lag hides
     /// what the offset does: the frames' own kept, the prior range spanned).
@@ -350,6 +360,7 @@ fn find_offset(
             offset_dn: frames.offset,
             ci95: [Some(frames.offset); 2],
             systematic_range: frames.offset_range,
+            by_polarity: [None; 2],
             source: "given",
         };
     }
@@ -357,6 +368,7 @@ fn find_offset(
         offset_dn: frames.offset,
         ci95: [None, None],
         systematic_range: OFFSET_PRIOR,
+        by_polarity: [None; 2],
         source: "not determined",
     };
     // a strong lag also makes dark pixels' thresholds look larger; the offset would absorb it
@@ -400,15 +412,46 @@ fn find_offset(
             ..not_determined
         };
     }
-    Offset {
-        offset_dn: root,
-        ci95,
-        systematic_range: (
+    let by_polarity = polarity_offsets(pairs, options, fit, range);
+    let (lo, hi) = by_polarity.iter().flatten().fold(
+        (
             ci95[0].unwrap_or(OFFSET_PRIOR.0.min(root)),
             ci95[1].unwrap_or(OFFSET_PRIOR.1.max(root)),
         ),
+        |(lo, hi), &b| (lo.min(b), hi.max(b)),
+    );
+    Offset {
+        offset_dn: root,
+        ci95,
+        systematic_range: (lo, hi),
+        by_polarity,
         source: "fitted",
     }
+}
+
+/// The offset the ON and the OFF samples each give: the root of each polarity's own level
+/// slope within `range` (`fit` the whole fit at an offset, whose pairs and weights each
+/// polarity's fit keeps).
+fn polarity_offsets(
+    pairs: &[Pair],
+    options: &TimingOptions,
+    fit: &Fit<'_>,
+    range: (f32, f32),
+) -> [Option<f32>; 2] {
+    let slope = |b: f32, on: bool| {
+        let (_, values, weights) = fit(b)?;
+        let own: Vec<f64> = pairs
+            .iter()
+            .zip(&weights)
+            .map(|(p, &w)| if p.on == on { w } else { 0.0 })
+            .collect();
+        model::fit(pairs, &values, &own, options.fit_leak).map(|c| c.level_slope)
+    };
+    let (on, off) = rayon::join(
+        || offset_root(&|b| slope(b, true), range),
+        || offset_root(&|b| slope(b, false), range),
+    );
+    [on, off]
 }
 
 /// How much the photoreceptor's lag moves the samples at the frames' own offset: the
@@ -607,6 +650,15 @@ fn polarity(
         let mid = deviations.len() / 2;
         1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1 / ct
     };
+    let (distance, total) = pairs
+        .iter()
+        .zip(weight)
+        .filter(|(p, w)| p.on == on && **w > 0.0)
+        .fold((0.0, 0.0), |(d, t), (p, w)| {
+            (d + w * p.interpolation(), t + w)
+        });
+    let trend = if on { c.interp_on } else { c.interp_off };
+    let interpolation_share = -trend * distance / total.max(1e-300) / ct;
     let mut map = vec![(0.0, 0u32); sensor.pixels()];
     for ((s, n, _), &p) in sums.iter().zip(&which) {
         map[p] = (*s, *n);
@@ -625,6 +677,7 @@ fn polarity(
             pixels: sums.len(),
             rejected: own.len() - kept.len(),
             sample_spread,
+            interpolation_share,
         },
         map,
     ))

@@ -83,6 +83,7 @@ mod tests {
             around: [100.0, 100.0, dn1, dn1],
             span: 0.002,
             block: 0,
+            interp: [0.0; 2],
         }
     }
 
@@ -108,6 +109,8 @@ mod tests {
             c_on: 0.3,
             c_off: 0.3,
             drift: 0.0,
+            interp_on: 0.0,
+            interp_off: 0.0,
             drift_per_dn: 0.0,
             level_slope: 0.0,
             lag: 0.0,

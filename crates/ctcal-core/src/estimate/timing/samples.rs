@@ -25,6 +25,23 @@ pub struct Pair {
     /// The block of frames read that the pair lies in (0 when the recording was read
     /// whole; see [`PreparedFrames::unread`]).
     pub block: u16,
+    /// How far each event lies from a frame: `4 a (1 - a)`, `a` its phase within its frame
+    /// interval (0 at a frame, 1 midway; see [`Pair::interpolation`]).
+    pub interp: [f32; 2],
+}
+
+impl Pair {
+    /// The pair's mean distance from the frames, `(w0 + w1) / 2` with `w = 4 a (1 - a)`.
+    /// The frames are measured at their times and interpolated between them; an
+    /// interpolation that misses part of the scene's change between frames (a flow that
+    /// smooths occlusions, rotation or fine texture, a cross-fade where the flow fails)
+    /// changes samples in proportion to how far from a frame their events lie, and not at
+    /// all at the frames. Fitting the samples against it and reading the model at 0 gives
+    /// the thresholds the frames measure where they were taken, at any frame rate.
+    #[inline]
+    pub fn interpolation(&self) -> f64 {
+        0.5 * (self.interp[0] + self.interp[1]) as f64
+    }
 }
 
 /// Half the span over which a rate of change is measured, microseconds.
@@ -58,7 +75,7 @@ pub fn collect(
     let width = sensor.width as usize;
     // the previous event of each pixel: its DN (NaN when unknown or noise), time, and DN
     // around it
-    let mut previous = vec![(f32::NAN, 0 as TimeUs, (0.0f32, 0.0f32)); sensor.pixels()];
+    let mut previous = vec![(f32::NAN, 0 as TimeUs, (0.0f32, 0.0f32), 0.0f32); sensor.pixels()];
     let mut pairs = Vec::new();
     for i in 0..events.len() {
         let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
@@ -75,7 +92,8 @@ pub fn collect(
         } else {
             (dn, dn)
         };
-        let (before, t_before, near_before) = previous[pixel];
+        let (before, t_before, near_before, w_before) = previous[pixel];
+        let w_now = phase_weight(frames, t - shift);
         let block = frames.read_block(t);
         // a pixel's change across a span whose events were not read is unknown
         if before.is_finite() && dn.is_finite() && frames.read_block(t_before) == block {
@@ -88,9 +106,19 @@ pub fn collect(
                 around: [near_before.0, near_before.1, near.0, near.1],
                 span: (2 * HALF_SPAN_US) as f32 * 1e-6,
                 block: u16::try_from(block).unwrap_or(u16::MAX),
+                interp: [w_before, w_now],
             });
         }
-        previous[pixel] = (dn, t, near);
+        previous[pixel] = (dn, t, near, w_now);
     }
     pairs
+}
+
+/// `4 a (1 - a)`, `a` the phase of `t` within its frame interval (0 at a frame, 1 midway).
+fn phase_weight(frames: &PreparedFrames, t: TimeUs) -> f32 {
+    frames.interval_of(t).map_or(0.0, |k| {
+        let (t0, t1) = (frames.times[k], frames.times[k + 1]);
+        let a = (t - t0) as f32 / (t1 - t0) as f32;
+        4.0 * a * (1.0 - a)
+    })
 }
