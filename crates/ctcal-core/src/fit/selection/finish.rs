@@ -176,6 +176,9 @@ pub struct Parts<'a> {
     pub fixed: bool,
     /// The starting thresholds as measured (the intervals widen where the fit disagrees).
     pub start: Option<super::agreement::Measured>,
+    /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
+    /// miss (the intervals reach up by it).
+    pub interpolation_share: Option<[f64; 2]>,
     /// The thresholds at coarser frame rates and a doubled exposure (their systematics
     /// join the intervals).
     pub frame_quality: super::frame_quality::FrameQuality,
@@ -195,6 +198,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         mut assumptions,
         fixed,
         start,
+        interpolation_share,
         frame_quality,
         options,
         input,
@@ -213,6 +217,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     ));
     if let Some(start) = &start
         && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
+    {
+        assumptions.push(note);
+    }
+    if let Some(share) = interpolation_share
+        && let Some(note) = super::agreement::reach_for_interpolation(&mut state.uncertainty, share)
     {
         assumptions.push(note);
     }

@@ -208,6 +208,7 @@ pub fn fit(
             assumptions,
             fixed,
             start: start.measured,
+            interpolation_share: start.interpolation_share,
             frame_quality,
             options,
             input,

@@ -59,6 +59,9 @@ pub struct Start {
     /// The thresholds as `estimate aps` measured them, with their intervals (none for a
     /// start value).
     pub measured: Option<super::agreement::Measured>,
+    /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
+    /// miss ([`aps::ApsResult::interpolation_share`]; none for a start value).
+    pub interpolation_share: Option<[f64; 2]>,
     pub step: Step,
     pub assumptions: Vec<String>,
 }
@@ -96,6 +99,7 @@ pub fn thresholds(
         fixed,
         mismatch: None,
         measured: None,
+        interpolation_share: None,
         assumptions: vec![format!(
             "thresholds start at {default} (a start value, not a measurement): {reason}"
         )],
@@ -109,9 +113,12 @@ pub fn thresholds(
         );
     }
     let found = aps::estimate(&run.aps_input(input), &options.aps, &|_, _| {});
-    match found.map(|f| f.estimate) {
-        Ok(e) => match e.thresholds() {
-            Some((on, off)) => measured(&e, on, off),
+    match found.map(|f| (f.estimate, f.interpolation_share)) {
+        Ok((e, share)) => match e.thresholds() {
+            Some((on, off)) => Start {
+                interpolation_share: Some(share),
+                ..measured(&e, on, off)
+            },
             None => fallback(
                 format!(
                     "estimate aps on the fit run determined no thresholds: {}",
@@ -143,6 +150,7 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
             (on, e.ct_on_ci95.unwrap_or([None, None])),
             (off, e.ct_off_ci95.unwrap_or([None, None])),
         ]),
+        interpolation_share: None,
         assumptions: Vec::new(),
         step: step(
             format!(
