@@ -151,9 +151,10 @@ pub struct ApsArgs {
     /// Exposure time of the frames, where the file does not say.
     #[arg(long, value_name = "S")]
     pub exposure_s: Option<f64>,
-    /// Use at most this many frames: a window with more is measured on blocks of 20
-    /// consecutive frames, one in each equal part of it, each where its part has the most
-    /// events (only their frames and events are read).
+    /// Use at most this many frames (of a sensor up to 346x260; a larger sensor's frames
+    /// count for their pixels: 40 of 1280x720 at 120): a window with more is measured on
+    /// blocks of 20 consecutive frames, one in each equal part of it, each where its part
+    /// has the most events (only their frames and events are read).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
     /// Seconds to add to the frames' times (default: found where the events agree best with

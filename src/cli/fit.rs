@@ -22,9 +22,10 @@ pub struct FitArgs {
     /// each effect, the second measures the final error.
     #[arg(long, value_name = "FRACTION", default_value_t = 0.4)]
     pub holdout: f64,
-    /// Use at most this many frames: a window with more is measured on blocks of 20
-    /// consecutive frames, one in each equal part of it, each where its part has the most
-    /// events (only their frames and events are read).
+    /// Use at most this many frames (of a sensor up to 346x260; a larger sensor's frames
+    /// count for their pixels: 40 of 1280x720 at 120): a window with more is measured on
+    /// blocks of 20 consecutive frames, one in each equal part of it, each where its part
+    /// has the most events (only their frames and events are read).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
     /// Exposure time of the frames, where the file does not say.

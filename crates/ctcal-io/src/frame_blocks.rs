@@ -24,6 +24,27 @@
 /// otherwise it is measured on blocks of frames at most this far apart.
 pub const MAX_SPACING_US: i64 = 40_000;
 
+/// Pixels of the largest sensor a frame limit counts whole frames for: the DAVIS346 (346 x
+/// 260), the largest APS sensor the frame methods are checked on. The frame methods' time
+/// and memory grow with frames x pixels (prepared frames, a flow field per interval, the
+/// upsampled runs), and a larger sensor gives more samples per frame, so a larger sensor
+/// takes proportionally fewer frames (a 1280 x 720 sensor 1 / 10.2 of them).
+pub const LIMIT_PIXELS: usize = 346 * 260;
+
+/// The fewest frames a larger sensor's limit comes down to (two blocks of
+/// [`BLOCK_FRAMES`]), or the limit itself where it is smaller.
+pub const MIN_SCALED_FRAMES: usize = 2 * BLOCK_FRAMES;
+
+/// The frame limit for frames of `pixels` pixels: `max_frames` up to [`LIMIT_PIXELS`],
+/// proportionally fewer above (the same frame pixels), at least [`MIN_SCALED_FRAMES`].
+pub fn scaled_limit(max_frames: usize, pixels: usize) -> usize {
+    if pixels <= LIMIT_PIXELS {
+        return max_frames;
+    }
+    let scaled = (max_frames as u128 * LIMIT_PIXELS as u128 / pixels as u128) as usize;
+    scaled.max(MIN_SCALED_FRAMES.min(max_frames)).max(2)
+}
+
 /// How a window's frames are brought to the frame limit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Plan {
@@ -117,6 +138,18 @@ fn best_window(values: &[(u64, u64)], width: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_larger_sensor_takes_fewer_frames_of_the_same_pixels() {
+        assert_eq!(scaled_limit(120, 240 * 180), 120);
+        assert_eq!(scaled_limit(120, 346 * 260), 120);
+        // 1280 x 720: 120 x 89,960 / 921,600 = 11.7, raised to two blocks
+        assert_eq!(scaled_limit(120, 1280 * 720), 40);
+        // 640 x 480: 120 x 89,960 / 307,200 = 35.1
+        assert_eq!(scaled_limit(120, 640 * 480), 40);
+        assert_eq!(scaled_limit(1000, 1280 * 720), 97);
+        assert_eq!(scaled_limit(10, 1280 * 720), 10);
+    }
 
     #[test]
     fn frames_close_enough_are_thinned_evenly_and_far_ones_in_blocks() {

@@ -470,6 +470,21 @@ impl Recording {
         }
     }
 
+    /// The pixels of one frame (frame `index`): from the file's sensor where it states the
+    /// frames' size (HDF5), else by decoding that frame alone. `None` without frames.
+    pub fn frame_pixels(&self, index: usize) -> Result<Option<usize>, InputError> {
+        #[cfg(feature = "hdf5")]
+        if let Source::H5(info) = &self.source
+            && let Some(sensor) = info.sensor
+        {
+            return Ok(Some(sensor.pixels()));
+        }
+        Ok(self
+            .frames_where(|k, _| k == index)?
+            .first()
+            .map(|f| f.width as usize * f.height as usize))
+    }
+
     /// Frame timestamps (without decoding images where the format allows).
     pub fn frame_times(&self) -> Result<Vec<TimeUs>, InputError> {
         match &self.source {

@@ -394,6 +394,21 @@ fn choose_frames(
         available: inside.len(),
         ..Default::default()
     };
+    let given = max_frames;
+    // a larger sensor's frames count for more (only where the limit could bind)
+    let max_frames = match inside.first() {
+        Some(&i) if inside.len() > frame_blocks::MIN_SCALED_FRAMES.min(max_frames) => {
+            let pixels = recording.frame_pixels(i)?.unwrap_or(0);
+            frame_blocks::scaled_limit(max_frames, pixels)
+        }
+        _ => max_frames,
+    };
+    let scaled_note = (max_frames < given).then(|| {
+        format!(
+            "the frame limit of {given} is for sensors up to 346x260 pixels; these frames are larger, so at most {max_frames} of them (the same frame pixels, at least {} frames)",
+            frame_blocks::MIN_SCALED_FRAMES.min(given)
+        )
+    });
     let keep: std::collections::BTreeSet<usize> = match frame_blocks::plan(
         &inside_times,
         max_frames,
@@ -426,6 +441,9 @@ fn choose_frames(
         }
     };
     chosen.frames = recording.frames_where(|i, _| keep.contains(&i))?;
+    if let (Some(scaled), Some(note)) = (scaled_note, chosen.note.as_mut()) {
+        *note = format!("{scaled}: {note}");
+    }
     Ok(chosen)
 }
 

@@ -47,7 +47,8 @@ pub struct ReportArgs {
     #[arg(long, value_name = "S")]
     pub end: Option<f64>,
     /// Use at most this many frames of a recording for the frame-based estimate and the
-    /// fit: one with more is measured on blocks of consecutive frames (as `fit --max-frames`).
+    /// fit (of a sensor up to 346x260; fewer of a larger one): one with more is measured on
+    /// blocks of consecutive frames (as `fit --max-frames`).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
     /// The screen model for recordings of an on-screen stimulus (default: a typical 60 Hz
