@@ -38,7 +38,8 @@ pub struct EpppsArgs {
     /// them.
     #[arg(long, value_name = "N", default_value_t = ctcal::estimate::eppps::prior::COUNT)]
     pub scenes: usize,
-    /// Use at most this many frames for the dynamics.
+    /// Use at most this many frames for the dynamics (of a sensor up to 346x260; fewer of a
+    /// larger one).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
 }

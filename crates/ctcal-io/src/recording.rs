@@ -470,19 +470,21 @@ impl Recording {
         }
     }
 
-    /// The pixels of one frame (frame `index`): from the file's sensor where it states the
-    /// frames' size (HDF5), else by decoding that frame alone. `None` without frames.
+    /// The pixels of the frames, where known without decoding more than one: an IJRR
+    /// folder's frame `index` (one image file), else the sensor the file states (which a
+    /// window's frames must match to be read at all). `None` where neither is known.
     pub fn frame_pixels(&self, index: usize) -> Result<Option<usize>, InputError> {
-        #[cfg(feature = "hdf5")]
-        if let Source::H5(info) = &self.source
-            && let Some(sensor) = info.sensor
+        if let Source::Ijrr(files) = &self.source
+            && let Some(images) = &files.images
         {
-            return Ok(Some(sensor.pixels()));
+            let list = FrameList::read(images)?;
+            if index >= list.entries.len() {
+                return Ok(None);
+            }
+            let frame = list.load(index)?;
+            return Ok(Some(frame.width as usize * frame.height as usize));
         }
-        Ok(self
-            .frames_where(|k, _| k == index)?
-            .first()
-            .map(|f| f.width as usize * f.height as usize))
+        Ok(self.sensor.map(|s| s.pixels()))
     }
 
     /// Frame timestamps (without decoding images where the format allows).

@@ -26,6 +26,9 @@ pub struct Loaded {
     pub frames: Vec<Frame>,
     /// Frames in the window before thinning to the frame limit.
     pub frames_available: usize,
+    /// The frame limit the window was read with, scaled to the frames' size
+    /// ([`frame_blocks::scaled_limit`]); 0 when no frames were asked for.
+    pub frame_limit: usize,
     /// Spans between the blocks of frames read (see [`frame_blocks`]) whose events were not
     /// read: a pixel's change across one is unknown. Empty when the window was read whole.
     pub unread: Vec<(TimeUs, TimeUs)>,
@@ -42,7 +45,8 @@ pub struct Window {
     /// Seconds after the first event.
     pub start_s: Option<f64>,
     pub end_s: Option<f64>,
-    /// Read frames at all, and at most how many.
+    /// Read frames at all, and at most how many (of a sensor up to
+    /// [`frame_blocks::LIMIT_PIXELS`]; proportionally fewer of larger frames).
     pub frames: Option<usize>,
     /// Keep only the events between the first and last frame kept.
     pub events_between_frames: bool,
@@ -216,6 +220,7 @@ pub fn load(
         events,
         frames: read.chosen.frames,
         frames_available: read.chosen.available,
+        frame_limit: read.chosen.limit,
         unread: read.unread,
         notes,
     })
@@ -247,6 +252,7 @@ pub fn load_blocks(
         events: read.events,
         frames: read.chosen.frames,
         frames_available: read.chosen.available,
+        frame_limit: read.chosen.limit,
         unread: read.unread,
         selection: whole.selection.clone(),
         excluded: whole.excluded.clone(),
@@ -368,14 +374,17 @@ struct ChosenFrames {
     frames: Vec<Frame>,
     /// Frames in the window before the choice.
     available: usize,
+    /// The frame limit applied (scaled to the frames' size).
+    limit: usize,
     /// First and last frame time of each block (empty unless read in blocks).
     blocks: Vec<(TimeUs, TimeUs)>,
     /// What the choice says in `assumptions`.
     note: Option<String>,
 }
 
-/// At most `max_frames` of the frames in `[from, to]`, evenly thinned or in blocks (the
-/// latter only where the window keeps just the events between its frames).
+/// At most `max_frames` of the frames in `[from, to]` (fewer of frames larger than
+/// [`frame_blocks::LIMIT_PIXELS`]: [`frame_blocks::scaled_limit`]), evenly thinned or in
+/// blocks (the latter only where the window keeps just the events between its frames).
 fn choose_frames(
     recording: &Recording,
     source: Source,
@@ -403,6 +412,7 @@ fn choose_frames(
         }
         _ => max_frames,
     };
+    chosen.limit = max_frames;
     let scaled_note = (max_frames < given).then(|| {
         format!(
             "the frame limit of {given} is for sensors up to 346x260 pixels; these frames are larger, so at most {max_frames} of them (the same frame pixels, at least {} frames)",

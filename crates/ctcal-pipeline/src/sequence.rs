@@ -142,13 +142,7 @@ pub fn sequence(
     // frames thinned to the limit: the frame-based methods read blocks of consecutive
     // frames instead (see `ctcal_io::frame_blocks`), whose optical flow still holds
     // (from the events already read: the recording is decoded once)
-    let limit = loaded.frames.first().map_or(options.max_frames, |f| {
-        ctcal_io::frame_blocks::scaled_limit(
-            options.max_frames,
-            f.width as usize * f.height as usize,
-        )
-    });
-    let blocks = (loaded.frames_available > limit)
+    let blocks = (loaded.frames_available > loaded.frame_limit)
         .then(|| crate::window::load_blocks(&loaded, &window, &crate::window::Silent))
         .map(|read| {
             read.map_err(|e| format!("the blocks of consecutive frames could not be read: {e}"))

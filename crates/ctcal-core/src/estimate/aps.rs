@@ -426,13 +426,15 @@ pub fn estimate(
         });
         let (on_value, on_applied) = interpolation_corrected(r.ct_on, share(&full, true));
         let (off_value, off_applied) = interpolation_corrected(r.ct_off, share(&full, false));
-        assumptions.push(format!(
-            "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
-            100.0 * share(&full, true),
-            100.0 * share(&full, false),
-            r.ct_on,
-            r.ct_off,
-        ));
+        if on_applied > 0.0 || off_applied > 0.0 {
+            assumptions.push(format!(
+                "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
+                100.0 * share(&full, true),
+                100.0 * share(&full, false),
+                r.ct_on,
+                r.ct_off,
+            ));
+        }
         // the offset moves the re-simulation as it moves the timing (the same frames
         // through the same log)
         let on = Measured::new(
@@ -726,8 +728,8 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
             o.offset_dn,
             side(o.ci95[0]),
             side(o.ci95[1]),
-            side(o.by_polarity[0]),
-            side(o.by_polarity[1]),
+            o.by_polarity[0].map_or("none".into(), |b| format!("{b:.1}")),
+            o.by_polarity[1].map_or("none".into(), |b| format!("{b:.1}")),
             o.systematic_range.0,
             o.systematic_range.1
         ),

@@ -12,7 +12,9 @@
 //! The samples are fitted together ([`model`]): the thresholds, the leak drift (which makes
 //! ON events come early and OFF events late, in proportion to the time between them) and the
 //! frames' log offset `b` in `ln(DN + b)` (the one at which thresholds do not depend on
-//! brightness; its interval, and what it does to the thresholds, are reported). Per pixel
+//! brightness; its interval, each polarity's own offset, and what they do to the thresholds,
+//! are reported), and a trend with the events' distance from the frames, so that the
+//! thresholds are read where the frames were measured rather than interpolated. Per pixel
 //! the corrected samples are averaged into threshold maps; the frozen mismatch `ct_sigma` is
 //! the spread of the map with each pixel's estimation noise removed: `sigma^2 = Var_p(C_p) -
 //! mean_p(s^2 / n_p)`, `s^2` the pooled within-pixel variance of the samples.
@@ -126,8 +128,8 @@ pub struct Offset {
     /// range ([`OFFSET_PRIOR`]) where the data leave a side open, and the offsets the ON and
     /// the OFF samples each give.
     pub systematic_range: (f32, f32),
-    /// The offset each polarity's samples alone give (ON, OFF; `None` where one does not
-    /// make them independent of brightness). One offset belongs to the frames, so their
+    /// The offset each polarity's samples alone give (ON, OFF; `None` where none within
+    /// [`OFFSET_PRIOR`] makes them independent of brightness). One offset belongs to the frames, so their
     /// difference is what other brightness-dependent errors do to the fit.
     pub by_polarity: [Option<f32>; 2],
     /// `fitted`, `given` (by the caller), or `not determined...` (the thresholds do not
@@ -412,7 +414,9 @@ fn find_offset(
             ..not_determined
         };
     }
-    let by_polarity = polarity_offsets(pairs, options, fit, range);
+    // a polarity's offset beyond the prior range is no black level either (as the joint one)
+    let by_polarity = polarity_offsets(pairs, options, fit, range)
+        .map(|b| b.filter(|b| (OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(b)));
     let (lo, hi) = by_polarity.iter().flatten().fold(
         (
             ci95[0].unwrap_or(OFFSET_PRIOR.0.min(root)),
@@ -445,7 +449,7 @@ fn polarity_offsets(
             .zip(&weights)
             .map(|(p, &w)| if p.on == on { w } else { 0.0 })
             .collect();
-        model::fit(pairs, &values, &own, options.fit_leak).map(|c| c.level_slope)
+        model::fit_one_polarity(pairs, &values, &own, options.fit_leak).map(|c| c.level_slope)
     };
     let (on, off) = rayon::join(
         || offset_root(&|b| slope(b, true), range),

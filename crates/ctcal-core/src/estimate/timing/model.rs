@@ -25,7 +25,8 @@
 //!   lie at frame times, 1 when both lie midway): the frames are measured at their times and
 //!   interpolated between them, and where the interpolation misses part of the scene's
 //!   change (a flow field smoothed across occlusions, rotation, texture finer than the flow
-//!   resolves) the samples fall short in proportion to `w`. `g_pol` is that shortfall midway;
+//!   resolves) the samples fall short in proportion to `w`. `g_pol` is the samples' change
+//!   midway (negative where they fall short);
 //!   `C_pol` is read at `w = 0`, at the frames. In the coverage study's multi-object scenes
 //!   at 50 Hz the midway shortfall reached 15-20 % of the threshold; the frame-rate check
 //!   (every 2nd and 3rd frame) saw a third of it.
@@ -180,6 +181,27 @@ const MIN_INTERPOLATION_SPREAD: f64 = 0.05;
 /// Weighted least squares of the model over the pairs with positive `weight`; `leak` adds
 /// the drift columns. `None` when the system is singular.
 pub fn fit(pairs: &[Pair], v: &Values, weight: &[f64], leak: bool) -> Option<Coefficients> {
+    fit_columns(pairs, v, weight, leak, false)
+}
+
+/// [`fit`] of the pairs of one polarity (the other's weights 0): its threshold column and
+/// trend are left out (coefficients 0) rather than making the fit fail.
+pub fn fit_one_polarity(
+    pairs: &[Pair],
+    v: &Values,
+    weight: &[f64],
+    leak: bool,
+) -> Option<Coefficients> {
+    fit_columns(pairs, v, weight, leak, true)
+}
+
+fn fit_columns(
+    pairs: &[Pair],
+    v: &Values,
+    weight: &[f64],
+    leak: bool,
+    one_polarity: bool,
+) -> Option<Coefficients> {
     let wsum: f64 = weight.iter().sum();
     if wsum <= 0.0 {
         return None;
@@ -190,10 +212,14 @@ pub fn fit(pairs: &[Pair], v: &Values, weight: &[f64], leak: bool) -> Option<Coe
     let mut xtx = nalgebra::DMatrix::<f64>::from_fn(k, k, |a, b| sums[a][b]);
     let mut xty = nalgebra::DVector::<f64>::from_fn(k, |a, _| sums_y[a]);
     // a term the pairs carry no information on (no lag where every pair is a steady ramp,
-    // no level spread, a polarity weighted out) is left out: its coefficient 0
+    // no level spread, a polarity weighted out where that is asked for) is left out: its
+    // coefficient 0; a polarity without pairs otherwise fails the fit
     let largest = (0..k).map(|a| xtx[(a, a)]).fold(0.0, f64::max);
     for a in 0..k {
         if xtx[(a, a)] <= 1e-12 * largest {
+            if a < 2 && !one_polarity {
+                return None;
+            }
             for b in 0..k {
                 xtx[(a, b)] = 0.0;
                 xtx[(b, a)] = 0.0;
@@ -467,7 +493,7 @@ mod tests {
                     .zip(&w)
                     .map(|(p, &w)| if p.on == on { w } else { 0.0 })
                     .collect();
-                fit(&pairs, &v, &own, false).map(|c| c.level_slope)
+                fit_one_polarity(&pairs, &v, &own, false).map(|c| c.level_slope)
             };
             offset_root(&slope, (0.0, 255.0)).unwrap()
         };

@@ -215,13 +215,13 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         &mut state.uncertainty,
         &frame_quality,
     ));
-    if let Some(start) = &start
-        && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
+    if let Some(share) = interpolation_share
+        && let Some(note) = super::agreement::reach_for_interpolation(&mut state.uncertainty, share)
     {
         assumptions.push(note);
     }
-    if let Some(share) = interpolation_share
-        && let Some(note) = super::agreement::reach_for_interpolation(&mut state.uncertainty, share)
+    if let Some(start) = &start
+        && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
     {
         assumptions.push(note);
     }
