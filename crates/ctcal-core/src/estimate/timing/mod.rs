@@ -221,6 +221,7 @@ pub fn estimate(
             options.fit_leak,
         )
     };
+    let offset = with_polarity_offsets(offset, &pairs, options, &fit);
     let (coefficients, values, weights) = fit(offset.offset_dn)?;
     // the thresholds across the offset's interval
     let (lo, hi) = offset.systematic_range;
@@ -382,11 +383,7 @@ fn find_offset(
             ..not_determined
         };
     }
-    let floor = pairs
-        .iter()
-        .map(|p| p.dn0.min(p.dn1))
-        .fold(f32::INFINITY, f32::min);
-    let range = (OFFSET_SEARCH.0 * floor.max(0.0), OFFSET_SEARCH.1);
+    let range = search_range(pairs);
     let slope = |b: f32| fit(b).map(|f| f.0.level_slope);
     let Some(root) = offset_root(&slope, range) else {
         return not_determined;
@@ -414,22 +411,52 @@ fn find_offset(
             ..not_determined
         };
     }
-    // a polarity's offset beyond the prior range is no black level either (as the joint one)
-    let by_polarity = polarity_offsets(pairs, options, fit, range)
-        .map(|b| b.filter(|b| (OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(b)));
-    let (lo, hi) = by_polarity.iter().flatten().fold(
-        (
-            ci95[0].unwrap_or(OFFSET_PRIOR.0.min(root)),
-            ci95[1].unwrap_or(OFFSET_PRIOR.1.max(root)),
-        ),
-        |(lo, hi), &b| (lo.min(b), hi.max(b)),
-    );
     Offset {
         offset_dn: root,
         ci95,
-        systematic_range: (lo, hi),
-        by_polarity,
+        systematic_range: (
+            ci95[0].unwrap_or(OFFSET_PRIOR.0.min(root)),
+            ci95[1].unwrap_or(OFFSET_PRIOR.1.max(root)),
+        ),
+        by_polarity: [None; 2],
         source: "fitted",
+    }
+}
+
+/// The offsets the data may choose from: [`OFFSET_SEARCH`], its lower end scaled by the
+/// darkest DN a pair reads (so that `DN + b` stays positive).
+fn search_range(pairs: &[Pair]) -> (f32, f32) {
+    let floor = pairs
+        .iter()
+        .map(|p| p.dn0.min(p.dn1))
+        .fold(f32::INFINITY, f32::min);
+    (OFFSET_SEARCH.0 * floor.max(0.0), OFFSET_SEARCH.1)
+}
+
+/// A fitted offset with the offsets the ON and the OFF samples each give (within
+/// [`OFFSET_PRIOR`]: beyond, no black level, as for the joint one) joined to its systematic
+/// range; found for the chosen response only. Other offsets are returned as they are.
+fn with_polarity_offsets(
+    offset: Offset,
+    pairs: &[Pair],
+    options: &TimingOptions,
+    fit: &Fit<'_>,
+) -> Offset {
+    if offset.source != "fitted" {
+        return offset;
+    }
+    let by_polarity = polarity_offsets(pairs, options, fit, search_range(pairs))
+        .map(|b| b.filter(|b| (OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(b)));
+    let systematic_range = by_polarity
+        .iter()
+        .flatten()
+        .fold(offset.systematic_range, |(lo, hi), &b| {
+            (lo.min(b), hi.max(b))
+        });
+    Offset {
+        systematic_range,
+        by_polarity,
+        ..offset
     }
 }
 
