@@ -98,39 +98,47 @@ fn patch_members(
 
 /// Flows of every patch and window of `events` (time-sorted): a first pass on the first
 /// events of each patch gives the median speed, which sets the windows' length.
+///
+/// The patch side starts at [`EventFlowOptions::patch_px`] and doubles (up to 128 px)
+/// while the first pass at twice the side finds speeds where the smaller found none, or
+/// three quarters of its speeds (its lower quartile) above 1.3 times the smaller side's
+/// median: in a sparse recording (a high threshold, a smooth scene) a small patch's windows
+/// span more travel than its search can follow, and their flows are false and slow, while
+/// a larger patch fills its windows in less time. Where speeds differ across the view (the
+/// depths of a translating camera) the quartiles of both sides overlap, and the small
+/// patch (finer flow) stays.
 pub fn patch_flows(
     events: &EventChunk,
     sensor: Sensor,
     excluded: &[bool],
     options: &EventFlowOptions,
 ) -> Vec<PatchFlow> {
-    let p = options.patch_px;
+    let largest = (sensor.width.max(sensor.height) as usize)
+        .min(128)
+        .max(options.patch_px);
+    let mut p = options.patch_px;
+    let mut current = rough_pass(events, sensor, excluded, p, options);
+    while 2 * p <= largest {
+        let larger = rough_pass(events, sensor, excluded, 2 * p, options);
+        let larger_patches_faster = match (current.quartiles, larger.quartiles) {
+            (_, None) => false,
+            (None, Some(_)) => true,
+            (Some(small), Some(large)) => large[0] > 1.3 * small[1],
+        };
+        if !larger_patches_faster {
+            break;
+        }
+        p *= 2;
+        current = larger;
+    }
     let tiles_x = (sensor.width as usize).div_ceil(p);
-    let members = patch_members(events, sensor, excluded, p);
     let corner = |tile: usize| ((tile % tiles_x) * p, (tile / tiles_x) * p);
-    let mut rough: Vec<f64> = members
-        .par_iter()
-        .enumerate()
-        .filter(|(_, m)| m.len() >= options.min_events)
-        .map(|(tile, m)| {
-            window_flow(
-                events,
-                &m[..m.len().min(options.rough_events)],
-                corner(tile),
-                p,
-            )
-        })
-        .filter(|f| f.trusted())
-        .map(|f| f.speed())
-        .collect();
-    rough.sort_by(f64::total_cmp);
     // without a trusted rough flow every patch is one window
-    let window_us = rough
-        .get(rough.len() / 2)
-        .map_or(TimeUs::MAX / 4, |&speed| {
-            ((options.window_travel_px / speed.max(1e-3)) * 1e6).max(1.0) as TimeUs
-        });
-    members
+    let window_us = current.quartiles.map_or(TimeUs::MAX / 4, |[_, speed, _]| {
+        ((options.window_travel_px / speed.max(1e-3)) * 1e6).max(1.0) as TimeUs
+    });
+    current
+        .members
         .par_iter()
         .enumerate()
         .flat_map_iter(|(tile, indices)| {
@@ -142,6 +150,92 @@ pub fn patch_flows(
         })
         .collect()
 }
+
+/// The first pass at patch side `p`: each patch's events, and the quartiles of the
+/// patches' first speeds ([`rough_speed`]), px/s.
+struct RoughPass {
+    members: Vec<Vec<u32>>,
+    quartiles: Option<[f64; 3]>,
+}
+
+fn rough_pass(
+    events: &EventChunk,
+    sensor: Sensor,
+    excluded: &[bool],
+    p: usize,
+    options: &EventFlowOptions,
+) -> RoughPass {
+    let members = patch_members(events, sensor, excluded, p);
+    let tiles_x = (sensor.width as usize).div_ceil(p);
+    let mut speeds: Vec<f64> = members
+        .par_iter()
+        .enumerate()
+        .filter(|(_, m)| m.len() >= options.min_events)
+        .filter_map(|(tile, m)| {
+            rough_speed(
+                events,
+                m,
+                ((tile % tiles_x) * p, (tile / tiles_x) * p),
+                p,
+                options,
+            )
+        })
+        .collect();
+    speeds.sort_by(f64::total_cmp);
+    let at = |q: f64| speeds[((speeds.len() - 1) as f64 * q).round() as usize];
+    RoughPass {
+        quartiles: (!speeds.is_empty()).then(|| [at(0.25), speeds[speeds.len() / 2], at(0.75)]),
+        members,
+    }
+}
+
+/// The speed of a patch from its first events: the flows of its first
+/// [`EventFlowOptions::rough_events`] events, of half as many, and so on, until a flow that
+/// is trusted, travels at least [`MIN_SHARPENING_TRAVEL_PX`] and less than the search
+/// reaches (nine tenths of the patch's side) is confirmed by the next, shorter window
+/// (down to half of [`EventFlowOptions::min_events`]): the two agree (their difference
+/// within 30 % of the speed), or the shorter window is untrusted and, at that speed,
+/// travels less than [`MIN_SHARPENING_TRAVEL_PX`], too little to sharpen (a dense scene's
+/// short recording). A window whose true travel lies beyond the search (a dense scene's
+/// many events, a sparse one's long window) still has a best flow, a false one, and the
+/// next window's differs.
+fn rough_speed(
+    events: &EventChunk,
+    members: &[u32],
+    corner: (usize, usize),
+    p: usize,
+    options: &EventFlowOptions,
+) -> Option<f64> {
+    let mut n = members.len().min(options.rough_events);
+    let mut candidate: Option<PatchFlow> = None;
+    while n >= options.min_events || (candidate.is_some() && 2 * n >= options.min_events) {
+        let flow = window_flow(events, &members[..n], corner, p);
+        let span_s = (flow.t_end - flow.t_start) as f64 * 1e-6;
+        let travel = flow.speed() * span_s;
+        if let Some(before) = &candidate {
+            let agrees = flow.trusted()
+                && (flow.vx - before.vx).hypot(flow.vy - before.vy)
+                    <= 0.3 * flow.speed().max(before.speed());
+            let too_short = !flow.trusted() && before.speed() * span_s < MIN_SHARPENING_TRAVEL_PX;
+            if agrees {
+                return Some(0.5 * (flow.speed() + before.speed()));
+            }
+            if too_short {
+                return Some(before.speed());
+            }
+        }
+        let usable = n >= options.min_events
+            && flow.trusted()
+            && (MIN_SHARPENING_TRAVEL_PX..=0.9 * p as f64).contains(&travel);
+        candidate = usable.then_some(flow);
+        n /= 2;
+    }
+    None
+}
+
+/// The travel below which a window of events cannot sharpen under the right flow (its
+/// events sit within a couple of pixels of where they started), pixels.
+const MIN_SHARPENING_TRAVEL_PX: f64 = 2.0;
 
 /// `indices` (time-sorted) cut into windows of `window_us`; a last window shorter than half
 /// joins the one before.
@@ -388,6 +482,77 @@ mod tests {
         }
         e.sort_by_time();
         e
+    }
+
+    /// Sparse events of 400 short random edges (3 px segments at random places and
+    /// orientations) on a 128 x 128 view that wraps, moving at `v` px/s for 2 s, each edge
+    /// pixel firing with probability `q` per 5 ms step: few events per patch over much
+    /// travel (as a high threshold gives), and no period the flow could alias with.
+    fn sparse_moving_edges(v: (f64, f64), q: f64) -> EventChunk {
+        let mut e = EventChunk::default();
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut draw = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let features: Vec<(f64, f64, f64)> = (0..400)
+            .map(|_| {
+                (
+                    128.0 * draw(),
+                    128.0 * draw(),
+                    std::f64::consts::PI * draw(),
+                )
+            })
+            .collect();
+        for k in 0..400 {
+            let t = k as f64 * 5e-3;
+            for &(fx, fy, angle) in &features {
+                for s in [-1.0, 0.0, 1.0] {
+                    if draw() < q {
+                        let x = (fx + s * angle.cos() + v.0 * t)
+                            .rem_euclid(128.0)
+                            .min(127.0);
+                        let y = (fy + s * angle.sin() + v.1 * t)
+                            .rem_euclid(128.0)
+                            .min(127.0);
+                        let at = (t * 1e6) as TimeUs + (draw() * 5e3) as TimeUs;
+                        e.push(at, x as u16, y as u16, s >= 0.0);
+                    }
+                }
+            }
+        }
+        e.sort_by_time();
+        e
+    }
+
+    #[test]
+    fn a_sparse_scene_s_flow_is_found_on_larger_patches() {
+        let v = (-60.0, -25.0);
+        let events = sparse_moving_edges(v, 0.016);
+        let sensor = Sensor::new(128, 128);
+        let flows = patch_flows(
+            &events,
+            sensor,
+            &vec![false; sensor.pixels()],
+            &EventFlowOptions::default(),
+        );
+        let trusted: Vec<&PatchFlow> = flows.iter().filter(|f| f.trusted()).collect();
+        assert!(!trusted.is_empty(), "{} events, {flows:?}", events.len());
+        let mut speeds: Vec<f64> = trusted.iter().map(|f| f.speed()).collect();
+        speeds.sort_by(f64::total_cmp);
+        let median = speeds[speeds.len() / 2];
+        let truth = v.0.hypot(v.1);
+        // 32 px patches alone read 3.3 px/s here (their windows span more travel than
+        // their search follows)
+        assert!(trusted[0].size > 32, "{} px patches", trusted[0].size);
+        assert!(
+            (median / truth - 1.0).abs() < 0.15,
+            "median speed {median} for {truth} on {} px patches ({} events)",
+            trusted[0].size,
+            events.len()
+        );
     }
 
     #[test]

@@ -6,9 +6,9 @@
 //!
 //! Travel comes from the optical flow: of the frames where there are frames (each pixel's
 //! path over every used interval), else of the events themselves by contrast maximisation
-//! ([`crate::estimate::event_flow`]), per 32-pixel patch and time window. A window too
-//! sparse for a flow is left out, its events with it; one whose flow is not trusted takes
-//! the recording's median speed.
+//! ([`crate::estimate::event_flow`]), per patch (32 px, larger for a sparse recording) and
+//! time window. A window too sparse for a flow is left out, its events with it; one whose
+//! flow is not trusted takes the recording's median speed.
 //!
 //! Noise: events count when a neighbour fired within a few pixel-crossings before or after
 //! them (a two-sided support filter: an edge's first event, or an event at the start of a
@@ -52,7 +52,7 @@ pub struct RecordingRates {
     pub events_per_pixel_per_second: f64,
     /// Median flow speed, px/s, and its source.
     pub speed_median_px_s: f64,
-    pub flow_source: &'static str,
+    pub flow_source: String,
     /// Travel (px, per pixel) and flow direction (unit vector) of the counted units, for
     /// the scans.
     pub travels: Vec<f32>,
@@ -143,7 +143,7 @@ struct Finish {
     duration: f64,
     supported_total: f64,
     speed: f64,
-    source: &'static str,
+    source: String,
     travel_error: f64,
     window: TimeUs,
 }
@@ -275,7 +275,8 @@ pub fn from_events(
     let median = trusted[trusted.len() / 2];
     let window = support_window(median);
     let support = supported(events, sensor, window);
-    let p = options.patch_px;
+    // the patch side the flow settled on (larger than asked for a sparse recording)
+    let p = flows.first().map_or(options.patch_px, |f| f.size);
     let (w, tiles_x) = (sensor.width as usize, (sensor.width as usize).div_ceil(p));
     let tiles = tiles_x * (sensor.height as usize).div_ceil(p);
     let mut by_patch: Vec<Vec<&PatchFlow>> = vec![Vec::new(); tiles];
@@ -301,7 +302,7 @@ pub fn from_events(
         duration: duration_s(events),
         supported_total: support.iter().filter(|&&s| s).count() as f64,
         speed: median,
-        source: "the events (contrast maximisation per 32 px patch)",
+        source: format!("the events (contrast maximisation per {p} px patch)"),
         travel_error,
         window,
     };
@@ -385,7 +386,7 @@ pub fn from_frames(
         duration: duration_s(events),
         supported_total: support.iter().filter(|&&s| s).count() as f64,
         speed: median,
-        source: "the frames (pyramidal Lucas-Kanade)",
+        source: "the frames (pyramidal Lucas-Kanade)".into(),
         travel_error: 0.0,
         window,
     };
