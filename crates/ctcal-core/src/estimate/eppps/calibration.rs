@@ -11,7 +11,7 @@ use crate::estimate::frames::PreparedFrames;
 use rand::{RngExt, SeedableRng};
 
 /// Blocks of scans per prior image.
-pub const BLOCKS_PER_IMAGE: usize = 300;
+pub const BLOCKS_PER_IMAGE: usize = 100;
 /// The longest counted stretch of a scan, pixels: a longer travel is scanned this far (its
 /// events per pixel of travel are those of the long-travel regime already).
 pub const MAX_SCAN_PX: f64 = 100.0;

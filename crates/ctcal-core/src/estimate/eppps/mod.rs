@@ -9,12 +9,12 @@
 //!    removes blank and static parts of the view;
 //! 2. the calibration ([`calibration`], [`scans`]): ideal pixels along line scans with the
 //!    recording's own travel and directions, through the recording's frames when it has them
-//!    (its contrast measured) and otherwise through natural images ([`prior`]), at 25
-//!    thresholds from 0.03 to 3;
+//!    (its contrast measured) and otherwise through natural images ([`prior`]), at 31
+//!    thresholds from 0.03 to 9.5;
 //! 3. the threshold at which the scans make the recording's rate, per polarity; without
-//!    frames one per prior image, combined in their logarithm, and the spread between images
-//!    is the prior's share of the interval (events alone cannot separate a scene's contrast
-//!    from the threshold). The interval also holds the recording's sampling error (bootstrap
+//!    frames one per prior image and log-response floor, combined in their logarithm, and the
+//!    spread between them is the prior's share of the interval (events alone cannot separate
+//!    a scene's contrast from the threshold). The interval also holds the recording's sampling error (bootstrap
 //!    over 32 px patches) and the flow's precision.
 
 pub mod calibration;
@@ -28,7 +28,7 @@ use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor};
 use rayon::prelude::*;
 use recording::RecordingRates;
-use scans::{CurvePoint, ScanPixel, Side, curve, invert, log_slope, threshold_grid};
+use scans::{CurvePoint, Inverted, ScanPixel, Side, curve, invert, log_slope, threshold_grid};
 use serde::Serialize;
 use serde_json::json;
 
@@ -127,7 +127,8 @@ pub fn estimate(
     let (on, off) = measure_both(&symmetric, &rates);
     // the two thresholds interact in every pixel (see `scans::count`): scan again at the
     // OFF/ON ratio the symmetric scans found, and read both polarities there
-    let ratio = (off.measured.value / on.measured.value).clamp(0.2, 5.0);
+    let measured_ratio = off.measured.value / on.measured.value;
+    let ratio = measured_ratio.clamp(0.2, 5.0);
     let (on, off) = if ratio.is_finite() && (ratio.ln()).abs() > 0.02 {
         progress("calibration scans (OFF/ON ratio measured)", 0.6);
         pixel.ratio = ratio;
@@ -146,16 +147,41 @@ pub fn estimate(
         &on.measured,
         &off.measured,
         Determinable {
-            lo: grid[0],
-            hi: grid[grid.len() - 1],
+            lo: grid[0] * pixel.ratio.min(1.0),
+            hi: grid[grid.len() - 1] * pixel.ratio.max(1.0),
             what: "the calibration curve",
         },
     );
+    for (key, polarity) in [("ct_on", &on), ("ct_off", &off)] {
+        if let Some(why) = &polarity.why {
+            result.why.insert(key.into(), why.clone());
+            continue;
+        }
+        let b = polarity.beyond_grid;
+        for (count, side, end, open) in [
+            (b.above, "fewer", ("highest", b.top), "above"),
+            (b.below, "more", ("lowest", b.bottom), "below"),
+        ] {
+            if count > 0 {
+                result.assumptions.push(format!(
+                    "{key}: the recording makes {side} events than {count} of the {} calibrations even at the {} threshold simulated ({:.3}); they count at it, a bound, so the interval is open {open}",
+                    calibrations.len(),
+                    end.0,
+                    end.1
+                ));
+            }
+        }
+    }
     result
         .assumptions
         .extend(assumptions(&rates, &calibrations, frames.is_some(), hot));
+    let clamped = if measured_ratio.is_finite() && measured_ratio != ratio {
+        format!(", held to 0.2-5 from {measured_ratio:.3}")
+    } else {
+        String::new()
+    };
     result.assumptions.push(format!(
-        "thresholds read from scans with OFF = {:.3} x ON (the ratio the ON = OFF scans gave; a pixel's ON count depends on its OFF threshold wherever the profile turns); the calibration curve shown is the ON = OFF one of the paper's Fig. 2",
+        "thresholds read from scans with OFF = {:.3} x ON (the ratio the ON = OFF scans gave{clamped}; a pixel's ON count depends on its OFF threshold wherever the profile turns); the calibration curve shown is the ON = OFF one of the paper's Fig. 2",
         pixel.ratio
     ));
     result.assumptions.push(match &refractory {
@@ -231,12 +257,17 @@ fn calibrate(
         }],
         None => prior::images(options.scenes.max(1))
             .par_iter()
-            .enumerate()
-            .map(|(k, image)| Calibration {
-                name: image.name.to_string(),
+            .map(|image| Calibration {
+                name: image.label(),
+                // one photograph's floors scan the same places (common random numbers):
+                // their difference is the floor's alone
                 curve: scans::block_curve(
                     &image.log,
-                    &calibration::prior_blocks(&image.log, rates, options.seed + k as u64),
+                    &calibration::prior_blocks(
+                        &image.log,
+                        rates,
+                        options.seed + image.image as u64,
+                    ),
                     &grid,
                     pixel,
                 ),
@@ -247,10 +278,27 @@ fn calibrate(
 
 /// One polarity's threshold: per calibration, and combined.
 struct Polarity {
+    /// Each calibration's threshold (`null` where it is only bounded by the grid's end).
     per_calibration: Vec<Option<f64>>,
     measured: Measured,
     /// Standard deviation of ln C between calibrations (the prior's spread).
     prior_ln_sd: f64,
+    /// Calibrations the recording lies beyond the grid's top (fewer events than even the
+    /// highest threshold makes) or bottom: the grid's end stands in for them, a bound, and
+    /// the interval is open on that side.
+    beyond_grid: Beyond,
+    /// Why there is no value, where there is none.
+    why: Option<String>,
+}
+
+/// How many calibrations a recording lies beyond, at either end of the grid, and the
+/// thresholds of those ends (this polarity's: the OFF grid is the ON grid times the ratio).
+#[derive(Clone, Copy, Debug, Default)]
+struct Beyond {
+    above: usize,
+    below: usize,
+    top: f64,
+    bottom: f64,
 }
 
 /// Both polarities' thresholds from `calibrations`.
@@ -273,10 +321,53 @@ fn measure_both(calibrations: &[Calibration], rates: &RecordingRates) -> (Polari
     )
 }
 
+/// The calibrations' thresholds (the grid's end where the recording lies beyond it; the
+/// middle of two grid points where the curve drops to no events between them), or why
+/// they give none: a calibration with no threshold at all, or more than half of them only
+/// bounded.
+fn classify(
+    inverted: &[Inverted],
+    beyond: Beyond,
+    target: f64,
+    side: Side,
+) -> Result<Vec<f64>, String> {
+    let polarity = match side {
+        Side::On => "ON",
+        Side::Off => "OFF",
+    };
+    if target.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Err(format!(
+            "the recording has no supported {polarity} events in the windows with a flow"
+        ));
+    }
+    let values: Vec<f64> = inverted.iter().filter_map(|i| i.value()).collect();
+    let n = inverted.len();
+    if values.len() < n || n == 0 {
+        return Err(format!(
+            "{} of the {n} calibrations make no {polarity} events to compare with the recording's {target:.4} per pixel of travel",
+            n - values.len()
+        ));
+    }
+    if beyond.below * 2 > n {
+        return Err(format!(
+            "the recording makes more {polarity} events per pixel of travel ({target:.4}) than {} of the {n} calibrations make at the lowest threshold simulated ({:.3}): below the method's range",
+            beyond.below, beyond.bottom
+        ));
+    }
+    if beyond.above * 2 > n {
+        return Err(format!(
+            "the recording makes fewer {polarity} events per pixel of travel ({target:.4}) than {} of the {n} calibrations make at the highest threshold simulated ({:.2}): above the method's range",
+            beyond.above, beyond.top
+        ));
+    }
+    Ok(values)
+}
+
 /// Inverts every calibration at the recording's `target` rate and combines them in the
 /// logarithm: the statistical error is the recording's (bootstrap), turned into threshold
 /// by the curve's slope; the systematic holds the spread between calibrations and the
-/// flow's precision.
+/// flow's precision. A calibration the recording lies beyond counts at the grid's end, and
+/// the interval is then open on that side.
 fn measure(
     calibrations: &[Calibration],
     rates: &RecordingRates,
@@ -284,21 +375,43 @@ fn measure(
     target: f64,
     ln_se: f64,
 ) -> Polarity {
-    let per_calibration: Vec<Option<f64>> = calibrations
+    let inverted: Vec<Inverted> = calibrations
         .iter()
         .map(|c| invert(&c.curve, side, target))
         .collect();
-    let logs: Vec<f64> = per_calibration.iter().flatten().map(|v| v.ln()).collect();
-    if logs.len() < calibrations.len()
-        || logs.is_empty()
-        || target.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater)
-    {
-        return Polarity {
-            per_calibration,
-            measured: Measured::new(f64::NAN, f64::NAN, 0.0),
-            prior_ln_sd: f64::NAN,
-        };
-    }
+    let ends = calibrations.first().map(|c| &c.curve[..]).unwrap_or(&[]);
+    let beyond = Beyond {
+        above: inverted
+            .iter()
+            .filter(|i| matches!(i, Inverted::Above(_)))
+            .count(),
+        below: inverted
+            .iter()
+            .filter(|i| matches!(i, Inverted::Below(_)))
+            .count(),
+        top: ends.last().map_or(f64::NAN, |p| side.threshold(p)),
+        bottom: ends.first().map_or(f64::NAN, |p| side.threshold(p)),
+    };
+    let per_calibration = inverted
+        .iter()
+        .map(|i| match i {
+            Inverted::At(_) | Inverted::Between(..) => i.value(),
+            _ => None,
+        })
+        .collect();
+    let values = match classify(&inverted, beyond, target, side) {
+        Ok(values) => values,
+        Err(why) => {
+            return Polarity {
+                per_calibration,
+                measured: Measured::new(f64::NAN, f64::NAN, 0.0),
+                prior_ln_sd: f64::NAN,
+                beyond_grid: beyond,
+                why: Some(why),
+            };
+        }
+    };
+    let logs: Vec<f64> = values.iter().map(|v| v.ln()).collect();
     let n = logs.len() as f64;
     let mean = logs.iter().sum::<f64>() / n;
     let prior_ln_sd = if logs.len() > 1 {
@@ -317,14 +430,23 @@ fn measure(
         .travel_relative_error
         .hypot(rates.noise_relative_error)
         / slope.abs();
+    let mut measured = Measured::log_normal(
+        value,
+        stat,
+        prior_ln_sd.hypot(travel).hypot(METHOD_LN_SYSTEMATIC),
+    );
+    if beyond.above > 0 {
+        measured.ci95[1] = f64::INFINITY;
+    }
+    if beyond.below > 0 {
+        measured.ci95[0] = 0.0;
+    }
     Polarity {
         per_calibration,
-        measured: Measured::log_normal(
-            value,
-            stat,
-            prior_ln_sd.hypot(travel).hypot(METHOD_LN_SYSTEMATIC),
-        ),
+        measured,
         prior_ln_sd,
+        beyond_grid: beyond,
+        why: None,
     }
 }
 
@@ -361,14 +483,21 @@ fn assumptions(
     if frames {
         out.push("calibration: ideal pixels along each pixel's own path through the frames (the scene's contrast measured); ON = OFF threshold in the scans".into());
     } else {
+        let images = calibrations.len() / prior::FLOORS_OF_MEAN.len();
         out.push(format!(
-            "prior: events alone do not fix the scene's log contrast, so line scans through {} natural images (calib/priors/natural: {}) stand for it, with the recording's travel and flow directions; their spread between images is in the interval; a scene of unusual contrast (a printed pattern, a high-contrast lab scene) moves the threshold with it",
-            calibrations.len(),
-            calibrations.iter().map(|c| c.name.as_str()).collect::<Vec<_>>().join(", ")
+            "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread between images is in the interval; a scene of unusual contrast (a printed pattern, a high-contrast lab scene, a smooth texture) moves the threshold with it",
         ));
+        let (lo, hi) = prior::FLOOR_RANGE_OF_MEAN;
         out.push(format!(
-            "prior images: sRGB decoded to linear luminance, log taken above a floor of {} % of white",
-            100.0 * prior::LUMINANCE_FLOOR
+            "prior: the pixel's log response ln(light + floor), the floor (dark current and lens glare) {:.0}-{:.0} % of the scene's mean light (log-uniform; scanned at {}); not measured without frames, its spread is in the interval: sRGB photographs decoded to linear luminance, each under every floor ({} calibrations)",
+            100.0 * lo,
+            100.0 * hi,
+            prior::FLOORS_OF_MEAN
+                .iter()
+                .map(|f| format!("{:.1} %", 100.0 * f))
+                .collect::<Vec<_>>()
+                .join(", "),
+            calibrations.len()
         ));
         out.push(format!(
             "flow precision: half a pixel of displacement per window, or the split-half spread where larger: {:.1} % of the travel, a systematic error",

@@ -6,14 +6,29 @@
 //! contrast they stand for is documented there (Tolhurst, Tadmor & Chao 1992; Frazor &
 //! Geisler 2006).
 //!
-//! The photographs are 8-bit sRGB; they are decoded to linear luminance and taken as
-//! `ln(Y + 0.005)`: the 0.5 %-of-white floor stands for the flare and dark current that keep
-//! a real pixel's log response finite in the deepest shadows of a scene.
+//! The photographs are 8-bit sRGB; they are decoded to linear luminance `Y` and taken as
+//! `ln(Y + f m)`, `m` the image's mean luminance: a DVS photoreceptor responds to the log of
+//! its photocurrent plus its dark current (Lichtsteiner, Posch & Delbruck, JSSC 2008), and
+//! the lens adds veiling glare in proportion to the scene's light, so the darkest parts of
+//! a view never reach the log's steep end. How large that floor is against the scene's
+//! light is not known without frames, and it moves the threshold read from a recording
+//! as much as the choice of image does, so it is a prior of its own ([`FLOORS_OF_MEAN`]).
 
 use super::scans::LogImage;
 
-/// The floor added to linear luminance (fraction of white) before the log.
-pub const LUMINANCE_FLOOR: f32 = 0.005;
+/// The range of the floor `f` (as a fraction of the scene's mean luminance) the prior
+/// spans, log-uniform: from veiling glare alone in a bright scene (glare indices of camera
+/// lenses, ISO 9358, are 1-3 % of the scene's light) to a dark current as large as the
+/// mean photocurrent in a dim one. Real DVS cameras measured in the log domain lie inside:
+/// DVS-Voltmeter (Lin et al., ECCV 2022) calibrated `ln(DN + k2)` with k2 = 20 DN
+/// (DAVIS346) and 23 DN (DVS240), 13-58 % of the mean at frame levels of 40-150 DN; v2e
+/// (Hu, Liu & Delbruck, CVPRW 2021) makes the response linear below 20 DN for the same
+/// reason; ESIM's default `ln(I + 0.001)` is the ideal end.
+pub const FLOOR_RANGE_OF_MEAN: (f32, f32) = (0.02, 1.0);
+
+/// The floors the scans use: the 1/6, 1/2 and 5/6 quantiles of [`FLOOR_RANGE_OF_MEAN`]
+/// (log-uniform), so that three points carry its centre and most of its spread.
+pub const FLOORS_OF_MEAN: [f32; 3] = [0.0384, 0.1414, 0.5210];
 
 /// The prior images (binary PGM), embedded.
 const IMAGES: [(&str, &[u8]); 6] = [
@@ -46,22 +61,68 @@ const IMAGES: [(&str, &[u8]); 6] = [
 /// How many prior images there are.
 pub const COUNT: usize = IMAGES.len();
 
-/// A prior image: its name and log luminance.
+/// A prior image under one floor: its name, the floor (fraction of its mean luminance)
+/// and its log luminance.
 pub struct PriorImage {
     pub name: &'static str,
+    /// Which photograph (its place in the list): the floors of one photograph share it.
+    pub image: usize,
+    pub floor_of_mean: f32,
     pub log: LogImage,
 }
 
-/// The first `n` prior images (all when `n` is larger).
+impl PriorImage {
+    /// The image and floor, as named in the estimate's report.
+    pub fn label(&self) -> String {
+        format!(
+            "{} (floor {:.1} % of its mean)",
+            self.name,
+            100.0 * self.floor_of_mean
+        )
+    }
+}
+
+/// The first `n` prior images (all when `n` is larger), each under every floor of
+/// [`FLOORS_OF_MEAN`].
 pub fn images(n: usize) -> Vec<PriorImage> {
     IMAGES
         .iter()
         .take(n)
-        .map(|(name, bytes)| PriorImage {
-            name,
-            log: decode(bytes).expect("the embedded prior images are valid PGM (unit test)"),
+        .enumerate()
+        .flat_map(|(image, (name, bytes))| {
+            let linear =
+                decode(bytes).expect("the embedded prior images are valid PGM (unit test)");
+            FLOORS_OF_MEAN.map(|floor_of_mean| PriorImage {
+                name,
+                image,
+                floor_of_mean,
+                log: linear.log_above(floor_of_mean),
+            })
         })
         .collect()
+}
+
+/// A prior image in linear luminance (fraction of white), row-major.
+struct LinearImage {
+    width: usize,
+    height: usize,
+    data: Vec<f32>,
+}
+
+impl LinearImage {
+    fn mean(&self) -> f32 {
+        (self.data.iter().map(|&v| v as f64).sum::<f64>() / self.data.len().max(1) as f64) as f32
+    }
+
+    /// `ln(Y + floor_of_mean * mean)`.
+    fn log_above(&self, floor_of_mean: f32) -> LogImage {
+        let floor = floor_of_mean * self.mean();
+        LogImage {
+            width: self.width,
+            height: self.height,
+            data: self.data.iter().map(|&y| (y + floor).ln()).collect(),
+        }
+    }
 }
 
 /// sRGB-encoded 8-bit value to linear luminance (IEC 61966-2-1).
@@ -74,8 +135,8 @@ fn linear(v: u8) -> f32 {
     }
 }
 
-/// A binary 8-bit PGM (`P5`, maxval 255) as log luminance.
-fn decode(bytes: &[u8]) -> Option<LogImage> {
+/// A binary 8-bit PGM (`P5`, maxval 255) as linear luminance.
+fn decode(bytes: &[u8]) -> Option<LinearImage> {
     // header: magic, width, height, maxval, each after whitespace (no comments in ours)
     let mut fields = Vec::new();
     let mut i = 0;
@@ -94,10 +155,8 @@ fn decode(bytes: &[u8]) -> Option<LogImage> {
         return None;
     }
     let pixels = bytes.get(i + 1..i + 1 + width * height)?;
-    let table: Vec<f32> = (0..=255u8)
-        .map(|v| (linear(v) + LUMINANCE_FLOOR).ln())
-        .collect();
-    Some(LogImage {
+    let table: Vec<f32> = (0..=255u8).map(linear).collect();
+    Some(LinearImage {
         width,
         height,
         data: pixels.iter().map(|&v| table[v as usize]).collect(),
@@ -109,24 +168,59 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_prior_image_decodes() {
+    fn every_prior_image_decodes_under_every_floor() {
         let all = images(usize::MAX);
-        assert_eq!(all.len(), COUNT);
+        assert_eq!(all.len(), COUNT * FLOORS_OF_MEAN.len());
         for image in &all {
             assert_eq!(image.log.width, 256, "{}", image.name);
             assert!(image.log.height >= 150, "{}", image.name);
+            let linear = decode(IMAGES.iter().find(|i| i.0 == image.name).unwrap().1).unwrap();
+            let floor = image.floor_of_mean * linear.mean();
             let (lo, hi) = image
                 .log
                 .data
                 .iter()
                 .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
-            // from near the floor up to at least half of white
+            // the darkest pixels reach down to the floor (their own light is at most as
+            // large as it), the brightest above half of white
             assert!(
-                lo < -3.0 && hi > (0.5f32).ln(),
-                "{}: {lo} .. {hi}",
-                image.name
+                lo < floor.ln() + 2f32.ln(),
+                "{}: {lo} vs {}",
+                image.label(),
+                floor.ln()
             );
+            assert!(hi > (0.5f32).ln(), "{}: {hi}", image.label());
         }
         assert!((linear(255) - 1.0).abs() < 1e-6 && linear(0) == 0.0);
+    }
+
+    #[test]
+    fn the_floors_are_the_quantiles_of_their_log_uniform_range() {
+        let (a, b) = FLOOR_RANGE_OF_MEAN;
+        for (floor, q) in FLOORS_OF_MEAN.iter().zip([1.0f32 / 6.0, 0.5, 5.0 / 6.0]) {
+            let expected = (a.ln() + q * (b.ln() - a.ln())).exp();
+            assert!(
+                (floor / expected - 1.0).abs() < 1e-3,
+                "{floor} vs {expected}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_higher_floor_lowers_the_log_contrast_of_the_same_image() {
+        // the mean absolute difference of neighbouring log values: what the scans count
+        let contrast = |log: &LogImage| {
+            let mut sum = 0.0f64;
+            for row in log.data.chunks(log.width) {
+                sum += row
+                    .windows(2)
+                    .map(|w| (w[1] - w[0]).abs() as f64)
+                    .sum::<f64>();
+            }
+            sum / (log.height * (log.width - 1)) as f64
+        };
+        let all = images(1);
+        let values: Vec<f64> = all.iter().map(|i| contrast(&i.log)).collect();
+        assert!(values.windows(2).all(|w| w[1] < 0.9 * w[0]), "{values:?}");
     }
 }

@@ -22,9 +22,13 @@ pub const BURN_IN_PX: f64 = 16.0;
 /// (they carry the threshold: the higher it is, the fewer of them fire).
 pub const TILE_PX: usize = 8;
 
-/// Thresholds of the calibration curve: 25 log-spaced values from 0.03 to 3.
+/// Thresholds of the calibration curve: 31 log-spaced values from 0.03 to 9.5 (24 steps a
+/// factor 100). Real sensors' thresholds lie well inside; the top reaches past the log
+/// range of every prior image under every floor (1.7-5.8), so that each curve falls to no
+/// events inside the grid and a sparse recording's threshold is bracketed, not cut off at
+/// the grid's end. Thresholds above a scan's own range cost nothing ([`Profile::range`]).
 pub fn threshold_grid() -> Vec<f64> {
-    (0..25)
+    (0..31)
         .map(|k| (0.03f64.ln() + k as f64 * (100f64.ln() / 24.0)).exp())
         .collect()
 }
@@ -71,6 +75,17 @@ pub struct Profile {
     pub burn: usize,
     /// Counted length, pixels.
     pub length: f64,
+}
+
+impl Profile {
+    /// The largest change from the first sample: no threshold above it fires (the
+    /// memorised level starts at the first sample and moves only with an event).
+    pub fn range(&self) -> f32 {
+        let first = self.values.first().copied().unwrap_or(0.0);
+        self.values
+            .iter()
+            .fold(0f32, |r, &v| r.max((v - first).abs()))
+    }
 }
 
 /// The profile of `scan` through `image`.
@@ -132,10 +147,13 @@ impl ScanPixel {
         refractory_s: 0.0,
     };
 
-    /// ON and OFF events along `profile` at ON threshold `c`.
-    fn count(&self, profile: &Profile, c: f64) -> (u32, u32) {
+    /// ON and OFF events along `profile`, whose [`Profile::range`] is `range`, at ON
+    /// threshold `c`.
+    fn count(&self, profile: &Profile, range: f32, c: f64) -> (u32, u32) {
         let (c_on, c_off) = (c as f32, (c * self.ratio) as f32);
-        if self.refractory_s > 0.0 {
+        if c_on > range && c_off > range {
+            (0, 0)
+        } else if self.refractory_s > 0.0 {
             count_refractory(profile, c_on, c_off, self.refractory_s)
         } else {
             count(profile, c_on, c_off)
@@ -251,11 +269,12 @@ pub fn curve(
     fired_only: bool,
     pixel: ScanPixel,
 ) -> Vec<CurvePoint> {
+    let ranges: Vec<f32> = profiles.par_iter().map(Profile::range).collect();
     grid.par_iter()
         .map(|&ct| {
             let (mut on, mut off, mut travel, mut active) = (0u64, 0u64, 0.0f64, 0usize);
-            for p in profiles {
-                let (a, b) = pixel.count(p, ct);
+            for (p, &range) in profiles.iter().zip(&ranges) {
+                let (a, b) = pixel.count(p, range, ct);
                 active += (a + b > 0) as usize;
                 if a + b > 0 || !fired_only {
                     on += a as u64;
@@ -295,8 +314,9 @@ fn block_counts(image: &LogImage, block: &Block, grid: &[f64], pixel: ScanPixel)
                 ..block.corner
             };
             let p = profile(image, &scan);
+            let range = p.range();
             for (slot, &c) in out.iter_mut().zip(grid) {
-                let (on, off) = pixel.count(&p, c);
+                let (on, off) = pixel.count(&p, range, c);
                 slot[0] += on;
                 slot[1] += off;
             }
@@ -343,17 +363,64 @@ pub fn block_curve(
         .collect()
 }
 
-/// The threshold of `side` at which its rate (falling with the threshold) reaches
-/// `target`, interpolated in log-log between grid points; `None` outside the curve.
-pub fn invert(curve: &[CurvePoint], side: Side, target: f64) -> Option<f64> {
-    curve.windows(2).find_map(|w| {
+/// Where a target rate falls against a calibration curve (its rate falls with the
+/// threshold, though not always strictly: a noisy tail of few firing blocks can rise again).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Inverted {
+    /// At this threshold, interpolated in log-log between the two grid points around it.
+    At(f64),
+    /// Between two grid points: the curve makes more events than the target at the first
+    /// and none at the second (the scene's whole log range is crossed by one threshold
+    /// there), so the threshold lies in `(lo, hi]`.
+    Between(f64, f64),
+    /// Fewer events than the curve makes even at its highest threshold: above it.
+    Above(f64),
+    /// More events than the curve makes even at its lowest threshold: below it.
+    Below(f64),
+    /// A target that is not a positive rate, or a curve without events.
+    Outside,
+}
+
+impl Inverted {
+    /// The threshold this calibration gives, or the grid bound that stands in for it
+    /// (`Between`: the geometric middle of its two points).
+    pub fn value(self) -> Option<f64> {
+        match self {
+            Inverted::At(v) | Inverted::Above(v) | Inverted::Below(v) => Some(v),
+            Inverted::Between(lo, hi) => Some((lo * hi).sqrt()),
+            Inverted::Outside => None,
+        }
+    }
+}
+
+/// The threshold of `side` at which its rate reaches `target`: the first pair of grid
+/// points whose rates bracket it, interpolated in log-log (or bounded, where the second
+/// makes no events); else which end of the curve the target lies beyond.
+pub fn invert(curve: &[CurvePoint], side: Side, target: f64) -> Inverted {
+    if target.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return Inverted::Outside;
+    }
+    for w in curve.windows(2) {
         let (r0, r1) = (side.rate(&w[0]), side.rate(&w[1]));
         let (c0, c1) = (side.threshold(&w[0]), side.threshold(&w[1]));
-        (r0 >= target && target >= r1 && r1 > 0.0 && r0 > r1).then(|| {
-            let f = (target.ln() - r0.ln()) / (r1.ln() - r0.ln());
-            (c0.ln() + f * (c1.ln() - c0.ln())).exp()
-        })
-    })
+        if !(r0 >= target && target >= r1) {
+            continue;
+        }
+        if r1 == 0.0 {
+            return Inverted::Between(c0, c1);
+        }
+        if r0 == r1 {
+            // a plateau at the target
+            return Inverted::At((c0 * c1).sqrt());
+        }
+        let f = (target.ln() - r0.ln()) / (r1.ln() - r0.ln());
+        return Inverted::At((c0.ln() + f * (c1.ln() - c0.ln())).exp());
+    }
+    match (curve.first(), curve.last()) {
+        (Some(first), _) if target > side.rate(first) => Inverted::Below(side.threshold(first)),
+        (_, Some(last)) if target < side.rate(last) => Inverted::Above(side.threshold(last)),
+        _ => Inverted::Outside,
+    }
 }
 
 /// The local slope `d ln rate / d ln threshold` of `side` at threshold `ct` (for turning an
@@ -430,13 +497,69 @@ mod tests {
         let grid = threshold_grid();
         let c = curve(&profiles, &grid, true, ScanPixel::SYMMETRIC);
         // 0.05 per pixel: 0.05 / C events per pixel of travel
-        let ct = invert(&c, Side::On, 0.05 / 0.25).unwrap();
+        let Inverted::At(ct) = invert(&c, Side::On, 0.05 / 0.25) else {
+            panic!("the ramp's rate is on its curve");
+        };
         assert!((ct - 0.25).abs() < 0.01, "{ct}");
         let slope = log_slope(&c, Side::On, 0.25);
         // counts are whole events (17 at 0.3 for 16.7), so the slope between grid points is
         // about -1 within that rounding
         assert!((slope + 1.0).abs() < 0.2, "{slope}");
         assert!((grid[0] - 0.03).abs() < 1e-12 && (grid[24] - 3.0).abs() < 1e-9);
+    }
+
+    /// A curve with the given ON rates at thresholds 0.1, 0.2, 0.4, ...
+    fn rates_curve(rates: &[f64]) -> Vec<CurvePoint> {
+        rates
+            .iter()
+            .enumerate()
+            .map(|(k, &r)| CurvePoint {
+                ct: 0.1 * 2f64.powi(k as i32),
+                ct_off: 0.3 * 2f64.powi(k as i32),
+                on_per_px: r,
+                off_per_px: r,
+                active_fraction: 1.0,
+                events_per_scan: r,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_target_is_read_off_its_curve_or_bounded_where_the_curve_ends() {
+        let curve = rates_curve(&[0.8, 0.4, 0.1, 0.0, 0.0]);
+        // on the curve: log-log between 0.2 (0.4) and 0.4 (0.1)
+        match invert(&curve, Side::On, 0.2) {
+            Inverted::At(v) => assert!((v - 0.2 * 2f64.powf(0.5)).abs() < 1e-12, "{v}"),
+            other => panic!("{other:?}"),
+        }
+        // the OFF side reads its own thresholds
+        match invert(&curve, Side::Off, 0.4) {
+            Inverted::At(v) => assert!((v - 0.6).abs() < 1e-12, "{v}"),
+            other => panic!("{other:?}"),
+        }
+        // fewer events than at 0.4, none at 0.8: between them
+        assert_eq!(invert(&curve, Side::On, 0.05), Inverted::Between(0.4, 0.8));
+        assert!((Inverted::Between(0.4, 0.8).value().unwrap() - 0.32f64.sqrt()).abs() < 1e-12);
+        // beyond either end
+        assert_eq!(invert(&curve, Side::On, 1.0), Inverted::Below(0.1));
+        assert_eq!(
+            invert(&rates_curve(&[0.8, 0.4, 0.2]), Side::On, 0.1),
+            Inverted::Above(0.4)
+        );
+        // no rate, no curve
+        assert_eq!(invert(&curve, Side::On, 0.0), Inverted::Outside);
+        assert_eq!(invert(&curve, Side::On, f64::NAN), Inverted::Outside);
+        assert_eq!(invert(&[], Side::On, 0.1), Inverted::Outside);
+        // a tail that rises again after a zero: the first bracket counts
+        assert_eq!(
+            invert(&rates_curve(&[0.5, 0.2, 0.0, 0.001, 0.0]), Side::On, 0.1),
+            Inverted::Between(0.2, 0.4)
+        );
+        // a plateau at the target
+        assert_eq!(
+            invert(&rates_curve(&[0.5, 0.2, 0.2, 0.1]), Side::On, 0.2),
+            Inverted::At(0.2)
+        );
     }
 
     #[test]
