@@ -266,21 +266,34 @@ fn estimates(
             not_applied: Some("the recording has no grey frames".into()),
         });
     }
-    let eppps = crate::window::eppps_of(
-        loaded,
-        &aps_options,
-        crate::estimate::eppps::EpppsOptions {
-            seed: options.seed,
-            ..Default::default()
-        },
-        &quiet,
-    );
-    methods.push(MethodResult {
-        method: "eppps",
-        not_applied: eppps.as_ref().err().map(|e| e.to_string()),
-        estimate: eppps.ok(),
-    });
-    match loaded.recording.stimulus()? {
+    let stimulus = loaded.recording.stimulus()?;
+    if stimulus.is_some() && loaded.frames.len() < 2 {
+        // without frames eppps compares the events with natural images (its prior); an
+        // on-screen recording's scene is the stimulus, whose contrast the display sets
+        methods.push(MethodResult {
+            method: "eppps",
+            estimate: None,
+            not_applied: Some(
+                "an on-screen recording without grey frames: its scene is the stimulus on a display, not a natural scene, so the events-only prior (natural images) does not describe it; the screen method measures the thresholds through the stimulus".into(),
+            ),
+        });
+    } else {
+        let eppps = crate::window::eppps_of(
+            loaded,
+            &aps_options,
+            crate::estimate::eppps::EpppsOptions {
+                seed: options.seed,
+                ..Default::default()
+            },
+            &quiet,
+        );
+        methods.push(MethodResult {
+            method: "eppps",
+            not_applied: eppps.as_ref().err().map(|e| e.to_string()),
+            estimate: eppps.ok(),
+        });
+    }
+    match stimulus {
         Some(list) if list.len() >= 2 => {
             let frames = list.load_all()?;
             let found =
