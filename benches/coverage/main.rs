@@ -84,7 +84,9 @@ fn parse_methods(list: &str) -> anyhow::Result<Vec<Method>> {
     list.split(',')
         .map(|name| {
             Method::parse(name.trim()).ok_or_else(|| {
-                anyhow::anyhow!("--methods: unknown method `{name}` (aps, eppps, screen, fit)")
+                anyhow::anyhow!(
+                    "--methods: unknown method `{name}` (aps, eppps, eppps_events, screen, fit)"
+                )
             })
         })
         .collect()

@@ -12,8 +12,12 @@ use std::path::Path;
 pub enum Method {
     /// `ctcal estimate aps`: thresholds from APS frames.
     Aps,
-    /// `ctcal estimate eppps`: thresholds from the event rate.
+    /// `ctcal estimate eppps`: thresholds from the event rate (through the frames'
+    /// contrast where the case has frames).
     Eppps,
+    /// `ctcal estimate eppps --ignore-frames`: the same from the events alone, through the
+    /// natural-image prior (what a sensor without frames gets).
+    EpppsEvents,
     /// `ctcal estimate screen`: thresholds from an on-screen stimulus.
     Screen,
     /// `ctcal fit`: every simulator parameter.
@@ -38,12 +42,19 @@ const FITTED: [&str; 10] = [
 ];
 
 impl Method {
-    pub const ALL: [Method; 4] = [Method::Aps, Method::Eppps, Method::Screen, Method::Fit];
+    pub const ALL: [Method; 5] = [
+        Method::Aps,
+        Method::Eppps,
+        Method::EpppsEvents,
+        Method::Screen,
+        Method::Fit,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Method::Aps => "aps",
             Method::Eppps => "eppps",
+            Method::EpppsEvents => "eppps_events",
             Method::Screen => "screen",
             Method::Fit => "fit",
         }
@@ -64,9 +75,13 @@ impl Method {
     pub fn args(self, input: &Path, case: &CaseSpec) -> Vec<OsString> {
         let mut args: Vec<OsString> = match self {
             Method::Fit => vec!["fit".into()],
+            Method::EpppsEvents => vec!["estimate".into(), "eppps".into()],
             estimate => vec!["estimate".into(), estimate.name().into()],
         };
         args.push(input.as_os_str().to_owned());
+        if self == Method::EpppsEvents {
+            args.push("--ignore-frames".into());
+        }
         let exposure_s = match &case.recording {
             RecordingSpec::Scene { scene } => scene.aps.as_ref().map(|a| a.exposure_s),
             RecordingSpec::Screen { .. } => None,
