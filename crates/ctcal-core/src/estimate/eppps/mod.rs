@@ -626,3 +626,69 @@ fn report(
         }),
     );
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn beyond(above: usize, below: usize) -> Beyond {
+        Beyond {
+            above,
+            below,
+            top: 9.49,
+            bottom: 0.03,
+        }
+    }
+
+    #[test]
+    fn calibrations_give_their_thresholds_or_a_reason() {
+        let at = [
+            Inverted::At(0.3),
+            Inverted::Between(0.4, 0.8),
+            Inverted::Above(9.49),
+        ];
+        let values = classify(&at, beyond(1, 0), 0.05, Side::On).unwrap();
+        assert_eq!(values.len(), 3);
+        assert!((values[1] - 0.32f64.sqrt()).abs() < 1e-12 && values[2] == 9.49);
+        // a calibration without events to compare with: no value, and the count said
+        let why = classify(
+            &[Inverted::At(0.3), Inverted::Outside],
+            beyond(0, 0),
+            0.05,
+            Side::Off,
+        )
+        .unwrap_err();
+        assert!(
+            why.contains("1 of the 2 calibrations make no OFF events"),
+            "{why}"
+        );
+        // more than half only bounded: beyond the method's range, on the side it lies
+        let why = classify(
+            &[
+                Inverted::Above(9.49),
+                Inverted::Above(9.49),
+                Inverted::At(3.0),
+            ],
+            beyond(2, 0),
+            1e-4,
+            Side::On,
+        )
+        .unwrap_err();
+        assert!(why.contains("above the method's range"), "{why}");
+        let why = classify(
+            &[
+                Inverted::Below(0.03),
+                Inverted::Below(0.03),
+                Inverted::At(0.05),
+            ],
+            beyond(0, 2),
+            9.0,
+            Side::On,
+        )
+        .unwrap_err();
+        assert!(why.contains("below the method's range"), "{why}");
+        // no events of the polarity at all
+        let why = classify(&at, beyond(0, 0), 0.0, Side::On).unwrap_err();
+        assert!(why.contains("no supported ON events"), "{why}");
+    }
+}

@@ -115,3 +115,47 @@ fn describe(chance: Option<f64>) -> String {
         format!("{c:.4}")
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_effect_is_kept_when_its_fall_beats_measured_chance() {
+        // per-block falls of 10, 20 and 30 %: standard deviation 0.1; over four judging
+        // blocks chance is 2 x 0.1 / 2 = 10 % of the distance before
+        let falls = [0.1, 0.2, 0.3];
+        let kept = decide(2.0, 1.7, &falls, 4);
+        assert!((kept.chance.unwrap() - 0.2).abs() < 1e-12);
+        assert!(kept.kept, "{}", kept.reason);
+        let not = decide(2.0, 1.85, &falls, 4);
+        assert!(!not.kept, "{}", not.reason);
+        assert!(
+            not.reason.contains("needs a fall of 0.2000"),
+            "{}",
+            not.reason
+        );
+        // more judging blocks, less chance: the same fall of 7.5 % is kept over 16
+        assert!(decide(2.0, 1.85, &falls, 16).kept);
+    }
+
+    #[test]
+    fn without_three_fit_blocks_a_fixed_fall_stands_in_and_says_so() {
+        let falls = [0.5, 0.1];
+        let d = decide(1.0, 0.979, &falls, 3);
+        assert!(d.chance.is_none() && d.kept, "{}", d.reason);
+        let d = decide(1.0, 0.981, &falls, 3);
+        assert!(!d.kept);
+        assert!(d.reason.contains("not measurable"), "{}", d.reason);
+    }
+
+    #[test]
+    fn an_effect_too_small_to_matter_is_left_out_even_when_measurable() {
+        // identical falls: chance is 0, and the 1 % parsimony floor decides
+        let falls = [0.004, 0.004, 0.004, 0.004];
+        assert!(!decide(1.0, 0.991, &falls, 5).kept);
+        assert!(decide(1.0, 0.989, &falls, 5).kept);
+        // a candidate that is worse is never kept
+        assert!(!decide(1.0, 1.2, &falls, 5).kept);
+    }
+}
