@@ -10,7 +10,9 @@
 //! 2. the calibration ([`calibration`], [`scans`]): ideal pixels along line scans with the
 //!    recording's own travel and directions, through the recording's frames when it has them
 //!    (its contrast measured) and otherwise through natural images ([`prior`]), at 31
-//!    thresholds from 0.03 to 9.5;
+//!    thresholds from 0.03 to 9.5; without frames each image is read at the recording's
+//!    own sharpness, the blur at which its scans burst as often as the recording's events
+//!    do ([`sharpness`]);
 //! 3. the threshold at which the scans make the recording's rate, per polarity; without
 //!    frames one per prior image and log-response floor, combined in their logarithm, and the
 //!    spread between them is the prior's share of the interval (events alone cannot separate
@@ -21,6 +23,7 @@ pub mod calibration;
 pub mod prior;
 pub mod recording;
 pub mod scans;
+pub mod sharpness;
 
 use super::interval::{Measured, z95};
 use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
@@ -31,6 +34,7 @@ use recording::RecordingRates;
 use scans::{CurvePoint, Inverted, ScanPixel, Side, curve, invert, log_slope, threshold_grid};
 use serde::Serialize;
 use serde_json::json;
+use sharpness::{PriorTag, Reading, Selection};
 
 /// The method's own systematic error, in ln C: what ideal-pixel line scans along a measured
 /// flow miss of a real pixel's events (flow and exposure blur of the frames, where scans
@@ -123,7 +127,14 @@ pub fn estimate(
         refractory_s: refractory.as_ref().map_or(0.0, |e| e.edge_us * 1e-6),
     };
     progress("calibration scans (ON = OFF)", 0.3);
-    let symmetric = calibrate(frames, &rates, &excluded, options, pixel);
+    let basis = Basis::new(frames, &excluded, options);
+    let raw = basis.calibrate(&rates, pixel, None);
+    let reading = basis.select(&raw, &rates);
+    let selections = reading.as_ref().map(|r| &r.kept[..]);
+    let symmetric = match selections {
+        Some(s) => sharpness::mix(&raw, &basis.tags, s),
+        None => raw,
+    };
     let (on, off) = measure_both(&symmetric, &rates);
     // the two thresholds interact in every pixel (see `scans::count`): scan again at the
     // OFF/ON ratio the symmetric scans found, and read both polarities there
@@ -132,10 +143,7 @@ pub fn estimate(
     let (on, off) = if ratio.is_finite() && (ratio.ln()).abs() > 0.02 {
         progress("calibration scans (OFF/ON ratio measured)", 0.6);
         pixel.ratio = ratio;
-        measure_both(
-            &calibrate(frames, &rates, &excluded, options, pixel),
-            &rates,
-        )
+        measure_both(&basis.calibrate(&rates, pixel, selections), &rates)
     } else {
         (on, off)
     };
@@ -174,7 +182,17 @@ pub fn estimate(
     }
     result
         .assumptions
-        .extend(assumptions(&rates, &calibrations, frames.is_some(), hot));
+        .extend(assumptions(&rates, &calibrations, basis.images(), hot));
+    if frames.is_none() {
+        result.assumptions.push(match &reading {
+            Some(r) => r.describe(),
+            None => format!(
+                "prior not read at the recording's sharpness: {} consecutive same-polarity event pairs at a pixel, fewer than the {MIN_BURST_PAIRS} needed to measure it; every blur of the images (0-{:.0} px) is part of the prior",
+                rates.bursts.map_or(0, |b| b.pairs),
+                prior::BLUR_PX[prior::BLUR_PX.len() - 1]
+            ),
+        });
+    }
     let clamped = if measured_ratio.is_finite() && measured_ratio != ratio {
         format!(", held to 0.2-5 from {measured_ratio:.3}")
     } else {
@@ -236,43 +254,107 @@ fn refractory_edge(
     refractory::edge(&mut intervals, refractory::timestamp_step(events)).filter(|e| e.found)
 }
 
-/// The calibration curves for `pixel`: one through the frames, or one per prior image.
-fn calibrate(
-    frames: Option<&PreparedFrames>,
-    rates: &RecordingRates,
-    excluded: &[bool],
-    options: &EpppsOptions,
-    pixel: ScanPixel,
-) -> Vec<Calibration> {
-    let grid = threshold_grid();
-    match frames {
-        Some(f) => vec![Calibration {
-            name: "the recording's frames".into(),
-            curve: curve(
-                &calibration::frame_profiles(f, excluded),
-                &grid,
-                false,
-                pixel,
-            ),
-        }],
-        None => prior::images(options.scenes.max(1))
-            .par_iter()
-            .map(|image| Calibration {
-                name: image.label(),
-                // one photograph's floors scan the same places (common random numbers):
-                // their difference is the floor's alone
-                curve: scans::block_curve(
-                    &image.log,
-                    &calibration::prior_blocks(
-                        &image.log,
-                        rates,
-                        options.seed + image.image as u64,
-                    ),
+/// What a recording is compared with: its frames, or the prior's images under every blur
+/// and floor (and what each of them is).
+struct Basis<'a> {
+    frames: Option<&'a PreparedFrames>,
+    excluded: &'a [bool],
+    options: &'a EpppsOptions,
+    priors: Vec<prior::PriorImage>,
+    tags: Vec<PriorTag>,
+}
+
+/// Consecutive event pairs a recording needs for its burst share to choose the prior's
+/// blur (a share of 0.5 from 200 pairs is known to +-0.07 at 95 %).
+const MIN_BURST_PAIRS: usize = 200;
+
+impl<'a> Basis<'a> {
+    fn new(
+        frames: Option<&'a PreparedFrames>,
+        excluded: &'a [bool],
+        options: &'a EpppsOptions,
+    ) -> Self {
+        let priors = match frames {
+            Some(_) => Vec::new(),
+            None => prior::images(options.scenes.max(1)),
+        };
+        let tags = priors.iter().map(prior::PriorImage::tag).collect();
+        Basis {
+            frames,
+            excluded,
+            options,
+            priors,
+            tags,
+        }
+    }
+
+    /// The calibration curves for `pixel`: one through the frames; without frames one per
+    /// prior image, blur and floor (`selections` `None`), or per image and floor read at
+    /// the blurs `selections` chose.
+    fn calibrate(
+        &self,
+        rates: &RecordingRates,
+        pixel: ScanPixel,
+        selections: Option<&[Selection]>,
+    ) -> Vec<Calibration> {
+        let grid = threshold_grid();
+        if let Some(f) = self.frames {
+            return vec![Calibration {
+                name: "the recording's frames".into(),
+                curve: curve(
+                    &calibration::frame_profiles(f, self.excluded),
                     &grid,
+                    false,
                     pixel,
                 ),
-            })
-            .collect(),
+            }];
+        }
+        let scan = |images: &[&prior::PriorImage]| -> Vec<Calibration> {
+            images
+                .par_iter()
+                .map(|image| Calibration {
+                    name: image.label(),
+                    // one photograph's blurs and floors scan the same places (common
+                    // random numbers): their differences are theirs alone
+                    curve: scans::block_curve(
+                        &image.log,
+                        &calibration::prior_blocks(
+                            &image.log,
+                            rates,
+                            self.options.seed + image.image as u64,
+                        ),
+                        &grid,
+                        pixel,
+                    ),
+                })
+                .collect()
+        };
+        match selections {
+            None => scan(&self.priors.iter().collect::<Vec<_>>()),
+            Some(selections) => {
+                let (list, renumbered) = sharpness::used(selections);
+                let images: Vec<&prior::PriorImage> =
+                    list.iter().map(|&k| &self.priors[k]).collect();
+                let tags: Vec<PriorTag> = list.iter().map(|&k| self.tags[k]).collect();
+                sharpness::mix(&scan(&images), &tags, &renumbered)
+            }
+        }
+    }
+
+    /// How many prior images the calibrations scan (0 with frames).
+    fn images(&self) -> usize {
+        self.tags.iter().map(|t| t.image + 1).max().unwrap_or(0)
+    }
+
+    /// Without frames, each prior image and floor read at the blur whose burst share is the
+    /// recording's; `None` with frames, or where the recording has too few consecutive
+    /// events to measure its share (then every blur is part of the prior).
+    fn select(&self, raw: &[Calibration], rates: &RecordingRates) -> Option<Reading> {
+        let bursts = rates.bursts.filter(|b| b.pairs >= MIN_BURST_PAIRS)?;
+        (self.frames.is_none() && !self.tags.is_empty()).then(|| {
+            let all = sharpness::select(raw, &self.tags, rates, bursts.fraction());
+            Reading::new(bursts.fraction(), bursts.pairs, all, &self.tags)
+        })
     }
 }
 
@@ -450,12 +532,14 @@ fn measure(
     }
 }
 
+/// What the estimate assumed; `images`: the prior's images (0: the recording's frames).
 fn assumptions(
     rates: &RecordingRates,
     calibrations: &[Calibration],
-    frames: bool,
+    images: usize,
     hot: usize,
 ) -> Vec<String> {
+    let frames = images == 0;
     let mut out = Vec::new();
     if hot > 0 {
         out.push(format!("{hot} hot pixels left out"));
@@ -483,7 +567,6 @@ fn assumptions(
     if frames {
         out.push("calibration: ideal pixels along each pixel's own path through the frames (the scene's contrast measured); ON = OFF threshold in the scans".into());
     } else {
-        let images = calibrations.len() / prior::FLOORS_OF_MEAN.len();
         out.push(format!(
             "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread between images is in the interval; a scene of unusual contrast (a printed pattern, a high-contrast lab scene, a smooth texture) moves the threshold with it",
         ));

@@ -61,29 +61,50 @@ const IMAGES: [(&str, &[u8]); 6] = [
 /// How many prior images there are.
 pub const COUNT: usize = IMAGES.len();
 
-/// A prior image under one floor: its name, the floor (fraction of its mean luminance)
-/// and its log luminance.
+/// How blurred the prior's images are scanned, a Gaussian's standard deviation in pixels
+/// (in linear light, as optics blur): from the photographs' own sharpness to a scene whose
+/// edges spread over several pixels. A sensor's optics and defocus blur its view, and a
+/// scene may be smooth itself, by amounts a photograph does not carry; the recording's own
+/// events tell how sharp its scene is (the share of an edge's events that follow within
+/// a pixel of travel, [`super::scans::BURST_PX`]), and each image and floor is read at the
+/// blur that gives the same share.
+pub const BLUR_PX: [f32; 4] = [0.0, 1.0, 2.0, 4.0];
+
+/// A prior image under one blur and floor: its name, the blur (px), the floor (fraction of
+/// its mean luminance) and its log luminance.
 pub struct PriorImage {
     pub name: &'static str,
-    /// Which photograph (its place in the list): the floors of one photograph share it.
+    /// Which photograph (its place in the list): its blurs and floors share it.
     pub image: usize,
+    pub blur_px: f32,
     pub floor_of_mean: f32,
     pub log: LogImage,
 }
 
 impl PriorImage {
-    /// The image and floor, as named in the estimate's report.
+    /// Which image, blur and floor this is.
+    pub fn tag(&self) -> super::sharpness::PriorTag {
+        super::sharpness::PriorTag {
+            name: self.name,
+            image: self.image,
+            blur_px: self.blur_px,
+            floor_of_mean: self.floor_of_mean,
+        }
+    }
+
+    /// The image, blur and floor, as named in the estimate's report.
     pub fn label(&self) -> String {
         format!(
-            "{} (floor {:.1} % of its mean)",
+            "{} (blur {} px, floor {:.1} % of its mean)",
             self.name,
+            self.blur_px,
             100.0 * self.floor_of_mean
         )
     }
 }
 
-/// The first `n` prior images (all when `n` is larger), each under every floor of
-/// [`FLOORS_OF_MEAN`].
+/// The first `n` prior images (all when `n` is larger), each under every blur of
+/// [`BLUR_PX`] and floor of [`FLOORS_OF_MEAN`] (image by image, blur by blur).
 pub fn images(n: usize) -> Vec<PriorImage> {
     IMAGES
         .iter()
@@ -92,11 +113,15 @@ pub fn images(n: usize) -> Vec<PriorImage> {
         .flat_map(|(image, (name, bytes))| {
             let linear =
                 decode(bytes).expect("the embedded prior images are valid PGM (unit test)");
-            FLOORS_OF_MEAN.map(|floor_of_mean| PriorImage {
-                name,
-                image,
-                floor_of_mean,
-                log: linear.log_above(floor_of_mean),
+            BLUR_PX.into_iter().flat_map(move |blur_px| {
+                let blurred = linear.blurred(blur_px);
+                FLOORS_OF_MEAN.map(|floor_of_mean| PriorImage {
+                    name,
+                    image,
+                    blur_px,
+                    floor_of_mean,
+                    log: blurred.log_above(floor_of_mean),
+                })
             })
         })
         .collect()
@@ -112,6 +137,48 @@ struct LinearImage {
 impl LinearImage {
     fn mean(&self) -> f32 {
         (self.data.iter().map(|&v| v as f64).sum::<f64>() / self.data.len().max(1) as f64) as f32
+    }
+
+    /// Blurred by a Gaussian of `sigma_px` (separable, edges held; 0: as it is).
+    fn blurred(&self, sigma_px: f32) -> LinearImage {
+        if sigma_px <= 0.0 {
+            return LinearImage {
+                width: self.width,
+                height: self.height,
+                data: self.data.clone(),
+            };
+        }
+        let radius = (3.0 * sigma_px).ceil() as isize;
+        let kernel: Vec<f32> = (-radius..=radius)
+            .map(|k| (-0.5 * (k as f32 / sigma_px).powi(2)).exp())
+            .collect();
+        let total: f32 = kernel.iter().sum();
+        let (w, h) = (self.width as isize, self.height as isize);
+        let pass = |data: &[f32], step: (isize, isize)| -> Vec<f32> {
+            (0..h)
+                .flat_map(|y| (0..w).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    kernel
+                        .iter()
+                        .zip(-radius..=radius)
+                        .map(|(weight, k)| {
+                            let (sx, sy) = (
+                                (x + k * step.0).clamp(0, w - 1),
+                                (y + k * step.1).clamp(0, h - 1),
+                            );
+                            weight * data[(sy * w + sx) as usize]
+                        })
+                        .sum::<f32>()
+                        / total
+                })
+                .collect()
+        };
+        let rows = pass(&self.data, (1, 0));
+        LinearImage {
+            width: self.width,
+            height: self.height,
+            data: pass(&rows, (0, 1)),
+        }
     }
 
     /// `ln(Y + floor_of_mean * mean)`.
@@ -168,19 +235,24 @@ mod tests {
     use super::*;
 
     #[test]
-    fn every_prior_image_decodes_under_every_floor() {
+    fn every_prior_image_decodes_under_every_blur_and_floor() {
         let all = images(usize::MAX);
-        assert_eq!(all.len(), COUNT * FLOORS_OF_MEAN.len());
+        assert_eq!(all.len(), COUNT * BLUR_PX.len() * FLOORS_OF_MEAN.len());
         for image in &all {
             assert_eq!(image.log.width, 256, "{}", image.name);
             assert!(image.log.height >= 150, "{}", image.name);
-            let linear = decode(IMAGES.iter().find(|i| i.0 == image.name).unwrap().1).unwrap();
+            let linear = decode(IMAGES.iter().find(|i| i.0 == image.name).unwrap().1)
+                .unwrap()
+                .blurred(image.blur_px);
             let floor = image.floor_of_mean * linear.mean();
             let (lo, hi) = image
                 .log
                 .data
                 .iter()
                 .fold((f32::MAX, f32::MIN), |(a, b), &v| (a.min(v), b.max(v)));
+            if image.blur_px > 0.0 {
+                continue;
+            }
             // the darkest pixels reach down to the floor (their own light is at most as
             // large as it), the brightest above half of white
             assert!(
@@ -207,7 +279,7 @@ mod tests {
     }
 
     #[test]
-    fn a_higher_floor_lowers_the_log_contrast_of_the_same_image() {
+    fn a_higher_floor_or_a_wider_blur_lowers_the_log_contrast_of_the_same_image() {
         // the mean absolute difference of neighbouring log values: what the scans count
         let contrast = |log: &LogImage| {
             let mut sum = 0.0f64;
@@ -220,7 +292,28 @@ mod tests {
             sum / (log.height * (log.width - 1)) as f64
         };
         let all = images(1);
-        let values: Vec<f64> = all.iter().map(|i| contrast(&i.log)).collect();
-        assert!(values.windows(2).all(|w| w[1] < 0.9 * w[0]), "{values:?}");
+        for blur in BLUR_PX {
+            let values: Vec<f64> = all
+                .iter()
+                .filter(|i| i.blur_px == blur)
+                .map(|i| contrast(&i.log))
+                .collect();
+            assert_eq!(values.len(), FLOORS_OF_MEAN.len());
+            assert!(values.windows(2).all(|w| w[1] < 0.9 * w[0]), "{values:?}");
+        }
+        // and a wider blur lowers it at any floor, the light's mean kept
+        for floor in FLOORS_OF_MEAN {
+            let values: Vec<f64> = all
+                .iter()
+                .filter(|i| i.floor_of_mean == floor)
+                .map(|i| contrast(&i.log))
+                .collect();
+            assert!(values.windows(2).all(|w| w[1] < 0.9 * w[0]), "{values:?}");
+        }
+        let linear = decode(IMAGES[0].1).unwrap();
+        for blur in BLUR_PX {
+            let m = linear.blurred(blur).mean();
+            assert!((m / linear.mean() - 1.0).abs() < 0.01, "{blur}: {m}");
+        }
     }
 }

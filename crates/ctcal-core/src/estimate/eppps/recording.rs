@@ -58,6 +58,56 @@ pub struct RecordingRates {
     pub travels: Vec<f32>,
     pub directions: Vec<(f32, f32)>,
     pub support_window_us: TimeUs,
+    /// How the recording's events follow each other at a pixel (without frames: how sharp
+    /// its scene is, to read the prior at).
+    pub bursts: Option<BurstShare>,
+}
+
+/// Of a recording's consecutive supported events of one polarity at a pixel, how many
+/// (`pairs`) and how many within [`super::scans::BURST_PX`] of travel at their window's
+/// flow (`bursts`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct BurstShare {
+    pub pairs: usize,
+    pub bursts: usize,
+}
+
+impl BurstShare {
+    pub fn fraction(self) -> f64 {
+        self.bursts as f64 / self.pairs.max(1) as f64
+    }
+
+    /// Counts the consecutive events of `events` (time-sorted) at each pixel and polarity
+    /// among those that count: supported, not excluded, and in a window whose flow
+    /// `speed_px_s(i, pixel)` gives (`None`: not counted).
+    fn measure(
+        events: &EventChunk,
+        sensor: Sensor,
+        excluded: &[bool],
+        support: &[bool],
+        speed_px_s: impl Fn(usize, usize) -> Option<f64>,
+    ) -> Self {
+        let w = sensor.width as usize;
+        let mut last = vec![TimeUs::MIN; 2 * sensor.pixels()];
+        let mut share = BurstShare::default();
+        for (i, &supported) in support.iter().enumerate().take(events.len()) {
+            let pixel = events.y[i] as usize * w + events.x[i] as usize;
+            if !supported || excluded[pixel] {
+                continue;
+            }
+            let Some(speed) = speed_px_s(i, pixel) else {
+                continue;
+            };
+            let slot = &mut last[2 * pixel + events.on[i] as usize];
+            if *slot != TimeUs::MIN {
+                share.pairs += 1;
+                let travel = (events.t[i] - *slot) as f64 * 1e-6 * speed;
+                share.bursts += (travel < super::scans::BURST_PX) as usize;
+            }
+            *slot = events.t[i];
+        }
+        share
+    }
 }
 
 /// Per 32-px patch sums, for the bootstrap: ON, OFF, travel.
@@ -146,6 +196,7 @@ struct Finish {
     source: String,
     travel_error: f64,
     window: TimeUs,
+    bursts: Option<BurstShare>,
 }
 
 /// Per-pixel travel (px) and flow direction; travel 0: not counted.
@@ -252,6 +303,7 @@ fn finish(
         travels,
         directions,
         support_window_us: f.window,
+        bursts: f.bursts,
     })
 }
 
@@ -290,6 +342,13 @@ pub fn from_events(
             .iter()
             .any(|f| f.t_start <= t && t <= f.t_end)
     });
+    let bursts = BurstShare::measure(events, sensor, excluded, &support, |i, pixel| {
+        let t = events.t[i];
+        by_patch[patch_of(pixel)]
+            .iter()
+            .find(|f| f.t_start <= t && t <= f.t_end)
+            .map(|f| if f.trusted() { f.speed() } else { median })
+    });
     let (patches, travel_error) = patch_paths(&by_patch, median);
     let pixels = sensor.pixels();
     let paths = Paths {
@@ -305,6 +364,7 @@ pub fn from_events(
         source: format!("the events (contrast maximisation per {p} px patch)"),
         travel_error,
         window,
+        bursts: Some(bursts),
     };
     finish(&tally, &paths, excluded, w, finish_with)
 }
@@ -389,6 +449,8 @@ pub fn from_frames(
         source: "the frames (pyramidal Lucas-Kanade)".into(),
         travel_error: 0.0,
         window,
+        // the frames measure the scene's contrast: no prior to read at its sharpness
+        bursts: None,
     };
     finish(&tally, &paths, excluded, w, finish_with)
 }

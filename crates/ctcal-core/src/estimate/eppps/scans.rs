@@ -109,26 +109,75 @@ pub fn profile(image: &LogImage, scan: &Scan) -> Profile {
     }
 }
 
+/// The travel within which two consecutive events of one polarity at a pixel count as one
+/// burst (an edge passing), pixels: how sharp a scene is, as its events tell it (a sharp
+/// edge fires its events within a pixel of travel, a smooth gradient one per threshold's
+/// worth of slope).
+pub const BURST_PX: f64 = 1.0;
+
+/// What one scan fires at one pair of thresholds: its counted ON and OFF events, and of
+/// its consecutive counted events of one polarity (`pairs`) those within [`BURST_PX`] of
+/// travel (`bursts`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ScanCount {
+    pub on: u32,
+    pub off: u32,
+    pub pairs: u32,
+    pub bursts: u32,
+}
+
+impl ScanCount {
+    fn add(&mut self, other: ScanCount) {
+        self.on += other.on;
+        self.off += other.off;
+        self.pairs += other.pairs;
+        self.bursts += other.bursts;
+    }
+
+    /// A counted event of polarity `up` at `travel` pixels along the scan, after the one
+    /// before it of that polarity at `last[up]`.
+    fn event(&mut self, up: bool, travel: f64, last: &mut [Option<f64>; 2]) {
+        if up {
+            self.on += 1;
+        } else {
+            self.off += 1;
+        }
+        let slot = &mut last[up as usize];
+        if let Some(before) = *slot {
+            self.pairs += 1;
+            self.bursts += (travel - before < BURST_PX) as u32;
+        }
+        *slot = Some(travel);
+    }
+}
+
 /// ON and OFF events of an ideal pixel of thresholds `c_on`, `c_off` along `profile`,
 /// counted after its burn-in; the memorised level starts at the first sample and moves by
 /// one threshold per event. The two thresholds interact: the memorised level is a play
 /// operator of width `c_on + c_off` on the profile, so a pixel's ON count depends on its OFF
-/// threshold wherever the profile turns.
-pub fn count(profile: &Profile, c_on: f32, c_off: f32) -> (u32, u32) {
+/// threshold wherever the profile turns. Event positions (for the bursts) are the samples'
+/// travel, [`STEP_PX`] apart.
+pub fn count(profile: &Profile, c_on: f32, c_off: f32) -> ScanCount {
     let mut reference = profile.values[0];
-    let (mut on, mut off) = (0u32, 0u32);
+    let mut out = ScanCount::default();
+    let mut last = [None, None];
     for (i, &level) in profile.values.iter().enumerate() {
         let counted = i > profile.burn;
+        let travel = i as f64 * STEP_PX;
         while level - reference >= c_on {
             reference += c_on;
-            on += counted as u32;
+            if counted {
+                out.event(true, travel, &mut last);
+            }
         }
         while reference - level >= c_off {
             reference -= c_off;
-            off += counted as u32;
+            if counted {
+                out.event(false, travel, &mut last);
+            }
         }
     }
-    (on, off)
+    out
 }
 
 /// The pixel the scans simulate besides its ON threshold: its OFF threshold as a multiple
@@ -147,12 +196,11 @@ impl ScanPixel {
         refractory_s: 0.0,
     };
 
-    /// ON and OFF events along `profile`, whose [`Profile::range`] is `range`, at ON
-    /// threshold `c`.
-    fn count(&self, profile: &Profile, range: f32, c: f64) -> (u32, u32) {
+    /// What `profile`, whose [`Profile::range`] is `range`, fires at ON threshold `c`.
+    fn count(&self, profile: &Profile, range: f32, c: f64) -> ScanCount {
         let (c_on, c_off) = (c as f32, (c * self.ratio) as f32);
         if c_on > range && c_off > range {
-            (0, 0)
+            ScanCount::default()
         } else if self.refractory_s > 0.0 {
             count_refractory(profile, c_on, c_off, self.refractory_s)
         } else {
@@ -166,14 +214,20 @@ impl ScanPixel {
 /// `refractory_s`; a crossing inside the period stays pending and fires when it ends if the
 /// level is then still a threshold away, one event per period. Between samples the level
 /// is interpolated linearly in time, so crossings are timed within a sample.
-pub fn count_refractory(profile: &Profile, c_on: f32, c_off: f32, refractory_s: f64) -> (u32, u32) {
+pub fn count_refractory(profile: &Profile, c_on: f32, c_off: f32, refractory_s: f64) -> ScanCount {
     let (v, t) = (&profile.values, &profile.times_s);
     let mut reference = v[0];
     let mut ready = f64::NEG_INFINITY;
-    let (mut on, mut off) = (0u32, 0u32);
+    let mut out = ScanCount::default();
+    let mut last = [None, None];
+    // samples are STEP_PX of travel apart, evenly in time
+    let px_per_s = match t.as_slice() {
+        [a, b, ..] if b > a => STEP_PX / (b - a),
+        _ => 0.0,
+    };
     for i in 1..v.len().min(t.len()) {
         let (t0, t1, v0, v1) = (t[i - 1], t[i], v[i - 1], v[i]);
-        let counted = (i > profile.burn) as u32;
+        let counted = i > profile.burn;
         let level_at = |s: f64| {
             if t1 > t0 {
                 v0 + (v1 - v0) * ((s - t0) / (t1 - t0)) as f32
@@ -207,18 +261,15 @@ pub fn count_refractory(profile: &Profile, c_on: f32, c_off: f32, refractory_s: 
                 })
             };
             let Some((at, up)) = fired else { break };
-            if up {
-                reference += c_on;
-                on += counted;
-            } else {
-                reference -= c_off;
-                off += counted;
+            reference += if up { c_on } else { -c_off };
+            if counted {
+                out.event(up, (at - t[0]) * px_per_s, &mut last);
             }
             ready = at + refractory_s;
             from = at;
         }
     }
-    (on, off)
+    out
 }
 
 /// Which polarity a calibration curve is read for.
@@ -258,6 +309,57 @@ pub struct CurvePoint {
     pub active_fraction: f64,
     /// Events per scan (ON + OFF), over all scans.
     pub events_per_scan: f64,
+    /// Of the counted scans' consecutive events of one polarity, the share within
+    /// [`BURST_PX`] of travel (NaN without any).
+    pub burst_fraction: f64,
+}
+
+impl CurvePoint {
+    /// The point of `sum` (the counted scans' events) over `travel` pixels, `scans` scans
+    /// in all, `active_fraction` of them (or of their blocks) firing.
+    fn new(
+        ct: f64,
+        pixel: ScanPixel,
+        sum: ScanCount,
+        travel: f64,
+        active_fraction: f64,
+        scans: usize,
+    ) -> Self {
+        let travel = travel.max(1e-9);
+        let scans = scans.max(1) as f64;
+        CurvePoint {
+            ct,
+            ct_off: ct * pixel.ratio,
+            on_per_px: sum.on as f64 / travel,
+            off_per_px: sum.off as f64 / travel,
+            active_fraction,
+            events_per_scan: (sum.on + sum.off) as f64 / scans,
+            burst_fraction: if sum.pairs > 0 {
+                sum.bursts as f64 / sum.pairs as f64
+            } else {
+                f64::NAN
+            },
+        }
+    }
+}
+
+/// The burst fraction of `curve` at ON threshold `ct`, interpolated in ln threshold
+/// between the grid points around it (NaN outside the curve or where it has none).
+pub fn burst_fraction_at(curve: &[CurvePoint], ct: f64) -> f64 {
+    curve
+        .windows(2)
+        .find(|w| w[0].ct <= ct && ct <= w[1].ct)
+        .map_or(f64::NAN, |w| {
+            let f = (ct.ln() - w[0].ct.ln()) / (w[1].ct.ln() - w[0].ct.ln());
+            match (w[0].burst_fraction.is_nan(), w[1].burst_fraction.is_nan()) {
+                (false, false) => {
+                    w[0].burst_fraction + f * (w[1].burst_fraction - w[0].burst_fraction)
+                }
+                (false, true) => w[0].burst_fraction,
+                (true, false) => w[1].burst_fraction,
+                (true, true) => f64::NAN,
+            }
+        })
 }
 
 /// The calibration curve of `profiles` at every ON threshold of `grid` for `pixel`: per
@@ -272,25 +374,25 @@ pub fn curve(
     let ranges: Vec<f32> = profiles.par_iter().map(Profile::range).collect();
     grid.par_iter()
         .map(|&ct| {
-            let (mut on, mut off, mut travel, mut active) = (0u64, 0u64, 0.0f64, 0usize);
+            let (mut sum, mut travel, mut active) = (ScanCount::default(), 0.0f64, 0usize);
             for (p, &range) in profiles.iter().zip(&ranges) {
-                let (a, b) = pixel.count(p, range, ct);
-                active += (a + b > 0) as usize;
-                if a + b > 0 || !fired_only {
-                    on += a as u64;
-                    off += b as u64;
+                let c = pixel.count(p, range, ct);
+                let fired = c.on + c.off > 0;
+                active += fired as usize;
+                if fired || !fired_only {
+                    sum.add(c);
                     travel += p.length;
                 }
             }
-            let travel = travel.max(1e-9);
-            CurvePoint {
+            let scans = profiles.len();
+            CurvePoint::new(
                 ct,
-                ct_off: ct * pixel.ratio,
-                on_per_px: on as f64 / travel,
-                off_per_px: off as f64 / travel,
-                active_fraction: active as f64 / profiles.len().max(1) as f64,
-                events_per_scan: (on + off) as f64 / profiles.len().max(1) as f64,
-            }
+                pixel,
+                sum,
+                travel,
+                active as f64 / scans.max(1) as f64,
+                scans,
+            )
         })
         .collect()
 }
@@ -303,9 +405,9 @@ pub struct Block {
     pub corner: Scan,
 }
 
-/// ON and OFF events of a block's pixels at each ON threshold of `grid`.
-fn block_counts(image: &LogImage, block: &Block, grid: &[f64], pixel: ScanPixel) -> Vec<[u32; 2]> {
-    let mut out = vec![[0u32; 2]; grid.len()];
+/// What a block's pixels fire at each ON threshold of `grid`.
+fn block_counts(image: &LogImage, block: &Block, grid: &[f64], pixel: ScanPixel) -> Vec<ScanCount> {
+    let mut out = vec![ScanCount::default(); grid.len()];
     for j in 0..TILE_PX {
         for i in 0..TILE_PX {
             let scan = Scan {
@@ -316,9 +418,7 @@ fn block_counts(image: &LogImage, block: &Block, grid: &[f64], pixel: ScanPixel)
             let p = profile(image, &scan);
             let range = p.range();
             for (slot, &c) in out.iter_mut().zip(grid) {
-                let (on, off) = pixel.count(&p, range, c);
-                slot[0] += on;
-                slot[1] += off;
+                slot.add(pixel.count(&p, range, c));
             }
         }
     }
@@ -334,31 +434,30 @@ pub fn block_curve(
     grid: &[f64],
     pixel: ScanPixel,
 ) -> Vec<CurvePoint> {
-    let counts: Vec<Vec<[u32; 2]>> = blocks
+    let counts: Vec<Vec<ScanCount>> = blocks
         .par_iter()
         .map(|b| block_counts(image, b, grid, pixel))
         .collect();
-    let pixels = (TILE_PX * TILE_PX) as f64;
+    let pixels = TILE_PX * TILE_PX;
     (0..grid.len())
         .map(|k| {
-            let (mut on, mut off, mut travel, mut active) = (0u64, 0u64, 0.0f64, 0usize);
+            let (mut sum, mut travel, mut active) = (ScanCount::default(), 0.0f64, 0usize);
             for (b, c) in blocks.iter().zip(&counts) {
-                if c[k][0] + c[k][1] > 0 {
-                    on += c[k][0] as u64;
-                    off += c[k][1] as u64;
-                    travel += pixels * b.corner.length;
+                if c[k].on + c[k].off > 0 {
+                    sum.add(c[k]);
+                    travel += pixels as f64 * b.corner.length;
                     active += 1;
                 }
             }
-            let travel = travel.max(1e-9);
-            CurvePoint {
-                ct: grid[k],
-                ct_off: grid[k] * pixel.ratio,
-                on_per_px: on as f64 / travel,
-                off_per_px: off as f64 / travel,
-                active_fraction: active as f64 / blocks.len().max(1) as f64,
-                events_per_scan: (on + off) as f64 / (pixels * blocks.len().max(1) as f64),
-            }
+            let active_fraction = active as f64 / blocks.len().max(1) as f64;
+            CurvePoint::new(
+                grid[k],
+                pixel,
+                sum,
+                travel,
+                active_fraction,
+                pixels * blocks.len(),
+            )
         })
         .collect()
 }
@@ -464,7 +563,7 @@ mod tests {
             seconds_per_px: 0.01,
         };
         let p = profile(&image, &scan);
-        let (on, off) = count(&p, 0.3, 0.3);
+        let ScanCount { on, off, .. } = count(&p, 0.3, 0.3);
         assert_eq!(off, 0);
         assert!(on == 6 || on == 7, "{on}");
         // against the ramp: OFF
@@ -473,7 +572,7 @@ mod tests {
             x: 120.0,
             ..scan
         };
-        assert_eq!(count(&profile(&image, &back), 0.3, 0.3).0, 0);
+        assert_eq!(count(&profile(&image, &back), 0.3, 0.3).on, 0);
     }
 
     #[test]
@@ -520,6 +619,7 @@ mod tests {
                 off_per_px: r,
                 active_fraction: 1.0,
                 events_per_scan: r,
+                burst_fraction: f64::NAN,
             })
             .collect()
     }
@@ -579,11 +679,42 @@ mod tests {
             burn: 400,
             length: 900.0,
         };
-        let (on_sym, off_sym) = count(&p, 0.2, 0.2);
-        let (on_wide, off_wide) = count(&p, 0.2, 0.6);
+        let (sym, wide) = (count(&p, 0.2, 0.2), count(&p, 0.2, 0.6));
         // 18 rises and falls after the burn-in
-        assert_eq!((on_sym, off_sym), (72, 72));
-        assert_eq!((on_wide, off_wide), (54, 18));
+        assert_eq!((sym.on, sym.off), (72, 72));
+        assert_eq!((wide.on, wide.off), (54, 18));
+    }
+
+    #[test]
+    fn a_sharp_edge_fires_its_events_in_a_burst_and_a_gradient_spreads_them() {
+        // a step of 1.2 (four events of 0.3 within a pixel) against a ramp of 1.2 over
+        // 40 px (one event every 10 px), each scanned over 60 px at STEP_PX
+        let step: Vec<f32> = (0..240).map(|i| if i < 120 { 0.0 } else { 1.2 }).collect();
+        let ramp: Vec<f32> = (0..240)
+            .map(|i| (i as f32 * 0.25 / 40.0 * 1.2).min(1.2))
+            .collect();
+        let scan = |values: Vec<f32>| Profile {
+            times_s: (0..values.len()).map(|i| i as f64 * 1e-3).collect(),
+            values,
+            burn: 0,
+            length: 60.0,
+        };
+        let edge = count(&scan(step), 0.3, 0.3);
+        assert_eq!((edge.on, edge.pairs, edge.bursts), (4, 3, 3));
+        let gradient = count(&scan(ramp), 0.3, 0.3);
+        assert_eq!((gradient.on, gradient.pairs, gradient.bursts), (4, 3, 0));
+        // the refractory pixel's positions come from its crossing times: the same
+        assert_eq!(
+            count_refractory(&scan(vec![0.0; 1]), 0.3, 0.3, 1e-3),
+            ScanCount::default()
+        );
+        let slow = count_refractory(
+            &scan((0..240).map(|i| (i as f32 * 0.03).min(1.2)).collect()),
+            0.3,
+            0.3,
+            1e-4,
+        );
+        assert_eq!((slow.on, slow.pairs, slow.bursts), (4, 3, 0));
     }
 
     #[test]
@@ -596,13 +727,13 @@ mod tests {
             burn: 0,
             length: 25.0,
         };
+        let events = |c: ScanCount| (c.on, c.off);
         let ideal = count(&p, 0.1, 0.1);
-        assert_eq!(count_refractory(&p, 0.1, 0.1, 0.0), ideal);
+        assert_eq!(events(count_refractory(&p, 0.1, 0.1, 0.0)), events(ideal));
         // 1 ms < 2 ms between crossings: nothing lost, nothing delayed past the end
-        assert_eq!(count_refractory(&p, 0.1, 0.1, 1e-3), ideal);
+        assert_eq!(events(count_refractory(&p, 0.1, 0.1, 1e-3)), events(ideal));
         // 5 ms: one event per 5 ms over the 100 ms ramp (the first at 2 ms)
-        let (on, off) = count_refractory(&p, 0.1, 0.1, 5e-3);
-        assert_eq!((on, off), (20, 0));
-        assert!(ideal.0 >= 49, "{ideal:?}");
+        assert_eq!(events(count_refractory(&p, 0.1, 0.1, 5e-3)), (20, 0));
+        assert!(ideal.on >= 49, "{ideal:?}");
     }
 }
