@@ -580,7 +580,10 @@ pub fn eppps_of(
         match aps::prepare(&input, excluded, options) {
             Ok(p) => {
                 notes.extend(p.assumptions.iter().cloned());
-                Some(p.frames)
+                let known = !options.choose_response
+                    || options.frame_offset_dn.is_some()
+                    || p.offset.is_some();
+                Some((p.frames, known))
             }
             Err(e) => {
                 notes.push(format!("frames not used for the dynamics: {}", e.problem));
@@ -594,7 +597,8 @@ pub fn eppps_of(
         &eppps::EpppsInput {
             sensor: loaded.sensor,
             events: &loaded.events,
-            frames: prepared.as_ref(),
+            frames: prepared.as_ref().map(|(f, _)| f),
+            response_known: prepared.as_ref().is_some_and(|(_, known)| *known),
             excluded,
         },
         &eppps_options,

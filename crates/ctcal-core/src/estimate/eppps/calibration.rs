@@ -8,6 +8,8 @@
 use super::recording::RecordingRates;
 use super::scans::{BURN_IN_PX, Block, LogImage, Profile, STEP_PX, Scan, TILE_PX};
 use crate::estimate::frames::PreparedFrames;
+use crate::sim::log_response::LogMap;
+use crate::sim::params::LogResponse;
 use rand::{RngExt, SeedableRng};
 
 /// Blocks of scans per prior image.
@@ -57,11 +59,60 @@ pub fn prior_blocks(image: &LogImage, rates: &RecordingRates, seed: u64) -> Vec<
         .collect()
 }
 
+/// A log response the frames are read through: a map and the DN added before it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Response {
+    pub map: LogMap,
+    pub offset_dn: f32,
+}
+
+impl Response {
+    /// The frames' own (measured or given) response.
+    pub fn of(frames: &PreparedFrames) -> Self {
+        Response {
+            map: frames.log_map,
+            offset_dn: frames.offset,
+        }
+    }
+
+    /// The two ends of what sensors and simulators use where a recording does not measure
+    /// it: v2e's lin-log (linear below 20 DN, as an offset of about 20 DN would be;
+    /// DVS-Voltmeter fits `ln(DN + k2)` with k2 = 20-23 DN on a DAVIS346 and a DVS240) and a
+    /// pure log (ESIM's `ln(I + 0.001)`, 0.26 DN).
+    pub fn ends() -> [(Self, &'static str); 2] {
+        [
+            (
+                Response {
+                    map: LogMap::new(LogResponse::V2e, 0.001),
+                    offset_dn: 0.0,
+                },
+                "v2e's lin-log",
+            ),
+            (
+                Response {
+                    map: LogMap::new(LogResponse::Eps, 0.001),
+                    offset_dn: 0.0,
+                },
+                "a pure log ln(DN/255 + 0.001)",
+            ),
+        ]
+    }
+
+    #[inline]
+    fn log(&self, dn: f32) -> f32 {
+        self.map.apply(dn + self.offset_dn)
+    }
+}
+
 /// Every second pixel (in x and y) of the frames, each along its path through every run of
 /// consecutive used intervals where it is reliable: log intensity interpolated along the
 /// flow, sampled every quarter pixel of travel; burn-in along the first interval's flow
 /// backwards from the run's first frame.
-pub fn frame_profiles(frames: &PreparedFrames, excluded: &[bool]) -> Vec<Profile> {
+pub fn frame_profiles(
+    frames: &PreparedFrames,
+    excluded: &[bool],
+    response: &Response,
+) -> Vec<Profile> {
     let (w, h) = (frames.width, frames.height);
     let mut out = Vec::new();
     for y in (0..h).step_by(2) {
@@ -77,8 +128,8 @@ pub fn frame_profiles(frames: &PreparedFrames, excluded: &[bool]) -> Vec<Profile
                     out.extend(run.take());
                     continue;
                 }
-                let profile = run.get_or_insert_with(|| burn_in(frames, k, x, y));
-                extend(profile, frames, k, x, y);
+                let profile = run.get_or_insert_with(|| burn_in(frames, response, k, x, y));
+                extend(profile, frames, response, k, x, y);
             }
             out.extend(run);
         }
@@ -88,7 +139,7 @@ pub fn frame_profiles(frames: &PreparedFrames, excluded: &[bool]) -> Vec<Profile
 }
 
 /// A profile holding only the burn-in before frame `k` at (x, y).
-fn burn_in(frames: &PreparedFrames, k: usize, x: usize, y: usize) -> Profile {
+fn burn_in(frames: &PreparedFrames, response: &Response, k: usize, x: usize, y: usize) -> Profile {
     let (u, v) = frames.flows[k].as_ref().map_or((0.0, 0.0), |f| f.at(x, y));
     let norm = u.hypot(v).max(1e-6) as f64;
     let (dx, dy) = (u as f64 / norm, v as f64 / norm);
@@ -108,7 +159,7 @@ fn burn_in(frames: &PreparedFrames, k: usize, x: usize, y: usize) -> Profile {
         .map(|i| {
             let s = (burn - i) as f64 * STEP_PX;
             let dn = frame.sample_cubic((x as f64 + s * dx) as f32, (y as f64 + s * dy) as f32);
-            frames.log(dn.max(0.0))
+            response.log(dn.max(0.0))
         })
         .collect();
     Profile {
@@ -120,7 +171,14 @@ fn burn_in(frames: &PreparedFrames, k: usize, x: usize, y: usize) -> Profile {
 }
 
 /// Appends the pixel's samples over interval `k` (at most a quarter pixel apart).
-fn extend(profile: &mut Profile, frames: &PreparedFrames, k: usize, x: usize, y: usize) {
+fn extend(
+    profile: &mut Profile,
+    frames: &PreparedFrames,
+    response: &Response,
+    k: usize,
+    x: usize,
+    y: usize,
+) {
     let (u, v) = frames.flows[k].as_ref().map_or((0.0, 0.0), |f| f.at(x, y));
     let travel = u.hypot(v) as f64;
     let steps = ((travel / STEP_PX).ceil() as usize).clamp(1, 4000);
@@ -128,10 +186,29 @@ fn extend(profile: &mut Profile, frames: &PreparedFrames, k: usize, x: usize, y:
     for j in 0..=steps {
         let t = t0 + ((t1 - t0) as f64 * j as f64 / steps as f64) as crate::events::TimeUs;
         let t = t.min(t1 - 1);
-        if let Some(level) = frames.log_at(x as u16, y as u16, t) {
-            profile.values.push(level);
+        if let Some(dn) = frames.dn_at(x as u16, y as u16, t) {
+            profile.values.push(response.log(dn));
             profile.times_s.push(t as f64 * 1e-6);
         }
     }
     profile.length += travel;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The two ends of the response prior agree on a bright scene and part in a dim one: a
+    /// factor 2 in light is ln 2 = 0.693 through both at 100 -> 200 DN, but 15 -> 30 DN
+    /// crosses the lin-log's knee at 20 DN, 0.15 * 15 = 2.247 -> ln 30 = 3.401 (1.154),
+    /// against ln((30/255 + 0.001) / (15/255 + 0.001)) = 0.685 through the pure log.
+    #[test]
+    fn the_response_ends_agree_in_bright_light_and_part_in_the_dark() {
+        let [(lin_log, _), (pure, _)] = Response::ends();
+        let step = |r: &Response, a: f32, b: f32| (r.log(b) - r.log(a)) as f64;
+        assert!((step(&lin_log, 100.0, 200.0) - 2f64.ln()).abs() < 2e-3);
+        assert!((step(&pure, 100.0, 200.0) - 0.6919).abs() < 2e-3);
+        assert!((step(&lin_log, 15.0, 30.0) - 1.154).abs() < 2e-3);
+        assert!((step(&pure, 15.0, 30.0) - 0.6848).abs() < 2e-3);
+    }
 }

@@ -9,7 +9,9 @@
 //!    removes blank and static parts of the view;
 //! 2. the calibration ([`calibration`], [`scans`]): ideal pixels along line scans with the
 //!    recording's own travel and directions, through the recording's frames when it has them
-//!    (its contrast measured) and otherwise through natural images ([`prior`]), at 31
+//!    (its contrast measured, through the log response the events' timing measured, or
+//!    through both ends of what sensors use where it does not, [`calibration::Response`])
+//!    and otherwise through natural images ([`prior`]), at 31
 //!    thresholds from 0.03 to 9.5; without frames each image is read at the recording's
 //!    own sharpness, the blur at which its scans burst as often as the recording's events
 //!    do ([`sharpness`]);
@@ -74,6 +76,9 @@ pub struct EpppsInput<'a> {
     pub events: &'a EventChunk,
     /// The recording's frames, prepared (when it has frames and they are used).
     pub frames: Option<&'a PreparedFrames>,
+    /// Whether the frames' log response is known (given, or measured from the events'
+    /// timing): otherwise the frames are scanned through both ends of what sensors use.
+    pub response_known: bool,
     pub excluded: &'a [bool],
 }
 
@@ -127,7 +132,7 @@ pub fn estimate(
         refractory_s: refractory.as_ref().map_or(0.0, |e| e.edge_us * 1e-6),
     };
     progress("calibration scans (ON = OFF)", 0.3);
-    let basis = Basis::new(frames, &excluded, options);
+    let basis = Basis::new(frames, input.response_known, &excluded, options);
     let raw = basis.calibrate(&rates, pixel, None);
     let reading = basis.select(&raw, &rates);
     let selections = reading.as_ref().map(|r| &r.kept[..]);
@@ -258,6 +263,8 @@ fn refractory_edge(
 /// and floor (and what each of them is).
 struct Basis<'a> {
     frames: Option<&'a PreparedFrames>,
+    /// The log responses the frames are read through, and their names.
+    responses: Vec<(calibration::Response, String)>,
     excluded: &'a [bool],
     options: &'a EpppsOptions,
     priors: Vec<prior::PriorImage>,
@@ -271,9 +278,21 @@ const MIN_BURST_PAIRS: usize = 200;
 impl<'a> Basis<'a> {
     fn new(
         frames: Option<&'a PreparedFrames>,
+        response_known: bool,
         excluded: &'a [bool],
         options: &'a EpppsOptions,
     ) -> Self {
+        let responses = match frames {
+            Some(f) if response_known => vec![(
+                calibration::Response::of(f),
+                "the recording's frames".to_string(),
+            )],
+            Some(_) => calibration::Response::ends()
+                .into_iter()
+                .map(|(r, name)| (r, format!("the recording's frames through {name}")))
+                .collect(),
+            None => Vec::new(),
+        };
         let priors = match frames {
             Some(_) => Vec::new(),
             None => prior::images(options.scenes.max(1)),
@@ -281,6 +300,7 @@ impl<'a> Basis<'a> {
         let tags = priors.iter().map(prior::PriorImage::tag).collect();
         Basis {
             frames,
+            responses,
             excluded,
             options,
             priors,
@@ -299,15 +319,19 @@ impl<'a> Basis<'a> {
     ) -> Vec<Calibration> {
         let grid = threshold_grid();
         if let Some(f) = self.frames {
-            return vec![Calibration {
-                name: "the recording's frames".into(),
-                curve: curve(
-                    &calibration::frame_profiles(f, self.excluded),
-                    &grid,
-                    false,
-                    pixel,
-                ),
-            }];
+            return self
+                .responses
+                .iter()
+                .map(|(response, name)| Calibration {
+                    name: name.clone(),
+                    curve: curve(
+                        &calibration::frame_profiles(f, self.excluded, response),
+                        &grid,
+                        false,
+                        pixel,
+                    ),
+                })
+                .collect();
         }
         let scan = |images: &[&prior::PriorImage]| -> Vec<Calibration> {
             images
@@ -566,7 +590,13 @@ fn assumptions(
     ));
     if frames {
         out.push("calibration: ideal pixels along each pixel's own path through the frames (the scene's contrast measured); ON = OFF threshold in the scans".into());
-    } else {
+    }
+    if frames && calibrations.len() > 1 {
+        out.push(format!(
+            "log response of the frames not measured (the events' timing did not fix it) nor given: they are scanned through both ends of what sensors and simulators use, v2e's lin-log (linear below 20 DN, as an offset of about 20 DN; DVS-Voltmeter fits ln(DN + 20-23 DN)) and a pure log (ESIM's ln(I + 0.001)); the threshold is their geometric mean and their spread ({} calibrations) is in the interval; they differ where the scene is dim (give --log-response where the sensor's is known)",
+            calibrations.len()
+        ));
+    } else if !frames {
         out.push(format!(
             "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread between images is in the interval; a scene of unusual contrast (a printed pattern, a high-contrast lab scene, a smooth texture) moves the threshold with it",
         ));

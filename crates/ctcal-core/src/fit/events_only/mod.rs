@@ -305,6 +305,7 @@ fn thresholds(
             sensor: input.sensor,
             events: &fit_events,
             frames: None,
+            response_known: false,
             excluded: input.excluded,
         },
         &EpppsOptions {
