@@ -162,6 +162,10 @@ pub fn count(profile: &Profile, c_on: f32, c_off: f32) -> ScanCount {
     let mut out = ScanCount::default();
     let mut last = [None, None];
     for (i, &level) in profile.values.iter().enumerate() {
+        if level - reference < c_on && reference - level < c_off {
+            // most samples fire nothing: nothing else to do for them
+            continue;
+        }
         let counted = i > profile.burn;
         let travel = i as f64 * STEP_PX;
         while level - reference >= c_on {
