@@ -46,26 +46,45 @@ fn default_object_size() -> [f64; 2] {
 
 #[derive(Clone, Debug)]
 enum Shape {
-    Ellipse { rx: f64, ry: f64 },
-    Rectangle { hx: f64, hy: f64 },
-    Polygon { sides: u32, apothem: f64 },
+    Ellipse {
+        rx: f64,
+        ry: f64,
+    },
+    Rectangle {
+        hx: f64,
+        hy: f64,
+    },
+    /// A regular polygon; `normals` holds `(sin, cos)` of its edges' normal angles
+    /// `TAU k / sides`, computed once ([`Shape::polygon`]) instead of at every pixel.
+    Polygon {
+        sides: u32,
+        apothem: f64,
+        normals: Vec<(f64, f64)>,
+    },
 }
 
 impl Shape {
+    fn polygon(sides: u32, apothem: f64) -> Self {
+        let step = std::f64::consts::TAU / sides as f64;
+        let normals = (0..sides).map(|k| (step * k as f64).sin_cos()).collect();
+        Shape::Polygon {
+            sides,
+            apothem,
+            normals,
+        }
+    }
+
     /// Approximate signed distance (negative inside) in unscaled object units.
     fn distance(&self, qx: f64, qy: f64) -> f64 {
-        match *self {
-            Shape::Ellipse { rx, ry } => ((qx / rx).hypot(qy / ry) - 1.0) * rx.min(ry),
-            Shape::Rectangle { hx, hy } => (qx.abs() - hx).max(qy.abs() - hy),
-            Shape::Polygon { sides, apothem } => {
-                let step = std::f64::consts::TAU / sides as f64;
-                (0..sides)
-                    .map(|k| {
-                        let (s, c) = (step * k as f64).sin_cos();
-                        qx * c + qy * s - apothem
-                    })
-                    .fold(f64::NEG_INFINITY, f64::max)
-            }
+        match self {
+            &Shape::Ellipse { rx, ry } => ((qx / rx).hypot(qy / ry) - 1.0) * rx.min(ry),
+            &Shape::Rectangle { hx, hy } => (qx.abs() - hx).max(qy.abs() - hy),
+            Shape::Polygon {
+                apothem, normals, ..
+            } => normals
+                .iter()
+                .map(|&(s, c)| qx * c + qy * s - apothem)
+                .fold(f64::NEG_INFINITY, f64::max),
         }
     }
 
@@ -73,7 +92,7 @@ impl Shape {
         match *self {
             Shape::Ellipse { rx, ry } => rx.max(ry),
             Shape::Rectangle { hx, hy } => hx.hypot(hy),
-            Shape::Polygon { sides, apothem } => {
+            Shape::Polygon { sides, apothem, .. } => {
                 apothem / (std::f64::consts::PI / sides as f64).cos()
             }
         }
@@ -205,10 +224,7 @@ impl MultiObjectScene {
                     hx: size,
                     hy: size * aspect,
                 },
-                _ => Shape::Polygon {
-                    sides: rng.random_range(3..=8),
-                    apothem: size,
-                },
+                _ => Shape::polygon(rng.random_range(3..=8), size),
             };
             let texture = if images.is_empty() {
                 let params = TextureParams {
@@ -263,49 +279,92 @@ impl MultiObjectWorld {
         self.objects.len()
     }
 
-    /// Renders rows `rows` into `out` (those rows only).
+    /// Renders rows `rows` into `out` (those rows only): the background, then every object
+    /// over it in depth order. Coordinates are computed a row at a time and the textures
+    /// sampled along the row at once ([`Canvas::sample_many`]).
     pub fn render(&self, width: usize, rows: std::ops::Range<usize>, t: f64, out: &mut [f32]) {
+        let mut row = RowBuffers::new(width);
         // background: the image is the texture seen through the inverse of its motion
         let (centre, angle, scale) = self.background.pose(t);
         let (s, c) = angle.sin_cos();
-        let texture = &self.textures[0];
-        let first = rows.start;
-        for y in rows.clone() {
-            for x in 0..width {
-                let (dx, dy) = (x as f64 - centre[0], y as f64 - centre[1]);
-                let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                out[(y - first) * width + x] = texture.sample(qx, qy);
+        for (y, out) in rows.clone().zip(out.chunks_exact_mut(width)) {
+            let dy = y as f64 - centre[1];
+            for (x, (qx, qy)) in row.xs.iter_mut().zip(&mut row.ys).enumerate() {
+                let dx = x as f64 - centre[0];
+                (*qx, *qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
             }
+            self.textures[0].sample_many(&row.xs, &row.ys, out);
         }
         for object in &self.objects {
-            let (centre, angle, scale) = object.trajectory.pose(t);
-            let reach = object.shape.radius() * scale + 1.0;
-            let (x_lo, x_hi) = (
-                (centre[0] - reach).floor().max(0.0),
-                (centre[0] + reach).ceil().min(width as f64 - 1.0),
-            );
-            let (y_lo, y_hi) = (
-                (centre[1] - reach).floor().max(rows.start as f64),
-                (centre[1] + reach).ceil().min(rows.end as f64 - 1.0),
-            );
-            if x_lo > x_hi || y_lo > y_hi {
-                continue;
+            self.render_object(object, width, rows.clone(), t, &mut row, out);
+        }
+    }
+
+    /// Blends one object over rows `rows` of `out`, by its pixel coverage.
+    fn render_object(
+        &self,
+        object: &Object,
+        width: usize,
+        rows: std::ops::Range<usize>,
+        t: f64,
+        row: &mut RowBuffers,
+        out: &mut [f32],
+    ) {
+        let (centre, angle, scale) = object.trajectory.pose(t);
+        let reach = object.shape.radius() * scale + 1.0;
+        let (x_lo, x_hi) = (
+            (centre[0] - reach).floor().max(0.0),
+            (centre[0] + reach).ceil().min(width as f64 - 1.0),
+        );
+        let (y_lo, y_hi) = (
+            (centre[1] - reach).floor().max(rows.start as f64),
+            (centre[1] + reach).ceil().min(rows.end as f64 - 1.0),
+        );
+        if x_lo > x_hi || y_lo > y_hi {
+            return;
+        }
+        let (s, c) = angle.sin_cos();
+        let texture = &self.textures[object.texture];
+        let (x_lo, x_hi) = (x_lo as usize, x_hi as usize);
+        let span = x_hi - x_lo + 1;
+        for y in y_lo as usize..=y_hi as usize {
+            let dy = y as f64 - centre[1];
+            let points = row.xs[..span].iter_mut().zip(&mut row.ys[..span]);
+            for ((x, (px, py)), cover) in (x_lo..).zip(points).zip(&mut row.coverage) {
+                let dx = x as f64 - centre[0];
+                let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
+                *cover = (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
+                (*px, *py) = (qx + 64.0, qy + 64.0);
             }
-            let (s, c) = angle.sin_cos();
-            let texture = &self.textures[object.texture];
-            for y in y_lo as usize..=y_hi as usize {
-                for x in x_lo as usize..=x_hi as usize {
-                    let (dx, dy) = (x as f64 - centre[0], y as f64 - centre[1]);
-                    let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                    let coverage =
-                        (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
-                    if coverage > 0.0 {
-                        let value = texture.sample(qx + 64.0, qy + 64.0);
-                        let pixel = &mut out[(y - first) * width + x];
-                        *pixel += (value - *pixel) * coverage;
-                    }
+            texture.sample_many(&row.xs[..span], &row.ys[..span], &mut row.values[..span]);
+            let pixels = &mut out[(y - rows.start) * width + x_lo..][..span];
+            for ((pixel, &value), &coverage) in
+                pixels.iter_mut().zip(&row.values).zip(&row.coverage)
+            {
+                // the test keeps a pixel outside the object untouched (not even its sign of 0)
+                if coverage > 0.0 {
+                    *pixel += (value - *pixel) * coverage;
                 }
             }
+        }
+    }
+}
+
+/// A row's sample coordinates, object coverages and sampled values, reused from row to row.
+struct RowBuffers {
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    coverage: Vec<f32>,
+    values: Vec<f32>,
+}
+
+impl RowBuffers {
+    fn new(width: usize) -> Self {
+        Self {
+            xs: vec![0.0; width],
+            ys: vec![0.0; width],
+            coverage: vec![0.0; width],
+            values: vec![0.0; width],
         }
     }
 }
@@ -322,10 +381,7 @@ mod tests {
         let r = Shape::Rectangle { hx: 4.0, hy: 2.0 };
         assert_eq!(r.distance(4.0, 0.0), 0.0);
         assert_eq!(r.distance(6.0, 0.0), 2.0);
-        let square = Shape::Polygon {
-            sides: 4,
-            apothem: 3.0,
-        };
+        let square = Shape::polygon(4, 3.0);
         assert!((square.distance(3.0, 0.0)).abs() < 1e-9);
         assert!((square.radius() - 3.0 * 2f64.sqrt()).abs() < 1e-9);
     }
