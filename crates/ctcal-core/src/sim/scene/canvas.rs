@@ -203,16 +203,16 @@ impl Canvas {
     }
 
     /// `out[k] = self.sample(xs[k], ys[k])` for every `k`, to the bit: the hot loop of
-    /// rendering a scene, a row at a time. On a power-of-two canvas (every procedural one)
-    /// with an AVX2 CPU the wrap and split of the coordinates into cell and fraction run
-    /// vectorised over blocks of [`BLOCK`] points ([`cells`]), then the four neighbours are
-    /// read and blended; anywhere else each point is [`Self::sample`]d.
+    /// rendering a scene, a row at a time. With an AVX2 CPU the wrap and split of the
+    /// coordinates into cell and fraction run vectorised over blocks of [`BLOCK`] points
+    /// ([`cells`]), then the four neighbours are read and blended; without AVX2 (or on a
+    /// canvas over 2^15 px a side) each point is [`Self::sample`]d.
     pub fn sample_many(&self, xs: &[f64], ys: &[f64], out: &mut [f32]) {
         assert!(xs.len() == out.len() && ys.len() == out.len());
         // a NaN or a coordinate past 4e15 (see `wrap`) fails the comparison
         let in_range = |c: &[f64]| c.iter().fold(true, |ok, v| ok & (v.abs() < 4.0e15));
         // offsets into the canvas are u32: up to 2^15 a side
-        let vectorised = self.size.is_power_of_two() && self.size <= 1 << 15 && use_avx2();
+        let vectorised = self.size <= 1 << 15 && use_avx2();
         if !(vectorised && in_range(xs) && in_range(ys)) {
             for ((o, &x), &y) in out.iter_mut().zip(xs).zip(ys) {
                 *o = self.sample(x, y);
@@ -225,8 +225,8 @@ impl Canvas {
             .zip(ys.chunks(BLOCK))
             .zip(out.chunks_mut(BLOCK))
         {
-            // SAFETY: use_avx2() is true, so the CPU has AVX2; the canvas is a power of two
-            // up to 2^15 and every coordinate is finite and within 4e15 (checked above).
+            // SAFETY: use_avx2() is true, so the CPU has AVX2; the canvas is up to 2^15 px a
+            // side and every coordinate is finite and within 4e15 (checked above).
             unsafe {
                 cells(xs, self.size, 1, &mut column);
                 cells(ys, self.size, self.size, &mut row);
@@ -307,23 +307,31 @@ impl Cells {
     }
 }
 
-/// The cells of `coords` on a canvas of `size` (a power of two), offsets scaled by `stride`:
-/// [`wrap`] and the split of [`Canvas::sample`], the same operations on four lanes. The
-/// floor is `floor(x / n) + 0`: `wrap`'s truncation-and-correction is the floor, and it
-/// never gives `-0` (the `+ 0` turns `floor(-0) = -0` into `+0`, as `wrap` has it); `x / n`
-/// is `x * (1 / n)` exactly for a power of two.
+/// The cells of `coords` on a canvas of `size`, offsets scaled by `stride`: the wrap and
+/// split of [`Canvas::sample`] on four lanes, without libm's `fmod`.
+///
+/// The wrap is `r = x - n k` with `k = floor(x / n)` (`+ 0`, so never `-0`, as in [`wrap`]),
+/// then `r + n` where `r < 0`. For a power of two it is [`wrap`] (`x / n` exact, `r >= 0`).
+/// For any `n` up to 2^15 and `|x| < 2^52` it is `x.rem_euclid(n)` (up to the sign of a
+/// zero, which the blend cannot see): with `F = floor(x / n)` exactly, the rounded
+/// quotient's floor `k` is `F` or `F + 1` (rounding is monotone and `F` representable), `n k`
+/// is an exact integer, and `x - n F` (`x >= 0`, the remainder) and `x - n (F + 1)` (`x`'s
+/// `fmod` when `x < 0`, or minus the remainder's complement) are exact; `x - n F` for `x < 0`
+/// is the rounded `fmod + n` of `rem_euclid` itself, and `fmod + n` from `k = F + 1` is the
+/// same operation.
 ///
 /// # Safety
-/// The CPU must have AVX2; `size` must be a power of two up to 2^15 and every coordinate
-/// finite and smaller than 4e15 in magnitude (so the wrapped value is in `[0, size]`).
+/// The CPU must have AVX2; `size` must be at most 2^15 and every coordinate finite and
+/// smaller than 4e15 in magnitude (so the wrapped value is in `[0, size]`).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn cells(coords: &[f64], size: usize, stride: usize, out: &mut Cells) {
-    let (n, inverse) = (size as f64, 1.0 / size as f64);
+    let n = size as f64;
     let (size, stride) = (size as u32, stride as u32);
     let lanes = out.c0.iter_mut().zip(&mut out.c1).zip(&mut out.f);
     for (((c0, c1), f), &x) in lanes.zip(coords) {
-        let x = x - n * ((x * inverse).floor() + 0.0);
+        let x = x - n * ((x / n).floor() + 0.0);
+        let x = if x < 0.0 { x + n } else { x };
         // SAFETY: x is in [0, n], n <= 2^15 (the caller's contract)
         let i = unsafe { x.to_int_unchecked::<i32>() } as u32;
         *f = (x - i as f64) as f32;
@@ -411,6 +419,12 @@ mod tests {
         }
         points.push((-0.0, -0.0));
         points.push((-1e-20, 3.0 * n - 1e-13));
+        // far from the origin, up to the fast wrap's limit (4e15), then past it
+        for _ in 0..2_000 {
+            let far = rng.random_range(-3.99e15..3.99e15);
+            points.push((far, -far / 3.0));
+        }
+        points.extend([(4.1e15, 1.0), (1.0, -4.1e15), (-1e300, 1e300)]);
         (c, points)
     }
 

@@ -325,36 +325,38 @@ impl MultiObjectWorld {
         }
         let (s, c) = angle.sin_cos();
         let texture = &self.textures[object.texture];
-        let (x_lo, x_hi) = (x_lo as usize, x_hi as usize);
-        let span = x_hi - x_lo + 1;
         for y in y_lo as usize..=y_hi as usize {
             let dy = y as f64 - centre[1];
-            let points = row.xs[..span].iter_mut().zip(&mut row.ys[..span]);
-            for ((x, (px, py)), cover) in (x_lo..).zip(points).zip(&mut row.coverage) {
+            // the pixels the object covers, gathered (written at `m` always, kept where
+            // covered: no branch), then sampled at once and blended
+            let mut m = 0;
+            for x in x_lo as usize..=x_hi as usize {
                 let dx = x as f64 - centre[0];
                 let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                *cover = (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
-                (*px, *py) = (qx + 64.0, qy + 64.0);
+                let coverage = (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
+                (row.xs[m], row.ys[m]) = (qx + 64.0, qy + 64.0);
+                (row.coverage[m], row.column[m]) = (coverage, x);
+                m += usize::from(coverage > 0.0);
             }
-            texture.sample_many(&row.xs[..span], &row.ys[..span], &mut row.values[..span]);
-            let pixels = &mut out[(y - rows.start) * width + x_lo..][..span];
-            for ((pixel, &value), &coverage) in
-                pixels.iter_mut().zip(&row.values).zip(&row.coverage)
+            texture.sample_many(&row.xs[..m], &row.ys[..m], &mut row.values[..m]);
+            let line = &mut out[(y - rows.start) * width..][..width];
+            for ((&x, &value), &coverage) in
+                row.column[..m].iter().zip(&row.values).zip(&row.coverage)
             {
-                // the test keeps a pixel outside the object untouched (not even its sign of 0)
-                if coverage > 0.0 {
-                    *pixel += (value - *pixel) * coverage;
-                }
+                let pixel = &mut line[x];
+                *pixel += (value - *pixel) * coverage;
             }
         }
     }
 }
 
-/// A row's sample coordinates, object coverages and sampled values, reused from row to row.
+/// A row's sample coordinates, object coverages, their columns and sampled values, reused
+/// from row to row.
 struct RowBuffers {
     xs: Vec<f64>,
     ys: Vec<f64>,
     coverage: Vec<f32>,
+    column: Vec<usize>,
     values: Vec<f32>,
 }
 
@@ -364,6 +366,7 @@ impl RowBuffers {
             xs: vec![0.0; width],
             ys: vec![0.0; width],
             coverage: vec![0.0; width],
+            column: vec![0; width],
             values: vec![0.0; width],
         }
     }
