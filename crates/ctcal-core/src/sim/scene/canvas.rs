@@ -349,7 +349,7 @@ unsafe fn cells(_: &[f64], _: usize, _: usize, _: &mut Cells) {
 
 /// Whether [`Canvas::sample_many`] takes its vectorised path: when the CPU has AVX2, unless
 /// `CTCAL_SIMD=scalar` asks for the portable path (as the simulator's pixel pass does).
-fn use_avx2() -> bool {
+pub(super) fn use_avx2() -> bool {
     #[cfg(target_arch = "x86_64")]
     {
         static AVX2: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
