@@ -1,6 +1,8 @@
 //! Simulator throughput (input frames per second) at DAVIS240 and DAVIS346 sizes, ideal and
 //! with every effect, on one thread and on all threads. `examples/simulator_throughput.rs`
-//! prints the same matrix with events per second as a table.
+//! prints the same matrix with events per second as a table. The `render` group guards the
+//! scene renderers (one frame of every scene family of `calib/scenes`, on one thread), the
+//! hot loop of `simulate --scene`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use ctcal::sim::scene::SceneSpec;
@@ -63,5 +65,36 @@ fn simulator(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, simulator);
+/// One frame of each scene family, rendered on the calling thread (frames per second).
+fn render(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render");
+    group.throughput(Throughput::Elements(1));
+    for name in [
+        "texture_translation",
+        "texture_rotation_davis346",
+        "natural_image_rotation",
+        "checkerboard",
+        "multi_object_fast",
+        "multi_object_variety",
+    ] {
+        let path = std::path::PathBuf::from(format!("calib/scenes/{name}.toml"));
+        let spec = SceneSpec::from_file(&path).unwrap();
+        let scene = spec.realise().unwrap();
+        let hz = spec.render_hz(&scene);
+        let mut out = vec![0f32; spec.width * spec.height];
+        let mut k = 0u64;
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                // a new time every frame, over the scene's length
+                let t = (k % (spec.duration_s * hz) as u64) as f64 / hz;
+                k += 1;
+                scene.render(spec.width, spec.height, t, &mut out);
+                out[0]
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, simulator, render);
 criterion_main!(benches);

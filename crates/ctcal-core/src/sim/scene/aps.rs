@@ -38,7 +38,7 @@ pub fn render(
                 } else {
                     0.5
                 };
-                scene.render(width, height, t, &mut buffer);
+                scene.render_parallel(width, height, t, &mut buffer);
                 for (s, &b) in sum.iter_mut().zip(&buffer) {
                     *s += weight * b as f64;
                 }

@@ -46,25 +46,68 @@ fn default_object_size() -> [f64; 2] {
 
 #[derive(Clone, Debug)]
 enum Shape {
-    Ellipse { rx: f64, ry: f64 },
-    Rectangle { hx: f64, hy: f64 },
-    Polygon { sides: u32, apothem: f64 },
+    Ellipse {
+        rx: f64,
+        ry: f64,
+    },
+    Rectangle {
+        hx: f64,
+        hy: f64,
+    },
+    /// A regular polygon; `normals` holds `(sin, cos)` of its edges' normal angles
+    /// `TAU k / sides`, computed once ([`Shape::polygon`]) instead of at every pixel.
+    Polygon {
+        sides: u32,
+        apothem: f64,
+        normals: Vec<(f64, f64)>,
+    },
 }
 
 impl Shape {
+    fn polygon(sides: u32, apothem: f64) -> Self {
+        let step = std::f64::consts::TAU / sides as f64;
+        let normals = (0..sides).map(|k| (step * k as f64).sin_cos()).collect();
+        Shape::Polygon {
+            sides,
+            apothem,
+            normals,
+        }
+    }
+
     /// Approximate signed distance (negative inside) in unscaled object units.
+    #[cfg(test)]
     fn distance(&self, qx: f64, qy: f64) -> f64 {
-        match *self {
-            Shape::Ellipse { rx, ry } => ((qx / rx).hypot(qy / ry) - 1.0) * rx.min(ry),
-            Shape::Rectangle { hx, hy } => (qx.abs() - hx).max(qy.abs() - hy),
-            Shape::Polygon { sides, apothem } => {
-                let step = std::f64::consts::TAU / sides as f64;
-                (0..sides)
-                    .map(|k| {
-                        let (s, c) = (step * k as f64).sin_cos();
-                        qx * c + qy * s - apothem
-                    })
-                    .fold(f64::NEG_INFINITY, f64::max)
+        let mut d = [0.0];
+        self.distances(&[qx], &[qy], &mut d);
+        d[0]
+    }
+
+    /// [`Self::distance`] of the points `(qx[k], qy[k])` into `d[k]`: one shape's loop over
+    /// a row, so that it vectorises (a polygon takes its edges one at a time over the row,
+    /// each point's maximum in the same order as edge by edge).
+    #[inline(always)]
+    fn distances(&self, qx: &[f64], qy: &[f64], d: &mut [f64]) {
+        let points = d.iter_mut().zip(qx).zip(qy);
+        match self {
+            &Shape::Ellipse { rx, ry } => {
+                for ((d, qx), qy) in points {
+                    *d = ((qx / rx).hypot(qy / ry) - 1.0) * rx.min(ry);
+                }
+            }
+            &Shape::Rectangle { hx, hy } => {
+                for ((d, qx), qy) in points {
+                    *d = (qx.abs() - hx).max(qy.abs() - hy);
+                }
+            }
+            Shape::Polygon {
+                apothem, normals, ..
+            } => {
+                d.fill(f64::NEG_INFINITY);
+                for &(s, c) in normals {
+                    for ((d, qx), qy) in d.iter_mut().zip(qx).zip(qy) {
+                        *d = d.max(qx * c + qy * s - apothem);
+                    }
+                }
             }
         }
     }
@@ -73,7 +116,7 @@ impl Shape {
         match *self {
             Shape::Ellipse { rx, ry } => rx.max(ry),
             Shape::Rectangle { hx, hy } => hx.hypot(hy),
-            Shape::Polygon { sides, apothem } => {
+            Shape::Polygon { sides, apothem, .. } => {
                 apothem / (std::f64::consts::PI / sides as f64).cos()
             }
         }
@@ -205,10 +248,7 @@ impl MultiObjectScene {
                     hx: size,
                     hy: size * aspect,
                 },
-                _ => Shape::Polygon {
-                    sides: rng.random_range(3..=8),
-                    apothem: size,
-                },
+                _ => Shape::polygon(rng.random_range(3..=8), size),
             };
             let texture = if images.is_empty() {
                 let params = TextureParams {
@@ -263,49 +303,170 @@ impl MultiObjectWorld {
         self.objects.len()
     }
 
-    /// Renders rows `rows` into `out` (those rows only).
+    /// Renders rows `rows` into `out` (those rows only): the background, then every object
+    /// over it in depth order. Coordinates are computed a row at a time and the textures
+    /// sampled along the row at once ([`Canvas::sample_many`]).
     pub fn render(&self, width: usize, rows: std::ops::Range<usize>, t: f64, out: &mut [f32]) {
+        let mut row = RowBuffers::new(width);
         // background: the image is the texture seen through the inverse of its motion
         let (centre, angle, scale) = self.background.pose(t);
         let (s, c) = angle.sin_cos();
-        let texture = &self.textures[0];
-        let first = rows.start;
-        for y in rows.clone() {
-            for x in 0..width {
-                let (dx, dy) = (x as f64 - centre[0], y as f64 - centre[1]);
-                let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                out[(y - first) * width + x] = texture.sample(qx, qy);
+        for (y, out) in rows.clone().zip(out.chunks_exact_mut(width)) {
+            let dy = y as f64 - centre[1];
+            for (x, (qx, qy)) in row.xs.iter_mut().zip(&mut row.ys).enumerate() {
+                let dx = x as f64 - centre[0];
+                (*qx, *qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
             }
+            self.textures[0].sample_many(&row.xs, &row.ys, out);
         }
         for object in &self.objects {
-            let (centre, angle, scale) = object.trajectory.pose(t);
-            let reach = object.shape.radius() * scale + 1.0;
-            let (x_lo, x_hi) = (
-                (centre[0] - reach).floor().max(0.0),
-                (centre[0] + reach).ceil().min(width as f64 - 1.0),
-            );
-            let (y_lo, y_hi) = (
-                (centre[1] - reach).floor().max(rows.start as f64),
-                (centre[1] + reach).ceil().min(rows.end as f64 - 1.0),
-            );
-            if x_lo > x_hi || y_lo > y_hi {
-                continue;
+            self.render_object(object, width, rows.clone(), t, &mut row, out);
+        }
+    }
+
+    /// Blends one object over rows `rows` of `out`, by its pixel coverage.
+    fn render_object(
+        &self,
+        object: &Object,
+        width: usize,
+        rows: std::ops::Range<usize>,
+        t: f64,
+        row: &mut RowBuffers,
+        out: &mut [f32],
+    ) {
+        let (centre, angle, scale) = object.trajectory.pose(t);
+        let reach = object.shape.radius() * scale + 1.0;
+        let (x_lo, x_hi) = (
+            (centre[0] - reach).floor().max(0.0),
+            (centre[0] + reach).ceil().min(width as f64 - 1.0),
+        );
+        let (y_lo, y_hi) = (
+            (centre[1] - reach).floor().max(rows.start as f64),
+            (centre[1] + reach).ceil().min(rows.end as f64 - 1.0),
+        );
+        if x_lo > x_hi || y_lo > y_hi {
+            return;
+        }
+        let (s, c) = angle.sin_cos();
+        let texture = &self.textures[object.texture];
+        let (x_lo, span) = (x_lo as usize, (x_hi - x_lo) as usize + 1);
+        for y in y_lo as usize..=y_hi as usize {
+            let dy = y as f64 - centre[1];
+            let pose = Pose {
+                centre,
+                sin: s,
+                cos: c,
+                scale,
+            };
+            cover_row(&object.shape, &pose, dy, x_lo, span, row);
+            // the pixels the object covers, gathered (written at `m` always, kept where
+            // covered: no branch), then sampled at once and blended
+            let mut m = 0;
+            for i in 0..span {
+                let coverage = row.coverage[i];
+                (row.xs[m], row.ys[m]) = (row.qx[i] + 64.0, row.qy[i] + 64.0);
+                (row.coverage[m], row.column[m]) = (coverage, x_lo + i);
+                m += usize::from(coverage > 0.0);
             }
-            let (s, c) = angle.sin_cos();
-            let texture = &self.textures[object.texture];
-            for y in y_lo as usize..=y_hi as usize {
-                for x in x_lo as usize..=x_hi as usize {
-                    let (dx, dy) = (x as f64 - centre[0], y as f64 - centre[1]);
-                    let (qx, qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-                    let coverage =
-                        (0.5 - object.shape.distance(qx, qy) * scale).clamp(0.0, 1.0) as f32;
-                    if coverage > 0.0 {
-                        let value = texture.sample(qx + 64.0, qy + 64.0);
-                        let pixel = &mut out[(y - first) * width + x];
-                        *pixel += (value - *pixel) * coverage;
-                    }
-                }
+            texture.sample_many(&row.xs[..m], &row.ys[..m], &mut row.values[..m]);
+            let line = &mut out[(y - rows.start) * width..][..width];
+            for ((&x, &value), &coverage) in
+                row.column[..m].iter().zip(&row.values).zip(&row.coverage)
+            {
+                let pixel = &mut line[x];
+                *pixel += (value - *pixel) * coverage;
             }
+        }
+    }
+}
+
+/// An object's pose at one time: centre, rotation and scale.
+struct Pose {
+    centre: [f64; 2],
+    sin: f64,
+    cos: f64,
+    scale: f64,
+}
+
+/// The object-space points (`row.qx`, `row.qy`) and pixel coverages (`row.coverage`) of
+/// pixels `x_lo..x_lo + span` of the row at `dy` below the object's centre; with AVX2 when
+/// the CPU has it (the same operations, so the same bits).
+fn cover_row(shape: &Shape, pose: &Pose, dy: f64, x_lo: usize, span: usize, row: &mut RowBuffers) {
+    #[cfg(target_arch = "x86_64")]
+    if super::canvas::use_avx2() {
+        // SAFETY: use_avx2() is true only when the CPU has AVX2.
+        unsafe { cover_row_avx2(shape, pose, dy, x_lo, span, row) };
+        return;
+    }
+    cover_row_portable(shape, pose, dy, x_lo, span, row);
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn cover_row_avx2(
+    shape: &Shape,
+    pose: &Pose,
+    dy: f64,
+    x_lo: usize,
+    span: usize,
+    row: &mut RowBuffers,
+) {
+    cover_row_portable(shape, pose, dy, x_lo, span, row);
+}
+
+#[inline(always)]
+fn cover_row_portable(
+    shape: &Shape,
+    pose: &Pose,
+    dy: f64,
+    x_lo: usize,
+    span: usize,
+    row: &mut RowBuffers,
+) {
+    let Pose {
+        centre,
+        sin: s,
+        cos: c,
+        scale,
+    } = *pose;
+    let (qx, qy) = (&mut row.qx[..span], &mut row.qy[..span]);
+    // columns as i32 (a sensor is at most MAX_SIDE wide): the same f64, and a conversion
+    // AVX2 has
+    for ((x, qx), qy) in (x_lo as i32..).zip(qx.iter_mut()).zip(qy.iter_mut()) {
+        let dx = x as f64 - centre[0];
+        (*qx, *qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
+    }
+    let distance = &mut row.distance[..span];
+    shape.distances(qx, qy, distance);
+    for (coverage, d) in row.coverage.iter_mut().zip(distance.iter()) {
+        *coverage = (0.5 - d * scale).clamp(0.0, 1.0) as f32;
+    }
+}
+
+/// A row's object-space points, distances and coverages, the sample coordinates and columns
+/// of the covered pixels and their sampled values, reused from row to row.
+struct RowBuffers {
+    qx: Vec<f64>,
+    qy: Vec<f64>,
+    distance: Vec<f64>,
+    xs: Vec<f64>,
+    ys: Vec<f64>,
+    coverage: Vec<f32>,
+    column: Vec<usize>,
+    values: Vec<f32>,
+}
+
+impl RowBuffers {
+    fn new(width: usize) -> Self {
+        Self {
+            qx: vec![0.0; width],
+            qy: vec![0.0; width],
+            distance: vec![0.0; width],
+            xs: vec![0.0; width],
+            ys: vec![0.0; width],
+            coverage: vec![0.0; width],
+            column: vec![0; width],
+            values: vec![0.0; width],
         }
     }
 }
@@ -322,10 +483,7 @@ mod tests {
         let r = Shape::Rectangle { hx: 4.0, hy: 2.0 };
         assert_eq!(r.distance(4.0, 0.0), 0.0);
         assert_eq!(r.distance(6.0, 0.0), 2.0);
-        let square = Shape::Polygon {
-            sides: 4,
-            apothem: 3.0,
-        };
+        let square = Shape::polygon(4, 3.0);
         assert!((square.distance(3.0, 0.0)).abs() < 1e-9);
         assert!((square.radius() - 3.0 * 2f64.sqrt()).abs() < 1e-9);
     }

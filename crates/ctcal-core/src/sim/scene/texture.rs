@@ -77,13 +77,18 @@ impl TextureScene {
         );
         let gain = (self.mod_amp_ln * (std::f64::consts::TAU * self.mod_hz * t).sin()).exp() as f32;
         let (cx, cy) = ((width as f64 - 1.0) / 2.0, (height as f64 - 1.0) / 2.0);
-        let first = rows.start;
-        for y in rows {
+        // a row's coordinates first (the same expressions, so the same bits), then the canvas
+        // sampled along it at once
+        let (mut xs, mut ys) = (vec![0f64; width], vec![0f64; width]);
+        for (y, out) in rows.zip(out.chunks_exact_mut(width)) {
             let v = y as f64 - cy;
-            for x in 0..width {
+            for (x, (px, py)) in xs.iter_mut().zip(&mut ys).enumerate() {
                 let u = x as f64 - cx;
-                let value = canvas.sample(ox + c * u - s * v, oy + s * u + c * v);
-                out[(y - first) * width + x] = (value * gain).clamp(0.0, 255.0);
+                (*px, *py) = (ox + c * u - s * v, oy + s * u + c * v);
+            }
+            canvas.sample_many(&xs, &ys, out);
+            for value in out {
+                *value = (*value * gain).clamp(0.0, 255.0);
             }
         }
     }
