@@ -85,6 +85,8 @@ pub struct EpppsInput<'a> {
 /// One calibration curve: what it ran through, and the curve.
 struct Calibration {
     name: String,
+    /// The prior's photograph it scanned (`None`: the recording's frames).
+    image: Option<usize>,
     curve: Vec<CurvePoint>,
 }
 
@@ -324,6 +326,7 @@ impl<'a> Basis<'a> {
                 .iter()
                 .map(|(response, name)| Calibration {
                     name: name.clone(),
+                    image: None,
                     curve: curve(
                         &calibration::frame_profiles(f, self.excluded, response),
                         &grid,
@@ -338,6 +341,7 @@ impl<'a> Basis<'a> {
                 .par_iter()
                 .map(|image| Calibration {
                     name: image.label(),
+                    image: Some(image.image),
                     // one photograph's blurs and floors scan the same places (common
                     // random numbers): their differences are theirs alone
                     curve: scans::block_curve(
@@ -387,7 +391,8 @@ struct Polarity {
     /// Each calibration's threshold (`null` where it is only bounded by the grid's end).
     per_calibration: Vec<Option<f64>>,
     measured: Measured,
-    /// Standard deviation of ln C between calibrations (the prior's spread).
+    /// Standard deviation of ln C between calibrations (the prior's spread), widened to a
+    /// prediction for one more scene ([`prediction_scale`]).
     prior_ln_sd: f64,
     /// Calibrations the recording lies beyond the grid's top (fewer events than even the
     /// highest threshold makes) or bottom: the grid's end stands in for them, a bound, and
@@ -525,6 +530,8 @@ fn measure(
     } else {
         0.0
     };
+    let scale = prediction_scale(calibrations);
+    let prior_ln_sd = prior_ln_sd * scale;
     let value = mean.exp();
     let slope = calibrations
         .iter()
@@ -557,6 +564,22 @@ fn measure(
 }
 
 /// What the estimate assumed; `images`: the prior's images (0: the recording's frames).
+/// How much the spread between a prior's `k` photographs is widened to be a 95 %
+/// prediction interval for the recording's scene, one more draw from the scenes they
+/// stand for: `t(0.975, k - 1) sqrt(1 + 1/k) / 1.96` (1.42 for six images, 2.5 for three),
+/// the spread being measured on `k` of them and their mean taken; 1 for the recording's
+/// frames (no photographs: its calibrations bracket a response, they are not draws).
+fn prediction_scale(calibrations: &[Calibration]) -> f64 {
+    let mut images: Vec<usize> = calibrations.iter().filter_map(|c| c.image).collect();
+    images.sort_unstable();
+    images.dedup();
+    let k = images.len();
+    if k < 2 {
+        return 1.0;
+    }
+    crate::stats::jackknife::t95_scale(k) * (1.0 + 1.0 / k as f64).sqrt()
+}
+
 fn assumptions(
     rates: &RecordingRates,
     calibrations: &[Calibration],
@@ -598,7 +621,9 @@ fn assumptions(
         ));
     } else if !frames {
         out.push(format!(
-            "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread between images is in the interval; a scene of unusual contrast (a printed pattern, a high-contrast lab scene, a smooth texture) moves the threshold with it",
+            "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread is in the interval as a 95 % prediction interval for one more scene ({} images read: Student t with one degree of freedom fewer, and the spread of their mean, x {:.2} the spread); a scene of unusual contrast (a printed pattern, a high-contrast lab scene, a smooth texture) moves the threshold with it",
+            calibrations.iter().filter_map(|c| c.image).collect::<std::collections::BTreeSet<_>>().len(),
+            prediction_scale(calibrations),
         ));
         let (lo, hi) = prior::FLOOR_RANGE_OF_MEAN;
         out.push(format!(
@@ -712,6 +737,7 @@ fn report(
             "per_calibration_off": off.per_calibration,
             "prior_ln_sd_on": on.prior_ln_sd,
             "prior_ln_sd_off": off.prior_ln_sd,
+            "prior_prediction_scale": prediction_scale(calibrations),
             "z95": z95(),
         }),
     }];

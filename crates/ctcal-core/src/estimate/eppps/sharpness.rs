@@ -152,8 +152,10 @@ fn bracket(members: &[usize], at: &[f64], tags: &[PriorTag], share: f64) -> Sele
     }
 }
 
-/// Images that must reproduce the recording's burst share for the others to be left out.
-pub const MIN_MATCHING_IMAGES: usize = 2;
+/// Images that must reproduce the recording's burst share for the others to be left out:
+/// half of the prior's, so that the spread between those left is still measured (their
+/// prediction interval widens the spread 2.5x for three images, see `prediction_scale`).
+pub const MIN_MATCHING_IMAGES: usize = 3;
 
 /// The prior read at a recording's sharpness: the recording's burst share, every image and
 /// floor's selection, and those kept.
@@ -262,6 +264,7 @@ pub(super) fn mix(
                 .collect();
             let tag = tags[s.a];
             Calibration {
+                image: Some(tag.image),
                 name: format!(
                     "{} (blur {:.1} px, floor {:.1} % of its mean)",
                     tag.name,
@@ -336,7 +339,7 @@ mod tests {
             blur_px: 0.0,
             floor_of_mean: 0.1,
         };
-        let tags: Vec<PriorTag> = (0..3).map(tag).collect();
+        let tags: Vec<PriorTag> = (0..4).map(tag).collect();
         let pick = |a, reach| Selection {
             a,
             b: a,
@@ -344,31 +347,29 @@ mod tests {
             blur_px: 1.0,
             reach,
         };
-        // two images make the share: the third, burstier even at the widest blur, goes
-        let all = vec![
-            pick(0, Reach::Inside),
-            pick(1, Reach::Inside),
-            pick(2, Reach::Smoother),
-        ];
+        let inside = |k| pick(k, Reach::Inside);
+        // three images make the share: the fourth, burstier even at the widest blur, goes
+        let all = vec![inside(0), inside(1), inside(2), pick(3, Reach::Smoother)];
         let reading = Reading::new(0.5, 1000, all.clone(), &tags);
-        assert_eq!(reading.kept, all[..2].to_vec());
+        assert_eq!(reading.kept, all[..3].to_vec());
         assert!(
             reading
                 .describe()
-                .contains("1 of 3 make that share at no blur scanned")
+                .contains("1 of 4 make that share at no blur scanned")
         );
-        // one image alone is too few to judge the others by: every one stays, and the
+        // two images are too few to judge the others by: every one stays, and the
         // direction each reads is said
         let all = vec![
-            pick(0, Reach::Inside),
-            pick(1, Reach::Sharper),
-            pick(2, Reach::Smoother),
+            inside(0),
+            inside(1),
+            pick(2, Reach::Sharper),
+            pick(3, Reach::Smoother),
         ];
         let reading = Reading::new(0.5, 1000, all.clone(), &tags);
         assert_eq!(reading.kept, all);
         let text = reading.describe();
         assert!(
-            text.contains("1 of 3 are smoother than the recording even unblurred"),
+            text.contains("1 of 4 are smoother than the recording even unblurred"),
             "{text}"
         );
         assert!(text.contains("so they read it high"), "{text}");
