@@ -36,9 +36,10 @@ fn calibration_scans(c: &mut Criterion) {
         .expect("the unblurred middle floor");
     let grid = scans::threshold_grid();
     let blocks = blocks();
-    c.bench_function("eppps block_curve (20 blocks x 64 scans x 31 thresholds)", |b| {
-        b.iter(|| scans::block_curve(&image.log, &blocks, &grid, ScanPixel::SYMMETRIC))
-    });
+    c.bench_function(
+        "eppps block_curve (20 blocks x 64 scans x 31 thresholds)",
+        |b| b.iter(|| scans::block_curve(&image.log, &blocks, &grid, ScanPixel::SYMMETRIC)),
+    );
     let profile = scans::profile(&image.log, &blocks[0].corner);
     c.bench_function("eppps count (one 40 px profile, 31 thresholds)", |b| {
         b.iter(|| {
