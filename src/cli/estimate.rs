@@ -227,6 +227,11 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
             .assumptions
             .push("frames ignored (--ignore-frames)".into());
     }
+    for said in &mut estimate.assumptions {
+        if said.starts_with(eppps::RESPONSE_NOT_MEASURED) {
+            said.push_str("; give it with --log-response");
+        }
+    }
     present(&estimate, &loaded, common, &policy)
 }
 

@@ -47,6 +47,11 @@ use sharpness::{PriorTag, Reading, Selection};
 /// Six cases: a rough size, listed in `assumptions`.
 pub const METHOD_LN_SYSTEMATIC: f64 = 0.10;
 
+/// How the assumption begins that says the frames' log response was neither measured nor
+/// given (a caller may add how to give it).
+pub const RESPONSE_NOT_MEASURED: &str =
+    "log response of the frames not measured (the events' timing did not fix it) nor given";
+
 /// The fixed presets of the paper's Fig. 2.
 pub const PRESETS: [f64; 5] = [0.2, 0.5, 0.75, 1.0, 1.5];
 
@@ -570,14 +575,19 @@ fn measure(
 /// the spread being measured on `k` of them and their mean taken; 1 for the recording's
 /// frames (no photographs: its calibrations bracket a response, they are not draws).
 fn prediction_scale(calibrations: &[Calibration]) -> f64 {
-    let mut images: Vec<usize> = calibrations.iter().filter_map(|c| c.image).collect();
-    images.sort_unstable();
-    images.dedup();
-    let k = images.len();
+    let k = images_read(calibrations);
     if k < 2 {
         return 1.0;
     }
     crate::stats::jackknife::t95_scale(k) * (1.0 + 1.0 / k as f64).sqrt()
+}
+
+/// How many of the prior's photographs `calibrations` scanned.
+fn images_read(calibrations: &[Calibration]) -> usize {
+    let mut images: Vec<usize> = calibrations.iter().filter_map(|c| c.image).collect();
+    images.sort_unstable();
+    images.dedup();
+    images.len()
 }
 
 fn assumptions(
@@ -616,13 +626,13 @@ fn assumptions(
     }
     if frames && calibrations.len() > 1 {
         out.push(format!(
-            "log response of the frames not measured (the events' timing did not fix it) nor given: they are scanned through both ends of what sensors and simulators use, v2e's lin-log (linear below 20 DN, as an offset of about 20 DN; DVS-Voltmeter fits ln(DN + 20-23 DN)) and a pure log (ESIM's ln(I + 0.001)); the threshold is their geometric mean and their spread ({} calibrations) is in the interval; they differ where the scene is dim (give --log-response where the sensor's is known)",
+            "{RESPONSE_NOT_MEASURED}: they are scanned through both ends of what sensors and simulators use, v2e's lin-log (linear below 20 DN, as an offset of about 20 DN; DVS-Voltmeter fits ln(DN + 20-23 DN)) and a pure log (ESIM's ln(I + 0.001)); the threshold is their geometric mean and their spread ({} calibrations) is in the interval; they differ where the scene is dim (a response given where the sensor's is known replaces them)",
             calibrations.len()
         ));
     } else if !frames {
         out.push(format!(
             "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread is in the interval as a 95 % prediction interval for one more scene ({} images read: Student t with one degree of freedom fewer, and the spread of their mean, x {:.2} the spread); a scene of unusual contrast (a printed pattern, a high-contrast lab scene, a smooth texture) moves the threshold with it",
-            calibrations.iter().filter_map(|c| c.image).collect::<std::collections::BTreeSet<_>>().len(),
+            images_read(calibrations),
             prediction_scale(calibrations),
         ));
         let (lo, hi) = prior::FLOOR_RANGE_OF_MEAN;

@@ -83,8 +83,7 @@ pub(super) fn select(
         .iter()
         .map(|t| (t.image, t.floor_of_mean.to_bits()))
         .collect();
-    groups.dedup();
-    groups.sort();
+    groups.sort_unstable();
     groups.dedup();
     groups
         .into_iter()
@@ -181,7 +180,6 @@ impl Reading {
             .filter(|s| s.reach == Reach::Inside)
             .collect();
         let mut images: Vec<usize> = inside.iter().map(|s| tags[s.a].image).collect();
-        images.dedup();
         images.sort_unstable();
         images.dedup();
         let kept = if images.len() >= MIN_MATCHING_IMAGES {
