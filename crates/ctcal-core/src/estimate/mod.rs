@@ -19,6 +19,7 @@ pub mod image;
 pub mod interval;
 pub mod lsq;
 pub mod resim;
+pub mod root;
 pub mod screen;
 pub mod timing;
 

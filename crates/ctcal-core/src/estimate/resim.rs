@@ -18,11 +18,12 @@
 
 use super::EstimateError;
 use super::frames::PreparedFrames;
+use super::root::{Crossing, Search, threshold_root};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::sim::source::ReplaySamples;
 use crate::sim::{PixelMaps, PixelParams, Sample};
 use crate::stats::support::supported;
-use argmin::core::{CostFunction, Error as ArgminError, Executor};
+use argmin::core::{CostFunction, Error as ArgminError};
 use serde::Serialize;
 
 /// Side of the count tiles, pixels (before they grow for sparse recordings).
@@ -235,6 +236,40 @@ pub fn log_ratio(real: &[u32], simulated: &[u32]) -> f64 {
     *ratios.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
+/// How far one polarity's per-cell counts lie from the simulation's at the fitted
+/// thresholds, over the cells with at least 5 real events.
+#[derive(Clone, Copy, Debug)]
+pub struct CellSpread {
+    /// The median |ln((s + 0.5) / (r + 0.5))|.
+    pub median_abs_log_ratio: f64,
+    /// The relative standard error of the threshold: the median log ratio moves 1:1 with
+    /// ln(threshold), and the standard error of a median is 1.2533 sigma / sqrt(n), with
+    /// sigma = 1.4826 x the median absolute ratio (its MAD about the fitted 0).
+    pub relative_standard_error: f64,
+    pub cells: usize,
+}
+
+/// The [`CellSpread`] of `real` against `simulated`; `None` when no cell holds 5 events
+/// (the spread cannot be measured).
+pub fn cell_spread(real: &[u32], simulated: &[u32]) -> Option<CellSpread> {
+    let mut logs: Vec<f64> = real
+        .iter()
+        .zip(simulated)
+        .filter(|(r, _)| **r >= 5)
+        .map(|(&r, &s)| ((s as f64 + 0.5) / (r as f64 + 0.5)).ln().abs())
+        .collect();
+    let cells = logs.len();
+    if cells == 0 {
+        return None;
+    }
+    let median_abs_log_ratio = *logs.select_nth_unstable_by(cells / 2, f64::total_cmp).1;
+    Some(CellSpread {
+        median_abs_log_ratio,
+        relative_standard_error: 1.2533 * 1.4826 * median_abs_log_ratio / (cells as f64).sqrt(),
+        cells,
+    })
+}
+
 /// Simulates the upsampled runs with `params`, all events together.
 pub fn simulate(
     runs: &[Vec<Sample>],
@@ -331,10 +366,14 @@ impl CostFunction for Mismatch<'_, '_> {
     }
 }
 
+/// How far the re-simulation's thresholds may move from the start (the timing estimate)
+/// before the frames are taken not to explain the events.
+const MAX_CHANGE: f64 = 0.6;
+
 /// Fits `Cp` and `Cn` from `start` (e.g. the timing estimate), with frozen mismatch
-/// `sigma` (a fixed seed, so the same pixels at every evaluation). Two rounds of a Brent
-/// root search per polarity, each from a bracket around the current value, widened until
-/// the mismatch changes sign.
+/// `sigma` (a fixed seed, so the same pixels at every evaluation). Two rounds of a root
+/// search per polarity ([`super::root`]), each walking from the current value, the first in
+/// steps from 8 %, the second from 3 %, at most [`MAX_CHANGE`] away.
 pub fn fit(
     resim: &Resimulation,
     start: (f64, f64),
@@ -356,64 +395,39 @@ pub fn fit(
                 on,
             };
             let current = estimate[slot];
-            let mut width = if round == 0 { 0.08 } else { 0.03 };
-            let bracket = loop {
-                let (lo, hi) = (current * (1.0 - width), current * (1.0 + width));
-                let cost = |c: f64| {
-                    problem
-                        .cost(&c)
-                        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
-                };
-                let (f_lo, f_hi) = (cost(lo)?, cost(hi)?);
-                if f_lo >= 0.0 && f_hi <= 0.0 {
-                    break Some((lo, hi));
-                }
-                if width > 0.6 {
-                    break None;
-                }
-                width *= 2.0;
+            let search = Search {
+                first_log_step: if round == 0 { 0.08 } else { 0.03 },
+                limits: [current * (1.0 - MAX_CHANGE), current * (1.0 + MAX_CHANGE)],
+                relative_tolerance: 0.002,
+                max_iterations: 20,
             };
-            let Some((lo, hi)) = bracket else {
-                return Err(EstimateError::new(
-                    format!(
-                        "the re-simulated {} counts do not cross the real ones for thresholds within 60 % of {current:.3}",
-                        if on { "ON" } else { "OFF" }
-                    ),
-                    "the frames do not explain the events (check the frame times and exposure, or use `estimate eppps`)",
-                ));
+            let cost = |c: f64| {
+                problem
+                    .cost(&c)
+                    .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
             };
-            let solver = argmin::solver::brent::BrentRoot::new(lo, hi, 0.002 * current);
-            let result = Executor::new(problem, solver)
-                .configure(|state| state.param(current).max_iters(20))
-                .run()
-                .map_err(|e| {
-                    EstimateError::new(
-                        format!("the re-simulation fit failed: {e}"),
-                        "report this as a bug",
-                    )
-                })?;
-            estimate[slot] = result.state.best_param.unwrap_or(current);
+            estimate[slot] = match threshold_root(cost, current, &search)? {
+                Crossing::Root(c) => c,
+                Crossing::Beyond { .. } => {
+                    return Err(EstimateError::new(
+                        format!(
+                            "the re-simulated {} counts do not cross the real ones for thresholds within {:.0} % of {current:.3}",
+                            if on { "ON" } else { "OFF" },
+                            100.0 * MAX_CHANGE
+                        ),
+                        "the frames do not explain the events (check the frame times and exposure, or use `estimate eppps`)",
+                    ));
+                }
+            };
         }
     }
     base.ct_on = estimate[0];
     base.ct_off = estimate[1];
     let simulated = resim.counts(&base)?;
     let spread = |r: &[u32], s: &[u32]| {
-        let mut logs: Vec<f64> = r
-            .iter()
-            .zip(s)
-            .filter(|(r, _)| **r >= 5)
-            .map(|(&r, &s)| ((s as f64 + 0.5) / (r as f64 + 0.5)).ln().abs())
-            .collect();
-        if logs.is_empty() {
-            return (0.0, 0.0, 0);
-        }
-        let n = logs.len();
-        let mid = n / 2;
-        let mad = *logs.select_nth_unstable_by(mid, f64::total_cmp).1;
-        // the median log ratio moves 1:1 with ln(threshold); its standard error is
-        // 1.2533 * (1.4826 * MAD) / sqrt(n)
-        (mad, 1.2533 * 1.4826 * mad / (n as f64).sqrt(), n)
+        cell_spread(r, s).map_or((0.0, 0.0, 0), |c| {
+            (c.median_abs_log_ratio, c.relative_standard_error, c.cells)
+        })
     };
     let (mismatch_on, se_on, cells) = spread(&resim.real.on, &simulated.on);
     let (mismatch_off, se_off, _) = spread(&resim.real.off, &simulated.off);

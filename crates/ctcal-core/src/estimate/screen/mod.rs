@@ -38,7 +38,8 @@ pub mod register;
 mod tests;
 
 use super::interval::Measured;
-use super::resim::{Cells, Counts, Intervals, log_ratio};
+use super::resim::{Cells, Counts, Intervals, cell_spread, log_ratio};
+use super::root::{Crossing, Search, threshold_root};
 use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::hint::{Hint, Text};
@@ -48,7 +49,6 @@ use crate::sim::screen_geometry::ScreenWarp;
 use crate::sim::source::{DisplaySource, MemoryFrames};
 use crate::sim::{DisplayParams, PixelMaps, PixelParams};
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
-use argmin::solver::brent::BrentRoot;
 use argmin::solver::neldermead::NelderMead;
 use located::Located;
 use nalgebra::DVector;
@@ -292,59 +292,56 @@ impl Setup<'_> {
         Ok(self.cells.count(&events))
     }
 
-    /// Brent roots of the ON and OFF median log ratios, the display fixed.
+    /// The roots of the ON and OFF median log ratios ([`super::root`]), the display fixed.
     fn thresholds(
         &self,
         start: (f64, f64),
         display: Option<&DisplayParams>,
     ) -> Result<(f64, f64), EstimateError> {
         let mut ct = [start.0, start.1];
-        {
-            for slot in 0..2 {
-                let problem = Root {
-                    setup: self,
-                    display,
-                    other: ct[1 - slot],
-                    on: slot == 0,
-                };
-                let current = ct[slot];
-                let cost = |c: f64| {
-                    problem
-                        .cost(&c)
-                        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
-                };
-                let mut width: f64 = 0.3;
-                let bracket = loop {
-                    let (lo, hi) = (
-                        current * (1.0 - width).max(0.05),
-                        current * (1.0 + 3.0 * width),
-                    );
-                    if cost(lo)? >= 0.0 && cost(hi)? <= 0.0 {
-                        break Some((lo, hi));
-                    }
-                    if width > 0.9 {
-                        break None;
-                    }
-                    width = (width * 1.8).min(0.95);
-                };
-                let Some((lo, hi)) = bracket else {
+        for slot in 0..2 {
+            let problem = Root {
+                setup: self,
+                display,
+                other: ct[1 - slot],
+                on: slot == 0,
+            };
+            let cost = |c: f64| {
+                problem
+                    .cost(&c)
+                    .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
+            };
+            let search = Search {
+                first_log_step: 0.25,
+                limits: THRESHOLD_LIMITS,
+                relative_tolerance: 0.002,
+                max_iterations: 25,
+            };
+            ct[slot] = match threshold_root(cost, ct[slot], &search)? {
+                Crossing::Root(c) => c,
+                Crossing::Beyond { reached, too_many } => {
                     return Err(EstimateError::new(
-                        "the simulated stimulus makes too few or too many events for every threshold tried",
+                        format!(
+                            "the simulated stimulus makes {} {} events than the recording even at a threshold of {reached} (the {} tried)",
+                            if too_many { "more" } else { "fewer" },
+                            if slot == 0 { "ON" } else { "OFF" },
+                            if too_many { "largest" } else { "smallest" },
+                        ),
                         "check that the stimulus is the one the recording shows",
                     ));
-                };
-                let result = Executor::new(problem, BrentRoot::new(lo, hi, 0.002 * current))
-                    .configure(|s| s.param(current).max_iters(25))
-                    .run()
-                    .map_err(|e| {
-                        EstimateError::new(format!("threshold fit: {e}"), "report this as a bug")
-                    })?;
-                ct[slot] = result.state.best_param.unwrap_or(current);
-            }
+                }
+            };
         }
         Ok((ct[0], ct[1]))
     }
 }
+
+/// The thresholds the stimulus may be simulated at: below 0.03 a black-white transition
+/// fires some 180 events per pixel (the simulation's cost grows with them), above 6 one
+/// event takes a 400-fold change of light; thresholds in use lie far inside (v2e's presets
+/// 0.2-0.5, Hu et al. 2021). A recording that needs a threshold outside is refused with the
+/// side it lies on.
+const THRESHOLD_LIMITS: [f64; 2] = [0.03, 6.0];
 
 /// The median log ratio of one polarity as a function of its threshold.
 struct Root<'a, 'b> {
@@ -558,21 +555,10 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             / prior.ends_in_sigmas()
     };
     let simulated = setup.counts(fitted, Some(&display))?;
+    // no cell holding 5 events: the spread cannot be measured, nor the threshold's
+    // uncertainty
     let standard_error = |r: &[u32], s: &[u32], c: f64| {
-        let mut logs: Vec<f64> = r
-            .iter()
-            .zip(s)
-            .filter(|(r, _)| **r >= 5)
-            .map(|(&r, &s)| ((s as f64 + 0.5) / (r as f64 + 0.5)).ln().abs())
-            .collect();
-        if logs.is_empty() {
-            // no cell holds 5 events: the spread cannot be measured, so neither can the
-            // threshold's uncertainty
-            return f64::NAN;
-        }
-        let mid = logs.len() / 2;
-        let mad = *logs.select_nth_unstable_by(mid, f64::total_cmp).1;
-        c * 1.2533 * 1.4826 * mad / (logs.len() as f64).sqrt()
+        cell_spread(r, s).map_or(f64::NAN, |spread| c * spread.relative_standard_error)
     };
     let on = Measured::new(
         fitted.0,
