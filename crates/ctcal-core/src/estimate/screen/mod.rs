@@ -336,6 +336,9 @@ impl Setup<'_> {
     }
 }
 
+/// The pixel model of the simulations, and what leaving the photoreceptor's lag out does.
+const IDEAL_PIXELS: &str = "ideal pixels (no mismatch, noise or photoreceptor lag), v2e lin-log response; a photoreceptor's bandwidth falls with its light, so in a screen's black squares it is many times slower than in white, and a recording whose pixels lag there reads too large thresholds (on the coverage study's on-screen draws with a 17-140 Hz cutoff at white: 1.4-2.6 times the truth, outside the intervals; not yet measured or corrected)";
+
 /// The thresholds the stimulus may be simulated at: below 0.03 a black-white transition
 /// fires some 180 events per pixel (the simulation's cost grows with them), above 6 one
 /// event takes a 400-fold change of light; thresholds in use lie far inside (v2e's presets
@@ -599,7 +602,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             display.gamma,
         ),
         prior.says(),
-        "ideal pixels (no mismatch, noise or bandwidth); v2e lin-log response".into(),
+        IDEAL_PIXELS.into(),
     ]);
     if hot > 0 {
         estimate
