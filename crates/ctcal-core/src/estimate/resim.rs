@@ -20,6 +20,7 @@ use super::EstimateError;
 use super::frames::PreparedFrames;
 use super::root::{Crossing, Search, threshold_root};
 use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::hint::{Analysis, Hint, Text};
 use crate::sim::source::ReplaySamples;
 use crate::sim::{PixelMaps, PixelParams, Sample};
 use crate::stats::support::supported;
@@ -415,7 +416,9 @@ pub fn fit(
                             if on { "ON" } else { "OFF" },
                             100.0 * MAX_CHANGE
                         ),
-                        "the frames do not explain the events (check the frame times and exposure, or use `estimate eppps`)",
+                        Text::from("the frames do not explain the events (check the frame times and exposure, or use ")
+                            .name(Hint::Analysis(Analysis::Eppps))
+                            .words(")"),
                     ));
                 }
             };

@@ -58,16 +58,35 @@ pub fn threshold_root(
     let [lowest, highest] = search.limits;
     let start = start.clamp(lowest, highest);
     let at_start = cached.value(start)?;
-    if at_start == 0.0 {
-        return Ok(Crossing::Root(plateau_middle(
-            &cached,
-            start,
-            (start, start),
-            search,
-        )?));
-    }
+    let (root, ends) = if at_start == 0.0 {
+        (start, (start, start))
+    } else {
+        let (lo, hi) = match bracket(&cached, start, at_start > 0.0, search)? {
+            Ok(bracket) => bracket,
+            Err(beyond) => return Ok(beyond),
+        };
+        let root = if cached.value(lo)? == 0.0 {
+            lo
+        } else if cached.value(hi)? == 0.0 {
+            hi
+        } else {
+            brent(&cached, (lo, hi), start, search)?
+        };
+        (root, (lo, hi))
+    };
+    Ok(Crossing::Root(plateau_middle(&cached, root, ends, search)?))
+}
+
+/// The walk from `start` (where `f` is positive when `too_many`) to the first probe where
+/// `f` is 0 or changes sign: the bracket `(lo, hi)`, or [`Crossing::Beyond`] at a limit.
+fn bracket<F: Fn(f64) -> Result<f64, EstimateError>>(
+    cached: &Cached<F>,
+    start: f64,
+    too_many: bool,
+    search: &Search,
+) -> Result<Result<(f64, f64), Crossing>, EstimateError> {
+    let [lowest, highest] = search.limits;
     // f > 0: too many simulated events, so the threshold must grow
-    let too_many = at_start > 0.0;
     let (limit, direction) = if too_many {
         (highest, 1.0)
     } else {
@@ -75,41 +94,34 @@ pub fn threshold_root(
     };
     let mut previous = start;
     let mut step = search.first_log_step;
-    let next = loop {
+    loop {
         if previous == limit {
-            return Ok(Crossing::Beyond {
+            return Ok(Err(Crossing::Beyond {
                 reached: limit,
                 too_many,
-            });
+            }));
         }
-        let probe = (previous.ln() + direction * step).exp();
-        let probe = if too_many {
-            probe.min(limit)
-        } else {
-            probe.max(limit)
-        };
+        let probe = (previous.ln() + direction * step)
+            .exp()
+            .clamp(lowest, highest);
         let value = cached.value(probe)?;
-        if value == 0.0 {
-            return Ok(Crossing::Root(plateau_middle(
-                &cached,
-                probe,
-                (previous, probe),
-                search,
-            )?));
-        }
-        if (value > 0.0) != too_many {
-            break probe;
+        if value == 0.0 || (value > 0.0) != too_many {
+            return Ok(Ok((previous.min(probe), previous.max(probe))));
         }
         previous = probe;
         step *= 2.0;
-    };
-    let (lo, hi) = if previous < next {
-        (previous, next)
-    } else {
-        (next, previous)
-    };
+    }
+}
+
+/// Brent's root of `f` within `(lo, hi)`, where it changes sign.
+fn brent<F: Fn(f64) -> Result<f64, EstimateError>>(
+    cached: &Cached<F>,
+    (lo, hi): (f64, f64),
+    start: f64,
+    search: &Search,
+) -> Result<f64, EstimateError> {
     let solver = BrentRoot::new(lo, hi, search.relative_tolerance * start);
-    let result = Executor::new(&cached, solver)
+    let result = Executor::new(cached, solver)
         .configure(|state| state.param(start).max_iters(search.max_iterations))
         .run()
         .map_err(|e| {
@@ -118,13 +130,7 @@ pub fn threshold_root(
                 "report this as a bug",
             )
         })?;
-    let root = result.state.best_param.unwrap_or(0.5 * (lo + hi));
-    Ok(Crossing::Root(plateau_middle(
-        &cached,
-        root,
-        (lo, hi),
-        search,
-    )?))
+    Ok(result.state.best_param.unwrap_or(0.5 * (lo + hi)))
 }
 
 /// The middle of the plateau of zeros `root` lies on (`root` itself where `f(root)` is not
