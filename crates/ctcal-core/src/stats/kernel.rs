@@ -49,19 +49,18 @@ pub(super) struct Settings {
     pub window_us: TimeUs,
 }
 
-/// Hints the cache to load `value` (no effect on results; a no-op off x86-64).
+/// Hints the cache to load the memory at `address` (no effect on results; a no-op off
+/// x86-64). Takes a pointer rather than a reference so that the caller needs no bounds
+/// check to name it: a prefetch never faults, whatever the address.
 #[inline(always)]
-fn prefetch<T>(value: &T) {
+fn prefetch<T>(address: *const T) {
     #[cfg(target_arch = "x86_64")]
     // SAFETY: prefetching is a hint and never faults, whatever the address.
     unsafe {
-        std::arch::x86_64::_mm_prefetch(
-            value as *const T as *const i8,
-            std::arch::x86_64::_MM_HINT_T0,
-        );
+        std::arch::x86_64::_mm_prefetch(address as *const i8, std::arch::x86_64::_MM_HINT_T0);
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
+    let _ = address;
 }
 
 /// Cell indices of the events (`indices` is scratch, reused between chunks).
@@ -107,15 +106,18 @@ pub(super) fn accumulate<const SELECTED: bool>(
     let mut window_end = windows.end;
     let mut window_count = windows.count;
     const AHEAD: usize = 16;
+    // the addresses to prefetch are computed, not indexed: with six bounds checks an
+    // event the kernel took 15-25 % longer
+    let base = cells.as_ptr();
     for (i, (&t, &k)) in ts.iter().zip(indices).enumerate() {
         if let Some(&ahead) = indices.get(i + AHEAD) {
             let ahead = ahead as usize;
-            prefetch(&cells[ahead - stride - 1]);
-            prefetch(&cells[ahead - stride + 1]);
-            prefetch(&cells[ahead - 1]);
-            prefetch(&cells[ahead + 1]);
-            prefetch(&cells[ahead + stride - 1]);
-            prefetch(&cells[ahead + stride + 1]);
+            prefetch(base.wrapping_add(ahead - stride - 1));
+            prefetch(base.wrapping_add(ahead - stride + 1));
+            prefetch(base.wrapping_add(ahead - 1));
+            prefetch(base.wrapping_add(ahead + 1));
+            prefetch(base.wrapping_add(ahead + stride - 1));
+            prefetch(base.wrapping_add(ahead + stride + 1));
         }
         let k = k as usize;
         let newest = newest_neighbour(cells, k, stride);
