@@ -485,6 +485,37 @@ fn screen_finds_thresholds_far_from_where_it_starts() {
         // the display's gamma and white are not measured: within a factor 2
         assert!((v / truth).ln().abs() < 2f64.ln(), "{key} {v} for {truth}");
     }
+    // ideal pixels (the draw has no photoreceptor cutoff): no lag read into its timing
+    assert!(
+        e["photoreceptor"]["cutoff_hz"].is_null(),
+        "{}",
+        e["photoreceptor"]
+    );
+}
+
+/// Coverage draw 36: a photoreceptor cutoff of 20.3 Hz at 255 DN (2 Hz in the black
+/// squares), which ideal pixels read as thresholds 1.13 / 2.27 for a true 0.64 / 0.86.
+#[test]
+fn screen_measures_the_photoreceptors_lag_and_matches_the_thresholds_with_it() {
+    use ctcal::coverage::{CaseSpec, write_case};
+    let case = CaseSpec::draw(36);
+    assert_eq!(case.params.cutoff_hz, Some(20.3268));
+    let dir = tempfile::tempdir().unwrap();
+    write_case(&case, dir.path()).expect("the case is written");
+    let e = json(&["estimate", "screen", dir.path().to_str().unwrap()]);
+    let lag = &e["photoreceptor"];
+    let cutoff = lag["cutoff_hz"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no lag: {lag}"));
+    assert!((5.0..80.0).contains(&cutoff), "cutoff {cutoff} Hz for 20.3");
+    for (key, truth) in [("ct_on", 0.640784), ("ct_off", 0.864748)] {
+        let v = e[key].as_f64().unwrap();
+        let ideal = lag[format!("ideal_pixels_{key}")].as_f64().unwrap();
+        assert!(
+            (v / truth).ln().abs() < 0.8 * (ideal / truth).ln().abs(),
+            "{key} {v} (ideal pixels {ideal}) for {truth}: not nearer"
+        );
+    }
 }
 
 #[test]

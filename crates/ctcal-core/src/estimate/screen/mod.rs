@@ -27,10 +27,15 @@
 //!    at its centre and, from a dim and a bright white, at both ends; the best fit is
 //!    reported, and the spread of the fits that explain the counts as well is in the
 //!    intervals. A measured screen model (`--screen`) fixes white and gamma within +-0.1.
+//! 4. lag: a photoreceptor slowed in the black squares fires fewer events than ideal pixels
+//!    and reads too large thresholds; its cutoff is measured from when the events come
+//!    after the refreshes and the changes ([`lag`]), and the thresholds are matched again
+//!    through the fitted display with that photoreceptor.
 
 mod coarse;
 pub mod dlt;
 mod images;
+pub mod lag;
 pub mod located;
 mod matching;
 pub mod register;
@@ -214,17 +219,32 @@ struct Setup<'a> {
     refresh_hz: f64,
     /// The screen seen at an angle (`None`: 1:1).
     warp: Option<std::sync::Arc<ScreenWarp>>,
+    /// The photoreceptor's cutoff at 255 camera DN ([`lag`]; `None`: ideal pixels).
+    cutoff_hz: Option<f64>,
     evaluations: std::sync::atomic::AtomicUsize,
 }
 
 impl Setup<'_> {
     /// Counts simulated with thresholds and a display (`None`: the naive simulation, the
-    /// stimulus values as the camera's).
+    /// stimulus values as the camera's), with the setup's photoreceptor.
     fn counts(
         &self,
         ct: (f64, f64),
         display: Option<&DisplayParams>,
     ) -> Result<Counts, EstimateError> {
+        Ok(self
+            .cells
+            .count(&self.events_at(ct, display, self.cutoff_hz)?))
+    }
+
+    /// The events simulated with thresholds, a display and the photoreceptor's cutoff at
+    /// 255 camera DN (`None`: ideal pixels).
+    fn events_at(
+        &self,
+        ct: (f64, f64),
+        display: Option<&DisplayParams>,
+        cutoff_hz: Option<f64>,
+    ) -> Result<EventChunk, EstimateError> {
         self.evaluations
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let bug = |e: crate::sim::SimError| {
@@ -252,7 +272,10 @@ impl Setup<'_> {
             Some(_) => MemoryFrames::new(self.input.stimulus, Transition::Hold),
         }
         .map_err(bug)?;
-        let params = PixelParams::ideal(ct.0, ct.1);
+        let params = PixelParams {
+            cutoff_hz,
+            ..PixelParams::ideal(ct.0, ct.1)
+        };
         let mut events = EventChunk::default();
         let mut sink = |chunk: &EventChunk| -> Result<(), crate::sim::SimError> {
             events.extend_from(chunk);
@@ -289,7 +312,7 @@ impl Setup<'_> {
             }
         }
         events.sort_by_time();
-        Ok(self.cells.count(&events))
+        Ok(events)
     }
 
     /// The roots of the ON and OFF median log ratios ([`super::root`]), the display fixed.
@@ -335,9 +358,6 @@ impl Setup<'_> {
         Ok((ct[0], ct[1]))
     }
 }
-
-/// The pixel model of the simulations, and what leaving the photoreceptor's lag out does.
-const IDEAL_PIXELS: &str = "ideal pixels (no mismatch, noise or photoreceptor lag), v2e lin-log response; a photoreceptor's bandwidth falls with its light, so in a screen's black squares it is many times slower than in white, and a recording whose pixels lag there reads too large thresholds (on the coverage study's on-screen draws with a 17-140 Hz cutoff at white: 1.4-2.6 times the truth, outside the intervals; not yet measured or corrected)";
 
 /// The thresholds the stimulus may be simulated at: below 0.03 a black-white transition
 /// fires some 180 events per pixel (the simulation's cost grows with them), above 6 one
@@ -518,6 +538,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         offset_us,
         refresh_hz,
         warp: located.warp.clone(),
+        cutoff_hz: None,
         evaluations: std::sync::atomic::AtomicUsize::new(0),
     };
     progress("naive estimate (no display model)", 0.1);
@@ -547,13 +568,59 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     };
     progress("refining the thresholds", 0.8);
     let fitted = setup.thresholds((best.param[0].exp(), best.param[1].exp()), Some(&display))?;
+    let ideal = fitted;
+    progress(
+        "measuring the photoreceptor's lag from the events' timing",
+        0.85,
+    );
+    let clock = lag::RefreshClock {
+        start_us: offset_us + input.stimulus[0].t,
+        period_us: period,
+        end_us: offset_us
+            + input.stimulus[0].t
+            + (input.stimulus.len() as f64 * period).round() as TimeUs,
+    };
+    let width = sensor.0;
+    let keep =
+        |i: usize| !excluded[input.events.y[i] as usize * width + input.events.x[i] as usize];
+    let included: Vec<bool> = excluded.iter().map(|&e| !e).collect();
+    let histogram = lag::PhaseHistogram::of(input.events, clock, keep);
+    let recorded = lag::Recorded {
+        events: input.events,
+        histogram: &histogram,
+        clock,
+        included: &included,
+        sensor,
+        noise_max: lag::noise_share_bound(
+            input.events,
+            input.sensor,
+            (2.0 * period).max(5_000.0) as TimeUs,
+            keep,
+        ),
+    };
+    let lag_profile = lag::profile(&setup, &recorded, fitted, Some(&display))?;
+    // the display was fitted with ideal pixels; the thresholds are matched again through
+    // it with the photoreceptor that lags
+    let (setup, fitted) = match lag_profile.cutoff_hz() {
+        Some(cutoff) => {
+            let slow = Setup {
+                cutoff_hz: Some(cutoff),
+                ..setup
+            };
+            let ct = slow.thresholds(fitted, Some(&display))?;
+            (slow, ct)
+        }
+        None => (setup, fitted),
+    };
     let variants = fits.compatible();
     // the fits as good as the best span the prior's effect: their largest change is the
     // systematic (see `GammaPrior::ends_in_sigmas`)
-    let spread = |pick: fn(&(f64, f64)) -> f64, value: f64| -> f64 {
+    // (the fits were made with ideal pixels: their spread is taken about the ideal pixels'
+    // thresholds and scaled to the final ones)
+    let spread = |pick: fn(&(f64, f64)) -> f64, value: f64, ideal: f64| -> f64 {
         variants
             .iter()
-            .map(|v| (pick(v) - value).abs())
+            .map(|v| (pick(v) - ideal).abs() * value / ideal)
             .fold(0.0, f64::max)
             / prior.ends_in_sigmas()
     };
@@ -566,12 +633,12 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     let on = Measured::new(
         fitted.0,
         standard_error(&setup.real.on, &simulated.on, fitted.0),
-        spread(|v| v.0, fitted.0),
+        spread(|v| v.0, fitted.0, ideal.0).hypot(lag::CORRECTION_SYSTEMATIC * (fitted.0 - ideal.0)),
     );
     let off = Measured::new(
         fitted.1,
         standard_error(&setup.real.off, &simulated.off, fitted.1),
-        spread(|v| v.1, fitted.1),
+        spread(|v| v.1, fitted.1, ideal.1).hypot(lag::CORRECTION_SYSTEMATIC * (fitted.1 - ideal.1)),
     );
     let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
     let naive_ct = 0.5 * (naive.0 + naive.1);
@@ -602,7 +669,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             display.gamma,
         ),
         prior.says(),
-        IDEAL_PIXELS.into(),
+        lag_profile.says(),
     ]);
     if hot > 0 {
         estimate
@@ -620,6 +687,9 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             "naive_ct_on": naive.0,
             "naive_ct_off": naive.1,
             "display_fits": fits.json(),
+            "lag": lag_profile.json(),
+            "cutoff_hz": setup.cutoff_hz,
+            "ideal_pixels_ct": [ideal.0, ideal.1],
             "simulations": setup.evaluations.load(std::sync::atomic::Ordering::Relaxed),
         }),
     }];
@@ -635,6 +705,14 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         }),
     );
     estimate.extra.insert("naive_ct".into(), json!(naive_ct));
+    estimate.extra.insert(
+        "photoreceptor".into(),
+        json!({
+            "cutoff_hz": setup.cutoff_hz,
+            "ideal_pixels_ct_on": ideal.0,
+            "ideal_pixels_ct_off": ideal.1,
+        }),
+    );
     estimate.extra.insert("registration".into(), located.json());
     estimate.extra.insert(
         "display_explains".into(),
