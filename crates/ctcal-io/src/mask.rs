@@ -1,4 +1,4 @@
-//! Pixel masks (`--mask FILE`): a PNG image or a NumPy `.npy` array (H x W, row = y) of the
+//! Pixel masks (a file of the pixels to keep): a PNG image or a NumPy `.npy` array (H x W, row = y) of the
 //! sensor's size; a non-zero value keeps the pixel.
 
 use super::error::InputError;

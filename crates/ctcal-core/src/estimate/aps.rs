@@ -57,7 +57,7 @@ pub struct ApsOptions {
     pub choose_response: bool,
     pub frames: FrameOptions,
     pub timing: TimingOptions,
-    /// The exposure, where the file gives none (`--exposure-s`).
+    /// The exposure, where the file gives none (the user's setting).
     pub exposure_us: Option<TimeUs>,
     /// Shift to add to the frames' times, seconds; `None`: found from the data
     /// ([`super::align`]).

@@ -143,7 +143,7 @@ pub struct SequenceStats {
     /// mask or exclusion was applied), and what was applied.
     pub pixels_kept: u64,
     pub selection: String,
-    /// Hot pixels left out before measuring (`--exclude-hot-pixels`), as a first pass found
+    /// Hot pixels left out before measuring (the caller's choice), as a first pass found
     /// them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub excluded_hot_pixels: Vec<HotPixel>,

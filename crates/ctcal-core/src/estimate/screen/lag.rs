@@ -76,15 +76,17 @@ pub struct PhaseHistogram {
 }
 
 impl PhaseHistogram {
-    /// The histogram of `events` whose pixel `keep` accepts, within the clock's span.
-    pub fn of(events: &EventChunk, clock: RefreshClock, keep: impl Fn(usize) -> bool) -> Self {
+    /// The histogram of `events` at `included` pixels (row-major, `width` wide), within the
+    /// clock's span.
+    pub fn of(events: &EventChunk, clock: RefreshClock, included: &[bool], width: usize) -> Self {
         let mut h = PhaseHistogram {
             on: [0; BINS],
             off: [0; BINS],
         };
         for i in 0..events.len() {
             let t = events.t[i];
-            if t < clock.start_us || t >= clock.end_us || !keep(i) {
+            let pixel = events.y[i] as usize * width + events.x[i] as usize;
+            if t < clock.start_us || t >= clock.end_us || !included[pixel] {
                 continue;
             }
             let phase = ((t - clock.start_us) as f64 / clock.period_us).fract();
@@ -349,12 +351,13 @@ pub fn noise_share_bound(
     events: &EventChunk,
     sensor: Sensor,
     window_us: TimeUs,
-    keep: impl Fn(usize) -> bool,
+    included: &[bool],
 ) -> f64 {
     let supported = crate::stats::support::supported_two_sided(events, sensor, window_us);
+    let width = sensor.width as usize;
     let (mut kept, mut isolated) = (0usize, 0usize);
     for (i, &s) in supported.iter().enumerate() {
-        if keep(i) {
+        if included[events.y[i] as usize * width + events.x[i] as usize] {
             kept += 1;
             isolated += usize::from(!s);
         }
@@ -449,14 +452,37 @@ impl LagProfile {
     }
 }
 
-/// What the profile compares against.
+/// What the profile compares against: the recording's events at the included pixels,
+/// their phase histogram and the bound of their flat share.
 pub(super) struct Recorded<'a> {
-    pub events: &'a EventChunk,
-    pub histogram: &'a PhaseHistogram,
-    pub clock: RefreshClock,
-    pub included: &'a [bool],
-    pub sensor: (usize, usize),
-    pub noise_max: f64,
+    events: &'a EventChunk,
+    histogram: PhaseHistogram,
+    clock: RefreshClock,
+    included: Vec<bool>,
+    sensor: (usize, usize),
+    noise_max: f64,
+}
+
+impl<'a> Recorded<'a> {
+    /// `events` at the `included` pixels; isolated events are those without a neighbour
+    /// within two refresh periods (at least 5 ms) either side.
+    pub fn new(
+        events: &'a EventChunk,
+        clock: RefreshClock,
+        included: Vec<bool>,
+        sensor: Sensor,
+    ) -> Self {
+        let width = sensor.width as usize;
+        let window_us = (2.0 * clock.period_us).max(5_000.0) as TimeUs;
+        Self {
+            histogram: PhaseHistogram::of(events, clock, &included, width),
+            noise_max: noise_share_bound(events, sensor, window_us, &included),
+            events,
+            clock,
+            included,
+            sensor: (width, sensor.height as usize),
+        }
+    }
 }
 
 /// The recording's delays and what the simulations' are compared with.
@@ -471,11 +497,8 @@ impl Reference<'_> {
     /// The match of simulated `events` made at `cutoff_hz`.
     fn point(&self, cutoff_hz: Option<f64>, events: &EventChunk) -> LagPoint {
         let r = self.recorded;
-        let width = r.sensor.0;
-        let phases = PhaseHistogram::of(events, r.clock, |i| {
-            r.included[events.y[i] as usize * width + events.x[i] as usize]
-        });
-        let delays = self.changes.histogram(events, r.included);
+        let phases = PhaseHistogram::of(events, r.clock, &r.included, r.sensor.0);
+        let delays = self.changes.histogram(events, &r.included);
         let period = r.clock.period_us;
         LagPoint {
             cutoff_hz,
@@ -502,10 +525,10 @@ pub(super) fn profile(
         recorded.clock,
         recorded.sensor,
         super::TILE_PX,
-        recorded.included,
+        &recorded.included,
     );
     let reference = Reference {
-        delays: changes.histogram(recorded.events, recorded.included),
+        delays: changes.histogram(recorded.events, &recorded.included),
         flat: changes.flat(),
         changes,
         recorded,
@@ -622,7 +645,7 @@ mod tests {
             period_us: 10_000.0,
             end_us: 101_000,
         };
-        let h = PhaseHistogram::of(&events, clock, |_| true);
+        let h = PhaseHistogram::of(&events, clock, &[true], 1);
         assert_eq!(h.on[0], 1);
         assert_eq!(h.on[1], 1);
         assert_eq!(h.off[0], 1);

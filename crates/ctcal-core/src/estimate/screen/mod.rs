@@ -26,7 +26,8 @@
 //!    ends where its start leads it), so gamma is a prior ([`GammaPrior`]): the fit is made
 //!    at its centre and, from a dim and a bright white, at both ends; the best fit is
 //!    reported, and the spread of the fits that explain the counts as well is in the
-//!    intervals. A measured screen model (`--screen`) fixes white and gamma within +-0.1.
+//!    intervals. A measured screen model (its photometered gamma and white) fixes white
+//!    and gamma within +-0.1.
 //! 4. lag: a photoreceptor slowed in the black squares fires fewer events than ideal pixels
 //!    and reads too large thresholds; its cutoff is measured from when the events come
 //!    after the refreshes and the changes ([`lag`]), and the thresholds are matched again
@@ -580,24 +581,8 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             + input.stimulus[0].t
             + (input.stimulus.len() as f64 * period).round() as TimeUs,
     };
-    let width = sensor.0;
-    let keep =
-        |i: usize| !excluded[input.events.y[i] as usize * width + input.events.x[i] as usize];
-    let included: Vec<bool> = excluded.iter().map(|&e| !e).collect();
-    let histogram = lag::PhaseHistogram::of(input.events, clock, keep);
-    let recorded = lag::Recorded {
-        events: input.events,
-        histogram: &histogram,
-        clock,
-        included: &included,
-        sensor,
-        noise_max: lag::noise_share_bound(
-            input.events,
-            input.sensor,
-            (2.0 * period).max(5_000.0) as TimeUs,
-            keep,
-        ),
-    };
+    let included = excluded.iter().map(|&e| !e).collect();
+    let recorded = lag::Recorded::new(input.events, clock, included, input.sensor);
     let lag_profile = lag::profile(&setup, &recorded, fitted, Some(&display))?;
     // the display was fitted with ideal pixels; the thresholds are matched again through
     // it with the photoreceptor that lags
