@@ -886,4 +886,15 @@ mod tests {
         let m = model::mode(&values, 0.25).unwrap();
         assert!((m - 0.30).abs() < 0.01, "{m}");
     }
+
+    #[test]
+    fn the_mode_is_the_largest_peak_when_the_median_lies_in_a_smaller_one() {
+        // 520 noise samples over 0.06-0.12 and 480 threshold samples at 0.33-0.37: the
+        // median (0.12) lies in the noise, whose window holds fewer samples than the
+        // threshold's; mean shift from the median alone ends at 0.09
+        let mut values: Vec<f64> = (0..520).map(|i| 0.06 + 0.06 * (i as f64 / 520.0)).collect();
+        values.extend((0..480).map(|i| 0.33 + 0.04 * (i as f64 / 480.0)));
+        let m = model::mode(&values, 0.25).unwrap();
+        assert!((m - 0.35).abs() < 0.01, "{m}");
+    }
 }

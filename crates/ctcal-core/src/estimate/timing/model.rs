@@ -108,18 +108,43 @@ pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
     Values { y, level, lag }
 }
 
-/// The mode of positive `values`: from the median, repeatedly the mean within the window.
+/// The mode of positive `values`: mean shift (repeatedly the mean within the relative
+/// window) from the median and from every decile, the converged point whose window holds
+/// the most values. Mean shift climbs to the nearest density peak (Fukunaga & Hostetler,
+/// "The estimation of the gradient of a density function", 1975); from several starts the
+/// largest peak wins. From the median alone it climbed to a peak of noise samples below the
+/// threshold's when the median lay between them (a rotating natural image, OFF: 0.097 for
+/// 0.35, half the samples rejected).
 pub fn mode(values: &[f64], window: f64) -> Option<f64> {
     let mut sorted: Vec<f64> = values.iter().copied().filter(|v| *v > 0.0).collect();
     if sorted.len() < 10 {
         return None;
     }
     sorted.sort_by(f64::total_cmp);
-    let mut m = sorted[sorted.len() / 2];
+    let within = |m: f64| -> usize {
+        let a = sorted.partition_point(|&v| v < m * (1.0 - window));
+        let b = sorted.partition_point(|&v| v <= m * (1.0 + window));
+        b.saturating_sub(a)
+    };
+    let n = sorted.len();
+    let starts = std::iter::once(n / 2).chain((1..10).map(|decile| (decile * n / 10).min(n - 1)));
+    let mut best: Option<(f64, usize)> = None;
+    for start in starts {
+        let m = mean_shift(&sorted, sorted[start], window);
+        let held = within(m);
+        if best.is_none_or(|(_, most)| held > most) {
+            best = Some((m, held));
+        }
+    }
+    best.map(|(m, _)| m)
+}
+
+/// Mean shift over `sorted` values from `m`: the mean of the values within `m (1 +- window)`
+/// until it stops moving (at most 50 steps).
+fn mean_shift(sorted: &[f64], mut m: f64, window: f64) -> f64 {
     for _ in 0..50 {
-        let (lo, hi) = (m * (1.0 - window), m * (1.0 + window));
-        let a = sorted.partition_point(|&v| v < lo);
-        let b = sorted.partition_point(|&v| v <= hi);
+        let a = sorted.partition_point(|&v| v < m * (1.0 - window));
+        let b = sorted.partition_point(|&v| v <= m * (1.0 + window));
         if b <= a {
             break;
         }
@@ -130,7 +155,7 @@ pub fn mode(values: &[f64], window: f64) -> Option<f64> {
             break;
         }
     }
-    Some(m)
+    m
 }
 
 /// Which pairs are kept: within the window around their polarity's mode. `None` when a
