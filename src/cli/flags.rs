@@ -10,7 +10,8 @@ pub fn flag(hint: &Hint) -> String {
         Hint::Sensor(None) => "--sensor WxH".into(),
         Hint::Sensor(Some(sensor)) => format!("--sensor {sensor}"),
         Hint::Force => "--force".into(),
-        Hint::Sort => "--sort".into(),
+        // only `stats` and `convert` sort; the other commands read a sorted copy
+        Hint::Sort => "--sort (of `ctcal stats` or `ctcal convert`; for the other commands write a sorted copy first: `ctcal convert INPUT --out SORTED --sort`)".into(),
         Hint::Format(None) => "--format".into(),
         Hint::Format(Some(format)) => format!("--format {format}"),
         Hint::TimeWindow => "--start/--end".into(),

@@ -567,19 +567,7 @@ impl EventStream {
                     path: self.path.clone(),
                 });
             }
-            let order = self.decoder.order();
-            if order.backwards > 0
-                && !self.allow_unsorted
-                && let Some((place, previous_us, t_us)) = order.first.clone()
-            {
-                return Err(InputError::Unsorted {
-                    path: self.path.clone(),
-                    count: order.backwards,
-                    place,
-                    previous_us,
-                    t_us,
-                });
-            }
+            self.check_order()?;
             return Ok(None);
         }
         self.events += self.chunk.len() as u64;
@@ -588,6 +576,25 @@ impl EventStream {
             self.max_y = self.max_y.max(y);
         }
         Ok(Some(&self.chunk))
+    }
+
+    /// An error if the events read so far went back in time (unless unsorted events are
+    /// allowed): checked at the end of the stream, and by a reader that stops early.
+    pub fn check_order(&self) -> Result<(), InputError> {
+        let order = self.decoder.order();
+        if order.backwards > 0
+            && !self.allow_unsorted
+            && let Some((place, previous_us, t_us)) = order.first.clone()
+        {
+            return Err(InputError::Unsorted {
+                path: self.path.clone(),
+                count: order.backwards,
+                place,
+                previous_us,
+                t_us,
+            });
+        }
+        Ok(())
     }
 
     /// The chunk the last [`Self::next_chunk`] returned.

@@ -361,6 +361,8 @@ fn each_chunk(
         let progress = stream.progress();
         observer.reading(progress.done, progress.total);
         if chunk.t.last().is_some_and(|&t| t > to) {
+            // the events read must be in order even where the reading stops early
+            stream.check_order()?;
             break;
         }
     }
