@@ -59,14 +59,16 @@ fn with_a_corrupted_recording() -> &'static (tempfile::TempDir, PathBuf, Option<
 #[test]
 fn a_corrupted_recording_is_listed_and_the_others_are_written() {
     let (_work, out, code, stderr) = with_a_corrupted_recording();
+    // the recording failed on its input: exit 2, its error (with the fix) repeated
     assert_eq!(
         *code,
-        Some(1),
-        "exit 1 when some recordings failed: {stderr}"
+        Some(2),
+        "exit 2 when some recordings failed on their input: {stderr}"
     );
     assert!(
         stderr.contains("1 of 3 recordings could not be reported")
-            && stderr.contains("broken_ijrr"),
+            && stderr.contains("broken_ijrr: ")
+            && stderr.contains("fix:"),
         "{stderr}"
     );
     let r = read_json(&out.join("results.json"));

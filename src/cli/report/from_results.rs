@@ -39,5 +39,6 @@ pub(super) fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
         ))
         .into());
     }
-    super::finish(args, global, &report, staged)
+    // failures carried over from the reports gathered: their kind is not known here
+    super::finish(args, global, &report, staged, false)
 }

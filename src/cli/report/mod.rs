@@ -62,7 +62,8 @@ pub struct ReportArgs {
     pub selection: SelectionArgs,
 }
 
-/// Some recordings could not be reported (the others were): exit code 1.
+/// Some recordings could not be reported (the others were), ctcal failing on one: exit
+/// code 1.
 #[derive(Debug, thiserror::Error)]
 #[error("{0}")]
 pub struct SomeFailed(pub String);
@@ -142,7 +143,9 @@ pub fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
     let mut merged = Vec::new();
     let mut first_error = None;
     let mut any = false;
+    let mut all_bad_input = true;
     for (input, outcome) in inputs.iter().zip(outcomes.sequences) {
+        all_bad_input &= !matches!(outcome, Err(SequenceError::Panic(_)));
         let outcome = outcome.map_err(hinted).map_err(|e| {
             let message = super::flags::message(&e);
             first_error.get_or_insert(e);
@@ -164,16 +167,18 @@ pub fn run(args: &ReportArgs, global: &Global) -> anyhow::Result<()> {
             .chain(std::env::args().skip(1))
             .collect(),
     );
-    finish(args, global, &report, staged)
+    finish(args, global, &report, staged, all_bad_input)
 }
 
 /// The summary written beside the sequences, the folder committed, and what was made
-/// told; some recordings failed: exit code 1.
+/// told. Some recordings failed: exit code 2 when each failed on its input (the message
+/// repeats each error with its fix), else 1 (ctcal failed on one).
 fn finish(
     args: &ReportArgs,
     global: &Global,
     report: &Report,
     staged: ctcal::io::write::StagedFolder,
+    all_bad_input: bool,
 ) -> anyhow::Result<()> {
     for f in ctcal::report::render_summary(report) {
         staged.write(&f.path, &f.bytes)?;
@@ -184,14 +189,22 @@ fn finish(
         Ok(())
     } else {
         let names: Vec<&str> = report.failed.iter().map(|f| f.name.as_str()).collect();
-        Err(SomeFailed(format!(
+        let message = format!(
             "{} of {} recordings could not be reported ({}); the report of the others is in {} and lists the errors",
             report.failed.len(),
             report.failed.len() + report.sequences.len(),
             names.join(", "),
             args.out.display()
-        ))
-        .into())
+        );
+        if all_bad_input {
+            let errors: String = report
+                .failed
+                .iter()
+                .map(|f| format!("\n{}: {}", f.name, f.error))
+                .collect();
+            return Err(BadInput(format!("{message}:{errors}")).into());
+        }
+        Err(SomeFailed(message).into())
     }
 }
 
