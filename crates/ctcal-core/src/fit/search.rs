@@ -44,6 +44,15 @@ pub struct Simulation<'a> {
     pub hot_events: EventChunk,
 }
 
+/// How far above the recording's shortest intervals a refractory period may lie: a
+/// timestamp jitter of 0.3 ms puts the 1 % quantile of the intervals 25 % below a 3.8 ms
+/// period (a coverage draw, 2026-11-27), the bin edge above it may be 10 % below.
+pub const JITTER_ALLOWANCE: f64 = 1.5;
+
+/// The factor either side of a threshold that balanced at its start where
+/// [`Simulation::settle_flat`] probes.
+pub const FLAT_PROBE: f64 = 1.1;
+
 /// Secant steps of the threshold profile after its first simulation.
 const PROFILE_STEPS: usize = 4;
 
@@ -164,13 +173,69 @@ impl Simulation<'_> {
         })
     }
 
+    /// `profiled` (the thresholds profiled from `start`) with each threshold that balanced
+    /// at its very first evaluation read again from two probes [`FLAT_PROBE`] either side.
+    /// The median cell ratio is a step function of the threshold (counts are integers),
+    /// flat around its root: a start that happens to lie on the flat step would otherwise
+    /// be reported as the fitted value. The threshold is taken where the line through the
+    /// probes' medians crosses zero (within the probes), or kept where both probes balance
+    /// as well (then the interval says how little the counts fix it).
+    pub fn settle_flat(
+        &self,
+        start: &PixelParams,
+        profiled: Simulated,
+        masked: &[bool],
+    ) -> Result<Simulated, EstimateError> {
+        let flat: Vec<usize> = (0..2)
+            .filter(|&pol| threshold_of(&profiled.params, pol) == threshold_of(start, pol))
+            .collect();
+        if flat.is_empty() {
+            return Ok(profiled);
+        }
+        let mut probes: [Vec<(f64, f64)>; 2] = [Vec::new(), Vec::new()];
+        for factor in [FLAT_PROBE, 1.0 / FLAT_PROBE] {
+            let mut p = profiled.params.clone();
+            for &pol in &flat {
+                set_threshold(&mut p, pol, threshold_of(&profiled.params, pol) * factor);
+            }
+            let medians = median_ratios(
+                &self.real,
+                &self.observe(&p, masked)?,
+                self.geometry,
+                Subset::Fit,
+            );
+            for &pol in &flat {
+                if let Some(m) = medians[pol] {
+                    probes[pol].push((threshold_of(&p, pol).ln(), m));
+                }
+            }
+        }
+        let mut settled = profiled.params.clone();
+        for &pol in &flat {
+            if let [(x1, m1), (x2, m2)] = probes[pol][..]
+                && m1 != m2
+            {
+                let root = (x1 - m1 * (x2 - x1) / (m2 - m1)).clamp(x1.min(x2), x1.max(x2));
+                set_threshold(&mut settled, pol, root.exp());
+            }
+        }
+        if settled == profiled.params {
+            return Ok(profiled);
+        }
+        Ok(Simulated {
+            observed: self.observe(&settled, masked)?,
+            params: settled,
+        })
+    }
+
     /// The largest value `effect`'s parameter can take in this recording, read from the
-    /// recording itself. A refractory period cannot be longer than the recording's
+    /// recording itself. A refractory period cannot be much longer than the recording's
     /// shortest same-pixel intervals (a change inside the period is delayed to its end or
-    /// dropped, so no interval is shorter): the upper edge of the interval bin where the
-    /// fit blocks' interval distribution passes 1 % (the share a jittered or noisy
-    /// timestamp may fall below it; with under 100 intervals, the shortest one's bin);
-    /// without any interval, the fit blocks' duration. `None`: no limit for this effect.
+    /// dropped, so no interval is shorter): [`JITTER_ALLOWANCE`] times the upper edge of the
+    /// interval bin where the fit blocks' interval distribution passes 1 % (the share a
+    /// jittered or noisy timestamp may fall below it; with under 100 intervals, the
+    /// shortest one's bin); without any interval, the fit blocks' duration. `None`: no
+    /// limit for this effect.
     pub fn upper_limit(&self, effect: super::effects::Effect) -> Option<f64> {
         use super::observe::{INTERVAL_BINS, interval_bin_start};
         if effect != super::effects::Effect::Refractory {
@@ -184,7 +249,7 @@ impl Simulation<'_> {
         let mut cumulative = 0.0;
         (0..INTERVAL_BINS - 1).find_map(|k| {
             cumulative += counts[k] as f64;
-            (cumulative >= 0.01 * total).then(|| interval_bin_start(k + 1))
+            (cumulative >= 0.01 * total).then(|| JITTER_ALLOWANCE * interval_bin_start(k + 1))
         })
     }
 

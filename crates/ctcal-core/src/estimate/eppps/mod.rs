@@ -262,7 +262,8 @@ fn refractory_edge(
     let pixels = sensor.width as usize * sensor.height as usize;
     let mut last = vec![crate::events::TimeUs::MIN; pixels];
     let inside = events.len();
-    let mut intervals = refractory::intervals(events, 0..inside, sensor.width as usize, &mut last);
+    let mut intervals =
+        refractory::intervals(events, 0..inside, sensor.width as usize, &mut last, None);
     refractory::edge(&mut intervals, refractory::timestamp_step(events)).filter(|e| e.found)
 }
 

@@ -142,6 +142,7 @@ impl Fixture {
             model: &self.model,
             mismatch_estimate: None,
             timestamp_grid_us: None,
+            shortest_interval_s: None,
             subset: Subset::Fit,
         }
     }

@@ -68,6 +68,13 @@ impl Effect {
         }
     }
 
+    /// Whether a candidate of this effect is also judged on its own signature
+    /// ([`crate::fit::selection`]'s keep rule): a refractory period, whose gap in the
+    /// shortest intervals the distance barely sees.
+    pub fn judged_by_signature(self) -> bool {
+        self == Effect::Refractory
+    }
+
     pub fn parse(name: &str) -> Option<Effect> {
         Effect::ALL.into_iter().find(|e| e.name() == name)
     }
@@ -133,6 +140,9 @@ impl Effect {
             Effect::Bandwidth => (2.0, 5000.0),
             Effect::Mismatch => ((start / 3.0).max(0.002), (start * 3.0).min(0.3)),
             Effect::TimestampJitter => (5e-6, 5e-3),
+            // started at the recording's shortest intervals, which a period bounds from
+            // below and jitter moves below it
+            Effect::Refractory => (start / 2.0, start * 2.0),
             _ => (start / 5.0, start * 5.0),
         }
     }
@@ -157,6 +167,9 @@ pub struct Context<'a> {
     pub mismatch_estimate: Option<(f64, [f64; 2])>,
     /// The recording's timestamp grid period, when its stamps are quantised.
     pub timestamp_grid_us: Option<i64>,
+    /// The recording's shortest same-pixel intervals on the fit blocks, seconds
+    /// ([`refractory::shortest_interval_s`]), when there are enough.
+    pub shortest_interval_s: Option<f64>,
     pub subset: Subset,
 }
 

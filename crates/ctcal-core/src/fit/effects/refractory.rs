@@ -1,16 +1,44 @@
 //! Refractory period: after an event the pixel is blind while its reset switch is held;
 //! a change inside that time fires when it ends (v2e's semantics,
-//! [`crate::sim::effects::refractory`]).
+//! [`crate::sim::effects::refractory`]) or is dropped (IEBCS, DVS-Voltmeter).
 //!
 //! Signature: a gap in the shortest same-pixel intervals (and a count deficit at high
 //! local rates): the recording has far fewer intervals below some time than a model
-//! without it. Evidence: the largest interval bin below which the recording holds less
-//! than a quarter of the model's share, with the model's share above 2 %; the difference of
-//! the shares in binomial standard errors. Start: that bin's upper edge.
+//! without it, whatever the brightness. Evidence: the largest interval bin below which the
+//! recording holds less than a quarter of the model's share, with the model's share above
+//! 2 %; the difference of the shares in binomial standard errors. Start: the recording's
+//! shortest same-pixel intervals ([`shortest_interval_s`]: no interval is shorter than the
+//! period, and v2e's pile-up puts many exactly at it), else that bin's upper edge.
 
 use super::{Context, Effect, Evidence};
+use crate::events::{EventChunk, TimeUs};
 use crate::fit::metric::normalised;
 use crate::fit::observe::{INTERVAL_BINS, interval_bin_start};
+
+/// The recording's shortest same-pixel intervals, seconds: the lower edge of the intervals
+/// between consecutive events of each `kept` pixel of time-sorted `events` on a
+/// `step_us` timestamp grid, found as the events-only fit finds it
+/// ([`crate::fit::events_only::refractory::edge`]: the longest gap with a plateau above it,
+/// its edge the 2nd percentile of the intervals around it; without a gap, the shortest
+/// interval). `None` with too few intervals. A refractory period leaves no interval below
+/// it (v2e piles the held-back events up at it: Hu, Liu & Delbruck, "v2e", CVPRW 2021); a
+/// timestamp jitter of standard deviation s moves the edge about 2 s below the period.
+pub fn shortest_interval_s(
+    events: &EventChunk,
+    width: usize,
+    kept: &[bool],
+    step_us: u32,
+) -> Option<f64> {
+    let mut last = vec![TimeUs::MIN; kept.len()];
+    let mut intervals = crate::fit::events_only::refractory::intervals(
+        events,
+        0..events.len(),
+        width,
+        &mut last,
+        Some(kept),
+    );
+    crate::fit::events_only::refractory::edge(&mut intervals, step_us).map(|e| e.edge_us * 1e-6)
+}
 
 pub fn evidence(c: &Context) -> Evidence {
     let real_counts = c.real.intervals_of(c.geometry, c.subset);
@@ -50,14 +78,13 @@ pub fn evidence(c: &Context) -> Evidence {
             edge * 1e3,
             100.0 * sim_share
         ),
-        start: Some(edge),
+        start: Some(c.shortest_interval_s.unwrap_or(edge)),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::events::{EventChunk, TimeUs};
     use crate::fit::effects::EVIDENCE_THRESHOLD;
     use crate::fit::effects::fixture::{Fixture, chunk, poisson_times, rng, static_frames};
 
@@ -116,5 +143,36 @@ mod tests {
         assert!(!e.calls_for(), "{e:?}");
         assert_eq!(e.score, 0.0);
         assert_eq!(e.start, None);
+    }
+
+    #[test]
+    fn the_shortest_intervals_read_the_period_and_leave_out_pixels_not_compared() {
+        let (model, recording) = model_and_refractory(2e-3);
+        let kept = vec![true; 16 * 12];
+        // every interval of the recording is at least 2 ms, and piled up at 2 ms
+        let q = shortest_interval_s(&recording, 16, &kept, 1).unwrap();
+        assert!((q - 2e-3).abs() < 1e-6, "{q}");
+        // the model (Poisson at 200 Hz) has no gap: its shortest interval, a few us
+        let q = shortest_interval_s(&model, 16, &kept, 1).unwrap();
+        assert!(q < 20e-6, "{q}");
+        // one pixel kept: about 200 intervals, still enough; none kept: none
+        let mut one = vec![false; 16 * 12];
+        one[5] = true;
+        assert!(shortest_interval_s(&recording, 16, &one, 1).is_some_and(|q| q >= 2e-3));
+        assert_eq!(
+            shortest_interval_s(&recording, 16, &[false; 16 * 12], 1),
+            None
+        );
+    }
+
+    #[test]
+    fn the_evidence_starts_at_the_measured_shortest_intervals() {
+        let (model, recording) = model_and_refractory(2e-3);
+        let f = Fixture::new(&static_frames(16, 12, 1.0, 100.0), &recording, &model);
+        let context = Context {
+            shortest_interval_s: Some(2.1e-3),
+            ..f.context()
+        };
+        assert_eq!(evidence(&context).start, Some(2.1e-3));
     }
 }

@@ -181,7 +181,7 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
         .collect();
     let mut last = vec![TimeUs::MIN; w * h];
     for (b, range) in blocks.iter_mut().zip(&ranges) {
-        b.intervals = super::refractory::intervals(&clean, range.clone(), w, &mut last);
+        b.intervals = super::refractory::intervals(&clean, range.clone(), w, &mut last, None);
     }
     for window in SUPPORT_WINDOWS_US {
         let support = crate::stats::support::supported_two_sided(&clean, m.sensor, window);

@@ -43,17 +43,21 @@ pub struct Edge {
     pub intervals: usize,
 }
 
-/// Same-pixel intervals (µs) of the events `range`; `last` carries each pixel's previous
-/// event across blocks.
+/// Same-pixel intervals (µs) of the events `range` (of the pixels `kept`, where given);
+/// `last` carries each pixel's previous event across blocks.
 pub fn intervals(
     clean: &crate::events::EventChunk,
     range: std::ops::Range<usize>,
     width: usize,
     last: &mut [crate::events::TimeUs],
+    kept: Option<&[bool]>,
 ) -> Vec<u32> {
     let mut out = Vec::new();
     for i in range {
         let p = clean.y[i] as usize * width + clean.x[i] as usize;
+        if kept.is_some_and(|k| !k.get(p).copied().unwrap_or(false)) {
+            continue;
+        }
         if last[p] != crate::events::TimeUs::MIN {
             out.push((clean.t[i] - last[p]).clamp(0, u32::MAX as crate::events::TimeUs) as u32);
         }

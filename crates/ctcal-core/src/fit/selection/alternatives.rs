@@ -10,8 +10,9 @@
 //!
 //! - the look-alike wins beyond chance: it replaces the kept effect (the greedy order chose
 //!   wrongly);
-//! - neither wins: the fit keeps its effect and reports the pair as not separated, with
-//!   what data would separate them.
+//! - neither wins: the fit keeps the one whose selection error is the lower (a point
+//!   estimate of which explains more, whichever came first) and reports the pair as not
+//!   separated, with what data would separate them.
 
 use super::super::effects::{self, Context, Effect};
 use super::super::search::{Simulated, Simulation, search};
@@ -107,7 +108,37 @@ pub fn compare(
         let c = compare_one(simulation, state, known, kept, other, (fixed, noise))?;
         let mut step = c.step;
         step.simulations = simulation.count.get() - count_before;
-        if c.replaces {
+        // not separated: the model with the lower selection error is kept, both are named
+        let (before, after) = (
+            step.error_before.unwrap_or(f64::NAN),
+            step.error_after.unwrap_or(f64::NAN),
+        );
+        let lower = after < before;
+        if c.ambiguous {
+            let (named, alternative, value) = if lower {
+                (other, kept, kept_value(kept, state))
+            } else {
+                (kept, other, c.value)
+            };
+            found.push(Ambiguity {
+                kept: named.name().into(),
+                alternative: alternative.name().into(),
+                parameter: alternative.parameter().unwrap_or_default().into(),
+                value,
+                error_kept: if lower { after } else { before },
+                error_alternative: if lower { before } else { after },
+                chance: step.chance,
+                separated_by: separated_by.into(),
+            });
+            if lower {
+                step.reason = format!(
+                    "{}; its selection error is the lower, so it takes the place of {}, both named",
+                    step.reason,
+                    kept.name()
+                );
+            }
+        }
+        if c.replaces || (c.ambiguous && lower) {
             let key = kept.parameter().expect("a searched effect");
             state.uncertainty.remove(key);
             state.at_bound.remove(key);
@@ -124,21 +155,15 @@ pub fn compare(
                     error_after: step.error_after.unwrap_or(a.error_after),
                 };
             }
-        } else if c.ambiguous {
-            found.push(Ambiguity {
-                kept: kept.name().into(),
-                alternative: other.name().into(),
-                parameter: other.parameter().unwrap_or_default().into(),
-                value: c.value,
-                error_kept: step.error_before.unwrap_or(f64::NAN),
-                error_alternative: step.error_after.unwrap_or(f64::NAN),
-                chance: step.chance,
-                separated_by: separated_by.into(),
-            });
         }
         steps.push(step);
     }
     Ok(found)
+}
+
+/// The fitted value of `kept`'s parameter in the current model.
+fn kept_value(kept: Effect, state: &State) -> f64 {
+    kept.value(&state.model.params).unwrap_or(f64::NAN)
 }
 
 /// The model with `other` in place of `kept`, judged against the fitted one both ways.

@@ -43,12 +43,13 @@ use crate::stats::hot_pixels::HotPixel;
 use std::cell::Cell;
 use std::collections::BTreeMap;
 
-/// What is known besides the residuals: the estimators' mismatch (value, 95 % interval)
-/// and the recording's timestamp grid.
+/// What is known besides the residuals: the estimators' mismatch (value, 95 % interval),
+/// the recording's timestamp grid and its shortest same-pixel intervals on the fit run.
 #[derive(Clone, Copy)]
 struct Known {
     mismatch: Option<(f64, [f64; 2])>,
     grid: Option<(i64, i64)>,
+    shortest_interval_s: Option<f64>,
 }
 
 /// The fit's state between steps.
@@ -133,6 +134,12 @@ pub fn fit(
     let known = Known {
         mismatch: start.mismatch,
         grid,
+        shortest_interval_s: effects::refractory::shortest_interval_s(
+            &run.events,
+            input.sensor.width as usize,
+            &state.kept,
+            grid.map_or(1, |g| g.0.clamp(1, u32::MAX as i64) as u32),
+        ),
     };
     let mut steps = vec![start.step];
     let loop_run = LoopRun {
@@ -258,7 +265,10 @@ fn ideal_model(
 ) -> Result<(Simulated, bool), FitError> {
     let g = simulation.geometry;
     let no_mask = vec![false; g.sensor.pixels()];
-    let ideal = simulation.profile(start, &no_mask, fixed)?;
+    let mut ideal = simulation.profile(start, &no_mask, fixed)?;
+    if !fixed {
+        ideal = simulation.settle_flat(start, ideal, &no_mask)?;
+    }
     if !fixed && ideal.observed.total(g, Subset::All) * 20 < simulation.real.total(g, Subset::All) {
         assumptions.push(
             "the frames explain under 5 % of the events: thresholds kept where they started (not identified)".into(),
@@ -335,7 +345,7 @@ fn run_loop(
         tried.push(evidence.effect);
         let hot =
             (evidence.effect == Effect::HotPixels).then(|| hot_trains(&context, run.fit_events));
-        let step = steps::try_effect(simulation, state, &evidence, hot, run.fixed, run.noise)?;
+        let step = steps::try_effect(simulation, state, &evidence, hot, run)?;
         if step.kept {
             added.push(AddedEffect {
                 effect: evidence.effect,
@@ -442,7 +452,7 @@ fn prune_added(
             .copied()
             .filter(|&e| e != effect && added.iter().any(|a| a.effect == e))
             .collect();
-        let step = steps::prune(simulation, state, effect, &others, run.fixed, run.noise)?;
+        let step = steps::prune(simulation, state, effect, &others, run)?;
         if !step.kept {
             added.retain(|a| a.effect != effect);
         }
@@ -461,6 +471,24 @@ fn searched_together(added: &[AddedEffect]) -> Vec<Effect> {
 }
 
 /// The evidence context of the current state (fit blocks).
+/// The evidence for `effect` on the judging blocks against `model` (for the keep rule by
+/// signature, [`keep::by_signature`]).
+fn judging_evidence(
+    state: &State,
+    simulation: &Simulation,
+    known: Known,
+    effect: Effect,
+    model: &Simulated,
+) -> effects::Evidence {
+    let context = Context {
+        sim: &model.observed,
+        model: &model.params,
+        subset: simulation.geometry.judging(),
+        ..context_of(state, simulation, known)
+    };
+    effects::evidence(effect, &context)
+}
+
 fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) -> Context<'a> {
     Context {
         real: &simulation.real,
@@ -470,6 +498,7 @@ fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) ->
         model: &state.model.params,
         mismatch_estimate: known.mismatch,
         timestamp_grid_us: known.grid.map(|g| g.0),
+        shortest_interval_s: known.shortest_interval_s,
         subset: Subset::Fit,
     }
 }

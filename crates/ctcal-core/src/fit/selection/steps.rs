@@ -8,8 +8,8 @@ use super::super::observe::Subset;
 use super::super::residuals::residuals;
 use super::super::search::{Searched, Simulated, Simulation, search};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
-use super::State;
-use super::keep::{Verdict, judge};
+use super::keep::{Verdict, by_signature, judge};
+use super::{Known, LoopRun, State, judging_evidence};
 use crate::stats::hot_pixels::HotPixel;
 use std::collections::BTreeMap;
 
@@ -44,9 +44,9 @@ pub fn try_effect(
     state: &mut State,
     evidence: &effects::Evidence,
     hot_found: Option<(Vec<HotPixel>, Vec<HotTrain>)>,
-    fixed: bool,
-    noise: f64,
+    run: &LoopRun,
 ) -> Result<Step, FitError> {
+    let (fixed, noise) = (run.fixed, run.noise);
     let effect = evidence.effect;
     let count_before = simulation.count.get();
     let mut step = Step::untried(effect.name().into(), evidence.text.clone(), evidence.score);
@@ -116,11 +116,12 @@ pub fn try_effect(
             (searched.model, Some(uncertain))
         }
     };
-    let verdict = judge(
+    let verdict = judge_effect(
         simulation,
-        &state.model.observed,
-        &candidate.observed,
-        &state.kept,
+        state,
+        run.known,
+        effect,
+        (&state.model, &candidate),
     );
     Ok(finish_step(
         simulation,
@@ -131,6 +132,25 @@ pub fn try_effect(
         uncertain,
         count_before,
     ))
+}
+
+/// The judgement of `effect`'s model `with` against the model `without` it on the
+/// judging blocks: by the distance ([`judge`]), and for an effect the distance barely sees
+/// also by its signature ([`by_signature`]).
+fn judge_effect(
+    simulation: &Simulation,
+    state: &State,
+    known: Known,
+    effect: Effect,
+    (without, with): (&Simulated, &Simulated),
+) -> Verdict {
+    let verdict = judge(simulation, &without.observed, &with.observed, &state.kept);
+    if !effect.judged_by_signature() {
+        return verdict;
+    }
+    let before = judging_evidence(state, simulation, known, effect, without);
+    let after = judging_evidence(state, simulation, known, effect, with);
+    by_signature(verdict, &before, &after)
 }
 
 /// The searched value with its standard error, or the bound it sits at.
@@ -228,19 +248,20 @@ pub fn prune(
     state: &mut State,
     effect: Effect,
     others: &[Effect],
-    fixed: bool,
-    noise: f64,
+    run: &LoopRun,
 ) -> Result<Step, FitError> {
+    let (fixed, noise) = (run.fixed, run.noise);
     let key = effect.parameter().expect("a searched effect");
     let count_before = simulation.count.get();
     let mut reduced = state.model.params.clone();
     effect.clear(&mut reduced);
     let (without, refitted) = best_without(simulation, state, &reduced, others, fixed, noise)?;
-    let verdict = judge(
+    let verdict = judge_effect(
         simulation,
-        &without.observed,
-        &state.model.observed,
-        &state.kept,
+        state,
+        run.known,
+        effect,
+        (&without, &state.model),
     );
     let mut step = Step::untried(
         format!("{} (still needed?)", effect.name()),
