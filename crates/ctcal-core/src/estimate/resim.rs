@@ -380,6 +380,15 @@ pub fn fit(
     start: (f64, f64),
     sigma: f64,
 ) -> Result<ResimEstimate, EstimateError> {
+    if !(start.0.is_finite() && start.0 > 0.0 && start.1.is_finite() && start.1 > 0.0) {
+        return Err(EstimateError::new(
+            format!(
+                "the re-simulation has no positive thresholds to start from (ON {:.4}, OFF {:.4})",
+                start.0, start.1
+            ),
+            "the event timing found no threshold: see its reason",
+        ));
+    }
     let mut base = PixelParams::ideal(start.0, start.1);
     if sigma > 0.0 {
         base.ct_sigma = Some(sigma);

@@ -56,6 +56,20 @@ pub fn threshold_root(
         seen: Mutex::new(Vec::new()),
     };
     let [lowest, highest] = search.limits;
+    if !(lowest.is_finite() && highest.is_finite() && lowest > 0.0 && highest >= lowest) {
+        return Err(EstimateError::new(
+            format!(
+                "no thresholds to search: the range {lowest} .. {highest} is not a range of positive values"
+            ),
+            "report this as a bug, with the recording",
+        ));
+    }
+    if !start.is_finite() {
+        return Err(EstimateError::new(
+            format!("the threshold search cannot start at {start}"),
+            "report this as a bug, with the recording",
+        ));
+    }
     let start = start.clamp(lowest, highest);
     let at_start = cached.value(start)?;
     let (root, ends) = if at_start == 0.0 {
@@ -261,6 +275,22 @@ mod tests {
                 too_many: false
             }
         );
+    }
+
+    #[test]
+    fn a_start_or_limits_that_are_not_positive_thresholds_are_an_error_not_a_panic() {
+        // a coverage draw's event timing gave ON -0.001: limits -0.0004 .. -0.0016
+        let search = Search {
+            limits: [-0.0004, -0.0016],
+            ..SEARCH
+        };
+        let e = threshold_root(falling(0.3), -0.001, &search).unwrap_err();
+        assert!(
+            e.to_string().contains("not a range of positive values"),
+            "{e}"
+        );
+        let e = threshold_root(falling(0.3), f64::NAN, &SEARCH).unwrap_err();
+        assert!(e.to_string().contains("cannot start at NaN"), "{e}");
     }
 
     #[test]
