@@ -343,11 +343,31 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     let loaded = common.load(Some(args.max_frames), true, global)?;
     let path = loaded.recording.path.clone();
     if loaded.frames.len() < 2 {
+        let windowed = common.start.is_some() || common.end.is_some();
+        let on_screen = matches!(loaded.recording.stimulus(), Ok(Some(_)));
         return Err(BadInput(format!(
-            "{}: `estimate aps` needs grey frames; {} has {}\n  fix: use `ctcal estimate eppps`, which needs no frames",
+            "{}: `estimate aps` needs grey frames (two or more); {} holds {}\n  fix: {}use {}",
             path.display(),
-            if loaded.frames_available > 0 { "the selected window" } else { "the recording" },
-            if loaded.frames.len() == 1 { "only one" } else { "none" }
+            if windowed {
+                "the window --start/--end selects"
+            } else {
+                "the recording"
+            },
+            if loaded.frames.len() == 1 {
+                "only one"
+            } else {
+                "none"
+            },
+            if windowed {
+                "widen the window to hold two frames, or "
+            } else {
+                ""
+            },
+            if on_screen {
+                "`ctcal estimate screen`, which measures through the stimulus played"
+            } else {
+                "`ctcal estimate eppps`, which needs no frames"
+            }
         ))
         .into());
     }

@@ -11,7 +11,7 @@ pub fn flag(hint: &Hint) -> String {
         Hint::Sensor(Some(sensor)) => format!("--sensor {sensor}"),
         Hint::Force => "--force".into(),
         // only `stats` and `convert` sort; the other commands read a sorted copy
-        Hint::Sort => "--sort (of `ctcal stats` or `ctcal convert`; for the other commands write a sorted copy first: `ctcal convert INPUT --out SORTED --sort`)".into(),
+        Hint::Sort => "--sort; only `ctcal stats` and `ctcal convert` take it: for the other commands write a sorted copy first with `ctcal convert INPUT --out SORTED --sort`".into(),
         Hint::Format(None) => "--format".into(),
         Hint::Format(Some(format)) => format!("--format {format}"),
         Hint::TimeWindow => "--start/--end".into(),

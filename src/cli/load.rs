@@ -13,14 +13,16 @@ pub fn check_window(start: Option<f64>, end: Option<f64>) -> Result<(), BadInput
             && !(v.is_finite() && (0.0..=1e12).contains(&v))
         {
             return Err(BadInput(format!(
-                "{name} {v} must be a number of seconds from the first event, between 0 and 1e12"
+                "{name} {v} must be a number of seconds from the first event, between 0 and 1e12\n  fix: give {name} in seconds from the first event"
             )));
         }
     }
     if let (Some(s), Some(e)) = (start, end)
         && e <= s
     {
-        return Err(BadInput(format!("--end {e} is not after --start {s}")));
+        return Err(BadInput(format!(
+            "--end {e} is not after --start {s}\n  fix: give an --end after --start (both in seconds from the first event)"
+        )));
     }
     Ok(())
 }

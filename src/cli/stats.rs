@@ -56,7 +56,7 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
             && !(v.is_finite() && (0.0..=MAX_SECONDS).contains(&v))
         {
             return Err(BadInput(format!(
-                "{name} {v} must be a number of seconds from the first event, between 0 and {MAX_SECONDS:e}"
+                "{name} {v} must be a number of seconds from the first event, between 0 and {MAX_SECONDS:e}\n  fix: give {name} in seconds from the first event"
             ))
             .into());
         }
@@ -64,7 +64,10 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
     if let (Some(s), Some(e)) = (args.start, args.end)
         && e < s
     {
-        return Err(BadInput(format!("--end {e} is before --start {s}")).into());
+        return Err(BadInput(format!(
+            "--end {e} is before --start {s}\n  fix: give an --end after --start (both in seconds from the first event)"
+        ))
+        .into());
     }
     let recording = Recording::open(&args.input.input, &args.input.open_options())?;
     for note in &recording.notes {

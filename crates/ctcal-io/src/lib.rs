@@ -100,7 +100,10 @@ pub(crate) fn outside_sensor(
         height,
         claimed: String::new(),
         fix: match sensor {
-            Some(_) => Text::from("if the sensor is larger than the file says, "),
+            Some(s) => Text::from(format!(
+                "if the sensor is larger than {s} (the size given, or the file's own: x must stay below {}, y below {}), ",
+                s.width, s.height
+            )),
             None => Text::from(format!("the file does not state its sensor and ctcal infers at most {MAX_SENSOR_SIDE}x{MAX_SENSOR_SIDE}: if the sensor really is that large, ")),
         }
         .act(Hint::Sensor(None))

@@ -231,12 +231,23 @@ pub fn estimate(
     }
     let used = frames.intervals.iter().filter(|i| i.used).count();
     if used < MIN_USED_INTERVALS {
+        let total = frames.intervals.len();
+        let why = if used == total {
+            format!("the recording (or the part read) has only {total} frame intervals")
+        } else {
+            format!(
+                "only {used} of {total} frame intervals can be used (the flow between the frames fails: motion too fast for the frame rate, or frames too dark or blurred)"
+            )
+        };
         return Err(EstimateError::new(
             format!(
-                "only {used} of {} frame intervals can be used (the flow between the frames fails: motion too fast for the frame rate, or frames too dark or blurred); thresholds from frames need {MIN_USED_INTERVALS} at least, or they rest on a single stretch of motion whose flow nothing checks",
-                frames.intervals.len()
+                "{why}; thresholds from frames need {MIN_USED_INTERVALS} at least, or they rest on a single stretch of motion whose flow nothing checks"
             ),
-            "use a recording, or a part of one, with more frames per unit of motion; without usable frames estimate with the eppps or screen method",
+            if used == total {
+                "read a longer part of the recording; without enough frames estimate with the eppps or screen method"
+            } else {
+                "use a recording, or a part of one, with more frames per unit of motion; without usable frames estimate with the eppps or screen method"
+            },
         ));
     }
     let exposure = super::frames::exposure_of(input.frames, options.exposure_us);
