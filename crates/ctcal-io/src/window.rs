@@ -8,7 +8,7 @@ use crate::estimate::aps::{self, ApsInput, ApsOptions};
 use crate::estimate::{CtEstimate, EstimateError, eppps, screen};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
 use crate::frame_blocks;
-use crate::hint::Text;
+use crate::hint::{Hint, Text};
 use crate::selection::{PixelSelection, Roi};
 use crate::sim::DisplayParams;
 use crate::{InputError, OpenOptions, Recording};
@@ -191,6 +191,10 @@ pub fn load(
     if let Some(w) = &resolved.warning {
         observer.warn(w);
     }
+    if let Some(w) = frames_larger_than_events(&resolved, events.max_coordinates(), &recording.path)
+    {
+        observer.warn(&w);
+    }
     if let Some(f) = read.chosen.frames.first()
         && (f.width as u16, f.height as u16) != (resolved.sensor.width, resolved.sensor.height)
     {
@@ -225,6 +229,33 @@ pub fn load(
         notes,
     })
 }
+
+/// A warning where the sensor's size comes from the grey frames and the events reach under
+/// [`EVENTS_REACH`] of it across or down: frames resized (or from another camera) would
+/// give every estimate the wrong active area.
+fn frames_larger_than_events(
+    resolved: &crate::recording::ResolvedSensor,
+    reach: Option<(u16, u16)>,
+    path: &Path,
+) -> Option<Text> {
+    let (x, y) = reach?;
+    let s = resolved.sensor;
+    let short = |reach: u16, side: u16| reach as f64 + 1.0 < EVENTS_REACH * side as f64;
+    (resolved.source.contains("images") && (short(x, s.width) || short(y, s.height))).then(|| {
+        Text::from(format!(
+            "{}: the sensor size {s} comes from the grey frames, but the events reach only x < {}, y < {}: if the frames were resized or are another camera's, the estimates are off; ",
+            path.display(),
+            x as u32 + 1,
+            y as u32 + 1
+        ))
+        .act(Hint::Sensor(None))
+        .words(" with the event camera's size")
+    })
+}
+
+/// The share of the frames' width or height the events must reach before
+/// [`frames_larger_than_events`] warns.
+const EVENTS_REACH: f64 = 0.8;
 
 /// The same window as `whole` (read whole by [`load`] with `window`), in blocks of
 /// consecutive frames with only the events between them ([`Window::events_between_frames`]),
