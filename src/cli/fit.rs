@@ -2,7 +2,7 @@
 //! residuals call for them and the held-out error falls (see `ctcal::fit`).
 
 use super::estimate::{CommonArgs, estimate_failed, stage_spinner};
-use super::{BadInput, Global, JsonTarget, emit_json, output};
+use super::{BadInput, Global, JsonTarget, emit_json, output, warn};
 use clap::Args;
 use ctcal::estimate::aps::ApsOptions;
 use ctcal::fit::effects::Effect;
@@ -175,6 +175,13 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
         common.load(Some(args.max_frames), true, global)?
     };
     let path = loaded.recording.path.clone();
+    // an on-screen recording's camera frames show the display, whose refresh and response
+    // the re-simulation of those frames does not model: its thresholds are the screen
+    // method's to measure
+    let on_screen = thresholds.is_none() && matches!(loaded.recording.stimulus(), Ok(Some(_)));
+    if on_screen {
+        warn(global, ON_SCREEN);
+    }
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
     let options = FitOptions {
@@ -204,6 +211,9 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     spinner.finish_and_clear();
     let mut result = result.map_err(|e| estimate_failed(&path, &e))?;
     result.assumptions.extend(loaded.notes.iter().cloned());
+    if on_screen {
+        result.assumptions.push(ON_SCREEN.into());
+    }
     result.biases = loaded.recording.biases();
     let target = common.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
@@ -214,6 +224,9 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+/// What a fit of an on-screen recording without the screen method's thresholds says.
+const ON_SCREEN: &str = "an on-screen recording (its stimulus.txt is given): the thresholds are fitted to the camera's own frames of the display, whose refresh, response and gamma that re-simulation does not model, so they and their intervals may be off; measure them through the stimulus with `ctcal estimate screen --json SCREEN.json` and fit with --thresholds-from SCREEN.json (as `ctcal report` does)";
 
 fn print_human(r: &FitResult) -> std::io::Result<()> {
     let threshold = |key: &str, v: f64| {
