@@ -51,7 +51,9 @@ fn check_contract(f: &serde_json::Value) {
     for e in f["effects_added"].as_array().unwrap() {
         assert!(e["evidence"].as_str().unwrap().len() > 10);
     }
-    // every kept step beat chance on the selection blocks; the test blocks judged nothing
+    // every kept step beat chance on the selection blocks, but for an effect kept on its
+    // signature (the error rising by no more than chance) and a look-alike the distance
+    // did not separate (the lower error); the test blocks judged nothing
     for step in f["steps"].as_array().unwrap() {
         // hot pixels are measured directly (found on fit and selection blocks alike)
         if step["effect"] == "hot_pixels" {
@@ -63,7 +65,14 @@ fn check_contract(f: &serde_json::Value) {
             step["kept"].as_bool().unwrap(),
         ) {
             let chance = step["chance"].as_f64().unwrap_or(0.0);
-            assert!(b - a > chance && b - a >= 0.01 * b, "{step}");
+            let reason = step["reason"].as_str().unwrap();
+            if reason.starts_with("kept on its signature") {
+                assert!(a - b <= chance.max(0.02 * b), "{step}");
+            } else if reason.contains("takes the place of") {
+                assert!(a < b, "{step}");
+            } else {
+                assert!(b - a > chance && b - a >= 0.01 * b, "{step}");
+            }
         }
     }
     let h = &f["holdout"];

@@ -131,6 +131,7 @@ pub fn compare(
                 separated_by: separated_by.into(),
             });
             if lower {
+                step.kept = true;
                 step.reason = format!(
                     "{}; its selection error is the lower, so it takes the place of {}, both named",
                     step.reason,

@@ -122,10 +122,38 @@ pub fn decide(before: f64, after: f64, relative_falls: &[f64], judging_blocks: u
 /// (`after`). A candidate the distance did not keep is kept when the signature calls for
 /// the effect against the current model (it replicates on blocks no search saw), no longer
 /// calls for it against the candidate (the candidate explains it), and the distance rises
-/// by no more than chance (or the unmeasured-chance floor).
+/// by no more than chance (or the unmeasured-chance floor). A candidate the distance kept
+/// on the fixed floor alone (chance not measurable, under three fit blocks) stays only
+/// when its signature agrees so.
 pub fn by_signature(verdict: Verdict, before: &Evidence, after: &Evidence) -> Verdict {
-    if verdict.kept {
+    if verdict.kept && verdict.chance.is_some() {
         return verdict;
+    }
+    if verdict.kept {
+        // kept on the fixed floor alone (chance not measurable): the signature must agree
+        return if before.calls_for() && !after.calls_for() {
+            verdict
+        } else {
+            Verdict {
+                kept: false,
+                reason: format!(
+                    "{}; but with chance not measurable the fixed floor needs the signature to agree, and {}",
+                    verdict.reason,
+                    if before.calls_for() {
+                        format!(
+                            "the candidate leaves it on the selection blocks (z {:.1} -> {:.1})",
+                            before.score, after.score
+                        )
+                    } else {
+                        format!(
+                            "it does not replicate on the selection blocks (z {:.1})",
+                            before.score
+                        )
+                    }
+                ),
+                ..verdict
+            }
+        };
     }
     let rise = verdict.after.total - verdict.before.total;
     let allowed = verdict
@@ -288,6 +316,23 @@ mod tests {
     }
 
     #[test]
+    fn a_fall_on_the_fixed_floor_alone_needs_the_signature_to_agree() {
+        // ijrr_slider_depth_50k: one fit block, the distance falls 2.0 % (the floor) while
+        // the candidate leaves the gap it was tried for
+        let mut floor = verdict(1.2084, 1.1837, None);
+        floor.kept = true;
+        let v = by_signature(floor, &refractory(57.6), &refractory(56.3));
+        assert!(!v.kept && v.reason.contains("leaves it"), "{}", v.reason);
+        let mut floor = verdict(1.2084, 1.1837, None);
+        floor.kept = true;
+        assert!(by_signature(floor, &refractory(57.6), &refractory(0.0)).kept);
+        // with chance measured, the distance's verdict stands
+        let mut measured = verdict(1.2084, 1.1, Some(0.05));
+        measured.kept = true;
+        assert!(by_signature(measured, &refractory(57.6), &refractory(56.3)).kept);
+    }
+
+    #[test]
     fn a_signature_not_seen_again_or_left_by_the_candidate_keeps_nothing() {
         let v = by_signature(
             verdict(2.0, 1.95, Some(0.2)),
@@ -309,7 +354,7 @@ mod tests {
             "{}",
             v.reason
         );
-        // a verdict the distance already keeps stands as it is
+        // a verdict the distance keeps beyond measured chance stands as it is
         let mut kept = verdict(2.0, 1.0, Some(0.2));
         kept.kept = true;
         assert_eq!(
