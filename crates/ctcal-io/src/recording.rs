@@ -16,6 +16,8 @@ use std::path::{Path, PathBuf};
 
 /// The [`Recording::sensor_source`] of a sensor size the caller gave ([`OpenOptions::sensor`]).
 pub const GIVEN_SENSOR: &str = "given";
+/// The sensor source of an IJRR folder whose size comes from its grey frames.
+pub const FRAMES_SENSOR: &str = "the size of the images in images.txt";
 
 /// Options for opening a recording.
 #[derive(Clone, Debug, Default)]
@@ -118,7 +120,7 @@ impl Recording {
                 // frames (or, for an on-screen recording, the stimulus mapped 1:1 onto the
                 // sensor) give the size
                 for (index, origin) in [
-                    (&files.images, "the size of the images in images.txt"),
+                    (&files.images, FRAMES_SENSOR),
                     (
                         &files.stimulus,
                         "the size of the stimulus in stimulus.txt (screen mapped 1:1)",

@@ -241,7 +241,7 @@ fn frames_larger_than_events(
     let (x, y) = reach?;
     let s = resolved.sensor;
     let short = |reach: u16, side: u16| reach as f64 + 1.0 < EVENTS_REACH * side as f64;
-    (resolved.source.contains("images") && (short(x, s.width) || short(y, s.height))).then(|| {
+    (resolved.source == crate::recording::FRAMES_SENSOR && (short(x, s.width) || short(y, s.height))).then(|| {
         Text::from(format!(
             "{}: the sensor size {s} comes from the grey frames, but the events reach only x < {}, y < {}: if the frames were resized or are another camera's, the estimates are off; ",
             path.display(),

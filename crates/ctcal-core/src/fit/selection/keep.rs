@@ -129,51 +129,30 @@ pub fn by_signature(verdict: Verdict, before: &Evidence, after: &Evidence) -> Ve
     if verdict.kept && verdict.chance.is_some() {
         return verdict;
     }
+    let disagrees = signature_disagrees(before, after);
     if verdict.kept {
         // kept on the fixed floor alone (chance not measurable): the signature must agree
-        return if before.calls_for() && !after.calls_for() {
-            verdict
-        } else {
-            Verdict {
+        return match disagrees {
+            None => verdict,
+            Some(why) => Verdict {
                 kept: false,
                 reason: format!(
-                    "{}; but with chance not measurable the fixed floor needs the signature to agree, and {}",
-                    verdict.reason,
-                    if before.calls_for() {
-                        format!(
-                            "the candidate leaves it on the selection blocks (z {:.1} -> {:.1})",
-                            before.score, after.score
-                        )
-                    } else {
-                        format!(
-                            "it does not replicate on the selection blocks (z {:.1})",
-                            before.score
-                        )
-                    }
+                    "{}; but with chance not measurable the fixed floor needs the signature to agree, and {why}",
+                    verdict.reason
                 ),
                 ..verdict
-            }
+            },
         };
     }
     let rise = verdict.after.total - verdict.before.total;
     let allowed = verdict
         .chance
         .unwrap_or(UNMEASURED_CHANCE * verdict.before.total);
-    let (replicated, explained, within) = (before.calls_for(), !after.calls_for(), rise <= allowed);
-    if !(replicated && explained && within) {
-        let why = if !replicated {
-            format!(
-                "its signature does not replicate on the selection blocks (z {:.1})",
-                before.score
-            )
-        } else if !explained {
-            format!(
-                "the candidate leaves its signature on the selection blocks (z {:.1} -> {:.1})",
-                before.score, after.score
-            )
-        } else {
-            format!("the error rises by {rise:.4}, more than chance ({allowed:.4})")
-        };
+    let why = disagrees.or_else(|| {
+        (rise > allowed)
+            .then(|| format!("the error rises by {rise:.4}, more than chance ({allowed:.4})"))
+    });
+    if let Some(why) = why {
         return Verdict {
             reason: format!("{}; not kept on its signature: {why}", verdict.reason),
             ..verdict
@@ -186,6 +165,25 @@ pub fn by_signature(verdict: Verdict, before: &Evidence, after: &Evidence) -> Ve
             before.text, before.score, after.score, verdict.before.total, verdict.after.total
         ),
         ..verdict
+    }
+}
+
+/// Why the signature does not agree with the candidate: it does not replicate on the
+/// judging blocks against the current model (`before`), or the candidate leaves it
+/// (`after`); `None` where it agrees.
+fn signature_disagrees(before: &Evidence, after: &Evidence) -> Option<String> {
+    if !before.calls_for() {
+        Some(format!(
+            "its signature does not replicate on the selection blocks (z {:.1})",
+            before.score
+        ))
+    } else if after.calls_for() {
+        Some(format!(
+            "the candidate leaves its signature on the selection blocks (z {:.1} -> {:.1})",
+            before.score, after.score
+        ))
+    } else {
+        None
     }
 }
 
@@ -262,15 +260,26 @@ mod tests {
         }
     }
 
+    /// [`by_signature`] of a candidate (errors `before` -> `after` on the selection
+    /// blocks, `chance`, kept by the distance or not) whose signature is `z` standard
+    /// errors against the current model and `z_after` against the candidate.
+    fn judged(
+        (before, after, chance, kept): (f64, f64, Option<f64>, bool),
+        z: f64,
+        z_after: f64,
+    ) -> Verdict {
+        let v = Verdict {
+            kept,
+            ..verdict(before, after, chance)
+        };
+        by_signature(v, &refractory(z), &refractory(z_after))
+    }
+
     #[test]
     fn a_signature_that_replicates_and_is_explained_keeps_an_effect_the_distance_does_not() {
         // case-49 of the coverage draws: 3.5 % fall against a chance of 11 %, the gap
         // 60 standard errors before and gone with the effect
-        let v = by_signature(
-            verdict(2.14, 2.07, Some(0.237)),
-            &refractory(60.0),
-            &refractory(0.0),
-        );
+        let v = judged((2.14, 2.07, Some(0.237), false), 60.0, 0.0);
         assert!(v.kept, "{}", v.reason);
         assert!(
             v.reason.starts_with("kept on its signature"),
@@ -278,88 +287,45 @@ mod tests {
             v.reason
         );
         // a rise within chance is allowed, beyond it not
-        assert!(
-            by_signature(
-                verdict(2.0, 2.2, Some(0.237)),
-                &refractory(60.0),
-                &refractory(0.0)
-            )
-            .kept
-        );
-        let v = by_signature(
-            verdict(2.0, 2.3, Some(0.237)),
-            &refractory(60.0),
-            &refractory(0.0),
-        );
+        assert!(judged((2.0, 2.2, Some(0.237), false), 60.0, 0.0).kept);
+        let v = judged((2.0, 2.3, Some(0.237), false), 60.0, 0.0);
         assert!(
             !v.kept && v.reason.contains("more than chance"),
             "{}",
             v.reason
         );
         // without measured chance the 2 % floor bounds the rise
-        assert!(
-            by_signature(
-                verdict(1.0, 1.015, None),
-                &refractory(60.0),
-                &refractory(0.0)
-            )
-            .kept
-        );
-        assert!(
-            !by_signature(
-                verdict(1.0, 1.025, None),
-                &refractory(60.0),
-                &refractory(0.0)
-            )
-            .kept
-        );
+        assert!(judged((1.0, 1.015, None, false), 60.0, 0.0).kept);
+        assert!(!judged((1.0, 1.025, None, false), 60.0, 0.0).kept);
     }
 
     #[test]
     fn a_fall_on_the_fixed_floor_alone_needs_the_signature_to_agree() {
         // ijrr_slider_depth_50k: one fit block, the distance falls 2.0 % (the floor) while
         // the candidate leaves the gap it was tried for
-        let mut floor = verdict(1.2084, 1.1837, None);
-        floor.kept = true;
-        let v = by_signature(floor, &refractory(57.6), &refractory(56.3));
+        let v = judged((1.2084, 1.1837, None, true), 57.6, 56.3);
         assert!(!v.kept && v.reason.contains("leaves it"), "{}", v.reason);
-        let mut floor = verdict(1.2084, 1.1837, None);
-        floor.kept = true;
-        assert!(by_signature(floor, &refractory(57.6), &refractory(0.0)).kept);
+        assert!(judged((1.2084, 1.1837, None, true), 57.6, 0.0).kept);
         // with chance measured, the distance's verdict stands
-        let mut measured = verdict(1.2084, 1.1, Some(0.05));
-        measured.kept = true;
-        assert!(by_signature(measured, &refractory(57.6), &refractory(56.3)).kept);
+        assert!(judged((1.2084, 1.1, Some(0.05), true), 57.6, 56.3).kept);
     }
 
     #[test]
     fn a_signature_not_seen_again_or_left_by_the_candidate_keeps_nothing() {
-        let v = by_signature(
-            verdict(2.0, 1.95, Some(0.2)),
-            &refractory(3.0),
-            &refractory(0.0),
-        );
+        let v = judged((2.0, 1.95, Some(0.2), false), 3.0, 0.0);
         assert!(
             !v.kept && v.reason.contains("does not replicate"),
             "{}",
             v.reason
         );
-        let v = by_signature(
-            verdict(2.0, 1.95, Some(0.2)),
-            &refractory(60.0),
-            &refractory(20.0),
-        );
+        let v = judged((2.0, 1.95, Some(0.2), false), 60.0, 20.0);
         assert!(
             !v.kept && v.reason.contains("leaves its signature"),
             "{}",
             v.reason
         );
         // a verdict the distance keeps beyond measured chance stands as it is
-        let mut kept = verdict(2.0, 1.0, Some(0.2));
-        kept.kept = true;
-        assert_eq!(
-            by_signature(kept, &refractory(0.0), &refractory(0.0)).reason,
-            "error on the selection blocks"
-        );
+        let v = judged((2.0, 1.0, Some(0.2), true), 0.0, 0.0);
+        assert_eq!(v.reason, "error on the selection blocks");
     }
 }
