@@ -3,7 +3,7 @@
 //! results files as they come (so an interrupted study keeps what it measured).
 
 use crate::Args;
-use ctcal::coverage::run::{RunOptions, run_method};
+use crate::run::{RunOptions, run_method};
 use ctcal::coverage::{CaseSpec, Method, Outcome, RunRecord, write_case};
 use std::collections::BTreeSet;
 use std::io::Write;

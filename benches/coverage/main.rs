@@ -15,6 +15,7 @@
 
 mod jobs;
 mod report;
+mod run;
 
 use clap::Parser;
 use ctcal::coverage::{Generator, Method};

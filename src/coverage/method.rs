@@ -1,10 +1,8 @@
 //! The methods whose intervals the study scores, how each is called, which cases it
 //! applies to, and which parameters it reports.
 
-use super::case::{CaseSpec, RecordingSpec};
+use super::case::CaseSpec;
 use serde::{Deserialize, Serialize};
-use std::ffi::OsString;
-use std::path::Path;
 
 /// A ctcal command that reports values with 95 % intervals.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -15,8 +13,8 @@ pub enum Method {
     /// `ctcal estimate eppps`: thresholds from the event rate (through the frames'
     /// contrast where the case has frames).
     Eppps,
-    /// `ctcal estimate eppps --ignore-frames`: the same from the events alone, through the
-    /// natural-image prior (what a sensor without frames gets).
+    /// `ctcal estimate eppps` told to leave the frames aside: the same from the events
+    /// alone, through the natural-image prior (what a sensor without frames gets).
     EpppsEvents,
     /// `ctcal estimate screen`: thresholds from an on-screen stimulus.
     Screen,
@@ -67,33 +65,6 @@ impl Method {
     /// On-screen cases go to `screen` only; every other case to the rest.
     pub fn applies_to(self, case: &CaseSpec) -> bool {
         (self == Method::Screen) == case.is_screen()
-    }
-
-    /// The command line after `ctcal` (without `--json -`). The methods that read frames
-    /// are told the frames' exposure, as a user who knows the camera's setting would (the
-    /// IJRR text a case is written in has no field for it).
-    pub fn args(self, input: &Path, case: &CaseSpec) -> Vec<OsString> {
-        let mut args: Vec<OsString> = match self {
-            Method::Fit => vec!["fit".into()],
-            Method::EpppsEvents => vec!["estimate".into(), "eppps".into()],
-            estimate => vec!["estimate".into(), estimate.name().into()],
-        };
-        args.push(input.as_os_str().to_owned());
-        if self == Method::EpppsEvents {
-            args.push("--ignore-frames".into());
-        }
-        let exposure_s = match &case.recording {
-            RecordingSpec::Scene { scene } => scene.aps.as_ref().map(|a| a.exposure_s),
-            RecordingSpec::Screen { .. } => None,
-        };
-        if let Some(e) = exposure_s
-            && matches!(self, Method::Fit | Method::Aps)
-        {
-            // the binary's option, by name (as `run::output_options` names its own)
-            let name = "exposure-s";
-            args.extend([format!("--{name}").into(), e.to_string().into()]);
-        }
-        args
     }
 
     pub fn parameters(self) -> &'static [&'static str] {

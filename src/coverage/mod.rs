@@ -4,8 +4,8 @@
 //! intervals. This module draws random recordings with known parameters ([`CaseSpec::draw`]:
 //! scene family, brightness, speed, frame rate, thresholds and every effect at random
 //! strengths, or the calibration checkerboard on a random display), writes them as IJRR
-//! folders with their truth ([`write_case`]), runs the `ctcal` binary on them
-//! ([`run::run_method`]), reads each parameter's value and interval out of its JSON
+//! folders with their truth ([`write_case`]); the runner (`benches/coverage/run.rs`) runs
+//! the `ctcal` binary on them; this module reads each parameter's value and interval out of its JSON
 //! ([`reported`]) and tabulates the empirical coverage ([`summary`]). The runner is
 //! `benches/coverage/` (`cargo run --release --example coverage`); its measurement is
 //! `benches/coverage/COVERAGE.md`.
@@ -17,7 +17,6 @@ mod draw_scene;
 pub mod method;
 pub mod record;
 pub mod reported;
-pub mod run;
 pub mod summary;
 pub mod truth;
 pub mod write;

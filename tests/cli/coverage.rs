@@ -2,11 +2,15 @@
 //! a seeded random subset: eight drawn cases with APS frames, written with their truth,
 //! estimated by `ctcal estimate aps` and tabulated by the same library code as the study.
 
-use ctcal::coverage::run::{RunOptions, run_method};
 use ctcal::coverage::summary::Summary;
 use ctcal::coverage::{CaseSpec, Method, Reported, RunRecord, write_case};
 use std::path::Path;
 use std::time::Duration;
+
+/// The study's runner (it builds the binary's command line).
+#[path = "../../benches/coverage/run.rs"]
+mod run;
+use run::{RunOptions, run_method};
 
 /// Seeds from here on are drawn; the first [`CASES`] cases with APS frames are used.
 const FIRST_SEED: u64 = 9000;

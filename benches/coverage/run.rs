@@ -1,10 +1,13 @@
 //! Running one method on one case: the `ctcal` binary as a subprocess with `--json -`,
 //! bounded threads and a time limit; stdout and stderr go to files beside the case (so a
 //! large JSON never blocks a pipe), and the outcome is the parsed JSON or the error.
+//!
+//! The binary's command line is built here, on the runner's side: the library
+//! (`ctcal::coverage`) says which method runs on which case, never how the binary spells it.
+//! `tests/cli/coverage.rs` uses this file too.
 
-use super::case::CaseSpec;
-use super::method::Method;
-use super::record::Outcome;
+use ctcal::coverage::{CaseSpec, Method, Outcome, RecordingSpec};
+use std::ffi::OsString;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -72,18 +75,39 @@ pub fn run_method(
     (outcome, started.elapsed().as_secs_f64())
 }
 
+/// The command line after `ctcal` (without the output options). The methods that read
+/// frames are told the frames' exposure, as a user who knows the camera's setting would
+/// (the IJRR text a case is written in has no field for it).
+pub fn command_line(method: Method, input: &Path, case: &CaseSpec) -> Vec<OsString> {
+    let mut args: Vec<OsString> = match method {
+        Method::Fit => vec!["fit".into()],
+        Method::EpppsEvents => vec!["estimate".into(), "eppps".into()],
+        estimate => vec!["estimate".into(), estimate.name().into()],
+    };
+    args.push(input.as_os_str().to_owned());
+    if method == Method::EpppsEvents {
+        args.push("--ignore-frames".into());
+    }
+    let exposure_s = match &case.recording {
+        RecordingSpec::Scene { scene } => scene.aps.as_ref().map(|a| a.exposure_s),
+        RecordingSpec::Screen { .. } => None,
+    };
+    if let Some(e) = exposure_s
+        && matches!(method, Method::Fit | Method::Aps)
+    {
+        args.extend(["--exposure-s".into(), e.to_string().into()]);
+    }
+    args
+}
+
 /// The options of every run: the JSON on stdout, no progress or warnings, `threads` worker
-/// threads (the binary's options, by name).
+/// threads.
 fn output_options(threads: usize) -> Vec<String> {
-    let threads = threads.to_string();
-    [
-        ("json", Some("-")),
-        ("quiet", None),
-        ("threads", Some(threads.as_str())),
-    ]
-    .into_iter()
-    .flat_map(|(name, value)| std::iter::once(format!("--{name}")).chain(value.map(String::from)))
-    .collect()
+    ["--json", "-", "--quiet", "--threads"]
+        .map(String::from)
+        .into_iter()
+        .chain([threads.to_string()])
+        .collect()
 }
 
 fn run(
@@ -95,7 +119,7 @@ fn run(
     let capture = |stream: &str| input.with_extension(format!("{}.{stream}", method.name()));
     let (stdout_path, stderr_path) = (capture("stdout"), capture("stderr"));
     let mut child = Command::new(&options.binary)
-        .args(method.args(input, case))
+        .args(command_line(method, input, case))
         .args(output_options(options.threads))
         .env("HDF5_USE_FILE_LOCKING", "FALSE")
         .stdin(Stdio::null())
