@@ -75,6 +75,15 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
     }
     let mut stats = compute(&recording, args, global)?;
     stats.biases = recording.biases();
+    if let Some(note) = &stats.rate_window_note {
+        warn(
+            global,
+            &format!(
+                "--window {} s: {note} (rate_window_s in the JSON)\n  fix: for finer windows, select a shorter span with --start/--end",
+                args.window
+            ),
+        );
+    }
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
         emit_json(
@@ -222,11 +231,14 @@ fn over_budget_message(recording: &Recording, over: ctcal::stats::OverBudget) ->
 }
 
 fn print_human(s: &SequenceStats) -> std::io::Result<()> {
-    let rate = |r: Option<f64>| {
-        r.map_or("undefined (zero duration)".to_string(), |r| {
-            format!("{r:.6}")
+    // a value, or why it is not determined
+    let shown = |value: Option<String>, key: &str| {
+        value.unwrap_or_else(|| {
+            let why = s.why.get(key).map_or("", String::as_str);
+            format!("not determined: {why}")
         })
     };
+    let rate = |r: Option<f64>| shown(r.map(|r| format!("{r:.6}")), "events_per_pixel_per_second");
     let mut rows = vec![
         (
             "sensor".to_string(),
@@ -255,11 +267,10 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
         ("events/pixel/s".into(), rate(s.events_per_pixel_per_second)),
         (
             "  ON / OFF".into(),
-            format!(
-                "{} / {}",
-                rate(s.on_per_pixel_per_second),
-                rate(s.off_per_pixel_per_second)
-            ),
+            match (s.on_per_pixel_per_second, s.off_per_pixel_per_second) {
+                (Some(on), Some(off)) => format!("{on:.6} / {off:.6}"),
+                _ => "not determined (as above)".into(),
+            },
         ),
         (
             "active pixels".into(),
@@ -267,15 +278,22 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
         ),
         (
             "background activity".into(),
-            format!(
-                "{:.4} Hz per pixel (events with no neighbour event in the {} before; hot pixels excluded)",
-                s.background_rate_hz,
-                output::seconds(s.support_window_s)
+            shown(
+                s.background_rate_hz.map(|r| {
+                    format!(
+                        "{r:.4} Hz per pixel (events with no neighbour event in the {} before; hot pixels excluded)",
+                        output::seconds(s.support_window_s)
+                    )
+                }),
+                "background_rate_hz",
             ),
         ),
         (
             "median pixel rate".into(),
-            format!("{:.4} Hz", s.median_pixel_rate_hz),
+            shown(
+                s.median_pixel_rate_hz.map(|r| format!("{r:.4} Hz")),
+                "median_pixel_rate_hz",
+            ),
         ),
         (
             "same-pixel interval".into(),
@@ -304,14 +322,14 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
     let peak = s
         .rate_timeline
         .iter()
-        .map(|w| w.events_per_pixel_per_second)
+        .filter_map(|w| w.events_per_pixel_per_second)
         .fold(0.0, f64::max);
     rows.push((
         "rate timeline".into(),
         format!(
             "{} windows of {}, peak {peak:.3} e/pix/s",
             s.rate_timeline.len(),
-            output::seconds(s.rate_timeline.first().map_or(0.0, |w| w.window_s))
+            output::seconds(s.rate_window_s)
         ),
     ));
     rows.push((

@@ -50,6 +50,54 @@ fn json_carries_every_contract_key() {
 }
 
 #[test]
+fn a_window_counts_its_own_frames_and_leaves_undetermined_rates_null_with_why() {
+    let input = real("ijrr_slider_depth_50k");
+    let input = input.to_str().unwrap();
+    // slider_depth's 5 frames are 38.8 ms apart from t = 0: 1 ms at 50 ms holds none
+    let s = json(&["stats", input, "--start", "0.05", "--end", "0.051"]);
+    assert_eq!(s["frames"]["count"], 0);
+    assert!(s["frames"]["median_interval_s"].is_null());
+    assert!(s["why"]["frames.median_interval_s"].is_string());
+    // frames inside [0, 0.1 s] from the first event (3811 us): the first three
+    let s = json(&["stats", input, "--end", "0.1"]);
+    assert_eq!(s["frames"]["count"], 3, "{}", s["frames"]);
+    // one instant: one event, no duration, so no rate; each null says why
+    let s = json(&["stats", input, "--start", "0", "--end", "0"]);
+    assert_eq!(
+        (s["events"].as_u64(), s["duration_s"].as_f64()),
+        (Some(1), Some(0.0))
+    );
+    for key in [
+        "events_per_pixel_per_second",
+        "background_rate_hz",
+        "median_pixel_rate_hz",
+    ] {
+        assert!(s[key].is_null(), "{key}: {}", s[key]);
+        assert!(s["why"][key].as_str().unwrap().contains("no time"), "{key}");
+    }
+    assert!(s["rate_timeline"][0]["events_per_pixel_per_second"].is_null());
+}
+
+#[test]
+fn a_window_too_fine_for_the_span_is_widened_and_said() {
+    let input = real("ijrr_slider_depth_50k");
+    // not quiet: the warning is part of what is tested
+    let out = succeeded(
+        std::process::Command::new(assert_cmd::cargo::cargo_bin("ctcal"))
+            .args(["stats", input.to_str().unwrap(), "--window", "0.000001"])
+            .args(["--json", "-"])
+            .output(),
+    );
+    let s: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // 170,345 us in 1 us windows is more than 100,000 windows: merged by 2, 85,172.5 of
+    // them rounded to 85,173 (the last absorbs the remainder)
+    assert_eq!(s["rate_window_s"], 2e-6);
+    assert_eq!(s["rate_timeline"].as_array().unwrap().len(), 85_173);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("2 us used"), "{stderr}");
+}
+
+#[test]
 fn finds_the_injected_hot_pixels_of_the_oracle() {
     let params = oracle_params("dev_hot_pixels");
     let injected: Vec<(u64, u64)> = params["post_processing"]["injection"]["hot_pixels"]

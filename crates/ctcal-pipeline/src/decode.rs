@@ -260,9 +260,9 @@ structs! {
     SequenceStats { biases, width, height, sensor_source, events, on_events, off_events,
         on_fraction, t_first_us, t_last_us, duration_s, events_per_pixel_per_second,
         on_per_pixel_per_second, off_per_pixel_per_second, active_pixel_fraction,
-        rate_timeline, hot_pixels, hot_pixel_method, background_rate_hz,
-        background_rate_method, support_window_s, median_pixel_rate_hz,
-        inter_event_interval_s, frames, pixels_kept, selection, excluded_hot_pixels }
+        rate_timeline, rate_window_s, rate_window_note, hot_pixels, hot_pixel_method,
+        background_rate_hz, background_rate_method, support_window_s, median_pixel_rate_hz,
+        inter_event_interval_s, frames, pixels_kept, selection, excluded_hot_pixels, why }
     RateWindow { t_s, window_s, events, events_per_pixel_per_second }
     HotPixel { x, y, events, rate_hz, z }
     IntervalSummary { p5, median, count, resolution }

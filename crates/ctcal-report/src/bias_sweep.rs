@@ -52,7 +52,8 @@ pub struct SweepPoint {
     pub value: i64,
     /// The best thresholds (ON, OFF) and the method they come from, where measured.
     pub thresholds: Option<(f64, f64, &'static str)>,
-    pub background_rate_hz: f64,
+    /// Null where the recording does not determine it (see its statistics' `why`).
+    pub background_rate_hz: Option<f64>,
 }
 
 /// For each bias that differs between recordings of one sensor, the recordings that set it,
@@ -124,7 +125,7 @@ pub fn bias_sweep(sequences: &[&SequenceReport]) -> Option<Table> {
         floats(
             "background_rate_hz",
             with.iter()
-                .map(|(s, _)| Some(s.stats.background_rate_hz))
+                .map(|(s, _)| s.stats.background_rate_hz)
                 .collect(),
         ),
     ]);

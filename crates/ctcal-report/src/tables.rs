@@ -88,10 +88,7 @@ pub fn statistics(sequences: &[&SequenceReport]) -> Table {
                 "active_pixel_fraction",
                 s(&|q| Some(q.stats.active_pixel_fraction)),
             ),
-            floats(
-                "background_rate_hz",
-                s(&|q| Some(q.stats.background_rate_hz)),
-            ),
+            floats("background_rate_hz", s(&|q| q.stats.background_rate_hz)),
             counts(
                 "hot_pixels",
                 sequences

@@ -36,6 +36,7 @@ use kernel::WindowCounter;
 use pixel_grid::PixelGrid;
 pub use pixel_grid::{BYTES_PER_PIXEL, PIXEL_BUDGET};
 use serde::Serialize;
+use std::collections::BTreeMap;
 pub use timeline::{FrameSummary, RateWindow};
 
 /// How `background_rate_hz` is defined (reported with it).
@@ -127,16 +128,24 @@ pub struct SequenceStats {
     pub off_per_pixel_per_second: Option<f64>,
     pub active_pixel_fraction: f64,
     pub rate_timeline: Vec<RateWindow>,
+    /// The window the rate timeline uses, seconds: the one asked for, unless that would
+    /// give more than [`timeline::MAX_WINDOWS`] windows (then a whole multiple of it, said
+    /// under `rate_window_note`).
+    pub rate_window_s: f64,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rate_window_note: Option<String>,
     pub hot_pixels: Vec<HotPixel>,
     pub hot_pixel_method: &'static str,
     /// Background activity: unsupported events per pixel per second, hot pixels excluded
-    /// (see [`BACKGROUND_RATE_METHOD`]).
-    pub background_rate_hz: f64,
+    /// (see [`BACKGROUND_RATE_METHOD`]); null (reason under `why`) when the duration is zero
+    /// or every kept pixel is hot.
+    pub background_rate_hz: Option<f64>,
     pub background_rate_method: &'static str,
     /// The support window of `background_rate_hz`, seconds.
     pub support_window_s: f64,
-    /// Median over all pixels of each pixel's events / duration_s.
-    pub median_pixel_rate_hz: f64,
+    /// Median over all pixels of each pixel's events / duration_s; null when the duration
+    /// is zero.
+    pub median_pixel_rate_hz: Option<f64>,
     pub inter_event_interval_s: IntervalSummary,
     pub frames: Option<FrameSummary>,
     /// Pixels every per-pixel quantity divides by (all of the sensor's, unless a region,
@@ -147,6 +156,9 @@ pub struct SequenceStats {
     /// them.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub excluded_hot_pixels: Vec<HotPixel>,
+    /// Why each value reported as null is not determined (key: the field's name).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub why: BTreeMap<String, String>,
 }
 
 /// Accumulates statistics chunk by chunk.
@@ -398,6 +410,17 @@ impl StatsAccumulator {
                 .collect();
         let background_rate_hz =
             background_rate(&unsupported, area_w, &hot, duration_s, &keep, kept_pixels);
+        let median_pixel_rate_hz = median_rate(&counts, silent, duration_s);
+        let timeline = timeline::rate_timeline(
+            &self.windows.timeline,
+            self.window_us,
+            self.last - first,
+            us_to_s(first - self.stream_first.unwrap_or(first)),
+            pixels,
+        );
+        let frames =
+            timeline::frame_summary(&self.frames_selected(frame_times), !frame_times.is_empty());
+        let why = undetermined(duration_s, &background_rate_hz, &timeline, frames.as_ref());
         let off = self.events - self.on;
         Some(SequenceStats {
             biases: None,
@@ -415,19 +438,15 @@ impl StatsAccumulator {
             on_per_pixel_per_second: per_pixel_per_second(self.on),
             off_per_pixel_per_second: per_pixel_per_second(off),
             active_pixel_fraction: active as f64 / pixels,
-            rate_timeline: timeline::rate_timeline(
-                &self.windows.timeline,
-                self.window_us,
-                self.last - first,
-                us_to_s(first - self.stream_first.unwrap_or(first)),
-                pixels,
-            ),
+            rate_window_s: us_to_s(timeline.window_us),
+            rate_window_note: timeline.note(self.window_us),
+            rate_timeline: timeline.windows,
             hot_pixels: hot,
             hot_pixel_method: hot_pixels::METHOD,
-            background_rate_hz,
+            background_rate_hz: background_rate_hz.ok(),
             background_rate_method: BACKGROUND_RATE_METHOD,
             support_window_s: us_to_s(self.support_us),
-            median_pixel_rate_hz: median_rate(&counts, silent, duration_s),
+            median_pixel_rate_hz,
             pixels_kept: kept_pixels as u64,
             selection: selection.map_or_else(|| "the whole sensor".into(), |s| s.description()),
             excluded_hot_pixels: Vec::new(),
@@ -437,9 +456,63 @@ impl StatsAccumulator {
                 count: self.intervals.total(),
                 resolution: "histogram quantiles: exact below 128 us, above that within 1/128 (0.8 %) of the value",
             },
-            frames: timeline::frame_summary(frame_times),
+            frames,
+            why,
         })
     }
+
+    /// The frame times within the selected time window (all of them without one).
+    fn frames_selected(&self, frame_times: &[TimeUs]) -> Vec<TimeUs> {
+        frame_times
+            .iter()
+            .copied()
+            .filter(|t| (self.select_from..=self.select_to).contains(t))
+            .collect()
+    }
+}
+
+/// Why each value the statistics leave null is not determined.
+fn undetermined(
+    duration_s: f64,
+    background_rate_hz: &Result<f64, String>,
+    timeline: &timeline::Timeline,
+    frames: Option<&FrameSummary>,
+) -> BTreeMap<String, String> {
+    let mut why = BTreeMap::new();
+    if duration_s <= 0.0 {
+        let reason = "the selected events span no time (first and last at the same microsecond): a rate needs a duration";
+        for key in [
+            "events_per_pixel_per_second",
+            "on_per_pixel_per_second",
+            "off_per_pixel_per_second",
+            "median_pixel_rate_hz",
+        ] {
+            why.insert(key.to_string(), reason.to_string());
+        }
+    }
+    if let Err(reason) = background_rate_hz {
+        why.insert("background_rate_hz".into(), reason.clone());
+    }
+    if timeline
+        .windows
+        .iter()
+        .any(|w| w.events_per_pixel_per_second.is_none())
+    {
+        why.insert(
+            "rate_timeline".into(),
+            "a window of zero length (the selected events span no time) has no rate".into(),
+        );
+    }
+    if let Some(f) = frames.filter(|f| f.count < 2) {
+        why.insert(
+            "frames.median_interval_s".into(),
+            format!(
+                "{} frame(s) in the selected time window: an interval needs two",
+                f.count
+            ),
+        );
+    }
+    why
 }
 
 /// Unsupported events per pixel per second over the kept pixels that are not hot (`hot`
@@ -451,9 +524,9 @@ fn background_rate(
     duration_s: f64,
     keep: &impl Fn(usize) -> bool,
     kept_pixels: usize,
-) -> f64 {
+) -> Result<f64, String> {
     if duration_s <= 0.0 {
-        return 0.0;
+        return Err("the selected events span no time: a rate needs a duration".into());
     }
     let hot_events: u64 = hot
         .iter()
@@ -465,17 +538,19 @@ fn background_rate(
         .sum();
     let kept = kept_pixels - hot.len();
     if kept == 0 {
-        return 0.0;
+        return Err(format!(
+            "every one of the {kept_pixels} kept pixel(s) is hot: no pixel is left to measure background activity on"
+        ));
     }
-    (total - hot_events) as f64 / (kept as f64 * duration_s)
+    Ok((total - hot_events) as f64 / (kept as f64 * duration_s))
 }
 
 /// Median over all pixels of events / duration: the pixels of `counts` and `zeros` more
 /// without events.
-fn median_rate(counts: &[u32], zeros: usize, duration_s: f64) -> f64 {
+fn median_rate(counts: &[u32], zeros: usize, duration_s: f64) -> Option<f64> {
     let n = counts.len() + zeros;
     if duration_s <= 0.0 || n == 0 {
-        return 0.0;
+        return None;
     }
     // in sorted order the extra zeros come first (no count is smaller)
     let mut sorted = counts.to_vec();
@@ -492,7 +567,7 @@ fn median_rate(counts: &[u32], zeros: usize, duration_s: f64) -> f64 {
     } else {
         (nth(mid - 1) + nth(mid)) / 2.0
     };
-    median / duration_s
+    Some(median / duration_s)
 }
 
 #[cfg(test)]
@@ -522,10 +597,10 @@ mod tests {
         acc.add(&chunk);
         let s = acc.finish(Sensor::new(4, 3), "test", &[]).unwrap();
         // 4 unsupported events over 12 pixels and 0.1 s
+        let background = s.background_rate_hz.unwrap();
         assert!(
-            (s.background_rate_hz - 4.0 / (12.0 * 0.1)).abs() < 1e-12,
-            "{}",
-            s.background_rate_hz
+            (background - 4.0 / (12.0 * 0.1)).abs() < 1e-12,
+            "{background}"
         );
         assert_eq!(s.support_window_s, 0.01);
     }
@@ -582,13 +657,14 @@ mod tests {
         assert_eq!(s.rate_timeline.len(), 2);
         assert_eq!(s.rate_timeline[0].events, 2);
         assert_eq!(s.rate_timeline[1].events, 2);
-        assert_eq!(s.rate_timeline[1].events_per_pixel_per_second, 1.0);
+        assert_eq!(s.rate_timeline[1].events_per_pixel_per_second, Some(1.0));
         // per-pixel counts 3, 0, 0, 1 -> median 0.5 events over 1 s
-        assert_eq!(s.median_pixel_rate_hz, 0.5);
+        assert_eq!(s.median_pixel_rate_hz, Some(0.5));
         // (1,1) at 0.25 s has no neighbour event in the 10 ms before it, nor have the three
         // events of (0,0) (its neighbour (1,1) fired 250 ms before 0.5 s): 4 unsupported
         // events over 4 pixels and 1 s
-        assert_eq!(s.background_rate_hz, 1.0);
+        assert_eq!(s.background_rate_hz, Some(1.0));
+        assert!(s.why.is_empty(), "{:?}", s.why);
         assert_eq!(
             s.frames,
             Some(FrameSummary {
@@ -623,8 +699,9 @@ mod tests {
         assert_eq!(b.inter_event_interval_s, a.inter_event_interval_s);
         let scale = small.pixels() as f64 / huge.pixels() as f64;
         assert!((b.active_pixel_fraction - a.active_pixel_fraction * scale).abs() < 1e-15);
-        assert!((b.background_rate_hz - a.background_rate_hz * scale).abs() < 1e-12);
-        assert_eq!(b.median_pixel_rate_hz, 0.0);
+        let (ba, bb) = (a.background_rate_hz.unwrap(), b.background_rate_hz.unwrap());
+        assert!((bb - ba * scale).abs() < 1e-12);
+        assert_eq!(b.median_pixel_rate_hz, Some(0.0));
         // events far apart on the huge sensor pass the budget: the pass stops
         let far: EventChunk = [event(0, 1, 1), event(10, 60_000, 60_000)]
             .into_iter()
@@ -646,11 +723,11 @@ mod tests {
 
     #[test]
     fn median_counts_the_pixels_without_events() {
-        assert_eq!(median_rate(&[4, 2, 8], 0, 1.0), 4.0);
-        assert_eq!(median_rate(&[4, 2, 8], 1, 1.0), 3.0);
-        assert_eq!(median_rate(&[4, 2, 8], 2, 2.0), 1.0);
-        assert_eq!(median_rate(&[], 3, 1.0), 0.0);
-        assert_eq!(median_rate(&[6, 6], 0, 2.0), 3.0);
+        assert_eq!(median_rate(&[4, 2, 8], 0, 1.0), Some(4.0));
+        assert_eq!(median_rate(&[4, 2, 8], 1, 1.0), Some(3.0));
+        assert_eq!(median_rate(&[4, 2, 8], 2, 2.0), Some(1.0));
+        assert_eq!(median_rate(&[], 3, 1.0), Some(0.0));
+        assert_eq!(median_rate(&[6, 6], 0, 2.0), Some(3.0));
     }
 
     #[test]
@@ -677,5 +754,67 @@ mod tests {
         assert!((s.rate_timeline[0].t_s - 0.2).abs() < 1e-12);
         assert_eq!(s.rate_timeline.len(), 3);
         assert_eq!(s.rate_timeline.iter().map(|w| w.events).sum::<u64>(), 4);
+    }
+
+    #[test]
+    fn a_window_of_one_instant_leaves_its_rates_null_and_says_why() {
+        let chunk: EventChunk = [event(0, 0, 0), event(500_000, 1, 1), event(900_000, 0, 1)]
+            .into_iter()
+            .collect();
+        let options = StatsOptions {
+            start_s: Some(0.5),
+            end_s: Some(0.5),
+            ..StatsOptions::default()
+        };
+        let mut acc = StatsAccumulator::new(options, Some(Sensor::new(2, 2)));
+        acc.add(&chunk);
+        // frames at 0.2, 0.4, 0.6 s: none in the window
+        let s = acc
+            .finish(Sensor::new(2, 2), "test", &[200_000, 400_000, 600_000])
+            .unwrap();
+        assert_eq!((s.events, s.duration_s), (1, 0.0));
+        assert_eq!(s.events_per_pixel_per_second, None);
+        assert_eq!(s.background_rate_hz, None);
+        assert_eq!(s.median_pixel_rate_hz, None);
+        assert_eq!(s.rate_timeline.len(), 1);
+        assert_eq!(s.rate_timeline[0].events_per_pixel_per_second, None);
+        assert_eq!(
+            s.frames,
+            Some(FrameSummary {
+                count: 0,
+                median_interval_s: None
+            })
+        );
+        let keys: Vec<&str> = s.why.keys().map(String::as_str).collect();
+        assert_eq!(
+            keys,
+            [
+                "background_rate_hz",
+                "events_per_pixel_per_second",
+                "frames.median_interval_s",
+                "median_pixel_rate_hz",
+                "off_per_pixel_per_second",
+                "on_per_pixel_per_second",
+                "rate_timeline"
+            ]
+        );
+    }
+
+    #[test]
+    fn frames_are_counted_in_the_selected_window() {
+        let chunk: EventChunk = (0..10).map(|i| event(i * 100_000, 0, 0)).collect();
+        let options = StatsOptions {
+            start_s: Some(0.15),
+            end_s: Some(0.65),
+            ..StatsOptions::default()
+        };
+        let mut acc = StatsAccumulator::new(options, Some(Sensor::new(1, 1)));
+        acc.add(&chunk);
+        let frames: Vec<TimeUs> = (0..10).map(|i| i * 100_000 + 50_000).collect();
+        let s = acc.finish(Sensor::new(1, 1), "test", &frames).unwrap();
+        // frames at 0.15, 0.25, ..., 0.65 s are inside [0.15, 0.65]
+        let frames = s.frames.unwrap();
+        assert_eq!(frames.count, 6);
+        assert!((frames.median_interval_s.unwrap() - 0.1).abs() < 1e-12);
     }
 }

@@ -13,7 +13,29 @@ pub struct RateWindow {
     /// one and a half windows).
     pub window_s: f64,
     pub events: u64,
-    pub events_per_pixel_per_second: f64,
+    /// Null for a window of zero length (the selected events span no time).
+    pub events_per_pixel_per_second: Option<f64>,
+}
+
+/// A rate timeline and the window it used.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Timeline {
+    pub windows: Vec<RateWindow>,
+    /// The window used, microseconds: the one asked for, or a whole multiple of it when
+    /// that would have given more than [`MAX_WINDOWS`] windows.
+    pub window_us: TimeUs,
+}
+
+impl Timeline {
+    /// What was changed, when the window used is not the one asked for (`asked_us`).
+    pub fn note(&self, asked_us: TimeUs) -> Option<String> {
+        (self.window_us != asked_us).then(|| {
+            format!(
+                "windows of {} us asked for; {} us used: the selected span would have given more than {MAX_WINDOWS} windows",
+                asked_us, self.window_us
+            )
+        })
+    }
 }
 
 /// The most windows a rate timeline has; a longer recording (or one whose timestamps jump)
@@ -48,7 +70,7 @@ pub fn rate_timeline(
     span_us: TimeUs,
     offset_s: f64,
     pixels: f64,
-) -> Vec<RateWindow> {
+) -> Timeline {
     let natural = ((span_us as f64 / window_us as f64).round() as u64).max(1);
     let factor = natural.div_ceil(MAX_WINDOWS as u64).max(1);
     let window_us = window_us.saturating_mul(factor as TimeUs);
@@ -59,7 +81,7 @@ pub fn rate_timeline(
         merged[k] += events;
     }
     let n = merged.len();
-    merged
+    let windows = merged
         .iter()
         .enumerate()
         .map(|(k, &events)| {
@@ -73,14 +95,12 @@ pub fn rate_timeline(
                 t_s: offset_s + us_to_s(k as TimeUs * window_us),
                 window_s,
                 events,
-                events_per_pixel_per_second: if window_s > 0.0 {
-                    events as f64 / (pixels * window_s)
-                } else {
-                    0.0
-                },
+                events_per_pixel_per_second: (window_s > 0.0)
+                    .then(|| events as f64 / (pixels * window_s)),
             }
         })
-        .collect()
+        .collect();
+    Timeline { windows, window_us }
 }
 
 /// Frame timing.
@@ -90,9 +110,11 @@ pub struct FrameSummary {
     pub median_interval_s: Option<f64>,
 }
 
-/// Count and median interval of the frame times.
-pub fn frame_summary(times: &[TimeUs]) -> Option<FrameSummary> {
-    if times.is_empty() {
+/// Count and median interval of the frame times of the selected window; `None` when the
+/// recording has no frames (`recording_has_frames` false), a count of 0 when it has some but
+/// none in the window.
+pub fn frame_summary(times: &[TimeUs], recording_has_frames: bool) -> Option<FrameSummary> {
+    if !recording_has_frames {
         return None;
     }
     let mut gaps: Vec<TimeUs> = times.windows(2).map(|w| w[1] - w[0]).collect();
@@ -125,7 +147,14 @@ mod tests {
         sparse.add(1_000_000_000, 7);
         assert_eq!(sparse.windows, vec![(0, 10), (1_000_000_000, 7)]);
         let span = 10_000_000_000_000; // 1e7 s in us
-        let windows = rate_timeline(&sparse, 10_000, span, 0.0, 1.0);
+        let timeline = rate_timeline(&sparse, 10_000, span, 0.0, 1.0);
+        // 1e9 natural windows merged by 10,000 into 100 s windows, and said
+        assert_eq!(timeline.window_us, 100_000_000);
+        assert_eq!(
+            timeline.note(10_000).unwrap(),
+            "windows of 10000 us asked for; 100000000 us used: the selected span would have given more than 100000 windows"
+        );
+        let windows = timeline.windows;
         assert_eq!(windows.len(), MAX_WINDOWS);
         assert_eq!(windows[0].events, 10);
         assert_eq!(windows.last().unwrap().events, 7);
@@ -134,6 +163,42 @@ mod tests {
             (windows[0].window_s - 100.0).abs() < 1e-9,
             "{}",
             windows[0].window_s
+        );
+    }
+
+    #[test]
+    fn a_zero_length_span_has_one_window_without_a_rate() {
+        let mut sparse = SparseTimeline::default();
+        sparse.add(0, 1);
+        let timeline = rate_timeline(&sparse, 10_000, 0, 0.0, 100.0);
+        assert_eq!(timeline.note(10_000), None);
+        assert_eq!(
+            timeline.windows,
+            vec![RateWindow {
+                t_s: 0.0,
+                window_s: 0.0,
+                events: 1,
+                events_per_pixel_per_second: None
+            }]
+        );
+    }
+
+    #[test]
+    fn frames_of_the_window_are_counted_and_a_window_without_frames_says_zero() {
+        assert_eq!(frame_summary(&[], false), None);
+        assert_eq!(
+            frame_summary(&[], true),
+            Some(FrameSummary {
+                count: 0,
+                median_interval_s: None
+            })
+        );
+        assert_eq!(
+            frame_summary(&[0, 40_000, 80_000, 130_000], true),
+            Some(FrameSummary {
+                count: 4,
+                median_interval_s: Some(0.04)
+            })
         );
     }
 }

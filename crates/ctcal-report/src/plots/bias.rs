@@ -31,7 +31,7 @@ pub(super) fn sweep(bias: &str, points: &[SweepPoint]) -> Pair {
             label("background", sensor),
             of_sensor
                 .iter()
-                .map(|p| (p.value as f64, p.background_rate_hz))
+                .filter_map(|p| Some((p.value as f64, p.background_rate_hz?)))
                 .collect(),
         ));
     }

@@ -250,7 +250,9 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
                 s.stats
                     .rate_timeline
                     .iter()
-                    .map(|w| (w.t_s + 0.5 * w.window_s, w.events_per_pixel_per_second))
+                    .filter_map(|w| {
+                        Some((w.t_s + 0.5 * w.window_s, w.events_per_pixel_per_second?))
+                    })
                     .collect(),
             )],
             zero: false,
