@@ -42,6 +42,9 @@ pub struct EpppsArgs {
     /// larger one).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
+    /// Seed of the calibration simulations (`ctcal report --seed` gives the same numbers).
+    #[arg(long, value_name = "N", default_value_t = ctcal::DEFAULT_SEED)]
+    pub seed: u64,
 }
 
 #[derive(Args, Debug)]
@@ -216,6 +219,7 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
         &options,
         eppps::EpppsOptions {
             scenes: args.scenes,
+            seed: args.seed,
             ..eppps::EpppsOptions::default()
         },
         &progress,

@@ -39,6 +39,9 @@ pub struct FitArgs {
     /// result (e.g. `estimate screen` on the same recording) instead of running eppps.
     #[arg(long, value_name = "ESTIMATE.json")]
     pub thresholds_from: Option<std::path::PathBuf>,
+    /// Seed of every simulation of the fit (`ctcal report --seed` gives the same numbers).
+    #[arg(long, value_name = "N", default_value_t = ctcal::DEFAULT_SEED)]
+    pub seed: u64,
 }
 
 /// Reads the thresholds of an `estimate --json` result.
@@ -195,6 +198,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
             ..ApsOptions::default()
         },
         thresholds,
+        seed: args.seed,
         ..FitOptions::default()
     };
     let result = ctcal::fit::fit(

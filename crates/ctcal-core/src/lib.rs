@@ -21,6 +21,12 @@ pub mod selection;
 pub mod sensors;
 
 pub use events::{CHUNK_EVENTS, Event, EventChunk, Frame, Sensor, TimeUs};
+
+/// The seed of the fit's and eppps's simulations unless one is given (the year of
+/// Stoffregen et al.'s paper), the same in `fit`, `estimate eppps` and `report`, so that
+/// each reproduces the others' numbers. (aps's re-simulation keeps its own fixed seed,
+/// `estimate::aps::ApsOptions::default`.)
+pub const DEFAULT_SEED: u64 = 2020;
 pub mod sim;
 pub mod stats;
 pub mod synthetic;

@@ -63,7 +63,7 @@ impl Default for Options {
             end_s: None,
             max_frames: 120,
             screen: None,
-            seed: 2020,
+            seed: ctcal_core::DEFAULT_SEED,
             fit_left_out: None,
             selection: SelectionSpec::default(),
             force: false,

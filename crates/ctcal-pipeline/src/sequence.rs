@@ -139,10 +139,12 @@ pub fn sequence(
             progress,
         },
     )?;
-    // frames thinned to the limit: the frame-based methods read blocks of consecutive
-    // frames instead (see `ctcal_io::frame_blocks`), whose optical flow still holds
-    // (from the events already read: the recording is decoded once)
-    let blocks = (loaded.frames_available > loaded.frame_limit)
+    // the frame-based methods (aps, fit) read the events between the first and last frame,
+    // in blocks of consecutive frames where the frames pass the limit (see
+    // `ctcal_io::frame_blocks`: their optical flow still holds), as `ctcal estimate aps`
+    // and `ctcal fit` read them, so that the report's numbers are theirs (from the events
+    // already read: the recording is decoded once)
+    let blocks = (loaded.frames.len() >= 2)
         .then(|| crate::window::load_blocks(&loaded, &window, &crate::window::Silent))
         .map(|read| {
             read.map_err(|e| format!("the blocks of consecutive frames could not be read: {e}"))

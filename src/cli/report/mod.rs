@@ -56,7 +56,7 @@ pub struct ReportArgs {
     #[arg(long, value_name = "SCREEN.toml")]
     pub screen: Option<PathBuf>,
     /// Seed of every simulation.
-    #[arg(long, value_name = "N", default_value_t = 2020)]
+    #[arg(long, value_name = "N", default_value_t = ctcal::DEFAULT_SEED)]
     pub seed: u64,
     #[command(flatten)]
     pub selection: SelectionArgs,

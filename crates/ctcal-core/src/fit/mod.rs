@@ -79,7 +79,7 @@ impl Default for FitOptions {
             aps: crate::estimate::aps::ApsOptions::default(),
             default_threshold: 0.3,
             thresholds: None,
-            seed: 2020,
+            seed: crate::DEFAULT_SEED,
         }
     }
 }

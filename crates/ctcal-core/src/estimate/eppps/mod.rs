@@ -70,7 +70,7 @@ impl Default for EpppsOptions {
         Self {
             scenes: prior::COUNT,
             use_frames: true,
-            seed: 2020,
+            seed: crate::DEFAULT_SEED,
         }
     }
 }
