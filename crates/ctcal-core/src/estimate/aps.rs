@@ -251,7 +251,10 @@ pub fn estimate(
         ));
     }
     let exposure = super::frames::exposure_of(input.frames, options.exposure_us);
-    assumptions.push(format!("log response: {}", options.log_response_name));
+    assumptions.push(format!(
+        "log response: {}, of the frame value plus the frames' log offset b (DN + b; b as said below)",
+        options.log_response_name
+    ));
     assumptions.push(format!(
         "frames: {} of {} intervals used; frame times are exposure midpoints (as the file gives them); {}",
         used,
@@ -535,24 +538,12 @@ pub fn estimate(
         "frame_offset_dn".into(),
         json!({"value": frames.offset, "estimate": offset_report}),
     );
-    estimate.extra.insert(
-        "photoreceptor_lag".into(),
-        json!({
-            "tau_times_dn_s": full.timing.lag.tau_times_dn,
-            "standard_error": full.timing.lag.standard_error,
-            "cutoff_hz_at_median_dn": full.timing.lag.cutoff_hz_at_median_dn,
-            "meaning": "the photoreceptor's lag behind the light, tau = tau_times_dn / (DN + b), measured from how pairs of events straddling a change of speed deviate; taken out of the thresholds",
-        }),
-    );
-    estimate.extra.insert(
-        "leak_drift".into(),
-        json!({
-            "log_units_per_second_at_median_dn": full.timing.drift.at_median_dn,
-            "standard_error": full.timing.drift.standard_error,
-            "per_dn": full.timing.drift.per_dn,
-            "meaning": "the memorised level's downward drift the event timing measured (ON events come early, OFF late); taken out of the thresholds",
-        }),
-    );
+    estimate
+        .extra
+        .insert("photoreceptor_lag".into(), lag_report(&full.timing.lag));
+    estimate
+        .extra
+        .insert("leak_drift".into(), drift_report(&full.timing.drift));
     estimate.extra.insert(
         "time_span_s".into(),
         json!([
@@ -730,6 +721,47 @@ fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
     (v.max(0.0) + super::interval::z95() * se).sqrt()
 }
 
+/// Whether a nuisance coefficient of the event timing differs from zero at 95 %, in words.
+fn resolved(value: f64, standard_error: f64) -> &'static str {
+    if value.abs() > super::interval::z95() * standard_error {
+        "resolved: differs from zero at 95 %"
+    } else {
+        "not resolved: within 1.96 standard errors of zero"
+    }
+}
+
+/// The photoreceptor lag the timing took out of the thresholds, for the JSON: a coefficient
+/// of its regression, so noise can make it negative (no lag to speak of); the cutoff it
+/// stands for exists only for a positive lag, and where there is none the reason says so.
+fn lag_report(lag: &super::timing::Lag) -> serde_json::Value {
+    let mut report = json!({
+        "tau_times_dn_s": lag.tau_times_dn,
+        "standard_error": lag.standard_error,
+        "resolved": resolved(lag.tau_times_dn, lag.standard_error),
+        "cutoff_hz_at_median_dn": lag.cutoff_hz_at_median_dn,
+        "median_dn": lag.median_dn,
+        "meaning": "the photoreceptor's lag behind the light, tau = tau_times_dn / (DN + b), measured from how pairs of events straddling a change of speed deviate; taken out of the thresholds (a regression coefficient: noise makes it negative where there is no lag)",
+    });
+    if lag.cutoff_hz_at_median_dn.is_none() {
+        report["why"] = json!(format!(
+            "no cutoff: the lag measured is not positive ({:.2e} s DN, standard error {:.1e}), so it stands for no photoreceptor bandwidth limit (a negative value beyond its noise is an effect the timing model lacks, such as refractory delays, not a lag)",
+            lag.tau_times_dn, lag.standard_error
+        ));
+    }
+    report
+}
+
+/// The drift of the memorised level the timing took out of the thresholds, for the JSON.
+fn drift_report(drift: &super::timing::Drift) -> serde_json::Value {
+    json!({
+        "log_units_per_second_at_median_dn": drift.at_median_dn,
+        "standard_error": drift.standard_error,
+        "resolved": resolved(drift.at_median_dn, drift.standard_error),
+        "per_dn": drift.per_dn,
+        "meaning": "the memorised level's drift the event timing measured, positive downward (leak: ON events come early, OFF late); a negative value is an upward drift, which leak does not make: noise, or an effect the timing lacks; taken out of the thresholds either way",
+    })
+}
+
 /// The offset, in words for the assumptions.
 fn offset_assumption(o: &super::timing::Offset) -> String {
     let side = |v: Option<f32>| v.map_or("open".to_string(), |v| format!("{v:.1}"));
@@ -823,7 +855,42 @@ fn self_calibrate(
 
 #[cfg(test)]
 mod tests {
-    use super::interpolation_corrected;
+    use super::{drift_report, interpolation_corrected, lag_report};
+
+    #[test]
+    fn a_negative_lag_has_no_cutoff_and_says_why_and_an_upward_drift_says_what_it_is() {
+        // slider_depth's event timing: tau (DN + b) -0.0071 s DN, a drift of -0.29 log/s
+        let lag = super::super::timing::Lag {
+            tau_times_dn: -0.0071,
+            standard_error: 0.002,
+            cutoff_hz_at_median_dn: None,
+            median_dn: 80.0,
+        };
+        let report = lag_report(&lag);
+        assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
+        assert!(report["cutoff_hz_at_median_dn"].is_null());
+        assert!(report["why"].as_str().unwrap().contains("not positive"));
+        let lag = super::super::timing::Lag {
+            standard_error: 0.004,
+            cutoff_hz_at_median_dn: Some(120.0),
+            ..lag
+        };
+        let report = lag_report(&lag);
+        assert_eq!(
+            report["resolved"],
+            "not resolved: within 1.96 standard errors of zero"
+        );
+        assert!(report.get("why").is_none());
+        let drift = super::super::timing::Drift {
+            at_zero_dn: -0.3,
+            per_dn: 0.0001,
+            at_median_dn: -0.29,
+            standard_error: 0.1,
+        };
+        let report = drift_report(&drift);
+        assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
+        assert!(report["meaning"].as_str().unwrap().contains("upward drift"));
+    }
 
     #[test]
     fn the_interpolations_share_is_put_back_into_a_resimulated_threshold() {
