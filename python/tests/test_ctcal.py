@@ -112,6 +112,17 @@ def test_stats_of_a_window_equal_the_command() -> None:
     assert got == cli("stats", str(path), "--start", "0.5", "--end", "1.5", "--window", "0.05")
 
 
+def test_stats_of_one_instant_leave_rates_undetermined_with_reasons() -> None:
+    path = REAL / "ijrr_slider_depth_50k"
+    got = ctcal.stats(path, start=0.0, end=0.0)
+    assert got["events"] == 1 and got["duration_s"] == 0.0
+    for key in ("events_per_pixel_per_second", "background_rate_hz", "median_pixel_rate_hz"):
+        assert got[key] is None, key
+        assert "no time" in got["why"][key], key
+    # slider_depth's five frames lie outside this instant
+    assert got["frames"] == {"count": 0, "median_interval_s": None}
+
+
 def test_stats_of_events_in_memory_count_what_was_read() -> None:
     path = REAL / "evk4_faery_evt3.raw"
     events = ctcal.read(path)
