@@ -97,6 +97,14 @@ impl EventColumns {
     }
 }
 
+/// A statistics window as `ctcal stats` takes it: an end equal to the start selects one
+/// instant (whose rates are then null, with their reasons); an end before it is an error.
+fn check_stats_window(start: Option<f64>, end: Option<f64>) -> Result<(), String> {
+    let instant = matches!((start, end), (Some(s), Some(e)) if s == e);
+    ctcal_io::window::check_window(start, if instant { None } else { end })
+        .map_err(|e| e.to_string())
+}
+
 /// The events of `path` (between `start` and `end` seconds after the first event) as
 /// four arrays: t (int64 us), x, y (uint16), p (uint8, 1 = ON).
 #[pyfunction]
@@ -616,7 +624,7 @@ fn stats(
     let stats = py
         .detach(|| -> Result<_, String> {
             check_seconds(window_s, support_window_s)?;
-            ctcal_io::window::check_window(start, end).map_err(|e| e.to_string())?;
+            check_stats_window(start, end)?;
             let recording = Recording::open(&path, &open).map_err(|e| e.to_string())?;
             let windowed = start.is_some() || end.is_some();
             let origin = if windowed {

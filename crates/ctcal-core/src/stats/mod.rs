@@ -471,6 +471,9 @@ impl StatsAccumulator {
     }
 }
 
+/// Why a rate of events that span no time is not determined.
+const NO_DURATION: &str = "the selected events span no time (first and last at the same microsecond): a rate needs a duration";
+
 /// Why each value the statistics leave null is not determined.
 fn undetermined(
     duration_s: f64,
@@ -480,14 +483,13 @@ fn undetermined(
 ) -> BTreeMap<String, String> {
     let mut why = BTreeMap::new();
     if duration_s <= 0.0 {
-        let reason = "the selected events span no time (first and last at the same microsecond): a rate needs a duration";
         for key in [
             "events_per_pixel_per_second",
             "on_per_pixel_per_second",
             "off_per_pixel_per_second",
             "median_pixel_rate_hz",
         ] {
-            why.insert(key.to_string(), reason.to_string());
+            why.insert(key.to_string(), NO_DURATION.to_string());
         }
     }
     if let Err(reason) = background_rate_hz {
@@ -526,7 +528,7 @@ fn background_rate(
     kept_pixels: usize,
 ) -> Result<f64, String> {
     if duration_s <= 0.0 {
-        return Err("the selected events span no time: a rate needs a duration".into());
+        return Err(NO_DURATION.into());
     }
     let hot_events: u64 = hot
         .iter()
