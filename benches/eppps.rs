@@ -5,10 +5,15 @@
 //!
 //! Input: the first natural image of the prior (`calib/priors/natural`), unblurred, under
 //! the middle floor; 20 blocks scanning 40 px at 200 px/s in four directions.
+//!
+//! Also the two-sided support filter (`stats::support::supported_two_sided`), which eppps,
+//! the fit's observation, the re-simulation and the event timing run on every recording and
+//! simulation: 1 M events on 240 x 180, four to a microsecond (as EVT3 packs them).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctcal::estimate::eppps::prior;
 use ctcal::estimate::eppps::scans::{self, Block, Scan, ScanPixel};
+use ctcal::{EventChunk, Sensor};
 
 fn blocks() -> Vec<Block> {
     (0..20)
@@ -50,5 +55,30 @@ fn calibration_scans(c: &mut Criterion) {
     });
 }
 
-criterion_group!(benches, calibration_scans);
+/// 1 M events on 240 x 180 from a fixed linear congruential sequence, four per microsecond.
+fn events() -> EventChunk {
+    let mut state: u64 = 2020;
+    let mut next = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 33) as u32
+    };
+    let mut chunk = EventChunk::default();
+    for i in 0..1_000_000i64 {
+        let (x, y) = ((next() % 240) as u16, (next() % 180) as u16);
+        chunk.push(i / 4, x, y, next() % 2 == 0);
+    }
+    chunk
+}
+
+fn support_filter(c: &mut Criterion) {
+    let events = events();
+    let sensor = Sensor::new(240, 180);
+    c.bench_function("support filter, two-sided (1 M events, 240x180)", |b| {
+        b.iter(|| ctcal::stats::support::supported_two_sided(&events, sensor, 10_000))
+    });
+}
+
+criterion_group!(benches, calibration_scans, support_filter);
 criterion_main!(benches);

@@ -12,39 +12,8 @@ use crate::events::{EventChunk, Sensor, TimeUs};
 /// For each event of the time-sorted `events`, whether a neighbour fired in the `window_us`
 /// before it (or at the same time).
 pub fn supported(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<bool> {
-    let stride = sensor.width as usize + 2;
-    let mut last = vec![TimeUs::MIN; stride * (sensor.height as usize + 2)];
-    let cell = |i: usize| (events.y[i] as usize + 1) * stride + events.x[i] as usize + 1;
-    let mut flags = Vec::with_capacity(events.len());
-    let mut start = 0;
-    while start < events.len() {
-        // the events of one timestamp: mark them all first, so they see each other
-        let t = events.t[start];
-        let end = start + events.t[start..].partition_point(|&u| u == t);
-        let mut own = Vec::with_capacity(end - start);
-        for i in start..end {
-            let k = cell(i);
-            own.push(last[k]);
-            last[k] = t;
-        }
-        for (i, &before) in (start..end).zip(&own) {
-            let k = cell(i);
-            // the pixel's own mark is not a neighbour's: restore it while looking around
-            let mark = std::mem::replace(&mut last[k], before);
-            let newest = last[k - stride - 1]
-                .max(last[k - stride])
-                .max(last[k - stride + 1])
-                .max(last[k - 1])
-                .max(last[k + 1])
-                .max(last[k + stride - 1])
-                .max(last[k + stride])
-                .max(last[k + stride + 1]);
-            last[k] = mark;
-            flags.push(newest >= t.saturating_sub(window_us));
-        }
-        start = end;
-    }
-    flags
+    let grid = Grid::new(events, sensor);
+    grid.pass(events, window_us, Direction::Forward)
 }
 
 /// For each event of the time-sorted `events`, whether a neighbour fired within `window_us`
@@ -52,14 +21,97 @@ pub fn supported(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<
 /// estimator comparing counts uses it so that an edge's first event, or any event near the
 /// start of a short recording, is not taken for noise for want of a past.
 pub fn supported_two_sided(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<bool> {
-    let forward = supported(events, sensor, window_us);
-    let mut reversed = EventChunk::default();
-    for i in (0..events.len()).rev() {
-        reversed.push(-events.t[i], events.x[i], events.y[i], events.on[i]);
+    let grid = Grid::new(events, sensor);
+    let mut flags = grid.pass(events, window_us, Direction::Forward);
+    let backward = grid.pass(events, window_us, Direction::Backward);
+    // the backward pass flags events in reversed order
+    for (flag, &b) in flags.iter_mut().zip(backward.iter().rev()) {
+        *flag |= b;
     }
-    let backward = supported(&reversed, sensor, window_us);
-    let n = events.len();
-    (0..n).map(|i| forward[i] || backward[n - 1 - i]).collect()
+    flags
+}
+
+/// Which way a pass walks the events: backwards it reads them from the last, with times
+/// negated (so that they still grow).
+#[derive(Clone, Copy, PartialEq)]
+enum Direction {
+    Forward,
+    Backward,
+}
+
+/// The cell of every event in a grid with a one-cell border (so that every event has eight
+/// neighbour cells), computed once for both passes.
+struct Grid {
+    stride: usize,
+    size: usize,
+    cells: Vec<u32>,
+}
+
+impl Grid {
+    fn new(events: &EventChunk, sensor: Sensor) -> Self {
+        let stride = sensor.width as usize + 2;
+        let cells = events
+            .x
+            .iter()
+            .zip(&events.y)
+            .map(|(&x, &y)| ((y as usize + 1) * stride + x as usize + 1) as u32)
+            .collect();
+        Self {
+            stride,
+            size: stride * (sensor.height as usize + 2),
+            cells,
+        }
+    }
+
+    /// One causal pass: each event's flag, in the order the pass reads them. The events of
+    /// one timestamp are marked first, so that they see each other.
+    fn pass(&self, events: &EventChunk, window_us: TimeUs, direction: Direction) -> Vec<bool> {
+        let n = events.len();
+        let index = |j: usize| match direction {
+            Direction::Forward => j,
+            Direction::Backward => n - 1 - j,
+        };
+        let time = |j: usize| match direction {
+            Direction::Forward => events.t[j],
+            Direction::Backward => -events.t[n - 1 - j],
+        };
+        let stride = self.stride;
+        let mut last = vec![TimeUs::MIN; self.size];
+        let mut flags = Vec::with_capacity(n);
+        // the marks the events of one timestamp replaced (reused: runs are short)
+        let mut own = Vec::new();
+        let mut start = 0;
+        while start < n {
+            let t = time(start);
+            let mut end = start + 1;
+            while end < n && time(end) == t {
+                end += 1;
+            }
+            own.clear();
+            for j in start..end {
+                let k = self.cells[index(j)] as usize;
+                own.push(last[k]);
+                last[k] = t;
+            }
+            for (j, &before) in (start..end).zip(&own) {
+                let k = self.cells[index(j)] as usize;
+                // the pixel's own mark is not a neighbour's: restore it while looking around
+                let mark = std::mem::replace(&mut last[k], before);
+                let newest = last[k - stride - 1]
+                    .max(last[k - stride])
+                    .max(last[k - stride + 1])
+                    .max(last[k - 1])
+                    .max(last[k + 1])
+                    .max(last[k + stride - 1])
+                    .max(last[k + stride])
+                    .max(last[k + stride + 1]);
+                last[k] = mark;
+                flags.push(newest >= t.saturating_sub(window_us));
+            }
+            start = end;
+        }
+        flags
+    }
 }
 
 #[cfg(test)]
@@ -90,5 +142,40 @@ mod tests {
             supported_two_sided(&events, Sensor::new(4, 4), 10_000),
             vec![true, true, false, false]
         );
+    }
+
+    #[test]
+    fn two_sided_support_is_a_neighbour_event_within_the_window_either_side() {
+        // 3,000 events on 10 x 8, three to a timestamp, pixels from a fixed sequence:
+        // the definition checked by brute force
+        let mut state: u64 = 7;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        let events: EventChunk = (0..3000)
+            .map(|i| Event {
+                t: (i / 3) * 700,
+                x: (next() % 10) as u16,
+                y: (next() % 8) as u16,
+                on: true,
+            })
+            .collect();
+        let window = 2_000;
+        let flags = supported_two_sided(&events, Sensor::new(10, 8), window);
+        for i in 0..events.len() {
+            let (xi, yi, ti) = (events.x[i] as i32, events.y[i] as i32, events.t[i]);
+            let expected = (0..events.len()).any(|j| {
+                let (dx, dy) = (events.x[j] as i32 - xi, events.y[j] as i32 - yi);
+                (dx, dy) != (0, 0)
+                    && dx.abs() <= 1
+                    && dy.abs() <= 1
+                    && (events.t[j] - ti).abs() <= window
+            });
+            assert_eq!(flags[i], expected, "event {i}");
+        }
+        assert!(flags.iter().any(|&f| f) && flags.iter().any(|&f| !f));
     }
 }
