@@ -14,6 +14,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use ctcal::estimate::eppps::prior;
 use ctcal::estimate::eppps::scans::{self, Block, Scan, ScanPixel};
 use ctcal::{EventChunk, Sensor};
+use rand::{RngExt, SeedableRng};
 
 fn blocks() -> Vec<Block> {
     (0..20)
@@ -55,19 +56,13 @@ fn calibration_scans(c: &mut Criterion) {
     });
 }
 
-/// 1 M events on 240 x 180 from a fixed linear congruential sequence, four per microsecond.
+/// 1 M events on 240 x 180 at pixels drawn with a fixed seed, four per microsecond.
 fn events() -> EventChunk {
-    let mut state: u64 = 2020;
-    let mut next = move || {
-        state = state
-            .wrapping_mul(6_364_136_223_846_793_005)
-            .wrapping_add(1_442_695_040_888_963_407);
-        (state >> 33) as u32
-    };
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(2020);
     let mut chunk = EventChunk::default();
     for i in 0..1_000_000i64 {
-        let (x, y) = ((next() % 240) as u16, (next() % 180) as u16);
-        chunk.push(i / 4, x, y, next() % 2 == 0);
+        let (x, y) = (rng.random_range(0..240), rng.random_range(0..180));
+        chunk.push(i / 4, x, y, rng.random_bool(0.5));
     }
     chunk
 }
