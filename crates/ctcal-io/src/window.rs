@@ -259,7 +259,8 @@ const EVENTS_REACH: f64 = 0.8;
 
 /// The same window as `whole` (read whole by [`load`] with `window`), in blocks of
 /// consecutive frames with only the events between them ([`Window::events_between_frames`]),
-/// its events taken from `whole` rather than decoded again: only the chosen frames are read.
+/// its events taken from `whole` rather than decoded again, and its frames too where `whole`
+/// holds every frame of the window (otherwise only the chosen frames are read).
 pub fn load_blocks(
     whole: &Loaded,
     window: &Window,
@@ -271,7 +272,10 @@ pub fn load_blocks(
     };
     let read = read_window(
         &whole.recording,
-        Source::Read(&whole.events),
+        Source::Read {
+            events: &whole.events,
+            frames: (whole.frames.len() == whole.frames_available).then_some(&whole.frames[..]),
+        },
         &window,
         observer,
     )?;
@@ -300,11 +304,15 @@ fn notes(chosen: &ChosenFrames, selection: &PixelSelection) -> Vec<String> {
     notes
 }
 
-/// Where a window's events come from: decoded from the recording, or already read.
+/// Where a window's events and frames come from: decoded from the recording, or already
+/// read (`frames`: every frame of the window, in time order, where they were all read).
 #[derive(Clone, Copy)]
 enum Source<'a> {
     Decode,
-    Read(&'a EventChunk),
+    Read {
+        events: &'a EventChunk,
+        frames: Option<&'a [Frame]>,
+    },
 }
 
 /// A window's frames and events, before the sensor is resolved.
@@ -380,7 +388,7 @@ fn each_chunk(
     mut each: impl FnMut(&EventChunk) -> Result<(), LoadError>,
 ) -> Result<(), LoadError> {
     let mut stream = match source {
-        Source::Read(events) => return each(events),
+        Source::Read { events, .. } => return each(events),
         Source::Decode => recording.events_between(from, to)?,
     };
     for note in &stream.notes {
@@ -483,7 +491,18 @@ fn choose_frames(
             inside.iter().step_by(stride).copied().collect()
         }
     };
-    chosen.frames = recording.frames_where(|i, _| keep.contains(&i))?;
+    chosen.frames = match source {
+        // the frames already read are the window's, in the order of `inside`
+        Source::Read {
+            frames: Some(read), ..
+        } if read.len() == inside.len() => inside
+            .iter()
+            .zip(read)
+            .filter(|(i, _)| keep.contains(i))
+            .map(|(_, frame)| frame.clone())
+            .collect(),
+        _ => recording.frames_where(|i, _| keep.contains(&i))?,
+    };
     if let (Some(scaled), Some(note)) = (scaled_note, chosen.note.as_mut()) {
         *note = format!("{scaled}: {note}");
     }
@@ -692,8 +711,9 @@ mod tests {
         assert!(!in_unread(&[], 7));
     }
 
-    /// 75 frames at 25 Hz under a limit of 60: three blocks of consecutive frames. Taken from the
-    /// events of the whole window already read, they are the blocks a second decoding reads.
+    /// 75 frames at 25 Hz under a limit of 60: three blocks of consecutive frames; under 100:
+    /// all of them. Taken from the events (and frames) of the whole window already read, they
+    /// are the blocks a second decoding reads.
     #[test]
     fn blocks_from_the_whole_window_are_the_blocks_decoded_again() {
         use crate::write::{IjrrWriter, OutputPolicy};
@@ -723,38 +743,53 @@ mod tests {
                 .unwrap();
         }
         writer.finish().unwrap();
-        let window = Window {
-            start_s: None,
-            end_s: None,
-            frames: Some(60),
-            events_between_frames: false,
-        };
-        let load_with = |between: bool| {
-            load(
-                &path,
-                &OpenOptions::default(),
-                &Window {
-                    events_between_frames: between,
-                    ..window.clone()
-                },
-                &SelectionSpec::default(),
-                false,
-                &Silent,
-            )
-            .unwrap()
-        };
-        let decoded = load_with(true);
-        let whole = load_with(false);
-        let taken = load_blocks(&whole, &window, &Silent).unwrap();
-        assert!(!decoded.unread.is_empty(), "{:?}", decoded.notes);
-        assert_eq!(taken.unread, decoded.unread);
-        assert_eq!(taken.events.t, decoded.events.t);
-        assert_eq!(taken.events.x, decoded.events.x);
-        assert_eq!(taken.events.on, decoded.events.on);
-        let times = |l: &Loaded| l.frames.iter().map(|f| f.t).collect::<Vec<_>>();
-        assert_eq!(times(&taken), times(&decoded));
-        assert_eq!(taken.notes, decoded.notes);
-        assert_eq!(taken.frames_available, 75);
-        assert!(taken.events.len() < whole.events.len());
+        // under the limit of 60 the whole window holds every other frame (its frames for the
+        // blocks are read from disk); under 100 it holds them all (taken from memory)
+        for limit in [60, 100] {
+            let window = Window {
+                start_s: None,
+                end_s: None,
+                frames: Some(limit),
+                events_between_frames: false,
+            };
+            let load_with = |between: bool| {
+                load(
+                    &path,
+                    &OpenOptions::default(),
+                    &Window {
+                        events_between_frames: between,
+                        ..window.clone()
+                    },
+                    &SelectionSpec::default(),
+                    false,
+                    &Silent,
+                )
+                .unwrap()
+            };
+            let decoded = load_with(true);
+            let whole = load_with(false);
+            assert_eq!(whole.frames.len() == 75, limit == 100);
+            let taken = load_blocks(&whole, &window, &Silent).unwrap();
+            assert_eq!(
+                decoded.unread.is_empty(),
+                limit == 100,
+                "{:?}",
+                decoded.notes
+            );
+            assert_eq!(taken.unread, decoded.unread);
+            assert_eq!(taken.events.t, decoded.events.t);
+            assert_eq!(taken.events.x, decoded.events.x);
+            assert_eq!(taken.events.on, decoded.events.on);
+            let frames = |l: &Loaded| {
+                l.frames
+                    .iter()
+                    .map(|f| (f.t, f.pixels.clone()))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(frames(&taken), frames(&decoded));
+            assert_eq!(taken.notes, decoded.notes);
+            assert_eq!(taken.frames_available, 75);
+            assert!(taken.events.len() < whole.events.len());
+        }
     }
 }
