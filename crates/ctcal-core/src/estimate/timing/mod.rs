@@ -29,7 +29,7 @@ use crate::sim::LogResponse;
 use crate::sim::log_response::LogMap;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
 use model::{Coefficients, fit_at, offset_interval, offset_root, resampled_weights};
-use pixels::{PixelSlots, pixel_sums};
+use pixels::{PixelSlots, pixel_sums, pixel_sums_both};
 use rayon::prelude::*;
 use samples::{Pair, collect};
 use serde::Serialize;
@@ -548,10 +548,8 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
     let draw = |k: usize| -> Option<[f64; 8]> {
         let w = resampled_weights(pairs, weights, pixels, 11 + k as u64);
         let c = model::fit(pairs, values, &w, options.fit_leak)?;
-        let excess = |on: bool| {
-            pixel_sums(pairs, slots, values, &w, &c, on).map_or(0.0, |s| mean_and_excess(&s.0).1)
-        };
-        let (on, off) = (excess(true), excess(false));
+        let [off, on] = pixel_sums_both(pairs, slots, values, &w, &c)
+            .map(|sums| sums.map_or(0.0, |s| mean_and_excess(&s.0).1));
         Some([
             c.c_on,
             c.c_off,

@@ -233,7 +233,11 @@ fn fit_columns(
     }
     let mean_level = v.level.iter().zip(weight).map(|(l, w)| l * w).sum::<f64>() / wsum;
     let k = if leak { 8 } else { 6 };
-    let (sums, sums_y) = normal_sums(pairs, v, weight, mean_level, k);
+    let (sums, sums_y) = if leak {
+        normal_sums::<8>(pairs, v, weight, mean_level)
+    } else {
+        normal_sums::<6>(pairs, v, weight, mean_level)
+    };
     let mut xtx = nalgebra::DMatrix::<f64>::from_fn(k, k, |a, b| sums[a][b]);
     let mut xty = nalgebra::DVector::<f64>::from_fn(k, |a, _| sums_y[a]);
     // a term the pairs carry no information on (no lag where every pair is a steady ramp,
@@ -280,17 +284,20 @@ fn fit_columns(
 }
 
 /// The sums of the normal equations over the pairs with positive `weight`, `X^T W X` and
-/// `X^T W y`, for the first `k` columns of the model. Fixed-size arrays, summed pair by
-/// pair in order (the same sums, to the bit, as any other layout summing in that order).
-fn normal_sums(
+/// `X^T W y`, for the first `K` columns of the model. Fixed-size arrays, summed pair by
+/// pair in order (the same sums, to the bit, as any other layout summing in that order);
+/// `K` a constant so that the inner loops unroll and vectorise (each element's sum keeps
+/// its order, and `w row[a] row[b]` is `(w row[a]) row[b]` as before).
+fn normal_sums<const K: usize>(
     pairs: &[Pair],
     v: &Values,
     weight: &[f64],
     mean_level: f64,
-    k: usize,
 ) -> ([[f64; 8]; 8], [f64; 8]) {
     let mut xtx = [[0.0; 8]; 8];
     let mut xty = [0.0; 8];
+    let n = pairs.len();
+    let (weight, level, lag, y) = (&weight[..n], &v.level[..n], &v.lag[..n], &v.y[..n]);
     for (i, p) in pairs.iter().enumerate() {
         let w = weight[i];
         if w <= 0.0 {
@@ -304,17 +311,18 @@ fn normal_sums(
         let row = [
             on,
             off,
-            v.level[i] - mean_level,
-            v.lag[i],
+            level[i] - mean_level,
+            lag[i],
             on * interp,
             off * interp,
             s * dt,
             s * dt * dn,
         ];
-        for a in 0..k {
-            xty[a] += w * row[a] * v.y[i];
-            for b in 0..k {
-                xtx[a][b] += w * row[a] * row[b];
+        for a in 0..K {
+            let weighted = w * row[a];
+            xty[a] += weighted * y[i];
+            for b in 0..K {
+                xtx[a][b] += weighted * row[b];
             }
         }
     }

@@ -42,21 +42,58 @@ pub fn pixel_sums(
     c: &Coefficients,
     on: bool,
 ) -> Option<PixelSums> {
-    let mut by_slot = vec![(0.0f64, 0u32, 0.0f64, 0.0f64); slots.pixels.len()];
+    let [off_sums, on_sums] = slot_sums(pairs, slots, values, weight, c, [!on, on]);
+    expand(slots, if on { &on_sums } else { &off_sums })
+}
+
+/// [`pixel_sums`] of both polarities, `[OFF, ON]`, in one pass over the pairs (each
+/// polarity's sums the same, to the bit, as its own pass: every slot sums in pair order).
+pub fn pixel_sums_both(
+    pairs: &[Pair],
+    slots: &PixelSlots,
+    values: &Values,
+    weight: &[f64],
+    c: &Coefficients,
+) -> [Option<PixelSums>; 2] {
+    slot_sums(pairs, slots, values, weight, c, [true, true]).map(|sums| expand(slots, &sums))
+}
+
+/// Per slot (sum, count, sum of squares, weight) of the corrected samples with positive
+/// weight, `[OFF, ON]`; a polarity not `wanted` is left empty.
+type SlotSums = Vec<(f64, u32, f64, f64)>;
+
+fn slot_sums(
+    pairs: &[Pair],
+    slots: &PixelSlots,
+    values: &Values,
+    weight: &[f64],
+    c: &Coefficients,
+    wanted: [bool; 2],
+) -> [SlotSums; 2] {
+    let empty = |want: bool| {
+        vec![(0.0f64, 0u32, 0.0f64, 0.0f64); if want { slots.pixels.len() } else { 0 }]
+    };
+    let mut by_slot = [empty(wanted[0]), empty(wanted[1])];
     for (i, p) in pairs.iter().enumerate() {
-        if p.on != on || weight[i] <= 0.0 {
+        if !wanted[p.on as usize] || weight[i] <= 0.0 {
             continue;
         }
         let v = c.corrected(p, values, i);
-        let e = &mut by_slot[slots.slot[i] as usize];
+        let e = &mut by_slot[p.on as usize][slots.slot[i] as usize];
         e.0 += v;
         e.1 += 1;
         e.2 += v * v;
         e.3 += weight[i];
     }
+    by_slot
+}
+
+/// The slots' sums in pixel order, each pixel repeated as often as it was drawn (`None`
+/// with fewer than 10 entries).
+fn expand(slots: &PixelSlots, by_slot: &SlotSums) -> Option<PixelSums> {
     let mut sums = Vec::new();
     let mut which = Vec::new();
-    for (&pixel, &(s, n, sq, w)) in slots.pixels.iter().zip(&by_slot) {
+    for (&pixel, &(s, n, sq, w)) in slots.pixels.iter().zip(by_slot) {
         if n == 0 {
             continue;
         }
@@ -128,5 +165,21 @@ mod tests {
         assert_eq!(sums[0], sums[1]);
         assert!((sums[0].0 - 0.0).abs() < 1e-12 && sums[0].1 == 1);
         assert!(pixel_sums(&pairs[..8], &slots, &values, &weight, &c, false).is_none());
+        // both polarities in one pass are each polarity's own (6 OFF pairs: too few)
+        let [off, on] = pixel_sums_both(&pairs, &slots, &values, &weight, &c);
+        assert!(off.is_none());
+        assert_eq!(on.unwrap(), (sums, which));
+        let more: Vec<Pair> = pairs.iter().chain(&pairs).copied().collect();
+        let slots = PixelSlots::new(&more);
+        let values = Values {
+            y: (0..more.len()).map(|k| 0.07 * k as f64).collect(),
+            level: vec![0.0; more.len()],
+            lag: vec![0.0; more.len()],
+        };
+        let weight = vec![1.0; more.len()];
+        let [off, on] = pixel_sums_both(&more, &slots, &values, &weight, &c);
+        assert_eq!(off, pixel_sums(&more, &slots, &values, &weight, &c, false));
+        assert!(off.is_some());
+        assert_eq!(on, pixel_sums(&more, &slots, &values, &weight, &c, true));
     }
 }
