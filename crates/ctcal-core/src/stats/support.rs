@@ -19,11 +19,14 @@ pub fn supported(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<
 /// For each event of the time-sorted `events`, whether a neighbour fired within `window_us`
 /// before or after it: the causal filter run forwards and on the time-reversed stream. An
 /// estimator comparing counts uses it so that an edge's first event, or any event near the
-/// start of a short recording, is not taken for noise for want of a past.
+/// start of a short recording, is not taken for noise for want of a past. The two passes
+/// run on two threads where there are.
 pub fn supported_two_sided(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<bool> {
     let grid = Grid::new(events, sensor);
-    let mut flags = grid.pass(events, window_us, Direction::Forward);
-    let backward = grid.pass(events, window_us, Direction::Backward);
+    let (mut flags, backward) = rayon::join(
+        || grid.pass(events, window_us, Direction::Forward),
+        || grid.pass(events, window_us, Direction::Backward),
+    );
     // the backward pass flags events in reversed order
     for (flag, &b) in flags.iter_mut().zip(backward.iter().rev()) {
         *flag |= b;
