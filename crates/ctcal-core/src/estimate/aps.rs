@@ -196,75 +196,24 @@ fn run_pass(
     })
 }
 
-/// Estimates the contrast thresholds of `input` from its frames.
+/// Estimates the contrast thresholds of `input` from its frames, in stages: the frames
+/// prepared and checked; the full frames' pass (event timing and re-simulation) with the
+/// self-calibration's simulation; the frame-time alignment's systematic; the passes over
+/// every 2nd and 3rd frame; the self-calibration; each estimator's value with its
+/// interval; their combination and the report.
 pub fn estimate(
     input: &ApsInput,
     options: &ApsOptions,
     progress: Progress,
 ) -> Result<ApsResult, EstimateError> {
-    let mut assumptions = Vec::new();
     progress("frames: selection and optical flow", 0.0);
-    let (excluded, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
-    if hot > 0 {
-        assumptions.push(format!("{hot} hot pixels left out"));
-    }
-    let Prepared {
+    let Checked {
+        excluded,
         mut frames,
         alignment,
-        offset: offset_report,
-        assumptions: prepared_notes,
-    } = prepare(input, &excluded, options)?;
-    assumptions.extend(prepared_notes);
-    let change = super::dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
-    if change < super::dynamics::STATIC_CHANGE_RATE {
-        return Err(EstimateError::new(
-            format!(
-                "the frames show a static scene (log intensity changes by {change:.4} per pixel per second): nothing crosses a threshold, so the events are noise and do not measure thresholds"
-            ),
-            Text::from("use a part of the recording where the scene moves")
-                .aside(Hint::TimeWindow)
-                .words("; measure the noise with ")
-                .name(Hint::Analysis(Analysis::Fit))
-                .words(" or ")
-                .name(Hint::Analysis(Analysis::Stats)),
-        ));
-    }
-    let used = frames.intervals.iter().filter(|i| i.used).count();
-    if used < MIN_USED_INTERVALS {
-        let total = frames.intervals.len();
-        let why = if used == total {
-            format!("the recording (or the part read) has only {total} frame intervals")
-        } else {
-            format!(
-                "only {used} of {total} frame intervals can be used (the flow between the frames fails: motion too fast for the frame rate, or frames too dark or blurred)"
-            )
-        };
-        return Err(EstimateError::new(
-            format!(
-                "{why}; thresholds from frames need {MIN_USED_INTERVALS} at least, or they rest on a single stretch of motion whose flow nothing checks"
-            ),
-            if used == total {
-                "read a longer part of the recording; without enough frames estimate with the eppps or screen method"
-            } else {
-                "use a recording, or a part of one, with more frames per unit of motion; without usable frames estimate with the eppps or screen method"
-            },
-        ));
-    }
-    let exposure = super::frames::exposure_of(input.frames, options.exposure_us);
-    assumptions.push(format!(
-        "log response: {}, of the frame value plus the frames' log offset b (DN + b; b as said below)",
-        options.log_response_name
-    ));
-    assumptions.push(format!(
-        "frames: {} of {} intervals used; frame times are exposure midpoints (as the file gives them); {}",
-        used,
-        frames.intervals.len(),
-        match exposure {
-            Some(e) => format!("exposure {:.3} ms, treated as instantaneous (motion during it blurs frames slightly)", e as f64 / 1e3),
-            None => "exposure unknown (give the frame exposure where it is known); frames treated as instantaneous".into(),
-        }
-    ));
-    assumptions.push("between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity up to the offset b (no gamma: a gamma scales every log change alike, so it cannot be told from the thresholds by events and frames; frames encoded with gamma g give thresholds 1/g times the true ones)".into());
+        offset_report,
+        mut assumptions,
+    } = checked_frames(input, options)?;
 
     progress("event timing and re-simulation", 0.2);
     // the full frames upsampled once: for their pass and the self-calibration's simulation
@@ -274,66 +223,13 @@ pub fn estimate(
     let grid = timestamp_grid(input.events);
     let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
     drop(runs);
-    // the alignment's precision as a systematic error of event timing
-    let alignment_systematic = match &alignment {
-        Some(a) if a.precision_s > 0.0 => {
-            let precision = (a.precision_s * 1e6).round() as TimeUs;
-            let mut at = |shift: TimeUs| {
-                frames.shift_times(shift);
-                let t = super::timing::estimate(
-                    input.events,
-                    &frames,
-                    input.sensor,
-                    &excluded,
-                    &options.timing,
-                );
-                frames.shift_times(-shift);
-                t
-            };
-            match (at(precision), at(-precision)) {
-                (Some(a), Some(b)) => (
-                    0.5 * (a.on.ct - b.on.ct).abs(),
-                    0.5 * (a.off.ct - b.off.ct).abs(),
-                ),
-                _ => (0.0, 0.0),
-            }
-        }
-        _ => (0.0, 0.0),
-    };
+    let alignment_systematic =
+        alignment_systematic(input, &excluded, &mut frames, options, alignment.as_ref());
 
-    // frame-rate systematic: every 2nd and 3rd frame
     progress("frame-rate check (every 2nd and 3rd frame)", 0.5);
+    let subsampled = subsampled_passes(input, &excluded, &frames, options, &full);
     let mut passes = vec![(1usize, &full)];
-    let subsampled: Vec<(usize, Pass)> = [2usize, 3]
-        .iter()
-        .filter_map(|&step| {
-            let f = frames.every(step, &options.frames)?;
-            let start = full.resim.as_ref().map(|r| {
-                (
-                    r.ct_on,
-                    r.ct_off,
-                    0.5 * (full.timing.on.sigma + full.timing.off.sigma),
-                )
-            });
-            let runs = f.upsample_runs(0.5, options.max_upsampled_bytes);
-            run_pass(input, &excluded, &f, &runs, options, start)
-                .ok()
-                .map(|p| (step, p))
-        })
-        .collect();
     passes.extend(subsampled.iter().map(|(s, p)| (*s, p)));
-    let series = |value: &dyn Fn(&Pass) -> Option<f64>| -> Vec<FrameRatePoint> {
-        passes
-            .iter()
-            .filter_map(|(step, p)| {
-                Some(FrameRatePoint {
-                    frame_step: *step,
-                    frame_interval_s: p.interval_s,
-                    value: value(p)?,
-                })
-            })
-            .collect()
-    };
 
     // self-calibration of the timing estimator on a simulation of the same frames
     progress("self-calibration on a simulation of the frames", 0.8);
@@ -357,138 +253,18 @@ pub fn estimate(
             (shift, alignment.is_some()),
         )
     });
-
-    // event timing: corrected value, statistical and systematic errors
-    let timing_series_on = series(&|p| Some(p.timing.on.ct));
-    let timing_series_off = series(&|p| Some(p.timing.off.ct));
     if calibration.is_none() {
         assumptions.push("the self-calibration (a simulation of these frames with the measured model) could not be run: the event timing's thresholds and spread are not corrected for the method's own bias, and no bias is in their intervals".into());
     }
-    let (bias_on, bias_off, sigma_bias) = calibration.map_or((0.0, 0.0, 0.0), |c| c);
-    if let (Some(on), Some(off)) = (
-        full.timing.on.between_blocks_standard_error,
-        full.timing.off.between_blocks_standard_error,
-    ) {
-        assumptions.push(format!(
-            "read in blocks of frames: the event timing's statistical error adds to the bootstrap over pixels the spread between the blocks in quadrature (weighted delete-one-block jackknife, scaled by t(0.975, blocks - 1) / 1.96: ON {on:.4}, OFF {off:.4}; together: ON {:.4}, OFF {:.4}), so that thresholds that change over the recording widen the interval; the parts not read are not measured",
-            full.timing.on.standard_error, full.timing.off.standard_error
-        ));
-    }
-    let timing_measure = |estimate: f64,
-                          se: f64,
-                          bias: f64,
-                          series: &[FrameRatePoint],
-                          alignment: f64,
-                          offset: f64| {
-        let (_, frame_rate) = frame_rate_systematic(series);
-        // half the applied correction stays in the interval
-        Measured::new(
-            estimate - bias,
-            se,
-            frame_rate.hypot(0.5 * bias).hypot(alignment).hypot(offset),
-        )
-    };
-    let timing_on = timing_measure(
-        full.timing.on.ct,
-        full.timing.on.standard_error,
-        bias_on,
-        &timing_series_on,
-        alignment_systematic.0,
-        full.timing.on.offset_systematic,
-    );
-    let timing_off = timing_measure(
-        full.timing.off.ct,
-        full.timing.off.standard_error,
-        bias_off,
-        &timing_series_off,
-        alignment_systematic.1,
-        full.timing.off.offset_systematic,
-    );
-    let mut estimators = vec![EstimatorReport {
-        name: "event_timing",
-        description: "per-pixel log change between consecutive events, from frames interpolated along the optical flow; mean over pixels",
-        ct_on: timing_on.clone(),
-        ct_off: timing_off.clone(),
-        frame_rate_series_on: timing_series_on,
-        frame_rate_series_off: timing_series_off,
-        details: json!({
-            "on": full.timing.on,
-            "off": full.timing.off,
-            "self_calibration_bias_on": bias_on,
-            "self_calibration_bias_off": bias_off,
-            "self_calibration_bias_sigma": sigma_bias,
-            "alignment_systematic_on": alignment_systematic.0,
-            "alignment_systematic_off": alignment_systematic.1,
-        }),
-    }];
-    let mut on_estimates = vec![timing_on.clone()];
-    let mut off_estimates = vec![timing_off.clone()];
-    if let Some(r) = &full.resim {
-        let share = |p: &Pass, on: bool| {
-            let t = if on { &p.timing.on } else { &p.timing.off };
-            t.interpolation_share
-        };
-        let series_on = series(&|p| {
-            p.resim
-                .as_ref()
-                .map(|r| interpolation_corrected(r.ct_on, share(p, true)).0)
-        });
-        let series_off = series(&|p| {
-            p.resim
-                .as_ref()
-                .map(|r| interpolation_corrected(r.ct_off, share(p, false)).0)
-        });
-        let (on_value, on_applied) = interpolation_corrected(r.ct_on, share(&full, true));
-        let (off_value, off_applied) = interpolation_corrected(r.ct_off, share(&full, false));
-        if on_applied > 0.0 || off_applied > 0.0 {
-            assumptions.push(format!(
-                "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
-                100.0 * share(&full, true),
-                100.0 * share(&full, false),
-                r.ct_on,
-                r.ct_off,
-            ));
-        }
-        // the offset moves the re-simulation as it moves the timing (the same frames
-        // through the same log)
-        let on = Measured::new(
-            on_value,
-            r.standard_error_on,
-            frame_rate_systematic(&series_on)
-                .1
-                .hypot(full.timing.on.offset_systematic)
-                .hypot(0.5 * on_applied),
-        );
-        let off = Measured::new(
-            off_value,
-            r.standard_error_off,
-            frame_rate_systematic(&series_off)
-                .1
-                .hypot(full.timing.off.offset_systematic)
-                .hypot(0.5 * off_applied),
-        );
-        on_estimates.push(on.clone());
-        off_estimates.push(off.clone());
-        estimators.push(EstimatorReport {
-            name: "resimulation",
-            description: "the frames upsampled along the optical flow and simulated; thresholds whose counts match the real ones in every region and interval (median log ratio)",
-            ct_on: on,
-            ct_off: off,
-            frame_rate_series_on: series_on,
-            frame_rate_series_off: series_off,
-            details: serde_json::to_value(r).unwrap_or_default(),
-        });
-    }
-    let combined = |estimates: &[Measured]| {
-        let refs: Vec<&Measured> = estimates.iter().collect();
-        match combine(&refs) {
-            Some((value, error)) => Measured::new(value, error, 0.0),
-            None => Measured::new(f64::NAN, f64::NAN, 0.0),
-        }
-    };
-    let on = combined(&on_estimates);
-    let off = combined(&off_estimates);
+    let bias = calibration.unwrap_or((0.0, 0.0, 0.0));
+    assumptions.extend(blocks_assumption(&full.timing));
 
+    let mut estimators = vec![timing_report(&passes, bias, alignment_systematic)];
+    if let Some(r) = &full.resim {
+        let (report, note) = resimulation_report(&passes, r);
+        assumptions.extend(note);
+        estimators.push(report);
+    }
     // the least-squares cross-check
     let lsq = super::lsq::fit(
         input.events,
@@ -497,7 +273,360 @@ pub fn estimate(
         &excluded,
         Some((&full.timing.maps.ct_on, &full.timing.maps.ct_off)),
     );
+    let estimate = assemble(
+        estimators,
+        assumptions,
+        &frames,
+        &full,
+        Findings {
+            sigma,
+            sigma_bias: bias.2,
+            lsq,
+            alignment: json!(alignment),
+            offset: offset_report,
+        },
+    );
+    progress("done", 1.0);
+    Ok(ApsResult {
+        estimate,
+        interpolation_share: [
+            full.timing.on.interpolation_share,
+            full.timing.off.interpolation_share,
+        ],
+        maps: full.timing.maps,
+    })
+}
 
+/// The frames prepared for estimation and checked to measure thresholds, with the pixels
+/// left out and the assumptions so far.
+struct Checked {
+    excluded: Vec<bool>,
+    frames: PreparedFrames,
+    alignment: Option<super::align::Alignment>,
+    offset_report: Option<super::timing::Offset>,
+    assumptions: Vec<String>,
+}
+
+/// Hot pixels left out, the frames prepared ([`prepare`]), and refused where they show a
+/// static scene or too few usable intervals.
+fn checked_frames(input: &ApsInput, options: &ApsOptions) -> Result<Checked, EstimateError> {
+    let mut assumptions = Vec::new();
+    let (excluded, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
+    if hot > 0 {
+        assumptions.push(format!("{hot} hot pixels left out"));
+    }
+    let Prepared {
+        frames,
+        alignment,
+        offset: offset_report,
+        assumptions: prepared_notes,
+    } = prepare(input, &excluded, options)?;
+    assumptions.extend(prepared_notes);
+    let change = super::dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
+    if change < super::dynamics::STATIC_CHANGE_RATE {
+        return Err(EstimateError::new(
+            format!(
+                "the frames show a static scene (log intensity changes by {change:.4} per pixel per second): nothing crosses a threshold, so the events are noise and do not measure thresholds"
+            ),
+            Text::from("use a part of the recording where the scene moves")
+                .aside(Hint::TimeWindow)
+                .words("; measure the noise with ")
+                .name(Hint::Analysis(Analysis::Fit))
+                .words(" or ")
+                .name(Hint::Analysis(Analysis::Stats)),
+        ));
+    }
+    let used = frames.intervals.iter().filter(|i| i.used).count();
+    if used < MIN_USED_INTERVALS {
+        return Err(too_few_intervals(used, frames.intervals.len()));
+    }
+    assumptions.extend(frame_assumptions(input, options, &frames, used));
+    Ok(Checked {
+        excluded,
+        frames,
+        alignment,
+        offset_report,
+        assumptions,
+    })
+}
+
+/// The error of frames with fewer than [`MIN_USED_INTERVALS`] usable intervals, `used` of
+/// `total`.
+fn too_few_intervals(used: usize, total: usize) -> EstimateError {
+    let why = if used == total {
+        format!("the recording (or the part read) has only {total} frame intervals")
+    } else {
+        format!(
+            "only {used} of {total} frame intervals can be used (the flow between the frames fails: motion too fast for the frame rate, or frames too dark or blurred)"
+        )
+    };
+    EstimateError::new(
+        format!(
+            "{why}; thresholds from frames need {MIN_USED_INTERVALS} at least, or they rest on a single stretch of motion whose flow nothing checks"
+        ),
+        if used == total {
+            "read a longer part of the recording; without enough frames estimate with the eppps or screen method"
+        } else {
+            "use a recording, or a part of one, with more frames per unit of motion; without usable frames estimate with the eppps or screen method"
+        },
+    )
+}
+
+/// What the frames are taken to be: their log response, times and exposure, and the scene
+/// moving along the flow between them.
+fn frame_assumptions(
+    input: &ApsInput,
+    options: &ApsOptions,
+    frames: &PreparedFrames,
+    used: usize,
+) -> [String; 3] {
+    let exposure = super::frames::exposure_of(input.frames, options.exposure_us);
+    [
+        format!(
+            "log response: {}, of the frame value plus the frames' log offset b (DN + b; b as said below)",
+            options.log_response_name
+        ),
+        format!(
+            "frames: {} of {} intervals used; frame times are exposure midpoints (as the file gives them); {}",
+            used,
+            frames.intervals.len(),
+            match exposure {
+                Some(e) => format!("exposure {:.3} ms, treated as instantaneous (motion during it blurs frames slightly)", e as f64 / 1e3),
+                None => "exposure unknown (give the frame exposure where it is known); frames treated as instantaneous".into(),
+            }
+        ),
+        "between frames the scene moves along the optical flow (pyramidal Lucas-Kanade on log frames); frames are linear in intensity up to the offset b (no gamma: a gamma scales every log change alike, so it cannot be told from the thresholds by events and frames; frames encoded with gamma g give thresholds 1/g times the true ones)".into(),
+    ]
+}
+
+/// The frame-time alignment's precision as a systematic error of event timing (ON, OFF):
+/// half the change of the thresholds between the frames shifted by its precision either
+/// way; 0 without an alignment found, or where a shifted estimate fails.
+fn alignment_systematic(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &mut PreparedFrames,
+    options: &ApsOptions,
+    alignment: Option<&super::align::Alignment>,
+) -> (f64, f64) {
+    let Some(a) = alignment.filter(|a| a.precision_s > 0.0) else {
+        return (0.0, 0.0);
+    };
+    let precision = (a.precision_s * 1e6).round() as TimeUs;
+    let mut at = |shift: TimeUs| {
+        frames.shift_times(shift);
+        let t = super::timing::estimate(
+            input.events,
+            frames,
+            input.sensor,
+            excluded,
+            &options.timing,
+        );
+        frames.shift_times(-shift);
+        t
+    };
+    match (at(precision), at(-precision)) {
+        (Some(a), Some(b)) => (
+            0.5 * (a.on.ct - b.on.ct).abs(),
+            0.5 * (a.off.ct - b.off.ct).abs(),
+        ),
+        _ => (0.0, 0.0),
+    }
+}
+
+/// The passes over every 2nd and every 3rd frame (those that can be made), the
+/// re-simulation started at the full pass's thresholds.
+fn subsampled_passes(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &PreparedFrames,
+    options: &ApsOptions,
+    full: &Pass,
+) -> Vec<(usize, Pass)> {
+    let start = full.resim.as_ref().map(|r| {
+        (
+            r.ct_on,
+            r.ct_off,
+            0.5 * (full.timing.on.sigma + full.timing.off.sigma),
+        )
+    });
+    [2usize, 3]
+        .iter()
+        .filter_map(|&step| {
+            let f = frames.every(step, &options.frames)?;
+            let runs = f.upsample_runs(0.5, options.max_upsampled_bytes);
+            run_pass(input, excluded, &f, &runs, options, start)
+                .ok()
+                .map(|p| (step, p))
+        })
+        .collect()
+}
+
+/// One value of each pass, against the pass's frame interval (passes without it left out).
+fn series(passes: &[(usize, &Pass)], value: impl Fn(&Pass) -> Option<f64>) -> Vec<FrameRatePoint> {
+    passes
+        .iter()
+        .filter_map(|(step, p)| {
+            Some(FrameRatePoint {
+                frame_step: *step,
+                frame_interval_s: p.interval_s,
+                value: value(p)?,
+            })
+        })
+        .collect()
+}
+
+/// What the event timing's error is made of where the frames were read in blocks.
+fn blocks_assumption(timing: &TimingEstimate) -> Option<String> {
+    let (on, off) = (
+        timing.on.between_blocks_standard_error?,
+        timing.off.between_blocks_standard_error?,
+    );
+    Some(format!(
+        "read in blocks of frames: the event timing's statistical error adds to the bootstrap over pixels the spread between the blocks in quadrature (weighted delete-one-block jackknife, scaled by t(0.975, blocks - 1) / 1.96: ON {on:.4}, OFF {off:.4}; together: ON {:.4}, OFF {:.4}), so that thresholds that change over the recording widen the interval; the parts not read are not measured",
+        timing.on.standard_error, timing.off.standard_error
+    ))
+}
+
+/// The event timing's thresholds: the full pass's, less the self-calibration's `bias` (ON,
+/// OFF, spread), with the frame-rate, half-the-correction, alignment and offset
+/// systematics in their intervals.
+fn timing_report(
+    passes: &[(usize, &Pass)],
+    (bias_on, bias_off, sigma_bias): (f64, f64, f64),
+    alignment: (f64, f64),
+) -> EstimatorReport {
+    let full = passes[0].1;
+    let series_on = series(passes, |p| Some(p.timing.on.ct));
+    let series_off = series(passes, |p| Some(p.timing.off.ct));
+    let measure = |t: &super::timing::PolarityEstimate,
+                   bias: f64,
+                   series: &[FrameRatePoint],
+                   alignment: f64| {
+        let (_, frame_rate) = frame_rate_systematic(series);
+        // half the applied correction stays in the interval
+        Measured::new(
+            t.ct - bias,
+            t.standard_error,
+            frame_rate
+                .hypot(0.5 * bias)
+                .hypot(alignment)
+                .hypot(t.offset_systematic),
+        )
+    };
+    EstimatorReport {
+        name: "event_timing",
+        description: "per-pixel log change between consecutive events, from frames interpolated along the optical flow; mean over pixels",
+        ct_on: measure(&full.timing.on, bias_on, &series_on, alignment.0),
+        ct_off: measure(&full.timing.off, bias_off, &series_off, alignment.1),
+        frame_rate_series_on: series_on,
+        frame_rate_series_off: series_off,
+        details: json!({
+            "on": full.timing.on,
+            "off": full.timing.off,
+            "self_calibration_bias_on": bias_on,
+            "self_calibration_bias_off": bias_off,
+            "self_calibration_bias_sigma": sigma_bias,
+            "alignment_systematic_on": alignment.0,
+            "alignment_systematic_off": alignment.1,
+        }),
+    }
+}
+
+/// The re-simulation's thresholds `r` (of the full pass), with the share of the change the
+/// interpolation misses put back, and the frame-rate, offset and half-the-correction
+/// systematics in their intervals; and the assumption naming the correction where one was
+/// applied.
+fn resimulation_report(
+    passes: &[(usize, &Pass)],
+    r: &super::resim::ResimEstimate,
+) -> (EstimatorReport, Option<String>) {
+    let full = passes[0].1;
+    let share = |p: &Pass, on: bool| {
+        let t = if on { &p.timing.on } else { &p.timing.off };
+        t.interpolation_share
+    };
+    let series_on = series(passes, |p| {
+        p.resim
+            .as_ref()
+            .map(|r| interpolation_corrected(r.ct_on, share(p, true)).0)
+    });
+    let series_off = series(passes, |p| {
+        p.resim
+            .as_ref()
+            .map(|r| interpolation_corrected(r.ct_off, share(p, false)).0)
+    });
+    let (on_value, on_applied) = interpolation_corrected(r.ct_on, share(full, true));
+    let (off_value, off_applied) = interpolation_corrected(r.ct_off, share(full, false));
+    let note = (on_applied > 0.0 || off_applied > 0.0).then(|| {
+        format!(
+            "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
+            100.0 * share(full, true),
+            100.0 * share(full, false),
+            r.ct_on,
+            r.ct_off,
+        )
+    });
+    // the offset moves the re-simulation as it moves the timing (the same frames through
+    // the same log)
+    let on = Measured::new(
+        on_value,
+        r.standard_error_on,
+        frame_rate_systematic(&series_on)
+            .1
+            .hypot(full.timing.on.offset_systematic)
+            .hypot(0.5 * on_applied),
+    );
+    let off = Measured::new(
+        off_value,
+        r.standard_error_off,
+        frame_rate_systematic(&series_off)
+            .1
+            .hypot(full.timing.off.offset_systematic)
+            .hypot(0.5 * off_applied),
+    );
+    let report = EstimatorReport {
+        name: "resimulation",
+        description: "the frames upsampled along the optical flow and simulated; thresholds whose counts match the real ones in every region and interval (median log ratio)",
+        ct_on: on,
+        ct_off: off,
+        frame_rate_series_on: series_on,
+        frame_rate_series_off: series_off,
+        details: serde_json::to_value(r).unwrap_or_default(),
+    };
+    (report, note)
+}
+
+/// What the estimate reports beside its thresholds.
+struct Findings {
+    /// The event timing's per-pixel spread and the self-calibration's bias of it.
+    sigma: f64,
+    sigma_bias: f64,
+    /// The least-squares cross-check ([`super::lsq`]).
+    lsq: Option<super::lsq::LeastSquares>,
+    alignment: serde_json::Value,
+    offset: Option<super::timing::Offset>,
+}
+
+/// The estimate: the estimators' thresholds combined, the mismatch, the assumptions (the
+/// method's, then the range checks'), a withheld value where the re-simulation found no
+/// threshold, and the maps, alignment, offset, lag, drift and span found.
+fn assemble(
+    estimators: Vec<EstimatorReport>,
+    mut assumptions: Vec<String>,
+    frames: &PreparedFrames,
+    full: &Pass,
+    findings: Findings,
+) -> CtEstimate {
+    let combined = |pick: fn(&EstimatorReport) -> &Measured| {
+        let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
+        match combine(&refs) {
+            Some((value, error)) => Measured::new(value, error, 0.0),
+            None => Measured::new(f64::NAN, f64::NAN, 0.0),
+        }
+    };
+    let on = combined(|e| &e.ct_on);
+    let off = combined(|e| &e.ct_off);
     let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames
@@ -509,8 +638,8 @@ pub fn estimate(
     sigma_result(
         &mut estimate,
         &mut assumptions,
-        sigma,
-        sigma_bias,
+        findings.sigma,
+        findings.sigma_bias,
         &full.timing,
     );
     let range_notes = std::mem::replace(&mut estimate.assumptions, assumptions);
@@ -518,48 +647,39 @@ pub fn estimate(
     if full.resim.is_none() {
         estimate.withhold(&format!(
             "the re-simulation of these frames reproduces the recording's event counts at no threshold: its events are not what ideal pixels make from these frames (noise, or effects the frames do not show), so the event timing's value (ON {:.4}, OFF {:.4}, under `estimators`) has no independent check (in the coverage study's test subset both such values missed the truth, one by a factor of 6.5)",
-            timing_on.value, timing_off.value
+            estimators[0].ct_on.value, estimators[0].ct_off.value
         ));
     }
     estimate.estimators = estimators;
     let maps = &full.timing.maps;
-    estimate.extra.insert(
-        "maps".into(),
-        json!({
-            "pixels_on": maps.ct_on.iter().filter(|v| v.is_finite()).count(),
-            "pixels_off": maps.ct_off.iter().filter(|v| v.is_finite()).count(),
-            "least_squares_cross_check": lsq,
-        }),
-    );
+    let extra = [
+        (
+            "maps",
+            json!({
+                "pixels_on": maps.ct_on.iter().filter(|v| v.is_finite()).count(),
+                "pixels_off": maps.ct_off.iter().filter(|v| v.is_finite()).count(),
+                "least_squares_cross_check": findings.lsq,
+            }),
+        ),
+        ("frame_time_alignment", findings.alignment),
+        (
+            "frame_offset_dn",
+            json!({"value": frames.offset, "estimate": findings.offset}),
+        ),
+        ("photoreceptor_lag", lag_report(&full.timing.lag)),
+        ("leak_drift", drift_report(&full.timing.drift)),
+        (
+            "time_span_s",
+            json!([
+                us_to_s(frames.times[0]),
+                us_to_s(*frames.times.last().expect("two frames"))
+            ]),
+        ),
+    ];
+    for (key, value) in extra {
+        estimate.extra.insert(key.into(), value);
+    }
     estimate
-        .extra
-        .insert("frame_time_alignment".into(), json!(alignment));
-    estimate.extra.insert(
-        "frame_offset_dn".into(),
-        json!({"value": frames.offset, "estimate": offset_report}),
-    );
-    estimate
-        .extra
-        .insert("photoreceptor_lag".into(), lag_report(&full.timing.lag));
-    estimate
-        .extra
-        .insert("leak_drift".into(), drift_report(&full.timing.drift));
-    estimate.extra.insert(
-        "time_span_s".into(),
-        json!([
-            us_to_s(frames.times[0]),
-            us_to_s(*frames.times.last().expect("two frames"))
-        ]),
-    );
-    progress("done", 1.0);
-    Ok(ApsResult {
-        estimate,
-        interpolation_share: [
-            full.timing.on.interpolation_share,
-            full.timing.off.interpolation_share,
-        ],
-        maps: full.timing.maps,
-    })
 }
 
 /// Frames ready for estimation, and what was found about them.
