@@ -22,29 +22,17 @@
 //! correction in its interval.
 
 use super::frames::{FrameOptions, PreparedFrames};
-use super::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
 use super::resim::{Cells, Intervals, Resimulation};
 use super::timing::{ThresholdMaps, TimingEstimate, TimingOptions};
-use super::{
-    CtEstimate, Determinable, EstimateError, EstimatorReport, Progress, quantise, timestamp_grid,
-};
-use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
+use super::{CtEstimate, EstimateError, Progress, quantise, timestamp_grid};
+use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::hint::{Analysis, Hint, Text};
 use crate::sim::log_response::LogMap;
 use crate::sim::{PixelParams, Sample};
+use report::{Findings, assemble, blocks_assumption, resimulation_report, timing_report};
 use serde_json::json;
 
-/// A re-simulated threshold with the share of the change the frames' interpolation misses
-/// (the event timing's, [`super::timing::PolarityEstimate::interpolation_share`]) put back:
-/// the value, and the size of the correction. Shares beyond +-50 % are not trusted to be
-/// the interpolation's and are not applied.
-fn interpolation_corrected(value: f64, share: f64) -> (f64, f64) {
-    if !share.is_finite() || share.abs() >= 0.5 {
-        return (value, 0.0);
-    }
-    let corrected = value / (1.0 - share);
-    (corrected, (corrected - value).abs())
-}
+mod report;
 
 /// Settings of `estimate aps`.
 #[derive(Clone, Debug)]
@@ -462,226 +450,6 @@ fn subsampled_passes(
         .collect()
 }
 
-/// One value of each pass, against the pass's frame interval (passes without it left out).
-fn series(passes: &[(usize, &Pass)], value: impl Fn(&Pass) -> Option<f64>) -> Vec<FrameRatePoint> {
-    passes
-        .iter()
-        .filter_map(|(step, p)| {
-            Some(FrameRatePoint {
-                frame_step: *step,
-                frame_interval_s: p.interval_s,
-                value: value(p)?,
-            })
-        })
-        .collect()
-}
-
-/// What the event timing's error is made of where the frames were read in blocks.
-fn blocks_assumption(timing: &TimingEstimate) -> Option<String> {
-    let (on, off) = (
-        timing.on.between_blocks_standard_error?,
-        timing.off.between_blocks_standard_error?,
-    );
-    Some(format!(
-        "read in blocks of frames: the event timing's statistical error adds to the bootstrap over pixels the spread between the blocks in quadrature (weighted delete-one-block jackknife, scaled by t(0.975, blocks - 1) / 1.96: ON {on:.4}, OFF {off:.4}; together: ON {:.4}, OFF {:.4}), so that thresholds that change over the recording widen the interval; the parts not read are not measured",
-        timing.on.standard_error, timing.off.standard_error
-    ))
-}
-
-/// The event timing's thresholds: the full pass's, less the self-calibration's `bias` (ON,
-/// OFF, spread), with the frame-rate, half-the-correction, alignment and offset
-/// systematics in their intervals.
-fn timing_report(
-    passes: &[(usize, &Pass)],
-    (bias_on, bias_off, sigma_bias): (f64, f64, f64),
-    alignment: (f64, f64),
-) -> EstimatorReport {
-    let full = passes[0].1;
-    let series_on = series(passes, |p| Some(p.timing.on.ct));
-    let series_off = series(passes, |p| Some(p.timing.off.ct));
-    let measure = |t: &super::timing::PolarityEstimate,
-                   bias: f64,
-                   series: &[FrameRatePoint],
-                   alignment: f64| {
-        let (_, frame_rate) = frame_rate_systematic(series);
-        // half the applied correction stays in the interval
-        Measured::new(
-            t.ct - bias,
-            t.standard_error,
-            frame_rate
-                .hypot(0.5 * bias)
-                .hypot(alignment)
-                .hypot(t.offset_systematic),
-        )
-    };
-    EstimatorReport {
-        name: "event_timing",
-        description: "per-pixel log change between consecutive events, from frames interpolated along the optical flow; mean over pixels",
-        ct_on: measure(&full.timing.on, bias_on, &series_on, alignment.0),
-        ct_off: measure(&full.timing.off, bias_off, &series_off, alignment.1),
-        frame_rate_series_on: series_on,
-        frame_rate_series_off: series_off,
-        details: json!({
-            "on": full.timing.on,
-            "off": full.timing.off,
-            "self_calibration_bias_on": bias_on,
-            "self_calibration_bias_off": bias_off,
-            "self_calibration_bias_sigma": sigma_bias,
-            "alignment_systematic_on": alignment.0,
-            "alignment_systematic_off": alignment.1,
-        }),
-    }
-}
-
-/// The re-simulation's thresholds `r` (of the full pass), with the share of the change the
-/// interpolation misses put back, and the frame-rate, offset and half-the-correction
-/// systematics in their intervals; and the assumption naming the correction where one was
-/// applied.
-fn resimulation_report(
-    passes: &[(usize, &Pass)],
-    r: &super::resim::ResimEstimate,
-) -> (EstimatorReport, Option<String>) {
-    let full = passes[0].1;
-    let share = |p: &Pass, on: bool| {
-        let t = if on { &p.timing.on } else { &p.timing.off };
-        t.interpolation_share
-    };
-    let series_on = series(passes, |p| {
-        p.resim
-            .as_ref()
-            .map(|r| interpolation_corrected(r.ct_on, share(p, true)).0)
-    });
-    let series_off = series(passes, |p| {
-        p.resim
-            .as_ref()
-            .map(|r| interpolation_corrected(r.ct_off, share(p, false)).0)
-    });
-    let (on_value, on_applied) = interpolation_corrected(r.ct_on, share(full, true));
-    let (off_value, off_applied) = interpolation_corrected(r.ct_off, share(full, false));
-    let note = (on_applied > 0.0 || off_applied > 0.0).then(|| {
-        format!(
-            "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
-            100.0 * share(full, true),
-            100.0 * share(full, false),
-            r.ct_on,
-            r.ct_off,
-        )
-    });
-    // the offset moves the re-simulation as it moves the timing (the same frames through
-    // the same log)
-    let on = Measured::new(
-        on_value,
-        r.standard_error_on,
-        frame_rate_systematic(&series_on)
-            .1
-            .hypot(full.timing.on.offset_systematic)
-            .hypot(0.5 * on_applied),
-    );
-    let off = Measured::new(
-        off_value,
-        r.standard_error_off,
-        frame_rate_systematic(&series_off)
-            .1
-            .hypot(full.timing.off.offset_systematic)
-            .hypot(0.5 * off_applied),
-    );
-    let report = EstimatorReport {
-        name: "resimulation",
-        description: "the frames upsampled along the optical flow and simulated; thresholds whose counts match the real ones in every region and interval (median log ratio)",
-        ct_on: on,
-        ct_off: off,
-        frame_rate_series_on: series_on,
-        frame_rate_series_off: series_off,
-        details: serde_json::to_value(r).unwrap_or_default(),
-    };
-    (report, note)
-}
-
-/// What the estimate reports beside its thresholds.
-struct Findings {
-    /// The event timing's per-pixel spread and the self-calibration's bias of it.
-    sigma: f64,
-    sigma_bias: f64,
-    /// The least-squares cross-check ([`super::lsq`]).
-    lsq: Option<super::lsq::LeastSquares>,
-    alignment: serde_json::Value,
-    offset: Option<super::timing::Offset>,
-}
-
-/// The estimate: the estimators' thresholds combined, the mismatch, the assumptions (the
-/// method's, then the range checks'), a withheld value where the re-simulation found no
-/// threshold, and the maps, alignment, offset, lag, drift and span found.
-fn assemble(
-    estimators: Vec<EstimatorReport>,
-    mut assumptions: Vec<String>,
-    frames: &PreparedFrames,
-    full: &Pass,
-    findings: Findings,
-) -> CtEstimate {
-    let combined = |pick: fn(&EstimatorReport) -> &Measured| {
-        let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
-        match combine(&refs) {
-            Some((value, error)) => Measured::new(value, error, 0.0),
-            None => Measured::new(f64::NAN, f64::NAN, 0.0),
-        }
-    };
-    let on = combined(|e| &e.ct_on);
-    let off = combined(|e| &e.ct_off);
-    let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
-    estimate.intervals_used = frames.used_intervals();
-    estimate.intervals_dropped = frames
-        .intervals
-        .iter()
-        .filter(|i| !i.used)
-        .cloned()
-        .collect();
-    sigma_result(
-        &mut estimate,
-        &mut assumptions,
-        findings.sigma,
-        findings.sigma_bias,
-        &full.timing,
-    );
-    let range_notes = std::mem::replace(&mut estimate.assumptions, assumptions);
-    estimate.assumptions.extend(range_notes);
-    if full.resim.is_none() {
-        estimate.withhold(&format!(
-            "the re-simulation of these frames reproduces the recording's event counts at no threshold: its events are not what ideal pixels make from these frames (noise, or effects the frames do not show), so the event timing's value (ON {:.4}, OFF {:.4}, under `estimators`) has no independent check (in the coverage study's test subset both such values missed the truth, one by a factor of 6.5)",
-            estimators[0].ct_on.value, estimators[0].ct_off.value
-        ));
-    }
-    estimate.estimators = estimators;
-    let maps = &full.timing.maps;
-    let extra = [
-        (
-            "maps",
-            json!({
-                "pixels_on": maps.ct_on.iter().filter(|v| v.is_finite()).count(),
-                "pixels_off": maps.ct_off.iter().filter(|v| v.is_finite()).count(),
-                "least_squares_cross_check": findings.lsq,
-            }),
-        ),
-        ("frame_time_alignment", findings.alignment),
-        (
-            "frame_offset_dn",
-            json!({"value": frames.offset, "estimate": findings.offset}),
-        ),
-        ("photoreceptor_lag", lag_report(&full.timing.lag)),
-        ("leak_drift", drift_report(&full.timing.drift)),
-        (
-            "time_span_s",
-            json!([
-                us_to_s(frames.times[0]),
-                us_to_s(*frames.times.last().expect("two frames"))
-            ]),
-        ),
-    ];
-    for (key, value) in extra {
-        estimate.extra.insert(key.into(), value);
-    }
-    estimate
-}
-
 /// Frames ready for estimation, and what was found about them.
 pub struct Prepared {
     pub frames: PreparedFrames,
@@ -794,94 +562,6 @@ fn measured_model(timing: &TimingEstimate, sigma: f64) -> PixelParams {
     params
 }
 
-/// The frozen threshold spread: the timing's per-pixel spread (estimation noise removed)
-/// less the self-calibration's bias. Its interval carries the whole bias and at least 10 %
-/// of the value as systematic (the spread a mismatch-free simulation of the same frames
-/// shows varies by about that between seeds); where the bias eats the measured spread, the
-/// spread is not resolved: `null` with an upper bound.
-fn sigma_result(
-    estimate: &mut CtEstimate,
-    assumptions: &mut Vec<String>,
-    sigma: f64,
-    sigma_bias: f64,
-    timing: &TimingEstimate,
-) {
-    let se = 0.5 * (timing.on.sigma_standard_error + timing.off.sigma_standard_error);
-    let value = sigma - sigma_bias;
-    let systematic = sigma_bias.abs().max(0.1 * value.abs());
-    let measure = Measured::new(value, se, systematic);
-    assumptions.push(format!(
-        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value as systematic ({systematic:.4})"
-    ));
-    if measure.ci95[0] > 0.0 {
-        estimate.ct_sigma = Some(value);
-        estimate.ct_sigma_ci95 = Some([measure.ci95[0].max(0.0), measure.ci95[1]]);
-    } else {
-        let upper = measure.ci95[1].max(unresolved_upper_bound(timing));
-        estimate.ct_sigma = None;
-        estimate.ct_sigma_ci95 = Some([0.0, upper]);
-        estimate.why.insert(
-            "ct_sigma".into(),
-            format!(
-                "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
-            ),
-        );
-    }
-}
-
-/// The 95 % upper bound of a spread the data do not resolve, found where it is bounded: in
-/// the excess variance (between-pixel variance less estimation noise, which the bootstrap
-/// follows through zero), `sqrt(max(v, 0) + 1.96 se(v))`. With few samples per pixel
-/// the estimation noise is large and so is the bound; the spread of `sigma` itself (zero in
-/// most draws there) would give a bound near zero that the data do not support.
-fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
-    let v = 0.5 * (timing.on.excess_variance + timing.off.excess_variance);
-    let se = 0.5
-        * (timing.on.excess_variance_standard_error + timing.off.excess_variance_standard_error);
-    (v.max(0.0) + super::interval::z95() * se).sqrt()
-}
-
-/// Whether a nuisance coefficient of the event timing differs from zero at 95 %, in words.
-fn resolved(value: f64, standard_error: f64) -> &'static str {
-    if value.abs() > super::interval::z95() * standard_error {
-        "resolved: differs from zero at 95 %"
-    } else {
-        "not resolved: within 1.96 standard errors of zero"
-    }
-}
-
-/// The photoreceptor lag the timing took out of the thresholds, for the JSON: a coefficient
-/// of its regression, so noise can make it negative (no lag to speak of); the cutoff it
-/// stands for exists only for a positive lag, and where there is none the reason says so.
-fn lag_report(lag: &super::timing::Lag) -> serde_json::Value {
-    let mut report = json!({
-        "tau_times_dn_s": lag.tau_times_dn,
-        "standard_error": lag.standard_error,
-        "resolved": resolved(lag.tau_times_dn, lag.standard_error),
-        "cutoff_hz_at_median_dn": lag.cutoff_hz_at_median_dn,
-        "median_dn": lag.median_dn,
-        "meaning": "the photoreceptor's lag behind the light, tau = tau_times_dn / (DN + b), measured from how pairs of events straddling a change of speed deviate; taken out of the thresholds (a regression coefficient: noise makes it negative where there is no lag)",
-    });
-    if lag.cutoff_hz_at_median_dn.is_none() {
-        report["why"] = json!(format!(
-            "no cutoff: the lag measured is not positive ({:.2e} s DN, standard error {:.1e}), so it stands for no photoreceptor bandwidth limit (a negative value beyond its noise is an effect the timing model lacks, such as refractory delays, not a lag)",
-            lag.tau_times_dn, lag.standard_error
-        ));
-    }
-    report
-}
-
-/// The drift of the memorised level the timing took out of the thresholds, for the JSON.
-fn drift_report(drift: &super::timing::Drift) -> serde_json::Value {
-    json!({
-        "log_units_per_second_at_median_dn": drift.at_median_dn,
-        "standard_error": drift.standard_error,
-        "resolved": resolved(drift.at_median_dn, drift.standard_error),
-        "per_dn": drift.per_dn,
-        "meaning": "the memorised level's drift the event timing measured, positive downward (leak: ON events come early, OFF late); a negative value is an upward drift, which leak does not make: noise, or an effect the timing lacks; taken out of the thresholds either way",
-    })
-}
-
 /// The offset, in words for the assumptions.
 fn offset_assumption(o: &super::timing::Offset) -> String {
     let side = |v: Option<f32>| v.map_or("open".to_string(), |v| format!("{v:.1}"));
@@ -975,7 +655,7 @@ fn self_calibrate(
 
 #[cfg(test)]
 mod tests {
-    use super::{drift_report, interpolation_corrected, lag_report};
+    use super::report::{drift_report, interpolation_corrected, lag_report};
 
     #[test]
     fn a_negative_lag_has_no_cutoff_and_says_why_and_an_upward_drift_says_what_it_is() {
