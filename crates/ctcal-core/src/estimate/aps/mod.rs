@@ -51,7 +51,8 @@ pub struct ApsOptions {
     /// ([`super::align`]).
     pub frame_time_offset_s: Option<f64>,
     /// DN to add to the frames before the log (a subtracted black level); `None`: estimate
-    /// it when the frames show one ([`super::offset`]).
+    /// it where the events constrain it ([`super::timing`]: thresholds that do not depend on
+    /// brightness).
     pub frame_offset_dn: Option<f64>,
     /// Memory for the upsampled frames of the re-simulation, bytes.
     pub max_upsampled_bytes: usize,
