@@ -466,15 +466,7 @@ fn log_variation(stimulus: &[Frame], display: Option<&DisplayParams>) -> f64 {
 
 /// Estimates the thresholds from a recording of `input.stimulus` on a screen.
 pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, EstimateError> {
-    let refresh_hz = match input.refresh_hz.or_else(|| stimulus_rate(input.stimulus)) {
-        Some(r) if r.is_finite() && r > 0.0 => r,
-        _ => {
-            return Err(EstimateError::new(
-                "the stimulus does not give its refresh rate (fewer than two frames)",
-                Text::default().act(Hint::RefreshHz),
-            ));
-        }
-    };
+    let refresh_hz = refresh_rate(input)?;
     progress("aligning the stimulus with the events", 0.0);
     let offset_us = align(input.events, input.stimulus).ok_or_else(|| {
         EstimateError::new(
@@ -482,19 +474,11 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             Text::from("check that this recording shows this stimulus").aside(Hint::Stimulus),
         )
     })?;
-    // cells: tiles x refresh intervals, each interval starting half a refresh before the
-    // refresh whose burst it holds
-    let period = 1e6 / refresh_hz;
-    let count = input.stimulus.len() + 1;
-    let times: Vec<TimeUs> = (0..=count)
-        .map(|k| offset_us + input.stimulus[0].t + ((k as f64 - 0.5) * period).round() as TimeUs)
-        .collect();
     let (hot_mask, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
     progress("finding the screen on the sensor", 0.05);
-    let sensor = (input.sensor.width as usize, input.sensor.height as usize);
     let inputs = register::Inputs {
         events: input.events,
-        sensor,
+        sensor: (input.sensor.width as usize, input.sensor.height as usize),
         excluded: &hot_mask,
         stimulus: input.stimulus,
         offset_us,
@@ -506,6 +490,41 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         Ok(located) => located,
         Err(reason) => return Ok(unregistered(&reason)),
     };
+    let (setup, excluded) = counting_setup(input, &hot_mask, &located, offset_us, refresh_hz);
+    let matched = matched_thresholds(setup, &excluded, &inputs, &mut located, progress)?;
+    let (on, off) = measured(&matched, input.gamma_prior)?;
+    let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
+    describe(&mut estimate, &matched, &located, hot, (on, off));
+    progress("done", 1.0);
+    Ok(estimate)
+}
+
+/// The stimulus's refresh rate: given, or its frames' median interval.
+fn refresh_rate(input: &ScreenInput) -> Result<f64, EstimateError> {
+    match input.refresh_hz.or_else(|| stimulus_rate(input.stimulus)) {
+        Some(r) if r.is_finite() && r > 0.0 => Ok(r),
+        _ => Err(EstimateError::new(
+            "the stimulus does not give its refresh rate (fewer than two frames)",
+            Text::default().act(Hint::RefreshHz),
+        )),
+    }
+}
+
+/// The real counts in cells of tiles x refresh intervals (each interval starting half a
+/// refresh before the refresh whose burst it holds), over the pixels on the screen and
+/// not hot, and what the simulations need to count alike; and the pixels left out.
+fn counting_setup<'a>(
+    input: &'a ScreenInput<'a>,
+    hot_mask: &[bool],
+    located: &Located,
+    offset_us: TimeUs,
+    refresh_hz: f64,
+) -> (Setup<'a>, Vec<bool>) {
+    let period = 1e6 / refresh_hz;
+    let count = input.stimulus.len() + 1;
+    let times: Vec<TimeUs> = (0..=count)
+        .map(|k| offset_us + input.stimulus[0].t + ((k as f64 - 0.5) * period).round() as TimeUs)
+        .collect();
     let excluded: Vec<bool> = hot_mask
         .iter()
         .zip(&located.on_screen)
@@ -542,16 +561,44 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         cutoff_hz: None,
         evaluations: std::sync::atomic::AtomicUsize::new(0),
     };
+    (setup, excluded)
+}
+
+/// The thresholds matched through the display, and how they were reached.
+struct Matched<'a> {
+    /// The final setup (the screen registered again, the photoreceptor measured).
+    setup: Setup<'a>,
+    /// Without a display model (the paper's on-screen method).
+    naive: (f64, f64),
+    fits: DisplayFits,
+    display: DisplayParams,
+    /// Through the fitted display with ideal pixels, and with the measured photoreceptor.
+    ideal: (f64, f64),
+    fitted: (f64, f64),
+    lag_profile: lag::LagProfile,
+}
+
+/// The thresholds in stages: the naive estimate; thresholds, white and black level fitted
+/// together (every gamma of the prior); the screen registered again through the best
+/// display; the thresholds refined; the photoreceptor's lag measured from the events'
+/// timing (over the pixels not `excluded` where the screen was first found) and, where
+/// found, the thresholds matched again with it.
+fn matched_thresholds<'a>(
+    setup: Setup<'a>,
+    excluded: &[bool],
+    inputs: &register::Inputs,
+    located: &mut Located,
+    progress: Progress,
+) -> Result<Matched<'a>, EstimateError> {
+    let input = setup.input;
     progress("naive estimate (no display model)", 0.1);
     let naive = setup.thresholds((0.3, 0.3), None)?;
     progress("fitting thresholds, white and black level", 0.3);
-    let screen = &input.screen;
-    let prior = input.gamma_prior;
-    let fits = fit_displays(&setup, screen, prior, naive)?;
+    let fits = fit_displays(&setup, &input.screen, input.gamma_prior, naive)?;
     let best = fits.best();
     let display = Joint {
         setup: &setup,
-        screen,
+        screen: &input.screen,
         gamma: best.gamma,
     }
     .display(&best.param);
@@ -559,8 +606,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         "refining the screen's position through the fitted display",
         0.75,
     );
-    let reregistered = reregister(&inputs, &display, &mut located);
-    let setup = match reregistered {
+    let setup = match reregister(inputs, &display, located) {
         Some(warp) => Setup {
             warp: Some(warp),
             ..setup
@@ -568,22 +614,22 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         None => setup,
     };
     progress("refining the thresholds", 0.8);
-    let fitted = setup.thresholds((best.param[0].exp(), best.param[1].exp()), Some(&display))?;
-    let ideal = fitted;
+    let ideal = setup.thresholds((best.param[0].exp(), best.param[1].exp()), Some(&display))?;
     progress(
         "measuring the photoreceptor's lag from the events' timing",
         0.85,
     );
+    let period = 1e6 / setup.refresh_hz;
     let clock = lag::RefreshClock {
-        start_us: offset_us + input.stimulus[0].t,
+        start_us: setup.offset_us + input.stimulus[0].t,
         period_us: period,
-        end_us: offset_us
+        end_us: setup.offset_us
             + input.stimulus[0].t
             + (input.stimulus.len() as f64 * period).round() as TimeUs,
     };
     let included = excluded.iter().map(|&e| !e).collect();
     let recorded = lag::Recorded::new(input.events, clock, included, input.sensor);
-    let lag_profile = lag::profile(&setup, &recorded, fitted, Some(&display))?;
+    let lag_profile = lag::profile(&setup, &recorded, ideal, Some(&display))?;
     // the display was fitted with ideal pixels; the thresholds are matched again through
     // it with the photoreceptor that lags
     let (setup, fitted) = match lag_profile.cutoff_hz() {
@@ -592,16 +638,30 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
                 cutoff_hz: Some(cutoff),
                 ..setup
             };
-            let ct = slow.thresholds(fitted, Some(&display))?;
+            let ct = slow.thresholds(ideal, Some(&display))?;
             (slow, ct)
         }
-        None => (setup, fitted),
+        None => (setup, ideal),
     };
-    let variants = fits.compatible();
-    // the fits as good as the best span the prior's effect: their largest change is the
-    // systematic (see `GammaPrior::ends_in_sigmas`)
-    // (the fits were made with ideal pixels: their spread is taken about the ideal pixels'
-    // thresholds and scaled to the final ones)
+    Ok(Matched {
+        setup,
+        naive,
+        fits,
+        display,
+        ideal,
+        fitted,
+        lag_profile,
+    })
+}
+
+/// ON and OFF with their intervals: the standard error from the cells' spread about the
+/// final simulation (NaN where no cell holds 5 events), and as systematic the largest
+/// change over the display fits as good as the best (the prior's effect, see
+/// [`GammaPrior::ends_in_sigmas`]) with a share of the photoreceptor's correction.
+fn measured(m: &Matched, prior: GammaPrior) -> Result<(Measured, Measured), EstimateError> {
+    let variants = m.fits.compatible();
+    // the fits were made with ideal pixels: their spread is taken about the ideal pixels'
+    // thresholds and scaled to the final ones
     let spread = |pick: fn(&(f64, f64)) -> f64, value: f64, ideal: f64| -> f64 {
         variants
             .iter()
@@ -609,26 +669,42 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             .fold(0.0, f64::max)
             / prior.ends_in_sigmas()
     };
-    let simulated = setup.counts(fitted, Some(&display))?;
-    // no cell holding 5 events: the spread cannot be measured, nor the threshold's
-    // uncertainty
+    let simulated = m.setup.counts(m.fitted, Some(&m.display))?;
     let standard_error = |r: &[u32], s: &[u32], c: f64| {
         cell_spread(r, s).map_or(f64::NAN, |spread| c * spread.relative_standard_error)
     };
+    let (fitted, ideal, real) = (m.fitted, m.ideal, &m.setup.real);
     let on = Measured::new(
         fitted.0,
-        standard_error(&setup.real.on, &simulated.on, fitted.0),
+        standard_error(&real.on, &simulated.on, fitted.0),
         spread(|v| v.0, fitted.0, ideal.0).hypot(lag::CORRECTION_SYSTEMATIC * (fitted.0 - ideal.0)),
     );
     let off = Measured::new(
         fitted.1,
-        standard_error(&setup.real.off, &simulated.off, fitted.1),
+        standard_error(&real.off, &simulated.off, fitted.1),
         spread(|v| v.1, fitted.1, ideal.1).hypot(lag::CORRECTION_SYSTEMATIC * (fitted.1 - ideal.1)),
     );
-    let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
+    Ok((on, off))
+}
+
+/// What the estimate says of how it was made: the registration, the stimulus clock, the
+/// display, the prior and the lag first among the assumptions; the estimator's details;
+/// the display, the naive thresholds, the photoreceptor and how much of the difference to
+/// the naive thresholds the display explains.
+fn describe(
+    estimate: &mut CtEstimate,
+    m: &Matched,
+    located: &Located,
+    hot: usize,
+    (on, off): (Measured, Measured),
+) {
+    let (setup, display, naive) = (&m.setup, &m.display, m.naive);
+    let prior = setup.input.gamma_prior;
+    let (offset_us, refresh_hz) = (setup.offset_us, setup.refresh_hz);
+    let stimulus = setup.input.stimulus;
     let naive_ct = 0.5 * (naive.0 + naive.1);
-    let contrast = log_variation(input.stimulus, Some(&display))
-        / log_variation(input.stimulus, None).max(1e-12);
+    let contrast =
+        log_variation(stimulus, Some(display)) / log_variation(stimulus, None).max(1e-12);
     let ct = estimate.ct.unwrap_or(f64::NAN);
     let gap = (ct / naive_ct).ln();
     let explained = if gap.abs() > 1e-6 {
@@ -654,7 +730,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             display.gamma,
         ),
         prior.says(),
-        lag_profile.says(),
+        m.lag_profile.says(),
     ]);
     if hot > 0 {
         estimate
@@ -671,47 +747,50 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         details: json!({
             "naive_ct_on": naive.0,
             "naive_ct_off": naive.1,
-            "display_fits": fits.json(),
-            "lag": lag_profile.json(),
+            "display_fits": m.fits.json(),
+            "lag": m.lag_profile.json(),
             "cutoff_hz": setup.cutoff_hz,
-            "ideal_pixels_ct": [ideal.0, ideal.1],
+            "ideal_pixels_ct": [m.ideal.0, m.ideal.1],
             "simulations": setup.evaluations.load(std::sync::atomic::Ordering::Relaxed),
         }),
     }];
-    estimate.extra.insert(
-        "display".into(),
-        json!({
-            "gamma": display.gamma,
-            "black_level": display.black_level,
-            "refresh_hz": refresh_hz,
-            "time_offset_s": offset_us as f64 * 1e-6,
-            "white_dn": display.white_dn,
-            "blur_px": display.blur_px,
-        }),
-    );
-    estimate.extra.insert("naive_ct".into(), json!(naive_ct));
-    estimate.extra.insert(
-        "photoreceptor".into(),
-        json!({
-            "cutoff_hz": setup.cutoff_hz,
-            "ideal_pixels_ct_on": ideal.0,
-            "ideal_pixels_ct_off": ideal.1,
-        }),
-    );
-    estimate.extra.insert("registration".into(), located.json());
-    estimate.extra.insert(
-        "display_explains".into(),
-        json!(format!(
-            "without a display model the thresholds come out at {naive_ct:.3} (the paper's on-screen method); through the fitted display (gamma {:.2}, black level {:.4}) the camera sees {:.2} times the stimulus's log contrast, which accounts for {:.0} % of the difference to {:.3}",
-            display.gamma,
-            display.black_level,
-            contrast,
-            100.0 * explained,
-            ct
-        )),
-    );
-    progress("done", 1.0);
-    Ok(estimate)
+    let extra = [
+        (
+            "display",
+            json!({
+                "gamma": display.gamma,
+                "black_level": display.black_level,
+                "refresh_hz": refresh_hz,
+                "time_offset_s": offset_us as f64 * 1e-6,
+                "white_dn": display.white_dn,
+                "blur_px": display.blur_px,
+            }),
+        ),
+        ("naive_ct", json!(naive_ct)),
+        (
+            "photoreceptor",
+            json!({
+                "cutoff_hz": setup.cutoff_hz,
+                "ideal_pixels_ct_on": m.ideal.0,
+                "ideal_pixels_ct_off": m.ideal.1,
+            }),
+        ),
+        ("registration", located.json()),
+        (
+            "display_explains",
+            json!(format!(
+                "without a display model the thresholds come out at {naive_ct:.3} (the paper's on-screen method); through the fitted display (gamma {:.2}, black level {:.4}) the camera sees {:.2} times the stimulus's log contrast, which accounts for {:.0} % of the difference to {:.3}",
+                display.gamma,
+                display.black_level,
+                contrast,
+                100.0 * explained,
+                ct
+            )),
+        ),
+    ];
+    for (key, value) in extra {
+        estimate.extra.insert(key.into(), value);
+    }
 }
 
 /// The result when the screen is not found: nothing determinable, and why.
