@@ -148,7 +148,7 @@ pub fn fit(
         noise,
         fit_events: &run.events,
     };
-    let mut added = run_loop(
+    let (added, ambiguities) = choose_effects(
         &mut simulation,
         &mut state,
         options,
@@ -156,36 +156,6 @@ pub fn fit(
         &mut steps,
         progress,
     )?;
-    refit_together(
-        &simulation,
-        &mut state,
-        &loop_run,
-        &mut added,
-        &mut steps,
-        progress,
-    )?;
-    prune_added(&simulation, &mut state, &loop_run, &mut added, &mut steps)?;
-    let ambiguities = if matches!(options.effects, EffectChoice::List(_)) {
-        Vec::new()
-    } else {
-        progress("effects that look alike", 0.95);
-        alternatives::compare(
-            &simulation,
-            &mut state,
-            known,
-            &mut added,
-            &mut steps,
-            (fixed, noise),
-        )?
-    };
-    if !matches!(options.effects, EffectChoice::List(_)) {
-        let context = context_of(&state, &simulation, known);
-        for &effect in planned(options).iter() {
-            if !steps.iter().any(|s| s.effect == effect.name()) {
-                steps.push(steps::untried(&effects::evidence(effect, &context)));
-            }
-        }
-    }
     progress(
         "frame checks (every 2nd and 3rd frame, a doubled exposure)",
         0.96,
@@ -312,6 +282,41 @@ fn planned(options: &FitOptions) -> Vec<Effect> {
         EffectChoice::None => Vec::new(),
         EffectChoice::List(list) => list.clone(),
     }
+}
+
+/// The effects chosen: the loop ([`run_loop`]), the added effects refitted together and
+/// pruned, the effects that look alike compared (unless the effects were listed), and a
+/// record of each planned effect never tried; with the look-alikes not told apart.
+fn choose_effects(
+    simulation: &mut Simulation,
+    state: &mut State,
+    options: &FitOptions,
+    loop_run: &LoopRun,
+    steps: &mut Vec<Step>,
+    progress: Progress,
+) -> Result<(Vec<AddedEffect>, Vec<Ambiguity>), FitError> {
+    let mut added = run_loop(simulation, state, options, loop_run, steps, progress)?;
+    refit_together(simulation, state, loop_run, &mut added, steps, progress)?;
+    prune_added(simulation, state, loop_run, &mut added, steps)?;
+    if matches!(options.effects, EffectChoice::List(_)) {
+        return Ok((added, Vec::new()));
+    }
+    progress("effects that look alike", 0.95);
+    let ambiguities = alternatives::compare(
+        simulation,
+        state,
+        loop_run.known,
+        &mut added,
+        steps,
+        (loop_run.fixed, loop_run.noise),
+    )?;
+    let context = context_of(state, simulation, loop_run.known);
+    for &effect in planned(options).iter() {
+        if !steps.iter().any(|s| s.effect == effect.name()) {
+            steps.push(steps::untried(&effects::evidence(effect, &context)));
+        }
+    }
+    Ok((added, ambiguities))
 }
 
 /// The loop: the effect called for most strongly (or the next listed), tried, until none is
