@@ -172,7 +172,32 @@ pub fn estimate(
             what: "the calibration curve",
         },
     );
-    for (key, polarity) in [("ct_on", &on), ("ct_off", &off)] {
+    beyond_grid(&mut result, (&on, &off), calibrations.len());
+    result
+        .assumptions
+        .extend(assumptions(&rates, &calibrations, basis.images(), hot));
+    result.assumptions.extend(scan_assumptions(
+        frames.is_none().then_some(&reading),
+        &rates,
+        (measured_ratio, ratio, pixel.ratio),
+        refractory.as_ref(),
+    ));
+    report(
+        &mut result,
+        &rates,
+        &calibrations,
+        (&on, &off),
+        frames.is_some(),
+    );
+    progress("done", 1.0);
+    Ok(result)
+}
+
+/// A polarity without a value gets its reason under `why`; one whose recording makes more
+/// or fewer events than some calibrations give at the grid's ends says so: those count at
+/// the end, a bound, and its interval is open that way.
+fn beyond_grid(result: &mut CtEstimate, (on, off): (&Polarity, &Polarity), calibrations: usize) {
+    for (key, polarity) in [("ct_on", on), ("ct_off", off)] {
         if let Some(why) = &polarity.why {
             result.why.insert(key.into(), why.clone());
             continue;
@@ -184,19 +209,27 @@ pub fn estimate(
         ] {
             if count > 0 {
                 result.assumptions.push(format!(
-                    "{key}: the recording makes {side} events than {count} of the {} calibrations even at the {} threshold simulated ({:.3}); they count at it, a bound, so the interval is open {open}",
-                    calibrations.len(),
+                    "{key}: the recording makes {side} events than {count} of the {calibrations} calibrations even at the {} threshold simulated ({:.3}); they count at it, a bound, so the interval is open {open}",
                     end.0,
                     end.1
                 ));
             }
         }
     }
-    result
-        .assumptions
-        .extend(assumptions(&rates, &calibrations, basis.images(), hot));
-    if frames.is_none() {
-        result.assumptions.push(match &reading {
+}
+
+/// What the scans assumed: the prior read at the recording's sharpness (`reading`, only
+/// without frames; `Some(None)` where too few bursts allowed it), the OFF/ON ratio scanned
+/// (`(measured, held, scanned)`), and the refractory period simulated.
+fn scan_assumptions(
+    reading: Option<&Option<Reading>>,
+    rates: &RecordingRates,
+    (measured_ratio, ratio, scanned): (f64, f64, f64),
+    refractory: Option<&crate::fit::events_only::refractory::Edge>,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    if let Some(reading) = reading {
+        notes.push(match reading {
             Some(r) => r.describe(),
             None => format!(
                 "prior not read at the recording's sharpness: {} consecutive same-polarity event pairs at a pixel, fewer than the {MIN_BURST_PAIRS} needed to measure it; every blur of the images (0-{:.0} px) is part of the prior",
@@ -210,11 +243,10 @@ pub fn estimate(
     } else {
         String::new()
     };
-    result.assumptions.push(format!(
-        "thresholds read from scans with OFF = {:.3} x ON (the ratio the ON = OFF scans gave{clamped}; a pixel's ON count depends on its OFF threshold wherever the profile turns); the calibration curve shown is the ON = OFF one of the paper's Fig. 2",
-        pixel.ratio
+    notes.push(format!(
+        "thresholds read from scans with OFF = {scanned:.3} x ON (the ratio the ON = OFF scans gave{clamped}; a pixel's ON count depends on its OFF threshold wherever the profile turns); the calibration curve shown is the ON = OFF one of the paper's Fig. 2"
     ));
-    result.assumptions.push(match &refractory {
+    notes.push(match refractory {
         Some(e) => format!(
             "refractory period {:.3} ms simulated in the scans: the lower edge of the recording's same-pixel intervals, with the pile-up just above it that a refractory period leaves ({} intervals below it, {} in the octave above)",
             e.edge_us * 1e-3,
@@ -223,15 +255,7 @@ pub fn estimate(
         ),
         None => "no refractory period in the scans: the recording's same-pixel intervals show no lower edge with a pile-up above it".to_string(),
     });
-    report(
-        &mut result,
-        &rates,
-        &calibrations,
-        (&on, &off),
-        frames.is_some(),
-    );
-    progress("done", 1.0);
-    Ok(result)
+    notes
 }
 
 fn check_length(events: &EventChunk) -> Result<(), EstimateError> {

@@ -58,10 +58,11 @@ pub fn pixel_sums_both(
     slot_sums(pairs, slots, values, weight, c, [true, true]).map(|sums| expand(slots, &sums))
 }
 
-/// Per slot (sum, count, sum of squares, weight) of the corrected samples with positive
-/// weight, `[OFF, ON]`; a polarity not `wanted` is left empty.
+/// Per slot: the sum, count, sum of squares and weight of the corrected samples.
 type SlotSums = Vec<(f64, u32, f64, f64)>;
 
+/// The [`SlotSums`] of the samples with positive weight, `[OFF, ON]`; a polarity not
+/// `wanted` is left empty.
 fn slot_sums(
     pairs: &[Pair],
     slots: &PixelSlots,
