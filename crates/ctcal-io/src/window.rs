@@ -305,7 +305,8 @@ fn notes(chosen: &ChosenFrames, selection: &PixelSelection) -> Vec<String> {
 }
 
 /// Where a window's events and frames come from: decoded from the recording, or already
-/// read (`frames`: every frame of the window, in time order, where they were all read).
+/// read (`frames`: every frame of the window, in the recording's order, where they were all
+/// read).
 #[derive(Clone, Copy)]
 enum Source<'a> {
     Decode,
@@ -492,15 +493,20 @@ fn choose_frames(
         }
     };
     chosen.frames = match source {
-        // the frames already read are the window's, in the order of `inside`
+        // the frames already read are the window's, in the order of `inside` (checked by
+        // their times)
         Source::Read {
             frames: Some(read), ..
-        } if read.len() == inside.len() => inside
-            .iter()
-            .zip(read)
-            .filter(|(i, _)| keep.contains(i))
-            .map(|(_, frame)| frame.clone())
-            .collect(),
+        } if read.len() == inside.len()
+            && read.iter().zip(&inside_times).all(|(f, &t)| f.t == t) =>
+        {
+            inside
+                .iter()
+                .zip(read)
+                .filter(|(i, _)| keep.contains(i))
+                .map(|(_, frame)| frame.clone())
+                .collect()
+        }
         _ => recording.frames_where(|i, _| keep.contains(&i))?,
     };
     if let (Some(scaled), Some(note)) = (scaled_note, chosen.note.as_mut()) {

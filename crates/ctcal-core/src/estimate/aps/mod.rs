@@ -212,7 +212,7 @@ pub fn estimate(
     let grid = timestamp_grid(input.events);
     let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
     drop(runs);
-    let alignment_systematic =
+    let alignment_error =
         alignment_systematic(input, &excluded, &mut frames, options, alignment.as_ref());
 
     progress("frame-rate check (every 2nd and 3rd frame)", 0.5);
@@ -248,7 +248,7 @@ pub fn estimate(
     let bias = calibration.unwrap_or((0.0, 0.0, 0.0));
     assumptions.extend(blocks_assumption(&full.timing));
 
-    let mut estimators = vec![timing_report(&passes, bias, alignment_systematic)];
+    let mut estimators = vec![timing_report(&passes, bias, alignment_error)];
     if let Some(r) = &full.resim {
         let (report, note) = resimulation_report(&passes, r);
         assumptions.extend(note);
@@ -652,54 +652,4 @@ fn self_calibrate(
         again.off.ct - timing.off.ct,
         sigma_again - sigma,
     ))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::report::{drift_report, interpolation_corrected, lag_report};
-
-    #[test]
-    fn a_negative_lag_has_no_cutoff_and_says_why_and_an_upward_drift_says_what_it_is() {
-        // slider_depth's event timing: tau (DN + b) -0.0071 s DN, a drift of -0.29 log/s
-        let lag = super::super::timing::Lag {
-            tau_times_dn: -0.0071,
-            standard_error: 0.002,
-            cutoff_hz_at_median_dn: None,
-            median_dn: 80.0,
-        };
-        let report = lag_report(&lag);
-        assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
-        assert!(report["cutoff_hz_at_median_dn"].is_null());
-        assert!(report["why"].as_str().unwrap().contains("not positive"));
-        let lag = super::super::timing::Lag {
-            standard_error: 0.004,
-            cutoff_hz_at_median_dn: Some(120.0),
-            ..lag
-        };
-        let report = lag_report(&lag);
-        assert_eq!(
-            report["resolved"],
-            "not resolved: within 1.96 standard errors of zero"
-        );
-        assert!(report.get("why").is_none());
-        let drift = super::super::timing::Drift {
-            at_zero_dn: -0.3,
-            per_dn: 0.0001,
-            at_median_dn: -0.29,
-            standard_error: 0.1,
-        };
-        let report = drift_report(&drift);
-        assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
-        assert!(report["meaning"].as_str().unwrap().contains("upward drift"));
-    }
-
-    #[test]
-    fn the_interpolations_share_is_put_back_into_a_resimulated_threshold() {
-        // counts from frames that show 90 % of the change give 90 % of the threshold
-        let (value, applied) = interpolation_corrected(0.27, 0.1);
-        assert!((value - 0.3).abs() < 1e-12 && (applied - 0.03).abs() < 1e-12);
-        // a share that large is not the interpolation's: left alone
-        assert_eq!(interpolation_corrected(0.27, 0.6), (0.27, 0.0));
-        assert_eq!(interpolation_corrected(0.27, f64::NAN), (0.27, 0.0));
-    }
 }

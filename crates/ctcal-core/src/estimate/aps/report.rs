@@ -15,7 +15,7 @@ use serde_json::json;
 /// (the event timing's, [`crate::estimate::timing::PolarityEstimate::interpolation_share`]) put back:
 /// the value, and the size of the correction. Shares beyond +-50 % are not trusted to be
 /// the interpolation's and are not applied.
-pub(super) fn interpolation_corrected(value: f64, share: f64) -> (f64, f64) {
+fn interpolation_corrected(value: f64, share: f64) -> (f64, f64) {
     if !share.is_finite() || share.abs() >= 0.5 {
         return (value, 0.0);
     }
@@ -24,10 +24,7 @@ pub(super) fn interpolation_corrected(value: f64, share: f64) -> (f64, f64) {
 }
 
 /// One value of each pass, against the pass's frame interval (passes without it left out).
-pub(super) fn series(
-    passes: &[(usize, &Pass)],
-    value: impl Fn(&Pass) -> Option<f64>,
-) -> Vec<FrameRatePoint> {
+fn series(passes: &[(usize, &Pass)], value: impl Fn(&Pass) -> Option<f64>) -> Vec<FrameRatePoint> {
     passes
         .iter()
         .filter_map(|(step, p)| {
@@ -163,10 +160,11 @@ pub(super) fn resimulation_report(
 
 /// What the estimate reports beside its thresholds.
 pub(super) struct Findings {
-    /// The event timing's per-pixel spread and the self-calibration's bias of it.
+    /// The event timing's per-pixel spread.
     pub(super) sigma: f64,
+    /// The self-calibration's bias of that spread.
     pub(super) sigma_bias: f64,
-    /// The least-squares cross-check ([`super::lsq`]).
+    /// The least-squares cross-check ([`crate::estimate::lsq`]).
     pub(super) lsq: Option<crate::estimate::lsq::LeastSquares>,
     pub(super) alignment: serde_json::Value,
     pub(super) offset: Option<crate::estimate::timing::Offset>,
@@ -251,7 +249,7 @@ pub(super) fn assemble(
 /// of the value as systematic (the spread a mismatch-free simulation of the same frames
 /// shows varies by about that between seeds); where the bias eats the measured spread, the
 /// spread is not resolved: `null` with an upper bound.
-pub(super) fn sigma_result(
+fn sigma_result(
     estimate: &mut CtEstimate,
     assumptions: &mut Vec<String>,
     sigma: f64,
@@ -286,7 +284,7 @@ pub(super) fn sigma_result(
 /// follows through zero), `sqrt(max(v, 0) + 1.96 se(v))`. With few samples per pixel
 /// the estimation noise is large and so is the bound; the spread of `sigma` itself (zero in
 /// most draws there) would give a bound near zero that the data do not support.
-pub(super) fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
+fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
     let v = 0.5 * (timing.on.excess_variance + timing.off.excess_variance);
     let se = 0.5
         * (timing.on.excess_variance_standard_error + timing.off.excess_variance_standard_error);
@@ -294,7 +292,7 @@ pub(super) fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
 }
 
 /// Whether a nuisance coefficient of the event timing differs from zero at 95 %, in words.
-pub(super) fn resolved(value: f64, standard_error: f64) -> &'static str {
+fn resolved(value: f64, standard_error: f64) -> &'static str {
     if value.abs() > crate::estimate::interval::z95() * standard_error {
         "resolved: differs from zero at 95 %"
     } else {
@@ -305,7 +303,7 @@ pub(super) fn resolved(value: f64, standard_error: f64) -> &'static str {
 /// The photoreceptor lag the timing took out of the thresholds, for the JSON: a coefficient
 /// of its regression, so noise can make it negative (no lag to speak of); the cutoff it
 /// stands for exists only for a positive lag, and where there is none the reason says so.
-pub(super) fn lag_report(lag: &crate::estimate::timing::Lag) -> serde_json::Value {
+fn lag_report(lag: &crate::estimate::timing::Lag) -> serde_json::Value {
     let mut report = json!({
         "tau_times_dn_s": lag.tau_times_dn,
         "standard_error": lag.standard_error,
@@ -324,7 +322,7 @@ pub(super) fn lag_report(lag: &crate::estimate::timing::Lag) -> serde_json::Valu
 }
 
 /// The drift of the memorised level the timing took out of the thresholds, for the JSON.
-pub(super) fn drift_report(drift: &crate::estimate::timing::Drift) -> serde_json::Value {
+fn drift_report(drift: &crate::estimate::timing::Drift) -> serde_json::Value {
     json!({
         "log_units_per_second_at_median_dn": drift.at_median_dn,
         "standard_error": drift.standard_error,
@@ -332,4 +330,54 @@ pub(super) fn drift_report(drift: &crate::estimate::timing::Drift) -> serde_json
         "per_dn": drift.per_dn,
         "meaning": "the memorised level's drift the event timing measured, positive downward (leak: ON events come early, OFF late); a negative value is an upward drift, which leak does not make: noise, or an effect the timing lacks; taken out of the thresholds either way",
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{drift_report, interpolation_corrected, lag_report};
+
+    #[test]
+    fn a_negative_lag_has_no_cutoff_and_says_why_and_an_upward_drift_says_what_it_is() {
+        // slider_depth's event timing: tau (DN + b) -0.0071 s DN, a drift of -0.29 log/s
+        let lag = super::super::timing::Lag {
+            tau_times_dn: -0.0071,
+            standard_error: 0.002,
+            cutoff_hz_at_median_dn: None,
+            median_dn: 80.0,
+        };
+        let report = lag_report(&lag);
+        assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
+        assert!(report["cutoff_hz_at_median_dn"].is_null());
+        assert!(report["why"].as_str().unwrap().contains("not positive"));
+        let lag = super::super::timing::Lag {
+            standard_error: 0.004,
+            cutoff_hz_at_median_dn: Some(120.0),
+            ..lag
+        };
+        let report = lag_report(&lag);
+        assert_eq!(
+            report["resolved"],
+            "not resolved: within 1.96 standard errors of zero"
+        );
+        assert!(report.get("why").is_none());
+        let drift = super::super::timing::Drift {
+            at_zero_dn: -0.3,
+            per_dn: 0.0001,
+            at_median_dn: -0.29,
+            standard_error: 0.1,
+        };
+        let report = drift_report(&drift);
+        assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
+        assert!(report["meaning"].as_str().unwrap().contains("upward drift"));
+    }
+
+    #[test]
+    fn the_interpolations_share_is_put_back_into_a_resimulated_threshold() {
+        // counts from frames that show 90 % of the change give 90 % of the threshold
+        let (value, applied) = interpolation_corrected(0.27, 0.1);
+        assert!((value - 0.3).abs() < 1e-12 && (applied - 0.03).abs() < 1e-12);
+        // a share that large is not the interpolation's: left alone
+        assert_eq!(interpolation_corrected(0.27, 0.6), (0.27, 0.0));
+        assert_eq!(interpolation_corrected(0.27, f64::NAN), (0.27, 0.0));
+    }
 }

@@ -172,7 +172,7 @@ pub fn estimate(
             what: "the calibration curve",
         },
     );
-    beyond_grid(&mut result, (&on, &off), calibrations.len());
+    polarity_notes(&mut result, (&on, &off), calibrations.len());
     result
         .assumptions
         .extend(assumptions(&rates, &calibrations, basis.images(), hot));
@@ -196,7 +196,7 @@ pub fn estimate(
 /// A polarity without a value gets its reason under `why`; one whose recording makes more
 /// or fewer events than some calibrations give at the grid's ends says so: those count at
 /// the end, a bound, and its interval is open that way.
-fn beyond_grid(result: &mut CtEstimate, (on, off): (&Polarity, &Polarity), calibrations: usize) {
+fn polarity_notes(result: &mut CtEstimate, (on, off): (&Polarity, &Polarity), calibrations: usize) {
     for (key, polarity) in [("ct_on", on), ("ct_off", off)] {
         if let Some(why) = &polarity.why {
             result.why.insert(key.into(), why.clone());

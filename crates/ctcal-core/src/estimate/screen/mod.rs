@@ -572,8 +572,10 @@ struct Matched<'a> {
     naive: (f64, f64),
     fits: DisplayFits,
     display: DisplayParams,
-    /// Through the fitted display with ideal pixels, and with the measured photoreceptor.
+    /// Through the fitted display, with ideal pixels.
     ideal: (f64, f64),
+    /// Through the fitted display, with the measured photoreceptor (`ideal` where no lag
+    /// was found).
     fitted: (f64, f64),
     lag_profile: lag::LagProfile,
 }
@@ -689,8 +691,7 @@ fn measured(m: &Matched, prior: GammaPrior) -> Result<(Measured, Measured), Esti
 
 /// What the estimate says of how it was made: the registration, the stimulus clock, the
 /// display, the prior and the lag first among the assumptions; the estimator's details;
-/// the display, the naive thresholds, the photoreceptor and how much of the difference to
-/// the naive thresholds the display explains.
+/// and its [`extras`].
 fn describe(
     estimate: &mut CtEstimate,
     m: &Matched,
@@ -701,17 +702,6 @@ fn describe(
     let (setup, display, naive) = (&m.setup, &m.display, m.naive);
     let prior = setup.input.gamma_prior;
     let (offset_us, refresh_hz) = (setup.offset_us, setup.refresh_hz);
-    let stimulus = setup.input.stimulus;
-    let naive_ct = 0.5 * (naive.0 + naive.1);
-    let contrast =
-        log_variation(stimulus, Some(display)) / log_variation(stimulus, None).max(1e-12);
-    let ct = estimate.ct.unwrap_or(f64::NAN);
-    let gap = (ct / naive_ct).ln();
-    let explained = if gap.abs() > 1e-6 {
-        contrast.ln() / gap
-    } else {
-        1.0
-    };
     estimate.assumptions.splice(0..0, [
         located.assumption(),
         format!(
@@ -754,14 +744,34 @@ fn describe(
             "simulations": setup.evaluations.load(std::sync::atomic::Ordering::Relaxed),
         }),
     }];
-    let extra = [
+    let ct = estimate.ct.unwrap_or(f64::NAN);
+    for (key, value) in extras(m, located, ct) {
+        estimate.extra.insert(key.into(), value);
+    }
+}
+
+/// The display, the naive thresholds, the photoreceptor, the registration, and how much of
+/// the difference between the naive thresholds and `ct` the display explains.
+fn extras(m: &Matched, located: &Located, ct: f64) -> [(&'static str, serde_json::Value); 5] {
+    let (setup, display, naive) = (&m.setup, &m.display, m.naive);
+    let stimulus = setup.input.stimulus;
+    let naive_ct = 0.5 * (naive.0 + naive.1);
+    let contrast =
+        log_variation(stimulus, Some(display)) / log_variation(stimulus, None).max(1e-12);
+    let gap = (ct / naive_ct).ln();
+    let explained = if gap.abs() > 1e-6 {
+        contrast.ln() / gap
+    } else {
+        1.0
+    };
+    [
         (
             "display",
             json!({
                 "gamma": display.gamma,
                 "black_level": display.black_level,
-                "refresh_hz": refresh_hz,
-                "time_offset_s": offset_us as f64 * 1e-6,
+                "refresh_hz": setup.refresh_hz,
+                "time_offset_s": setup.offset_us as f64 * 1e-6,
                 "white_dn": display.white_dn,
                 "blur_px": display.blur_px,
             }),
@@ -787,10 +797,7 @@ fn describe(
                 ct
             )),
         ),
-    ];
-    for (key, value) in extra {
-        estimate.extra.insert(key.into(), value);
-    }
+    ]
 }
 
 /// The result when the screen is not found: nothing determinable, and why.

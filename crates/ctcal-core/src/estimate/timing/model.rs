@@ -287,7 +287,7 @@ fn fit_columns(
 /// `X^T W y`, for the first `K` columns of the model. Fixed-size arrays, summed pair by
 /// pair in order (the same sums, to the bit, as any other layout summing in that order);
 /// `K` a constant so that the inner loops unroll and vectorise (each element's sum keeps
-/// its order, and `w row[a] row[b]` is `(w row[a]) row[b]` as before).
+/// its order, and `w row[a] row[b]` is evaluated as `(w row[a]) row[b]`).
 fn normal_sums<const K: usize>(
     pairs: &[Pair],
     v: &Values,
