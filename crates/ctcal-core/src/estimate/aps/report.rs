@@ -339,7 +339,7 @@ mod tests {
     #[test]
     fn a_negative_lag_has_no_cutoff_and_says_why_and_an_upward_drift_says_what_it_is() {
         // slider_depth's event timing: tau (DN + b) -0.0071 s DN, a drift of -0.29 log/s
-        let lag = super::super::timing::Lag {
+        let lag = crate::estimate::timing::Lag {
             tau_times_dn: -0.0071,
             standard_error: 0.002,
             cutoff_hz_at_median_dn: None,
@@ -349,7 +349,7 @@ mod tests {
         assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");
         assert!(report["cutoff_hz_at_median_dn"].is_null());
         assert!(report["why"].as_str().unwrap().contains("not positive"));
-        let lag = super::super::timing::Lag {
+        let lag = crate::estimate::timing::Lag {
             standard_error: 0.004,
             cutoff_hz_at_median_dn: Some(120.0),
             ..lag
@@ -360,7 +360,7 @@ mod tests {
             "not resolved: within 1.96 standard errors of zero"
         );
         assert!(report.get("why").is_none());
-        let drift = super::super::timing::Drift {
+        let drift = crate::estimate::timing::Drift {
             at_zero_dn: -0.3,
             per_dn: 0.0001,
             at_median_dn: -0.29,
