@@ -130,21 +130,26 @@ pub(super) fn resimulation_report(
     });
     // the offset moves the re-simulation as it moves the timing (the same frames through
     // the same log)
-    let on = Measured::new(
+    let measure = |value: f64, se: f64, series: &[FrameRatePoint], offset: f64, applied: f64| {
+        let systematic = frame_rate_systematic(series)
+            .1
+            .hypot(offset)
+            .hypot(0.5 * applied);
+        Measured::new(value, se, systematic)
+    };
+    let on = measure(
         on_value,
         r.standard_error_on,
-        frame_rate_systematic(&series_on)
-            .1
-            .hypot(full.timing.on.offset_systematic)
-            .hypot(0.5 * on_applied),
+        &series_on,
+        full.timing.on.offset_systematic,
+        on_applied,
     );
-    let off = Measured::new(
+    let off = measure(
         off_value,
         r.standard_error_off,
-        frame_rate_systematic(&series_off)
-            .1
-            .hypot(full.timing.off.offset_systematic)
-            .hypot(0.5 * off_applied),
+        &series_off,
+        full.timing.off.offset_systematic,
+        off_applied,
     );
     let report = EstimatorReport {
         name: "resimulation",
