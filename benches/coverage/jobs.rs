@@ -133,10 +133,15 @@ impl Plan<'_> {
     fn work_on(&self, send: mpsc::Sender<Vec<RunRecord>>) {
         loop {
             let i = self.next.fetch_add(1, Ordering::SeqCst);
-            if i >= self.args.cases {
-                return;
-            }
-            let case = CaseSpec::draw_from(self.args.seed + i, &self.args.generators.0);
+            let seed = match &self.args.only {
+                Some(seeds) => match seeds.get(i as usize) {
+                    Some(&seed) => seed,
+                    None => return,
+                },
+                None if i < self.args.cases => self.args.seed + i,
+                None => return,
+            };
+            let case = CaseSpec::draw_from(seed, &self.args.generators.0);
             let todo = self.todo(&case);
             if todo.is_empty() {
                 continue;

@@ -30,6 +30,10 @@ pub struct Args {
     /// Seed of the first case (case i has seed SEED + i).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// Only the cases of these seeds, comma-separated (instead of `--cases` from `--seed`):
+    /// to run a study's draws again.
+    #[arg(long, value_delimiter = ',')]
+    pub only: Option<Vec<u64>>,
     /// Output folder (results.jsonl, results.compact.jsonl, COVERAGE.md).
     #[arg(long)]
     pub out: PathBuf,

@@ -11,8 +11,15 @@ fn header(run: Option<(&Args, f64)>, results: &Path) -> String {
     out.push_str("Random recordings with known parameters (`ctcal::coverage::CaseSpec::draw`: scene family, brightness, speed, APS rate and exposure, thresholds, mismatch and every effect at random strengths; on-screen cases through a random display), each run through `ctcal estimate aps|eppps|screen` and `ctcal fit` with `--json -`; see `benches/coverage/README.md`.\n\n");
     match run {
         Some((args, wall_s)) => out.push_str(&format!(
-            "Run: `coverage --cases {} --seed {} --methods {} --jobs {} --threads {} --timeout-s {} --generators {}`, wall time {:.0} s ({:.1} min) on this machine.\n\n",
-            args.cases, args.seed, args.methods, args.jobs, args.threads, args.timeout_s,
+            "Run: `coverage {} --methods {} --jobs {} --threads {} --timeout-s {} --generators {}`, wall time {:.0} s ({:.1} min) on this machine.\n\n",
+            match &args.only {
+                Some(seeds) => format!(
+                    "--only {}",
+                    seeds.iter().map(u64::to_string).collect::<Vec<_>>().join(",")
+                ),
+                None => format!("--cases {} --seed {}", args.cases, args.seed),
+            },
+            args.methods, args.jobs, args.threads, args.timeout_s,
             args.generators.0.iter().map(|g| g.name()).collect::<Vec<_>>().join(","),
             wall_s, wall_s / 60.0
         )),
