@@ -148,11 +148,7 @@ fn run_pass(
                     .name(Hint::Analysis(Analysis::Eppps)),
             )
         })?;
-    let (cp, cn, sigma) = start.unwrap_or((
-        timing.on.ct,
-        timing.off.ct,
-        0.5 * (timing.on.sigma + timing.off.sigma),
-    ));
+    let (cp, cn, sigma) = start.unwrap_or((timing.on.ct, timing.off.ct, simulated_sigma(&timing)));
     let cells = Cells::new(
         Intervals::of_frames(frames, input.sensor),
         input.sensor,
@@ -208,7 +204,8 @@ pub fn estimate(
     // the full frames upsampled once: for their pass and the self-calibration's simulation
     let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
     let full = run_pass(input, &excluded, &frames, &runs, options, None)?;
-    let sigma = 0.5 * (full.timing.on.sigma + full.timing.off.sigma);
+    let spread = full.timing.spread();
+    let sigma = simulated_sigma(&full.timing);
     let grid = timestamp_grid(input.events);
     let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
     drop(runs);
@@ -268,8 +265,11 @@ pub fn estimate(
         &frames,
         &full,
         Findings {
-            sigma,
+            spread,
             sigma_bias: bias.2,
+            sigma_series: report::series(&passes, |p| {
+                Some(p.timing.spread().sigma).filter(|s| s.is_finite())
+            }),
             lsq,
             alignment: json!(alignment),
             offset: offset_report,
@@ -432,13 +432,10 @@ fn subsampled_passes(
     options: &ApsOptions,
     full: &Pass,
 ) -> Vec<(usize, Pass)> {
-    let start = full.resim.as_ref().map(|r| {
-        (
-            r.ct_on,
-            r.ct_off,
-            0.5 * (full.timing.on.sigma + full.timing.off.sigma),
-        )
-    });
+    let start = full
+        .resim
+        .as_ref()
+        .map(|r| (r.ct_on, r.ct_off, simulated_sigma(&full.timing)));
     [2usize, 3]
         .iter()
         .filter_map(|&step| {
@@ -616,6 +613,14 @@ fn calibration_events(
     Some(simulated)
 }
 
+/// The mismatch the re-simulation and the self-calibration simulate: the timing's combined
+/// spread ([`super::timing::spread`]), or none where neither polarity determines it (the
+/// simulations then have no mismatch, and the spread is reported as not determinable).
+fn simulated_sigma(timing: &TimingEstimate) -> f64 {
+    let sigma = timing.spread().sigma;
+    if sigma.is_finite() { sigma } else { 0.0 }
+}
+
 /// The timing estimator's bias, found by running the same pipeline on `simulated`, a
 /// simulation of the same frames with the thresholds `timing` found
 /// ([`calibration_events`]): the simulation sees the frames where the alignment put them,
@@ -646,7 +651,8 @@ fn self_calibrate(
         super::timing::estimate(&simulated, frames, input.sensor, excluded, &options.timing);
     frames.shift_times(shift - again_shift);
     let again = again?;
-    let sigma_again = 0.5 * (again.on.sigma + again.off.sigma);
+    // NaN where the simulation's spread is not determined: no bias is then known
+    let sigma_again = again.spread().sigma;
     Some((
         again.on.ct - timing.on.ct,
         again.off.ct - timing.off.ct,

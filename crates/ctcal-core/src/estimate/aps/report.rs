@@ -7,6 +7,7 @@ use super::Pass;
 use crate::estimate::frames::PreparedFrames;
 use crate::estimate::interval::{FrameRatePoint, Measured, combine, frame_rate_systematic};
 use crate::estimate::timing::TimingEstimate;
+use crate::estimate::timing::spread::Spread;
 use crate::estimate::{CtEstimate, Determinable, EstimatorReport};
 use crate::events::us_to_s;
 use serde_json::json;
@@ -24,7 +25,10 @@ fn interpolation_corrected(value: f64, share: f64) -> (f64, f64) {
 }
 
 /// One value of each pass, against the pass's frame interval (passes without it left out).
-fn series(passes: &[(usize, &Pass)], value: impl Fn(&Pass) -> Option<f64>) -> Vec<FrameRatePoint> {
+pub(super) fn series(
+    passes: &[(usize, &Pass)],
+    value: impl Fn(&Pass) -> Option<f64>,
+) -> Vec<FrameRatePoint> {
     passes
         .iter()
         .filter_map(|(step, p)| {
@@ -165,10 +169,12 @@ pub(super) fn resimulation_report(
 
 /// What the estimate reports beside its thresholds.
 pub(super) struct Findings {
-    /// The event timing's per-pixel spread.
-    pub(super) sigma: f64,
+    /// The event timing's per-pixel spread, both polarities combined.
+    pub(super) spread: Spread,
     /// The self-calibration's bias of that spread.
     pub(super) sigma_bias: f64,
+    /// That spread over the passes (every frame, every 2nd and 3rd frame).
+    pub(super) sigma_series: Vec<FrameRatePoint>,
     /// The least-squares cross-check ([`crate::estimate::lsq`]).
     pub(super) lsq: Option<crate::estimate::lsq::LeastSquares>,
     pub(super) alignment: serde_json::Value,
@@ -205,9 +211,11 @@ pub(super) fn assemble(
     sigma_result(
         &mut estimate,
         &mut assumptions,
-        findings.sigma,
-        findings.sigma_bias,
-        &full.timing,
+        (
+            &findings.spread,
+            findings.sigma_bias,
+            &findings.sigma_series,
+        ),
     );
     let range_notes = std::mem::replace(&mut estimate.assumptions, assumptions);
     estimate.assumptions.extend(range_notes);
@@ -233,6 +241,7 @@ pub(super) fn assemble(
             "frame_offset_dn",
             json!({"value": frames.offset, "estimate": findings.offset}),
         ),
+        ("ct_sigma_frame_rate_series", json!(findings.sigma_series)),
         ("photoreceptor_lag", lag_report(&full.timing.lag)),
         ("leak_drift", drift_report(&full.timing.drift)),
         (
@@ -249,30 +258,54 @@ pub(super) fn assemble(
     estimate
 }
 
-/// The frozen threshold spread: the timing's per-pixel spread (estimation noise removed)
-/// less the self-calibration's bias. Its interval carries the whole bias and at least 10 %
-/// of the value as systematic (the spread a mismatch-free simulation of the same frames
-/// shows varies by about that between seeds); where the bias eats the measured spread, the
-/// spread is not resolved: `null` with an upper bound.
+/// The frozen threshold spread: the timing's per-pixel spread (estimation noise removed,
+/// both polarities combined: [`crate::estimate::timing::spread`]) less the
+/// self-calibration's bias. Its interval carries the whole bias and at least 10 % of the
+/// value as systematic (the spread a mismatch-free simulation of the same frames shows
+/// varies by about that between seeds), and, in quadrature, the frame-rate systematic of
+/// the spread over the passes (`series`): how far the spread moves when every 2nd and 3rd
+/// frame is used, as for the thresholds. Where a polarity showed that the noise
+/// subtraction overshoots, the upper side is raised by what it overshot. Where the bias
+/// eats the measured spread, the spread is not resolved: `null` with an upper bound; where
+/// neither polarity determines it, `null` without one.
 fn sigma_result(
     estimate: &mut CtEstimate,
     assumptions: &mut Vec<String>,
-    sigma: f64,
-    sigma_bias: f64,
-    timing: &TimingEstimate,
+    (spread, sigma_bias, series): (&Spread, f64, &[FrameRatePoint]),
 ) {
-    let se = 0.5 * (timing.on.sigma_standard_error + timing.off.sigma_standard_error);
+    if spread.has_overshoot() {
+        assumptions.push(overshoot_note(spread));
+    }
+    if !spread.sigma.is_finite() {
+        estimate.ct_sigma = None;
+        estimate.ct_sigma_ci95 = None;
+        estimate.why.insert(
+            "ct_sigma".into(),
+            "not determinable: in both polarities the per-pixel thresholds spread less than their estimation noise by more than chance allows, so the noise subtraction is not right for this recording and gives no spread".into(),
+        );
+        return;
+    }
+    let sigma = spread.sigma;
+    // no spread from the self-calibration's simulation: no correction, and none known
+    let sigma_bias = if sigma_bias.is_finite() {
+        sigma_bias
+    } else {
+        0.0
+    };
     let value = sigma - sigma_bias;
-    let systematic = sigma_bias.abs().max(0.1 * value.abs());
-    let measure = Measured::new(value, se, systematic);
+    let (_, frame_rate) = frame_rate_systematic(series);
+    let floor = sigma_bias.abs().max(0.1 * value.abs());
+    let systematic = floor.hypot(frame_rate);
+    let measure = Measured::new(value, spread.sigma_standard_error, systematic);
     assumptions.push(format!(
-        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value as systematic ({systematic:.4})"
+        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}) as systematic ({systematic:.4})"
     ));
+    let hi = spread.raised(measure.ci95[1]);
     if measure.ci95[0] > 0.0 {
         estimate.ct_sigma = Some(value);
-        estimate.ct_sigma_ci95 = Some([measure.ci95[0].max(0.0), measure.ci95[1]]);
+        estimate.ct_sigma_ci95 = Some([measure.ci95[0], hi]);
     } else {
-        let upper = measure.ci95[1].max(unresolved_upper_bound(timing));
+        let upper = hi.max(unresolved_upper_bound(spread));
         estimate.ct_sigma = None;
         estimate.ct_sigma_ci95 = Some([0.0, upper]);
         estimate.why.insert(
@@ -284,16 +317,32 @@ fn sigma_result(
     }
 }
 
+/// What a polarity whose noise subtraction overshoots does to `ct_sigma`, in words.
+fn overshoot_note(spread: &Spread) -> String {
+    let left_out = match spread.used {
+        [true, false] => "OFF",
+        [false, true] => "ON",
+        _ => "both polarities'",
+    };
+    format!(
+        "ct_sigma: the {left_out} per-pixel thresholds spread less than their estimation noise by more than {} standard errors (the pooled within-pixel variance of busy pixels overstates the noise of pixels with one or two samples), so that polarity is left out; the same subtraction may lower the other polarity's spread by as much, so the interval's upper side is raised by it in variance ({:.2e} log^2: sqrt(hi^2 + that))",
+        crate::estimate::timing::spread::OVERSHOOT_Z,
+        spread.overshoot
+    )
+}
+
 /// The 95 % upper bound of a spread the data do not resolve, found where it is bounded: in
-/// the excess variance (between-pixel variance less estimation noise, which the bootstrap
-/// follows through zero), `sqrt(max(v, 0) + 1.96 se(v))`. With few samples per pixel
-/// the estimation noise is large and so is the bound; the spread of `sigma` itself (zero in
-/// most draws there) would give a bound near zero that the data do not support.
-fn unresolved_upper_bound(timing: &TimingEstimate) -> f64 {
-    let v = 0.5 * (timing.on.excess_variance + timing.off.excess_variance);
-    let se = 0.5
-        * (timing.on.excess_variance_standard_error + timing.off.excess_variance_standard_error);
-    (v.max(0.0) + crate::estimate::interval::z95() * se).sqrt()
+/// the combined excess variance (between-pixel variance less estimation noise, which the
+/// bootstrap follows through zero), `sqrt(max(v, 0) + 1.96 se(v))`, raised by an
+/// overshoot. With few samples per pixel the estimation noise is large and so is the
+/// bound; the spread of `sigma` itself (zero in most draws there) would give a bound near
+/// zero that the data do not support.
+fn unresolved_upper_bound(spread: &Spread) -> f64 {
+    let (v, se) = (
+        spread.excess_variance,
+        spread.excess_variance_standard_error,
+    );
+    spread.raised((v.max(0.0) + crate::estimate::interval::z95() * se).sqrt())
 }
 
 /// Whether a nuisance coefficient of the event timing differs from zero at 95 %, in words.

@@ -22,6 +22,7 @@
 pub mod model;
 pub mod pixels;
 pub mod samples;
+pub mod spread;
 
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
