@@ -25,6 +25,7 @@ use crate::sim::source::ReplaySamples;
 use crate::sim::{PixelMaps, PixelParams, Sample};
 use crate::stats::support::supported;
 use argmin::core::{CostFunction, Error as ArgminError};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Side of the count tiles, pixels (before they grow for sparse recordings).
@@ -39,6 +40,21 @@ pub struct Counts {
     pub on: Vec<u32>,
     pub off: Vec<u32>,
 }
+
+impl Counts {
+    /// Adds `other`'s counts cell by cell.
+    fn add(&mut self, other: &Counts) {
+        for (a, b) in self.on.iter_mut().zip(&other.on) {
+            *a += b;
+        }
+        for (a, b) in self.off.iter_mut().zip(&other.off) {
+            *a += b;
+        }
+    }
+}
+
+/// Events counted together on one thread by [`Cells::count`].
+const COUNT_STRETCH: usize = 1 << 16;
 
 /// The cells of a recording: tiles of the sensor times the used intervals.
 #[derive(Clone, Debug)]
@@ -180,16 +196,54 @@ impl Cells {
     }
 
     /// Counts `events` (time-sorted) into the cells; events outside used intervals, of
-    /// excluded pixels or without support are not counted.
+    /// excluded pixels or without support are not counted. Stretches of
+    /// [`COUNT_STRETCH`] events are counted on the pool and their counts added (sums of
+    /// integers: the same whatever the order).
     pub fn count(&self, events: &EventChunk) -> Counts {
         let support = supported(events, self.sensor, self.support_us);
         let n = self.rows * self.tiles;
-        let mut counts = Counts {
+        let zeros = || Counts {
             on: vec![0; n],
             off: vec![0; n],
         };
-        for (i, (&t, &supported)) in events.t.iter().zip(&support).enumerate() {
-            let Some(k) = self.times.partition_point(|&s| s <= t).checked_sub(1) else {
+        (0..events.len().div_ceil(COUNT_STRETCH))
+            .into_par_iter()
+            .map(|k| {
+                let mut counts = zeros();
+                let end = ((k + 1) * COUNT_STRETCH).min(events.len());
+                self.count_stretch(events, &support, k * COUNT_STRETCH..end, &mut counts);
+                counts
+            })
+            .reduce(zeros, |mut a, b| {
+                a.add(&b);
+                a
+            })
+    }
+
+    /// Adds the events of `stretch` to `counts`: the interval of each found by walking
+    /// forward from the previous one's (searched afresh where time goes back).
+    fn count_stretch(
+        &self,
+        events: &EventChunk,
+        support: &[bool],
+        stretch: std::ops::Range<usize>,
+        counts: &mut Counts,
+    ) {
+        let Some(&first) = events.t.get(stretch.start) else {
+            return;
+        };
+        // the number of boundaries at or before the current time
+        let mut after = self.times.partition_point(|&s| s <= first);
+        for i in stretch {
+            let t = events.t[i];
+            if after > 0 && self.times[after - 1] > t {
+                // out of order: found afresh
+                after = self.times.partition_point(|&s| s <= t);
+            }
+            while after < self.times.len() && self.times[after] <= t {
+                after += 1;
+            }
+            let Some(k) = after.checked_sub(1) else {
                 continue;
             };
             let Some(Some(row)) = self.interval_row.get(k) else {
@@ -199,7 +253,7 @@ impl Cells {
             let pixel = y * self.width + x;
             let used = self.used_index[k].expect("a row is a used interval");
             let mask = &self.unreliable[used];
-            if !supported || self.excluded[pixel] || (!mask.is_empty() && mask[pixel]) {
+            if !support[i] || self.excluded[pixel] || (!mask.is_empty() && mask[pixel]) {
                 continue;
             }
             let cell = row * self.tiles + (y / self.tile_px) * self.tiles_x + x / self.tile_px;
@@ -209,7 +263,6 @@ impl Cells {
                 counts.off[cell] += 1;
             }
         }
-        counts
     }
 }
 
