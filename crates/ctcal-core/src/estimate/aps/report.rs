@@ -267,7 +267,7 @@ pub(super) fn assemble(
 /// frame is used, as for the thresholds. Where a polarity showed that the noise
 /// subtraction overshoots, the upper side is raised by what it overshot. Where the bias
 /// eats the measured spread, the spread is not resolved: `null` with an upper bound; where
-/// neither polarity determines it, `null` without one.
+/// both polarities overshoot, `null` with the spread the larger overshoot can hide as bound.
 fn sigma_result(
     estimate: &mut CtEstimate,
     assumptions: &mut Vec<String>,
@@ -277,11 +277,15 @@ fn sigma_result(
         assumptions.push(overshoot_note(spread));
     }
     if !spread.sigma.is_finite() {
+        // as for one polarity: no more spread than the larger overshoot can hide
+        let upper = spread.raised(0.0);
         estimate.ct_sigma = None;
-        estimate.ct_sigma_ci95 = None;
+        estimate.ct_sigma_ci95 = Some([0.0, upper]);
         estimate.why.insert(
             "ct_sigma".into(),
-            "not determinable: in both polarities the per-pixel thresholds spread less than their estimation noise by more than chance allows, so the noise subtraction is not right for this recording and gives no spread".into(),
+            format!(
+                "not resolved: in both polarities the per-pixel thresholds spread less than their estimation noise by more than chance allows (the noise subtraction overshoots), so no spread is measured; 95 % upper bound {upper:.4}, the spread the larger overshoot can hide"
+            ),
         );
         return;
     }
