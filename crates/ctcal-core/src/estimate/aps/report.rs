@@ -291,6 +291,9 @@ fn sigma_result(
     }
     let sigma = spread.sigma;
     // no spread from the self-calibration's simulation: no correction, and none known
+    if !sigma_bias.is_finite() {
+        assumptions.push("ct_sigma: the self-calibration's simulation gave no spread (both its polarities overshoot), so the method's own bias of the spread is not known and 0 is used: only the 10 % floor stands for it".into());
+    }
     let sigma_bias = if sigma_bias.is_finite() {
         sigma_bias
     } else {
