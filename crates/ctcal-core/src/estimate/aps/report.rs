@@ -279,10 +279,9 @@ fn sigma_result(
     if !spread.sigma.is_finite() {
         // as for one polarity: no more spread than the larger overshoot can hide
         let upper = spread.raised(0.0);
-        estimate.ct_sigma = None;
-        estimate.ct_sigma_ci95 = Some([0.0, upper]);
-        estimate.why.insert(
-            "ct_sigma".into(),
+        not_resolved(
+            estimate,
+            upper,
             format!(
                 "not resolved: in both polarities the per-pixel thresholds spread less than their estimation noise by more than chance allows (the noise subtraction overshoots), so no spread is measured; 95 % upper bound {upper:.4}, the spread the larger overshoot can hide"
             ),
@@ -291,12 +290,10 @@ fn sigma_result(
     }
     let sigma = spread.sigma;
     // no spread from the self-calibration's simulation: no correction, and none known
-    if !sigma_bias.is_finite() {
-        assumptions.push("ct_sigma: the self-calibration's simulation gave no spread (both its polarities overshoot), so the method's own bias of the spread is not known and 0 is used: only the 10 % floor stands for it".into());
-    }
     let sigma_bias = if sigma_bias.is_finite() {
         sigma_bias
     } else {
+        assumptions.push("ct_sigma: the self-calibration's simulation gave no spread (both its polarities overshoot), so the method's own bias of the spread is not known and 0 is used: only the 10 % floor stands for it".into());
         0.0
     };
     let value = sigma - sigma_bias;
@@ -313,15 +310,21 @@ fn sigma_result(
         estimate.ct_sigma_ci95 = Some([measure.ci95[0], hi]);
     } else {
         let upper = hi.max(unresolved_upper_bound(spread));
-        estimate.ct_sigma = None;
-        estimate.ct_sigma_ci95 = Some([0.0, upper]);
-        estimate.why.insert(
-            "ct_sigma".into(),
+        not_resolved(
+            estimate,
+            upper,
             format!(
                 "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
             ),
         );
     }
+}
+
+/// `ct_sigma` not resolved: `null`, `[0, upper]` and the reason.
+fn not_resolved(estimate: &mut CtEstimate, upper: f64, why: String) {
+    estimate.ct_sigma = None;
+    estimate.ct_sigma_ci95 = Some([0.0, upper]);
+    estimate.why.insert("ct_sigma".into(), why);
 }
 
 /// What a polarity whose noise subtraction overshoots does to `ct_sigma`, in words.
