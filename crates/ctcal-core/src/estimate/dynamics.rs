@@ -12,8 +12,10 @@
 //!   median is a statistic of the motion that is measured the same way on the simulated
 //!   calibration scenes, so that their motion can be matched to it.
 
+use super::flow::FlowField;
 use super::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
+use rayon::prelude::*;
 use serde::Serialize;
 
 /// Below this total-variation rate of the log intensity (per pixel per second) the frames
@@ -33,27 +35,17 @@ pub struct FrameDynamics {
 
 /// Measures `frames` (upsampled along their flow, `max_step_px` apart).
 pub fn from_frames(frames: &PreparedFrames, max_step_px: f64) -> Option<FrameDynamics> {
-    let mut speeds = Vec::new();
-    for (k, flow) in frames.flows.iter().enumerate() {
-        let Some(flow) = flow else { continue };
-        let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
-        let (gx, gy) = frames.dn[k].gradients();
-        // textured pixels: where events come from
-        let mut energies: Vec<f32> = gx
-            .data
-            .iter()
-            .zip(&gy.data)
-            .map(|(a, b)| a.hypot(*b))
-            .collect();
-        let mut sorted = energies.clone();
-        sorted.sort_by(f32::total_cmp);
-        let threshold = sorted[sorted.len() / 2];
-        for (i, e) in energies.iter_mut().enumerate() {
-            if *e >= threshold {
-                speeds.push(flow.u[i].hypot(flow.v[i]) as f64 / dt);
-            }
-        }
-    }
+    // each frame's speeds on the pool, kept in frame order
+    let per_frame: Vec<Vec<f64>> = frames
+        .flows
+        .par_iter()
+        .enumerate()
+        .map(|(k, flow)| {
+            flow.as_ref()
+                .map_or_else(Vec::new, |f| textured_speeds(frames, k, f))
+        })
+        .collect();
+    let mut speeds = per_frame.concat();
     if speeds.is_empty() {
         return None;
     }
@@ -64,13 +56,20 @@ pub fn from_frames(frames: &PreparedFrames, max_step_px: f64) -> Option<FrameDyn
     let pixels = frames.width * frames.height;
     let log = |v: f32| frames.log(v);
     for run in frames.upsample_runs(max_step_px, 512 << 20) {
-        for pair in run.windows(2) {
-            variation += pair[0]
-                .dn
-                .iter()
-                .zip(&pair[1].dn)
-                .map(|(&a, &b)| (log(b - frames.offset) - log(a - frames.offset)).abs() as f64)
-                .sum::<f64>();
+        // each pair's sum on the pool, added in order (the same total as one by one)
+        let sums: Vec<f64> = run
+            .par_windows(2)
+            .map(|pair| {
+                pair[0]
+                    .dn
+                    .iter()
+                    .zip(&pair[1].dn)
+                    .map(|(&a, &b)| (log(b - frames.offset) - log(a - frames.offset)).abs() as f64)
+                    .sum::<f64>()
+            })
+            .collect();
+        for (pair, sum) in run.windows(2).zip(sums) {
+            variation += sum;
             duration += (pair[1].t - pair[0].t) as f64 * 1e-6;
         }
     }
@@ -79,6 +78,28 @@ pub fn from_frames(frames: &PreparedFrames, max_step_px: f64) -> Option<FrameDyn
         speed_p90_px_s: quantile(0.9),
         log_change_rate: variation / (pixels as f64 * duration),
     })
+}
+
+/// The flow speeds (px/s) of frame `k`'s textured pixels (gradient at or above the
+/// median): where events come from.
+fn textured_speeds(frames: &PreparedFrames, k: usize, flow: &FlowField) -> Vec<f64> {
+    let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
+    let (gx, gy) = frames.dn[k].gradients();
+    let energies: Vec<f32> = gx
+        .data
+        .iter()
+        .zip(&gy.data)
+        .map(|(a, b)| a.hypot(*b))
+        .collect();
+    let mut ranked = energies.clone();
+    let middle = ranked.len() / 2;
+    let threshold = *ranked.select_nth_unstable_by(middle, f32::total_cmp).1;
+    energies
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| **e >= threshold)
+        .map(|(i, _)| flow.u[i].hypot(flow.v[i]) as f64 / dt)
+        .collect()
 }
 
 /// The median normal speed of moving edges, px/s, from plane fits to the surface of

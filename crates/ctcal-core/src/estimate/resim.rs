@@ -21,8 +21,7 @@ use super::frames::PreparedFrames;
 use super::root::{Crossing, Search, threshold_root};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::hint::{Analysis, Hint, Text};
-use crate::sim::source::ReplaySamples;
-use crate::sim::{PixelMaps, PixelParams, Sample};
+use crate::sim::{PixelMaps, PixelParams, Sample, Simulator};
 use crate::stats::support::supported;
 use argmin::core::{CostFunction, Error as ArgminError};
 use rayon::prelude::*;
@@ -332,23 +331,16 @@ pub fn simulate(
     params: &PixelParams,
 ) -> Result<EventChunk, EstimateError> {
     let mut all = EventChunk::default();
-    // each run an independent stretch of time: its own draw of the noise
+    // each run an independent stretch of time: its own draw of the noise; each simulated
+    // whole, its rows on the pool (`Simulator::run_all`)
     for (k, run) in runs.iter().enumerate() {
-        let mut source = ReplaySamples::new(run, width, height);
-        crate::sim::run_noise_stream::<crate::sim::SimError>(
-            &mut source,
-            params,
-            PixelMaps::default(),
-            k as u64,
-            |chunk| {
-                all.extend_from(chunk);
-                Ok(())
-            },
-            |_| {},
-        )
-        .map_err(|e| {
-            EstimateError::new(format!("re-simulation failed: {e}"), "report this as a bug")
-        })?;
+        let events = Simulator::new(params, width, height, PixelMaps::default())
+            .noise_stream(k as u64)
+            .run_all(run)
+            .map_err(|e| {
+                EstimateError::new(format!("re-simulation failed: {e}"), "report this as a bug")
+            })?;
+        all.extend_from(&events);
     }
     all.sort_by_time();
     Ok(all)

@@ -29,18 +29,18 @@ pub struct PixelMaps {
 
 /// A running simulation.
 pub struct Simulator {
-    width: usize,
-    height: usize,
-    model: PixelModel,
-    log_map: LogMap,
-    rows: Vec<Row>,
-    origin: Option<TimeUs>,
-    previous_us: f64,
-    jitter: Option<(JitterBuffer, Xoshiro256PlusPlus)>,
+    pub(super) width: usize,
+    pub(super) height: usize,
+    pub(super) model: PixelModel,
+    pub(super) log_map: LogMap,
+    pub(super) rows: Vec<Row>,
+    pub(super) origin: Option<TimeUs>,
+    pub(super) previous_us: f64,
+    pub(super) jitter: Option<(JitterBuffer, Xoshiro256PlusPlus)>,
     merged: Vec<Event>,
     staged: EventChunk,
     out: EventChunk,
-    log_frame: Vec<f32>,
+    pub(super) log_frame: Vec<f32>,
     seed: u64,
     /// Which draw of the pixels' random updates (shot noise, temporal threshold noise,
     /// hot-pixel trains, jitter) this simulation takes; the frozen draws (thresholds, leak

@@ -6,6 +6,7 @@
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::stats::support::supported;
+use rayon::prelude::*;
 
 /// One pair of consecutive events of a pixel.
 #[derive(Clone, Copy, Debug)]
@@ -59,6 +60,19 @@ fn around(frames: &PreparedFrames, x: u16, y: u16, t: TimeUs) -> Option<(f32, f3
     Some((before, after))
 }
 
+/// What the frames say at one event: its DN (NaN when unknown or noise), the DN around it
+/// and its distance from a frame ([`phase_weight`]).
+#[derive(Clone, Copy)]
+struct Reading {
+    dn: f32,
+    near: (f32, f32),
+    weight: f32,
+}
+
+/// Events read against the frames per stretch: each stretch's readings (interpolated DN, the
+/// costly part) on the pool, then paired in event order; memory is one stretch's readings.
+const READ_STRETCH: usize = 1 << 16;
+
 /// Every usable pair of `events` (time-sorted) against `frames` with their times moved by
 /// `shift` (an event at `t` is read at `t - shift` on the frames' own clock, exactly what
 /// frames whose times were shifted give, without changing them): both events in used
@@ -73,15 +87,10 @@ pub fn collect(
 ) -> Vec<Pair> {
     let support = support_window_us.map(|w| supported(events, sensor, w));
     let width = sensor.width as usize;
-    // the previous event of each pixel: its DN (NaN when unknown or noise), time, and DN
-    // around it
-    let mut previous = vec![(f32::NAN, 0 as TimeUs, (0.0f32, 0.0f32), 0.0f32); sensor.pixels()];
-    let mut pairs = Vec::new();
-    for i in 0..events.len() {
+    let read = |i: usize| -> Option<Reading> {
         let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
-        let pixel = y as usize * width + x as usize;
-        if excluded[pixel] {
-            continue;
+        if excluded[y as usize * width + x as usize] {
+            return None;
         }
         let dn = match frames.dn_at(x, y, t - shift) {
             Some(dn) if support.as_ref().is_none_or(|s| s[i]) => dn,
@@ -92,24 +101,42 @@ pub fn collect(
         } else {
             (dn, dn)
         };
-        let (before, t_before, near_before, w_before) = previous[pixel];
-        let w_now = phase_weight(frames, t - shift);
-        let block = frames.read_block(t);
-        // a pixel's change across a span whose events were not read is unknown
-        if before.is_finite() && dn.is_finite() && frames.read_block(t_before) == block {
-            pairs.push(Pair {
-                pixel: pixel as u32,
-                on: events.on[i],
-                dn0: before,
-                dn1: dn,
-                dt: ((t - t_before) as f64 * 1e-6) as f32,
-                around: [near_before.0, near_before.1, near.0, near.1],
-                span: (2 * HALF_SPAN_US) as f32 * 1e-6,
-                block: u16::try_from(block).unwrap_or(u16::MAX),
-                interp: [w_before, w_now],
-            });
+        let weight = phase_weight(frames, t - shift);
+        Some(Reading { dn, near, weight })
+    };
+    // the previous event of each pixel: its reading and time
+    let unknown = Reading {
+        dn: f32::NAN,
+        near: (0.0, 0.0),
+        weight: 0.0,
+    };
+    let mut previous = vec![(unknown, 0 as TimeUs); sensor.pixels()];
+    let mut pairs = Vec::new();
+    for first in (0..events.len()).step_by(READ_STRETCH) {
+        let stretch = first..(first + READ_STRETCH).min(events.len());
+        let readings: Vec<Option<Reading>> = stretch.clone().into_par_iter().map(read).collect();
+        for (i, reading) in stretch.zip(readings) {
+            let Some(now) = reading else { continue };
+            let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
+            let pixel = y as usize * width + x as usize;
+            let (before, t_before) = previous[pixel];
+            let block = frames.read_block(t);
+            // a pixel's change across a span whose events were not read is unknown
+            if before.dn.is_finite() && now.dn.is_finite() && frames.read_block(t_before) == block {
+                pairs.push(Pair {
+                    pixel: pixel as u32,
+                    on: events.on[i],
+                    dn0: before.dn,
+                    dn1: now.dn,
+                    dt: ((t - t_before) as f64 * 1e-6) as f32,
+                    around: [before.near.0, before.near.1, now.near.0, now.near.1],
+                    span: (2 * HALF_SPAN_US) as f32 * 1e-6,
+                    block: u16::try_from(block).unwrap_or(u16::MAX),
+                    interp: [before.weight, now.weight],
+                });
+            }
+            previous[pixel] = (now, t);
         }
-        previous[pixel] = (dn, t, near, w_now);
     }
     pairs
 }

@@ -1,0 +1,213 @@
+//! A whole run of samples simulated at once, for callers that hold the samples in memory
+//! (the re-simulation of a recording's upsampled frames, `estimate aps` and `fit`).
+//!
+//! [`Simulator::step`] updates the rows of one sample on the pool and merges their events
+//! between samples. On a small sensor one sample's work (tens of microseconds) is shorter
+//! than waking a second thread, so the pool's other thread mostly sleeps. Each row's pixels
+//! are independent of the other rows and every row owns its random generator
+//! ([`super::rng`]), so a row can instead be advanced through every sample of the run as
+//! one task, and the rows' events merged once at the end, in the order `step` gives them
+//! (by sample, then time, row, column; a pixel's events in generation order). The result
+//! is the same events, bit for bit, as `start` + `step` per sample + `finish` (tested
+//! below).
+
+use super::SimError;
+use super::row::Step;
+use super::simulator::Simulator;
+use super::source::Sample;
+use crate::events::{Event, EventChunk};
+use rayon::prelude::*;
+
+impl Simulator {
+    /// Simulates `samples` (times non-decreasing, each frame `width x height`): the
+    /// events of [`Self::start`] on the first sample, [`Self::step`] on each later one and
+    /// [`Self::finish`], with each row advanced through the whole run on the pool.
+    pub fn run_all(&mut self, samples: &[Sample]) -> Result<EventChunk, SimError> {
+        let Some((first, rest)) = samples.split_first() else {
+            return Err(SimError::Invalid("the input has no frames".into()));
+        };
+        let pixels = self.width * self.height;
+        if let Some(bad) = samples.iter().position(|s| s.dn.len() != pixels) {
+            return Err(SimError::Invalid(format!(
+                "sample {bad} has {} values for a {}x{} sensor",
+                samples[bad].dn.len(),
+                self.width,
+                self.height
+            )));
+        }
+        self.start(first.t, &first.dn);
+        let windows = self.windows(first, rest)?;
+        let merged = self.advance_rows(rest, &windows);
+        Ok(self.emit(rest, &merged))
+    }
+
+    /// Each later sample's interval `(t0, t1]` in microseconds since the origin, as
+    /// [`Self::step`] computes it; an error where sample times go backwards.
+    fn windows(&mut self, first: &Sample, rest: &[Sample]) -> Result<Vec<(f64, f64)>, SimError> {
+        let origin = self.origin.expect("started");
+        let mut last = first.t;
+        let mut windows = Vec::with_capacity(rest.len());
+        for sample in rest {
+            if sample.t < last {
+                return Err(SimError::Invalid(format!(
+                    "input sample times go backwards ({} us after {} us)",
+                    sample.t, last
+                )));
+            }
+            last = sample.t;
+            let t1 = ((sample.t - origin) as f64).max(self.previous_us);
+            windows.push((self.previous_us, t1));
+            self.previous_us = t1;
+        }
+        Ok(windows)
+    }
+
+    /// Every row through every sample, one row a task; the events tagged with their
+    /// sample's index and sorted as `step` sorts each sample's (a stable sort: a pixel's
+    /// events keep their generation order when times tie).
+    fn advance_rows(&mut self, rest: &[Sample], windows: &[(f64, f64)]) -> Vec<(u32, Event)> {
+        let origin = self.origin.expect("started");
+        let (width, model, log_map) = (self.width, &self.model, self.log_map);
+        let per_row: Vec<Vec<(u32, Event)>> = self
+            .rows
+            .par_iter_mut()
+            .zip(self.log_frame.par_chunks_mut(width))
+            .enumerate()
+            .map(|(y, (row, log_row))| {
+                let mut events = Vec::new();
+                for (k, (sample, &(t0, t1))) in rest.iter().zip(windows).enumerate() {
+                    let step = Step {
+                        model,
+                        log_map,
+                        origin,
+                        t0,
+                        t1,
+                        transition: sample.transition,
+                    };
+                    let dn_row = &sample.dn[y * width..(y + 1) * width];
+                    row.vector_phase(&step, dn_row, log_row);
+                    row.busy_phase(&step, dn_row, log_row);
+                    events.extend(row.events.iter().map(|&e| (k as u32, e)));
+                }
+                events
+            })
+            .collect();
+        let mut merged = per_row.concat();
+        merged.par_sort_by_key(|&(k, e)| (k, e.t, e.y, e.x));
+        merged
+    }
+
+    /// The merged events as `step` and `finish` emit them: as they are, or through the
+    /// timestamp-jitter buffer one sample at a time.
+    fn emit(&mut self, rest: &[Sample], merged: &[(u32, Event)]) -> EventChunk {
+        let mut out = EventChunk::default();
+        let Some((buffer, rng)) = &mut self.jitter else {
+            for &(_, e) in merged {
+                out.push_event(e);
+            }
+            return out;
+        };
+        let mut staged = EventChunk::default();
+        let mut next = 0;
+        for (k, sample) in rest.iter().enumerate() {
+            staged.clear();
+            while let Some(&(_, e)) = merged.get(next).filter(|(s, _)| *s == k as u32) {
+                staged.push_event(e);
+                next += 1;
+            }
+            buffer.push(&staged, sample.t, rng, &mut out);
+        }
+        buffer.flush(&mut out);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::{PixelMaps, PixelParams, Transition};
+
+    /// Moving bright bars over a 37 x 11 sensor: enough events per row and sample for
+    /// ties, refractory, noise and jitter to matter.
+    fn samples(n: usize) -> Vec<Sample> {
+        let (w, h) = (37usize, 11usize);
+        (0..n)
+            .map(|k| Sample {
+                t: 1_000 + 700 * k as i64,
+                dn: (0..w * h)
+                    .map(|i| {
+                        let (x, y) = ((i % w) as f32, (i / w) as f32);
+                        40.0 + 150.0 * (0.5 + 0.5 * ((x + 0.3 * y - 0.9 * k as f32) * 0.5).sin())
+                    })
+                    .collect(),
+                transition: Transition::Linear,
+            })
+            .collect()
+    }
+
+    fn stepped(params: &PixelParams, samples: &[Sample], stream: u64) -> EventChunk {
+        let mut sim = Simulator::new(params, 37, 11, PixelMaps::default()).noise_stream(stream);
+        sim.start(samples[0].t, &samples[0].dn);
+        let mut all = EventChunk::default();
+        for s in &samples[1..] {
+            all.extend_from(sim.step(s.t, &s.dn, s.transition));
+        }
+        all.extend_from(sim.finish());
+        all
+    }
+
+    fn batch(params: &PixelParams, samples: &[Sample], stream: u64) -> EventChunk {
+        Simulator::new(params, 37, 11, PixelMaps::default())
+            .noise_stream(stream)
+            .run_all(samples)
+            .unwrap()
+    }
+
+    #[test]
+    fn the_same_events_as_stepping_with_and_without_effects() {
+        let samples = samples(60);
+        let ideal = PixelParams::ideal(0.2, 0.25);
+        let noisy = PixelParams {
+            ct_sigma: Some(0.03),
+            refractory_s: Some(200e-6),
+            shot_noise_rate_hz: Some(2.0),
+            timestamp_jitter_s: Some(150e-6),
+            cutoff_hz: Some(400.0),
+            leak_rate_hz: Some(0.5),
+            hot_pixel_fraction: Some(0.02),
+            hot_pixel_rate_hz: Some(80.0),
+            ..ideal.clone()
+        };
+        for (params, stream) in [(&ideal, 0), (&noisy, 0), (&noisy, 3)] {
+            let a = stepped(params, &samples, stream);
+            assert!(
+                a.len() > 500,
+                "{} events: the case exercises too little",
+                a.len()
+            );
+            assert_eq!(a, batch(params, &samples, stream));
+        }
+    }
+
+    #[test]
+    fn errors_name_backward_times_and_wrong_sizes() {
+        let mut s = samples(3);
+        s[2].t = 0;
+        let p = PixelParams::ideal(0.2, 0.2);
+        let e = Simulator::new(&p, 37, 11, PixelMaps::default()).run_all(&s);
+        assert!(e.unwrap_err().to_string().contains("backwards"));
+        let mut s = samples(3);
+        s[1].dn.pop();
+        let e = Simulator::new(&p, 37, 11, PixelMaps::default()).run_all(&s);
+        assert!(
+            e.unwrap_err()
+                .to_string()
+                .contains("sample 1 has 406 values")
+        );
+        assert!(
+            Simulator::new(&p, 37, 11, PixelMaps::default())
+                .run_all(&[])
+                .is_err()
+        );
+    }
+}
