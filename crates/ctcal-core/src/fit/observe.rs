@@ -18,9 +18,10 @@
 //! some blocks are held out of the fit ([`Subset`]) to judge each added effect on data the
 //! fit has not seen.
 
-use crate::estimate::frames::{PreparedFrames, read_block};
-use crate::events::{EventChunk, Sensor, TimeUs};
-use crate::stats::support::supported;
+use crate::estimate::frames::PreparedFrames;
+use crate::events::{Sensor, TimeUs};
+
+mod count;
 
 /// Upper edges of the intensity bins (frame DN; the last bin holds the rest).
 pub const INTENSITY_EDGES: [f32; 5] = [10.0, 20.0, 40.0, 80.0, 160.0];
@@ -378,76 +379,6 @@ pub struct Observed {
 }
 
 impl Observed {
-    /// The statistics of the time-sorted `events`, leaving out the pixels `masked` flags
-    /// (hot pixels) besides the geometry's own exclusions.
-    pub fn new(events: &EventChunk, geometry: &Geometry, masked: &[bool]) -> Self {
-        let g = geometry;
-        let blocks = g.blocks;
-        let pixels = g.sensor.pixels();
-        let mut o = Self {
-            blocks,
-            cells: vec![0; blocks * CELLS],
-            background: vec![0; blocks * INTENSITY_BINS * 2],
-            by_region: vec![0; blocks * REGIONS * 2],
-            intervals: vec![0; blocks * INTERVAL_BINS],
-            pixel_counts: vec![0; blocks * pixels],
-            polarity: vec![[0; 2]; blocks],
-            timeline: vec![0; ((g.span.1 - g.span.0) / TIMELINE_BIN_US).max(0) as usize + 1],
-        };
-        if events.is_empty() {
-            return o;
-        }
-        let support = supported(events, g.sensor, SUPPORT_US);
-        let width = g.sensor.width as usize;
-        let mut last = vec![TimeUs::MIN; pixels];
-        let mut k = 0usize;
-        for (i, &is_supported) in support.iter().enumerate() {
-            let t = events.t[i];
-            let p = events.y[i] as usize * width + events.x[i] as usize;
-            let previous = std::mem::replace(&mut last[p], t);
-            // the frame interval of t (events arrive sorted)
-            while k + 1 < g.times.len() && g.times[k + 1] <= t {
-                k += 1;
-            }
-            if t < g.times[0] || k + 1 >= g.times.len() {
-                continue;
-            }
-            let Some(block) = g.interval_block[k] else {
-                continue;
-            };
-            if g.excluded[p] || masked[p] {
-                continue;
-            }
-            let pol = events.on[i] as usize;
-            o.pixel_counts[block * pixels + p] += 1;
-            o.polarity[block][pol] += 1;
-            // a same-pixel interval across a span whose events were not read is unknown
-            if previous != TimeUs::MIN
-                && read_block(&g.unread, previous) == read_block(&g.unread, t)
-            {
-                o.intervals[block * INTERVAL_BINS + interval_bin((t - previous) as f64 * 1e-6)] +=
-                    1;
-            }
-            let slot = ((t - g.span.0) / TIMELINE_BIN_US) as usize;
-            if let Some(bin) = o.timeline.get_mut(slot) {
-                *bin += 1;
-            }
-            let intensity = g.intensity[k][p];
-            if intensity == u8::MAX {
-                continue;
-            }
-            let intensity = intensity as usize;
-            if is_supported {
-                let change = g.change[k][p] as usize;
-                o.cells[block * CELLS + cell_index(intensity, change, pol)] += 1;
-                o.by_region[(block * REGIONS + g.region[p] as usize) * 2 + pol] += 1;
-            } else {
-                o.background[(block * INTENSITY_BINS + intensity) * 2 + pol] += 1;
-            }
-        }
-        o
-    }
-
     /// Count cells (see [`cell_index`]) summed over `subset`.
     pub fn cells_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
         sum_blocks(&self.cells, CELLS, self.blocks, |b| g.in_subset(b, subset))

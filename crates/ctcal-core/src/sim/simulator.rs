@@ -178,7 +178,31 @@ impl Simulator {
             }
         }
         let log_map = self.log_map;
-        self.rows = (0..self.height)
+        // each pixel's noise rate (on the pool), then the first noise time of every pixel
+        // drawn in pixel order from the one set-up generator
+        let rates: Vec<(f64, f32)> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                if noise_rate > 0.0 {
+                    shot_noise::pixel_rates(
+                        noise_rate,
+                        params.ct_on,
+                        params.ct_off,
+                        theta_on[i],
+                        theta_off[i],
+                    )
+                } else {
+                    (0.0, 0.5)
+                }
+            })
+            .collect();
+        let next_noise: Vec<f64> = rates
+            .iter()
+            .map(|&(rate, _)| exponential_us(rate, &mut noise_rng))
+            .collect();
+        let this = &*self;
+        let rows: Vec<Row> = (0..self.height)
+            .into_par_iter()
             .map(|y| {
                 let range = y * width..(y + 1) * width;
                 let input: Vec<f32> = dn[range.clone()]
@@ -187,30 +211,17 @@ impl Simulator {
                     .collect();
                 let cold: Vec<Cold> = range
                     .clone()
-                    .map(|i| {
-                        let (rate, on_share) = if noise_rate > 0.0 {
-                            shot_noise::pixel_rates(
-                                noise_rate,
-                                params.ct_on,
-                                params.ct_off,
-                                theta_on[i],
-                                theta_off[i],
-                            )
-                        } else {
-                            (0.0, 0.5)
-                        };
-                        Cold {
-                            frozen_on: theta_on[i],
-                            frozen_off: theta_off[i],
-                            noise_rate_per_us: rate,
-                            noise_on_share: on_share,
-                            last_event_us: f64::NEG_INFINITY,
-                            next_noise_us: exponential_us(rate, &mut noise_rng),
-                            next_hot_us: hot_next[i],
-                        }
+                    .map(|i| Cold {
+                        frozen_on: theta_on[i],
+                        frozen_off: theta_off[i],
+                        noise_rate_per_us: rates[i].0,
+                        noise_on_share: rates[i].1,
+                        last_event_us: f64::NEG_INFINITY,
+                        next_noise_us: next_noise[i],
+                        next_hot_us: hot_next[i],
                     })
                     .collect();
-                Row {
+                let mut row = Row {
                     y: y as u16,
                     reference: input.clone(),
                     filtered: input.clone(),
@@ -231,18 +242,18 @@ impl Simulator {
                     busy: vec![0; width],
                     filter_end: vec![0.0; width],
                     cold,
-                    rng: generator(self.seed, Stream::Rows, self.noise_index(y as u64)),
+                    rng: generator(this.seed, Stream::Rows, this.noise_index(y as u64)),
                     events: Vec::new(),
+                };
+                if this.model.intensity_window {
+                    for x in 0..width {
+                        row.update_window(x, &log_map);
+                    }
                 }
+                row
             })
             .collect();
-        if self.model.intensity_window {
-            for row in &mut self.rows {
-                for x in 0..width {
-                    row.update_window(x, &log_map);
-                }
-            }
-        }
+        self.rows = rows;
     }
 
     /// The next sample at time `t`: returns the events in (previous sample, `t`], sorted
