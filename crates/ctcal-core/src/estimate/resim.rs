@@ -53,7 +53,7 @@ impl Counts {
 }
 
 /// Events counted together on one thread by [`Cells::count`].
-const COUNT_STRETCH: usize = 1 << 16;
+const COUNT_STRETCH: usize = 1 << 14;
 
 /// The cells of a recording: tiles of the sensor times the used intervals.
 #[derive(Clone, Debug)]

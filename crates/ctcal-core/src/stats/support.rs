@@ -17,7 +17,7 @@ pub fn supported(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<
 }
 
 /// Fewer events than this are filtered in one stretch.
-const MIN_STRETCH: usize = 1 << 16;
+const MIN_STRETCH: usize = 1 << 14;
 
 /// [`supported`] in at most `threads` stretches of time-sorted events, on the pool. A
 /// stretch's flags depend only on the marks of the `window_us` before it, so each stretch

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 /// Fewer events than this are counted in one stretch (cutting them costs more than it
 /// saves).
-const MIN_STRETCH: usize = 1 << 16;
+const MIN_STRETCH: usize = 1 << 14;
 
 /// A stretch's counts, and what it leaves to be completed in order: the counted events
 /// whose pixel had no earlier event in the stretch (pixel, block, time), and each pixel's
