@@ -5,8 +5,8 @@
 //! between samples. On a small sensor one sample's work (tens of microseconds) is shorter
 //! than waking a second thread, so the pool's other thread mostly sleeps. Each row's pixels
 //! are independent of the other rows and every row owns its random generator
-//! ([`super::rng`]), so a row can instead be advanced through every sample of the run as
-//! one task, and the rows' events merged once at the end, in the order `step` gives them
+//! ([`super::rng`]), so a row can instead be advanced through a batch of samples as one
+//! task, and the rows' events merged once per batch, in the order `step` gives them
 //! (by sample, then time, row, column; a pixel's events in generation order). The result
 //! is the same events, bit for bit, as `start` + `step` per sample + `finish` (tested
 //! below).
@@ -18,10 +18,15 @@ use super::source::Sample;
 use crate::events::{Event, EventChunk};
 use rayon::prelude::*;
 
+/// Samples a row is advanced through per task: enough work to keep every thread busy,
+/// few enough that the events held for merging stay a small part of the run's.
+const BATCH: usize = 32;
+
 impl Simulator {
     /// Simulates `samples` (times non-decreasing, each frame `width x height`): the
     /// events of [`Self::start`] on the first sample, [`Self::step`] on each later one and
-    /// [`Self::finish`], with each row advanced through the whole run on the pool.
+    /// [`Self::finish`], with each row advanced through [`BATCH`] samples at a time on the
+    /// pool.
     pub fn run_all(&mut self, samples: &[Sample]) -> Result<EventChunk, SimError> {
         let Some((first, rest)) = samples.split_first() else {
             return Err(SimError::Invalid("the input has no frames".into()));
@@ -37,8 +42,15 @@ impl Simulator {
         }
         self.start(first.t, &first.dn);
         let windows = self.windows(first, rest)?;
-        let merged = self.advance_rows(rest, &windows);
-        Ok(self.emit(rest, &merged))
+        let mut out = EventChunk::default();
+        for (batch, spans) in rest.chunks(BATCH).zip(windows.chunks(BATCH)) {
+            let merged = self.advance_rows(batch, spans);
+            self.emit(batch, &merged, &mut out);
+        }
+        if let Some((buffer, _)) = &mut self.jitter {
+            buffer.flush(&mut out);
+        }
+        Ok(out)
     }
 
     /// Each later sample's interval `(t0, t1]` in microseconds since the origin, as
@@ -62,10 +74,10 @@ impl Simulator {
         Ok(windows)
     }
 
-    /// Every row through every sample, one row a task; the events tagged with their
-    /// sample's index and sorted as `step` sorts each sample's (a stable sort: a pixel's
+    /// Every row through the samples of `batch`, one row a task; the events tagged with
+    /// their sample's index in the batch and sorted as `step` sorts each sample's (a stable sort: a pixel's
     /// events keep their generation order when times tie).
-    fn advance_rows(&mut self, rest: &[Sample], windows: &[(f64, f64)]) -> Vec<(u32, Event)> {
+    fn advance_rows(&mut self, batch: &[Sample], spans: &[(f64, f64)]) -> Vec<(u32, Event)> {
         let origin = self.origin.expect("started");
         let (width, model, log_map) = (self.width, &self.model, self.log_map);
         let per_row: Vec<Vec<(u32, Event)>> = self
@@ -75,7 +87,7 @@ impl Simulator {
             .enumerate()
             .map(|(y, (row, log_row))| {
                 let mut events = Vec::new();
-                for (k, (sample, &(t0, t1))) in rest.iter().zip(windows).enumerate() {
+                for (k, (sample, &(t0, t1))) in batch.iter().zip(spans).enumerate() {
                     let step = Step {
                         model,
                         log_map,
@@ -97,28 +109,25 @@ impl Simulator {
         merged
     }
 
-    /// The merged events as `step` and `finish` emit them: as they are, or through the
-    /// timestamp-jitter buffer one sample at a time.
-    fn emit(&mut self, rest: &[Sample], merged: &[(u32, Event)]) -> EventChunk {
-        let mut out = EventChunk::default();
+    /// Appends the merged events of `batch` to `out` as `step` emits them: as they are,
+    /// or through the timestamp-jitter buffer one sample at a time.
+    fn emit(&mut self, batch: &[Sample], merged: &[(u32, Event)], out: &mut EventChunk) {
         let Some((buffer, rng)) = &mut self.jitter else {
             for &(_, e) in merged {
                 out.push_event(e);
             }
-            return out;
+            return;
         };
         let mut staged = EventChunk::default();
         let mut next = 0;
-        for (k, sample) in rest.iter().enumerate() {
+        for (k, sample) in batch.iter().enumerate() {
             staged.clear();
             while let Some(&(_, e)) = merged.get(next).filter(|(s, _)| *s == k as u32) {
                 staged.push_event(e);
                 next += 1;
             }
-            buffer.push(&staged, sample.t, rng, &mut out);
+            buffer.push(&staged, sample.t, rng, out);
         }
-        buffer.flush(&mut out);
-        out
     }
 }
 
