@@ -1,12 +1,13 @@
 //! Simulator throughput (input frames per second) at DAVIS240 and DAVIS346 sizes, ideal and
-//! with every effect, on one thread and on all threads. `examples/simulator_throughput.rs`
+//! with every effect, on one thread and on all threads, stepped one sample at a time and
+//! run whole from memory (`Simulator::run_all`). `examples/simulator_throughput.rs`
 //! prints the same matrix with events per second as a table. The `render` group guards the
 //! scene renderers (one frame of every scene family of `calib/scenes`, on one thread), the
 //! hot loop of `simulate --scene`.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use ctcal::sim::scene::SceneSpec;
-use ctcal::sim::{PixelMaps, PixelParams, Simulator, Transition};
+use ctcal::sim::{PixelMaps, PixelParams, Sample, Simulator, Transition};
 
 fn frames(width: usize, height: usize, count: usize) -> Vec<(i64, Vec<f32>)> {
     let spec = SceneSpec::moving_texture(width, height, count as f64 / 1000.0, 1000.0);
@@ -34,6 +35,14 @@ fn simulator(c: &mut Criterion) {
     group.sample_size(10);
     for (width, height) in [(240, 180), (346, 260)] {
         let input = frames(width, height, 200);
+        let samples: Vec<Sample> = input
+            .iter()
+            .map(|(t, dn)| Sample {
+                t: *t,
+                dn: dn.clone(),
+                transition: Transition::Linear,
+            })
+            .collect();
         group.throughput(Throughput::Elements((input.len() - 1) as u64));
         for (model, params) in [
             ("ideal", PixelParams::ideal(0.3, 0.3)),
@@ -59,6 +68,21 @@ fn simulator(c: &mut Criterion) {
                         })
                     })
                 });
+                // the same frames held in memory, each row through 32 samples a task
+                // (`Simulator::run_all`, the re-simulation's path)
+                group.bench_function(
+                    format!("{width}x{height}/{model}/{threads}_threads/run_all"),
+                    |b| {
+                        b.iter(|| {
+                            pool.install(|| {
+                                Simulator::new(&params, width, height, PixelMaps::default())
+                                    .run_all(&samples)
+                                    .unwrap()
+                                    .len()
+                            })
+                        })
+                    },
+                );
             }
         }
     }

@@ -25,7 +25,7 @@ const BATCH: usize = 32;
 impl Simulator {
     /// Simulates `samples` (times non-decreasing, each frame `width x height`): the
     /// events of [`Self::start`] on the first sample, [`Self::step`] on each later one and
-    /// [`Self::finish`], with each row advanced through [`BATCH`] samples at a time on the
+    /// [`Self::finish`], with each row advanced through 32 samples at a time on the
     /// pool.
     pub fn run_all(&mut self, samples: &[Sample]) -> Result<EventChunk, SimError> {
         let Some((first, rest)) = samples.split_first() else {

@@ -106,7 +106,7 @@ fn stretches(events: &EventChunk, threads: usize) -> Vec<std::ops::Range<usize>>
     let n = events.len();
     let count = threads.min(n / MIN_STRETCH).max(1);
     if count == 1 || !events.is_time_sorted() {
-        return vec![0..n];
+        return std::iter::once(0..n).collect();
     }
     (0..count)
         .map(|k| k * n / count..(k + 1) * n / count)
