@@ -181,6 +181,30 @@ impl EventChunk {
         self.t.windows(2).all(|w| w[0] <= w[1])
     }
 
+    /// How to cut a pass over the time-sorted events among `count` threads: consecutive
+    /// stretches of about equal length, each beginning where the timestamp changes (the
+    /// events of one instant stay together). One stretch when the events are not
+    /// time-sorted or fewer than `min_len` would fall to each.
+    pub fn time_stretches(&self, count: usize, min_len: usize) -> Vec<std::ops::Range<usize>> {
+        let n = self.len();
+        let count = count.min(n / min_len.max(1)).max(1);
+        if count == 1 || !self.is_time_sorted() {
+            return std::iter::once(0..n).collect();
+        }
+        let mut starts: Vec<usize> = (0..count)
+            .map(|k| {
+                let mut s = k * n / count;
+                while s > 0 && s < n && self.t[s] == self.t[s - 1] {
+                    s += 1;
+                }
+                s
+            })
+            .collect();
+        starts.push(n);
+        starts.dedup();
+        starts.windows(2).map(|w| w[0]..w[1]).collect()
+    }
+
     /// Sorts by time; events with equal times keep their order (stable).
     pub fn sort_by_time(&mut self) {
         if self.is_time_sorted() {

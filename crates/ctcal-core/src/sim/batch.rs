@@ -97,8 +97,7 @@ impl Simulator {
                         transition: sample.transition,
                     };
                     let dn_row = &sample.dn[y * width..(y + 1) * width];
-                    row.vector_phase(&step, dn_row, log_row);
-                    row.busy_phase(&step, dn_row, log_row);
+                    row.advance(&step, dn_row, log_row);
                     events.extend(row.events.iter().map(|&e| (k as u32, e)));
                 }
                 events

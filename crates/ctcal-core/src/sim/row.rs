@@ -258,7 +258,7 @@ impl Row {
     }
 
     /// Phase 1: the quiet pixels (same results with or without AVX2).
-    pub fn vector_phase(&mut self, step: &Step, dn1: &[f32], u1: &mut [f32]) {
+    fn vector_phase(&mut self, step: &Step, dn1: &[f32], u1: &mut [f32]) {
         self.events.clear();
         #[cfg(target_arch = "x86_64")]
         if use_avx2() {
@@ -267,6 +267,13 @@ impl Row {
             return;
         }
         self.vector_work(step, dn1, u1);
+    }
+
+    /// Advances the row by one sample: the quiet pixels, then the busy ones
+    /// ([`Self::vector_phase`], [`Self::busy_phase`]).
+    pub fn advance(&mut self, step: &Step, dn1: &[f32], u1: &mut [f32]) {
+        self.vector_phase(step, dn1, u1);
+        self.busy_phase(step, dn1, u1);
     }
 
     /// Calls `f` for every busy pixel (blocks of 16 quiet pixels are skipped with one OR).
@@ -287,7 +294,7 @@ impl Row {
 
     /// Phase 2: the full update of every busy pixel. In window mode `u1` was not computed
     /// and the log is taken here, for busy pixels only.
-    pub fn busy_phase(&mut self, step: &Step, dn1: &[f32], u1: &[f32]) {
+    fn busy_phase(&mut self, step: &Step, dn1: &[f32], u1: &[f32]) {
         let busy = std::mem::take(&mut self.busy);
         Self::for_each_busy(&busy, |x| {
             let u = if step.model.intensity_window {

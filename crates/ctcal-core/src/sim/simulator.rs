@@ -283,8 +283,7 @@ impl Simulator {
                     t1,
                     transition,
                 };
-                row.vector_phase(&step, dn_row, log_row);
-                row.busy_phase(&step, dn_row, log_row);
+                row.advance(&step, dn_row, log_row);
             });
         self.previous_us = t1;
         self.merged.clear();

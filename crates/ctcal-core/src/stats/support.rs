@@ -31,26 +31,13 @@ fn supported_in(
     threads: usize,
 ) -> Vec<bool> {
     let grid = Grid::new(events, sensor);
-    let n = events.len();
-    let count = threads.min(n / MIN_STRETCH).max(1);
-    if count == 1 || !events.is_time_sorted() {
+    let stretches = events.time_stretches(threads, MIN_STRETCH);
+    if stretches.len() == 1 {
         return grid.pass(events, window_us, Direction::Forward);
     }
-    let t = &events.t;
-    let mut starts: Vec<usize> = (0..count)
-        .map(|k| {
-            let mut s = k * n / count;
-            while s > 0 && s < n && t[s] == t[s - 1] {
-                s += 1;
-            }
-            s
-        })
-        .collect();
-    starts.push(n);
-    starts.dedup();
-    let parts: Vec<Vec<bool>> = starts
-        .par_windows(2)
-        .map(|w| grid.forward_stretch(events, window_us, w[0]..w[1]))
+    let parts: Vec<Vec<bool>> = stretches
+        .into_par_iter()
+        .map(|stretch| grid.forward_stretch(events, window_us, stretch))
         .collect();
     parts.concat()
 }
@@ -199,6 +186,8 @@ impl Grid {
 mod tests {
     use super::*;
     use crate::events::Event;
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
 
     #[test]
     fn a_neighbour_within_the_window_supports_an_event() {
@@ -259,13 +248,10 @@ mod tests {
     fn stretches_flag_what_one_pass_flags() {
         // 400,000 events on 20 x 10 pixels over 2 s, with runs of equal timestamps, so
         // that both supported and isolated events are many
-        let mut state = 7u64;
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(7);
         let events: EventChunk = (0..400_000u64)
             .map(|i| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let r = state >> 33;
+                let r = rng.random::<u64>() >> 33;
                 Event {
                     t: (i / 3 * 15) as TimeUs,
                     x: (r % 20) as u16,

@@ -41,7 +41,8 @@ impl Observed {
             return o;
         }
         let support = supported(events, geometry.sensor, SUPPORT_US);
-        let parts: Vec<Part> = stretches(events, threads)
+        let parts: Vec<Part> = events
+            .time_stretches(threads, MIN_STRETCH)
             .into_par_iter()
             .map(|range| count_stretch(events, &support, range, geometry, masked))
             .collect();
@@ -97,20 +98,6 @@ impl Observed {
             self.intervals[block * INTERVAL_BINS + interval_bin((t - previous) as f64 * 1e-6)] += 1;
         }
     }
-}
-
-/// Consecutive stretches of `events`, one per thread when there are enough events and they
-/// are time-sorted (each stretch finds its frame interval by search); one stretch
-/// otherwise.
-fn stretches(events: &EventChunk, threads: usize) -> Vec<std::ops::Range<usize>> {
-    let n = events.len();
-    let count = threads.min(n / MIN_STRETCH).max(1);
-    if count == 1 || !events.is_time_sorted() {
-        return std::iter::once(0..n).collect();
-    }
-    (0..count)
-        .map(|k| k * n / count..(k + 1) * n / count)
-        .collect()
 }
 
 /// Counts the events of `range` as one pass in order would, except the intervals of each
@@ -186,6 +173,8 @@ mod tests {
     use super::super::{CHANGE_BINS, Role};
     use super::*;
     use crate::events::{Event, Sensor};
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
 
     /// 8 x 4 pixels, four frame intervals of 10 ms (the third unused), an unread span in
     /// the fourth; some pixels without a reliable intensity, one excluded, one masked.
@@ -227,14 +216,11 @@ mod tests {
     fn stretches_count_what_one_pass_counts() {
         let (g, masked) = geometry();
         // 300,000 events over 45 ms (some after the last frame), pixels and polarities
-        // from a fixed sequence; times non-decreasing with ties
-        let mut state = 12345u64;
+        // from a seeded generator; times non-decreasing with ties
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(12345);
         let events: EventChunk = (0..300_000u64)
             .map(|i| {
-                state = state
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let r = state >> 33;
+                let r = rng.random::<u64>() >> 33;
                 Event {
                     t: (i * 45_000 / 300_000) as TimeUs,
                     x: (r % 8) as u16,
@@ -248,7 +234,7 @@ mod tests {
         assert!(one.intervals.iter().sum::<u32>() > 150_000);
         for threads in [2, 3, 4] {
             let many = Observed::counted(&events, &g, &masked, threads);
-            assert_eq!(stretches(&events, threads).len(), threads);
+            assert_eq!(events.time_stretches(threads, MIN_STRETCH).len(), threads);
             assert_eq!(many.cells, one.cells);
             assert_eq!(many.background, one.background);
             assert_eq!(many.by_region, one.by_region);
