@@ -20,6 +20,7 @@
 //! mean_p(s^2 / n_p)`, `s^2` the pooled within-pixel variance of the samples.
 
 pub mod model;
+pub mod moments;
 pub mod pixels;
 pub mod samples;
 pub mod spread;
@@ -29,8 +30,9 @@ use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::sim::LogResponse;
 use crate::sim::log_response::LogMap;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
-use model::{Coefficients, fit_at, offset_interval, offset_root, resampled_weights};
-use pixels::{PixelSlots, pixel_sums, pixel_sums_both};
+use model::{Coefficients, fit_at, offset_interval, offset_root};
+use moments::Resampler;
+use pixels::{PixelSlots, pixel_sums};
 use rayon::prelude::*;
 use samples::{Pair, collect};
 use serde::Serialize;
@@ -394,9 +396,12 @@ fn find_offset(
         return not_determined;
     };
     let pixels = frames.width * frames.height;
+    let slots = PixelSlots::new(pairs);
+    let resampler = Resampler::new(pairs, &slots, &values, &weights, pixels);
     let slopes: Vec<f64> = in_order(40, |k| {
-        let w = resampled_weights(pairs, &weights, pixels, 500 + k as u64);
-        model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.level_slope)
+        resampler
+            .fit(&resampler.draw(500 + k as u64), options.fit_leak)
+            .map(|c| c.level_slope)
     });
     let bound = 1.96 * std_dev(&slopes);
     let ci95 = offset_interval(&slope, root, bound, range);
@@ -497,9 +502,12 @@ fn lag_strength(
 ) -> Option<(f64, f64)> {
     let (c, values, weights) = fit(frames.offset)?;
     let pixels = frames.width * frames.height;
+    let slots = PixelSlots::new(pairs);
+    let resampler = Resampler::new(pairs, &slots, &values, &weights, pixels);
     let lags: Vec<f64> = in_order(30, |k| {
-        let w = resampled_weights(pairs, &weights, pixels, 900 + k as u64);
-        model::fit(pairs, &values, &w, options.fit_leak).map(|c| c.lag)
+        resampler
+            .fit(&resampler.draw(900 + k as u64), options.fit_leak)
+            .map(|c| c.lag)
     });
     let wsum: f64 = weights.iter().sum();
     let rms = (values
@@ -546,11 +554,10 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
         weights,
     } = *fitted;
     let median_dn = median_level(pairs);
+    let resampler = Resampler::new(pairs, slots, values, weights, pixels);
     let draw = |k: usize| -> Option<[f64; 8]> {
-        let w = resampled_weights(pairs, weights, pixels, 11 + k as u64);
-        let c = model::fit(pairs, values, &w, options.fit_leak)?;
-        let [off, on] = pixel_sums_both(pairs, slots, values, &w, &c)
-            .map(|sums| sums.map_or(0.0, |s| mean_and_excess(&s.0).1));
+        let (c, sums) = resampler.fit_and_sums(&resampler.draw(11 + k as u64), options.fit_leak)?;
+        let [off, on] = sums.map(|sums| sums.map_or(0.0, |s| mean_and_excess(&s).1));
         Some([
             c.c_on,
             c.c_off,

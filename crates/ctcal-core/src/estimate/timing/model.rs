@@ -232,12 +232,25 @@ fn fit_columns(
         return None;
     }
     let mean_level = v.level.iter().zip(weight).map(|(l, w)| l * w).sum::<f64>() / wsum;
-    let k = if leak { 8 } else { 6 };
     let (sums, sums_y) = if leak {
         normal_sums::<8>(pairs, v, weight, mean_level)
     } else {
         normal_sums::<6>(pairs, v, weight, mean_level)
     };
+    solve(&sums, &sums_y, leak, one_polarity)
+}
+
+/// The coefficients from the normal equations' sums `X^T W X` and `X^T W y` (the model's
+/// columns, the level centred on its weighted mean; the first 8 columns with `leak`, else
+/// 6): terms the pairs carry no information on are left out (coefficient 0). `None` when
+/// the system is singular or a polarity without pairs is not `one_polarity`'s to leave out.
+pub(super) fn solve(
+    sums: &[[f64; 8]; 8],
+    sums_y: &[f64; 8],
+    leak: bool,
+    one_polarity: bool,
+) -> Option<Coefficients> {
+    let k = if leak { 8 } else { 6 };
     let mut xtx = nalgebra::DMatrix::<f64>::from_fn(k, k, |a, b| sums[a][b]);
     let mut xty = nalgebra::DVector::<f64>::from_fn(k, |a, _| sums_y[a]);
     // a term the pairs carry no information on (no lag where every pair is a steady ramp,
@@ -303,21 +316,7 @@ fn normal_sums<const K: usize>(
         if w <= 0.0 {
             continue;
         }
-        let s = if p.on { -1.0 } else { 1.0 };
-        let dt = p.dt as f64;
-        let dn = 0.5 * (p.dn0 + p.dn1) as f64;
-        let (on, off) = (p.on as u8 as f64, (!p.on) as u8 as f64);
-        let interp = p.interpolation();
-        let row = [
-            on,
-            off,
-            level[i] - mean_level,
-            lag[i],
-            on * interp,
-            off * interp,
-            s * dt,
-            s * dt * dn,
-        ];
+        let row = columns(p, level[i] - mean_level, lag[i]);
         for a in 0..K {
             let weighted = w * row[a];
             xty[a] += weighted * y[i];
@@ -327,6 +326,28 @@ fn normal_sums<const K: usize>(
         }
     }
     (xtx, xty)
+}
+
+/// The model's columns of pair `p` with its level (centred or not) and lag covariate:
+/// ON, OFF, level, lag, ON and OFF distance from the frames, and the leak's drift and its
+/// growth with DN (signed `+1` OFF, `-1` ON, as the samples are).
+#[inline]
+pub(super) fn columns(p: &Pair, level: f64, lag: f64) -> [f64; 8] {
+    let s = if p.on { -1.0 } else { 1.0 };
+    let dt = p.dt as f64;
+    let dn = 0.5 * (p.dn0 + p.dn1) as f64;
+    let (on, off) = (p.on as u8 as f64, (!p.on) as u8 as f64);
+    let interp = p.interpolation();
+    [
+        on,
+        off,
+        level,
+        lag,
+        on * interp,
+        off * interp,
+        s * dt,
+        s * dt * dn,
+    ]
 }
 
 /// The whole fit at offset `b`: values, kept pairs, weights and coefficients.

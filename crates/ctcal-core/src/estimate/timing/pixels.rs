@@ -25,15 +25,29 @@ impl PixelSlots {
             .collect();
         Self { pixels, slot }
     }
+
+    /// How many pixels hold pairs.
+    pub fn len(&self) -> usize {
+        self.pixels.len()
+    }
+
+    /// Whether no pixel holds a pair.
+    pub fn is_empty(&self) -> bool {
+        self.pixels.is_empty()
+    }
+
+    /// The slot of pair `i`.
+    pub fn slot_of(&self, i: usize) -> usize {
+        self.slot[i] as usize
+    }
 }
 
 /// Per-pixel (sum, count, sum of squares) of the corrected kept samples of one polarity,
-/// with every pixel drawn `weight * n` times (1 when the weights are the fit's own), and the
-/// pixel of each entry.
+/// each pixel once or as often as a bootstrap drew it, and the pixel of each entry.
 pub type PixelSums = (Vec<(f64, u32, f64)>, Vec<usize>);
 
-/// The per-pixel sums of the pairs of polarity `on` with positive `weight` (`None` with
-/// fewer than 10 entries).
+/// The per-pixel sums of the pairs of polarity `on` with positive `weight` (the fit's own
+/// weights: each pixel once; `None` with fewer than 10 entries).
 pub fn pixel_sums(
     pairs: &[Pair],
     slots: &PixelSlots,
@@ -43,11 +57,14 @@ pub fn pixel_sums(
     on: bool,
 ) -> Option<PixelSums> {
     let [off_sums, on_sums] = slot_sums(pairs, slots, values, weight, c, [!on, on]);
-    expand(slots, if on { &on_sums } else { &off_sums })
+    expand(slots, if on { &on_sums } else { &off_sums }, |_| 1)
 }
 
-/// [`pixel_sums`] of both polarities, `[OFF, ON]`, in one pass over the pairs (each
-/// polarity's sums the same, to the bit, as its own pass: every slot sums in pair order).
+/// [`pixel_sums`] of both polarities, `[OFF, ON]`, in one pass over the pairs, with
+/// `weight` a bootstrap draw's ([`super::model::resampled_weights`]): each pixel repeated as
+/// often as it was drawn, the weights of its pairs of both polarities summed (the fit gives
+/// each pixel's pairs `1 / n`, so they sum to the draw count; one polarity's alone sum to a
+/// fraction of it).
 pub fn pixel_sums_both(
     pairs: &[Pair],
     slots: &PixelSlots,
@@ -55,7 +72,9 @@ pub fn pixel_sums_both(
     weight: &[f64],
     c: &Coefficients,
 ) -> [Option<PixelSums>; 2] {
-    slot_sums(pairs, slots, values, weight, c, [true, true]).map(|sums| expand(slots, &sums))
+    let sums = slot_sums(pairs, slots, values, weight, c, [true, true]);
+    let drawn = |slot: usize| (sums[0][slot].3 + sums[1][slot].3).round() as usize;
+    [0, 1].map(|k| expand(slots, &sums[k], drawn))
 }
 
 /// Per slot: the sum, count, sum of squares and weight of the corrected samples.
@@ -89,17 +108,20 @@ fn slot_sums(
     by_slot
 }
 
-/// The slots' sums in pixel order, each pixel repeated as often as it was drawn (`None`
-/// with fewer than 10 entries).
-fn expand(slots: &PixelSlots, by_slot: &SlotSums) -> Option<PixelSums> {
+/// The slots' sums in pixel order, each pixel `repeats(slot)` times, at least once
+/// (`None` with fewer than 10 entries).
+fn expand(
+    slots: &PixelSlots,
+    by_slot: &SlotSums,
+    repeats: impl Fn(usize) -> usize,
+) -> Option<PixelSums> {
     let mut sums = Vec::new();
     let mut which = Vec::new();
-    for (&pixel, &(s, n, sq, w)) in slots.pixels.iter().zip(by_slot) {
+    for (slot, (&pixel, &(s, n, sq, _))) in slots.pixels.iter().zip(by_slot).enumerate() {
         if n == 0 {
             continue;
         }
-        // a pixel drawn m times weighs m (its pairs' weights sum to m)
-        for _ in 0..(w.round() as usize).max(1) {
+        for _ in 0..repeats(slot).max(1) {
             sums.push((s, n, sq));
             which.push(pixel as usize);
         }
@@ -154,8 +176,10 @@ mod tests {
             lag: 0.0,
         };
         let mut weight = vec![1.0; pairs.len()];
-        weight[0] = 2.0; // pixel 7 drawn twice
-        let (sums, which) = pixel_sums(&pairs, &slots, &values, &weight, &c, true).unwrap();
+        weight[0] = 2.0; // pixel 7 drawn twice (its only pair)
+        let (sums, which) = pixel_sums_both(&pairs, &slots, &values, &weight, &c)[1]
+            .clone()
+            .unwrap();
         let mut expected: Vec<usize> = (0..24)
             .filter(|k| k % 4 != 1)
             .map(|k: usize| [7, 3, 40, 12][k % 4] + (k / 4) * 100)
@@ -166,10 +190,10 @@ mod tests {
         assert_eq!(sums[0], sums[1]);
         assert!((sums[0].0 - 0.0).abs() < 1e-12 && sums[0].1 == 1);
         assert!(pixel_sums(&pairs[..8], &slots, &values, &weight, &c, false).is_none());
-        // both polarities in one pass are each polarity's own (6 OFF pairs: too few)
-        let [off, on] = pixel_sums_both(&pairs, &slots, &values, &weight, &c);
-        assert!(off.is_none());
-        assert_eq!(on.unwrap(), (sums, which));
+        // the fit's own weights: each pixel once (6 OFF pairs: too few)
+        let once = pixel_sums(&pairs, &slots, &values, &weight, &c, true).unwrap();
+        assert_eq!(once.1, expected[1..]);
+        assert!(pixel_sums_both(&pairs, &slots, &values, &weight, &c)[0].is_none());
         let more: Vec<Pair> = pairs.iter().chain(&pairs).copied().collect();
         let slots = PixelSlots::new(&more);
         let values = Values {
@@ -177,10 +201,11 @@ mod tests {
             level: vec![0.0; more.len()],
             lag: vec![0.0; more.len()],
         };
-        let weight = vec![1.0; more.len()];
+        // two pairs a pixel, weighed 1/2 each as the fit weighs them: drawn once
+        let weight = vec![0.5; more.len()];
         let [off, on] = pixel_sums_both(&more, &slots, &values, &weight, &c);
         assert_eq!(off, pixel_sums(&more, &slots, &values, &weight, &c, false));
-        assert!(off.is_some());
+        assert!(on.is_some());
         assert_eq!(on, pixel_sums(&more, &slots, &values, &weight, &c, true));
     }
 }
