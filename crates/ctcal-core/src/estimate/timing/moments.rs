@@ -19,8 +19,9 @@
 //!
 //! The result is the pair-by-pair bootstrap's, draw for draw (the same pixels drawn from the
 //! same seeds), to rounding: the sums are added in another order (tested below to 1e-9).
-//! Where the moments would take more memory than the pairs themselves (few pairs per pixel
-//! on a large sensor), or a pixel's pairs do not share one weight, the draws run pair by pair.
+//! Where pixels hold fewer than 8 pairs on average (the moments then cost more than they
+//! save), the moments would take more memory than the pairs themselves (a large sensor), or
+//! a pixel's pairs do not share one weight, the draws run pair by pair.
 
 use super::model::{self, Coefficients, Values, columns, resampled_weights};
 use super::pixels::{PixelSlots, pixel_sums_both};
@@ -107,8 +108,9 @@ pub enum Resampler<'a> {
 
 impl<'a> Resampler<'a> {
     /// The resampler of `pairs` with their `values` and fit `weights` (`slots` their
-    /// pixels): from moments where they take no more memory than the pairs (or 64 MB) and
-    /// every pixel's kept pairs share one weight, else pair by pair.
+    /// pixels): from moments where pixels hold 8 pairs or more on average, the moments take
+    /// no more memory than the pairs (or 64 MB) and every pixel's kept pairs share one
+    /// weight; else pair by pair.
     pub fn new(
         pairs: &'a [Pair],
         slots: &'a PixelSlots,
