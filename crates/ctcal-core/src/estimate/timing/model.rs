@@ -378,16 +378,25 @@ pub fn resampled_weights(pairs: &[Pair], weight: &[f64], pixels: usize, seed: u6
         }
         (0..pixels as u32).filter(|&p| seen[p as usize]).collect()
     };
-    let mut times = vec![0u32; pixels];
-    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
-    for _ in 0..present.len() {
-        times[present[rng.random_range(0..present.len())] as usize] += 1;
-    }
+    let times = draw_counts(&present, pixels, seed);
     pairs
         .iter()
         .zip(weight)
         .map(|(p, &w)| w * times[p.pixel as usize] as f64)
         .collect()
+}
+
+/// One bootstrap draw over `units` (indices below `len`, each a pixel or a pixel's slot):
+/// as many draws with replacement as there are units, from `seed`; how often each index
+/// was drawn. The one draw both the pair-by-pair and the moments bootstrap make
+/// ([`super::moments`]), so that they draw the same pixels.
+pub(super) fn draw_counts(units: &[u32], len: usize, seed: u64) -> Vec<u32> {
+    let mut times = vec![0u32; len];
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    for _ in 0..units.len() {
+        times[units[rng.random_range(0..units.len())] as usize] += 1;
+    }
+    times
 }
 
 /// The offset's interval: where the level slope is within `z` of its standard error of

@@ -26,7 +26,6 @@
 use super::model::{self, Coefficients, Values, columns, resampled_weights};
 use super::pixels::{PixelSlots, pixel_sums_both};
 use super::samples::Pair;
-use rand::{RngExt, SeedableRng};
 
 /// The columns past the two polarity indicators: level, lag, the ON and OFF distance from
 /// the frames, the drift and its growth with DN ([`columns`]).
@@ -173,12 +172,7 @@ impl<'a> Resampler<'a> {
     pub fn draw(&self, seed: u64) -> Draw {
         match self {
             Self::Moments { slots, present, .. } => {
-                let mut times = vec![0u32; slots.len()];
-                let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
-                for _ in 0..present.len() {
-                    times[present[rng.random_range(0..present.len())] as usize] += 1;
-                }
-                Draw::Counts(times)
+                Draw::Counts(model::draw_counts(present, slots.len(), seed))
             }
             Self::Pairs { .. } => Draw::Seed(seed),
         }
