@@ -518,6 +518,49 @@ fn screen_measures_the_photoreceptors_lag_and_matches_the_thresholds_with_it() {
     }
 }
 
+/// Coverage draw 46: a 42.6 Hz photoreceptor (at 255 DN), refractory period and leak under
+/// v2e's lin-log response, whose frames need no offset (about 1 DN). The photoreceptor's
+/// lag made the event timing fit an offset of 35.6 DN, and both estimators read 0.34 / 0.33
+/// for a true 0.475 / 0.440, their intervals excluding it. The re-simulation's dark cells
+/// match its bright ones near 3 DN: the offset is read there, and the range between the
+/// two is in the intervals.
+#[test]
+fn aps_reads_the_frames_offset_from_the_counts_where_a_photoreceptor_lag_distorts_the_timing() {
+    use ctcal::coverage::{CaseSpec, write_case};
+    let case = CaseSpec::draw(46);
+    assert_eq!(case.params.cutoff_hz, Some(42.5699));
+    let dir = tempfile::tempdir().unwrap();
+    write_case(&case, dir.path()).expect("the case is written");
+    let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
+    let offset = &e["frame_offset_dn"];
+    let timing = offset["estimate"]["offset_dn"].as_f64().unwrap();
+    let counts = offset["from_counts"]["offset_dn"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("no offset from the counts: {offset}"));
+    assert!(
+        timing > 20.0,
+        "the timing's offset {timing}: the lag no longer pushes it"
+    );
+    assert!((0.0..8.0).contains(&counts), "the counts' offset {counts}");
+    assert_eq!(offset["value"].as_f64().unwrap(), counts);
+    for (key, truth) in [("ct_on", 0.475323), ("ct_off", 0.439951)] {
+        let v = e[key].as_f64().unwrap();
+        let (lo, hi) = interval(&e[format!("{key}_ci95")]);
+        assert!(
+            lo <= truth && truth <= hi,
+            "{key} {v} [{lo}, {hi}] misses {truth}"
+        );
+        assert!((v / truth - 1.0).abs() < 0.1, "{key} {v} for {truth}");
+    }
+    assert!(
+        strings(&e["assumptions"])
+            .iter()
+            .any(|a| a.contains("log offset from the counts") && a.contains("photoreceptor lag")),
+        "{}",
+        e["assumptions"]
+    );
+}
+
 #[test]
 fn screen_without_a_stimulus_names_the_fix() {
     let e = bad_input(&[

@@ -194,6 +194,32 @@ impl Cells {
         }
     }
 
+    /// Each cell's mean frame value (DN, without the offset) over its reliable, included
+    /// pixels and the two frames of each of its intervals; `None` for a cell without such a
+    /// pixel.
+    pub fn mean_levels(&self, frames: &PreparedFrames) -> Vec<Option<f64>> {
+        let mut sums = vec![(0.0f64, 0usize); self.rows * self.tiles];
+        for (k, row) in self.interval_row.iter().enumerate() {
+            let (Some(row), Some(used)) = (row, self.used_index[k]) else {
+                continue;
+            };
+            let mask = &self.unreliable[used];
+            let (a, b) = (&frames.dn[k].data, &frames.dn[k + 1].data);
+            for (pixel, (&v0, &v1)) in a.iter().zip(b).enumerate() {
+                if self.excluded[pixel] || (!mask.is_empty() && mask[pixel]) {
+                    continue;
+                }
+                let (x, y) = (pixel % self.width, pixel / self.width);
+                let cell = row * self.tiles + (y / self.tile_px) * self.tiles_x + x / self.tile_px;
+                sums[cell].0 += 0.5 * (v0 + v1) as f64;
+                sums[cell].1 += 1;
+            }
+        }
+        sums.iter()
+            .map(|&(sum, n)| (n > 0).then(|| sum / n as f64))
+            .collect()
+    }
+
     /// Counts `events` (time-sorted) into the cells; events outside used intervals, of
     /// excluded pixels or without support are not counted. Stretches of
     /// [`COUNT_STRETCH`] events are counted on the pool and their counts added (sums of
@@ -360,6 +386,9 @@ pub struct ResimEstimate {
     pub standard_error_off: f64,
     pub cells: usize,
     pub simulations: usize,
+    /// The simulated counts at the thresholds found.
+    #[serde(skip)]
+    pub counts: Counts,
 }
 
 /// The input of one re-simulation fit.
@@ -375,7 +404,8 @@ pub struct Resimulation<'a> {
 }
 
 impl Resimulation<'_> {
-    fn counts(&self, params: &PixelParams) -> Result<Counts, EstimateError> {
+    /// The cells' counts of the runs simulated with `params` (on the recording's grid).
+    pub fn counts(&self, params: &PixelParams) -> Result<Counts, EstimateError> {
         self.evaluations.set(self.evaluations.get() + 1);
         let mut events = simulate(self.runs, self.width, self.height, params)?;
         if let Some(grid) = self.grid {
@@ -425,6 +455,19 @@ pub fn fit(
     start: (f64, f64),
     sigma: f64,
 ) -> Result<ResimEstimate, EstimateError> {
+    fit_with(resim, start, sigma, None, 2)
+}
+
+/// [`fit`] of a model with the photoreceptor's `cutoff_hz` (at white, as the simulator
+/// takes it), in `rounds` rounds of root searches (the first from 8 % steps, later ones
+/// from 3 %).
+pub fn fit_with(
+    resim: &Resimulation,
+    start: (f64, f64),
+    sigma: f64,
+    cutoff_hz: Option<f64>,
+    rounds: usize,
+) -> Result<ResimEstimate, EstimateError> {
     if !(start.0.is_finite() && start.0 > 0.0 && start.1.is_finite() && start.1 > 0.0) {
         return Err(EstimateError::new(
             format!(
@@ -439,8 +482,9 @@ pub fn fit(
         base.ct_sigma = Some(sigma);
     }
     base.seed = Some(20_200_823);
+    base.cutoff_hz = cutoff_hz;
     let mut estimate = [start.0, start.1];
-    for round in 0..2 {
+    for round in 0..rounds {
         for (slot, on) in [(0, true), (1, false)] {
             base.ct_on = estimate[0];
             base.ct_off = estimate[1];
@@ -497,6 +541,7 @@ pub fn fit(
         standard_error_off: se_off * estimate[1],
         cells,
         simulations: resim.evaluations.get(),
+        counts: simulated,
     })
 }
 

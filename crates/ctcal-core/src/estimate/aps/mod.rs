@@ -32,6 +32,7 @@ use crate::sim::{PixelParams, Sample};
 use report::{Findings, assemble, blocks_assumption, resimulation_report, timing_report};
 use serde_json::json;
 
+mod count_offset;
 mod report;
 
 /// Settings of `estimate aps`.
@@ -99,6 +100,10 @@ pub struct ApsResult {
     /// timing's samples ([`super::timing::PolarityEstimate::interpolation_share`]): what a
     /// method matching counts of the interpolated frames misses.
     pub interpolation_share: [f64; 2],
+    /// The frames' log offset the thresholds were read at, DN, and the offsets their
+    /// systematic error spans (the timing's, or the counts' where they disagree:
+    /// [`count_offset::reconcile`]).
+    pub frame_offset_dn: (f32, (f32, f32)),
 }
 
 /// The fewest usable frame intervals the frame-based thresholds rest on.
@@ -126,6 +131,9 @@ struct Pass {
     timing: TimingEstimate,
     resim: Option<super::resim::ResimEstimate>,
     interval_s: f64,
+    /// The re-simulation's cells and the recording's counts in them.
+    cells: Cells,
+    real: super::resim::Counts,
 }
 
 /// The timing and re-simulation estimates of `frames`, with `runs` their frames upsampled
@@ -178,6 +186,8 @@ fn run_pass(
         timing,
         resim,
         interval_s,
+        cells,
+        real,
     })
 }
 
@@ -202,11 +212,25 @@ pub fn estimate(
 
     progress("event timing and re-simulation", 0.2);
     // the full frames upsampled once: for their pass and the self-calibration's simulation
-    let runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
-    let full = run_pass(input, &excluded, &frames, &runs, options, None)?;
+    let mut runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    let mut full = run_pass(input, &excluded, &frames, &runs, options, None)?;
+    let grid = timestamp_grid(input.events);
+    let offset_from_counts = offset_from_counts(
+        input,
+        &excluded,
+        &mut frames,
+        options,
+        (&mut runs, &mut full),
+        offset_report.as_ref(),
+        grid,
+    )?;
+    assumptions.extend(
+        offset_from_counts
+            .as_ref()
+            .map(|c| count_offset_assumption(c, &frames)),
+    );
     let spread = full.timing.spread();
     let sigma = simulated_sigma(&full.timing);
-    let grid = timestamp_grid(input.events);
     let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
     drop(runs);
     let alignment_error =
@@ -273,6 +297,7 @@ pub fn estimate(
             lsq,
             alignment: json!(alignment),
             offset: offset_report,
+            offset_from_counts: offset_from_counts.map(|c| c.found),
         },
     );
     progress("done", 1.0);
@@ -283,6 +308,7 @@ pub fn estimate(
             full.timing.off.interpolation_share,
         ],
         maps: full.timing.maps,
+        frame_offset_dn: (frames.offset, frames.offset_range),
     })
 }
 
@@ -547,10 +573,7 @@ fn measured_model(timing: &TimingEstimate, sigma: f64) -> PixelParams {
         params.ct_sigma = Some(sigma);
     }
     let lag = &timing.lag;
-    if let Some(f) = lag.cutoff_hz_at_median_dn
-        && lag.tau_times_dn > 3.0 * lag.standard_error
-        && f < 1000.0
-    {
+    if let Some(f) = lag_resolved(lag) {
         params.cutoff_hz = Some(f * 275.0 / (lag.median_dn + 20.0));
     }
     let drift = &timing.drift;
@@ -558,6 +581,122 @@ fn measured_model(timing: &TimingEstimate, sigma: f64) -> PixelParams {
         params.leak_rate_hz = Some(drift.at_median_dn / timing.on.ct);
     }
     params
+}
+
+/// The photoreceptor cutoff at the median DN (Hz) where the timing's lag is significant
+/// (three standard errors) and slower than 1 kHz (faster, it is the frames' own timing
+/// noise rather than a photoreceptor).
+fn lag_resolved(lag: &super::timing::Lag) -> Option<f64> {
+    lag.cutoff_hz_at_median_dn
+        .filter(|&f| lag.tau_times_dn > 3.0 * lag.standard_error && f < 1000.0)
+}
+
+/// The counts' offset and whether it moved the frames' offset or its range.
+struct FromCounts {
+    found: count_offset::CountOffset,
+    /// The timing's offset and range before.
+    timing: (f32, (f32, f32)),
+    changed: bool,
+}
+
+/// The frames' offset as the counts give it ([`count_offset`]), where the timing fitted
+/// one and the re-simulation's dark cells disagree with its bright ones at it. Where the
+/// two offsets' intervals do not overlap, the frames' offset and range are reconciled
+/// ([`count_offset::reconcile`]) and the full pass (with its upsampled `runs`) is made
+/// again at them.
+fn offset_from_counts(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &mut PreparedFrames,
+    options: &ApsOptions,
+    (runs, full): (&mut Vec<Vec<Sample>>, &mut Pass),
+    timing_offset: Option<&super::timing::Offset>,
+    grid: Option<(TimeUs, TimeUs)>,
+) -> Result<Option<FromCounts>, EstimateError> {
+    let Some(timing_offset) = timing_offset.filter(|o| o.source == "fitted") else {
+        return Ok(None);
+    };
+    let Some(resim) = &full.resim else {
+        return Ok(None);
+    };
+    let Some(brightness) = count_offset::Brightness::new(&full.cells, frames, &full.real) else {
+        return Ok(None);
+    };
+    let setup = count_offset::Setup {
+        cells: &full.cells,
+        real: &full.real,
+        simulated: &resim.counts,
+        grid,
+        width: frames.width,
+        height: frames.height,
+    };
+    let found = count_offset::count_offset(
+        &setup,
+        &brightness,
+        runs,
+        frames.offset,
+        (resim.ct_on, resim.ct_off),
+        simulated_sigma(&full.timing),
+    );
+    let Some(found) = found else {
+        return Ok(None);
+    };
+    let timing = (frames.offset, frames.offset_range);
+    let change = count_offset::reconcile(
+        (frames.offset, frames.offset_range),
+        timing_offset.ci95,
+        &found,
+        lag_resolved(&full.timing.lag).is_some(),
+    );
+    if let Some((offset, range)) = change {
+        frames.offset = offset;
+        frames.offset_range = range;
+    }
+    // the runs were shifted by the search
+    *runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    if change.is_some() {
+        *full = run_pass(input, excluded, frames, runs, options, None)?;
+    }
+    Ok(Some(FromCounts {
+        found,
+        timing,
+        changed: change.is_some(),
+    }))
+}
+
+/// The counts' offset, in words for the assumptions.
+fn count_offset_assumption(c: &FromCounts, frames: &PreparedFrames) -> String {
+    let f = &c.found;
+    let found = if f.at_bound {
+        format!(
+            "at or beyond {:.1} DN, the end of the prior range",
+            f.offset_dn
+        )
+    } else {
+        format!(
+            "at b = {:.1} DN (95 % {:.1} .. {:.1})",
+            f.offset_dn, f.ci95[0], f.ci95[1]
+        )
+    };
+    let head = format!(
+        "the frames' log offset from the counts: at the event timing's b = {:.1} DN the re-simulation's dark cells differ from its bright ones by {:+.3} (+- {:.3}) in mean log ratio of simulated to real counts; they agree {found}",
+        c.timing.0, f.at_timing_offset.difference, f.at_timing_offset.standard_error
+    );
+    if c.changed {
+        format!(
+            "{head}. The two offsets disagree (a photoreceptor lag distorts the timing's samples and hardly the counts), so the thresholds' systematic error spans the offsets {:.1} .. {:.1} DN, and they are read at b = {:.1} DN ({})",
+            frames.offset_range.0,
+            frames.offset_range.1,
+            frames.offset,
+            if (frames.offset - c.timing.0).abs() > 0.0 {
+                "the counts' offset: the timing finds a photoreceptor lag, which pushes its offset up"
+            } else {
+                "the timing's offset: the timing finds no photoreceptor lag, or the counts' offset is the larger, which a lag does not explain"
+            }
+        )
+    } else {
+        format!("{head}, within the timing's offset interval: the timing's offset kept")
+    }
 }
 
 /// The offset, in words for the assumptions.

@@ -179,6 +179,8 @@ pub(super) struct Findings {
     pub(super) lsq: Option<crate::estimate::lsq::LeastSquares>,
     pub(super) alignment: serde_json::Value,
     pub(super) offset: Option<crate::estimate::timing::Offset>,
+    /// The offset the counts give, where it was searched ([`super::count_offset`]).
+    pub(super) offset_from_counts: Option<super::count_offset::CountOffset>,
 }
 
 /// The estimate: the estimators' thresholds combined, the mismatch, the assumptions (the
@@ -239,7 +241,7 @@ pub(super) fn assemble(
         ("frame_time_alignment", findings.alignment),
         (
             "frame_offset_dn",
-            json!({"value": frames.offset, "estimate": findings.offset}),
+            json!({"value": frames.offset, "estimate": findings.offset, "from_counts": findings.offset_from_counts}),
         ),
         ("ct_sigma_frame_rate_series", json!(findings.sigma_series)),
         ("photoreceptor_lag", lag_report(&full.timing.lag)),

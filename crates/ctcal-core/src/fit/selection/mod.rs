@@ -87,12 +87,26 @@ pub fn fit(
     progress("frames: selection and optical flow", 0.0);
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);
-    let (frames, mut assumptions) = prepare_frames(input, &run, options)?;
+    let (mut frames, mut assumptions) = prepare_frames(input, &run, options)?;
     let change_rate = dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
     let static_scene = change_rate < dynamics::STATIC_CHANGE_RATE;
     progress("starting thresholds (estimate aps on the fit run)", 0.05);
     let start = start::thresholds(input, &run, options, change_rate, static_scene);
     assumptions.extend(start.assumptions.iter().cloned());
+    // the offset the start's thresholds were read at (the counts' where a photoreceptor
+    // lag distorts the timing's: `estimate aps`), unless the user gave one
+    if let Some((offset, range)) = start
+        .frame_offset_dn
+        .filter(|_| options.aps.frame_offset_dn.is_none())
+        && offset != frames.offset
+    {
+        assumptions.push(format!(
+            "frames simulated at the log offset b = {offset:.1} DN where `estimate aps` read the starting thresholds (its offset from the counts, not the event timing's {:.1} DN)",
+            frames.offset
+        ));
+        frames.offset = offset;
+        frames.offset_range = range;
+    }
     let start_params = PixelParams {
         log_response: Some(frames.log_map.response()),
         log_eps: Some(frames.log_map.eps()),

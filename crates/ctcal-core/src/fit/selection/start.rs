@@ -62,6 +62,9 @@ pub struct Start {
     /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
     /// miss ([`aps::ApsResult::interpolation_share`]; none for a start value).
     pub interpolation_share: Option<[f64; 2]>,
+    /// The frames' log offset the start's thresholds were read at, and the range their
+    /// systematic spans ([`aps::ApsResult::frame_offset_dn`]; none for a start value).
+    pub frame_offset_dn: Option<(f32, (f32, f32))>,
     pub step: Step,
     pub assumptions: Vec<String>,
 }
@@ -100,6 +103,7 @@ pub fn thresholds(
         mismatch: None,
         measured: None,
         interpolation_share: None,
+        frame_offset_dn: None,
         assumptions: vec![format!(
             "thresholds start at {default} (a start value, not a measurement): {reason}"
         )],
@@ -113,10 +117,11 @@ pub fn thresholds(
         );
     }
     let found = aps::estimate(&run.aps_input(input), &options.aps, &|_, _| {});
-    match found.map(|f| (f.estimate, f.interpolation_share)) {
-        Ok((e, share)) => match e.thresholds() {
+    match found.map(|f| (f.estimate, f.interpolation_share, f.frame_offset_dn)) {
+        Ok((e, share, offset)) => match e.thresholds() {
             Some((on, off)) => Start {
                 interpolation_share: Some(share),
+                frame_offset_dn: Some(offset),
                 ..measured(&e, on, off)
             },
             None => fallback(
@@ -151,6 +156,7 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
             (off, e.ct_off_ci95.unwrap_or([None, None])),
         ]),
         interpolation_share: None,
+        frame_offset_dn: None,
         assumptions: Vec::new(),
         step: step(
             format!(
