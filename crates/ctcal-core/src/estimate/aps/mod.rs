@@ -294,6 +294,7 @@ pub fn estimate(
             sigma_series: report::series(&passes, |p| {
                 Some(p.timing.spread().sigma).filter(|s| s.is_finite())
             }),
+            sigma_offset_systematic: full.timing.sigma_offset_systematic,
             lsq,
             alignment: json!(alignment),
             offset: offset_report,

@@ -175,6 +175,9 @@ pub(super) struct Findings {
     pub(super) sigma_bias: f64,
     /// That spread over the passes (every frame, every 2nd and 3rd frame).
     pub(super) sigma_series: Vec<FrameRatePoint>,
+    /// How far the spread moves across the frames' offset range
+    /// ([`crate::estimate::timing::TimingEstimate::sigma_offset_systematic`]).
+    pub(super) sigma_offset_systematic: f64,
     /// The least-squares cross-check ([`crate::estimate::lsq`]).
     pub(super) lsq: Option<crate::estimate::lsq::LeastSquares>,
     pub(super) alignment: serde_json::Value,
@@ -217,6 +220,7 @@ pub(super) fn assemble(
             &findings.spread,
             findings.sigma_bias,
             &findings.sigma_series,
+            findings.sigma_offset_systematic,
         ),
     );
     let range_notes = std::mem::replace(&mut estimate.assumptions, assumptions);
@@ -266,14 +270,15 @@ pub(super) fn assemble(
 /// value as systematic (the spread a mismatch-free simulation of the same frames shows
 /// varies by about that between seeds), and, in quadrature, the frame-rate systematic of
 /// the spread over the passes (`series`): how far the spread moves when every 2nd and 3rd
-/// frame is used, as for the thresholds. Where a polarity showed that the noise
+/// frame is used, as for the thresholds, and its change across the frames' offset range
+/// (`offset`), as for the thresholds. Where a polarity showed that the noise
 /// subtraction overshoots, the upper side is raised by what it overshot. Where the bias
 /// eats the measured spread, the spread is not resolved: `null` with an upper bound; where
 /// both polarities overshoot, `null` with the spread the larger overshoot can hide as bound.
 fn sigma_result(
     estimate: &mut CtEstimate,
     assumptions: &mut Vec<String>,
-    (spread, sigma_bias, series): (&Spread, f64, &[FrameRatePoint]),
+    (spread, sigma_bias, series, offset): (&Spread, f64, &[FrameRatePoint], f64),
 ) {
     if spread.has_overshoot() {
         assumptions.push(overshoot_note(spread));
@@ -301,10 +306,10 @@ fn sigma_result(
     let value = sigma - sigma_bias;
     let (_, frame_rate) = frame_rate_systematic(series);
     let floor = sigma_bias.abs().max(0.1 * value.abs());
-    let systematic = floor.hypot(frame_rate);
+    let systematic = floor.hypot(frame_rate).hypot(offset);
     let measure = Measured::new(value, spread.sigma_standard_error, systematic);
     assumptions.push(format!(
-        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}) as systematic ({systematic:.4})"
+        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}) and across the frames' offset range ({offset:.4}) as systematic ({systematic:.4})"
     ));
     let hi = spread.raised(measure.ci95[1]);
     if measure.ci95[0] > 0.0 {

@@ -167,6 +167,10 @@ pub struct TimingEstimate {
     pub on: PolarityEstimate,
     pub off: PolarityEstimate,
     pub maps: ThresholdMaps,
+    /// How far the combined per-pixel spread ([`TimingEstimate::spread`]) moves across the
+    /// offset's range (the larger change at its ends over 1.96), a systematic as
+    /// [`PolarityEstimate::offset_systematic`] is for the thresholds.
+    pub sigma_offset_systematic: f64,
     pub offset: Offset,
     pub drift: Drift,
     pub lag: Lag,
@@ -226,20 +230,32 @@ pub fn estimate(
     };
     let offset = with_polarity_offsets(offset, &pairs, options, &fit);
     let (coefficients, values, weights) = fit(offset.offset_dn)?;
-    // the thresholds across the offset's interval
+    let slots = PixelSlots::new(&pairs);
+    // the thresholds, and each polarity's per-pixel spread, across the offset's interval
     let (lo, hi) = offset.systematic_range;
-    let ends: Vec<Coefficients> = [lo, hi]
+    let ends: Vec<(Coefficients, Option<[PolarityEstimate; 2]>)> = [lo, hi]
         .par_iter()
         .filter(|&&b| b != offset.offset_dn)
-        .filter_map(|&b| fit(b).map(|f| f.0))
+        .filter_map(|&b| {
+            let (c, values, weights) = fit(b)?;
+            let fitted = Fitted {
+                pairs: &pairs,
+                slots: &slots,
+                values: &values,
+                weights: &weights,
+            };
+            let spread = polarity(&fitted, &c, true, sensor)
+                .zip(polarity(&fitted, &c, false, sensor))
+                .map(|(on, off)| [on.0, off.0]);
+            Some((c, spread))
+        })
         .collect();
     let shift = |pick: fn(&Coefficients) -> f64| {
         ends.iter()
-            .map(|e| (pick(e) - pick(&coefficients)).abs())
+            .map(|e| (pick(&e.0) - pick(&coefficients)).abs())
             .fold(0.0, f64::max)
             / 1.96
     };
-    let slots = PixelSlots::new(&pairs);
     let fitted = Fitted {
         pairs: &pairs,
         slots: &slots,
@@ -251,6 +267,8 @@ pub fn estimate(
     let combined = |boot: f64, block: Option<f64>| block.map_or(boot, |b| b.hypot(boot));
     let on = polarity(&fitted, &coefficients, true, sensor)?;
     let off = polarity(&fitted, &coefficients, false, sensor)?;
+    let sigma_offset_systematic =
+        spread_offset_systematic(&ends, [&on.0, &off.0], [boot.excess_on, boot.excess_off]);
     let median_dn = median_level(&pairs);
     let cutoff = coefficients.cutoff_hz(median_dn, offset.offset_dn as f64);
     let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
@@ -273,6 +291,7 @@ pub fn estimate(
             ..off.0
         },
         maps: maps(sensor, &on.1, &off.1),
+        sigma_offset_systematic,
         offset,
         lag: Lag {
             tau_times_dn: coefficients.lag,
@@ -287,6 +306,35 @@ pub fn estimate(
             standard_error: boot.drift,
         },
     })
+}
+
+/// The combined spread's change across the offset's range: at each end the polarities'
+/// spreads (`ends`) combined with the bootstrap errors of the spread at the offset
+/// (`excess_se`, ON and OFF), against `at_offset` combined alike; the larger change over
+/// 1.96, or 0 where the spread at the offset is not determined.
+fn spread_offset_systematic(
+    ends: &[(Coefficients, Option<[PolarityEstimate; 2]>)],
+    at_offset: [&PolarityEstimate; 2],
+    excess_se: [f64; 2],
+) -> f64 {
+    let sigma = |[on, off]: [&PolarityEstimate; 2]| {
+        let with_error = |p: &PolarityEstimate, se: f64| PolarityEstimate {
+            excess_variance_standard_error: se,
+            ..p.clone()
+        };
+        spread::combined(&with_error(on, excess_se[0]), &with_error(off, excess_se[1])).sigma
+    };
+    let centre = sigma(at_offset);
+    if !centre.is_finite() {
+        return 0.0;
+    }
+    ends.iter()
+        .filter_map(|(_, p)| p.as_ref())
+        .map(|[on, off]| sigma([on, off]))
+        .filter(|s| s.is_finite())
+        .map(|s| (s - centre).abs())
+        .fold(0.0, f64::max)
+        / 1.96
 }
 
 /// The response and offset: for each candidate response (the frames' own; with
