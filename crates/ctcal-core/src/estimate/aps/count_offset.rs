@@ -128,23 +128,27 @@ pub struct Setup<'a> {
     pub height: usize,
 }
 
-/// The offset of the counts, searched where the difference at the timing's offset `own`
-/// is beyond [`DISAGREEMENT_Z`] standard errors; `runs` are the frames upsampled at `own`,
-/// shifted in place during the search (left shifted: upsample again to use them).
-/// `start` are the re-simulation's thresholds at `own`, `sigma` its mismatch. `None`
-/// where the counts agree with `own`, the cells are too few, or a fit fails.
-pub fn count_offset(
+/// The dark-bright difference of the re-simulation at the timing's offset, where it lies
+/// beyond [`DISAGREEMENT_Z`] standard errors (the counts disagree with that offset); `None`
+/// where they agree.
+pub fn disagreement(setup: &Setup, brightness: &Brightness) -> Option<DarkBright> {
+    let at_own = brightness.compare(setup.real, setup.simulated);
+    (at_own.difference.abs() > DISAGREEMENT_Z * at_own.standard_error).then_some(at_own)
+}
+
+/// The offset of the counts, searched from the timing's offset `own`, where the
+/// difference is `at_own` ([`disagreement`]). `runs` are the frames upsampled at `own`;
+/// the search shifts them in place and leaves them shifted (upsample again to use them).
+/// `start` are the re-simulation's thresholds at `own`, `sigma` its mismatch. `None` where
+/// the root lies on the other side of `own` from the prior's end, or a fit fails.
+pub fn search(
     setup: &Setup,
     brightness: &Brightness,
-    runs: &mut [Vec<Sample>],
-    own: f32,
+    (runs, own): (&mut [Vec<Sample>], f32),
+    at_own: DarkBright,
     start: (f64, f64),
     sigma: f64,
 ) -> Option<CountOffset> {
-    let at_own = brightness.compare(setup.real, setup.simulated);
-    if at_own.difference.abs() <= DISAGREEMENT_Z * at_own.standard_error {
-        return None;
-    }
     let mut shifted = 0.0f32;
     let mut thresholds = start;
     let mut at = |b: f32| -> Option<DarkBright> {

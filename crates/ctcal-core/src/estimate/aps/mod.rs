@@ -20,6 +20,12 @@
 //! ([`super::timing::model`]); the re-simulation, whose counts come from the same
 //! interpolated frames, gets back the share the timing found missing, and keeps half that
 //! correction in its interval.
+//!
+//! The frames' log offset `b` in `ln(DN + b)` is fitted by event timing where its samples
+//! stop depending on brightness; a photoreceptor lag pushes that fit up, and counts hardly
+//! see a lag, so the re-simulation checks it: where its dark cells disagree with its bright
+//! ones, the offset the counts give joins the thresholds' systematic, and replaces the
+//! timing's where the timing finds a lag ([`count_offset`]).
 
 use super::frames::{FrameOptions, PreparedFrames};
 use super::resim::{Cells, Intervals, Resimulation};
@@ -192,8 +198,8 @@ fn run_pass(
 }
 
 /// Estimates the contrast thresholds of `input` from its frames, in stages: the frames
-/// prepared and checked; the full frames' pass (event timing and re-simulation) with the
-/// self-calibration's simulation; the frame-time alignment's systematic; the passes over
+/// prepared and checked; the full frames' pass (event timing and re-simulation), its
+/// frames' offset checked against the counts, with the self-calibration's simulation; the frame-time alignment's systematic; the passes over
 /// every 2nd and 3rd frame; the self-calibration; each estimator's value with its
 /// interval; their combination and the report.
 pub fn estimate(
@@ -631,34 +637,36 @@ fn offset_from_counts(
         width: frames.width,
         height: frames.height,
     };
-    let found = count_offset::count_offset(
+    let Some(at_own) = count_offset::disagreement(&setup, &brightness) else {
+        return Ok(None);
+    };
+    let found = count_offset::search(
         &setup,
         &brightness,
-        runs,
-        frames.offset,
+        (runs, frames.offset),
+        at_own,
         (resim.ct_on, resim.ct_off),
         simulated_sigma(&full.timing),
     );
-    let Some(found) = found else {
-        return Ok(None);
-    };
     let timing = (frames.offset, frames.offset_range);
-    let change = count_offset::reconcile(
-        (frames.offset, frames.offset_range),
-        timing_offset.ci95,
-        &found,
-        lag_resolved(&full.timing.lag).is_some(),
-    );
+    let change = found.as_ref().and_then(|found| {
+        count_offset::reconcile(
+            timing,
+            timing_offset.ci95,
+            found,
+            lag_resolved(&full.timing.lag).is_some(),
+        )
+    });
     if let Some((offset, range)) = change {
         frames.offset = offset;
         frames.offset_range = range;
     }
-    // the runs were shifted by the search
+    // the search shifted the runs, whether or not it found the offset
     *runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
     if change.is_some() {
         *full = run_pass(input, excluded, frames, runs, options, None)?;
     }
-    Ok(Some(FromCounts {
+    Ok(found.map(|found| FromCounts {
         found,
         timing,
         changed: change.is_some(),

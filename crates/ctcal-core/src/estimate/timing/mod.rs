@@ -267,8 +267,11 @@ pub fn estimate(
     let combined = |boot: f64, block: Option<f64>| block.map_or(boot, |b| b.hypot(boot));
     let on = polarity(&fitted, &coefficients, true, sensor)?;
     let off = polarity(&fitted, &coefficients, false, sensor)?;
-    let sigma_offset_systematic =
-        spread_offset_systematic(&ends, [&on.0, &off.0], [boot.excess_on, boot.excess_off]);
+    let sigma_offset_systematic = spread::offset_systematic(
+        ends.iter().filter_map(|e| e.1.as_ref()),
+        [&on.0, &off.0],
+        [boot.excess_on, boot.excess_off],
+    );
     let median_dn = median_level(&pairs);
     let cutoff = coefficients.cutoff_hz(median_dn, offset.offset_dn as f64);
     let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
@@ -306,35 +309,6 @@ pub fn estimate(
             standard_error: boot.drift,
         },
     })
-}
-
-/// The combined spread's change across the offset's range: at each end the polarities'
-/// spreads (`ends`) combined with the bootstrap errors of the spread at the offset
-/// (`excess_se`, ON and OFF), against `at_offset` combined alike; the larger change over
-/// 1.96, or 0 where the spread at the offset is not determined.
-fn spread_offset_systematic(
-    ends: &[(Coefficients, Option<[PolarityEstimate; 2]>)],
-    at_offset: [&PolarityEstimate; 2],
-    excess_se: [f64; 2],
-) -> f64 {
-    let sigma = |[on, off]: [&PolarityEstimate; 2]| {
-        let with_error = |p: &PolarityEstimate, se: f64| PolarityEstimate {
-            excess_variance_standard_error: se,
-            ..p.clone()
-        };
-        spread::combined(&with_error(on, excess_se[0]), &with_error(off, excess_se[1])).sigma
-    };
-    let centre = sigma(at_offset);
-    if !centre.is_finite() {
-        return 0.0;
-    }
-    ends.iter()
-        .filter_map(|(_, p)| p.as_ref())
-        .map(|[on, off]| sigma([on, off]))
-        .filter(|s| s.is_finite())
-        .map(|s| (s - centre).abs())
-        .fold(0.0, f64::max)
-        / 1.96
 }
 
 /// The response and offset: for each candidate response (the frames' own; with

@@ -143,9 +143,63 @@ pub fn combined(on: &PolarityEstimate, off: &PolarityEstimate) -> Spread {
     }
 }
 
+/// The combined spread's change across the frames' offset range, a systematic: at each
+/// end the polarities' spreads (`ends`, ON and OFF) combined with the bootstrap errors of
+/// the spread at the offset (`excess_se`, ON and OFF), against `at_offset` combined alike;
+/// the larger change over 1.96 (as for the thresholds), or 0 where the spread at the
+/// offset is not determined.
+pub fn offset_systematic<'a>(
+    ends: impl IntoIterator<Item = &'a [PolarityEstimate; 2]>,
+    at_offset: [&PolarityEstimate; 2],
+    excess_se: [f64; 2],
+) -> f64 {
+    let sigma = |[on, off]: [&PolarityEstimate; 2]| {
+        let with_error = |p: &PolarityEstimate, se: f64| PolarityEstimate {
+            excess_variance_standard_error: se,
+            ..p.clone()
+        };
+        combined(
+            &with_error(on, excess_se[0]),
+            &with_error(off, excess_se[1]),
+        )
+        .sigma
+    };
+    let centre = sigma(at_offset);
+    if !centre.is_finite() {
+        return 0.0;
+    }
+    ends.into_iter()
+        .map(|[on, off]| sigma([on, off]))
+        .filter(|s| s.is_finite())
+        .map(|s| (s - centre).abs())
+        .fold(0.0, f64::max)
+        / 1.96
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_spreads_offset_systematic_is_its_largest_change_at_the_ends_over_1_96() {
+        // at the offset both polarities 0.04^2; at the ends 0.05^2 and 0.035^2 (their own
+        // bootstrap errors replaced by the offset's)
+        let at = [polarity(1.6e-3, 1e-4), polarity(1.6e-3, 1e-4)];
+        let ends = [
+            [polarity(2.5e-3, 9.0), polarity(2.5e-3, 9.0)],
+            [polarity(1.225e-3, 0.0), polarity(1.225e-3, 0.0)],
+        ];
+        let s = offset_systematic(&ends, [&at[0], &at[1]], [1e-4, 1e-4]);
+        assert!((s - 0.01 / 1.96).abs() < 1e-12, "{s}");
+        // no ends: none
+        assert_eq!(offset_systematic(&[], [&at[0], &at[1]], [1e-4, 1e-4]), 0.0);
+        // a spread not determined at the offset (both polarities overshoot): none
+        let overshooting = polarity(-1e-3, 1e-5);
+        assert_eq!(
+            offset_systematic(&ends, [&overshooting, &overshooting], [1e-5, 1e-5]),
+            0.0
+        );
+    }
 
     fn polarity(excess_variance: f64, se: f64) -> PolarityEstimate {
         PolarityEstimate {
