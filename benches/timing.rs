@@ -2,7 +2,7 @@
 //! of `fit` (issue 19): a whole estimate with the frames' log offset fitted (pairs read
 //! along the flow, the offset's root and interval, the 200 bootstrap draws) on one thread
 //! and on all threads, and one bootstrap draw (resampled weights, the weighted least
-//! squares, the per-pixel sums of both polarities).
+//! squares, the per-pixel sums of both polarities), and the samples' mode.
 //!
 //! Input: a 1/f texture translating over a 240x180 sensor for 0.5 s, rendered at 1 kHz
 //! and simulated with the ideal pixel (thresholds 0.3), its 25 Hz frames as 8-bit APS
@@ -94,6 +94,17 @@ fn timing_estimator(c: &mut Criterion) {
             let off = pixels::pixel_sums(&pairs, &slots, &values, &w, &c, false);
             (on.map(|s| s.0.len()), off.map(|s| s.0.len()))
         })
+    });
+    // the samples' mode (mean shift from the median and the deciles, over the sorted
+    // samples): once per polarity in every fit; 2.5 M samples are a dense recording's
+    // (coverage draw 51), this recording's log changes repeated, each copy scaled by 1e-7
+    // more (all distinct, as a real recording's)
+    let n = values.y.len();
+    let many: Vec<f64> = (0..2_500_000)
+        .map(|i| values.y[i % n] * (1.0 + 1e-7 * (i / n) as f64))
+        .collect();
+    group.bench_function(format!("mode/{}_samples", many.len()), |b| {
+        b.iter(|| model::mode(&many, 0.5))
     });
     group.finish();
 }

@@ -120,7 +120,8 @@ pub fn mode(values: &[f64], window: f64) -> Option<f64> {
     if sorted.len() < 10 {
         return None;
     }
-    sorted.sort_by(f64::total_cmp);
+    // unstable: values equal under `total_cmp` are the same bits, so the order is the same
+    sorted.sort_unstable_by(f64::total_cmp);
     let within = |m: f64| -> usize {
         let a = sorted.partition_point(|&v| v < m * (1.0 - window));
         let b = sorted.partition_point(|&v| v <= m * (1.0 + window));
