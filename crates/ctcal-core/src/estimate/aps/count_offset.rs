@@ -8,8 +8,8 @@
 //! threshold. The timing's first-order lag term does not hold once the time constant
 //! nears the time the signal takes to change, and the offset absorbs what is left: on the
 //! coverage study's draw 46 (a 42.6 Hz photoreceptor, v2e's lin-log response, whose offset
-//! is about 1 DN) the timing fitted b = 35.6 DN and both estimators read 0.34 for a true
-//! 0.475; at b = 1.2 they read 0.47.
+//! is about 1 DN) the timing fitted b = 35.6 DN and both estimators read ON 0.34 for a
+//! true 0.475; given b = 1.2 they read 0.463 and 0.478.
 //!
 //! Counts are far less sensitive to a lag: a low-pass delays events and removes only those
 //! of changes faster than itself. So the re-simulation gives a second measure of `b`: the
@@ -20,9 +20,12 @@
 //! through the difference's slope in `b`. Where the two measures disagree, the offsets
 //! the thresholds' systematic error spans cover both ([`reconcile`]).
 
+use super::{ApsInput, ApsOptions, Pass, lag_resolved, run_pass, simulated_sigma};
+use crate::estimate::EstimateError;
 use crate::estimate::frames::PreparedFrames;
 use crate::estimate::resim::{Cells, Counts, Resimulation, fit_with};
 use crate::estimate::timing::OFFSET_PRIOR;
+use crate::events::TimeUs;
 use crate::sim::Sample;
 use serde::Serialize;
 
@@ -226,6 +229,116 @@ pub fn search(
         at_timing_offset: at_own,
         at_bound: false,
     })
+}
+
+/// The counts' offset and whether it moved the frames' offset or its range.
+pub(super) struct FromCounts {
+    pub(super) found: CountOffset,
+    /// The timing's offset and range before.
+    timing: (f32, (f32, f32)),
+    changed: bool,
+}
+
+/// The frames' offset as the counts give it ([`search`]), where the timing fitted
+/// one and the re-simulation's dark cells disagree with its bright ones at it. Where the
+/// two offsets' intervals do not overlap, the frames' offset and range are reconciled
+/// ([`reconcile`]) and the full pass (with its upsampled `runs`) is made
+/// again at them.
+pub(super) fn offset_from_counts(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &mut PreparedFrames,
+    options: &ApsOptions,
+    (runs, full): (&mut Vec<Vec<Sample>>, &mut Pass),
+    timing_offset: Option<&crate::estimate::timing::Offset>,
+    grid: Option<(TimeUs, TimeUs)>,
+) -> Result<Option<FromCounts>, EstimateError> {
+    let Some(timing_offset) = timing_offset.filter(|o| o.source == "fitted") else {
+        return Ok(None);
+    };
+    let Some(resim) = &full.resim else {
+        return Ok(None);
+    };
+    let Some(brightness) = Brightness::new(&full.cells, frames, &full.real) else {
+        return Ok(None);
+    };
+    let setup = Setup {
+        cells: &full.cells,
+        real: &full.real,
+        simulated: &resim.counts,
+        grid,
+        width: frames.width,
+        height: frames.height,
+    };
+    let Some(at_own) = disagreement(&setup, &brightness) else {
+        return Ok(None);
+    };
+    let found = search(
+        &setup,
+        &brightness,
+        (runs, frames.offset),
+        at_own,
+        (resim.ct_on, resim.ct_off),
+        simulated_sigma(&full.timing),
+    );
+    let timing = (frames.offset, frames.offset_range);
+    let change = found.as_ref().and_then(|found| {
+        reconcile(
+            timing,
+            timing_offset.ci95,
+            found,
+            lag_resolved(&full.timing.lag).is_some(),
+        )
+    });
+    if let Some((offset, range)) = change {
+        frames.offset = offset;
+        frames.offset_range = range;
+    }
+    // the search shifted the runs, whether or not it found the offset
+    *runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    if change.is_some() {
+        *full = run_pass(input, excluded, frames, runs, options, None)?;
+    }
+    Ok(found.map(|found| FromCounts {
+        found,
+        timing,
+        changed: change.is_some(),
+    }))
+}
+
+/// The counts' offset, in words for the assumptions.
+pub(super) fn assumption(c: &FromCounts, frames: &PreparedFrames) -> String {
+    let f = &c.found;
+    let found = if f.at_bound {
+        format!(
+            "at or beyond {:.1} DN, the end of the prior range",
+            f.offset_dn
+        )
+    } else {
+        format!(
+            "at b = {:.1} DN (95 % {:.1} .. {:.1})",
+            f.offset_dn, f.ci95[0], f.ci95[1]
+        )
+    };
+    let head = format!(
+        "the frames' log offset from the counts: at the event timing's b = {:.1} DN the re-simulation's dark cells differ from its bright ones by {:+.3} (+- {:.3}) in mean log ratio of simulated to real counts; they agree {found}",
+        c.timing.0, f.at_timing_offset.difference, f.at_timing_offset.standard_error
+    );
+    if c.changed {
+        format!(
+            "{head}. The two offsets disagree (a photoreceptor lag distorts the timing's samples and hardly the counts), so the thresholds' systematic error spans the offsets {:.1} .. {:.1} DN, and they are read at b = {:.1} DN ({})",
+            frames.offset_range.0,
+            frames.offset_range.1,
+            frames.offset,
+            if (frames.offset - c.timing.0).abs() > 0.0 {
+                "the counts' offset: the timing finds a photoreceptor lag, which pushes its offset up"
+            } else {
+                "the timing's offset: the timing finds no photoreceptor lag, or the counts' offset is the larger, which a lag does not explain"
+            }
+        )
+    } else {
+        format!("{head}, within the timing's offset interval: the timing's offset kept")
+    }
 }
 
 /// Adds `delta` DN to every sample of `runs`.

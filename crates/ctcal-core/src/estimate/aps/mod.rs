@@ -221,7 +221,7 @@ pub fn estimate(
     let mut runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
     let mut full = run_pass(input, &excluded, &frames, &runs, options, None)?;
     let grid = timestamp_grid(input.events);
-    let offset_from_counts = offset_from_counts(
+    let offset_from_counts = count_offset::offset_from_counts(
         input,
         &excluded,
         &mut frames,
@@ -233,7 +233,7 @@ pub fn estimate(
     assumptions.extend(
         offset_from_counts
             .as_ref()
-            .map(|c| count_offset_assumption(c, &frames)),
+            .map(|c| count_offset::assumption(c, &frames)),
     );
     let spread = full.timing.spread();
     let sigma = simulated_sigma(&full.timing);
@@ -596,116 +596,6 @@ fn measured_model(timing: &TimingEstimate, sigma: f64) -> PixelParams {
 fn lag_resolved(lag: &super::timing::Lag) -> Option<f64> {
     lag.cutoff_hz_at_median_dn
         .filter(|&f| lag.tau_times_dn > 3.0 * lag.standard_error && f < 1000.0)
-}
-
-/// The counts' offset and whether it moved the frames' offset or its range.
-struct FromCounts {
-    found: count_offset::CountOffset,
-    /// The timing's offset and range before.
-    timing: (f32, (f32, f32)),
-    changed: bool,
-}
-
-/// The frames' offset as the counts give it ([`count_offset`]), where the timing fitted
-/// one and the re-simulation's dark cells disagree with its bright ones at it. Where the
-/// two offsets' intervals do not overlap, the frames' offset and range are reconciled
-/// ([`count_offset::reconcile`]) and the full pass (with its upsampled `runs`) is made
-/// again at them.
-fn offset_from_counts(
-    input: &ApsInput,
-    excluded: &[bool],
-    frames: &mut PreparedFrames,
-    options: &ApsOptions,
-    (runs, full): (&mut Vec<Vec<Sample>>, &mut Pass),
-    timing_offset: Option<&super::timing::Offset>,
-    grid: Option<(TimeUs, TimeUs)>,
-) -> Result<Option<FromCounts>, EstimateError> {
-    let Some(timing_offset) = timing_offset.filter(|o| o.source == "fitted") else {
-        return Ok(None);
-    };
-    let Some(resim) = &full.resim else {
-        return Ok(None);
-    };
-    let Some(brightness) = count_offset::Brightness::new(&full.cells, frames, &full.real) else {
-        return Ok(None);
-    };
-    let setup = count_offset::Setup {
-        cells: &full.cells,
-        real: &full.real,
-        simulated: &resim.counts,
-        grid,
-        width: frames.width,
-        height: frames.height,
-    };
-    let Some(at_own) = count_offset::disagreement(&setup, &brightness) else {
-        return Ok(None);
-    };
-    let found = count_offset::search(
-        &setup,
-        &brightness,
-        (runs, frames.offset),
-        at_own,
-        (resim.ct_on, resim.ct_off),
-        simulated_sigma(&full.timing),
-    );
-    let timing = (frames.offset, frames.offset_range);
-    let change = found.as_ref().and_then(|found| {
-        count_offset::reconcile(
-            timing,
-            timing_offset.ci95,
-            found,
-            lag_resolved(&full.timing.lag).is_some(),
-        )
-    });
-    if let Some((offset, range)) = change {
-        frames.offset = offset;
-        frames.offset_range = range;
-    }
-    // the search shifted the runs, whether or not it found the offset
-    *runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
-    if change.is_some() {
-        *full = run_pass(input, excluded, frames, runs, options, None)?;
-    }
-    Ok(found.map(|found| FromCounts {
-        found,
-        timing,
-        changed: change.is_some(),
-    }))
-}
-
-/// The counts' offset, in words for the assumptions.
-fn count_offset_assumption(c: &FromCounts, frames: &PreparedFrames) -> String {
-    let f = &c.found;
-    let found = if f.at_bound {
-        format!(
-            "at or beyond {:.1} DN, the end of the prior range",
-            f.offset_dn
-        )
-    } else {
-        format!(
-            "at b = {:.1} DN (95 % {:.1} .. {:.1})",
-            f.offset_dn, f.ci95[0], f.ci95[1]
-        )
-    };
-    let head = format!(
-        "the frames' log offset from the counts: at the event timing's b = {:.1} DN the re-simulation's dark cells differ from its bright ones by {:+.3} (+- {:.3}) in mean log ratio of simulated to real counts; they agree {found}",
-        c.timing.0, f.at_timing_offset.difference, f.at_timing_offset.standard_error
-    );
-    if c.changed {
-        format!(
-            "{head}. The two offsets disagree (a photoreceptor lag distorts the timing's samples and hardly the counts), so the thresholds' systematic error spans the offsets {:.1} .. {:.1} DN, and they are read at b = {:.1} DN ({})",
-            frames.offset_range.0,
-            frames.offset_range.1,
-            frames.offset,
-            if (frames.offset - c.timing.0).abs() > 0.0 {
-                "the counts' offset: the timing finds a photoreceptor lag, which pushes its offset up"
-            } else {
-                "the timing's offset: the timing finds no photoreceptor lag, or the counts' offset is the larger, which a lag does not explain"
-            }
-        )
-    } else {
-        format!("{head}, within the timing's offset interval: the timing's offset kept")
-    }
 }
 
 /// The offset, in words for the assumptions.
