@@ -452,6 +452,16 @@ fn screen_recovers_the_threshold_through_the_display_and_reports_the_naive_one()
     }
 }
 
+/// Coverage draw `seed` written to a temporary folder and run through `estimate METHOD`:
+/// its spec and the JSON.
+fn estimate_draw(seed: u64, method: &str) -> (ctcal::coverage::CaseSpec, serde_json::Value) {
+    let case = ctcal::coverage::CaseSpec::draw(seed);
+    let dir = tempfile::tempdir().unwrap();
+    ctcal::coverage::write_case(&case, dir.path()).expect("the case is written");
+    let e = json(&["estimate", method, dir.path().to_str().unwrap()]);
+    (case, e)
+}
+
 /// Coverage draw 50 (`ctcal::coverage::CaseSpec::draw(50)`): a board moving at 18 px/s
 /// through a gamma-2.59 display, Cp 0.737 / Cn 0.526, with mismatch, leak, timestamp jitter
 /// and a pure-log response. Its naive thresholds (the stimulus as the camera's light) lie
@@ -461,12 +471,11 @@ fn screen_recovers_the_threshold_through_the_display_and_reports_the_naive_one()
 /// now walks to them ([`ctcal::estimate::root`]).
 #[test]
 fn screen_finds_thresholds_far_from_where_it_starts() {
-    use ctcal::coverage::{CaseSpec, Method, write_case};
-    let case = CaseSpec::draw(50);
-    assert!(Method::Screen.applies_to(&case), "draw 50 is on screen");
-    let dir = tempfile::tempdir().unwrap();
-    write_case(&case, dir.path()).expect("the case is written");
-    let e = json(&["estimate", "screen", dir.path().to_str().unwrap()]);
+    let (case, e) = estimate_draw(50, "screen");
+    assert!(
+        ctcal::coverage::Method::Screen.applies_to(&case),
+        "draw 50 is on screen"
+    );
     let details = &e["estimators"][0]["details"];
     let naive_on = details["naive_ct_on"].as_f64().unwrap();
     assert!(
@@ -497,12 +506,8 @@ fn screen_finds_thresholds_far_from_where_it_starts() {
 /// squares), which ideal pixels read as thresholds 1.13 / 2.27 for a true 0.64 / 0.86.
 #[test]
 fn screen_measures_the_photoreceptors_lag_and_matches_the_thresholds_with_it() {
-    use ctcal::coverage::{CaseSpec, write_case};
-    let case = CaseSpec::draw(36);
+    let (case, e) = estimate_draw(36, "screen");
     assert_eq!(case.params.cutoff_hz, Some(20.3268));
-    let dir = tempfile::tempdir().unwrap();
-    write_case(&case, dir.path()).expect("the case is written");
-    let e = json(&["estimate", "screen", dir.path().to_str().unwrap()]);
     let lag = &e["photoreceptor"];
     let cutoff = lag["cutoff_hz"]
         .as_f64()
@@ -526,12 +531,8 @@ fn screen_measures_the_photoreceptors_lag_and_matches_the_thresholds_with_it() {
 /// two is in the intervals.
 #[test]
 fn aps_reads_the_frames_offset_from_the_counts_where_a_photoreceptor_lag_distorts_the_timing() {
-    use ctcal::coverage::{CaseSpec, write_case};
-    let case = CaseSpec::draw(46);
+    let (case, e) = estimate_draw(46, "aps");
     assert_eq!(case.params.cutoff_hz, Some(42.5699));
-    let dir = tempfile::tempdir().unwrap();
-    write_case(&case, dir.path()).expect("the case is written");
-    let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
     let offset = &e["frame_offset_dn"];
     let timing = offset["estimate"]["offset_dn"].as_f64().unwrap();
     let counts = offset["from_counts"]["offset_dn"]

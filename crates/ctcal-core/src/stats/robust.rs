@@ -1,14 +1,19 @@
-//! Summary statistics shared by the estimators and the fit: the sample standard deviation,
+//! Summary statistics shared by the estimators and the fit: the sample variance and standard deviation,
 //! the median and the median absolute deviation (scaled to a normal's sigma: Hampel 1974).
 
 /// The sample standard deviation (n - 1 denominator); `None` below two values.
 pub fn sample_std_dev(values: &[f64]) -> Option<f64> {
+    sample_variance(values).map(f64::sqrt)
+}
+
+/// The sample variance (n - 1 denominator); `None` below two values.
+pub fn sample_variance(values: &[f64]) -> Option<f64> {
     if values.len() < 2 {
         return None;
     }
     let n = values.len() as f64;
     let mean = values.iter().sum::<f64>() / n;
-    Some((values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0)).sqrt())
+    Some(values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0))
 }
 
 /// The median (the upper middle of an even count); `None` when empty.

@@ -27,6 +27,7 @@ use crate::estimate::resim::{Cells, Counts, Resimulation, fit_with};
 use crate::estimate::timing::OFFSET_PRIOR;
 use crate::events::TimeUs;
 use crate::sim::Sample;
+use crate::stats::robust;
 use serde::Serialize;
 
 /// Cells with at least this many real events (both polarities) are compared.
@@ -66,14 +67,13 @@ impl Brightness {
     pub fn new(cells: &Cells, frames: &PreparedFrames, real: &Counts) -> Option<Self> {
         let levels = cells.mean_levels(frames);
         let busy = |i: usize| real.on[i] + real.off[i] >= MIN_CELL_EVENTS;
-        let mut sorted: Vec<f64> = levels
+        let busy_levels: Vec<f64> = levels
             .iter()
             .enumerate()
             .filter(|(i, _)| busy(*i))
             .filter_map(|(_, l)| *l)
             .collect();
-        sorted.sort_by(f64::total_cmp);
-        let median = *sorted.get(sorted.len() / 2)?;
+        let median = robust::median(&busy_levels)?;
         let dark: Vec<Option<bool>> = levels
             .iter()
             .enumerate()
@@ -93,11 +93,11 @@ impl Brightness {
                 ratios[usize::from(*d)].push(((s + 0.5) / (r + 0.5)).ln());
             }
         }
+        // (mean, squared standard error of the mean) of each half
         let [bright, dark] = ratios.map(|v| {
             let n = v.len() as f64;
-            let mean = v.iter().sum::<f64>() / n;
-            let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (n - 1.0);
-            (mean, var / n)
+            let variance = robust::sample_variance(&v).unwrap_or(f64::NAN);
+            (v.iter().sum::<f64>() / n, variance / n)
         });
         DarkBright {
             difference: dark.0 - bright.0,
@@ -234,8 +234,8 @@ pub fn search(
 /// The counts' offset and whether it moved the frames' offset or its range.
 pub(super) struct FromCounts {
     pub(super) found: CountOffset,
-    /// The timing's offset and range before.
-    timing: (f32, (f32, f32)),
+    /// The timing's offset, DN.
+    timing_offset_dn: f32,
     changed: bool,
 }
 
@@ -301,7 +301,7 @@ pub(super) fn offset_from_counts(
     }
     Ok(found.map(|found| FromCounts {
         found,
-        timing,
+        timing_offset_dn: timing.0,
         changed: change.is_some(),
     }))
 }
@@ -322,7 +322,7 @@ pub(super) fn assumption(c: &FromCounts, frames: &PreparedFrames) -> String {
     };
     let head = format!(
         "the frames' log offset from the counts: at the event timing's b = {:.1} DN the re-simulation's dark cells differ from its bright ones by {:+.3} (+- {:.3}) in mean log ratio of simulated to real counts; they agree {found}",
-        c.timing.0, f.at_timing_offset.difference, f.at_timing_offset.standard_error
+        c.timing_offset_dn, f.at_timing_offset.difference, f.at_timing_offset.standard_error
     );
     if c.changed {
         format!(
@@ -330,7 +330,7 @@ pub(super) fn assumption(c: &FromCounts, frames: &PreparedFrames) -> String {
             frames.offset_range.0,
             frames.offset_range.1,
             frames.offset,
-            if (frames.offset - c.timing.0).abs() > 0.0 {
+            if frames.offset != c.timing_offset_dn {
                 "the counts' offset: the timing finds a photoreceptor lag, which pushes its offset up"
             } else {
                 "the timing's offset: the timing finds no photoreceptor lag, or the counts' offset is the larger, which a lag does not explain"
