@@ -35,6 +35,33 @@ pub fn ctcal() -> Command {
     cmd
 }
 
+/// Creates an HDF5 file for a test without libhdf5's file lock. A child `ctcal` that
+/// another test thread spawns while the file is open inherits its descriptor, and with it
+/// the lock, for the child's whole run: reopening the file here would then fail with
+/// EAGAIN. The tests have no concurrent writers, the lock's only purpose.
+pub fn h5_create(path: &Path) -> hdf5::File {
+    hdf5::File::with_options()
+        .with_fapl(|fapl| fapl.file_locking(false))
+        .create(path)
+        .unwrap_or_else(|e| panic!("creating {}: {e}", path.display()))
+}
+
+/// Opens an HDF5 file for writing without libhdf5's file lock (see [`h5_create`]).
+pub fn h5_open_rw(path: &Path) -> hdf5::File {
+    hdf5::File::with_options()
+        .with_fapl(|fapl| fapl.file_locking(false))
+        .open_rw(path)
+        .unwrap_or_else(|e| panic!("opening {}: {e}", path.display()))
+}
+
+/// Opens an HDF5 file for reading without libhdf5's file lock (see [`h5_create`]).
+pub fn h5_open(path: &Path) -> hdf5::File {
+    hdf5::File::with_options()
+        .with_fapl(|fapl| fapl.file_locking(false))
+        .open(path)
+        .unwrap_or_else(|e| panic!("opening {}: {e}", path.display()))
+}
+
 /// Runs `ctcal <args> --json -` and parses stdout.
 pub fn json(args: &[&str]) -> serde_json::Value {
     let output = ctcal()

@@ -265,7 +265,7 @@ fn damaged_bags_name_the_place() {
 
 /// The byte range of chunk `index` of a 1-D dataset.
 fn chunk_location(path: &std::path::Path, dataset: &str, element: u64) -> (u64, u64) {
-    let file = hdf5::File::open(path).unwrap();
+    let file = h5_open(path);
     let ds = file.dataset(dataset).unwrap();
     let (mut mask, mut address, mut size) = (0u32, 0u64, 0u64);
     let offset = [element];
@@ -307,7 +307,7 @@ fn an_mvsec_file_without_the_left_camera_names_the_side_to_use() {
     let path = dir.path().join("right_only.h5");
     let reference = read_events(&real("ijrr_slider_depth_50k"));
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         let rows: Vec<f64> = reference
             .iter()
             .take(1000)
@@ -593,7 +593,7 @@ fn a_dsec_index_that_contradicts_the_times_is_checked_against_them() {
     // millisecond 50 said to start where millisecond 53 does: a window from 50 ms used to
     // start 3 ms late and lose the events between
     {
-        let file = hdf5::File::open_rw(&path).unwrap();
+        let file = h5_open_rw(&path);
         let mut index: Vec<u64> = file.dataset("ms_to_idx").unwrap().read_raw().unwrap();
         let (right, wrong) = (index[50], index[53]);
         assert!(wrong > right + 100, "{right} {wrong}");
@@ -644,7 +644,7 @@ fn float32_times_that_lost_their_precision_are_refused() {
     // the whole recording used to collapse to one time (duration 0)
     let path = dir.path().join("mvsec_f32.h5");
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         let rows: Vec<f32> = reference
             .iter()
             .take(1000)
@@ -680,7 +680,7 @@ fn float32_times_that_lost_their_precision_are_refused() {
     // float32 seconds from zero keep their microseconds over a short recording
     let path = dir.path().join("event_utils_f32.h5");
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         let events = file.create_group("events").unwrap();
         let n = 1000;
         let ts: Vec<f32> = reference.t[..n].iter().map(|&t| t as f32 * 1e-6).collect();

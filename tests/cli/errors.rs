@@ -176,7 +176,7 @@ fn hdf5_with_missing_datasets() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("partial.h5");
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         let events = file.create_group("events").unwrap();
         events
             .new_dataset_builder()
@@ -212,7 +212,7 @@ fn hdf5_with_integer_microsecond_times_and_signed_polarity() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("int_times.h5");
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         let events = file.create_group("events").unwrap();
         events
             .new_dataset_builder()

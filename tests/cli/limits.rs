@@ -21,7 +21,7 @@ fn h5_events<X: hdf5::H5Type, P: hdf5::H5Type>(
     ys: &[X],
     ps: &[P],
 ) {
-    let file = hdf5::File::create(path).unwrap();
+    let file = h5_create(path);
     let events = file.create_group("events").unwrap();
     events
         .new_dataset_builder()
@@ -73,8 +73,7 @@ fn a_sensor_over_4096_pixels_needs_sensor_given() {
     // from sensor_resolution
     let h5 = dir.path().join("big.h5");
     h5_events(&h5, &[0.1, 0.2], &[1i16, 2], &[1i16, 2], &[true, false]);
-    hdf5::File::open_rw(&h5)
-        .unwrap()
+    h5_open_rw(&h5)
         .new_attr_builder()
         .with_data(&[100i64, 9000])
         .create("sensor_resolution")
@@ -183,7 +182,7 @@ fn hdf5_frames_are_checked_before_they_are_read() {
     // a scalar `frame` (v2e layout) used to panic
     let path = dir.path().join("scalar_frame.h5");
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         file.new_dataset_builder()
             .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
             .create("events")
@@ -195,7 +194,7 @@ fn hdf5_frames_are_checked_before_they_are_read() {
     // a frame stack claiming terabytes it does not store
     let path = dir.path().join("huge_frames.h5");
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         file.new_dataset_builder()
             .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
             .create("events")
@@ -227,7 +226,7 @@ fn hdf5_frames_are_checked_before_they_are_read() {
         h5_events(&path, &[0.1, 0.2], &[1i16, 2], &[1i16, 2], &[true, false]);
         {
             // every handle closed before ctcal reads the file
-            let file = hdf5::File::open_rw(&path).unwrap();
+            let file = h5_open_rw(&path);
             let images = file.create_group("images").unwrap();
             for (i, ((h, w), t)) in sizes.iter().zip(times).enumerate() {
                 let ds = images
@@ -290,7 +289,7 @@ fn an_lzf_compressed_hdf5_names_the_filter_and_the_fix() {
     let path = dir.path().join("lzf.h5");
     register_fake_lzf();
     {
-        let file = hdf5::File::create(&path).unwrap();
+        let file = h5_create(&path);
         let events = file.create_group("events").unwrap();
         let lzf = hdf5::filters::Filter::user(32000, &[]);
         events
@@ -889,7 +888,7 @@ fn frame_times_are_finite_and_in_order_in_every_reader() {
     ] {
         let path = dir.path().join(name);
         {
-            let file = hdf5::File::create(&path).unwrap();
+            let file = h5_create(&path);
             file.new_dataset_builder()
                 .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
                 .create("events")
