@@ -95,12 +95,12 @@ pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
         Vec::with_capacity(n),
     );
     let l = |dn: f32| log.apply(dn + b) as f64;
+    let span = f64::from(super::samples::RATE_SPAN_S);
     for p in pairs {
         let sign = if p.on { 1.0 } else { -1.0 };
         y.push(sign * (l(p.dn1) - l(p.dn0)));
         let mid = 0.5 * (p.dn0 + p.dn1);
         level.push(l(mid));
-        let span = p.span.max(1e-6) as f64;
         let r0 = (l(p.around[1]) - l(p.around[0])) / span;
         let r1 = (l(p.around[3]) - l(p.around[2])) / span;
         lag.push(sign * (r1 - r0) / (mid + b).max(1.0) as f64);
@@ -491,7 +491,6 @@ mod tests {
                 dt: dt as f32,
                 // a steady ramp through both events: no lag
                 around: [a as f32, a as f32, b as f32, b as f32],
-                span: 0.002,
                 block: 0,
                 interp,
             });

@@ -329,7 +329,6 @@ mod tests {
                     dn1: dn0 * rng.random_range(0.7..1.4f32),
                     dt: rng.random_range(0.001..0.2f32),
                     around: [dn0; 4],
-                    span: 0.002,
                     block: 0,
                     interp: [rng.random_range(0.0..1.0f32), rng.random_range(0.0..1.0f32)],
                 });

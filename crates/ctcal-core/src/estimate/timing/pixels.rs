@@ -141,7 +141,6 @@ mod tests {
             dn1,
             dt: 0.01,
             around: [100.0, 100.0, dn1, dn1],
-            span: 0.002,
             block: 0,
             interp: [0.0; 2],
         }

@@ -19,10 +19,10 @@ pub struct Pair {
     pub dn1: f32,
     /// Seconds between the two events.
     pub dt: f32,
-    /// DN a little before and after each event (at `t -+ h`), for the rate of change there:
-    /// `[before first, after first, before second, after second]`, and `2 h` in seconds.
+    /// DN a little before and after each event (at `t -+ h`, [`RATE_SPAN_S`] = `2 h`
+    /// apart), for the rate of change there:
+    /// `[before first, after first, before second, after second]`.
     pub around: [f32; 4],
-    pub span: f32,
     /// The block of frames read that the pair lies in (0 when the recording was read
     /// whole; see [`PreparedFrames::unread`]).
     pub block: u16,
@@ -47,6 +47,9 @@ impl Pair {
 
 /// Half the span over which a rate of change is measured, microseconds.
 const HALF_SPAN_US: TimeUs = 1000;
+
+/// The span over which a rate of change is measured ([`Pair::around`]), seconds.
+pub const RATE_SPAN_S: f32 = (2 * HALF_SPAN_US) as f32 * 1e-6;
 
 /// DN just before and after `t` along the flow (one-sided at the ends of a used interval);
 /// `t` on the frames' own clock.
@@ -111,7 +114,9 @@ pub fn collect(
         weight: 0.0,
     };
     let mut previous = vec![(unknown, 0 as TimeUs); sensor.pixels()];
-    let mut pairs = Vec::new();
+    // at most one pair per event: reserved once, and the unused tail given back, rather
+    // than doubling (which holds the old and the new buffer at once, 1.5-3x the pairs)
+    let mut pairs = Vec::with_capacity(events.len());
     for first in (0..events.len()).step_by(READ_STRETCH) {
         let stretch = first..(first + READ_STRETCH).min(events.len());
         let readings: Vec<Option<Reading>> = stretch.clone().into_par_iter().map(read).collect();
@@ -130,7 +135,6 @@ pub fn collect(
                     dn1: now.dn,
                     dt: ((t - t_before) as f64 * 1e-6) as f32,
                     around: [before.near.0, before.near.1, now.near.0, now.near.1],
-                    span: (2 * HALF_SPAN_US) as f32 * 1e-6,
                     block: u16::try_from(block).unwrap_or(u16::MAX),
                     interp: [before.weight, now.weight],
                 });
@@ -138,6 +142,7 @@ pub fn collect(
             previous[pixel] = (now, t);
         }
     }
+    pairs.shrink_to_fit();
     pairs
 }
 
