@@ -775,24 +775,24 @@ pub fn spread(
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<f64> {
-    let pairs = collect(
+    // only the samples and their polarity: 8 bytes a pair rather than a whole pair and
+    // its model values (the alignment tries nine shifts, two at a time)
+    let mut samples: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+    samples::PairSource {
         events,
         frames,
         shift,
         sensor,
         excluded,
-        options.support_window_us,
-    );
-    let values = model::values(&pairs, &frames.log_map, frames.offset);
+        support_window_us: options.support_window_us,
+    }
+    .for_each(samples::Read::DnOnly, |p| {
+        samples[p.on as usize].push(model::sample(&p, &frames.log_map, frames.offset));
+    });
     let mut total = 0.0;
     for on in [true, false] {
-        let own: Vec<f64> = pairs
-            .iter()
-            .zip(&values.y)
-            .filter(|(p, _)| p.on == on)
-            .map(|(_, &v)| v)
-            .collect();
-        let m = model::mode(&own, options.mode_window / 2.0)?;
+        let own = &samples[on as usize];
+        let m = model::mode(own, options.mode_window / 2.0)?;
         let (lo, hi) = (
             m * (1.0 - options.mode_window),
             m * (1.0 + 2.0 * options.mode_window),

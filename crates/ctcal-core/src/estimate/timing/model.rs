@@ -87,6 +87,16 @@ pub struct Values {
     pub lag: Vec<f64>,
 }
 
+/// The pair's sample: the log change between its events through `log` at offset `b`,
+/// signed by the second event's polarity (one threshold, or several, for a true change).
+#[inline]
+pub fn sample(p: &Pair, log: &LogMap, b: f32) -> f64 {
+    let l = |dn: f32| log.apply(dn + b) as f64;
+    let sign = if p.on { 1.0 } else { -1.0 };
+    sign * (l(p.dn1) - l(p.dn0))
+}
+
+/// The [`Values`] of `pairs` at offset `b`.
 pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
     let n = pairs.len();
     let (mut y, mut level, mut lag) = (
@@ -98,7 +108,7 @@ pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
     let span = f64::from(super::samples::RATE_SPAN_S);
     for p in pairs {
         let sign = if p.on { 1.0 } else { -1.0 };
-        y.push(sign * (l(p.dn1) - l(p.dn0)));
+        y.push(sample(p, log, b));
         let mid = 0.5 * (p.dn0 + p.dn1);
         level.push(l(mid));
         let r0 = (l(p.around[1]) - l(p.around[0])) / span;

@@ -76,6 +76,16 @@ struct Reading {
 /// costly part) on the pool, then paired in event order; memory is one stretch's readings.
 const READ_STRETCH: usize = 1 << 16;
 
+/// What a pass over the pairs reads at each event besides its DN.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Read {
+    /// Everything a [`Pair`] holds (the DN around each event, its phase).
+    Full,
+    /// The DN at the events only ([`Pair::around`] holds the DN itself, the phases 0): what
+    /// the samples alone need, without the two extra frame readings per event.
+    DnOnly,
+}
+
 /// Every usable pair of `events` (time-sorted) against `frames` with their times moved by
 /// `shift` (an event at `t` is read at `t - shift` on the frames' own clock, exactly what
 /// frames whose times were shifted give, without changing them): both events in used
@@ -88,62 +98,104 @@ pub fn collect(
     excluded: &[bool],
     support_window_us: Option<TimeUs>,
 ) -> Vec<Pair> {
-    let support = support_window_us.map(|w| supported(events, sensor, w));
-    let width = sensor.width as usize;
-    let read = |i: usize| -> Option<Reading> {
-        let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
-        if excluded[y as usize * width + x as usize] {
-            return None;
-        }
-        let dn = match frames.dn_at(x, y, t - shift) {
-            Some(dn) if support.as_ref().is_none_or(|s| s[i]) => dn,
-            _ => f32::NAN,
-        };
-        let near = if dn.is_finite() {
-            around(frames, x, y, t - shift).unwrap_or((dn, dn))
-        } else {
-            (dn, dn)
-        };
-        let weight = phase_weight(frames, t - shift);
-        Some(Reading { dn, near, weight })
+    // grown as they come (reserving one per event would hold far more than the pairs
+    // where few events pair up), and the unused tail given back before the fits run on
+    // them
+    let mut pairs = Vec::new();
+    let source = PairSource {
+        events,
+        frames,
+        shift,
+        sensor,
+        excluded,
+        support_window_us,
     };
-    // the previous event of each pixel: its reading and time
-    let unknown = Reading {
-        dn: f32::NAN,
-        near: (0.0, 0.0),
-        weight: 0.0,
-    };
-    let mut previous = vec![(unknown, 0 as TimeUs); sensor.pixels()];
-    // at most one pair per event: reserved once, and the unused tail given back, rather
-    // than doubling (which holds the old and the new buffer at once, 1.5-3x the pairs)
-    let mut pairs = Vec::with_capacity(events.len());
-    for first in (0..events.len()).step_by(READ_STRETCH) {
-        let stretch = first..(first + READ_STRETCH).min(events.len());
-        let readings: Vec<Option<Reading>> = stretch.clone().into_par_iter().map(read).collect();
-        for (i, reading) in stretch.zip(readings) {
-            let Some(now) = reading else { continue };
-            let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
-            let pixel = y as usize * width + x as usize;
-            let (before, t_before) = previous[pixel];
-            let block = frames.read_block(t);
-            // a pixel's change across a span whose events were not read is unknown
-            if before.dn.is_finite() && now.dn.is_finite() && frames.read_block(t_before) == block {
-                pairs.push(Pair {
-                    pixel: pixel as u32,
-                    on: events.on[i],
-                    dn0: before.dn,
-                    dn1: now.dn,
-                    dt: ((t - t_before) as f64 * 1e-6) as f32,
-                    around: [before.near.0, before.near.1, now.near.0, now.near.1],
-                    block: u16::try_from(block).unwrap_or(u16::MAX),
-                    interp: [before.weight, now.weight],
-                });
-            }
-            previous[pixel] = (now, t);
-        }
-    }
+    source.for_each(Read::Full, |pair| pairs.push(pair));
     pairs.shrink_to_fit();
     pairs
+}
+
+/// Where pairs come from: events against frames whose times are moved by `shift`, and what
+/// to leave out (see [`collect`]).
+pub struct PairSource<'a> {
+    pub events: &'a EventChunk,
+    pub frames: &'a PreparedFrames,
+    pub shift: TimeUs,
+    pub sensor: Sensor,
+    pub excluded: &'a [bool],
+    pub support_window_us: Option<TimeUs>,
+}
+
+impl PairSource<'_> {
+    /// Hands every usable pair to `sink`, in event order, without keeping them: memory is
+    /// one stretch's readings and the previous reading of each pixel.
+    pub fn for_each(&self, read: Read, mut sink: impl FnMut(Pair)) {
+        let (events, frames, shift) = (self.events, self.frames, self.shift);
+        let support = self
+            .support_window_us
+            .map(|w| supported(events, self.sensor, w));
+        let width = self.sensor.width as usize;
+        let reading = |i: usize| -> Option<Reading> {
+            let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
+            if self.excluded[y as usize * width + x as usize] {
+                return None;
+            }
+            let dn = match frames.dn_at(x, y, t - shift) {
+                Some(dn) if support.as_ref().is_none_or(|s| s[i]) => dn,
+                _ => f32::NAN,
+            };
+            if read == Read::DnOnly {
+                return Some(Reading {
+                    dn,
+                    near: (dn, dn),
+                    weight: 0.0,
+                });
+            }
+            let near = if dn.is_finite() {
+                around(frames, x, y, t - shift).unwrap_or((dn, dn))
+            } else {
+                (dn, dn)
+            };
+            let weight = phase_weight(frames, t - shift);
+            Some(Reading { dn, near, weight })
+        };
+        // the previous event of each pixel: its reading and time
+        let unknown = Reading {
+            dn: f32::NAN,
+            near: (0.0, 0.0),
+            weight: 0.0,
+        };
+        let mut previous = vec![(unknown, 0 as TimeUs); self.sensor.pixels()];
+        for first in (0..events.len()).step_by(READ_STRETCH) {
+            let stretch = first..(first + READ_STRETCH).min(events.len());
+            let readings: Vec<Option<Reading>> =
+                stretch.clone().into_par_iter().map(reading).collect();
+            for (i, reading) in stretch.zip(readings) {
+                let Some(now) = reading else { continue };
+                let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
+                let pixel = y as usize * width + x as usize;
+                let (before, t_before) = previous[pixel];
+                let block = frames.read_block(t);
+                // a pixel's change across a span whose events were not read is unknown
+                if before.dn.is_finite()
+                    && now.dn.is_finite()
+                    && frames.read_block(t_before) == block
+                {
+                    sink(Pair {
+                        pixel: pixel as u32,
+                        on: events.on[i],
+                        dn0: before.dn,
+                        dn1: now.dn,
+                        dt: ((t - t_before) as f64 * 1e-6) as f32,
+                        around: [before.near.0, before.near.1, now.near.0, now.near.1],
+                        block: u16::try_from(block).unwrap_or(u16::MAX),
+                        interp: [before.weight, now.weight],
+                    });
+                }
+                previous[pixel] = (now, t);
+            }
+        }
+    }
 }
 
 /// `4 a (1 - a)`, `a` the phase of `t` within its frame interval (0 at a frame, 1 midway).
