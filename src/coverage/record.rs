@@ -42,6 +42,11 @@ pub struct RunRecord {
     /// The effects a fit added, in order (empty for the estimators).
     #[serde(default)]
     pub effects_added: Vec<String>,
+    /// A fit's `hot_pixel_detection.probability`: `[rate_hz, share of pixels]` at which its
+    /// hot-pixel search names a hot pixel of that rate (what its `hot_pixel_fraction`
+    /// counts of hot pixels of each rate).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub hot_detection: Option<Vec<[f64; 2]>>,
 }
 
 /// The `effect` names of a fit's `effects_added`.
@@ -74,6 +79,7 @@ impl RunRecord {
             outcome,
             reported: BTreeMap::new(),
             effects_added: Vec::new(),
+            hot_detection: None,
         };
         record.read_output();
         record
@@ -86,6 +92,8 @@ impl RunRecord {
         } = &self.outcome
         {
             self.reported = extract(self.method, output);
+            self.hot_detection =
+                serde_json::from_value(output["hot_pixel_detection"]["probability"].clone()).ok();
             self.effects_added = effects_added(output);
         }
     }

@@ -16,7 +16,8 @@ use crate::fit::events_only::{EventsOnly, IntervalEdge};
 use crate::fit::metric::Components;
 use crate::fit::residuals::{BackgroundBin, Bin, IntervalDistributions, Residuals, Spectrum};
 use crate::fit::{
-    AddedEffect, Ambiguity, FitResult, FittedParams, Holdout, Step, StepResiduals, Uncertain,
+    AddedEffect, Ambiguity, FitResult, FittedParams, Holdout, HotPixelDetection, Step,
+    StepResiduals, Uncertain,
 };
 use crate::model::{
     InputFile, MethodResult, PlotEntry, PresetLevel, SequenceOutputs, SequenceReport, Truth,
@@ -274,8 +275,9 @@ structs! {
     IntervalInfo { t_start_s, t_end_s, used, reason, motion_px }
     FitResult { biases, params, identified, why, uncertainties, effects_added, error_metric,
         error_before, error_after, components_before, components_after, steps, ambiguities,
-        hot_pixels_masked, residuals_before, residuals_after, assumptions, holdout,
-        simulations, frame_exposure_us, events_only }
+        hot_pixels_masked, hot_pixel_detection, residuals_before, residuals_after, assumptions,
+        holdout, simulations, frame_exposure_us, events_only }
+    HotPixelDetection { detectable_above_hz, probability, meaning }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,
         predicted_error_before, predicted_error_after, simulated_back_why, quiet_pixel_seconds, support_window_ms, timestamp_step_us, interval_edge }

@@ -314,6 +314,9 @@ pub struct FitResult {
     pub ambiguities: Vec<Ambiguity>,
     /// Hot pixels named (simulated where they are as their own event trains).
     pub hot_pixels_masked: Vec<HotPixel>,
+    /// Which hot pixels `hot_pixel_fraction` counts: those fast enough to be found.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hot_pixel_detection: Option<HotPixelDetection>,
     /// Residuals of the ideal model and of the final one (fit blocks; a fit without
     /// frames simulates no scene and has none).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -331,6 +334,34 @@ pub struct FitResult {
     /// come from, the noise rates, the interval edge, the threshold ratio).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub events_only: Option<events_only::EventsOnly>,
+}
+
+/// Which hot pixels the hot-pixel search sees ([`crate::stats::hot_pixels::Detectability`])
+/// and so which `hot_pixel_fraction` counts.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct HotPixelDetection {
+    /// The rate at which a hot pixel placed at a random kept pixel is named at half of
+    /// them: hot pixels this fast or faster are counted in full.
+    pub detectable_above_hz: f64,
+    /// `[rate_hz, probability]`: the share of kept pixels at which a hot pixel of that rate
+    /// is named, at 1, 2, 5, ... 5000 Hz.
+    pub probability: Vec<[f64; 2]>,
+    pub meaning: &'static str,
+}
+
+impl HotPixelDetection {
+    /// The rates [`HotPixelDetection::probability`] is given at, Hz.
+    pub const RATES_HZ: [f64; 12] = [
+        1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0,
+    ];
+
+    pub fn new(detectable_above_hz: f64, probability: Vec<[f64; 2]>) -> Self {
+        Self {
+            detectable_above_hz,
+            probability,
+            meaning: "the hot-pixel search names a hot pixel of rate r at a share probability(r) of the kept pixels; each named pixel weighs 1 / max(probability, 1/2) in hot_pixel_fraction, so hot pixels at detectable_above_hz or faster are counted in full and a slower one as 2 probability(r) of one: the fraction does not determine slower hot pixels",
+        }
+    }
 }
 
 /// How the data were split.

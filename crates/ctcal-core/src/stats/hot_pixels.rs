@@ -44,15 +44,10 @@ fn neighbour_max(counts: &[u32], width: usize, height: usize, x: usize, y: usize
     max as f64
 }
 
-/// Finds hot pixels in a `width x height` map of per-pixel event counts over `duration_s`.
-pub fn find_hot_pixels(
-    counts: &[u32],
-    width: usize,
-    height: usize,
-    duration_s: f64,
-) -> Vec<HotPixel> {
-    // residuals of active pixels (a pixel with an active neighbourhood counts too)
-    let mut candidates = Vec::new();
+/// `1.4826 * MAD` of the residuals `c - m` over the active pixels (those that fired or
+/// whose busiest neighbour did): the robust scale of the z-score. `None` when no pixel is
+/// active.
+fn residual_scale(counts: &[u32], width: usize, height: usize) -> Option<f64> {
     let mut absolute_residuals = Vec::new();
     for y in 0..height {
         for x in 0..width {
@@ -61,36 +56,59 @@ pub fn find_hot_pixels(
                 continue;
             }
             let m = neighbour_max(counts, width, height, x, y);
-            let r = c as f64 - m;
-            absolute_residuals.push(r.abs());
-            if c >= MIN_EVENTS && r > 0.0 {
-                candidates.push((x, y, c, m, r));
-            }
+            absolute_residuals.push((c as f64 - m).abs());
         }
     }
     if absolute_residuals.is_empty() {
-        return Vec::new();
+        return None;
     }
     let mid = absolute_residuals.len() / 2;
     let (_, mad, _) = absolute_residuals.select_nth_unstable_by(mid, f64::total_cmp);
-    let scale = 1.4826 * *mad;
-    let mut hot: Vec<HotPixel> = candidates
-        .into_iter()
-        .filter_map(|(x, y, c, m, r)| {
+    Some(1.4826 * *mad)
+}
+
+/// The smallest count at which a pixel whose busiest neighbour fired `m` is named: at least
+/// [`MIN_EVENTS`] and `z > Z_THRESHOLD`, i.e. `c > m + Z * max(scale, sqrt(m + 1))`.
+fn count_to_be_named(m: f64, scale: f64) -> u64 {
+    let bound = m + Z_THRESHOLD * scale.max((m + 1.0).sqrt());
+    (bound.floor() as u64 + 1).max(MIN_EVENTS as u64)
+}
+
+/// Finds hot pixels in a `width x height` map of per-pixel event counts over `duration_s`.
+pub fn find_hot_pixels(
+    counts: &[u32],
+    width: usize,
+    height: usize,
+    duration_s: f64,
+) -> Vec<HotPixel> {
+    let Some(scale) = residual_scale(counts, width, height) else {
+        return Vec::new();
+    };
+    let mut hot = Vec::new();
+    for y in 0..height {
+        for x in 0..width {
+            let c = counts[y * width + x];
+            let m = neighbour_max(counts, width, height, x, y);
+            let r = c as f64 - m;
+            if c < MIN_EVENTS || r <= 0.0 {
+                continue;
+            }
             let z = r / scale.max((m + 1.0).sqrt());
-            (z > Z_THRESHOLD).then(|| HotPixel {
-                x: x as u16,
-                y: y as u16,
-                events: c as u64,
-                rate_hz: if duration_s > 0.0 {
-                    c as f64 / duration_s
-                } else {
-                    0.0
-                },
-                z,
-            })
-        })
-        .collect();
+            if z > Z_THRESHOLD {
+                hot.push(HotPixel {
+                    x: x as u16,
+                    y: y as u16,
+                    events: c as u64,
+                    rate_hz: if duration_s > 0.0 {
+                        c as f64 / duration_s
+                    } else {
+                        0.0
+                    },
+                    z,
+                });
+            }
+        }
+    }
     hot.sort_by(|a, b| {
         b.events
             .cmp(&a.events)
@@ -98,6 +116,106 @@ pub fn find_hot_pixels(
             .then(a.x.cmp(&b.x))
     });
     hot
+}
+
+/// How likely the search above is to name a hot pixel of a given rate placed at a random
+/// kept pixel of a recording: the detection probability of a defect that fires a Poisson
+/// train whatever the scene (as sensors' hot pixels do, and as simulators place them: at
+/// random pixels). At pixel `p` the train adds `Poisson(rate * T)` events to the scene's
+/// `c_p`, and is named when the sum reaches [`count_to_be_named`] for the pixel's busiest
+/// neighbour `m_p` (the neighbours and the robust scale are the recording's own; one hot
+/// pixel hardly moves either). Averaged over the kept pixels:
+/// `pi(rate) = mean_p P(Poisson(rate T) >= need_p - c_p)`.
+///
+/// A slow hot pixel on a busy scene does not stand out: `pi` says which rates the search
+/// sees, so that a count of named pixels can be turned into a fraction (Horvitz-Thompson:
+/// each named pixel stands for `1 / pi` of its kind; Horvitz & Thompson, JASA 1952), and a
+/// count of none bounds only the pixels fast enough to be seen.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Detectability {
+    /// (events a pixel lacks to be named, how many kept pixels lack that many), by deficit.
+    deficits: Vec<(u64, usize)>,
+    pixels: usize,
+    duration_s: f64,
+}
+
+impl Detectability {
+    /// The detectability of `counts` (a `width x height` map over `duration_s`) at the
+    /// pixels `kept`. `None` without an active or a kept pixel, or without duration.
+    pub fn new(
+        counts: &[u32],
+        kept: &[bool],
+        width: usize,
+        height: usize,
+        duration_s: f64,
+    ) -> Option<Self> {
+        let scale = residual_scale(counts, width, height)?;
+        let mut by_deficit = std::collections::BTreeMap::<u64, usize>::new();
+        for y in 0..height {
+            for x in 0..width {
+                if !kept[y * width + x] {
+                    continue;
+                }
+                let need = count_to_be_named(neighbour_max(counts, width, height, x, y), scale);
+                let deficit = need.saturating_sub(counts[y * width + x] as u64);
+                *by_deficit.entry(deficit).or_default() += 1;
+            }
+        }
+        let pixels = by_deficit.values().sum();
+        (pixels > 0 && duration_s > 0.0).then(|| Detectability {
+            deficits: by_deficit.into_iter().collect(),
+            pixels,
+            duration_s,
+        })
+    }
+
+    /// `pi(rate)`: the share of kept pixels at which a hot pixel of `rate_hz` is named.
+    pub fn probability(&self, rate_hz: f64) -> f64 {
+        let mean = rate_hz.max(0.0) * self.duration_s;
+        let reached = |deficit: u64| -> f64 {
+            if deficit == 0 {
+                1.0
+            } else if mean <= 0.0 {
+                0.0
+            } else {
+                // P(X >= k) = P(X > k - 1)
+                use statrs::distribution::{DiscreteCDF, Poisson};
+                Poisson::new(mean).map_or(0.0, |d| d.sf(deficit - 1))
+            }
+        };
+        self.deficits
+            .iter()
+            .map(|&(deficit, n)| n as f64 * reached(deficit))
+            .sum::<f64>()
+            / self.pixels as f64
+    }
+
+    /// The rate at which a hot pixel is named at `share` of the kept pixels (Brent's root
+    /// of `pi(rate) - share` in the rate's logarithm, argmin's `BrentRoot`), between 0.1
+    /// event and 10^7 events over the duration. `None` where `pi` is above `share` already
+    /// at the lower end or below it at the upper end.
+    pub fn rate_at(&self, share: f64) -> Option<f64> {
+        use argmin::core::{CostFunction, Error, Executor};
+        use argmin::solver::brent::BrentRoot;
+        struct Gap<'a>(&'a Detectability, f64);
+        impl CostFunction for Gap<'_> {
+            type Param = f64;
+            type Output = f64;
+            fn cost(&self, log_rate: &f64) -> Result<f64, Error> {
+                Ok(self.0.probability(log_rate.exp()) - self.1)
+            }
+        }
+        let (lo, hi) = ((0.1 / self.duration_s).ln(), (1e7 / self.duration_s).ln());
+        let gap = Gap(self, share);
+        if gap.cost(&lo).ok()? >= 0.0 || gap.cost(&hi).ok()? <= 0.0 {
+            return None;
+        }
+        let result = Executor::new(gap, BrentRoot::new(lo, hi, 1e-6))
+            .configure(|state| state.param(0.5 * (lo + hi)).max_iters(100))
+            .run()
+            .ok()?;
+        result.state.best_param.map(f64::exp)
+    }
 }
 
 #[cfg(test)]
@@ -129,5 +247,25 @@ mod tests {
             counts[10 * w + x] = 50 + (x % 3) as u32;
         }
         assert!(find_hot_pixels(&counts, w, h, 1.0).is_empty());
+    }
+
+    /// Every pixel at 20 events over 10 s (MAD 0, so the scale is sqrt(21)): a pixel is
+    /// named from 66 events (c > 20 + 10 sqrt(21) = 65.8), 46 more than the scene's. Half
+    /// the pixels name a train whose mean is the lambda of P(Poisson(lambda) >= 46) = 1/2,
+    /// 45.6671 (by the Poisson series, bisected): 4.56671 Hz.
+    #[test]
+    fn a_flat_scene_names_half_its_hot_pixels_at_the_poisson_median() {
+        let counts = vec![20u32; 40 * 20];
+        let d = Detectability::new(&counts, &[true; 800], 40, 20, 10.0).unwrap();
+        let half = d.rate_at(0.5).unwrap();
+        assert!((half - 4.56671).abs() < 1e-4, "{half}");
+        assert!((d.probability(half) - 0.5).abs() < 1e-6);
+        assert_eq!(d.probability(0.0), 0.0);
+        assert!(d.probability(10.0) > 0.999);
+        // pixels left out do not count: with only the first row kept, the same
+        let mut first_row = [false; 800];
+        first_row[..40].fill(true);
+        let d = Detectability::new(&counts, &first_row, 40, 20, 10.0).unwrap();
+        assert!((d.rate_at(0.5).unwrap() - half).abs() < 1e-9);
     }
 }

@@ -125,6 +125,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
         steps,
         ambiguities: Vec::new(),
         hot_pixels_masked: hot,
+        hot_pixel_detection: None,
         residuals_before: None,
         residuals_after: None,
         assumptions,

@@ -125,6 +125,12 @@ fn hot_pixels(
             *count = 0;
         }
     }
+    let mut real = simulation.real.pixels_of(g, Subset::Fit);
+    for (count, kept) in real.iter_mut().zip(&state.kept) {
+        if !kept {
+            *count = 0;
+        }
+    }
     let found = super::hot_excess::excess(&super::hot_excess::Counts {
         real_named: &state.hot,
         model: &model,
@@ -132,6 +138,8 @@ fn hot_pixels(
         height: g.sensor.height as usize,
         duration_s: g.duration_of(Subset::Fit),
         kept_pixels: input.excluded.iter().filter(|&&e| !e).count(),
+        real: &real,
+        kept: &state.kept,
     });
     params.hot_pixel_fraction = Some(found.fraction.value);
     params.hot_pixel_rate_hz = found.rate.as_ref().map(|r| r.value);
@@ -141,8 +149,13 @@ fn hot_pixels(
     if let Some(rate) = found.rate {
         state.uncertainty.insert("hot_pixel_rate_hz".into(), rate);
     }
+    state.hot_detection = found.detection.clone();
+    let scope = found.detection.as_ref().map(|d| d.detectable_above_hz).map_or(
+        "the search's detection probability not measurable: pixels too weak to stand out from their neighbours are not counted".to_string(),
+        |r| format!("each counted 1 / its detection probability at a random kept pixel (Horvitz-Thompson, at least 1/2), so hot pixels at {r:.1} Hz or faster (the rate the search names at half the kept pixels) are counted in full and a slower one as 2 p(r) of one (hot_pixel_detection.probability): slower hot pixels are not determinable on this recording"),
+    );
     format!(
-        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms; masked and simulated at their own rates), {} of them in excess of the {} count outliers the final model (mismatch, noise) makes by itself on the same blocks; hot_pixel_fraction and hot_pixel_rate_hz describe those {} (fraction interval: Poisson spread of both counts, Garwood's exact interval when the model makes none; pixels too weak to stand out from their neighbours are not counted)",
+        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms; masked and simulated at their own rates), {} of them in excess of the {} count outliers the final model (mismatch, noise) makes by itself on the same blocks; hot_pixel_fraction and hot_pixel_rate_hz describe those {} (fraction interval: Poisson spread of both counts, Garwood's exact interval when the model makes none), {scope}",
         state.hot.len(),
         found.hot.len(),
         found.model_outliers,
@@ -261,6 +274,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         steps,
         ambiguities,
         hot_pixels_masked: state.hot,
+        hot_pixel_detection: state.hot_detection,
         residuals_before: Some(residuals_before),
         residuals_after: Some(residuals_after),
         events_only: None,

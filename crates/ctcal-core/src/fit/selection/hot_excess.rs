@@ -16,11 +16,20 @@
 //! its upper end at least Garwood's 3.69 for a count of none), or is Garwood's exact
 //! Poisson interval of `n` when the model makes none. The pixels stay
 //! masked and simulated as named either way (they are outliers to the model too).
+//!
+//! A slow hot pixel on a busy scene is not named at all. The search's detection
+//! probability at a random kept pixel, `pi(rate)` ([`Detectability`], from the recording's
+//! own counts), turns the count into a fraction: each reported pixel counts `1 / pi` at its
+//! excess rate over its neighbours' median (Horvitz & Thompson, JASA 1952), with `pi`
+//! floored at 1/2, and the count's interval is scaled by the mean weight. Hot pixels at or
+//! above the rate named at half the pixels ([`HotExcess::detection`]) are counted in full
+//! (a count of none bounds them: Garwood's 3.69 over half the pixels), a slower one as
+//! `2 pi` of one: slower hot pixels are not determinable.
 
 use crate::estimate::interval::z95;
-use crate::fit::Uncertain;
+use crate::fit::{HotPixelDetection, Uncertain};
 use crate::stats::binomial::{median_interval95, poisson95};
-use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
+use crate::stats::hot_pixels::{Detectability, HotPixel, find_hot_pixels};
 
 /// The hot pixels a fit reports.
 #[derive(Clone, Debug, PartialEq)]
@@ -33,6 +42,8 @@ pub struct HotExcess {
     pub fraction: Uncertain,
     /// The median rate of the reported pixels, with its interval (`None`: none reported).
     pub rate: Option<Uncertain>,
+    /// Which hot pixels the search sees (`None`: not measurable).
+    pub detection: Option<HotPixelDetection>,
 }
 
 /// The per-pixel counts of the recording and of the final model, over the same blocks.
@@ -44,6 +55,10 @@ pub struct Counts<'a> {
     pub height: usize,
     pub duration_s: f64,
     pub kept_pixels: usize,
+    /// The recording's per-pixel counts over the same blocks (0 outside the kept pixels),
+    /// and which pixels are kept: where a hot pixel could be.
+    pub real: &'a [u32],
+    pub kept: &'a [bool],
 }
 
 /// The recording's named pixels in excess of the model's own outliers.
@@ -70,16 +85,68 @@ pub fn excess(c: &Counts) -> HotExcess {
     let mut hot = c.real_named.to_vec();
     hot.sort_by(|a, b| b.z.total_cmp(&a.z));
     hot.truncate(k);
+    let detectability = Detectability::new(c.real, c.kept, c.width, c.height, c.duration_s);
+    let detectable_above_hz = detectability.as_ref().and_then(|d| d.rate_at(0.5));
+    let weight = mean_weight(&hot, c, detectability.as_ref(), detectable_above_hz);
     HotExcess {
         rate: median_rate(&hot),
         fraction: Uncertain::with_interval(
-            k as f64 / pixels,
+            weight * k as f64 / pixels,
             None,
-            [Some(lo / pixels), Some((hi / pixels).min(1.0))],
+            [
+                Some(weight * lo / pixels),
+                Some((weight * hi / pixels).min(1.0)),
+            ],
         ),
         hot,
         model_outliers: m,
+        detection: detectability
+            .as_ref()
+            .zip(detectable_above_hz)
+            .map(|(d, half)| {
+                let curve = HotPixelDetection::RATES_HZ
+                    .iter()
+                    .map(|&r| [r, d.probability(r)])
+                    .collect();
+                HotPixelDetection::new(half, curve)
+            }),
     }
+}
+
+/// The mean Horvitz-Thompson weight `1 / max(pi, 1/2)` of the reported pixels, each at its
+/// excess rate over the median of its 8 neighbours; with none reported, the weight a pixel
+/// at the half-detection rate has (2), so that a count of none bounds the pixels hot at
+/// that rate or faster; 1 where the detectability is not measurable.
+fn mean_weight(
+    hot: &[HotPixel],
+    c: &Counts,
+    detectability: Option<&Detectability>,
+    half: Option<f64>,
+) -> f64 {
+    let Some(d) = detectability else {
+        return 1.0;
+    };
+    if hot.is_empty() {
+        return if half.is_some() { 2.0 } else { 1.0 };
+    }
+    let weights: f64 = hot
+        .iter()
+        .map(|h| 1.0 / d.probability(excess_rate(h, c)).max(0.5))
+        .sum();
+    weights / hot.len() as f64
+}
+
+/// A named pixel's rate beyond the scene's there: its count less the median of its 8
+/// neighbours' (the scene's count at the pixel, as far as the neighbours tell), per second.
+fn excess_rate(h: &HotPixel, c: &Counts) -> f64 {
+    let (x, y) = (h.x as usize, h.y as usize);
+    let around: Vec<f64> = (y.saturating_sub(1)..(y + 2).min(c.height))
+        .flat_map(|ny| (x.saturating_sub(1)..(x + 2).min(c.width)).map(move |nx| (nx, ny)))
+        .filter(|&p| p != (x, y))
+        .map(|(nx, ny)| c.real[ny * c.width + nx] as f64)
+        .collect();
+    let scene = crate::stats::robust::median(&around).unwrap_or(0.0);
+    (h.events as f64 - scene).max(0.0) / c.duration_s.max(1e-9)
 }
 
 /// The median rate of `hot` with the order-statistic interval of a median, or under six
@@ -125,7 +192,9 @@ mod tests {
         m
     }
 
-    fn counts<'a>(named: &'a [HotPixel], model: &'a [u32]) -> Counts<'a> {
+    const KEPT: [bool; 800] = [true; 800];
+
+    fn counts<'a>(named: &'a [HotPixel], model: &'a [u32], real: &'a [u32]) -> Counts<'a> {
         Counts {
             real_named: named,
             model,
@@ -133,6 +202,8 @@ mod tests {
             height: 20,
             duration_s: 10.0,
             kept_pixels: 800,
+            real,
+            kept: &KEPT,
         }
     }
 
@@ -143,21 +214,54 @@ mod tests {
             pixel(9, 80.0, 40.0),
             pixel(15, 60.0, 40.0),
         ];
+        let real = map(&[3, 9, 15]);
         // the model makes three outliers of its own elsewhere: nothing in excess
         let model = map(&[21, 27, 33]);
-        let e = excess(&counts(&named, &model));
+        let e = excess(&counts(&named, &model, &real));
         assert_eq!((e.model_outliers, e.hot.len()), (3, 0));
         assert_eq!(e.fraction.value, 0.0);
         let [lo, hi] = e.fraction.ci95.unwrap();
-        // 0 - 3 +- 1.96 sqrt(6): the interval reaches 4.8 pixels
+        // 0 - 3 +- 1.96 sqrt(6): the interval reaches 4.8 pixels, of those hot enough to
+        // be named at half the pixels or more: twice that
         assert_eq!(lo, Some(0.0));
-        assert!((hi.unwrap() * 800.0 - z95() * 6f64.sqrt()).abs() < 1e-9);
+        assert!((hi.unwrap() * 800.0 - 2.0 * z95() * 6f64.sqrt()).abs() < 1e-9);
         // one named against five of the model's: -4 + 4.8 is under what none leaves open
         let model = map(&[21, 25, 29, 33, 37]);
-        let e = excess(&counts(&named[..1], &model));
+        let e = excess(&counts(&named[..1], &model, &real));
         assert_eq!(e.model_outliers, 5);
-        assert!((e.fraction.ci95.unwrap()[1].unwrap() * 800.0 - 3.6889).abs() < 1e-3);
+        assert!((e.fraction.ci95.unwrap()[1].unwrap() * 800.0 - 2.0 * 3.6889).abs() < 1e-3);
         assert!(e.rate.is_none());
+        // the scene's 20 events over 10 s: named from 66, 46 more, by half the pixels of
+        // the 773 away from an outlier: P(Poisson(10 r) >= 46) = (400 - 3) / 773
+        let half = e.detection.unwrap().detectable_above_hz;
+        assert!((4.3..4.7).contains(&half), "{half}");
+    }
+
+    /// A slow hot pixel is named at few of the pixels a fast one is: it counts for more of
+    /// its kind (at most twice, the weight at the half-detection rate).
+    #[test]
+    fn a_slow_named_pixel_stands_for_more_than_itself() {
+        // 60 events over 10 s on a scene of 20: 4 Hz beyond the scene, named at under half
+        // the pixels (P(Poisson(40) >= 46) = 0.19), so it counts twice
+        let named = [HotPixel {
+            x: 3,
+            y: 5,
+            events: 60,
+            rate_hz: 6.0,
+            z: 12.0,
+        }];
+        let mut real = map(&[]);
+        real[5 * 40 + 3] = 60;
+        let model = map(&[]);
+        let e = excess(&counts(&named, &model, &real));
+        assert_eq!(e.hot.len(), 1);
+        assert!((e.fraction.value * 800.0 - 2.0).abs() < 1e-9);
+        // a fast one (38 Hz beyond the scene) is named anywhere but beside itself (its 8
+        // neighbours, 400 events away): it counts 800 / 792
+        let named = [pixel(3, 50.0, 40.0)];
+        let real = map(&[3]);
+        let e = excess(&counts(&named, &model, &real));
+        assert!((e.fraction.value * 800.0 - 800.0 / 792.0).abs() < 1e-6);
     }
 
     #[test]
@@ -165,13 +269,22 @@ mod tests {
         let named = [pixel(3, 50.0, 40.0), pixel(9, 80.0, 40.0)];
         // the model's trains at the named pixels are left out
         let model = map(&[3, 9]);
-        let e = excess(&counts(&named, &model));
+        let real = map(&[3, 9]);
+        let e = excess(&counts(&named, &model, &real));
         assert_eq!((e.model_outliers, e.hot.len()), (0, 2));
         assert_eq!(e.hot[0].x, 9, "highest z first");
         let [lo, hi] = e.fraction.ci95.unwrap();
-        // Garwood for 2 events: [0.242, 7.22]
-        assert!((lo.unwrap() * 800.0 - 0.2422).abs() < 1e-3, "{lo:?}");
-        assert!((hi.unwrap() * 800.0 - 7.2247).abs() < 1e-3, "{hi:?}");
+        // Garwood for 2 events: [0.242, 7.22], each weighing 800 / 784 (a hot pixel beside
+        // either of them, 16 pixels, would be hidden)
+        let weight = 800.0 / 784.0;
+        assert!(
+            (lo.unwrap() * 800.0 - 0.2422 * weight).abs() < 1e-3,
+            "{lo:?}"
+        );
+        assert!(
+            (hi.unwrap() * 800.0 - 7.2247 * weight).abs() < 1e-3,
+            "{hi:?}"
+        );
         assert_eq!(e.rate.unwrap().value, 40.0);
     }
 
@@ -183,7 +296,8 @@ mod tests {
             pixel(15, 60.0, 40.0),
         ];
         let model = map(&[30]);
-        let e = excess(&counts(&named, &model));
+        let real = map(&[3, 9, 15]);
+        let e = excess(&counts(&named, &model, &real));
         assert_eq!(e.model_outliers, 1);
         let kept: Vec<u16> = e.hot.iter().map(|h| h.x).collect();
         assert_eq!(kept, vec![9, 15]);

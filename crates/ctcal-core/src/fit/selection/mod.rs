@@ -60,6 +60,8 @@ pub(super) struct State {
     kept: Vec<bool>,
     /// Hot pixels named (and simulated as their own event trains).
     hot: Vec<HotPixel>,
+    /// Which hot pixels the hot-pixel search sees (set with the fraction).
+    hot_detection: Option<super::HotPixelDetection>,
     uncertainty: BTreeMap<String, Uncertain>,
     /// Parameters whose search ended at a bound of its range, and the bound.
     at_bound: BTreeMap<String, f64>,
@@ -143,6 +145,7 @@ pub fn fit(
         masked: no_mask,
         kept,
         hot: Vec::new(),
+        hot_detection: None,
         at_bound: BTreeMap::new(),
     };
     let known = Known {
