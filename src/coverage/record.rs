@@ -85,7 +85,8 @@ impl RunRecord {
         record
     }
 
-    /// Reads `reported` and `effects_added` from the full JSON, where it is kept.
+    /// Reads `reported`, `effects_added` and a fit's `hot_detection` from the full JSON,
+    /// where it is kept.
     fn read_output(&mut self) {
         if let Outcome::Ok {
             output: Some(output),

@@ -67,7 +67,9 @@ fn scored_truth(record: &RunRecord, truth: &Truth, parameter: &str) -> Option<f6
     let (Some(curve), "hot_pixel_fraction") = (&record.hot_detection, parameter) else {
         return Some(value);
     };
-    let rate = truth.value("hot_pixel_rate_hz").unwrap_or(0.0);
+    let Some(rate) = truth.value("hot_pixel_rate_hz") else {
+        return Some(value);
+    };
     Some(value * (2.0 * detected_share(curve, rate)).min(1.0))
 }
 

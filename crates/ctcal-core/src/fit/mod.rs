@@ -344,16 +344,17 @@ pub struct HotPixelDetection {
     /// them: hot pixels this fast or faster are counted in full.
     pub detectable_above_hz: f64,
     /// `[rate_hz, probability]`: the share of kept pixels at which a hot pixel of that rate
-    /// is named, at 1, 2, 5, ... 5000 Hz.
+    /// is named ([`HotPixelDetection::rates_hz`] and `detectable_above_hz`).
     pub probability: Vec<[f64; 2]>,
     pub meaning: &'static str,
 }
 
 impl HotPixelDetection {
-    /// The rates [`HotPixelDetection::probability`] is given at, Hz.
-    pub const RATES_HZ: [f64; 12] = [
-        1.0, 2.0, 5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0, 5000.0,
-    ];
+    /// The rates [`HotPixelDetection::probability`] is given at: eight a decade from 1 Hz
+    /// to 5.6 kHz.
+    pub fn rates_hz() -> Vec<f64> {
+        (0..30).map(|k| 10f64.powf(k as f64 / 8.0)).collect()
+    }
 
     pub fn new(detectable_above_hz: f64, probability: Vec<[f64; 2]>) -> Self {
         Self {

@@ -9,6 +9,9 @@
 //! neighbour's count. A pixel is hot when `z > Z_THRESHOLD` and it fired at least
 //! `MIN_EVENTS` events. Two hot pixels side by side hide each other; in real sensors that is
 //! rare. (Robust z-scores: Iglewicz & Hoaglin, "How to Detect and Handle Outliers", 1993.)
+//!
+//! [`Detectability`] says how likely the search is to name a hot pixel of a given rate on a
+//! given recording, so that the hot pixels it finds can stand for those it misses.
 
 use serde::Serialize;
 
@@ -31,17 +34,29 @@ pub struct HotPixel {
     pub z: f64,
 }
 
+/// The pixels (index `y * width + x`) of the 8-neighbourhood of (x, y) on the sensor.
+pub fn neighbours(width: usize, height: usize, x: usize, y: usize) -> impl Iterator<Item = usize> {
+    (y.saturating_sub(1)..(y + 2).min(height))
+        .flat_map(move |ny| (x.saturating_sub(1)..(x + 2).min(width)).map(move |nx| (nx, ny)))
+        .filter(move |&p| p != (x, y))
+        .map(move |(nx, ny)| ny * width + nx)
+}
+
 /// The largest count among the 8 neighbours of pixel (x, y).
 fn neighbour_max(counts: &[u32], width: usize, height: usize, x: usize, y: usize) -> f64 {
-    let mut max = 0;
-    for ny in y.saturating_sub(1)..(y + 2).min(height) {
-        for nx in x.saturating_sub(1)..(x + 2).min(width) {
-            if (nx, ny) != (x, y) {
-                max = max.max(counts[ny * width + nx]);
-            }
-        }
-    }
-    max as f64
+    neighbours(width, height, x, y)
+        .map(|p| counts[p])
+        .max()
+        .unwrap_or(0) as f64
+}
+
+/// The median count of the 8 neighbours of pixel (x, y): the scene's count there, as far
+/// as its neighbours tell.
+pub fn neighbour_median(counts: &[u32], width: usize, height: usize, x: usize, y: usize) -> f64 {
+    let around: Vec<f64> = neighbours(width, height, x, y)
+        .map(|p| counts[p] as f64)
+        .collect();
+    crate::stats::robust::median(&around).unwrap_or(0.0)
 }
 
 /// `1.4826 * MAD` of the residuals `c - m` over the active pixels (those that fired or
@@ -67,8 +82,9 @@ fn residual_scale(counts: &[u32], width: usize, height: usize) -> Option<f64> {
     Some(1.4826 * *mad)
 }
 
-/// The smallest count at which a pixel whose busiest neighbour fired `m` is named: at least
-/// [`MIN_EVENTS`] and `z > Z_THRESHOLD`, i.e. `c > m + Z * max(scale, sqrt(m + 1))`.
+/// The smallest count at which a pixel whose busiest neighbour fired `m` is named, the
+/// search's one rule: at least [`MIN_EVENTS`] and `z > Z_THRESHOLD`, i.e.
+/// `c > m + Z * max(scale, sqrt(m + 1))`.
 fn count_to_be_named(m: f64, scale: f64) -> u64 {
     let bound = m + Z_THRESHOLD * scale.max((m + 1.0).sqrt());
     (bound.floor() as u64 + 1).max(MIN_EVENTS as u64)
@@ -88,13 +104,12 @@ pub fn find_hot_pixels(
     for y in 0..height {
         for x in 0..width {
             let c = counts[y * width + x];
-            let m = neighbour_max(counts, width, height, x, y);
-            let r = c as f64 - m;
-            if c < MIN_EVENTS || r <= 0.0 {
+            if c < MIN_EVENTS {
                 continue;
             }
-            let z = r / scale.max((m + 1.0).sqrt());
-            if z > Z_THRESHOLD {
+            let m = neighbour_max(counts, width, height, x, y);
+            if (c as u64) >= count_to_be_named(m, scale) {
+                let z = (c as f64 - m) / scale.max((m + 1.0).sqrt());
                 hot.push(HotPixel {
                     x: x as u16,
                     y: y as u16,
@@ -126,6 +141,10 @@ pub fn find_hot_pixels(
 /// neighbour `m_p` (the neighbours and the robust scale are the recording's own; one hot
 /// pixel hardly moves either). Averaged over the kept pixels:
 /// `pi(rate) = mean_p P(Poisson(rate T) >= need_p - c_p)`.
+///
+/// `pi` is the z-test's chance alone: the fit's later filters (a pixel the model names too,
+/// one whose excess shows only while its neighbours fire, the model's own outliers) can
+/// only lower it, so it is an upper bound and the weights below a lower one.
 ///
 /// A slow hot pixel on a busy scene does not stand out: `pi` says which rates the search
 /// sees, so that a count of named pixels can be turned into a fraction (Horvitz-Thompson:

@@ -130,35 +130,11 @@ impl PairSource<'_> {
     /// Hands every usable pair to `sink`, in event order, without keeping them: memory is
     /// one stretch's readings and the previous reading of each pixel.
     pub fn for_each(&self, read: Read, mut sink: impl FnMut(Pair)) {
-        let (events, frames, shift) = (self.events, self.frames, self.shift);
+        let (events, frames) = (self.events, self.frames);
         let support = self
             .support_window_us
             .map(|w| supported(events, self.sensor, w));
         let width = self.sensor.width as usize;
-        let reading = |i: usize| -> Option<Reading> {
-            let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
-            if self.excluded[y as usize * width + x as usize] {
-                return None;
-            }
-            let dn = match frames.dn_at(x, y, t - shift) {
-                Some(dn) if support.as_ref().is_none_or(|s| s[i]) => dn,
-                _ => f32::NAN,
-            };
-            if read == Read::DnOnly {
-                return Some(Reading {
-                    dn,
-                    near: (dn, dn),
-                    weight: 0.0,
-                });
-            }
-            let near = if dn.is_finite() {
-                around(frames, x, y, t - shift).unwrap_or((dn, dn))
-            } else {
-                (dn, dn)
-            };
-            let weight = phase_weight(frames, t - shift);
-            Some(Reading { dn, near, weight })
-        };
         // the previous event of each pixel: its reading and time
         let unknown = Reading {
             dn: f32::NAN,
@@ -168,8 +144,11 @@ impl PairSource<'_> {
         let mut previous = vec![(unknown, 0 as TimeUs); self.sensor.pixels()];
         for first in (0..events.len()).step_by(READ_STRETCH) {
             let stretch = first..(first + READ_STRETCH).min(events.len());
-            let readings: Vec<Option<Reading>> =
-                stretch.clone().into_par_iter().map(reading).collect();
+            let readings: Vec<Option<Reading>> = stretch
+                .clone()
+                .into_par_iter()
+                .map(|i| self.reading(i, support.as_deref(), read))
+                .collect();
             for (i, reading) in stretch.zip(readings) {
                 let Some(now) = reading else { continue };
                 let (x, y, t) = (events.x[i], events.y[i], events.t[i]);
@@ -195,6 +174,39 @@ impl PairSource<'_> {
                 previous[pixel] = (now, t);
             }
         }
+    }
+
+    /// What the frames say at event `i` (`None` at an excluded pixel): its DN, NaN where
+    /// the frames do not know it or `support` says it is noise, and as much more as `read`
+    /// asks for.
+    fn reading(&self, i: usize, support: Option<&[bool]>, read: Read) -> Option<Reading> {
+        let (events, frames) = (self.events, self.frames);
+        let (x, y, t) = (events.x[i], events.y[i], events.t[i] - self.shift);
+        if self.excluded[y as usize * self.sensor.width as usize + x as usize] {
+            return None;
+        }
+        let dn = match frames.dn_at(x, y, t) {
+            Some(dn) if support.is_none_or(|s| s[i]) => dn,
+            _ => f32::NAN,
+        };
+        if read == Read::DnOnly || !dn.is_finite() {
+            let weight = if read == Read::DnOnly {
+                0.0
+            } else {
+                phase_weight(frames, t)
+            };
+            return Some(Reading {
+                dn,
+                near: (dn, dn),
+                weight,
+            });
+        }
+        let near = around(frames, x, y, t).unwrap_or((dn, dn));
+        Some(Reading {
+            dn,
+            near,
+            weight: phase_weight(frames, t),
+        })
     }
 }
 

@@ -29,7 +29,7 @@
 use crate::estimate::interval::z95;
 use crate::fit::{HotPixelDetection, Uncertain};
 use crate::stats::binomial::{median_interval95, poisson95};
-use crate::stats::hot_pixels::{Detectability, HotPixel, find_hot_pixels};
+use crate::stats::hot_pixels::{Detectability, HotPixel, find_hot_pixels, neighbour_median};
 
 /// The hot pixels a fit reports.
 #[derive(Clone, Debug, PartialEq)]
@@ -85,9 +85,15 @@ pub fn excess(c: &Counts) -> HotExcess {
     let mut hot = c.real_named.to_vec();
     hot.sort_by(|a, b| b.z.total_cmp(&a.z));
     hot.truncate(k);
-    let detectability = Detectability::new(c.real, c.kept, c.width, c.height, c.duration_s);
-    let detectable_above_hz = detectability.as_ref().and_then(|d| d.rate_at(0.5));
-    let weight = mean_weight(&hot, c, detectability.as_ref(), detectable_above_hz);
+    // the scene without the named pixels' own trains: each at its neighbours' median
+    let mut scene = c.real.to_vec();
+    for h in c.real_named {
+        let (x, y) = (h.x as usize, h.y as usize);
+        scene[y * c.width + x] = neighbour_median(c.real, c.width, c.height, x, y) as u32;
+    }
+    let detectability = Detectability::new(&scene, c.kept, c.width, c.height, c.duration_s)
+        .and_then(|d| Some((d.rate_at(0.5)?, d)));
+    let weight = mean_weight(&hot, c, detectability.as_ref().map(|(_, d)| d));
     HotExcess {
         rate: median_rate(&hot),
         fraction: Uncertain::with_interval(
@@ -100,34 +106,34 @@ pub fn excess(c: &Counts) -> HotExcess {
         ),
         hot,
         model_outliers: m,
-        detection: detectability
-            .as_ref()
-            .zip(detectable_above_hz)
-            .map(|(d, half)| {
-                let curve = HotPixelDetection::RATES_HZ
-                    .iter()
-                    .map(|&r| [r, d.probability(r)])
-                    .collect();
-                HotPixelDetection::new(half, curve)
-            }),
+        detection: detectability.map(|(half, d)| detection(half, &d)),
     }
 }
 
+/// What the search sees: the half-detection rate and `pi` on
+/// [`HotPixelDetection::rates_hz`] with the half-detection rate among them (the curve is
+/// steep there, and the coverage study reads it between its points).
+fn detection(half: f64, d: &Detectability) -> HotPixelDetection {
+    let mut rates = HotPixelDetection::rates_hz();
+    let at = rates.partition_point(|&r| r < half);
+    rates.insert(at, half);
+    let curve = rates.iter().map(|&r| [r, d.probability(r)]).collect();
+    HotPixelDetection::new(half, curve)
+}
+
 /// The mean Horvitz-Thompson weight `1 / max(pi, 1/2)` of the reported pixels, each at its
-/// excess rate over the median of its 8 neighbours; with none reported, the weight a pixel
-/// at the half-detection rate has (2), so that a count of none bounds the pixels hot at
-/// that rate or faster; 1 where the detectability is not measurable.
-fn mean_weight(
-    hot: &[HotPixel],
-    c: &Counts,
-    detectability: Option<&Detectability>,
-    half: Option<f64>,
-) -> f64 {
+/// excess rate over the median of its 8 neighbours. With none reported their rate is
+/// unknown: the weight is that of the slowest pixel counted in full (2), so that a count of
+/// none bounds the hot pixels at the half-detection rate or faster; with some reported, the
+/// bound is for pixels at their rates (one fast pixel found gives a lower upper end than
+/// none found: it says the hot pixels there are fast). 1 where the detectability is not
+/// measurable.
+fn mean_weight(hot: &[HotPixel], c: &Counts, detectability: Option<&Detectability>) -> f64 {
     let Some(d) = detectability else {
         return 1.0;
     };
     if hot.is_empty() {
-        return if half.is_some() { 2.0 } else { 1.0 };
+        return 2.0;
     }
     let weights: f64 = hot
         .iter()
@@ -136,16 +142,10 @@ fn mean_weight(
     weights / hot.len() as f64
 }
 
-/// A named pixel's rate beyond the scene's there: its count less the median of its 8
-/// neighbours' (the scene's count at the pixel, as far as the neighbours tell), per second.
+/// A named pixel's rate beyond the scene's there (its count less its neighbours' median),
+/// per second.
 fn excess_rate(h: &HotPixel, c: &Counts) -> f64 {
-    let (x, y) = (h.x as usize, h.y as usize);
-    let around: Vec<f64> = (y.saturating_sub(1)..(y + 2).min(c.height))
-        .flat_map(|ny| (x.saturating_sub(1)..(x + 2).min(c.width)).map(move |nx| (nx, ny)))
-        .filter(|&p| p != (x, y))
-        .map(|(nx, ny)| c.real[ny * c.width + nx] as f64)
-        .collect();
-    let scene = crate::stats::robust::median(&around).unwrap_or(0.0);
+    let scene = neighbour_median(c.real, c.width, c.height, h.x as usize, h.y as usize);
     (h.events as f64 - scene).max(0.0) / c.duration_s.max(1e-9)
 }
 
@@ -241,27 +241,35 @@ mod tests {
     /// its kind (at most twice, the weight at the half-detection rate).
     #[test]
     fn a_slow_named_pixel_stands_for_more_than_itself() {
-        // 60 events over 10 s on a scene of 20: 4 Hz beyond the scene, named at under half
-        // the pixels (P(Poisson(40) >= 46) = 0.19), so it counts twice
+        // a scene of 20 events a pixel over 10 s in rows 0-9 and 100 in rows 10-19: a train
+        // is named from 66 in the quiet half, from 201 in the busy one (100 + 10 sqrt(101))
+        let busy_half = |mut m: Vec<u32>| {
+            m[400..].fill(100);
+            m
+        };
+        // 70 events in the quiet half: z = 50 / sqrt(21) = 10.9, named; 5 Hz beyond the
+        // scene, named at (1 + 351 P(Poisson(50) >= 46)) / 800 = 0.33 of the pixels
         let named = [HotPixel {
             x: 3,
             y: 5,
-            events: 60,
-            rate_hz: 6.0,
-            z: 12.0,
+            events: 70,
+            rate_hz: 7.0,
+            z: 10.9,
         }];
-        let mut real = map(&[]);
-        real[5 * 40 + 3] = 60;
-        let model = map(&[]);
+        let mut real = busy_half(map(&[]));
+        real[5 * 40 + 3] = 70;
+        assert_eq!(find_hot_pixels(&real, 40, 20, 10.0).len(), 1);
+        let model = busy_half(map(&[]));
         let e = excess(&counts(&named, &model, &real));
         assert_eq!(e.hot.len(), 1);
         assert!((e.fraction.value * 800.0 - 2.0).abs() < 1e-9);
-        // a fast one (38 Hz beyond the scene) is named anywhere but beside itself (its 8
-        // neighbours, 400 events away): it counts 800 / 792
+        let model = map(&[]);
+        // a fast one (38 Hz beyond the scene) is named at every pixel once its own train
+        // is taken out of the scene (it hides no neighbour): it counts once
         let named = [pixel(3, 50.0, 40.0)];
         let real = map(&[3]);
         let e = excess(&counts(&named, &model, &real));
-        assert!((e.fraction.value * 800.0 - 800.0 / 792.0).abs() < 1e-6);
+        assert!((e.fraction.value * 800.0 - 1.0).abs() < 1e-9);
     }
 
     #[test]
@@ -274,9 +282,8 @@ mod tests {
         assert_eq!((e.model_outliers, e.hot.len()), (0, 2));
         assert_eq!(e.hot[0].x, 9, "highest z first");
         let [lo, hi] = e.fraction.ci95.unwrap();
-        // Garwood for 2 events: [0.242, 7.22], each weighing 800 / 784 (a hot pixel beside
-        // either of them, 16 pixels, would be hidden)
-        let weight = 800.0 / 784.0;
+        // Garwood for 2 events: [0.242, 7.22], each named anywhere at its 38 Hz
+        let weight = 1.0;
         assert!(
             (lo.unwrap() * 800.0 - 0.2422 * weight).abs() < 1e-3,
             "{lo:?}"
