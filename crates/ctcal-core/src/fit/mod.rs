@@ -356,6 +356,7 @@ impl HotPixelDetection {
         (0..30).map(|k| 10f64.powf(k as f64 / 8.0)).collect()
     }
 
+    /// The detection with its half-detection rate and its `[rate_hz, probability]` curve.
     pub fn new(detectable_above_hz: f64, probability: Vec<[f64; 2]>) -> Self {
         Self {
             detectable_above_hz,
