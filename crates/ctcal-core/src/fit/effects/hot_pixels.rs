@@ -129,16 +129,15 @@ pub fn independent_of_scene(
 }
 
 /// The pixels (y * W + x) of the 3 x 3 neighbourhood of `h` on the sensor, each with
-/// whether it is `h` itself.
+/// whether it is `h` itself ([`crate::stats::hot_pixels::neighbours`] and `h`).
 fn neighbourhood(
     h: &HotPixel,
     sensor: crate::events::Sensor,
 ) -> impl Iterator<Item = (usize, bool)> {
-    let (x, y, w) = (h.x as i64, h.y as i64, sensor.width as i64);
-    (-1..=1)
-        .flat_map(move |dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
-        .filter(move |&(nx, ny)| nx >= 0 && ny >= 0 && nx < w && ny < sensor.height as i64)
-        .map(move |(nx, ny)| ((ny * w + nx) as usize, (nx, ny) == (x, y)))
+    let (w, hgt) = (sensor.width as usize, sensor.height as usize);
+    let (x, y) = (h.x as usize, h.y as usize);
+    std::iter::once((y * w + x, true))
+        .chain(crate::stats::hot_pixels::neighbours(w, hgt, x, y).map(|p| (p, false)))
 }
 
 /// Seconds of `span` no neighbour event covers (within [`SCENE_WINDOW_US`]) and the own
