@@ -220,6 +220,7 @@ fn hot_pixels(input: &FitInput, blocks: &Blocks) -> (Vec<HotPixel>, Vec<HotTrain
         input.events,
         0..fit_to,
         input.sensor,
+        None,
     );
     let trains = hot
         .iter()

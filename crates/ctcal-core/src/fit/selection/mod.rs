@@ -37,7 +37,7 @@ use super::{
 };
 use crate::estimate::aps::{self, ApsInput};
 use crate::estimate::{Progress, dynamics, timestamp_grid};
-use crate::events::EventChunk;
+use crate::events::{EventChunk, TimeUs};
 use crate::sim::PixelParams;
 use crate::stats::hot_pixels::HotPixel;
 use std::cell::Cell;
@@ -164,6 +164,7 @@ pub fn fit(
         fixed,
         noise,
         fit_events: &run.events,
+        frames: &frames,
     };
     let (added, ambiguities) = choose_effects(
         &mut simulation,
@@ -291,6 +292,8 @@ struct LoopRun<'a> {
     fixed: bool,
     noise: f64,
     fit_events: &'a EventChunk,
+    /// The frames, for the named hot pixels' own brightness over time.
+    frames: &'a crate::estimate::frames::PreparedFrames,
 }
 
 fn planned(options: &FitOptions) -> Vec<Effect> {
@@ -366,7 +369,7 @@ fn run_loop(
         };
         tried.push(evidence.effect);
         let hot = (evidence.effect == Effect::HotPixels)
-            .then(|| hot_trains(&context, run.fit_events, simulation.events));
+            .then(|| hot_trains(&context, run, simulation.events));
         let step = steps::try_effect(simulation, state, &evidence, hot, run)?;
         if step.kept {
             added.push(AddedEffect {
@@ -402,26 +405,41 @@ fn next_effect(candidates: Vec<effects::Evidence>, forced: bool) -> Option<effec
 /// as independent of the scene on the events from the fit blocks' start to the judging
 /// blocks' end (`all`: the recording): a defect fires throughout, a low threshold under
 /// mismatch in bursts that a short fit run may not show the end of (coverage draw 59: ON
-/// at 540 Hz through the fit blocks, silent in the selection blocks).
+/// at 540 Hz through the fit blocks, silent in the selection blocks), and against their
+/// own brightness in the frames of that time.
 fn hot_trains(
     context: &Context,
-    fit_events: &EventChunk,
+    run: &LoopRun,
     all: &EventChunk,
 ) -> (Vec<HotPixel>, Vec<HotTrain>) {
-    let g = context.geometry;
+    let (g, fit_events, frames) = (context.geometry, run.fit_events, run.frames);
     let named = effects::hot_pixels::find(context);
+    let log_at = |x: u16, y: u16, t: TimeUs| frames.log_at(x, y, t);
     let (hot, _) = match (g.time_range_of(Subset::Fit), g.time_range_of(g.judging())) {
-        (Some((from, _)), Some((_, to))) => effects::hot_pixels::independent_of_scene(
-            &named,
-            all,
-            all.t.partition_point(|&t| t < from)..all.t.partition_point(|&t| t < to),
-            g.sensor,
-        ),
+        (Some((from, _)), Some((_, to))) => {
+            let intervals = frames
+                .times
+                .windows(2)
+                .map(|w| (w[0], w[1]))
+                .filter(|&(a, b)| a >= from && b <= to && frames.interval_of(a).is_some());
+            let scene = effects::hot_pixels::SceneTrace {
+                steps: effects::hot_pixels::SceneTrace::steps_of(intervals),
+                log_at: &log_at,
+            };
+            effects::hot_pixels::independent_of_scene(
+                &named,
+                all,
+                all.t.partition_point(|&t| t < from)..all.t.partition_point(|&t| t < to),
+                g.sensor,
+                Some(&scene),
+            )
+        }
         _ => effects::hot_pixels::independent_of_scene(
             &named,
             fit_events,
             0..fit_events.len(),
             g.sensor,
+            None,
         ),
     };
     let trains = hot

@@ -17,6 +17,12 @@ use crate::events::{EventChunk, TimeUs};
 use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
 use rand::{RngExt, SeedableRng};
 
+mod scene_trace;
+mod silence;
+
+pub use scene_trace::SceneTrace;
+use silence::silent_beyond_a_train;
+
 /// The recording's hot pixels (fit blocks) that the model does not have.
 pub fn find(c: &Context) -> Vec<HotPixel> {
     let g = c.geometry;
@@ -76,13 +82,17 @@ pub const SCENE_WINDOW_US: TimeUs = 30_000;
 /// it is kept. A pixel is also left out when it falls silent for longer than a train at
 /// its excess rate allows ([`silent_beyond_a_train`]; the rate at the lower end of the
 /// excess count, two Poisson standard deviations): a low threshold fires where its own
-/// brightness rises, which its neighbours' thresholds may not see. `range`: the events
-/// (of `events`) to judge by. Returns the kept pixels and the number left out.
+/// brightness rises, which its neighbours' thresholds may not see. Where the frames give
+/// the pixel's brightness (`scene`), a pixel whose counts its own brightness changes
+/// explain with no room for that train is left out too ([`SceneTrace::explains`]).
+/// `range`: the events (of `events`) to judge by. Returns the kept pixels and the number
+/// left out.
 pub fn independent_of_scene(
     hot: &[HotPixel],
     events: &EventChunk,
     range: std::ops::Range<usize>,
     sensor: crate::events::Sensor,
+    scene: Option<&SceneTrace>,
 ) -> (Vec<HotPixel>, usize) {
     if hot.is_empty() || range.is_empty() {
         return (hot.to_vec(), 0);
@@ -129,70 +139,15 @@ pub fn independent_of_scene(
         let train_hz = (excess - 2.0 * (own[k].len() as f64).sqrt()).max(0.0) / seconds;
         let predicted = excess_hz * uncovered;
         let fires_alone = predicted < 10.0 || unsupported as f64 >= 0.25 * predicted;
-        if fires_alone && !silent_beyond_a_train(&own[k], train_hz, &events.t[range.clone()]) {
+        if fires_alone
+            && !silent_beyond_a_train(&own[k], train_hz, &events.t[range.clone()])
+            && !scene.is_some_and(|s| s.explains(&own[k], h.x, h.y, train_hz))
+        {
             kept.push(h.clone());
         }
     }
     let left_out = hot.len() - kept.len();
     (kept, left_out)
-}
-
-/// The significance at which a pixel's longest silence rejects the train (about 40 pixels
-/// are tested in a fit: 0.001 each keeps the family's false rejections near 4 %).
-const SILENCE_SIGNIFICANCE: f64 = 1e-3;
-
-/// A stretch of this long without any event on the whole sensor is a pause of the
-/// recording (events not read, a stop), not a pixel's silence.
-const SENSOR_PAUSE_US: TimeUs = 10_000;
-
-/// Whether a pixel's own events (`own`, time-sorted) fall silent for longer than a Poisson
-/// train at `rate_hz` allows. The train's events are among the pixel's whatever the scene
-/// adds, so every silence of the pixel is a silence of the train. Over `T` seconds a train
-/// has on average `rate * T * exp(-rate * g)` gaps of `g` or longer, and its first and last
-/// events leave the span's ends open for `g` with probability `exp(-rate * g)` each, so a
-/// silence of `g` somewhere has probability at most `(2 + rate * T) * exp(-rate * g)`
-/// (Markov's inequality on the number of such gaps). Below [`SILENCE_SIGNIFICANCE`] the
-/// train is rejected. A low threshold under mismatch fires only while its brightness moves
-/// its way: bursts on rising edges, silence between them (coverage draw 59: ON bursts of
-/// 100-265 events in a frame interval and none in the next), a defective pixel at its rate
-/// throughout. `all`: every event of the sensor over the span judged (time-sorted); its
-/// pauses ([`SENSOR_PAUSE_US`]) count as neither silence nor time. The test assumes a
-/// constant rate: a blinking (random-telegraph) defect is not a train and is left to the
-/// scene too.
-fn silent_beyond_a_train(own: &[TimeUs], rate_hz: f64, all: &[TimeUs]) -> bool {
-    let (Some(&first), Some(&last)) = (all.first(), all.last()) else {
-        return false;
-    };
-    if rate_hz <= 0.0 {
-        return false;
-    }
-    let pauses: Vec<(TimeUs, TimeUs)> = all
-        .windows(2)
-        .filter(|w| w[1] - w[0] > SENSOR_PAUSE_US)
-        .map(|w| (w[0], w[1]))
-        .collect();
-    // the active time of [a, b): its length less the sensor's pauses inside it
-    let active = |a: TimeUs, b: TimeUs| -> TimeUs {
-        let paused: TimeUs = pauses[pauses.partition_point(|&(_, z)| z <= a)..]
-            .iter()
-            .take_while(|&&(p, _)| p < b)
-            .map(|&(p, z)| (z.min(b) - p.max(a)).max(0))
-            .sum();
-        b - a - paused
-    };
-    let span = (last + 1).max(first + 1);
-    let edges = std::iter::once(first)
-        .chain(own.iter().copied().filter(|t| (first..span).contains(t)))
-        .chain(std::iter::once(span))
-        .collect::<Vec<_>>();
-    let longest_us = edges
-        .windows(2)
-        .map(|w| active(w[0], w[1]))
-        .max()
-        .unwrap_or(0);
-    let seconds = active(first, span) as f64 * 1e-6;
-    let longest = longest_us as f64 * 1e-6;
-    (2.0 + rate_hz * seconds) * (-rate_hz * longest).exp() < SILENCE_SIGNIFICANCE
 }
 
 /// The pixels (y * W + x) of the 3 x 3 neighbourhood of `h` on the sensor, each with
@@ -318,51 +273,10 @@ mod tests {
             &chunk,
             0..chunk.len(),
             sensor,
+            None,
         );
         assert_eq!(left_out, 1);
         assert_eq!((kept[0].x, kept[0].y), (3, 3));
-    }
-
-    /// Coverage draw 59's pixel (206, 74): ON every 1.4-2.0 ms for 135 ms while its
-    /// brightness rises (a threshold near 0.01), then silent for 144 ms. A train at 196 Hz
-    /// (its excess's lower end) leaves a 144 ms silence with probability below
-    /// (2 + 196 * 0.279) * exp(-196 * 0.144) = 3e-11: rejected. Poisson trains at 196 Hz,
-    /// alone or with bursts of scene events, are not, over 200 draws (each is rejected with
-    /// probability below 0.001).
-    #[test]
-    fn a_pixel_silent_longer_than_its_train_allows_is_the_scene() {
-        let sensor: Vec<TimeUs> = (0..279_000).step_by(50).map(|t| t + 4_000).collect();
-        let bursts: Vec<TimeUs> = (0..90).map(|k| 5_000 + k * 1_500).collect();
-        assert!(silent_beyond_a_train(&bursts, 196.0, &sensor));
-        let mut rng = rng(3);
-        for draw in 0..200 {
-            let mut train = poisson_times(&mut rng, 196.0, 0.004, 0.283);
-            if draw % 2 == 1 {
-                train.extend(bursts.iter().copied());
-                train.sort_unstable();
-            }
-            assert!(
-                !silent_beyond_a_train(&train, 196.0, &sensor),
-                "draw {draw}"
-            );
-        }
-    }
-
-    /// A pause of the whole sensor (events not read between blocks) is neither silence nor
-    /// time: a train at 200 Hz whose events stop with the sensor's for 200 ms is kept, and
-    /// rejected once the sensor fires through the same 200 ms.
-    #[test]
-    fn a_pause_of_the_sensor_is_not_a_pixel_silence() {
-        let mut rng = rng(5);
-        let mut train = poisson_times(&mut rng, 200.0, 0.0, 0.2);
-        train.extend(poisson_times(&mut rng, 200.0, 0.4, 0.6));
-        let paused: Vec<TimeUs> = (0..600_000)
-            .step_by(100)
-            .filter(|t| !(200_000..400_000).contains(t))
-            .collect();
-        assert!(!silent_beyond_a_train(&train, 200.0, &paused));
-        let busy: Vec<TimeUs> = (0..600_000).step_by(100).collect();
-        assert!(silent_beyond_a_train(&train, 200.0, &busy));
     }
 
     #[test]
