@@ -32,7 +32,7 @@ impl SceneTrace<'_> {
     /// each ending a microsecond before the next interval begins.
     pub fn steps_of(intervals: impl Iterator<Item = (TimeUs, TimeUs)>) -> Vec<(TimeUs, TimeUs)> {
         let mut steps = Vec::new();
-        for (a, b) in intervals.filter(|&(a, b)| b - a >= STEPS_PER_INTERVAL as TimeUs + 1) {
+        for (a, b) in intervals.filter(|&(a, b)| b - a > STEPS_PER_INTERVAL as TimeUs) {
             let cut = |j: usize| a + (b - 1 - a) * j as TimeUs / STEPS_PER_INTERVAL as TimeUs;
             steps.extend((0..STEPS_PER_INTERVAL).map(|j| (cut(j), cut(j + 1))));
         }
