@@ -21,7 +21,7 @@ mod scene_trace;
 mod silence;
 
 pub use scene_trace::SceneTrace;
-use silence::silent_beyond_a_train;
+use silence::{SensorTime, silent_beyond_a_train};
 
 /// The recording's hot pixels (fit blocks) that the model does not have.
 pub fn find(c: &Context) -> Vec<HotPixel> {
@@ -125,6 +125,7 @@ pub fn independent_of_scene(
         }
     }
     let seconds = (span.1 - span.0) as f64 * 1e-6;
+    let sensor_time = SensorTime::of(&events.t[range.clone()]);
     let mut kept = Vec::new();
     for (k, h) in hot.iter().enumerate() {
         let (uncovered, unsupported) = uncovered_and_alone(&own[k], &neighbours[k], span);
@@ -140,7 +141,7 @@ pub fn independent_of_scene(
         let predicted = excess_hz * uncovered;
         let fires_alone = predicted < 10.0 || unsupported as f64 >= 0.25 * predicted;
         if fires_alone
-            && !silent_beyond_a_train(&own[k], train_hz, &events.t[range.clone()])
+            && !silent_beyond_a_train(&own[k], train_hz, &sensor_time)
             && !scene.is_some_and(|s| s.explains(&own[k], h.x, h.y, train_hz))
         {
             kept.push(h.clone());

@@ -13,6 +13,37 @@ const SILENCE_SIGNIFICANCE: f64 = 1e-3;
 /// recording (events not read, a stop), not a pixel's silence.
 const SENSOR_PAUSE_US: TimeUs = 10_000;
 
+/// The span judged and the sensor's pauses in it ([`SENSOR_PAUSE_US`]), read once from
+/// every event of the sensor over that span (`all`, time-sorted) for all named pixels.
+pub(super) struct SensorTime {
+    /// First event, and a microsecond past the last.
+    span: Option<(TimeUs, TimeUs)>,
+    pauses: Vec<(TimeUs, TimeUs)>,
+}
+
+impl SensorTime {
+    pub(super) fn of(all: &[TimeUs]) -> Self {
+        Self {
+            span: all.first().zip(all.last()).map(|(&a, &z)| (a, z + 1)),
+            pauses: all
+                .windows(2)
+                .filter(|w| w[1] - w[0] > SENSOR_PAUSE_US)
+                .map(|w| (w[0], w[1]))
+                .collect(),
+        }
+    }
+
+    /// The active time of [a, b): its length less the sensor's pauses inside it.
+    fn active(&self, a: TimeUs, b: TimeUs) -> TimeUs {
+        let paused: TimeUs = self.pauses[self.pauses.partition_point(|&(_, z)| z <= a)..]
+            .iter()
+            .take_while(|&&(p, _)| p < b)
+            .map(|&(p, z)| (z.min(b) - p.max(a)).max(0))
+            .sum();
+        b - a - paused
+    }
+}
+
 /// Whether a pixel's own events (`own`, time-sorted) fall silent for longer than a Poisson
 /// train at `rate_hz` allows. The train's events are among the pixel's whatever the scene
 /// adds, so every silence of the pixel is a silence of the train. Over `T` seconds a train
@@ -23,42 +54,27 @@ const SENSOR_PAUSE_US: TimeUs = 10_000;
 /// train is rejected. A low threshold under mismatch fires only while its brightness moves
 /// its way: bursts on rising edges, silence between them (coverage draw 59: ON bursts of
 /// 100-265 events in a frame interval and none in the next), a defective pixel at its rate
-/// throughout. `all`: every event of the sensor over the span judged (time-sorted); its
-/// pauses ([`SENSOR_PAUSE_US`]) count as neither silence nor time. The test assumes a
+/// throughout. `sensor`: the span judged, whose pauses ([`SENSOR_PAUSE_US`]) count as
+/// neither silence nor time. The test assumes a
 /// constant rate: a blinking (random-telegraph) defect is not a train and is left to the
 /// scene too.
-pub(super) fn silent_beyond_a_train(own: &[TimeUs], rate_hz: f64, all: &[TimeUs]) -> bool {
-    let (Some(&first), Some(&last)) = (all.first(), all.last()) else {
+pub(super) fn silent_beyond_a_train(own: &[TimeUs], rate_hz: f64, sensor: &SensorTime) -> bool {
+    let Some((first, end)) = sensor.span else {
         return false;
     };
     if rate_hz <= 0.0 {
         return false;
     }
-    let pauses: Vec<(TimeUs, TimeUs)> = all
-        .windows(2)
-        .filter(|w| w[1] - w[0] > SENSOR_PAUSE_US)
-        .map(|w| (w[0], w[1]))
-        .collect();
-    // the active time of [a, b): its length less the sensor's pauses inside it
-    let active = |a: TimeUs, b: TimeUs| -> TimeUs {
-        let paused: TimeUs = pauses[pauses.partition_point(|&(_, z)| z <= a)..]
-            .iter()
-            .take_while(|&&(p, _)| p < b)
-            .map(|&(p, z)| (z.min(b) - p.max(a)).max(0))
-            .sum();
-        b - a - paused
-    };
-    let span = (last + 1).max(first + 1);
     let edges = std::iter::once(first)
-        .chain(own.iter().copied().filter(|t| (first..span).contains(t)))
-        .chain(std::iter::once(span))
+        .chain(own.iter().copied().filter(|t| (first..end).contains(t)))
+        .chain(std::iter::once(end))
         .collect::<Vec<_>>();
     let longest_us = edges
         .windows(2)
-        .map(|w| active(w[0], w[1]))
+        .map(|w| sensor.active(w[0], w[1]))
         .max()
         .unwrap_or(0);
-    let seconds = active(first, span) as f64 * 1e-6;
+    let seconds = sensor.active(first, end) as f64 * 1e-6;
     let longest = longest_us as f64 * 1e-6;
     (2.0 + rate_hz * seconds) * (-rate_hz * longest).exp() < SILENCE_SIGNIFICANCE
 }
@@ -78,7 +94,11 @@ mod tests {
     fn a_pixel_silent_longer_than_its_train_allows_is_the_scene() {
         let sensor: Vec<TimeUs> = (0..279_000).step_by(50).map(|t| t + 4_000).collect();
         let bursts: Vec<TimeUs> = (0..90).map(|k| 5_000 + k * 1_500).collect();
-        assert!(silent_beyond_a_train(&bursts, 196.0, &sensor));
+        assert!(silent_beyond_a_train(
+            &bursts,
+            196.0,
+            &SensorTime::of(&sensor)
+        ));
         let mut rng = rng(3);
         for draw in 0..200 {
             let mut train = poisson_times(&mut rng, 196.0, 0.004, 0.283);
@@ -87,7 +107,7 @@ mod tests {
                 train.sort_unstable();
             }
             assert!(
-                !silent_beyond_a_train(&train, 196.0, &sensor),
+                !silent_beyond_a_train(&train, 196.0, &SensorTime::of(&sensor)),
                 "draw {draw}"
             );
         }
@@ -105,8 +125,12 @@ mod tests {
             .step_by(100)
             .filter(|t| !(200_000..400_000).contains(t))
             .collect();
-        assert!(!silent_beyond_a_train(&train, 200.0, &paused));
+        assert!(!silent_beyond_a_train(
+            &train,
+            200.0,
+            &SensorTime::of(&paused)
+        ));
         let busy: Vec<TimeUs> = (0..600_000).step_by(100).collect();
-        assert!(silent_beyond_a_train(&train, 200.0, &busy));
+        assert!(silent_beyond_a_train(&train, 200.0, &SensorTime::of(&busy)));
     }
 }
