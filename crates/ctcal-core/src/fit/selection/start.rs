@@ -127,7 +127,7 @@ pub fn thresholds(
             None => fallback(
                 format!(
                     "estimate aps on the fit run determined no thresholds: {}",
-                    e.why.values().cloned().collect::<Vec<_>>().join("; ")
+                    reasons_once(&e.why)
                 ),
                 "fitted to the counts from there".into(),
                 false,
@@ -139,6 +139,23 @@ pub fn thresholds(
             false,
         ),
     }
+}
+
+/// Each distinct reason once, after the quantities it is given for (`ct_on, ct_off: why`):
+/// aps usually gives one reason for every quantity.
+fn reasons_once(why: &BTreeMap<String, String>) -> String {
+    let mut grouped: Vec<(Vec<&str>, &str)> = Vec::new();
+    for (key, reason) in why {
+        match grouped.iter_mut().find(|(_, r)| *r == reason.as_str()) {
+            Some((keys, _)) => keys.push(key),
+            None => grouped.push((vec![key], reason)),
+        }
+    }
+    grouped
+        .iter()
+        .map(|(keys, reason)| format!("{}: {reason}", keys.join(", ")))
+        .collect::<Vec<_>>()
+        .join("; ")
 }
 
 fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
@@ -191,5 +208,21 @@ mod tests {
         assert_eq!(fit_end(&frames, 0.4), 1000 + 600);
         assert_eq!(fit_end(&frames, 0.0), TimeUs::MAX);
         assert_eq!(fit_end(&[], 0.3), TimeUs::MAX);
+    }
+
+    #[test]
+    fn a_reason_given_for_several_quantities_is_written_once_after_their_names() {
+        let why: BTreeMap<String, String> = [
+            ("ct_off", "no threshold reproduces the counts"),
+            ("ct_on", "no threshold reproduces the counts"),
+            ("ct_sigma", "no thresholds"),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+        assert_eq!(
+            reasons_once(&why),
+            "ct_off, ct_on: no threshold reproduces the counts; ct_sigma: no thresholds"
+        );
     }
 }
