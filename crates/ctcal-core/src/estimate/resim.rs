@@ -443,7 +443,10 @@ impl CostFunction for Mismatch<'_, '_> {
 }
 
 /// How far the re-simulation's thresholds may move from the start (the timing estimate)
-/// before the frames are taken not to explain the events.
+/// before the frames are taken not to explain the events. Wider is not better: on the 11
+/// coverage draws where this window finds no crossing, a factor 2.5 either side found
+/// thresholds on 5, and 6 of their 10 values missed the truth, by up to a factor 14
+/// (`benches/coverage/aps-window-2026-11-29`).
 const MAX_CHANGE: f64 = 0.6;
 
 /// Fits `Cp` and `Cn` from `start` (e.g. the timing estimate), with frozen mismatch
