@@ -338,7 +338,40 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
             ),
         );
     }
+    if let Some(reason) = hot_rate_unmeasured(&why, &state.uncertainty) {
+        why.insert(HOT_RATE.into(), reason);
+    }
     why
+}
+
+const HOT_FRACTION: &str = "hot_pixel_fraction";
+const HOT_RATE: &str = "hot_pixel_rate_hz";
+
+/// Why the hot pixels' rate is not a measurement, when the count of hot pixels is not
+/// determined (its interval spans more than [`UNMEASURED_SPAN`]) or reaches none: the named
+/// pixels may then be none of them hot, and their rate is that of pixels a low threshold of
+/// the scene can make as well (on the 38 hot-pixel coverage draws, 2 of the 5 fits that
+/// named a single pixel named a scene pixel, at 6 and 8 times the true rate:
+/// `benches/coverage/hot-lag-2026-11-29`).
+fn hot_rate_unmeasured(
+    why: &BTreeMap<String, String>,
+    uncertainty: &BTreeMap<String, Uncertain>,
+) -> Option<String> {
+    let rate = uncertainty.get(HOT_RATE)?;
+    let fraction = uncertainty.get(HOT_FRACTION)?;
+    let reaches_none = matches!(fraction.ci95, Some([Some(lo), _]) if lo <= 0.0);
+    if !why.contains_key(HOT_FRACTION) && !reaches_none {
+        return None;
+    }
+    Some(format!(
+        "the named pixels fire at {:.1} Hz, but the data do not determine whether any of them is hot (hot_pixel_fraction {}): a pixel with a low threshold under mismatch can fire as fast on the scene's changes, so this is not reported as the hot pixels' rate",
+        rate.value,
+        if reaches_none {
+            "reaches 0 at its 95 % lower end"
+        } else {
+            "is not determined"
+        }
+    ))
 }
 
 fn split_assumptions(simulation: &Simulation, options: &FitOptions) -> Vec<String> {
@@ -391,5 +424,43 @@ fn holdout(simulation: &Simulation, options: &FitOptions) -> Holdout {
         selection_seconds: g.duration_of(Subset::Selection),
         test_seconds: g.duration_of(Subset::Test),
         guard_seconds: g.guard_seconds,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn uncertain(value: f64, lo: f64, hi: f64) -> Uncertain {
+        Uncertain::with_interval(value, None, [Some(lo), Some(hi)])
+    }
+
+    /// Draw 59's single named pixel (a fraction spanning a factor 200) and draw 94's five
+    /// (a fraction reaching 0) leave the rate unmeasured; draw 62's 18 pixels do not.
+    #[test]
+    fn the_rate_of_hot_pixels_is_measured_only_where_their_count_is() {
+        let rate = uncertain(435.0, 337.0, 533.0);
+        let single = BTreeMap::from([
+            (HOT_FRACTION.to_string(), uncertain(3e-5, 7.5e-7, 1.6e-4)),
+            (HOT_RATE.to_string(), rate.clone()),
+        ]);
+        let spans = BTreeMap::from([(HOT_FRACTION.to_string(), "spans".to_string())]);
+        let why = hot_rate_unmeasured(&spans, &single).unwrap();
+        assert!(
+            why.contains("435.0 Hz") && why.contains("not determined"),
+            "{why}"
+        );
+        let reaching_none = BTreeMap::from([
+            (HOT_FRACTION.to_string(), uncertain(2.9e-4, 0.0, 1.1e-3)),
+            (HOT_RATE.to_string(), rate.clone()),
+        ]);
+        let why = hot_rate_unmeasured(&BTreeMap::new(), &reaching_none).unwrap();
+        assert!(why.contains("reaches 0"), "{why}");
+        let many = BTreeMap::from([
+            (HOT_FRACTION.to_string(), uncertain(4.6e-4, 2.8e-4, 7.3e-4)),
+            (HOT_RATE.to_string(), uncertain(83.0, 67.0, 93.0)),
+        ]);
+        assert_eq!(hot_rate_unmeasured(&BTreeMap::new(), &many), None);
+        assert_eq!(hot_rate_unmeasured(&spans, &BTreeMap::new()), None);
     }
 }
