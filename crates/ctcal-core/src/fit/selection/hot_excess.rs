@@ -95,7 +95,7 @@ pub fn excess(c: &Counts) -> HotExcess {
         .and_then(|d| Some((d.rate_at(0.5)?, d)));
     let weight = mean_weight(&hot, c, detectability.as_ref().map(|(_, d)| d));
     HotExcess {
-        rate: median_rate(&hot),
+        rate: median_rate(&hot, c),
         fraction: Uncertain::with_interval(
             weight * k as f64 / pixels,
             None,
@@ -149,21 +149,28 @@ fn excess_rate(h: &HotPixel, c: &Counts) -> f64 {
     (h.events as f64 - scene).max(0.0) / c.duration_s.max(1e-9)
 }
 
-/// The median rate of `hot` with the order-statistic interval of a median, or under six
-/// pixels the range of their rates widened by each rate's Poisson error
-/// (1.96 / sqrt(events)).
-fn median_rate(hot: &[HotPixel]) -> Option<Uncertain> {
-    let rates: Vec<f64> = hot.iter().map(|h| h.rate_hz).collect();
+/// The median train rate of `hot`: each pixel's rate beyond the scene's there
+/// ([`excess_rate`]), as the simulator adds a hot pixel's train on top of its normal events
+/// ([`crate::sim::effects::hot_pixels`]); a slow hot pixel on a busy scene would otherwise
+/// read high by its scene's rate. With the order-statistic interval of a median, or under
+/// six pixels the range of their rates widened by each count's Poisson error
+/// (1.96 sqrt(events) / seconds).
+fn median_rate(hot: &[HotPixel], c: &Counts) -> Option<Uncertain> {
+    let rates: Vec<f64> = hot.iter().map(|h| excess_rate(h, c)).collect();
     let rate = crate::stats::robust::median(&rates)?;
     let (lo, hi) = median_interval95(&rates).unwrap_or_else(|| {
-        let poisson = |h: &HotPixel, side: f64| {
-            h.rate_hz * (1.0 + side * z95() / (h.events.max(1) as f64).sqrt()).max(0.0)
+        let poisson = |(h, r): (&HotPixel, &f64), side: f64| {
+            (r + side * z95() * (h.events as f64).sqrt() / c.duration_s.max(1e-9)).max(0.0)
         };
         (
             hot.iter()
-                .map(|h| poisson(h, -1.0))
+                .zip(&rates)
+                .map(|p| poisson(p, -1.0))
                 .fold(f64::INFINITY, f64::min),
-            hot.iter().map(|h| poisson(h, 1.0)).fold(0.0, f64::max),
+            hot.iter()
+                .zip(&rates)
+                .map(|p| poisson(p, 1.0))
+                .fold(0.0, f64::max),
         )
     });
     Some(Uncertain::with_interval(rate, None, [Some(lo), Some(hi)]))
@@ -292,7 +299,13 @@ mod tests {
             (hi.unwrap() * 800.0 - 7.2247 * weight).abs() < 1e-3,
             "{hi:?}"
         );
-        assert_eq!(e.rate.unwrap().value, 40.0);
+        // the train beyond the scene's 20 events (2 Hz) at each: 400 - 20 events over 10 s;
+        // each count's Poisson error, 1.96 sqrt(400) / 10, either side
+        let rate = e.rate.unwrap();
+        assert_eq!(rate.value, 38.0);
+        let [lo, hi] = rate.ci95.unwrap();
+        assert!((lo.unwrap() - (38.0 - 3.92)).abs() < 1e-3, "{lo:?}");
+        assert!((hi.unwrap() - (38.0 + 3.92)).abs() < 1e-3, "{hi:?}");
     }
 
     #[test]
