@@ -36,7 +36,7 @@ use super::observe::Role;
 use super::{FitError, FitInput, FitOptions, FitResult, Uncertain};
 use crate::estimate::eppps::{EpppsInput, EpppsOptions};
 use crate::estimate::{CtEstimate, Interval, Progress};
-use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
+use crate::stats::hot_pixels::{HotPixel, find_hot_pixels, neighbour_median};
 use crate::stats::robust::sample_std_dev;
 use blocks::Blocks;
 use measure::{BlockMeasure, Measuring};
@@ -231,6 +231,7 @@ fn hot_pixels(input: &FitInput, blocks: &Blocks) -> (Vec<HotPixel>, Vec<HotTrain
                 y: p.y,
                 rate_hz: counts[k] as f64 / seconds,
                 on_share: on[k] as f64 / counts[k].max(1) as f64,
+                scene_hz: neighbour_median(&counts, w, h, p.x as usize, p.y as usize) / seconds,
             }
         })
         .collect();

@@ -85,8 +85,13 @@ pub(super) fn result(parts: Parts) -> FitResult {
     if !hot.is_empty() {
         let pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
         params.hot_pixel_fraction = Some(hot.len() as f64 / pixels as f64);
-        params.hot_pixel_rate_hz =
-            median(&run.trains.iter().map(|t| t.rate_hz).collect::<Vec<_>>());
+        // the train a simulator adds on top of the pixel's own events
+        params.hot_pixel_rate_hz = median(
+            &run.trains
+                .iter()
+                .map(|t| (t.rate_hz - t.scene_hz).max(0.0))
+                .collect::<Vec<_>>(),
+        );
     }
     let TestErrors {
         before,
