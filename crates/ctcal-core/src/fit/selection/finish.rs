@@ -155,7 +155,7 @@ fn hot_pixels(
         |r| format!("each counted 1 / its detection probability at a random kept pixel (Horvitz-Thompson, at least 1/2), so hot pixels at {r:.1} Hz or faster (the rate the search names at half the kept pixels) are counted in full and a slower one as 2 p(r) of one (hot_pixel_detection.probability): slower hot pixels are not determinable on this recording"),
     );
     format!(
-        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms; masked and simulated at their own rates), {} of them in excess of the {} count outliers the final model (mismatch, noise) makes by itself on the same blocks; hot_pixel_fraction and hot_pixel_rate_hz describe those {} (fraction interval: Poisson spread of both counts, Garwood's exact interval when the model makes none), {scope}",
+        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms; masked and simulated at their own rates), {} of them in excess of the {} count outliers the final model (mismatch, noise) makes by itself on the same blocks; hot_pixel_fraction and hot_pixel_rate_hz describe those {} (fraction interval: Poisson spread of both counts, Garwood's exact interval when the model makes none; rate: the median of their rates beyond their 8 neighbours' median, its interval reaching down to the rate the search names at 10 % of the kept pixels where it names that median at under 90 %: the named are then the upper tail of a slower kind), {scope}",
         state.hot.len(),
         found.hot.len(),
         found.model_outliers,
