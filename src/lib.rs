@@ -36,8 +36,8 @@
 
 pub use ctcal_core::*;
 pub use ctcal_io as io;
-pub use ctcal_io::window;
 pub use ctcal_io::{Format, InputError, OpenOptions, Recording};
+pub use ctcal_io::{fit_region, window};
 
 /// The report ([`ctcal_report`]) with its pipeline ([`ctcal_pipeline`]) under the path they
 /// had in one crate, `ctcal::report::pipeline`.

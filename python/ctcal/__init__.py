@@ -162,6 +162,7 @@ def fit(
     start: Optional[float] = None,
     end: Optional[float] = None,
     max_frames: int = 120,
+    max_pixels: int = 346 * 260,
     seed: int = 2020,
     roi: Optional[str] = None,
     mask: Optional[PathLike] = None,
@@ -169,13 +170,15 @@ def fit(
     sensor: Optional[str] = None,
 ) -> Dict[str, Any]:
     """``ctcal fit PATH --json -`` with the command's defaults: every simulator parameter
-    fitted, the effects the residuals call for added."""
+    fitted, the effects the residuals call for added. A sensor with more than ``max_pixels``
+    pixels is fitted on its busiest region of that size (0: the whole sensor)."""
     return json.loads(
         _ctcal.fit(
             _path(path),
             start,
             end,
             max_frames,
+            max_pixels,
             seed,
             roi,
             None if mask is None else _path(mask),
@@ -231,7 +234,7 @@ _Input = Tuple[str, str, Optional[str], str]
 
 
 def _report_options(opts: Mapping[str, Any], fit: bool) -> str:
-    known = {"start", "end", "max_frames", "seed", "screen", "roi", "mask", "force"}
+    known = {"start", "end", "max_frames", "max_pixels", "seed", "screen", "roi", "mask", "force"}
     unknown = set(opts) - known
     if unknown:
         raise CtcalError(
@@ -262,7 +265,7 @@ def report(
     folders of them; ``datasets`` names more: ``{name: folder}``), returned as the dict of
     its ``results.json``.
 
-    Options as the command's: ``start``, ``end``, ``max_frames``, ``seed``, ``screen`` (a
+    Options as the command's: ``start``, ``end``, ``max_frames``, ``max_pixels``, ``seed``, ``screen`` (a
     screen model TOML), ``roi``, ``mask``, ``force``; ``fit=False`` leaves the fit out.
 
     ``client``: a ``dask.distributed.Client``; each recording is then one task on its workers

@@ -57,6 +57,7 @@ def fit(
     start: Optional[float] = ...,
     end: Optional[float] = ...,
     max_frames: int = ...,
+    max_pixels: int = ...,
     seed: int = ...,
     roi: Optional[str] = ...,
     mask: Optional[PathLike] = ...,

@@ -340,7 +340,7 @@ fn estimate(
 
 /// `ctcal fit` of `path` with the default options, as JSON.
 #[pyfunction]
-#[pyo3(signature = (path, start=None, end=None, max_frames=120, seed=2020, roi=None, mask=None, format=None, sensor=None))]
+#[pyo3(signature = (path, start=None, end=None, max_frames=120, max_pixels=ctcal_io::fit_region::FIT_PIXELS, seed=2020, roi=None, mask=None, format=None, sensor=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -348,6 +348,7 @@ fn fit(
     start: Option<f64>,
     end: Option<f64>,
     max_frames: usize,
+    max_pixels: usize,
     seed: u64,
     roi: Option<&str>,
     mask: Option<PathBuf>,
@@ -358,30 +359,22 @@ fn fit(
     let result = py
         .detach(|| -> Result<_, String> {
             let loaded = load(&path, &open, start, end, max_frames, true, roi, mask)?;
-            let mut f = ctcal_core::fit::fit(
-                &ctcal_core::fit::FitInput {
-                    sensor: loaded.sensor,
-                    events: &loaded.events,
-                    frames: &loaded.frames,
-                    excluded: &loaded.excluded,
-                    unread: &loaded.unread,
-                },
+            ctcal_io::fit_region::fit(
+                &loaded,
                 &ctcal_core::fit::FitOptions {
                     seed,
                     ..Default::default()
                 },
+                max_pixels,
                 &|_: &str, _: f64| {},
             )
-            .map_err(|e| format!("{}: {e}", path.display()))?;
-            f.assumptions.extend(loaded.notes.iter().cloned());
-            f.biases = loaded.recording.biases();
-            Ok(f)
+            .map_err(|e| format!("{}: {e}", path.display()))
         })
         .map_err(err)?;
     json(&result)
 }
 
-/// The pipeline's options from the skin's JSON (`start`, `end`, `max_frames`, `seed`,
+/// The pipeline's options from the skin's JSON (`start`, `end`, `max_frames`, `max_pixels`, `seed`,
 /// `fit`, `screen` (a TOML file), `roi`, `mask`, `force`).
 fn report_options(text: &str) -> PyResult<Options> {
     let v: serde_json::Value = serde_json::from_str(text).map_err(err)?;
@@ -392,6 +385,9 @@ fn report_options(text: &str) -> PyResult<Options> {
     };
     if let Some(n) = v["max_frames"].as_u64() {
         o.max_frames = n as usize;
+    }
+    if let Some(n) = v["max_pixels"].as_u64() {
+        o.fit_max_pixels = n as usize;
     }
     if let Some(s) = v["seed"].as_u64() {
         o.seed = s;

@@ -142,6 +142,10 @@ def test_estimate_equals_the_command(method: str) -> None:
 def test_fit_equals_the_command() -> None:
     path = REAL / "ijrr_slider_depth_50k"
     assert ctcal.fit(path) == cli("fit", str(path))
+    # a pixel limit under the DAVIS240C's 43,200 pixels: fitted on a region, as the command
+    small = ctcal.fit(path, max_pixels=20000)
+    assert small == cli("fit", str(path), "--max-pixels", "20000")
+    assert any(a.startswith("fitted on the region") for a in small["assumptions"])
 
 
 def test_errors_carry_the_commands_message() -> None:

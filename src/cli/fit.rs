@@ -6,7 +6,7 @@ use super::{BadInput, Global, JsonTarget, emit_json, output, warn};
 use clap::Args;
 use ctcal::estimate::aps::ApsOptions;
 use ctcal::fit::effects::Effect;
-use ctcal::fit::{EffectChoice, FitInput, FitOptions, FitResult};
+use ctcal::fit::{EffectChoice, FitOptions, FitResult};
 
 #[derive(Args, Debug)]
 pub struct FitArgs {
@@ -28,6 +28,12 @@ pub struct FitArgs {
     /// has the most events (only their frames and events are read).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
+    /// Simulate at most this many pixels (0: the whole sensor). A larger sensor is fitted on
+    /// the rectangle of this many pixels, of its aspect, where its events are densest (named
+    /// in `assumptions`): thresholds and noise are per-pixel, and the fit re-simulates the
+    /// frames hundreds of times.
+    #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_PIXELS)]
+    pub max_pixels: usize,
     /// Exposure time of the frames, where the file does not say.
     #[arg(long, value_name = "S")]
     pub exposure_s: Option<f64>,
@@ -201,24 +207,12 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
         seed: args.seed,
         ..FitOptions::default()
     };
-    let result = ctcal::fit::fit(
-        &FitInput {
-            sensor: loaded.sensor,
-            events: &loaded.events,
-            frames: &loaded.frames,
-            excluded: &loaded.excluded,
-            unread: &loaded.unread,
-        },
-        &options,
-        &progress,
-    );
+    let result = ctcal::fit_region::fit(&loaded, &options, args.max_pixels, &progress);
     spinner.finish_and_clear();
     let mut result = result.map_err(|e| estimate_failed(&path, &e))?;
-    result.assumptions.extend(loaded.notes.iter().cloned());
     if on_screen {
         result.assumptions.push(ON_SCREEN.into());
     }
-    result.biases = loaded.recording.biases();
     let target = common.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
         emit_json(&result, target, &policy)?;

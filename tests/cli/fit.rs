@@ -189,6 +189,61 @@ fn exactly_the_injected_hot_pixels_are_masked() {
     assert!(param(&f, "hot_pixel_fraction").unwrap() > 0.0);
 }
 
+/// A sensor larger than `--max-pixels` is fitted on its busiest region (`dev_hot_pixels`,
+/// 240x180, at most 12,000 pixels: a 126x94 rectangle): the region is named, the hot pixels
+/// inside it are found at their sensor coordinates and none outside it, and the thresholds'
+/// intervals still hold the truth (0.35 / 0.35).
+#[test]
+fn a_sensor_larger_than_the_pixel_limit_is_fitted_on_its_busiest_region() {
+    let f = fit(&oracle("dev_hot_pixels"), &["--max-pixels", "12000"]);
+    check_contract(&f);
+    let note = f["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|a| a.as_str())
+        .find(|a| a.starts_with("fitted on the region"))
+        .expect("the region is named in the assumptions");
+    // "fitted on the region x X0..X1, y Y0..Y1 of ..."
+    let numbers: Vec<u64> = note
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|s| !s.is_empty())
+        .take(4)
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let [x0, x1, y0, y1] = numbers[..] else {
+        panic!("{note}")
+    };
+    assert!(
+        (x1 - x0) * (y1 - y0) <= 12_000 && x1 - x0 == 126 && y1 - y0 == 94,
+        "{note}"
+    );
+    let inside = |x: u64, y: u64| (x0..x1).contains(&x) && (y0..y1).contains(&y);
+    let mut masked: Vec<(u64, u64)> = f["hot_pixels_masked"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+        .collect();
+    let mut injected_inside: Vec<(u64, u64)> =
+        oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
+            .filter(|&(x, y)| inside(x, y))
+            .collect();
+    masked.sort_unstable();
+    injected_inside.sort_unstable();
+    assert!(!injected_inside.is_empty(), "{note}");
+    assert_eq!(masked, injected_inside);
+    for key in ["ct_on", "ct_off"] {
+        let ci = f["uncertainties"][key]["ci95"].as_array().unwrap();
+        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        assert!(lo < 0.35 && 0.35 < hi, "{key} [{lo}, {hi}]");
+    }
+}
+
 /// v2e's refractory period of 5 ms on a two-level checkerboard (the events held back, not
 /// dropped). The distance barely moves with it on the short selection run; its signature
 /// (no same-pixel interval under the period, replicated on the selection blocks and gone

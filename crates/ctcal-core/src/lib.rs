@@ -17,6 +17,7 @@ pub mod files;
 pub mod fit;
 pub mod format;
 pub mod hint;
+pub mod region;
 pub mod selection;
 pub mod sensors;
 

@@ -157,6 +157,19 @@ impl PixelSelection {
         self.sensor
     }
 
+    /// A selection of `sensor` keeping `keep` (row-major), with what this one applied and
+    /// `part` ([`crate::region`] cuts one to a region).
+    pub(crate) fn cut(&self, sensor: Sensor, keep: Vec<bool>, part: String) -> Self {
+        debug_assert_eq!(keep.len(), sensor.pixels());
+        let mut parts = self.parts.clone();
+        parts.push(part);
+        Self {
+            sensor,
+            keep,
+            parts,
+        }
+    }
+
     /// Whether pixel (x, y) is kept.
     #[inline]
     pub fn keeps(&self, x: u16, y: u16) -> bool {

@@ -25,6 +25,7 @@ mod detect;
 pub mod error;
 pub mod evt2;
 pub mod evt3;
+pub mod fit_region;
 pub mod frame_blocks;
 pub mod frame_list;
 pub mod h5;

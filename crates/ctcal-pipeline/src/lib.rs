@@ -22,7 +22,7 @@ pub mod sequence;
 // the core modules, the window loader and the report's modules by the paths they had when
 // this was a module of the report (`crate::sim`, `crate::model`, ...)
 use ctcal_core::{biases, estimate, files, fit, hint, sim, stats};
-use ctcal_io::window;
+use ctcal_io::{fit_region, window};
 use ctcal_report::{OutputFile, configs, grouping, model, presets};
 
 use crate::sim::{DisplayParams, SimError};
@@ -50,6 +50,9 @@ pub struct Options {
     pub seed: u64,
     /// `None`: fit every recording; else leave the fit out, with this reason in the report.
     pub fit_left_out: Option<String>,
+    /// The fit simulates at most this many pixels: a larger sensor is fitted on its
+    /// busiest region of that size (`ctcal_io::fit_region`; 0: the whole sensor).
+    pub fit_max_pixels: usize,
     /// The pixels to analyse.
     pub selection: SelectionSpec,
     /// Run work beyond the memory budgets.
@@ -65,6 +68,7 @@ impl Default for Options {
             screen: None,
             seed: ctcal_core::DEFAULT_SEED,
             fit_left_out: None,
+            fit_max_pixels: fit_region::FIT_PIXELS,
             selection: SelectionSpec::default(),
             force: false,
         }

@@ -5,7 +5,7 @@
 use super::inputs::Input;
 use super::{Event, Observer, Options, SequenceError, Stage};
 use crate::estimate::aps::{self, ApsInput, ApsOptions};
-use crate::fit::{FitInput, FitOptions, FitResult};
+use crate::fit::{FitOptions, FitResult};
 use crate::model::{InputFile, MethodResult, PixelData, PixelMaps, SequenceReport, Truth};
 use crate::sim::PixelParams;
 use crate::stats::{StatsAccumulator, StatsOptions};
@@ -327,25 +327,17 @@ fn fit_of(
     if let Some(why) = &options.fit_left_out {
         (None, Some(why.clone()))
     } else {
-        match crate::fit::fit(
-            &FitInput {
-                sensor: loaded.sensor,
-                events: &loaded.events,
-                frames: &loaded.frames,
-                excluded: &loaded.excluded,
-                unread: &loaded.unread,
-            },
+        match crate::fit_region::fit(
+            loaded,
             &FitOptions {
                 seed: options.seed,
                 thresholds: screen.cloned(),
                 ..FitOptions::default()
             },
+            options.fit_max_pixels,
             &quiet,
         ) {
-            Ok(mut f) => {
-                f.assumptions.extend(loaded.notes.iter().cloned());
-                (Some(f), None)
-            }
+            Ok(f) => (Some(f), None),
             Err(e) => (None, Some(e.to_string())),
         }
     }

@@ -51,6 +51,10 @@ pub struct ReportArgs {
     /// blocks of consecutive frames (as `fit --max-frames`).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
+    /// The fit simulates at most this many pixels: a larger sensor is fitted on its busiest
+    /// region of that size (as `fit --max-pixels`; 0: the whole sensor).
+    #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_PIXELS)]
+    pub max_pixels: usize,
     /// The screen model for recordings of an on-screen stimulus (default: a typical 60 Hz
     /// LCD).
     #[arg(long, value_name = "SCREEN.toml")]
@@ -113,6 +117,7 @@ fn options(args: &ReportArgs, global: &Global) -> anyhow::Result<pipeline::Optio
         screen: screen_of(args)?,
         seed: args.seed,
         fit_left_out: args.no_fit.then(|| "left out (--no-fit)".to_string()),
+        fit_max_pixels: args.max_pixels,
         selection: args.selection.spec(),
         force: global.force,
     })
