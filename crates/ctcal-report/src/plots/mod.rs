@@ -149,6 +149,20 @@ const MIN_RESIDUAL_EVENTS: u64 = 20;
 /// The plots of one sequence.
 pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, String>> {
     let mut plots = Vec::new();
+    plots.extend(calibration_curve(s));
+    plots.extend(thresholds_by_method(s));
+    plots.extend(threshold_maps(s, pixels));
+    plots.extend(rate_timeline(s));
+    plots.extend(pixel_counts(s, pixels));
+    plots.extend(fit_residuals(s));
+    plots
+}
+
+type Plots = Vec<Result<Plot, String>>;
+
+/// eppps' events per pixel per second against the threshold, the recording's rate on it.
+fn calibration_curve(s: &SequenceReport) -> Plots {
+    let mut plots = Vec::new();
     let name = |what: &str| format!("{}/{what}", s.name);
     if let Some(e) = s.estimate("eppps")
         && let Some(curve) = e.extra.get("calibration_curve")
@@ -170,6 +184,13 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
             },
         ));
     }
+    plots
+}
+
+/// Each method's thresholds with their intervals (and the truth of a simulation).
+fn thresholds_by_method(s: &SequenceReport) -> Plots {
+    let mut plots = Vec::new();
+    let name = |what: &str| format!("{}/{what}", s.name);
     let mut rows: Vec<MethodRow> = s
         .methods
         .iter()
@@ -205,6 +226,13 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
             &Methods { rows, truth },
         ));
     }
+    plots
+}
+
+/// aps' per-pixel thresholds as maps and histograms.
+fn threshold_maps(s: &SequenceReport, pixels: &PixelData) -> Plots {
+    let mut plots = Vec::new();
+    let name = |what: &str| format!("{}/{what}", s.name);
     if let Some(maps) = &pixels.maps {
         let heat = |values: &[f32], label: &str| Heat {
             width: maps.width,
@@ -237,6 +265,13 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
             },
         ));
     }
+    plots
+}
+
+/// The event rate over the recording.
+fn rate_timeline(s: &SequenceReport) -> Plots {
+    let mut plots = Vec::new();
+    let name = |what: &str| format!("{}/{what}", s.name);
     plots.push(render(
         name("rate_timeline"),
         &format!("{}: event rate over time", s.name),
@@ -258,6 +293,13 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
             zero: false,
         },
     ));
+    plots
+}
+
+/// Events per pixel, hot pixels circled.
+fn pixel_counts(s: &SequenceReport, pixels: &PixelData) -> Plots {
+    let mut plots = Vec::new();
+    let name = |what: &str| format!("{}/{what}", s.name);
     if !pixels.counts.is_empty() {
         let (w, h) = (s.stats.width as usize, s.stats.height as usize);
         plots.push(render(
@@ -281,6 +323,14 @@ pub fn sequence(s: &SequenceReport, pixels: &PixelData) -> Vec<Result<Plot, Stri
             },
         ));
     }
+    plots
+}
+
+/// The fit's residuals as each effect was added, and the same-pixel interval
+/// distributions of the recording and the models.
+fn fit_residuals(s: &SequenceReport) -> Plots {
+    let mut plots = Vec::new();
+    let name = |what: &str| format!("{}/{what}", s.name);
     if let Some((f, residuals_before, residuals_after)) = s
         .fit
         .as_ref()
