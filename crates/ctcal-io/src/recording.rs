@@ -76,6 +76,36 @@ pub struct ResolvedSensor {
     pub warning: Option<Text>,
 }
 
+/// An IJRR folder's files and the sensor size its first line, frames or stimulus give.
+fn ijrr_source(path: &Path) -> Result<(Source, Option<(Sensor, String)>), InputError> {
+    let files = ijrr::IjrrFiles::locate(path)?;
+    let header = ijrr::read_header(&files.events)?;
+    let mut sensor = header
+        .sensor
+        .map(|s| (s, "the `width height` first line of events.txt".to_string()));
+    // frames (or, for an on-screen recording, the stimulus mapped 1:1 onto the
+    // sensor) give the size
+    for (index, origin) in [
+        (&files.images, FRAMES_SENSOR),
+        (
+            &files.stimulus,
+            "the size of the stimulus in stimulus.txt (screen mapped 1:1)",
+        ),
+    ] {
+        if sensor.is_none()
+            && let Some(index) = index
+            && let Some((w, h)) = FrameList::read(index)?.image_size()?
+        {
+            let (w, h) = (
+                u16::try_from(w).unwrap_or(u16::MAX),
+                u16::try_from(h).unwrap_or(u16::MAX),
+            );
+            sensor = Some((Sensor::new(w, h), origin.to_string()));
+        }
+    }
+    Ok((Source::Ijrr(files), sensor))
+}
+
 impl Recording {
     /// Opens `path`, detecting its format from content unless `options.format` is set.
     pub fn open(path: &Path, options: &OpenOptions) -> Result<Self, InputError> {
@@ -84,7 +114,23 @@ impl Recording {
                 path: path.to_path_buf(),
             });
         }
-        let format = match options.format {
+        let format = Self::format_of(path, options)?;
+        let mut notes = Vec::new();
+        let (source, file_sensor) = Self::probe(path, format, options, &mut notes)?;
+        let (sensor, sensor_source) = Self::sensor_of(path, options, file_sensor, &mut notes)?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            format,
+            sensor,
+            sensor_source,
+            notes,
+            source,
+        })
+    }
+
+    /// The format forced by `options` (checked against the content) or detected.
+    fn format_of(path: &Path, options: &OpenOptions) -> Result<Format, InputError> {
+        Ok(match options.format {
             Some(forced) => {
                 // the content may still say what it is: a forced format that does not fit is
                 // named as such, rather than reported later as damage
@@ -108,37 +154,19 @@ impl Recording {
                 }
             }
             None => detect(path)?,
-        };
-        let mut notes = Vec::new();
-        let (source, file_sensor): (Source, Option<(Sensor, String)>) = match format {
-            Format::Ijrr => {
-                let files = ijrr::IjrrFiles::locate(path)?;
-                let header = ijrr::read_header(&files.events)?;
-                let mut sensor = header
-                    .sensor
-                    .map(|s| (s, "the `width height` first line of events.txt".to_string()));
-                // frames (or, for an on-screen recording, the stimulus mapped 1:1 onto the
-                // sensor) give the size
-                for (index, origin) in [
-                    (&files.images, FRAMES_SENSOR),
-                    (
-                        &files.stimulus,
-                        "the size of the stimulus in stimulus.txt (screen mapped 1:1)",
-                    ),
-                ] {
-                    if sensor.is_none()
-                        && let Some(index) = index
-                        && let Some((w, h)) = FrameList::read(index)?.image_size()?
-                    {
-                        let (w, h) = (
-                            u16::try_from(w).unwrap_or(u16::MAX),
-                            u16::try_from(h).unwrap_or(u16::MAX),
-                        );
-                        sensor = Some((Sensor::new(w, h), origin.to_string()));
-                    }
-                }
-                (Source::Ijrr(files), sensor)
-            }
+        })
+    }
+
+    /// The format's reader state and the sensor size the file claims, with where it says
+    /// so; what the probe warns of goes to `notes`.
+    fn probe(
+        path: &Path,
+        format: Format,
+        options: &OpenOptions,
+        notes: &mut Vec<String>,
+    ) -> Result<(Source, Option<(Sensor, String)>), InputError> {
+        Ok(match format {
+            Format::Ijrr => ijrr_source(path)?,
             Format::Bag => {
                 let info = bag::probe(
                     path,
@@ -204,8 +232,18 @@ impl Recording {
                 };
                 (source, sensor)
             }
-        };
-        let (sensor, sensor_source) = match (options.sensor, file_sensor) {
+        })
+    }
+
+    /// The sensor size given (over the file's, said in `notes`) or the file's, refused
+    /// where the file claims one larger than any sensor.
+    fn sensor_of(
+        path: &Path,
+        options: &OpenOptions,
+        file_sensor: Option<(Sensor, String)>,
+        notes: &mut Vec<String>,
+    ) -> Result<(Option<Sensor>, Option<String>), InputError> {
+        Ok(match (options.sensor, file_sensor) {
             (Some(s), Some((claimed, _))) if s != claimed => {
                 notes.push(format!(
                     "the sensor size given ({s}) overrides the file's {claimed}"
@@ -230,14 +268,6 @@ impl Recording {
                 (Some(s), Some(origin))
             }
             (None, None) => (None, None),
-        };
-        Ok(Self {
-            path: path.to_path_buf(),
-            format,
-            sensor,
-            sensor_source,
-            notes,
-            source,
         })
     }
 
