@@ -90,82 +90,44 @@ pub fn fit(
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);
     let (mut frames, mut assumptions) = prepare_frames(input, &run, options)?;
-    let change_rate = dynamics::from_frames(&frames, 0.5).map_or(0.0, |d| d.log_change_rate);
-    let static_scene = change_rate < dynamics::STATIC_CHANGE_RATE;
     progress("starting thresholds (estimate aps on the fit run)", 0.05);
-    let start = start::thresholds(input, &run, options, change_rate, static_scene);
-    assumptions.extend(start.assumptions.iter().cloned());
-    // the offset the start's thresholds were read at (the counts' where a photoreceptor
-    // lag distorts the timing's: `estimate aps`), unless the user gave one
-    if let Some((offset, range)) = start
-        .frame_offset_dn
-        .filter(|_| options.aps.frame_offset_dn.is_none())
-        && offset != frames.offset
-    {
-        assumptions.push(format!(
-            "frames simulated at the log offset b = {offset:.1} DN where `estimate aps` read the starting thresholds (its offset from the counts, not the event timing's {:.1} DN)",
-            frames.offset
-        ));
-        frames.offset = offset;
-        frames.offset_range = range;
-    }
-    let start_params = PixelParams {
-        log_response: Some(frames.log_map.response()),
-        log_eps: Some(frames.log_map.eps()),
-        ..start.params.clone()
-    };
+    let (start, start_params) = starting_point(input, &run, options, &mut frames, &mut assumptions);
 
     progress("the ideal model", 0.2);
     let geometry = Geometry::new(&frames, input.excluded, options.blocks, end);
     let runs = frames.upsample_runs(0.5, options.aps.max_upsampled_bytes);
-    let grid = timestamp_grid(input.events);
-    let no_mask = vec![false; input.sensor.pixels()];
-    let real = super::observe::Observed::new(input.events, &geometry, &no_mask);
     let mut simulation = Simulation {
         runs: &runs,
         width: frames.width,
         height: frames.height,
         geometry: &geometry,
         events: input.events,
-        real,
-        grid,
+        real: super::observe::Observed::new(
+            input.events,
+            &geometry,
+            &vec![false; input.sensor.pixels()],
+        ),
+        grid: timestamp_grid(input.events),
         seed: options.seed,
         count: Cell::new(0),
         hot_events: EventChunk::default(),
     };
-    let (ideal, fixed) = ideal_model(&simulation, &start_params, start.fixed, &mut assumptions)?;
-    let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
-    let before = simulation.distance(&ideal.observed, geometry.testing(), &kept);
-    let residuals_before = residuals(&simulation.real, &ideal.observed, &geometry, Subset::Fit);
-    let noise = distance_noise(&simulation, &ideal.observed, &kept);
-    finish::read_noise_note(&simulation, &ideal, &mut assumptions);
-    let mut state = State {
-        uncertainty: finish::threshold_uncertainty(&simulation, &ideal),
-        model: ideal,
-        masked: no_mask,
-        kept,
-        hot: Vec::new(),
-        hot_detection: None,
-        at_bound: BTreeMap::new(),
-    };
-    let known = Known {
-        mismatch: start.mismatch,
-        grid,
-        shortest_interval_s: effects::refractory::shortest_interval_s(
-            &run.events,
-            input.sensor.width as usize,
-            &state.kept,
-            grid.map_or(1, |g| g.0.clamp(1, u32::MAX as i64) as u32),
-        ),
-    };
-    let mut steps = vec![start.step];
+    let ideal = Ideal::measure(
+        &simulation,
+        &start_params,
+        start.fixed,
+        input,
+        &mut assumptions,
+    )?;
+    let mut state = ideal.state;
     let loop_run = LoopRun {
-        known,
-        fixed,
-        noise,
+        known: Known::of(&run, input, &state, start.mismatch, simulation.grid),
+        fixed: ideal.fixed,
+        noise: ideal.noise,
         fit_events: &run.events,
         frames: &frames,
     };
+    let mut steps = vec![start.step];
     let (added, ambiguities) = choose_effects(
         &mut simulation,
         &mut state,
@@ -178,30 +140,30 @@ pub fn fit(
         "frame checks (every 2nd and 3rd frame, a doubled exposure)",
         0.96,
     );
-    let frame_quality = if fixed {
-        frame_quality::FrameQuality::default()
-    } else {
-        let check = frame_quality::Check {
-            frames: &frames,
-            input,
-            options,
-            fit_end: end,
-            masked: &state.masked,
-        };
-        frame_quality::measure(&check, &simulation, &state.model)
-    };
+    let frame_quality = (!ideal.fixed)
+        .then(|| {
+            let check = frame_quality::Check {
+                frames: &frames,
+                input,
+                options,
+                fit_end: end,
+                masked: &state.masked,
+            };
+            frame_quality::measure(&check, &simulation, &state.model)
+        })
+        .unwrap_or_default();
     progress("the final model on the test blocks", 0.97);
     let result = finish::result(
         &simulation,
         state,
         finish::Parts {
-            before,
-            residuals_before,
+            before: ideal.before,
+            residuals_before: ideal.residuals_before,
             added,
             steps,
             ambiguities,
             assumptions,
-            fixed,
+            fixed: ideal.fixed,
             start: start.measured,
             interpolation_share: start.interpolation_share,
             frame_quality,
@@ -211,6 +173,109 @@ pub fn fit(
     );
     progress("done", 1.0);
     Ok(result)
+}
+
+/// The starting thresholds (`estimate aps` on the fit run) and the model they start, the
+/// frames moved to the log offset they were read at (the counts' where a photoreceptor lag
+/// distorts the timing's) unless the user gave one.
+fn starting_point(
+    input: &FitInput,
+    run: &start::FitRun,
+    options: &FitOptions,
+    frames: &mut crate::estimate::frames::PreparedFrames,
+    assumptions: &mut Vec<String>,
+) -> (start::Start, PixelParams) {
+    let change_rate = dynamics::from_frames(frames, 0.5).map_or(0.0, |d| d.log_change_rate);
+    let static_scene = change_rate < dynamics::STATIC_CHANGE_RATE;
+    let start = start::thresholds(input, run, options, change_rate, static_scene);
+    assumptions.extend(start.assumptions.iter().cloned());
+    if let Some((offset, range)) = start
+        .frame_offset_dn
+        .filter(|_| options.aps.frame_offset_dn.is_none())
+        && offset != frames.offset
+    {
+        assumptions.push(format!(
+            "frames simulated at the log offset b = {offset:.1} DN where `estimate aps` read the starting thresholds (its offset from the counts, not the event timing's {:.1} DN)",
+            frames.offset
+        ));
+        frames.offset = offset;
+        frames.offset_range = range;
+    }
+    let params = PixelParams {
+        log_response: Some(frames.log_map.response()),
+        log_eps: Some(frames.log_map.eps()),
+        ..start.params.clone()
+    };
+    (start, params)
+}
+
+/// The ideal model (the starting thresholds, no effect) measured: the loop's first state,
+/// its error on the test blocks and residuals, and the distance's chance spread.
+struct Ideal {
+    state: State,
+    /// Whether the thresholds are given, not fitted.
+    fixed: bool,
+    /// Its error on the test blocks.
+    before: super::Components,
+    residuals_before: super::residuals::Residuals,
+    noise: f64,
+}
+
+impl Ideal {
+    fn measure(
+        simulation: &Simulation,
+        start: &PixelParams,
+        start_fixed: bool,
+        input: &FitInput,
+        assumptions: &mut Vec<String>,
+    ) -> Result<Self, FitError> {
+        let (ideal, fixed) = ideal_model(simulation, start, start_fixed, assumptions)?;
+        let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
+        let geometry = simulation.geometry;
+        let before = simulation.distance(&ideal.observed, geometry.testing(), &kept);
+        let residuals_before = residuals(&simulation.real, &ideal.observed, geometry, Subset::Fit);
+        let noise = distance_noise(simulation, &ideal.observed, &kept);
+        finish::read_noise_note(simulation, &ideal, assumptions);
+        let state = State {
+            uncertainty: finish::threshold_uncertainty(simulation, &ideal),
+            model: ideal,
+            masked: vec![false; input.sensor.pixels()],
+            kept,
+            hot: Vec::new(),
+            hot_detection: None,
+            at_bound: BTreeMap::new(),
+        };
+        Ok(Self {
+            state,
+            fixed,
+            before,
+            residuals_before,
+            noise,
+        })
+    }
+}
+
+impl Known {
+    /// What the fit run tells before any effect is tried: the mismatch's evidence, the
+    /// timestamp grid and the shortest same-pixel interval of the kept pixels.
+    fn of(
+        run: &start::FitRun,
+        input: &FitInput,
+        state: &State,
+        mismatch: Option<(f64, [f64; 2])>,
+        grid: Option<(TimeUs, TimeUs)>,
+    ) -> Self {
+        Known {
+            mismatch,
+            grid,
+            shortest_interval_s: effects::refractory::shortest_interval_s(
+                &run.events,
+                input.sensor.width as usize,
+                &state.kept,
+                grid.map_or(1, |g| g.0.clamp(1, u32::MAX as i64) as u32),
+            ),
+        }
+    }
 }
 
 /// The frames as the simulator reads them: the frame-time alignment, the log offset and
