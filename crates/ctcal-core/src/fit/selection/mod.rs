@@ -140,18 +140,18 @@ pub fn fit(
         "frame checks (every 2nd and 3rd frame, a doubled exposure)",
         0.96,
     );
-    let frame_quality = (!ideal.fixed)
-        .then(|| {
-            let check = frame_quality::Check {
-                frames: &frames,
-                input,
-                options,
-                fit_end: end,
-                masked: &state.masked,
-            };
-            frame_quality::measure(&check, &simulation, &state.model)
-        })
-        .unwrap_or_default();
+    let frame_quality = if ideal.fixed {
+        frame_quality::FrameQuality::default()
+    } else {
+        let check = frame_quality::Check {
+            frames: &frames,
+            input,
+            options,
+            fit_end: end,
+            masked: &state.masked,
+        };
+        frame_quality::measure(&check, &simulation, &state.model)
+    };
     progress("the final model on the test blocks", 0.97);
     let result = finish::result(
         &simulation,
