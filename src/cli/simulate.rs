@@ -229,44 +229,17 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         None => layout_from_extension(&args.out)?,
     };
     let params = PixelParams::from_file(&args.params)?;
-    let mut inputs: Vec<&Path> = vec![args.params.as_path()];
-    inputs.extend(args.frames.as_deref());
-    inputs.extend(args.scene.as_deref());
-    for map in [&args.ct_on_map, &args.ct_off_map, &args.leak_factor_map] {
-        inputs.extend(map.as_deref());
-    }
-    let policy = global.outputs(inputs);
+    let policy = global.outputs(input_paths(args));
     let started = std::time::Instant::now();
     let SimInput {
-        mut source,
+        source,
         scene_spec,
         render_hz,
         aps_frames,
-        mut work,
+        work,
         span_s,
     } = open_input(args, global)?;
-    // the images of the input (a display blurs each once)
-    let images = work.samples;
-    if let Some(display) = &params.display {
-        // the display adds a sample at every refresh
-        work.samples += span_s * display.refresh_hz;
-        source = Box::new(DisplaySource::new(source, DisplayModel::new(display)));
-    }
-    let what = args
-        .frames
-        .as_deref()
-        .or(args.scene.as_deref())
-        .map(|p| p.display().to_string())
-        .unwrap_or_default();
-    work.check(
-        &what,
-        "simulate fewer frames, a shorter scene or a smaller sensor",
-        global.force,
-    )?;
-    // the events and blur the effects add, from the parameters: refused before the output
-    // is created
-    EffectWork::new(&params, &work, span_s, images)
-        .check(&args.params.display().to_string(), global.force)?;
+    let mut source = checked_source(args, global, &params, source, work, span_s)?;
     let (width, height) = source.size();
     let sensor = Sensor::new(width as u16, height as u16);
     let maps = load_maps(args, sensor)?;
@@ -286,17 +259,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     for frame in &aps_frames {
         writer.frame(frame)?;
     }
-    // a simulated recording of an on-screen stimulus carries the stimulus, so that
-    // `estimate screen` finds it beside the events
-    if let (Some(dir), Writer::Ijrr(w)) = (&args.frames, &mut writer) {
-        let index = frame_index(dir)?;
-        if index.file_name().is_some_and(|n| n == "stimulus.txt") {
-            let list = FrameList::read(&index)?;
-            for i in 0..list.len() {
-                w.write_stimulus_frame(&list.load(i)?)?;
-            }
-        }
-    }
+    write_stimulus(args, &mut writer)?;
     let wall_s = started.elapsed().as_secs_f64();
     let duration_s = (summary.t_last_sample_us - summary.t_first_sample_us) as f64 * 1e-6;
     let result = Provenance {
@@ -326,28 +289,98 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         }
         Writer::H5(w) => w.finish()?,
     }
-    let samples_per_second = summary.samples as f64 / wall_s;
+    let summary = Summary {
+        provenance: &result,
+        wall_s,
+        samples_per_second: summary.samples as f64 / wall_s,
+    };
+    present(args, global, &policy, &summary)
+}
+
+/// The files the simulation reads (never written over).
+fn input_paths(args: &SimulateArgs) -> Vec<&Path> {
+    let mut inputs: Vec<&Path> = vec![args.params.as_path()];
+    inputs.extend(args.frames.as_deref());
+    inputs.extend(args.scene.as_deref());
+    for map in [&args.ct_on_map, &args.ct_off_map, &args.leak_factor_map] {
+        inputs.extend(map.as_deref());
+    }
+    inputs
+}
+
+/// The input behind the display where the parameters have one, its work (images, display
+/// refreshes, and the events and blur the effects add) checked against the budget before
+/// the output is created.
+fn checked_source(
+    args: &SimulateArgs,
+    global: &Global,
+    params: &PixelParams,
+    mut source: Box<dyn FrameSource>,
+    mut work: Work,
+    span_s: f64,
+) -> anyhow::Result<Box<dyn FrameSource>> {
+    // the images of the input (a display blurs each once)
+    let images = work.samples;
+    if let Some(display) = &params.display {
+        // the display adds a sample at every refresh
+        work.samples += span_s * display.refresh_hz;
+        source = Box::new(DisplaySource::new(source, DisplayModel::new(display)));
+    }
+    let what = args
+        .frames
+        .as_deref()
+        .or(args.scene.as_deref())
+        .map(|p| p.display().to_string())
+        .unwrap_or_default();
+    work.check(
+        &what,
+        "simulate fewer frames, a shorter scene or a smaller sensor",
+        global.force,
+    )?;
+    EffectWork::new(params, &work, span_s, images)
+        .check(&args.params.display().to_string(), global.force)?;
+    Ok(source)
+}
+
+/// A simulated recording of an on-screen stimulus carries the stimulus, so that `estimate
+/// screen` finds it beside the events.
+fn write_stimulus(args: &SimulateArgs, writer: &mut Writer) -> anyhow::Result<()> {
+    if let (Some(dir), Writer::Ijrr(w)) = (&args.frames, writer) {
+        let index = frame_index(dir)?;
+        if index.file_name().is_some_and(|n| n == "stimulus.txt") {
+            let list = FrameList::read(&index)?;
+            for i in 0..list.len() {
+                w.write_stimulus_frame(&list.load(i)?)?;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The summary as JSON (`--json`) and as a table.
+fn present(
+    args: &SimulateArgs,
+    global: &Global,
+    policy: &super::OutputPolicy,
+    summary: &Summary,
+) -> anyhow::Result<()> {
+    let result = summary.provenance;
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(
-            &Summary {
-                provenance: &result,
-                wall_s,
-                samples_per_second,
-            },
-            target,
-            &policy,
-        )?;
+        emit_json(summary, target, policy)?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) && !global.quiet {
         output::print_table(&[
-            ("sensor".into(), format!("{width}x{height}")),
+            (
+                "sensor".into(),
+                format!("{}x{}", result.width, result.height),
+            ),
             ("input samples".into(), result.input_samples.to_string()),
             (
                 "events".into(),
                 format!("{} ({} ON)", result.events, result.on_events),
             ),
-            ("duration".into(), output::seconds(duration_s)),
+            ("duration".into(), output::seconds(result.duration_s)),
             (
                 "events/pixel/s".into(),
                 format!("{:.4}", result.events_per_pixel_per_second),
@@ -357,8 +390,8 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
                 "wall time".into(),
                 format!(
                     "{} ({:.0} samples/s)",
-                    output::seconds(wall_s),
-                    samples_per_second
+                    output::seconds(summary.wall_s),
+                    summary.samples_per_second
                 ),
             ),
             ("written".into(), args.out.display().to_string()),
