@@ -100,6 +100,94 @@ pub struct PreparedFrames {
     pub unread: Vec<(TimeUs, TimeUs)>,
 }
 
+/// What decides whether a frame interval is used: the frames' times, log images and
+/// problems, the events' times and the spans not read.
+struct Intervals<'a> {
+    times: &'a [TimeUs],
+    logs: &'a [Image],
+    frame_problems: &'a [Option<String>],
+    event_times: &'a [TimeUs],
+    unread: &'a [(TimeUs, TimeUs)],
+    options: &'a FrameOptions,
+}
+
+impl Intervals<'_> {
+    /// Interval `k`'s optical flow where it is used, and why not where it is not: it
+    /// crosses a span not read, a frame has a problem, the frames share a time, no event
+    /// falls between them, or the motion (95th percentile of the flow) is too large to
+    /// interpolate.
+    fn flow(&self, k: usize) -> (Option<FlowField>, IntervalInfo) {
+        let (t0, t1) = (self.times[k], self.times[k + 1]);
+        let mut info = IntervalInfo {
+            t_start_s: us_to_s(t0),
+            t_end_s: us_to_s(t1),
+            used: false,
+            reason: None,
+            motion_px: 0.0,
+        };
+        if self.unread.iter().any(|&(a, b)| a < t1 && b > t0) {
+            info.reason =
+                Some("between two blocks of frames read: its events were not read".into());
+            return (None, info);
+        }
+        let problem = self.frame_problems[k]
+            .as_ref()
+            .map(|p| format!("frame at {:.6} s: {p}", us_to_s(t0)))
+            .or_else(|| {
+                self.frame_problems[k + 1]
+                    .as_ref()
+                    .map(|p| format!("frame at {:.6} s: {p}", us_to_s(t1)))
+            });
+        if let Some(problem) = problem {
+            info.reason = Some(problem);
+            return (None, info);
+        }
+        if t1 <= t0 {
+            info.reason = Some("the two frames have the same time".into());
+            return (None, info);
+        }
+        let lo = self.event_times.partition_point(|&t| t < t0);
+        let hi = self.event_times.partition_point(|&t| t < t1);
+        if hi == lo {
+            info.reason = Some("no events between the frames".into());
+            return (None, info);
+        }
+        let flow = dense_flow(&self.logs[k], &self.logs[k + 1], &self.options.flow);
+        let mut magnitudes = flow.magnitudes();
+        magnitudes.sort_by(f32::total_cmp);
+        let motion = magnitudes[(magnitudes.len() - 1) * 95 / 100] as f64;
+        info.motion_px = motion;
+        if motion > self.options.max_motion_px {
+            info.reason = Some(format!(
+                "motion of {motion:.1} px between the frames is too large to interpolate (limit {} px)",
+                self.options.max_motion_px
+            ));
+            return (None, info);
+        }
+        info.used = true;
+        (Some(flow), info)
+    }
+}
+
+/// Why no interval of a recording's frames can be used (its first three reasons), and
+/// what to do.
+fn no_usable_interval(intervals: &[IntervalInfo]) -> EstimateError {
+    let reasons: Vec<String> = intervals
+        .iter()
+        .filter_map(|i| i.reason.clone())
+        .take(3)
+        .collect();
+    EstimateError::new(
+        format!(
+            "no usable frame interval among {} ({})",
+            intervals.len(),
+            reasons.join("; ")
+        ),
+        Text::from("record with a fixed exposure and moderate motion, or use ")
+            .name(Hint::Analysis(Analysis::Eppps)),
+    )
+}
+
 impl PreparedFrames {
     /// Prepares `frames` (time-sorted, one size); `event_times` (sorted) decide which
     /// intervals hold events; an interval across one of the `unread` spans is not used.
@@ -136,59 +224,17 @@ impl PreparedFrames {
                 )
             })
             .collect();
+        let intervals = Intervals {
+            times: &times,
+            logs: &logs,
+            frame_problems: &frame_problems,
+            event_times,
+            unread,
+            options,
+        };
         let results: Vec<(Option<FlowField>, IntervalInfo)> = (0..frames.len() - 1)
             .into_par_iter()
-            .map(|k| {
-                let (t0, t1) = (times[k], times[k + 1]);
-                let mut info = IntervalInfo {
-                    t_start_s: us_to_s(t0),
-                    t_end_s: us_to_s(t1),
-                    used: false,
-                    reason: None,
-                    motion_px: 0.0,
-                };
-                if unread.iter().any(|&(a, b)| a < t1 && b > t0) {
-                    info.reason =
-                        Some("between two blocks of frames read: its events were not read".into());
-                    return (None, info);
-                }
-                let problem = frame_problems[k]
-                    .as_ref()
-                    .map(|p| format!("frame at {:.6} s: {p}", us_to_s(t0)))
-                    .or_else(|| {
-                        frame_problems[k + 1]
-                            .as_ref()
-                            .map(|p| format!("frame at {:.6} s: {p}", us_to_s(t1)))
-                    });
-                if let Some(problem) = problem {
-                    info.reason = Some(problem);
-                    return (None, info);
-                }
-                if t1 <= t0 {
-                    info.reason = Some("the two frames have the same time".into());
-                    return (None, info);
-                }
-                let lo = event_times.partition_point(|&t| t < t0);
-                let hi = event_times.partition_point(|&t| t < t1);
-                if hi == lo {
-                    info.reason = Some("no events between the frames".into());
-                    return (None, info);
-                }
-                let flow = dense_flow(&logs[k], &logs[k + 1], &options.flow);
-                let mut magnitudes = flow.magnitudes();
-                magnitudes.sort_by(f32::total_cmp);
-                let motion = magnitudes[(magnitudes.len() - 1) * 95 / 100] as f64;
-                info.motion_px = motion;
-                if motion > options.max_motion_px {
-                    info.reason = Some(format!(
-                        "motion of {motion:.1} px between the frames is too large to interpolate (limit {} px)",
-                        options.max_motion_px
-                    ));
-                    return (None, info);
-                }
-                info.used = true;
-                (Some(flow), info)
-            })
+            .map(|k| intervals.flow(k))
             .collect();
         let (flows, intervals) = results.into_iter().unzip();
         let prepared = Self {
@@ -204,21 +250,7 @@ impl PreparedFrames {
             unread: unread.to_vec(),
         };
         if !prepared.intervals.iter().any(|i| i.used) {
-            let reasons: Vec<String> = prepared
-                .intervals
-                .iter()
-                .filter_map(|i| i.reason.clone())
-                .take(3)
-                .collect();
-            return Err(EstimateError::new(
-                format!(
-                    "no usable frame interval among {} ({})",
-                    prepared.intervals.len(),
-                    reasons.join("; ")
-                ),
-                Text::from("record with a fixed exposure and moderate motion, or use ")
-                    .name(Hint::Analysis(Analysis::Eppps)),
-            ));
+            return Err(no_usable_interval(&prepared.intervals));
         }
         Ok(prepared)
     }
