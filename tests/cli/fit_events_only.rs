@@ -39,6 +39,14 @@ fn hot_pixels_are_named_exactly_without_frames() {
     let median = (rates[1] + rates[2]) / 2.0;
     let rate = fit["params"]["hot_pixel_rate_hz"].as_f64().unwrap();
     assert!((rate / median - 1.0).abs() < 0.14, "{rate} for {median}");
+    // both with intervals that hold the truth: 4 hot pixels of 43,200, the injected median
+    let holds = |key: &str, truth: f64| {
+        let ci = fit["uncertainties"][key]["ci95"].as_array().unwrap();
+        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        assert!(lo < truth && truth < hi, "{key}: [{lo}, {hi}] for {truth}");
+    };
+    holds("hot_pixel_fraction", 4.0 / 43_200.0);
+    holds("hot_pixel_rate_hz", median);
     // the uniform background activity (0.03 Hz a pixel): within a factor 2 or an upper bound
     let rate = fit["params"]["shot_noise_rate_hz"].as_f64();
     if let Some(rate) = rate {

@@ -37,6 +37,7 @@ use super::{FitError, FitInput, FitOptions, FitResult, Uncertain};
 use crate::estimate::eppps::{EpppsInput, EpppsOptions};
 use crate::estimate::{CtEstimate, Interval, Progress};
 use crate::stats::hot_pixels::{HotPixel, find_hot_pixels, neighbour_median};
+use super::selection::hot_excess;
 use crate::stats::robust::sample_std_dev;
 use blocks::Blocks;
 use measure::{BlockMeasure, Measuring};
@@ -106,6 +107,8 @@ pub(super) struct FitRun {
     /// The named hot pixels' positions (x, y), in the order of `hot` and `trains`.
     hot_positions: Vec<(u16, u16)>,
     trains: Vec<HotTrain>,
+    /// The fraction and median rate of the named hot pixels, with their intervals.
+    hot_found: hot_excess::HotExcess,
     /// Isolated-event rates (OFF, ON) under the chosen support window.
     noise: [Option<(f64, f64)>; 2],
     window: usize,
@@ -129,7 +132,7 @@ pub fn fit(
     check(events)?;
     let blocks = Blocks::split(events, options.blocks, options.holdout);
     progress("hot pixels", 0.05);
-    let (hot, trains) = hot_pixels(input, &blocks);
+    let (hot, trains, hot_found) = hot_pixels(input, &blocks);
     progress("noise, intervals and balance per block", 0.15);
     let named: Vec<(u16, u16)> = hot.iter().map(|h| (h.x, h.y)).collect();
     let measures = measure::measure(
@@ -150,7 +153,7 @@ pub fn fit(
         },
     };
     let step = refractory::timestamp_step(events);
-    let run = fit_run(&judging, hot, trains, step);
+    let run = fit_run(&judging, (hot, trains, hot_found), step);
     let judging = Judging {
         reference: Reference {
             edge_us: run.edge.as_ref().map(|e| e.edge_us),
@@ -198,8 +201,14 @@ fn check(events: &crate::events::EventChunk) -> Result<(), FitError> {
     Ok(())
 }
 
-/// Hot pixels of the fit run, with their rates and ON shares there.
-fn hot_pixels(input: &FitInput, blocks: &Blocks) -> (Vec<HotPixel>, Vec<HotTrain>) {
+/// Hot pixels of the fit run, with their rates and ON shares there, and the fraction and
+/// median rate they give with their intervals ([`hot_excess::excess`], as the fit with
+/// frames counts them; without a model of the scene at each pixel, no outliers of the
+/// model's own are subtracted).
+fn hot_pixels(
+    input: &FitInput,
+    blocks: &Blocks,
+) -> (Vec<HotPixel>, Vec<HotTrain>, hot_excess::HotExcess) {
     let (w, h) = (input.sensor.width as usize, input.sensor.height as usize);
     let end = blocks.fit_end();
     let fit_to = input.events.t.partition_point(|&t| t < end);
@@ -235,14 +244,24 @@ fn hot_pixels(input: &FitInput, blocks: &Blocks) -> (Vec<HotPixel>, Vec<HotTrain
             }
         })
         .collect();
-    (hot, trains)
+    let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
+    let found = hot_excess::excess(&hot_excess::Counts {
+        real_named: &hot,
+        model: &vec![0; w * h],
+        width: w,
+        height: h,
+        duration_s: seconds,
+        kept_pixels: kept.iter().filter(|&&k| k).count(),
+        real: &counts,
+        kept: &kept,
+    });
+    (hot, trains, found)
 }
 
 /// Everything measured on the fit blocks.
 fn fit_run(
     judging: &Judging,
-    hot: Vec<HotPixel>,
-    trains: Vec<HotTrain>,
+    (hot, trains, hot_found): (Vec<HotPixel>, Vec<HotTrain>, hot_excess::HotExcess),
     timestamp_step_us: u32,
 ) -> FitRun {
     let fit = judging.of(Role::Fit);
@@ -278,6 +297,7 @@ fn fit_run(
         hot_positions: hot.iter().map(|h| (h.x, h.y)).collect(),
         hot,
         trains,
+        hot_found,
         noise: [
             BlockMeasure::isolated_rate(&fit, window, false),
             BlockMeasure::isolated_rate(&fit, window, true),

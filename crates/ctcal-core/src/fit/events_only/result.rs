@@ -14,12 +14,12 @@ use crate::estimate::CtEstimate;
 use crate::fit::effects::Effect;
 use crate::fit::metric::Components;
 use crate::fit::observe::Role;
+use crate::fit::selection::finish::{HOT_FRACTION, HOT_RATE, hot_rate_unmeasured};
 use crate::fit::selection::keep::PARSIMONY;
 use crate::fit::{
     AddedEffect, FitInput, FitOptions, FitResult, FittedParams, Holdout, Step, Uncertain,
 };
 use crate::sim::PixelParams;
-use crate::stats::robust::median;
 use std::collections::BTreeMap;
 
 /// Why mismatch, bandwidth and jitter are not identified without frames.
@@ -83,15 +83,17 @@ pub(super) fn result(parts: Parts) -> FitResult {
         Vec::new()
     };
     if !hot.is_empty() {
-        let pixels = input.excluded.iter().filter(|&&e| !e).count().max(1);
-        params.hot_pixel_fraction = Some(hot.len() as f64 / pixels as f64);
+        let found = &run.hot_found;
+        params.hot_pixel_fraction = Some(found.fraction.value);
+        uncertainties.insert(HOT_FRACTION.into(), found.fraction.clone());
         // the train a simulator adds on top of the pixel's own events
-        params.hot_pixel_rate_hz = median(
-            &run.trains
-                .iter()
-                .map(|t| (t.rate_hz - t.scene_hz).max(0.0))
-                .collect::<Vec<_>>(),
-        );
+        if let Some(rate) = &found.rate {
+            params.hot_pixel_rate_hz = Some(rate.value);
+            uncertainties.insert(HOT_RATE.into(), rate.clone());
+        }
+        if let Some(reason) = hot_rate_unmeasured(&why, &uncertainties) {
+            why.insert(HOT_RATE.into(), reason);
+        }
     }
     let TestErrors {
         before,
@@ -112,6 +114,12 @@ pub(super) fn result(parts: Parts) -> FitResult {
         Some(why) => format!("error_before and error_after from the model's parameters, not simulated back: {why}"),
     });
     events_only.simulated_back_why = not_simulated;
+    if !hot.is_empty() {
+        assumptions.push(format!(
+            "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms); hot_pixel_fraction counts each 1 / the search's detection probability at its rate (Horvitz-Thompson, at least 1/2; Garwood's exact Poisson interval of the count); hot_pixel_rate_hz is the median of their rates beyond their 8 neighbours' median, its interval the median's order-statistic one (the pixels' Poisson errors where too few are named), reaching down to the rate the search names at 10 % of the pixels where it names that median at under 90 %; without frames no model of the scene at each pixel is simulated, so no count outliers of the model's own (a low threshold under mismatch) are subtracted",
+            hot.len()
+        ));
+    }
     FitResult {
         biases: None,
         params: FittedParams {

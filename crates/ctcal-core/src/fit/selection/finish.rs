@@ -344,8 +344,8 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
     why
 }
 
-const HOT_FRACTION: &str = "hot_pixel_fraction";
-const HOT_RATE: &str = "hot_pixel_rate_hz";
+pub(in crate::fit) const HOT_FRACTION: &str = "hot_pixel_fraction";
+pub(in crate::fit) const HOT_RATE: &str = "hot_pixel_rate_hz";
 
 /// Why the hot pixels' rate is not a measurement, when the count of hot pixels is not
 /// determined (its interval spans more than [`UNMEASURED_SPAN`]) or reaches none: the named
@@ -353,7 +353,7 @@ const HOT_RATE: &str = "hot_pixel_rate_hz";
 /// the scene can make as well (on the 38 hot-pixel coverage draws, 2 of the 5 fits that
 /// named a single pixel named a scene pixel, at 6 and 8 times the true rate:
 /// `benches/coverage/hot-lag-2026-11-29`).
-fn hot_rate_unmeasured(
+pub(in crate::fit) fn hot_rate_unmeasured(
     why: &BTreeMap<String, String>,
     uncertainty: &BTreeMap<String, Uncertain>,
 ) -> Option<String> {

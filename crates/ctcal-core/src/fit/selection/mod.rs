@@ -21,9 +21,9 @@
 mod agreement;
 mod alternatives;
 pub use alternatives::Ambiguity;
-mod finish;
+pub(in crate::fit) mod finish;
 mod frame_quality;
-mod hot_excess;
+pub(in crate::fit) mod hot_excess;
 pub(in crate::fit) mod keep;
 mod start;
 mod steps;
