@@ -140,8 +140,21 @@ impl Simulator {
         if let Some((buffer, _)) = &mut self.jitter {
             buffer.start(t);
         }
+        let draws = self.draw_pixels();
+        let this = &*self;
+        let rows: Vec<Row> = (0..self.height)
+            .into_par_iter()
+            .map(|y| this.row_at_start(y, dn, &draws))
+            .collect();
+        self.rows = rows;
+    }
+
+    /// Every pixel's thresholds, leak factor, noise rate and first noise and hot-train
+    /// times, each from its own seeded stream (so that one effect's draws do not move
+    /// another's).
+    fn draw_pixels(&self) -> PixelDraws {
         let params = &self.params;
-        let (width, n) = (self.width, self.width * self.height);
+        let n = self.width * self.height;
         let mut threshold_rng = generator(self.seed, Stream::Thresholds, 0);
         let sigma = params.ct_sigma.unwrap_or(0.0);
         let mut draw_map = |given: &Option<Vec<f32>>, nominal: f64| -> Vec<f32> {
@@ -157,8 +170,7 @@ impl Simulator {
         };
         let theta_on = draw_map(&self.maps.ct_on, params.ct_on);
         let theta_off = draw_map(&self.maps.ct_off, params.ct_off);
-        let leak_rate = params.leak_rate_hz();
-        let leak_factors: Vec<f32> = match (&self.maps.leak_factor, leak_rate > 0.0) {
+        let leak_factors: Vec<f32> = match (&self.maps.leak_factor, params.leak_rate_hz() > 0.0) {
             (Some(map), _) => map.clone(),
             (None, true) => {
                 let mut rng = generator(self.seed, Stream::Leak, 0);
@@ -177,7 +189,6 @@ impl Simulator {
                 hot_next[index] = exponential_us(self.model.hot_rate_per_us, &mut rng);
             }
         }
-        let log_map = self.log_map;
         // each pixel's noise rate (on the pool), then the first noise time of every pixel
         // drawn in pixel order from the one set-up generator
         let rates: Vec<(f64, f32)> = (0..n)
@@ -200,60 +211,68 @@ impl Simulator {
             .iter()
             .map(|&(rate, _)| exponential_us(rate, &mut noise_rng))
             .collect();
-        let this = &*self;
-        let rows: Vec<Row> = (0..self.height)
-            .into_par_iter()
-            .map(|y| {
-                let range = y * width..(y + 1) * width;
-                let input: Vec<f32> = dn[range.clone()]
-                    .iter()
-                    .map(|&d| log_map.apply(d))
-                    .collect();
-                let cold: Vec<Cold> = range
-                    .clone()
-                    .map(|i| Cold {
-                        frozen_on: theta_on[i],
-                        frozen_off: theta_off[i],
-                        noise_rate_per_us: rates[i].0,
-                        noise_on_share: rates[i].1,
-                        last_event_us: f64::NEG_INFINITY,
-                        next_noise_us: next_noise[i],
-                        next_hot_us: hot_next[i],
-                    })
-                    .collect();
-                let mut row = Row {
-                    y: y as u16,
-                    reference: input.clone(),
-                    filtered: input.clone(),
-                    input,
-                    dn: dn[range.clone()].to_vec(),
-                    theta_on: theta_on[range.clone()].to_vec(),
-                    theta_off: theta_off[range.clone()].to_vec(),
-                    leak: range
-                        .clone()
-                        .map(|i| leak::drift_per_us(leak_rate, leak_factors[i], theta_on[i]))
-                        .collect(),
-                    next_interrupt: cold
-                        .iter()
-                        .map(|c| c.next_noise_us.min(c.next_hot_us))
-                        .collect(),
-                    window_low: vec![0.0; width],
-                    window_high: vec![0.0; width],
-                    busy: vec![0; width],
-                    filter_end: vec![0.0; width],
-                    cold,
-                    rng: generator(this.seed, Stream::Rows, this.noise_index(y as u64)),
-                    events: Vec::new(),
-                };
-                if this.model.intensity_window {
-                    for x in 0..width {
-                        row.update_window(x, &log_map);
-                    }
-                }
-                row
+        PixelDraws {
+            theta_on,
+            theta_off,
+            leak_factors,
+            hot_next,
+            rates,
+            next_noise,
+        }
+    }
+
+    /// Row `y` at the first sample `dn`: its references and filters at the frame, its
+    /// pixels' draws.
+    fn row_at_start(&self, y: usize, dn: &[f32], draws: &PixelDraws) -> Row {
+        let (width, log_map) = (self.width, self.log_map);
+        let leak_rate = self.params.leak_rate_hz();
+        let range = y * width..(y + 1) * width;
+        let input: Vec<f32> = dn[range.clone()]
+            .iter()
+            .map(|&d| log_map.apply(d))
+            .collect();
+        let cold: Vec<Cold> = range
+            .clone()
+            .map(|i| Cold {
+                frozen_on: draws.theta_on[i],
+                frozen_off: draws.theta_off[i],
+                noise_rate_per_us: draws.rates[i].0,
+                noise_on_share: draws.rates[i].1,
+                last_event_us: f64::NEG_INFINITY,
+                next_noise_us: draws.next_noise[i],
+                next_hot_us: draws.hot_next[i],
             })
             .collect();
-        self.rows = rows;
+        let mut row = Row {
+            y: y as u16,
+            reference: input.clone(),
+            filtered: input.clone(),
+            input,
+            dn: dn[range.clone()].to_vec(),
+            theta_on: draws.theta_on[range.clone()].to_vec(),
+            theta_off: draws.theta_off[range.clone()].to_vec(),
+            leak: range
+                .clone()
+                .map(|i| leak::drift_per_us(leak_rate, draws.leak_factors[i], draws.theta_on[i]))
+                .collect(),
+            next_interrupt: cold
+                .iter()
+                .map(|c| c.next_noise_us.min(c.next_hot_us))
+                .collect(),
+            window_low: vec![0.0; width],
+            window_high: vec![0.0; width],
+            busy: vec![0; width],
+            filter_end: vec![0.0; width],
+            cold,
+            rng: generator(self.seed, Stream::Rows, self.noise_index(y as u64)),
+            events: Vec::new(),
+        };
+        if self.model.intensity_window {
+            for x in 0..width {
+                row.update_window(x, &log_map);
+            }
+        }
+        row
     }
 
     /// The next sample at time `t`: returns the events in (previous sample, `t`], sorted
@@ -318,4 +337,15 @@ impl Simulator {
         }
         &self.out
     }
+}
+/// Every pixel's draws at the first sample (row-major).
+struct PixelDraws {
+    theta_on: Vec<f32>,
+    theta_off: Vec<f32>,
+    leak_factors: Vec<f32>,
+    /// The first event time of each pixel's hot train (infinite: not a hot pixel).
+    hot_next: Vec<f64>,
+    /// Each pixel's shot-noise rate per microsecond and ON share.
+    rates: Vec<(f64, f32)>,
+    next_noise: Vec<f64>,
 }

@@ -33,11 +33,11 @@ mod steps;
 
 use super::effects::hot_pixels::HotTrain;
 use super::observe::Role;
+use super::selection::hot_excess;
 use super::{FitError, FitInput, FitOptions, FitResult, Uncertain};
 use crate::estimate::eppps::{EpppsInput, EpppsOptions};
 use crate::estimate::{CtEstimate, Interval, Progress};
 use crate::stats::hot_pixels::{HotPixel, find_hot_pixels, neighbour_median};
-use super::selection::hot_excess;
 use crate::stats::robust::sample_std_dev;
 use blocks::Blocks;
 use measure::{BlockMeasure, Measuring};
