@@ -249,32 +249,16 @@ pub fn estimate(
 
     // self-calibration of the timing estimator on a simulation of the same frames
     progress("self-calibration on a simulation of the frames", 0.8);
-    if let Some((period, _)) = grid {
-        assumptions.push(format!(
-            "timestamps are quantised to {period} us (events share stamps: a simulator's frames); the self-calibration simulation is quantised alike"
-        ));
-    }
-    let shift = alignment
-        .as_ref()
-        .map_or(0, |a| (a.shift_s * 1e6).round() as TimeUs);
-    let calibration = calibration_events.and_then(|simulated| {
-        self_calibrate(
-            input,
-            &excluded,
-            &mut frames,
-            options,
-            &full.timing,
-            sigma,
-            simulated,
-            (shift, alignment.is_some()),
-        )
-    });
-    if calibration.is_none() {
-        assumptions.push("the self-calibration (a simulation of these frames with the measured model) could not be run: the event timing's thresholds and spread are not corrected for the method's own bias, and no bias is in their intervals".into());
-    }
-    let bias = calibration.unwrap_or((0.0, 0.0, 0.0));
+    let calibrating = Calibrating {
+        input,
+        excluded: &excluded,
+        options,
+        sigma,
+        alignment: alignment.as_ref(),
+        grid,
+    };
+    let bias = calibrating.bias(&mut frames, &full, calibration_events, &mut assumptions);
     assumptions.extend(blocks_assumption(&full.timing));
-
     let mut estimators = vec![timing_report(&passes, bias, alignment_error)];
     if let Some(r) = &full.resim {
         let (report, note) = resimulation_report(&passes, r);
@@ -657,6 +641,55 @@ fn calibration_events(
 fn simulated_sigma(timing: &TimingEstimate) -> f64 {
     let sigma = timing.spread().sigma;
     if sigma.is_finite() { sigma } else { 0.0 }
+}
+
+/// What the self-calibration needs beside the frames and the full pass.
+struct Calibrating<'a> {
+    input: &'a ApsInput<'a>,
+    excluded: &'a [bool],
+    options: &'a ApsOptions,
+    /// The measured threshold spread the simulation draws with.
+    sigma: f64,
+    alignment: Option<&'a super::align::Alignment>,
+    grid: Option<(TimeUs, TimeUs)>,
+}
+
+impl Calibrating<'_> {
+    /// The timing estimator's own bias (ON, OFF, spread) on `simulated`, a simulation of
+    /// the same frames with the measured model ([`self_calibrate`]); none where it could
+    /// not run, which `assumptions` then says (as it says the simulation's timestamp grid).
+    fn bias(
+        &self,
+        frames: &mut PreparedFrames,
+        full: &Pass,
+        simulated: Option<EventChunk>,
+        assumptions: &mut Vec<String>,
+    ) -> (f64, f64, f64) {
+        if let Some((period, _)) = self.grid {
+            assumptions.push(format!(
+                "timestamps are quantised to {period} us (events share stamps: a simulator's frames); the self-calibration simulation is quantised alike"
+            ));
+        }
+        let shift = self
+            .alignment
+            .map_or(0, |a| (a.shift_s * 1e6).round() as TimeUs);
+        let calibration = simulated.and_then(|simulated| {
+            self_calibrate(
+                self.input,
+                self.excluded,
+                frames,
+                self.options,
+                &full.timing,
+                self.sigma,
+                simulated,
+                (shift, self.alignment.is_some()),
+            )
+        });
+        if calibration.is_none() {
+            assumptions.push("the self-calibration (a simulation of these frames with the measured model) could not be run: the event timing's thresholds and spread are not corrected for the method's own bias, and no bias is in their intervals".into());
+        }
+        calibration.unwrap_or((0.0, 0.0, 0.0))
+    }
 }
 
 /// The timing estimator's bias, found by running the same pipeline on `simulated`, a
