@@ -1352,94 +1352,65 @@ pub fn index_window(
     Ok(found)
 }
 
-impl EventDecoder for H5Decoder {
-    fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
-        if self.position >= self.events {
-            return Ok(());
-        }
-        let end = (self.position + CHUNK_EVENTS.saturating_sub(out.len())).min(self.events);
-        self.table
-            .read(self.position..end, &mut self.buffers, &mut self.columns)
-            .map_err(|e| {
-                h5_error(
-                    &self.path,
-                    &format!("reading events {}..{end}", self.position),
-                    e,
+/// The columns appended to `out` (one fused pass split over the cores, converting while
+/// tracking each column's extremes), and the extremes of x, y, p and t.
+fn convert(columns: &Columns, out: &mut EventChunk) -> ([i64; 4], [i64; 4]) {
+    let Columns {
+        t,
+        x: xs,
+        y: ys,
+        p: ps,
+    } = columns;
+    let start = out.len();
+    let n = t.len();
+    out.t.extend_from_slice(t);
+    out.x.resize(start + n, 0);
+    out.y.resize(start + n, 0);
+    out.on.resize(start + n, false);
+    const PIECE: usize = 1 << 14;
+    let (lo, hi) = out.x[start..]
+        .par_chunks_mut(PIECE)
+        .zip(out.y[start..].par_chunks_mut(PIECE))
+        .zip(out.on[start..].par_chunks_mut(PIECE))
+        .enumerate()
+        .map(|(k, ((x_out, y_out), on_out))| {
+            let base = k * PIECE;
+            let (mut lo, mut hi) = ([i64::MAX; 4], [i64::MIN; 4]);
+            for j in 0..x_out.len() {
+                let i = base + j;
+                let values = [xs[i], ys[i], ps[i], t[i]];
+                for v in 0..4 {
+                    lo[v] = lo[v].min(values[v]);
+                    hi[v] = hi[v].max(values[v]);
+                }
+                x_out[j] = xs[i] as u16;
+                y_out[j] = ys[i] as u16;
+                on_out[j] = ps[i] == 1;
+            }
+            (lo, hi)
+        })
+        .reduce(
+            || ([i64::MAX; 4], [i64::MIN; 4]),
+            |(a_lo, a_hi), (b_lo, b_hi)| {
+                (
+                    std::array::from_fn(|v| a_lo[v].min(b_lo[v])),
+                    std::array::from_fn(|v| a_hi[v].max(b_hi[v])),
                 )
-            })?;
+            },
+        );
+    (lo, hi)
+}
+
+impl H5Decoder {
+    /// The chunk's events appended one by one, the first out of range named with its
+    /// index and the fix.
+    fn checked_one_by_one(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
         let Columns {
             t,
             x: xs,
             y: ys,
             p: ps,
         } = &self.columns;
-        // fast path: every value in range (four vectorisable min/max passes), then the
-        // columns moved over in bulk; anything out of range is found and named below
-        let limit = |sensor: Option<Sensor>| {
-            sensor.map_or((MAX_SENSOR_SIDE as i64, MAX_SENSOR_SIDE as i64), |s| {
-                (s.width as i64, s.height as i64)
-            })
-        };
-        let (width, height) = limit(self.sensor);
-        // one fused pass, split over the cores: convert while tracking the extremes, then
-        // check them
-        let start = out.len();
-        let n = t.len();
-        out.t.extend_from_slice(t);
-        out.x.resize(start + n, 0);
-        out.y.resize(start + n, 0);
-        out.on.resize(start + n, false);
-        const PIECE: usize = 1 << 14;
-        let (lo, hi) = out.x[start..]
-            .par_chunks_mut(PIECE)
-            .zip(out.y[start..].par_chunks_mut(PIECE))
-            .zip(out.on[start..].par_chunks_mut(PIECE))
-            .enumerate()
-            .map(|(k, ((x_out, y_out), on_out))| {
-                let base = k * PIECE;
-                let (mut lo, mut hi) = ([i64::MAX; 4], [i64::MIN; 4]);
-                for j in 0..x_out.len() {
-                    let i = base + j;
-                    let values = [xs[i], ys[i], ps[i], t[i]];
-                    for v in 0..4 {
-                        lo[v] = lo[v].min(values[v]);
-                        hi[v] = hi[v].max(values[v]);
-                    }
-                    x_out[j] = xs[i] as u16;
-                    y_out[j] = ys[i] as u16;
-                    on_out[j] = ps[i] == 1;
-                }
-                (lo, hi)
-            })
-            .reduce(
-                || ([i64::MAX; 4], [i64::MIN; 4]),
-                |(a_lo, a_hi), (b_lo, b_hi)| {
-                    (
-                        std::array::from_fn(|v| a_lo[v].min(b_lo[v])),
-                        std::array::from_fn(|v| a_hi[v].max(b_hi[v])),
-                    )
-                },
-            );
-        let all_valid = lo[0] >= 0
-            && hi[0] < width
-            && lo[1] >= 0
-            && hi[1] < height
-            && lo[2] >= -1
-            && hi[2] <= 1
-            && lo[3] != TimeUs::MIN;
-        if all_valid {
-            let position = self.position;
-            let names = self.table.names();
-            self.order
-                .check_all(t, |i| format!("{}[{}]", names.t, position + i));
-            self.position = end;
-            return Ok(());
-        }
-        // something is out of range: undo, and find and name it event by event
-        out.t.truncate(start);
-        out.x.truncate(start);
-        out.y.truncate(start);
-        out.on.truncate(start);
         let names = self.table.names();
         for i in 0..t.len() {
             let (x, y) = (xs[i], ys[i]);
@@ -1491,6 +1462,54 @@ impl EventDecoder for H5Decoder {
             };
             self.order.check(t[i], || format!("{}[{index}]", names.t));
             out.push(t[i], x as u16, y as u16, on);
+        }
+        Ok(())
+    }
+}
+
+impl EventDecoder for H5Decoder {
+    fn read_chunk(&mut self, out: &mut EventChunk) -> Result<(), InputError> {
+        if self.position >= self.events {
+            return Ok(());
+        }
+        let end = (self.position + CHUNK_EVENTS.saturating_sub(out.len())).min(self.events);
+        self.table
+            .read(self.position..end, &mut self.buffers, &mut self.columns)
+            .map_err(|e| {
+                h5_error(
+                    &self.path,
+                    &format!("reading events {}..{end}", self.position),
+                    e,
+                )
+            })?;
+        // fast path: every value in range (four vectorisable min/max passes), then the
+        // columns moved over in bulk; anything out of range is found and named below
+        let (width, height) = self
+            .sensor
+            .map_or((MAX_SENSOR_SIDE as i64, MAX_SENSOR_SIDE as i64), |s| {
+                (s.width as i64, s.height as i64)
+            });
+        let start = out.len();
+        let (lo, hi) = convert(&self.columns, out);
+        let all_valid = lo[0] >= 0
+            && hi[0] < width
+            && lo[1] >= 0
+            && hi[1] < height
+            && lo[2] >= -1
+            && hi[2] <= 1
+            && lo[3] != TimeUs::MIN;
+        if all_valid {
+            let (position, names) = (self.position, self.table.names());
+            self.order.check_all(&self.columns.t, |i| {
+                format!("{}[{}]", names.t, position + i)
+            });
+        } else {
+            // something is out of range: undo, and find and name it event by event
+            out.t.truncate(start);
+            out.x.truncate(start);
+            out.y.truncate(start);
+            out.on.truncate(start);
+            self.checked_one_by_one(out)?;
         }
         self.position = end;
         Ok(())
