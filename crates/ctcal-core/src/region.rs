@@ -3,10 +3,11 @@
 //!
 //! The fit re-simulates the recording's frames hundreds of times ([`crate::fit`]); its cost
 //! grows with the pixels simulated. Thresholds, their mismatch and the noise rates are
-//! properties of a pixel, which a sample of ~90,000 pixels measures as well as a megapixel
-//! (their intervals are set by the events per pixel and by the frames, not by the pixel
-//! count), so a larger sensor is measured on one rectangle of that size: the one where its
-//! events are densest, which carries the most of the scene's motion and texture. What a
+//! properties of a pixel, which a sample of ~90,000 pixels (a DAVIS346's, which the fit
+//! measures whole) measures too; more pixels would narrow only the statistical part of the
+//! intervals, not the frames' systematics (frame rate, exposure, the blocks' spread). So a
+//! larger sensor is measured on one rectangle of that size: the one where its events are
+//! densest, which carries the most of the scene's motion and texture. What a
 //! region cannot see is said in `assumptions` by the caller: a variation of the thresholds
 //! across the sensor beyond the per-pixel mismatch (e.g. from the readout's column
 //! circuits), and hot pixels outside it.
