@@ -1232,124 +1232,143 @@ pub fn index_window(
 ) -> Result<Option<IndexedRows>, InputError> {
     let file = open_file(path)?;
     let n = info.events;
-    let found = match info.layout {
-        Layout::Dsec if file.link_exists("ms_to_idx") => {
-            let offset = dsec_t_offset(&file).map_err(|e| h5_error(path, "t_offset", e))?;
-            let ms = check_dataset(path, &file, "ms_to_idx", 1)?[0];
-            if ms == 0 || n == 0 {
-                return Ok(None);
-            }
-            let at = |k: usize| -> Result<usize, InputError> {
-                let v: u64 =
-                    element(&file, "ms_to_idx", k).map_err(|e| h5_error(path, "ms_to_idx", e))?;
-                Ok((v as usize).min(n))
-            };
-            let time_at = |row: usize| -> Result<TimeUs, InputError> {
-                if row >= n {
-                    return Ok(TimeUs::MAX);
-                }
-                let t = element::<u64>(&file, "events/t", row)
-                    .map(|t| t as i64)
-                    .or_else(|_| element::<i64>(&file, "events/t", row))
-                    .map_err(|e| h5_error(path, "events/t", e))?;
-                Ok(t.saturating_add(offset))
-            };
-            let millisecond = |t: TimeUs| (t.saturating_sub(offset)).div_euclid(1000);
-            let mut notes = Vec::new();
-            // the row ms_to_idx gives for millisecond `k`, checked against the times: the
-            // first row at or after the millisecond's start
-            let checked = |k: usize, notes: &mut Vec<String>| -> Result<usize, InputError> {
-                let row = at(k)?;
-                let begins = offset.saturating_add(k as i64 * 1000);
-                let before_ok = row == 0 || time_at(row - 1)? < begins;
-                let at_ok = row >= n || time_at(row)? >= begins;
-                if !(before_ok && at_ok) {
-                    let actual = first_row_at_or_after(row, n, begins, &time_at)?;
-                    notes.push(format!(
-                        "{}: ms_to_idx[{k}] = {row} contradicts events/t: the first event of millisecond {k} is row {actual}; the window was found on the event times instead (the index is damaged: rewrite it)",
-                        path.display()
-                    ));
-                }
-                Ok(row)
-            };
-            let first = millisecond(from).clamp(0, ms as i64 - 1) as usize;
-            let last = millisecond(to).saturating_add(1);
-            let near_start = if from <= offset {
-                0
-            } else {
-                checked(first, &mut notes)?
-            };
-            let near_end = if last < 0 {
-                0
-            } else if (last as u64) < ms as u64 {
-                checked(last as usize, &mut notes)?
-            } else {
-                n
-            };
-            // the exact ends, on the times (the index's rows are where the search starts)
-            let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
-            let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
-            Some((start..end.max(start), notes.into_iter().next()))
-        }
-        Layout::Mvsec(side) => {
-            let inds = format!("{}/image_raw_event_inds", side.group());
-            let stamps = format!("{}/image_raw_ts", side.group());
-            if !file.link_exists(&inds) || !file.link_exists(&stamps) {
-                return Ok(None);
-            }
-            let err = |e| h5_error(path, &inds, e);
-            let times: Vec<f64> = file
-                .dataset(&stamps)
-                .and_then(|d| d.read_raw())
-                .map_err(err)?;
-            let indices: Vec<i64> = file
-                .dataset(&inds)
-                .and_then(|d| d.read_raw())
-                .map_err(err)?;
-            let usable = times.len() == indices.len()
-                && indices.windows(2).all(|w| w[0] <= w[1])
-                && indices.iter().all(|&i| i >= 0 && i as usize <= n)
-                && times.iter().all(|t| t.is_finite());
-            if !usable || times.is_empty() {
-                return Ok(None);
-            }
-            let us: Vec<TimeUs> = times.iter().map(|&t| crate::events::s_to_us(t)).collect();
-            // the frames around the window give rows near its ends (the event nearest each
-            // frame); the exact ends are then found on the event times themselves
-            let events = file
-                .dataset(&format!("{}/events", side.group()))
-                .map_err(|e| h5_error(path, "events", e))?;
-            let time_at = |row: usize| -> Result<TimeUs, InputError> {
-                let v = events
-                    .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, 2..3])
-                    .map_err(|e| h5_error(path, "events", e))?;
-                Ok(v.iter().next().map_or(TimeUs::MAX, |&s| {
-                    if s.is_finite() && s.abs() < 1e12 {
-                        crate::events::s_to_us(s)
-                    } else {
-                        TimeUs::MAX
-                    }
-                }))
-            };
-            let before = us.partition_point(|&t| t <= from);
-            let near_start = if before >= 1 {
-                indices[before - 1] as usize
-            } else {
-                0
-            };
-            let after = us.partition_point(|&t| t < to);
-            let near_end = if after < indices.len() {
-                indices[after] as usize
-            } else {
-                n
-            };
-            let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
-            let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
-            Some((start..end.max(start), None))
-        }
-        _ => None,
+    match info.layout {
+        Layout::Dsec if file.link_exists("ms_to_idx") => dsec_window(path, &file, n, from, to),
+        Layout::Mvsec(side) => mvsec_window(path, &file, side, n, from, to),
+        _ => Ok(None),
+    }
+}
+
+/// [`index_window`] through DSEC's `ms_to_idx`, each row it gives checked against the
+/// event times (a contradiction noted, the rows then found on the times).
+fn dsec_window(
+    path: &Path,
+    file: &hdf5::File,
+    n: usize,
+    from: TimeUs,
+    to: TimeUs,
+) -> Result<Option<IndexedRows>, InputError> {
+    let offset = dsec_t_offset(file).map_err(|e| h5_error(path, "t_offset", e))?;
+    let ms = check_dataset(path, file, "ms_to_idx", 1)?[0];
+    if ms == 0 || n == 0 {
+        return Ok(None);
+    }
+    let at = |k: usize| -> Result<usize, InputError> {
+        let v: u64 = element(file, "ms_to_idx", k).map_err(|e| h5_error(path, "ms_to_idx", e))?;
+        Ok((v as usize).min(n))
     };
-    Ok(found)
+    let time_at = |row: usize| -> Result<TimeUs, InputError> {
+        if row >= n {
+            return Ok(TimeUs::MAX);
+        }
+        let t = element::<u64>(file, "events/t", row)
+            .map(|t| t as i64)
+            .or_else(|_| element::<i64>(file, "events/t", row))
+            .map_err(|e| h5_error(path, "events/t", e))?;
+        Ok(t.saturating_add(offset))
+    };
+    let millisecond = |t: TimeUs| (t.saturating_sub(offset)).div_euclid(1000);
+    let mut notes = Vec::new();
+    // the row ms_to_idx gives for millisecond `k`, checked against the times: the
+    // first row at or after the millisecond's start
+    let checked = |k: usize, notes: &mut Vec<String>| -> Result<usize, InputError> {
+        let row = at(k)?;
+        let begins = offset.saturating_add(k as i64 * 1000);
+        let before_ok = row == 0 || time_at(row - 1)? < begins;
+        let at_ok = row >= n || time_at(row)? >= begins;
+        if !(before_ok && at_ok) {
+            let actual = first_row_at_or_after(row, n, begins, &time_at)?;
+            notes.push(format!(
+                "{}: ms_to_idx[{k}] = {row} contradicts events/t: the first event of millisecond {k} is row {actual}; the window was found on the event times instead (the index is damaged: rewrite it)",
+                path.display()
+            ));
+        }
+        Ok(row)
+    };
+    let first = millisecond(from).clamp(0, ms as i64 - 1) as usize;
+    let last = millisecond(to).saturating_add(1);
+    let near_start = if from <= offset {
+        0
+    } else {
+        checked(first, &mut notes)?
+    };
+    let near_end = if last < 0 {
+        0
+    } else if (last as u64) < ms as u64 {
+        checked(last as usize, &mut notes)?
+    } else {
+        n
+    };
+    // the exact ends, on the times (the index's rows are where the search starts)
+    let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
+    let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
+    Ok(Some((start..end.max(start), notes.into_iter().next())))
+}
+
+/// [`index_window`] through MVSEC's `image_raw_event_inds` (the event nearest each frame),
+/// where it is usable (as long as the frame stamps, non-decreasing, within the events).
+fn mvsec_window(
+    path: &Path,
+    file: &hdf5::File,
+    side: Side,
+    n: usize,
+    from: TimeUs,
+    to: TimeUs,
+) -> Result<Option<IndexedRows>, InputError> {
+    let inds = format!("{}/image_raw_event_inds", side.group());
+    let stamps = format!("{}/image_raw_ts", side.group());
+    if !file.link_exists(&inds) || !file.link_exists(&stamps) {
+        return Ok(None);
+    }
+    let err = |e| h5_error(path, &inds, e);
+    let times: Vec<f64> = file
+        .dataset(&stamps)
+        .and_then(|d| d.read_raw())
+        .map_err(err)?;
+    let indices: Vec<i64> = file
+        .dataset(&inds)
+        .and_then(|d| d.read_raw())
+        .map_err(err)?;
+    let usable = times.len() == indices.len()
+        && indices.windows(2).all(|w| w[0] <= w[1])
+        && indices.iter().all(|&i| i >= 0 && i as usize <= n)
+        && times.iter().all(|t| t.is_finite());
+    if !usable || times.is_empty() {
+        return Ok(None);
+    }
+    let us: Vec<TimeUs> = times.iter().map(|&t| crate::events::s_to_us(t)).collect();
+    // the frames around the window give rows near its ends (the event nearest each
+    // frame); the exact ends are then found on the event times themselves
+    let events = file
+        .dataset(&format!("{}/events", side.group()))
+        .map_err(|e| h5_error(path, "events", e))?;
+    let time_at = |row: usize| -> Result<TimeUs, InputError> {
+        let v = events
+            .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, 2..3])
+            .map_err(|e| h5_error(path, "events", e))?;
+        Ok(v.iter().next().map_or(TimeUs::MAX, |&s| {
+            if s.is_finite() && s.abs() < 1e12 {
+                crate::events::s_to_us(s)
+            } else {
+                TimeUs::MAX
+            }
+        }))
+    };
+    let before = us.partition_point(|&t| t <= from);
+    let near_start = if before >= 1 {
+        indices[before - 1] as usize
+    } else {
+        0
+    };
+    let after = us.partition_point(|&t| t < to);
+    let near_end = if after < indices.len() {
+        indices[after] as usize
+    } else {
+        n
+    };
+    let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
+    let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
+    Ok(Some((start..end.max(start), None)))
 }
 
 /// The columns appended to `out` (one fused pass split over the cores, converting while
