@@ -844,127 +844,152 @@ struct FrameIndex {
 }
 
 fn frame_index(path: &Path, file: &hdf5::File, layout: Layout) -> Result<FrameIndex, InputError> {
-    let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
     let mut index = FrameIndex {
         times: Vec::new(),
         datasets: Vec::new(),
         size: (0, 0),
     };
     match layout {
-        Layout::EventUtils => {
-            for name in image_names(file) {
-                let full = format!("images/{name}");
-                let shape = check_dataset(path, file, &full, 2)?;
-                let size = frame_size(path, &full, shape[0], shape[1])?;
-                let ds = file.dataset(&full).map_err(|e| err(&full, e))?;
-                let t: f64 = ds
-                    .attr("timestamp")
-                    .and_then(|a| a.read_scalar::<f64>())
-                    .map_err(|e| err(&format!("{full} attribute `timestamp`"), e))?;
-                if !t.is_finite() || t.abs() > 1e12 {
-                    return Err(InputError::hdf5(
-                        path,
-                        format!("{full} has timestamp {t}"),
-                        "frame timestamps are seconds; the file is damaged",
-                    ));
-                }
-                index.push(
-                    path,
-                    &full,
-                    crate::events::s_to_us(t),
-                    size,
-                    Some(full.clone()),
-                )?;
-            }
-        }
-        Layout::V2e => {
-            if file.dataset("frame").is_err() {
-                return Ok(index);
-            }
-            let shape = check_dataset(path, file, "frame", 3)?;
-            let size = frame_size(path, "frame", shape[1], shape[2])?;
-            // microseconds, as integers (v2e) or floats: a float NaN or infinity must not
-            // become a time by integer conversion
-            let stamps = file.dataset("frame_ts").map_err(|e| err("frame_ts", e))?;
-            let float = matches!(
-                stamps.dtype().and_then(|d| d.to_descriptor()),
-                Ok(TypeDescriptor::Float(_))
-            );
-            let times: Vec<i64> = if float {
-                let values: Vec<f64> = stamps.read_raw().map_err(|e| err("frame_ts", e))?;
-                let mut times = Vec::with_capacity(values.len());
-                for (i, &t) in values.iter().enumerate() {
-                    if !(t.is_finite() && t.abs() <= crate::events::TIME_LIMIT_US as f64) {
-                        return Err(InputError::hdf5(
-                            path,
-                            format!("frame_ts[{i}] is {t}, not a time in microseconds"),
-                            "frame timestamps are microseconds; the file is damaged",
-                        ));
-                    }
-                    times.push(t.round() as i64);
-                }
-                times
-            } else {
-                stamps.read_raw::<i64>().map_err(|e| err("frame_ts", e))?
-            };
-            if times.len() != shape[0] {
-                return Err(InputError::hdf5(
-                    path,
-                    format!(
-                        "frame holds {} frames but frame_ts {} timestamps",
-                        shape[0],
-                        times.len()
-                    ),
-                    "v2e frames are (N, H, W) with N timestamps (microseconds) in frame_ts",
-                ));
-            }
-            for (i, &t) in times.iter().enumerate() {
-                index.push(path, &format!("frame_ts[{i}]"), t, size, None)?;
-            }
-        }
-        Layout::Mvsec(side) => {
-            let stack = format!("{}/image_raw", side.group());
-            if !file.link_exists(&stack) {
-                return Ok(index);
-            }
-            let shape = check_dataset(path, file, &stack, 3)?;
-            let size = frame_size(path, &stack, shape[1], shape[2])?;
-            let stamps = format!("{stack}_ts");
-            let times: Vec<f64> = file
-                .dataset(&stamps)
-                .and_then(|d| d.read_raw::<f64>())
-                .map_err(|e| err(&stamps, e))?;
-            if times.len() != shape[0] {
-                return Err(InputError::hdf5(
-                    path,
-                    format!(
-                        "{stack} holds {} frames but {stamps} {} timestamps",
-                        shape[0],
-                        times.len()
-                    ),
-                    "MVSEC frames are (M, H, W) with M timestamps (seconds) in image_raw_ts",
-                ));
-            }
-            for (i, &t) in times.iter().enumerate() {
-                if !t.is_finite() || t.abs() > 1e12 {
-                    return Err(InputError::hdf5(
-                        path,
-                        format!("{stamps}[{i}] is {t}"),
-                        "frame timestamps are seconds; the file is damaged",
-                    ));
-                }
-                index.push(
-                    path,
-                    &format!("{stamps}[{i}]"),
-                    crate::events::s_to_us(t),
-                    size,
-                    None,
-                )?;
-            }
-        }
+        Layout::EventUtils => event_utils_frames(path, file, &mut index)?,
+        Layout::V2e => v2e_frames(path, file, &mut index)?,
+        Layout::Mvsec(side) => mvsec_frames(path, file, side, &mut index)?,
         Layout::Dsec => {}
     }
     Ok(index)
+}
+
+/// event_utils: one dataset per frame under `images/`, its time (seconds) an attribute.
+fn event_utils_frames(
+    path: &Path,
+    file: &hdf5::File,
+    index: &mut FrameIndex,
+) -> Result<(), InputError> {
+    let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
+    for name in image_names(file) {
+        let full = format!("images/{name}");
+        let shape = check_dataset(path, file, &full, 2)?;
+        let size = frame_size(path, &full, shape[0], shape[1])?;
+        let ds = file.dataset(&full).map_err(|e| err(&full, e))?;
+        let t: f64 = ds
+            .attr("timestamp")
+            .and_then(|a| a.read_scalar::<f64>())
+            .map_err(|e| err(&format!("{full} attribute `timestamp`"), e))?;
+        if !t.is_finite() || t.abs() > 1e12 {
+            return Err(InputError::hdf5(
+                path,
+                format!("{full} has timestamp {t}"),
+                "frame timestamps are seconds; the file is damaged",
+            ));
+        }
+        index.push(
+            path,
+            &full,
+            crate::events::s_to_us(t),
+            size,
+            Some(full.clone()),
+        )?;
+    }
+    Ok(())
+}
+
+/// v2e: the frames as rows of `frame` (N, H, W), their times in `frame_ts` (microseconds,
+/// integers or floats).
+fn v2e_frames(path: &Path, file: &hdf5::File, index: &mut FrameIndex) -> Result<(), InputError> {
+    let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
+    if file.dataset("frame").is_err() {
+        return Ok(());
+    }
+    let shape = check_dataset(path, file, "frame", 3)?;
+    let size = frame_size(path, "frame", shape[1], shape[2])?;
+    // microseconds, as integers (v2e) or floats: a float NaN or infinity must not
+    // become a time by integer conversion
+    let stamps = file.dataset("frame_ts").map_err(|e| err("frame_ts", e))?;
+    let float = matches!(
+        stamps.dtype().and_then(|d| d.to_descriptor()),
+        Ok(TypeDescriptor::Float(_))
+    );
+    let times: Vec<i64> = if float {
+        let values: Vec<f64> = stamps.read_raw().map_err(|e| err("frame_ts", e))?;
+        let mut times = Vec::with_capacity(values.len());
+        for (i, &t) in values.iter().enumerate() {
+            if !(t.is_finite() && t.abs() <= crate::events::TIME_LIMIT_US as f64) {
+                return Err(InputError::hdf5(
+                    path,
+                    format!("frame_ts[{i}] is {t}, not a time in microseconds"),
+                    "frame timestamps are microseconds; the file is damaged",
+                ));
+            }
+            times.push(t.round() as i64);
+        }
+        times
+    } else {
+        stamps.read_raw::<i64>().map_err(|e| err("frame_ts", e))?
+    };
+    if times.len() != shape[0] {
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "frame holds {} frames but frame_ts {} timestamps",
+                shape[0],
+                times.len()
+            ),
+            "v2e frames are (N, H, W) with N timestamps (microseconds) in frame_ts",
+        ));
+    }
+    for (i, &t) in times.iter().enumerate() {
+        index.push(path, &format!("frame_ts[{i}]"), t, size, None)?;
+    }
+    Ok(())
+}
+
+/// MVSEC: the frames of one side as rows of `image_raw` (M, H, W), their times in
+/// `image_raw_ts` (seconds).
+fn mvsec_frames(
+    path: &Path,
+    file: &hdf5::File,
+    side: Side,
+    index: &mut FrameIndex,
+) -> Result<(), InputError> {
+    let err = |what: &str, e: hdf5::Error| h5_error(path, what, e);
+    let stack = format!("{}/image_raw", side.group());
+    if !file.link_exists(&stack) {
+        return Ok(());
+    }
+    let shape = check_dataset(path, file, &stack, 3)?;
+    let size = frame_size(path, &stack, shape[1], shape[2])?;
+    let stamps = format!("{stack}_ts");
+    let times: Vec<f64> = file
+        .dataset(&stamps)
+        .and_then(|d| d.read_raw::<f64>())
+        .map_err(|e| err(&stamps, e))?;
+    if times.len() != shape[0] {
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "{stack} holds {} frames but {stamps} {} timestamps",
+                shape[0],
+                times.len()
+            ),
+            "MVSEC frames are (M, H, W) with M timestamps (seconds) in image_raw_ts",
+        ));
+    }
+    for (i, &t) in times.iter().enumerate() {
+        if !t.is_finite() || t.abs() > 1e12 {
+            return Err(InputError::hdf5(
+                path,
+                format!("{stamps}[{i}] is {t}"),
+                "frame timestamps are seconds; the file is damaged",
+            ));
+        }
+        index.push(
+            path,
+            &format!("{stamps}[{i}]"),
+            crate::events::s_to_us(t),
+            size,
+            None,
+        )?;
+    }
+    Ok(())
 }
 
 impl FrameIndex {
