@@ -138,6 +138,19 @@ pub fn oracle_params(case: &str) -> serde_json::Value {
     serde_json::from_str(&text).expect("valid JSON")
 }
 
+/// The (x, y) of each pixel of a JSON array of them (a fit's `hot_pixels_masked`, an
+/// oracle's injected hot pixels), sorted.
+pub fn pixel_positions(value: &serde_json::Value) -> Vec<(u64, u64)> {
+    let mut pixels: Vec<(u64, u64)> = value
+        .as_array()
+        .expect("an array of pixels")
+        .iter()
+        .map(|p| (p["x"].as_u64().unwrap(), p["y"].as_u64().unwrap()))
+        .collect();
+    pixels.sort_unstable();
+    pixels
+}
+
 /// The strings of a JSON array (panics where it is not one of strings).
 pub fn strings(value: &serde_json::Value) -> Vec<&str> {
     value

@@ -170,21 +170,10 @@ fn exactly_the_injected_hot_pixels_are_masked() {
     let f = fit(&oracle("dev_hot_pixels"), &[]);
     check_contract(&f);
     assert!(added(&f).contains(&"hot_pixels".to_string()));
-    let mut masked: Vec<(u64, u64)> = f["hot_pixels_masked"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
-        .collect();
-    let mut injected: Vec<(u64, u64)> =
-        oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
-            .collect();
-    masked.sort_unstable();
-    injected.sort_unstable();
+    let masked = pixel_positions(&f["hot_pixels_masked"]);
+    let injected = pixel_positions(
+        &oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"],
+    );
     assert_eq!(masked, injected);
     assert!(param(&f, "hot_pixel_fraction").unwrap() > 0.0);
 }
@@ -219,22 +208,13 @@ fn a_sensor_larger_than_the_pixel_limit_is_fitted_on_its_busiest_region() {
         "{note}"
     );
     let inside = |x: u64, y: u64| (x0..x1).contains(&x) && (y0..y1).contains(&y);
-    let mut masked: Vec<(u64, u64)> = f["hot_pixels_masked"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
-        .collect();
-    let mut injected_inside: Vec<(u64, u64)> =
-        oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
-            .filter(|&(x, y)| inside(x, y))
-            .collect();
-    masked.sort_unstable();
-    injected_inside.sort_unstable();
+    let masked = pixel_positions(&f["hot_pixels_masked"]);
+    let injected_inside: Vec<(u64, u64)> = pixel_positions(
+        &oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"],
+    )
+    .into_iter()
+    .filter(|&(x, y)| inside(x, y))
+    .collect();
     assert!(!injected_inside.is_empty(), "{note}");
     assert_eq!(masked, injected_inside);
     for key in ["ct_on", "ct_off"] {

@@ -1,7 +1,7 @@
 //! `ctcal fit` without grey frames: v2e oracle cases with their frames withheld against
 //! their known parameters, and the shared events-only recordings end to end (fit, config).
 
-use crate::common::{ctcal, json, oracle, oracle_params, real, succeeded};
+use crate::common::{ctcal, json, oracle, oracle_params, pixel_positions, real, succeeded};
 
 fn fit_without_frames(case: &str) -> serde_json::Value {
     json(&["fit", oracle(case).to_str().unwrap(), "--no-frames"])
@@ -11,21 +11,10 @@ fn fit_without_frames(case: &str) -> serde_json::Value {
 fn hot_pixels_are_named_exactly_without_frames() {
     let fit = fit_without_frames("dev_hot_pixels");
     let truth = &oracle_params("dev_hot_pixels")["post_processing"]["injection"]["hot_pixels"];
-    let mut named: Vec<(u64, u64)> = fit["hot_pixels_masked"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
-        .collect();
-    let mut injected: Vec<(u64, u64)> = truth
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|h| (h["x"].as_u64().unwrap(), h["y"].as_u64().unwrap()))
-        .collect();
-    named.sort_unstable();
-    injected.sort_unstable();
-    assert_eq!(named, injected);
+    assert_eq!(
+        pixel_positions(&fit["hot_pixels_masked"]),
+        pixel_positions(truth)
+    );
     // the trains' rate beyond the scene's at their pixels: the median of the injected
     // rates (ON + OFF: 297, 62, 48 and 34 Hz, so 55.1 Hz), within the Poisson error of
     // the two middle trains' 50-odd events each (14 %)

@@ -150,6 +150,14 @@ impl Roi {
     }
 }
 
+/// The values of a row-major image of `width` columns inside `roi`, row-major.
+fn cut<T: Copy>(values: &[T], width: usize, roi: Roi) -> Vec<T> {
+    (roi.y0 as usize..roi.y1 as usize)
+        .flat_map(|y| &values[y * width + roi.x0 as usize..y * width + roi.x1 as usize])
+        .copied()
+        .collect()
+}
+
 impl EventChunk {
     /// The events inside `roi`, in the region's coordinates (its corner at 0, 0).
     pub fn within(&self, roi: Roi) -> EventChunk {
@@ -167,13 +175,8 @@ impl EventChunk {
 impl Frame {
     /// The frame's pixels inside `roi` (which must lie on the frame).
     pub fn within(&self, roi: Roi) -> Frame {
-        let w = self.width as usize;
-        let pixels = (roi.y0 as usize..roi.y1 as usize)
-            .flat_map(|y| self.pixels[y * w + roi.x0 as usize..y * w + roi.x1 as usize].iter())
-            .copied()
-            .collect();
         Frame {
-            pixels,
+            pixels: cut(&self.pixels, self.width as usize, roi),
             width: roi.width() as u32,
             height: roi.height() as u32,
             ..*self
@@ -185,11 +188,7 @@ impl PixelSelection {
     /// The selection of the pixels inside `roi`, as a selection of a sensor of the region's
     /// size (what was applied is kept, the region added).
     pub fn within(&self, roi: Roi) -> PixelSelection {
-        let (w, kept) = (self.sensor().width as usize, self.kept_mask());
-        let keep = (roi.y0 as usize..roi.y1 as usize)
-            .flat_map(|y| kept[y * w + roi.x0 as usize..y * w + roi.x1 as usize].iter())
-            .copied()
-            .collect();
+        let keep = cut(self.kept_mask(), self.sensor().width as usize, roi);
         self.cut(
             roi.as_sensor(),
             keep,

@@ -858,6 +858,23 @@ fn frame_index(path: &Path, file: &hdf5::File, layout: Layout) -> Result<FrameIn
     Ok(index)
 }
 
+/// A frame time in seconds as microseconds; a value that is not a time (NaN, infinite,
+/// beyond 1e12 s) is refused with `problem`.
+fn frame_seconds(
+    path: &Path,
+    t: f64,
+    problem: impl FnOnce() -> String,
+) -> Result<TimeUs, InputError> {
+    if !t.is_finite() || t.abs() > 1e12 {
+        return Err(InputError::hdf5(
+            path,
+            problem(),
+            "frame timestamps are seconds; the file is damaged",
+        ));
+    }
+    Ok(crate::events::s_to_us(t))
+}
+
 /// event_utils: one dataset per frame under `images/`, its time (seconds) an attribute.
 fn event_utils_frames(
     path: &Path,
@@ -874,20 +891,8 @@ fn event_utils_frames(
             .attr("timestamp")
             .and_then(|a| a.read_scalar::<f64>())
             .map_err(|e| err(&format!("{full} attribute `timestamp`"), e))?;
-        if !t.is_finite() || t.abs() > 1e12 {
-            return Err(InputError::hdf5(
-                path,
-                format!("{full} has timestamp {t}"),
-                "frame timestamps are seconds; the file is damaged",
-            ));
-        }
-        index.push(
-            path,
-            &full,
-            crate::events::s_to_us(t),
-            size,
-            Some(full.clone()),
-        )?;
+        let t = frame_seconds(path, t, || format!("{full} has timestamp {t}"))?;
+        index.push(path, &full, t, size, Some(full.clone()))?;
     }
     Ok(())
 }
@@ -974,20 +979,8 @@ fn mvsec_frames(
         ));
     }
     for (i, &t) in times.iter().enumerate() {
-        if !t.is_finite() || t.abs() > 1e12 {
-            return Err(InputError::hdf5(
-                path,
-                format!("{stamps}[{i}] is {t}"),
-                "frame timestamps are seconds; the file is damaged",
-            ));
-        }
-        index.push(
-            path,
-            &format!("{stamps}[{i}]"),
-            crate::events::s_to_us(t),
-            size,
-            None,
-        )?;
+        let t = frame_seconds(path, t, || format!("{stamps}[{i}] is {t}"))?;
+        index.push(path, &format!("{stamps}[{i}]"), t, size, None)?;
     }
     Ok(())
 }

@@ -37,7 +37,7 @@ use super::selection::hot_excess;
 use super::{FitError, FitInput, FitOptions, FitResult, Uncertain};
 use crate::estimate::eppps::{EpppsInput, EpppsOptions};
 use crate::estimate::{CtEstimate, Interval, Progress};
-use crate::stats::hot_pixels::{HotPixel, find_hot_pixels, neighbour_median};
+use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
 use crate::stats::robust::sample_std_dev;
 use blocks::Blocks;
 use measure::{BlockMeasure, Measuring};
@@ -240,14 +240,13 @@ fn hot_pixels(
                 y: p.y,
                 rate_hz: counts[k] as f64 / seconds,
                 on_share: on[k] as f64 / counts[k].max(1) as f64,
-                scene_hz: neighbour_median(&counts, w, h, p.x as usize, p.y as usize) / seconds,
             }
         })
         .collect();
     let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
     let found = hot_excess::excess(&hot_excess::Counts {
         real_named: &hot,
-        model: &vec![0; w * h],
+        model: None,
         width: w,
         height: h,
         duration_s: seconds,

@@ -133,7 +133,7 @@ fn hot_pixels(
     }
     let found = super::hot_excess::excess(&super::hot_excess::Counts {
         real_named: &state.hot,
-        model: &model,
+        model: Some(&model),
         width: g.sensor.width as usize,
         height: g.sensor.height as usize,
         duration_s: g.duration_of(Subset::Fit),

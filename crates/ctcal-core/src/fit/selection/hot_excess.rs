@@ -49,8 +49,10 @@ pub struct HotExcess {
 /// The per-pixel counts of the recording and of the final model, over the same blocks.
 pub struct Counts<'a> {
     pub real_named: &'a [HotPixel],
-    /// The model's per-pixel counts (its named trains included: they are left out here).
-    pub model: &'a [u32],
+    /// The model's per-pixel counts (its named trains included: they are left out here);
+    /// `None` where no model is simulated per pixel (the fit without frames): no outliers
+    /// of its own are subtracted.
+    pub model: Option<&'a [u32]>,
     pub width: usize,
     pub height: usize,
     pub duration_s: f64,
@@ -63,14 +65,7 @@ pub struct Counts<'a> {
 
 /// The recording's named pixels in excess of the model's own outliers.
 pub fn excess(c: &Counts) -> HotExcess {
-    let mut model = c.model.to_vec();
-    for h in c.real_named {
-        model[h.y as usize * c.width + h.x as usize] = 0;
-    }
-    let m = find_hot_pixels(&model, c.width, c.height, c.duration_s)
-        .into_iter()
-        .filter(|p| !c.real_named.iter().any(|h| (h.x, h.y) == (p.x, p.y)))
-        .count();
+    let m = c.model.map_or(0, |model| model_outliers(model, c));
     let n = c.real_named.len();
     let k = n.saturating_sub(m);
     let (lo, hi) = if m == 0 {
@@ -109,6 +104,19 @@ pub fn excess(c: &Counts) -> HotExcess {
         model_outliers: m,
         detection: detectability.map(|(half, d)| detection(half, &d)),
     }
+}
+
+/// The count outliers `model` makes by itself, away from the recording's named pixels
+/// (their trains left out of it).
+fn model_outliers(model: &[u32], c: &Counts) -> usize {
+    let mut model = model.to_vec();
+    for h in c.real_named {
+        model[h.y as usize * c.width + h.x as usize] = 0;
+    }
+    find_hot_pixels(&model, c.width, c.height, c.duration_s)
+        .into_iter()
+        .filter(|p| !c.real_named.iter().any(|h| (h.x, h.y) == (p.x, p.y)))
+        .count()
 }
 
 /// What the search sees: the half-detection rate and `pi` on
@@ -232,7 +240,7 @@ mod tests {
     fn counts<'a>(named: &'a [HotPixel], model: &'a [u32], real: &'a [u32]) -> Counts<'a> {
         Counts {
             real_named: named,
-            model,
+            model: Some(model),
             width: 40,
             height: 20,
             duration_s: 10.0,

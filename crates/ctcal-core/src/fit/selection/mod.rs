@@ -39,7 +39,7 @@ use crate::estimate::aps::{self, ApsInput};
 use crate::estimate::{Progress, dynamics, timestamp_grid};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::PixelParams;
-use crate::stats::hot_pixels::{HotPixel, neighbour_median};
+use crate::stats::hot_pixels::HotPixel;
 use std::cell::Cell;
 use std::collections::BTreeMap;
 
@@ -507,8 +507,6 @@ fn hot_trains(
             None,
         ),
     };
-    let counts = context.real.pixels_of(g, context.subset);
-    let (w, hgt) = (g.sensor.width as usize, g.sensor.height as usize);
     let trains = hot
         .iter()
         .map(|h| {
@@ -524,8 +522,6 @@ fn hot_trains(
                 y: h.y,
                 rate_hz: h.rate_hz,
                 on_share: if all > 0 { on as f64 / all as f64 } else { 0.5 },
-                scene_hz: neighbour_median(&counts, w, hgt, h.x as usize, h.y as usize)
-                    / g.duration_of(context.subset).max(1e-9),
             }
         })
         .collect();

@@ -200,9 +200,6 @@ pub struct HotTrain {
     /// Events per second, and the share of them that are ON.
     pub rate_hz: f64,
     pub on_share: f64,
-    /// The scene's share of `rate_hz`: the median of the 8 neighbours' rates. The train a
-    /// simulator adds on top of the pixel's own events is `rate_hz - scene_hz`.
-    pub scene_hz: f64,
 }
 
 /// The hot pixels' own events over `span`: at each pixel a Poisson train at its rate, each
@@ -245,7 +242,6 @@ mod tests {
                 y: 3,
                 rate_hz: 50.0,
                 on_share: 0.5,
-                scene_hz: 0.0,
             }],
             (0, 4_000_000),
             1,
@@ -292,14 +288,12 @@ mod tests {
                 y: 4,
                 rate_hz: 1000.0,
                 on_share: 0.8,
-                scene_hz: 0.0,
             },
             HotTrain {
                 x: 7,
                 y: 1,
                 rate_hz: 200.0,
                 on_share: 0.0,
-                scene_hz: 0.0,
             },
         ];
         let e = events(&trains, (1_000_000, 3_000_000), 9);
