@@ -125,3 +125,48 @@ fn aps_intervals_on_a_random_subset_are_scored() {
     }
     eprintln!("{markdown}");
 }
+
+/// `estimate eppps` with frames on two draws of the study's first 100 whose line scans miss
+/// the truth by about 40 % (draw 23: a natural image at 15 px/s with a 9.7 Hz photoreceptor,
+/// both read 1.4x high; draw 46: multi-object at 18 px/s with bandwidth, refractory period
+/// and leak, both read 0.72x low). With the 10 % method systematic of six clean cases their
+/// intervals missed by 1.5-1.9 half-widths; the systematic measured on 262 polarity-cases
+/// of random draws (37 %) holds them. The values themselves are as before: the scans have
+/// not changed, only what the interval says of them.
+#[test]
+fn eppps_intervals_hold_the_truth_on_draws_its_scans_miss() {
+    let work = tempfile::tempdir().unwrap();
+    let options = RunOptions {
+        binary: env!("CARGO_BIN_EXE_ctcal").into(),
+        threads: 2,
+        timeout: Duration::from_secs(300),
+    };
+    for (seed, read_high) in [(23, true), (46, false)] {
+        let case = CaseSpec::draw(seed);
+        let dir = work.path().join(&case.id);
+        let truth = write_case(&case, &dir).expect("the case is written");
+        let (outcome, seconds) = run_method(&options, Method::Eppps, &dir, &case);
+        let record = RunRecord::new(
+            case.clone(),
+            Some(truth.clone()),
+            Method::Eppps,
+            seconds,
+            outcome,
+        );
+        for key in ["ct_on", "ct_off"] {
+            let true_value = truth.values[key];
+            let Reported::Interval { value, lo, hi } = record.reported[key].clone() else {
+                panic!("draw {seed} {key}: {:?}", record.reported[key]);
+            };
+            let error = (value / true_value).ln();
+            assert!(
+                error.abs() > 0.25 && (error > 0.0) == read_high,
+                "draw {seed} {key}: {value} for {true_value}, the scans' miss this test is about"
+            );
+            assert!(
+                lo.unwrap_or(0.0) <= true_value && true_value <= hi.unwrap_or(f64::INFINITY),
+                "draw {seed} {key}: [{lo:?}, {hi:?}] for {true_value}"
+            );
+        }
+    }
+}

@@ -15,18 +15,36 @@ fn project() -> &'static Path {
 }
 
 /// The report of `data_samples`, made once for every test here (run from the project root
-/// as a user would: `ctcal report data_samples --out DIR`).
+/// as a user would: `ctcal report data_samples --out DIR`). Under nextest every test is its
+/// own process: the report is written to a folder of this process and renamed into place,
+/// so that the first process to finish publishes it and the others read that one; the
+/// folder is named after the binary's size and time, so a rebuilt binary makes a new one
+/// (and the old ones are removed).
 pub(crate) fn sample_report() -> &'static Path {
     static REPORT: OnceLock<PathBuf> = OnceLock::new();
     REPORT.get_or_init(|| {
-        let out = Path::new(env!("CARGO_TARGET_TMPDIR")).join("sample_report");
-        if out.exists() {
-            std::fs::remove_dir_all(&out).unwrap();
+        let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+        let binary = std::fs::metadata(assert_cmd::cargo::cargo_bin("ctcal")).unwrap();
+        let modified = binary
+            .modified()
+            .unwrap()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_nanos();
+        let name = format!("sample_report-{}-{modified}", binary.len());
+        let out = tmp.join(&name);
+        if out.join("results.json").exists() {
+            return out;
+        }
+        remove_other_reports(tmp, &name);
+        let mine = tmp.join(format!("{name}.{}", std::process::id()));
+        if mine.exists() {
+            std::fs::remove_dir_all(&mine).unwrap();
         }
         let output = ctcal()
             .current_dir(project())
             .args(["report", "data_samples", "--out"])
-            .arg(&out)
+            .arg(&mine)
             .output()
             .unwrap();
         assert!(
@@ -34,8 +52,31 @@ pub(crate) fn sample_report() -> &'static Path {
             "ctcal report failed: {}",
             String::from_utf8_lossy(&output.stderr)
         );
+        // another process may have published its copy first: then that one is read
+        if std::fs::rename(&mine, &out).is_err() {
+            std::fs::remove_dir_all(&mine).unwrap();
+        }
+        assert!(
+            out.join("results.json").exists(),
+            "{} published",
+            out.display()
+        );
         out
     })
+}
+
+/// Removes the sample reports of other binaries (best effort: another process may be
+/// removing them too).
+fn remove_other_reports(tmp: &Path, keep: &str) {
+    let Ok(entries) = std::fs::read_dir(tmp) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if name.starts_with("sample_report") && !name.starts_with(keep) {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
 }
 
 fn results() -> Value {
