@@ -707,14 +707,13 @@ fn assumptions(
         "scans start from the state {} px of the same motion left (the recording is part of a longer one); ideal pixels: bandwidth, refractory period and noise of the real sensor are not in the scans",
         scans::BURN_IN_PX
     ));
-    out.push(format!(
-        "{}",
+    out.push(
         if frames {
             format!("method systematic: {:.0} % (in ln C) in every interval, the scans' error beyond their own intervals on simulated recordings with known thresholds, random scenes and random sensor effects read through their frames (coverage study, 262 polarity-cases: the smallest term that covers 95 % of them; 90 % of 80 draws it was not measured on); a sensor whose bandwidth, refractory period, leak or noise lies far outside that study's range moves the count further", 100.0 * METHOD_LN_SYSTEMATIC)
         } else {
             format!("method systematic: {:.0} % (in ln C) in every interval beside the prior's spread, the scans' error on simulated recordings with known thresholds and no other effect (six polarity-cases; with the prior it covered 90-92 % of 60 draws read without frames); bandwidth or a refractory period, which thin the events further, is not in it", 100.0 * METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES)
-        }
-    ));
+        },
+    );
     out
 }
 
