@@ -53,6 +53,11 @@ pub const JITTER_ALLOWANCE: f64 = 1.5;
 /// [`Simulation::settle_flat`] probes.
 pub const FLAT_PROBE: f64 = 1.1;
 
+/// The range a threshold profile searches: a threshold that ends at either end was not
+/// matched inside it, and is a bound rather than a measurement
+/// ([`super::selection`] reports it so).
+pub const THRESHOLD_RANGE: (f64, f64) = (0.02, 5.0);
+
 /// Secant steps of the threshold profile after its first simulation.
 const PROFILE_STEPS: usize = 4;
 
@@ -82,7 +87,7 @@ fn secant_step(history: &[(f64, f64)]) -> f64 {
     (x1 - y1 / slope)
         .exp()
         .clamp(c / 2.0, c * 2.0)
-        .clamp(0.02, 5.0)
+        .clamp(THRESHOLD_RANGE.0, THRESHOLD_RANGE.1)
 }
 
 /// A simulated model: its parameters (thresholds profiled) and statistics.

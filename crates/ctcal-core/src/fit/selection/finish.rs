@@ -4,7 +4,7 @@
 use super::super::metric::{ERROR_METRIC, cell_ratios, median_ratios_of, ratios_of_cells};
 use super::super::observe::{Observed, Role, Subset};
 use super::super::residuals::{Residuals, residuals};
-use super::super::search::{Simulated, Simulation};
+use super::super::search::{Simulated, Simulation, THRESHOLD_RANGE};
 use super::super::{
     AddedEffect, FitInput, FitOptions, FitResult, FittedParams, Holdout, Step, Uncertain,
 };
@@ -330,6 +330,24 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
             });
         }
     }
+    if !fixed {
+        for (k, value) in [
+            ("ct_on", state.model.params.ct_on),
+            ("ct_off", state.model.params.ct_off),
+        ] {
+            if let Some(bound) = threshold_at_bound(value) {
+                why.insert(
+                    k.to_string(),
+                    format!(
+                        "the threshold profile ended at the bound {bound} of its range ({} to {}): the model matches the recording's counts of this polarity at no threshold inside it (too {} events for any threshold: events the model lacks, or changes the frames show and the sensor did not see), so {value:.4} is a bound rather than a measurement",
+                        THRESHOLD_RANGE.0,
+                        THRESHOLD_RANGE.1,
+                        if bound == THRESHOLD_RANGE.1 { "few" } else { "many" },
+                    ),
+                );
+            }
+        }
+    }
     for (key, bound) in &state.at_bound {
         why.insert(
             key.clone(),
@@ -342,6 +360,18 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
         why.insert(HOT_RATE.into(), reason);
     }
     why
+}
+
+/// The end of [`THRESHOLD_RANGE`] that `value` sits at, if any.
+fn threshold_at_bound(value: f64) -> Option<f64> {
+    let (lo, hi) = THRESHOLD_RANGE;
+    if value >= hi * (1.0 - 1e-9) {
+        Some(hi)
+    } else if value <= lo * (1.0 + 1e-9) {
+        Some(lo)
+    } else {
+        None
+    }
 }
 
 pub(in crate::fit) const HOT_FRACTION: &str = "hot_pixel_fraction";
@@ -437,6 +467,18 @@ mod tests {
 
     /// Draw 59's single named pixel (a fraction spanning a factor 200) and draw 94's five
     /// (a fraction reaching 0) leave the rate unmeasured; draw 62's 18 pixels do not.
+    /// A threshold the profile left at an end of its range (draw 1028 of the coverage study:
+    /// OFF 4.999999999999999 for a true 0.50, reported with an interval [3.99, 6.26]) is a
+    /// bound; one a hair inside is a value.
+    #[test]
+    fn a_threshold_at_the_end_of_the_profile_range_is_a_bound() {
+        assert_eq!(threshold_at_bound(4.999999999999999), Some(5.0));
+        assert_eq!(threshold_at_bound(0.02), Some(0.02));
+        assert_eq!(threshold_at_bound(4.99), None);
+        assert_eq!(threshold_at_bound(0.0201), None);
+        assert_eq!(threshold_at_bound(0.35), None);
+    }
+
     #[test]
     fn the_rate_of_hot_pixels_is_measured_only_where_their_count_is() {
         let rate = uncertain(435.0, 337.0, 533.0);
