@@ -331,22 +331,7 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
         }
     }
     if !fixed {
-        for (k, value) in [
-            ("ct_on", state.model.params.ct_on),
-            ("ct_off", state.model.params.ct_off),
-        ] {
-            if let Some(bound) = threshold_at_bound(value) {
-                why.insert(
-                    k.to_string(),
-                    format!(
-                        "the threshold profile ended at the bound {bound} of its range ({} to {}): the model matches the recording's counts of this polarity at no threshold inside it (too {} events for any threshold: events the model lacks, or changes the frames show and the sensor did not see), so {value:.4} is a bound rather than a measurement",
-                        THRESHOLD_RANGE.0,
-                        THRESHOLD_RANGE.1,
-                        if bound == THRESHOLD_RANGE.1 { "few" } else { "many" },
-                    ),
-                );
-            }
-        }
+        why.extend(thresholds_at_bound(&state.model.params));
     }
     for (key, bound) in &state.at_bound {
         why.insert(
@@ -360,6 +345,26 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
         why.insert(HOT_RATE.into(), reason);
     }
     why
+}
+
+/// Why each threshold of `params` that its profile left at an end of [`THRESHOLD_RANGE`]
+/// is a bound rather than a measurement.
+fn thresholds_at_bound(params: &crate::sim::PixelParams) -> Vec<(String, String)> {
+    [("ct_on", params.ct_on), ("ct_off", params.ct_off)]
+        .into_iter()
+        .filter_map(|(key, value)| {
+            let bound = threshold_at_bound(value)?;
+            Some((
+                key.to_string(),
+                format!(
+                    "the threshold profile ended at the bound {bound} of its range ({} to {}): the model matches the recording's counts of this polarity at no threshold inside it (too {} events for any threshold: events the model lacks, or changes the frames show and the sensor did not see), so {value:.4} is a bound rather than a measurement",
+                    THRESHOLD_RANGE.0,
+                    THRESHOLD_RANGE.1,
+                    if bound == THRESHOLD_RANGE.1 { "few" } else { "many" },
+                ),
+            ))
+        })
+        .collect()
 }
 
 /// The end of [`THRESHOLD_RANGE`] that `value` sits at, if any.
@@ -465,8 +470,6 @@ mod tests {
         Uncertain::with_interval(value, None, [Some(lo), Some(hi)])
     }
 
-    /// Draw 59's single named pixel (a fraction spanning a factor 200) and draw 94's five
-    /// (a fraction reaching 0) leave the rate unmeasured; draw 62's 18 pixels do not.
     /// A threshold the profile left at an end of its range (draw 1028 of the coverage study:
     /// OFF 4.999999999999999 for a true 0.50, reported with an interval [3.99, 6.26]) is a
     /// bound; one a hair inside is a value.
@@ -479,6 +482,8 @@ mod tests {
         assert_eq!(threshold_at_bound(0.35), None);
     }
 
+    /// Draw 59's single named pixel (a fraction spanning a factor 200) and draw 94's five
+    /// (a fraction reaching 0) leave the rate unmeasured; draw 62's 18 pixels do not.
     #[test]
     fn the_rate_of_hot_pixels_is_measured_only_where_their_count_is() {
         let rate = uncertain(435.0, 337.0, 533.0);
