@@ -930,21 +930,33 @@ fn v2e_frames(path: &Path, file: &hdf5::File, index: &mut FrameIndex) -> Result<
     } else {
         stamps.read_raw::<i64>().map_err(|e| err("frame_ts", e))?
     };
-    if times.len() != shape[0] {
-        return Err(InputError::hdf5(
-            path,
-            format!(
-                "frame holds {} frames but frame_ts {} timestamps",
-                shape[0],
-                times.len()
-            ),
-            "v2e frames are (N, H, W) with N timestamps (microseconds) in frame_ts",
-        ));
-    }
+    check_frame_count(
+        path,
+        ("frame", shape[0]),
+        ("frame_ts", times.len()),
+        "v2e frames are (N, H, W) with N timestamps (microseconds) in frame_ts",
+    )?;
     for (i, &t) in times.iter().enumerate() {
         index.push(path, &format!("frame_ts[{i}]"), t, size, None)?;
     }
     Ok(())
+}
+
+/// A frame stack `(name, frames)` and its timestamps `(name, count)` must agree in number.
+fn check_frame_count(
+    path: &Path,
+    (stack, frames): (&str, usize),
+    (stamps, count): (&str, usize),
+    fix: &str,
+) -> Result<(), InputError> {
+    if count == frames {
+        return Ok(());
+    }
+    Err(InputError::hdf5(
+        path,
+        format!("{stack} holds {frames} frames but {stamps} {count} timestamps"),
+        fix,
+    ))
 }
 
 /// MVSEC: the frames of one side as rows of `image_raw` (M, H, W), their times in
@@ -967,17 +979,12 @@ fn mvsec_frames(
         .dataset(&stamps)
         .and_then(|d| d.read_raw::<f64>())
         .map_err(|e| err(&stamps, e))?;
-    if times.len() != shape[0] {
-        return Err(InputError::hdf5(
-            path,
-            format!(
-                "{stack} holds {} frames but {stamps} {} timestamps",
-                shape[0],
-                times.len()
-            ),
-            "MVSEC frames are (M, H, W) with M timestamps (seconds) in image_raw_ts",
-        ));
-    }
+    check_frame_count(
+        path,
+        (&stack, shape[0]),
+        (&stamps, times.len()),
+        "MVSEC frames are (M, H, W) with M timestamps (seconds) in image_raw_ts",
+    )?;
     for (i, &t) in times.iter().enumerate() {
         let t = frame_seconds(path, t, || format!("{stamps}[{i}] is {t}"))?;
         index.push(path, &format!("{stamps}[{i}]"), t, size, None)?;

@@ -1,6 +1,7 @@
 //! The fit's result: the final model's error on the test blocks, the thresholds' standard
 //! errors, what the data identify and what they do not, and every assumption with its size.
 
+use super::super::effects::Effect;
 use super::super::metric::{ERROR_METRIC, cell_ratios, median_ratios_of, ratios_of_cells};
 use super::super::observe::{Observed, Role, Subset};
 use super::super::residuals::{Residuals, residuals};
@@ -356,17 +357,17 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
 /// The effects whose parameters trade against the thresholds in the counts: a slow
 /// photoreceptor and a refractory period thin the events as a higher threshold does,
 /// leak and shot noise add events as a lower one does.
-const COUNT_EFFECTS: [&str; 4] = [
-    "cutoff_hz",
-    "refractory_s",
-    "leak_rate_hz",
-    "shot_noise_rate_hz",
+const COUNT_EFFECTS: [Effect; 4] = [
+    Effect::Bandwidth,
+    Effect::Refractory,
+    Effect::Leak,
+    Effect::ShotNoise,
 ];
 
 /// Why each fitted count effect is not a measurement when a threshold of a moving scene is
 /// not determined (`why` holds it): the effect was fitted against a threshold the data did
-/// not fix, so it absorbed that threshold's error. On the coverage study's draws (seeds 1-100 and
-/// 1001-1080) 5 of the 6 such effect intervals missed the truth, draw 1007's cutoff by 44
+/// not fix, so it absorbed that threshold's error. On the coverage study's draws (seeds 1-100
+/// and 1001-1080) 5 of the 6 such effect intervals missed the truth, draw 1007's cutoff by 44
 /// half-widths (3.7 Hz for 74 Hz, fitted on 618 events with both thresholds at their start
 /// values).
 fn confounded_with_thresholds(
@@ -382,6 +383,7 @@ fn confounded_with_thresholds(
     }
     COUNT_EFFECTS
         .into_iter()
+        .filter_map(Effect::parameter)
         .filter(|k| uncertainty.contains_key(*k))
         .map(|k| {
             (
