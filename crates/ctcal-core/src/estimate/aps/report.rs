@@ -284,6 +284,20 @@ pub(super) fn assemble(
     estimate
 }
 
+/// The method's own systematic error of the spread `ct_sigma`, absolute (ln units): what
+/// the per-pixel thresholds' spread misses beyond its measured terms (the self-calibration's
+/// bias, the 10 % floor, the frame-rate series, the offset range) where effects the frames
+/// do not show vary from pixel to pixel (bandwidth in dim pixels, several moving objects,
+/// refractory periods), adding apparent spread or hiding real spread. Measured on the
+/// coverage study's draws with frames (`benches/coverage/aps-sigma-systematic-2026-11-29`,
+/// its `sigma_systematic.py`: 53 draws of seeds 1-100 and 1001-1080 with a resolved
+/// spread): the smallest term, added in quadrature, at which 95 % of them are covered (0:
+/// 75.5 %, 0.010: 90.6 %, 0.012: 96.2 %). An absolute term because the misses are as large
+/// for spreads of 0.04 as of 0.08 (the largest: 0.022 for a true 0.076 in a multi-object
+/// scene); one relative to the thresholds covers as many draws only by leaving more spreads
+/// unresolved (25 against 19 at 95 %).
+pub const SIGMA_METHOD_SYSTEMATIC: f64 = 0.012;
+
 /// The frozen threshold spread: the timing's per-pixel spread (estimation noise removed,
 /// both polarities combined: [`crate::estimate::timing::spread`]) less the
 /// self-calibration's bias. Its interval carries the whole bias and at least 10 % of the
@@ -291,7 +305,8 @@ pub(super) fn assemble(
 /// varies by about that between seeds), and, in quadrature, the frame-rate systematic of
 /// the spread over the passes (`series`): how far the spread moves when every 2nd and 3rd
 /// frame is used, as for the thresholds, and its change across the frames' offset range
-/// (`offset`), as for the thresholds. Where a polarity showed that the noise
+/// (`offset`), as for the thresholds, and the method's own systematic
+/// ([`SIGMA_METHOD_SYSTEMATIC`]). Where a polarity showed that the noise
 /// subtraction overshoots, the upper side is raised by what it overshot. Where the bias
 /// eats the measured spread, the spread is not resolved: `null` with an upper bound; where
 /// both polarities overshoot, `null` with the spread the larger overshoot can hide as bound.
@@ -320,16 +335,19 @@ fn sigma_result(
     let sigma_bias = if sigma_bias.is_finite() {
         sigma_bias
     } else {
-        assumptions.push("ct_sigma: the self-calibration's simulation gave no spread (both its polarities overshoot), so the method's own bias of the spread is not known and 0 is used: only the 10 % floor stands for it".into());
+        assumptions.push("ct_sigma: the self-calibration's simulation gave no spread (both its polarities overshoot), so the method's own bias of the spread is not known and 0 is used: only the 10 % floor and the method systematic stand for it".into());
         0.0
     };
     let value = sigma - sigma_bias;
     let (_, frame_rate) = frame_rate_systematic(series);
     let floor = sigma_bias.abs().max(0.1 * value.abs());
-    let systematic = floor.hypot(frame_rate).hypot(offset);
+    let systematic = floor
+        .hypot(frame_rate)
+        .hypot(offset)
+        .hypot(SIGMA_METHOD_SYSTEMATIC);
     let measure = Measured::new(value, spread.sigma_standard_error, systematic);
     assumptions.push(format!(
-        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}) and across the frames' offset range ({offset:.4}) as systematic ({systematic:.4})"
+        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}), across the frames' offset range ({offset:.4}) and the method systematic {SIGMA_METHOD_SYSTEMATIC} (what the spread misses on simulated recordings with known mismatch and random sensor effects, coverage study, 53 draws: the smallest term that covers 95 % of them) as systematic ({systematic:.4})"
     ));
     let hi = spread.raised(measure.ci95[1]);
     if measure.ci95[0] > 0.0 {
@@ -341,7 +359,7 @@ fn sigma_result(
             estimate,
             upper,
             format!(
-                "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
+                "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors, the method systematic included; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
             ),
         );
     }
@@ -425,7 +443,57 @@ fn drift_report(drift: &crate::estimate::timing::Drift) -> serde_json::Value {
 
 #[cfg(test)]
 mod tests {
-    use super::{drift_report, interpolation_corrected, lag_report};
+    use super::{
+        SIGMA_METHOD_SYSTEMATIC, drift_report, interpolation_corrected, lag_report, sigma_result,
+    };
+    use crate::estimate::interval::{Measured, z95};
+    use crate::estimate::timing::spread::Spread;
+    use crate::estimate::{CtEstimate, Determinable};
+
+    /// `ct_sigma` from a spread of `sigma` +- `standard_error` with no bias, frame-rate
+    /// series or offset term: the value, its interval and the `why` of a null.
+    fn spread_reported(sigma: f64, standard_error: f64) -> CtEstimate {
+        let threshold = Measured::new(0.3, 0.01, 0.0);
+        let mut estimate =
+            CtEstimate::from_parts("aps", &threshold, &threshold, Determinable::POSITIVE);
+        let spread = Spread {
+            excess_variance: sigma * sigma,
+            excess_variance_standard_error: 2.0 * sigma * standard_error,
+            sigma,
+            sigma_standard_error: standard_error,
+            used: [true, true],
+            overshoot: 0.0,
+        };
+        let mut assumptions = Vec::new();
+        sigma_result(&mut estimate, &mut assumptions, (&spread, 0.0, &[], 0.0));
+        assert!(
+            assumptions
+                .iter()
+                .any(|a| a.contains("method systematic 0.012")),
+            "{assumptions:?}"
+        );
+        estimate
+    }
+
+    #[test]
+    fn the_spreads_interval_carries_the_method_systematic_and_a_small_spread_is_not_resolved() {
+        // 0.05 +- 0.004: half-width 1.96 sqrt(0.004^2 + 0.005^2 (the 10 % floor) + 0.012^2)
+        let estimate = spread_reported(0.05, 0.004);
+        let half = z95() * (0.004f64.powi(2) + 0.005f64.powi(2) + 0.012f64.powi(2)).sqrt();
+        assert!((half - 0.02662).abs() < 1e-4, "{half}");
+        assert_eq!(estimate.ct_sigma, Some(0.05));
+        let [lo, hi] = estimate.ct_sigma_ci95.unwrap();
+        assert!((lo - (0.05 - half)).abs() < 1e-12 && (hi - (0.05 + half)).abs() < 1e-12);
+        // 0.02 +- 0.003, which the old terms resolved ([0.013, 0.027]): the method's own
+        // error reaches 0, so the spread is `null` with its upper bound
+        let estimate = spread_reported(0.02, 0.003);
+        assert_eq!(estimate.ct_sigma, None);
+        let upper = estimate.ct_sigma_ci95.unwrap()[1];
+        let half =
+            z95() * (0.003f64.powi(2) + 0.002f64.powi(2) + SIGMA_METHOD_SYSTEMATIC.powi(2)).sqrt();
+        assert!(upper >= 0.02 + half - 1e-12, "{upper}");
+        assert!(estimate.why["ct_sigma"].contains("method systematic included"));
+    }
 
     #[test]
     fn a_negative_lag_has_no_cutoff_and_says_why_and_an_upward_drift_says_what_it_is() {
