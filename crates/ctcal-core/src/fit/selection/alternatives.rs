@@ -21,6 +21,7 @@ use super::keep::judge;
 use super::{Known, State, context_of};
 use crate::fit::Uncertain;
 use serde::Serialize;
+use std::collections::BTreeMap;
 
 /// Two effects that explain the recording equally well within chance.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -39,6 +40,56 @@ pub struct Ambiguity {
     pub chance: Option<f64>,
     /// What recording would tell the two apart.
     pub separated_by: String,
+    /// The kept effect's 95 % interval as fitted, which holds only if the effect is there:
+    /// its reported interval reaches 0 ([`reach_zero_where_not_separated`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kept_ci95_if_present: Option<crate::estimate::Interval>,
+}
+
+/// Widens the interval of each kept effect the data do not separate from a look-alike down
+/// to 0: the model with the look-alike in its place (and this effect absent) explains the
+/// recording as well, so the recording does not say the effect is there, only how large it
+/// is if it is (kept as the ambiguity's `kept_ci95_if_present`). Parameters without an
+/// interval or already withheld (`why`) are left. Returns the assumption to list, if any
+/// interval was widened.
+///
+/// Measured on the coverage study's draws (`benches/coverage/fit-ambiguity-2026-11-29`):
+/// of draws 25, 37, 44 and 81, whose fitted effect missed a true 0, all four had named the
+/// pair (a slow photoreceptor for a refractory period, shot noise for leak).
+pub fn reach_zero_where_not_separated(
+    uncertainty: &mut BTreeMap<String, Uncertain>,
+    ambiguities: &mut [Ambiguity],
+    why: &BTreeMap<String, String>,
+) -> Option<String> {
+    let mut widened = Vec::new();
+    for a in ambiguities.iter_mut() {
+        let Some(key) = Effect::parse(&a.kept).and_then(Effect::parameter) else {
+            continue;
+        };
+        if why.contains_key(key) {
+            continue;
+        }
+        let Some(u) = uncertainty.get_mut(key) else {
+            continue;
+        };
+        let Some(interval) = u.interval() else {
+            continue;
+        };
+        a.kept_ci95_if_present = Some(interval);
+        if interval[0] != Some(0.0) {
+            u.ci95 = Some([Some(0.0), interval[1]]);
+            widened.push(format!(
+                "{key} (kept) or {} ({})",
+                a.parameter, a.alternative
+            ));
+        }
+    }
+    (!widened.is_empty()).then(|| {
+        format!(
+            "effects the data do not separate: {}; the kept effect's 95 % interval reaches 0, since the model with the look-alike in its place explains the recording within chance (its interval if it is there: `ambiguities[].kept_ci95_if_present`)",
+            widened.join("; ")
+        )
+    })
 }
 
 const REFRACTORY_OR_BANDWIDTH: &str = "a refractory period drops events of fast changes at every brightness, a slow photoreceptor only in dim light: the same motion recorded at another brightness separates them";
@@ -104,16 +155,35 @@ pub fn compare(
         if !in_model(kept) || in_model(other) {
             continue;
         }
+        let named = |a: &Ambiguity| {
+            let pair = [a.kept.as_str(), a.alternative.as_str()];
+            pair == [kept.name(), other.name()] || pair == [other.name(), kept.name()]
+        };
+        if found.iter().any(named) {
+            // the reverse of a comparison that did not separate them: already named
+            continue;
+        }
         let count_before = simulation.count.get();
         let c = compare_one(simulation, state, known, kept, other, (fixed, noise))?;
         let mut step = c.step;
         step.simulations = simulation.count.get() - count_before;
-        // not separated: the model with the lower selection error is kept, both are named
+        // not separated: the effect whose own signature names it is kept, else the model
+        // with the lower selection error; both are named
         let (before, after) = (
             step.error_before.unwrap_or(f64::NAN),
             step.error_after.unwrap_or(f64::NAN),
         );
-        let lower = after < before;
+        let signature = c
+            .ambiguous
+            .then(|| signature_choice(simulation, state, known, (kept, other), &c.alternative))
+            .flatten();
+        let lower = match &signature {
+            Some((other_named, why)) => {
+                step.reason = format!("{}; {why}", step.reason);
+                *other_named
+            }
+            None => after < before,
+        };
         if c.ambiguous {
             let (named, alternative, value) = if lower {
                 (other, kept, kept_value(kept, state))
@@ -129,14 +199,22 @@ pub fn compare(
                 error_alternative: if lower { before } else { after },
                 chance: step.chance,
                 separated_by: separated_by.into(),
+                kept_ci95_if_present: None,
             });
             if lower {
                 step.kept = true;
+                let ground = if signature.is_some() {
+                    "its signature names it"
+                } else {
+                    "its selection error is the lower"
+                };
                 step.reason = format!(
-                    "{}; its selection error is the lower, so it takes the place of {}, both named",
+                    "{}; {ground}, so it takes the place of {}, both named",
                     step.reason,
                     kept.name()
                 );
+            } else {
+                step.reason = format!("{}; {} stays, both are named", step.reason, kept.name());
             }
         }
         if c.replaces || (c.ambiguous && lower) {
@@ -160,6 +238,52 @@ pub fn compare(
         steps.push(step);
     }
     Ok(found)
+}
+
+/// Which of two effects the distance does not separate the signature of one of them names
+/// (a refractory period's gap in the shortest same-pixel intervals, the effect judged by
+/// its signature, [`Effect::judged_by_signature`]): that effect, where its signature calls
+/// for it on the selection blocks against the model with the look-alike and not against
+/// the model with it (the look-alike leaves the gap, the effect explains it). Returns
+/// whether that effect is `other` (the look-alike of the current model) and why, or `None`
+/// where the signature does not decide (the lower selection error does).
+///
+/// A slow photoreceptor also thins the shortest intervals, so where it is the cause its
+/// model leaves no gap and the signature does not decide; a refractory period leaves a gap
+/// below its period at every brightness that a low-pass filter does not make (the issue's
+/// coverage draws 25 and 37: refractory periods of 0.5 and 4.7 ms replaced by cutoffs of
+/// 2 and 250 Hz on a lower selection error within chance).
+fn signature_choice(
+    simulation: &Simulation,
+    state: &State,
+    known: Known,
+    (kept, other): (Effect, Effect),
+    alternative: &Simulated,
+) -> Option<(bool, String)> {
+    let judged = [kept, other]
+        .into_iter()
+        .find(|e| e.judged_by_signature())?;
+    let (with, without) = if judged == kept {
+        (&state.model, alternative)
+    } else {
+        (alternative, &state.model)
+    };
+    let look_alike = if judged == kept { other } else { kept };
+    let against_without = super::judging_evidence(state, simulation, known, judged, without);
+    let against_with = super::judging_evidence(state, simulation, known, judged, with);
+    (against_without.calls_for() && !against_with.calls_for()).then(|| {
+        (
+            judged == other,
+            format!(
+                "the signature of {} names it: the model with {} in its place leaves it on the selection blocks ({}: z {:.1}), the model with it does not (z {:.1})",
+                judged.name(),
+                look_alike.name(),
+                against_without.text,
+                against_without.score,
+                against_with.score
+            ),
+        )
+    })
 }
 
 /// The fitted value of `kept`'s parameter in the current model.
@@ -229,9 +353,8 @@ fn compare_one(
         format!("replaces {}: {}", kept.name(), wins.reason)
     } else if ambiguous {
         format!(
-            "not separated: either explains the recording within chance ({}); {} stays, both are named",
-            wins.reason,
-            kept.name()
+            "not separated: either explains the recording within chance ({})",
+            wins.reason
         )
     } else {
         format!(
@@ -264,6 +387,66 @@ mod tests {
             );
             assert!(kept.parameter().is_some() && other.parameter().is_some());
         }
+    }
+
+    fn ambiguity(kept: Effect, alternative: Effect) -> Ambiguity {
+        Ambiguity {
+            kept: kept.name().into(),
+            alternative: alternative.name().into(),
+            parameter: alternative.parameter().unwrap().into(),
+            value: 0.5,
+            error_kept: 1.0,
+            error_alternative: 1.02,
+            chance: Some(0.1),
+            separated_by: LEAK_OR_SHOT_NOISE.into(),
+            kept_ci95_if_present: None,
+        }
+    }
+
+    #[test]
+    fn a_kept_effect_not_separated_from_its_look_alike_reaches_zero() {
+        // draw 81 of the coverage study: shot noise 2.08 [1.5, 2.9] Hz kept for a true leak
+        // of 0.95 Hz and no shot noise; draw 37: a cutoff kept for a refractory period,
+        // but withheld (its own reason) it is left as it is
+        let mut uncertainty = BTreeMap::from([
+            (
+                "shot_noise_rate_hz".to_string(),
+                Uncertain {
+                    value: 2.08,
+                    standard_error: Some(0.17),
+                    ci95: Some([Some(1.5), Some(2.9)]),
+                },
+            ),
+            (
+                "cutoff_hz".to_string(),
+                Uncertain::positive(250.0, Some(180.0)),
+            ),
+        ]);
+        let mut found = [
+            ambiguity(Effect::ShotNoise, Effect::Leak),
+            ambiguity(Effect::Bandwidth, Effect::Refractory),
+        ];
+        let why = BTreeMap::from([("cutoff_hz".to_string(), "a bound".to_string())]);
+        let note = reach_zero_where_not_separated(&mut uncertainty, &mut found, &why).unwrap();
+        assert_eq!(
+            uncertainty["shot_noise_rate_hz"].ci95,
+            Some([Some(0.0), Some(2.9)])
+        );
+        assert_eq!(found[0].kept_ci95_if_present, Some([Some(1.5), Some(2.9)]));
+        assert!(
+            note.contains("shot_noise_rate_hz (kept) or leak_rate_hz (leak)"),
+            "{note}"
+        );
+        assert!(!note.contains("cutoff_hz"), "{note}");
+        assert_eq!(found[1].kept_ci95_if_present, None);
+        assert!(uncertainty["cutoff_hz"].ci95.unwrap()[0].unwrap() > 0.0);
+        // nothing not separated: no note, nothing widened
+        let before = uncertainty.clone();
+        assert_eq!(
+            reach_zero_where_not_separated(&mut uncertainty, &mut [], &why),
+            None
+        );
+        assert_eq!(uncertainty, before);
     }
 
     #[test]

@@ -208,7 +208,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         residuals_before,
         added,
         steps,
-        ambiguities,
+        mut ambiguities,
         mut assumptions,
         fixed,
         start,
@@ -250,6 +250,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         assumptions.push(hot_pixels(simulation, &mut state, input, &mut params));
     }
     let not_identified = not_identified(&state, fixed);
+    assumptions.extend(super::alternatives::reach_zero_where_not_separated(
+        &mut state.uncertainty,
+        &mut ambiguities,
+        &not_identified,
+    ));
     for k in ["ct_on", "ct_off"] {
         if not_identified.contains_key(k) {
             state.uncertainty.remove(k);
