@@ -151,6 +151,10 @@ impl LineParser {
     #[inline]
     fn parse(&mut self, raw: &[u8], out: &mut EventChunk) -> Result<(), InputError> {
         self.line += 1;
+        if let Some((t, x, y, on)) = text::event_line(raw) {
+            self.seen_data_line = true;
+            return self.accept((t, x, y, on), out);
+        }
         let mut fields = [&b""[..]; 4];
         let count = text::split_fields(raw, &mut fields);
         if count == 0 || fields[0][0] == b'#' {
@@ -177,6 +181,16 @@ impl LineParser {
         let Some(on) = text::parse_polarity(fields[3]) else {
             return Err(self.bad_line(raw, "the polarity must be 0, 1 or -1"));
         };
+        self.accept((t, x, y, on), out)
+    }
+
+    /// Checks a parsed event against the sensor and the order, and appends it.
+    #[inline(always)]
+    fn accept(
+        &mut self,
+        (t, x, y, on): (i64, u32, u32, bool),
+        out: &mut EventChunk,
+    ) -> Result<(), InputError> {
         if !super::within(self.sensor, x, y) {
             return Err(super::outside_sensor(
                 &self.path,

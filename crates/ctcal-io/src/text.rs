@@ -118,6 +118,79 @@ pub fn split_fields<'a>(line: &'a [u8], fields: &mut [&'a [u8]]) -> usize {
     count
 }
 
+/// The usual event line in one pass: `SECONDS X Y P`, single spaces, the time unsigned
+/// decimal (at most 12 whole digits), x and y of at most 9 digits, P `0` or `1`, nothing
+/// after it. Returns (time in us, x, y, ON), exactly what [`split_fields`],
+/// [`seconds_to_us`], [`parse_u32`] and [`parse_polarity`] make of it; `None` for any other
+/// layout (signs, tabs, commas, `\r`, exponents, `-1`, comments, a `width height` line,
+/// errors), which those parse instead. It is a fast path: the general parse walks the line
+/// once to split it and again per field, and its time is most of a text file's decoding.
+#[inline]
+pub fn event_line(line: &[u8]) -> Option<(i64, u32, u32, bool)> {
+    let n = line.len();
+    let mut i = 0;
+    let mut whole: i64 = 0;
+    while i < n && line[i].is_ascii_digit() {
+        if i == 12 {
+            return None;
+        }
+        whole = whole * 10 + (line[i] - b'0') as i64;
+        i += 1;
+    }
+    if i == 0 {
+        return None;
+    }
+    let (mut micro, mut micro_digits, mut round_up) = (0i64, 0u32, false);
+    if i < n && line[i] == b'.' {
+        i += 1;
+        let start = i;
+        while i < n && line[i].is_ascii_digit() {
+            let d = (line[i] - b'0') as i64;
+            if micro_digits < 6 {
+                micro = micro * 10 + d;
+                micro_digits += 1;
+            } else if i - start == 6 {
+                // the seventh decimal decides, as in `seconds_to_us`
+                round_up = d >= 5;
+            }
+            i += 1;
+        }
+        if i == start {
+            return None;
+        }
+    }
+    let t = whole * 1_000_000 + micro * 10i64.pow(6 - micro_digits) + round_up as i64;
+    let (x, i) = space_then_u32(line, i)?;
+    let (y, i) = space_then_u32(line, i)?;
+    if i + 2 != n || line[i] != b' ' {
+        return None;
+    }
+    let on = match line[i + 1] {
+        b'0' => false,
+        b'1' => true,
+        _ => return None,
+    };
+    Some((t, x, y, on))
+}
+
+/// A single space at `i`, then 1 to 9 digits: their value and the index after them.
+#[inline(always)]
+fn space_then_u32(line: &[u8], i: usize) -> Option<(u32, usize)> {
+    if line.get(i) != Some(&b' ') {
+        return None;
+    }
+    let mut j = i + 1;
+    let mut value: u32 = 0;
+    while j < line.len() && line[j].is_ascii_digit() {
+        if j - i > 9 {
+            return None;
+        }
+        value = value * 10 + (line[j] - b'0') as u32;
+        j += 1;
+    }
+    (j > i + 1).then_some((value, j))
+}
+
 /// A short, printable excerpt of a line for error messages.
 pub fn excerpt(line: &[u8]) -> String {
     let text = String::from_utf8_lossy(&line[..line.len().min(60)]);
@@ -163,6 +236,105 @@ mod tests {
         assert_eq!(parse_polarity(b"-1"), Some(false));
         assert_eq!(parse_polarity(b"1"), Some(true));
         assert_eq!(parse_polarity(b"2"), None);
+    }
+
+    /// Marsaglia's xorshift64, enough to vary test lines.
+    struct XorShift(u64);
+
+    impl XorShift {
+        fn below(&mut self, n: usize) -> usize {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 % n as u64) as usize
+        }
+
+        fn pick<'a>(&mut self, choices: &[&'a [u8]]) -> &'a [u8] {
+            choices[self.below(choices.len())]
+        }
+
+        /// Up to `most - 1` random digits.
+        fn digits(&mut self, line: &mut Vec<u8>, most: usize) {
+            for _ in 0..self.below(most) {
+                let d = self.below(10) as u8;
+                line.push(b'0' + d);
+            }
+        }
+    }
+
+    /// What the general parse makes of a line that holds an event.
+    fn general(line: &[u8]) -> Option<(i64, u32, u32, bool)> {
+        let mut f = [&b""[..]; 4];
+        if split_fields(line, &mut f) != 4 {
+            return None;
+        }
+        Some((
+            seconds_to_us(f[0])?,
+            parse_u32(f[1])?,
+            parse_u32(f[2])?,
+            parse_polarity(f[3])?,
+        ))
+    }
+
+    #[test]
+    fn the_fast_event_line_is_the_general_parse_or_declines() {
+        let lines: [&[u8]; 24] = [
+            b"0.003811000 45 12 1",
+            b"2.0971630009999997 239 179 0",
+            b"13.595874999000001 1 1 1",
+            b"0.0000005 0 0 0",
+            b"0.0000004999 0 0 1",
+            b"12 3 4 1",
+            b"999999999999.9999995 9 9 1",
+            b"1589163147.368868 1 2 0",
+            b"0.5 123456789 0 1",
+            b"0.5 1234567890 0 1",
+            b"0.5 4294967296 0 1",
+            b"0.5 1 2 -1",
+            b"0.5 1 2 2",
+            b"0.5 1 2 1 ",
+            b"0.5 1 2 1\r",
+            b"0.5\t1 2 1",
+            b"0.5  1 2 1",
+            b"0.5,1,2,1",
+            b".5 1 2 1",
+            b"5. 1 2 1",
+            b"-0.5 1 2 1",
+            b"1.5e-3 1 2 1",
+            b"0.5 1 2",
+            b"# 0.5 1 2 1",
+        ];
+        let mut fast = 0;
+        for line in lines {
+            if let Some(event) = event_line(line) {
+                fast += 1;
+                assert_eq!(Some(event), general(line), "{}", excerpt(line));
+            }
+        }
+        assert_eq!(fast, 9, "the first nine take the fast path");
+        // random lines: fields of random lengths, separators and endings
+        let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+        let mut taken = 0;
+        for _ in 0..100_000 {
+            let mut line = Vec::new();
+            rng.digits(&mut line, 15);
+            if rng.below(4) > 0 {
+                line.push(b'.');
+                rng.digits(&mut line, 11);
+            }
+            for _ in 0..2 {
+                line.extend_from_slice(rng.pick(&[b" ", b" ", b" ", b"  ", b"\t", b","]));
+                rng.digits(&mut line, 12);
+            }
+            line.extend_from_slice(rng.pick(&[b" ", b" ", b" ", b","]));
+            line.extend_from_slice(rng.pick(&[b"0", b"1", b"2", b"-1"]));
+            line.extend_from_slice(rng.pick(&[b"", b"", b" ", b"\r"]));
+            if let Some(event) = event_line(&line) {
+                taken += 1;
+                assert_eq!(Some(event), general(&line), "{}", excerpt(&line));
+            }
+        }
+        assert!(taken > 100, "{taken} random lines took the fast path");
     }
 
     #[test]

@@ -1,10 +1,12 @@
 //! Text parsing on two threads: the whole lines at the front of a block are cut at a line
 //! boundary near their middle and the halves are parsed at once (`rayon::join`), the second
 //! into its own chunk that is then appended. Events, errors and their line numbers are
-//! those of parsing line by line: the second half's parser starts at the line number the
-//! first half ends at (newlines counted ahead, a memchr pass), an error in the first half
-//! wins, and the order of the second half's times is checked after both, against the
-//! first half's last time.
+//! those of parsing line by line: an error in the first half wins; the second half's parser
+//! counts its lines from 0 and they are numbered on once the first half has counted its own
+//! (an error of the second half is found again from the right line, a cold path); and the
+//! order of the second half's times is checked after both, against the first half's last
+//! time. What runs on one thread before the halves start is a vectorised newline count
+//! (memchr's `count`), not a walk from line to line.
 
 use super::super::error::InputError;
 use super::super::order::OrderCheck;
@@ -24,11 +26,7 @@ pub(super) fn parse_halves(
     debug_assert!(lines.seen_data_line && lines.check_order);
     let room = CHUNK_EVENTS.saturating_sub(out.len());
     // a line holds at most one event: `room` lines cannot overfill the chunk
-    let Some(end) = memchr::memchr_iter(b'\n', available)
-        .take(room)
-        .last()
-        .map(|i| i + 1)
-    else {
+    let Some(end) = end_of_lines(available, room) else {
         return Ok(0);
     };
     if end < MIN_SPLIT_BYTES {
@@ -37,22 +35,20 @@ pub(super) fn parse_halves(
     let region = &available[..end];
     let middle = end / 2 + memchr::memchr(b'\n', &region[end / 2..]).map_or(0, |i| i + 1);
     let (first_text, second_text) = region.split_at(middle);
-    let second_start = lines.line + memchr::memchr_iter(b'\n', first_text).count();
-    let mut second_lines = LineParser {
-        path: lines.path.clone(),
-        line: second_start,
-        seen_data_line: true,
-        sensor: lines.sensor,
-        order: OrderCheck::default(),
-        check_order: false,
-    };
+    let mut second_lines = lines.continuation(0);
     second.clear();
     let (first_result, second_result) = rayon::join(
         || parse_lines(lines, first_text, out),
         || parse_lines(&mut second_lines, second_text, second),
     );
     first_result?;
-    second_result?;
+    // the first half's parser has counted its lines: the second half's follow them
+    let second_start = lines.line;
+    if second_result.is_err() {
+        // the error again, its line numbered as one thread numbers it
+        parse_lines(&mut lines.continuation(second_start), second_text, second)?;
+        second_result?;
+    }
     lines.order.check_all(&second.t, |i| {
         format!(
             "line {}",
@@ -60,8 +56,35 @@ pub(super) fn parse_halves(
         )
     });
     out.extend_from(second);
-    lines.line = second_lines.line;
+    lines.line = second_start + second_lines.line;
     Ok(end)
+}
+
+/// Bytes per piece of [`end_of_lines`]' search for the `n`-th newline.
+const COUNT_PIECE_BYTES: usize = 64 << 10;
+
+/// The end (one past its newline) of the first `n` whole lines of `text`, or of all its
+/// whole lines where it has fewer; `None` where it has none or `n` is 0. Newlines are
+/// counted a piece at a time with memchr's vectorised `count`, and only the piece holding
+/// the `n`-th is walked newline by newline.
+fn end_of_lines(text: &[u8], n: usize) -> Option<usize> {
+    if n == 0 {
+        return None;
+    }
+    let mut left = n;
+    let mut start = 0;
+    while start < text.len() {
+        let piece = &text[start..text.len().min(start + COUNT_PIECE_BYTES)];
+        let newlines = memchr::memchr_iter(b'\n', piece).count();
+        if newlines >= left {
+            return memchr::memchr_iter(b'\n', piece)
+                .nth(left - 1)
+                .map(|i| start + i + 1);
+        }
+        left -= newlines;
+        start += piece.len();
+    }
+    memchr::memrchr(b'\n', text).map(|i| i + 1)
 }
 
 /// Parses `text`, whole lines each ending in a newline.
@@ -82,14 +105,7 @@ fn parse_lines(
 /// `start`), found by parsing it again: only for naming the place of an order violation.
 #[cold]
 fn line_of_event(template: &LineParser, text: &[u8], start: usize, index: usize) -> usize {
-    let mut lines = LineParser {
-        path: template.path.clone(),
-        line: start,
-        seen_data_line: true,
-        sensor: template.sensor,
-        order: OrderCheck::default(),
-        check_order: false,
-    };
+    let mut lines = template.continuation(start);
     let mut scratch = EventChunk::default();
     let mut line_start = 0;
     for end in memchr::memchr_iter(b'\n', text) {
@@ -101,6 +117,21 @@ fn line_of_event(template: &LineParser, text: &[u8], start: usize, index: usize)
         line_start = end + 1;
     }
     lines.line
+}
+
+impl LineParser {
+    /// A parser of the lines after `line` of a block this parser is reading, past its data
+    /// line: the same file and sensor, its order checked by the caller.
+    fn continuation(&self, line: usize) -> LineParser {
+        LineParser {
+            path: self.path.clone(),
+            line,
+            seen_data_line: true,
+            sensor: self.sensor,
+            order: OrderCheck::default(),
+            check_order: false,
+        }
+    }
 }
 
 #[cfg(test)]
@@ -149,6 +180,27 @@ mod tests {
             text.push('\n');
         }
         text
+    }
+
+    #[test]
+    fn the_end_of_n_lines_is_found_across_count_pieces() {
+        use super::{COUNT_PIECE_BYTES, end_of_lines};
+        // lines of 1 to 9 bytes (newline included), longer than three count pieces
+        let mut text = Vec::new();
+        let mut ends = Vec::new();
+        while text.len() < 3 * COUNT_PIECE_BYTES + 100 {
+            let len = ends.len() % 9;
+            text.extend(std::iter::repeat_n(b'7', len));
+            text.push(b'\n');
+            ends.push(text.len());
+        }
+        text.extend_from_slice(b"12 3 4"); // a last line without its newline
+        for n in [1, 2, 17, 7281, 7282, ends.len() - 1, ends.len()] {
+            assert_eq!(end_of_lines(&text, n), Some(ends[n - 1]), "{n}");
+        }
+        assert_eq!(end_of_lines(&text, ends.len() + 5), ends.last().copied());
+        assert_eq!(end_of_lines(&text, 0), None);
+        assert_eq!(end_of_lines(b"no newline", 3), None);
     }
 
     #[test]
