@@ -25,6 +25,7 @@ pub(in crate::fit) mod finish;
 mod frame_quality;
 pub(in crate::fit) mod hot_excess;
 pub(in crate::fit) mod keep;
+mod method_systematic;
 mod start;
 mod steps;
 
