@@ -12,50 +12,74 @@ pub fn seconds_to_us(s: &[u8]) -> Option<i64> {
         b'+' => (false, &s[1..]),
         _ => (false, s),
     };
-    let mut i = 0;
-    let mut whole: i64 = 0;
-    while i < digits.len() && digits[i].is_ascii_digit() {
-        whole = whole
-            .checked_mul(10)?
-            .checked_add((digits[i] - b'0') as i64)?;
-        i += 1;
-    }
-    let whole_digits = i;
-    let mut micro: i64 = 0;
-    let mut micro_digits = 0;
-    let mut round_up = false;
-    let mut fraction_digits = 0;
-    if i < digits.len() && digits[i] == b'.' {
-        i += 1;
-        let mut rounding_digit: Option<u8> = None;
-        while i < digits.len() && digits[i].is_ascii_digit() {
-            let d = digits[i] - b'0';
-            if micro_digits < 6 {
-                micro = micro * 10 + d as i64;
-                micro_digits += 1;
-            } else if rounding_digit.is_none() {
-                rounding_digit = Some(d);
-            }
-            fraction_digits += 1;
-            i += 1;
-        }
-        // The seventh decimal decides: 5 or more rounds the magnitude up (ties away from 0).
-        round_up = rounding_digit.is_some_and(|d| d >= 5);
-    }
-    if whole_digits == 0 && fraction_digits == 0 {
+    let decimal = Decimal::at_front(digits)?;
+    if decimal.whole_digits == 0 && decimal.fraction_digits == 0 {
         return None;
     }
-    if i != digits.len() {
+    if decimal.len != digits.len() {
         return float_fallback(s);
     }
-    while micro_digits < 6 {
-        micro *= 10;
-        micro_digits += 1;
-    }
-    let magnitude = whole
-        .checked_mul(1_000_000)?
-        .checked_add(micro + round_up as i64)?;
+    let magnitude = decimal.microseconds()?;
     Some(if negative { -magnitude } else { magnitude })
+}
+
+/// An unsigned decimal at the front of a field: digits, then optionally `.` and digits,
+/// read to the microsecond digit by digit (the seventh decimal decides the rounding).
+struct Decimal {
+    whole: i64,
+    /// The first six decimals as microseconds (padded with zeros).
+    micro: i64,
+    /// The seventh decimal is 5 or more: the magnitude rounds up (ties away from 0).
+    round_up: bool,
+    whole_digits: usize,
+    fraction_digits: usize,
+    /// Bytes read: the digits and the point.
+    len: usize,
+}
+
+impl Decimal {
+    /// The decimal at the front of `s`; `None` where its whole part overflows.
+    #[inline(always)]
+    fn at_front(s: &[u8]) -> Option<Decimal> {
+        let mut i = 0;
+        let mut whole: i64 = 0;
+        while i < s.len() && s[i].is_ascii_digit() {
+            whole = whole.checked_mul(10)?.checked_add((s[i] - b'0') as i64)?;
+            i += 1;
+        }
+        let whole_digits = i;
+        let (mut micro, mut round_up, mut fraction_digits) = (0i64, false, 0);
+        if i < s.len() && s[i] == b'.' {
+            i += 1;
+            while i < s.len() && s[i].is_ascii_digit() {
+                let d = (s[i] - b'0') as i64;
+                if fraction_digits < 6 {
+                    micro = micro * 10 + d;
+                } else if fraction_digits == 6 {
+                    round_up = d >= 5;
+                }
+                fraction_digits += 1;
+                i += 1;
+            }
+        }
+        micro *= 10i64.pow(6 - fraction_digits.min(6) as u32);
+        Some(Decimal {
+            whole,
+            micro,
+            round_up,
+            whole_digits,
+            fraction_digits,
+            len: i,
+        })
+    }
+
+    /// The magnitude in microseconds; `None` where it overflows.
+    #[inline(always)]
+    fn microseconds(&self) -> Option<i64> {
+        self.whole
+            .checked_mul(1_000_000)?
+            .checked_add(self.micro + self.round_up as i64)
+    }
 }
 
 #[cold]
@@ -118,8 +142,8 @@ pub fn split_fields<'a>(line: &'a [u8], fields: &mut [&'a [u8]]) -> usize {
     count
 }
 
-/// The usual event line in one pass: `SECONDS X Y P`, single spaces, the time unsigned
-/// decimal (at most 12 whole digits), x and y of at most 9 digits, P `0` or `1`, nothing
+/// The usual event line in one pass: `SECONDS X Y P`, single spaces, the time an unsigned
+/// decimal with digits before its point (and after it, where it has one), x and y of at most 9 digits, P `0` or `1`, nothing
 /// after it. Returns (time in us, x, y, ON), exactly what [`split_fields`],
 /// [`seconds_to_us`], [`parse_u32`] and [`parse_polarity`] make of it; `None` for any other
 /// layout (signs, tabs, commas, `\r`, exponents, `-1`, comments, a `width height` line,
@@ -127,42 +151,16 @@ pub fn split_fields<'a>(line: &'a [u8], fields: &mut [&'a [u8]]) -> usize {
 /// once to split it and again per field, and its time is most of a text file's decoding.
 #[inline]
 pub fn event_line(line: &[u8]) -> Option<(i64, u32, u32, bool)> {
-    let n = line.len();
-    let mut i = 0;
-    let mut whole: i64 = 0;
-    while i < n && line[i].is_ascii_digit() {
-        if i == 12 {
-            return None;
-        }
-        whole = whole * 10 + (line[i] - b'0') as i64;
-        i += 1;
-    }
-    if i == 0 {
+    let time = Decimal::at_front(line)?;
+    // digits before the point, and after it where there is one
+    let pointed = time.len > time.whole_digits;
+    if time.whole_digits == 0 || (pointed && time.fraction_digits == 0) {
         return None;
     }
-    let (mut micro, mut micro_digits, mut round_up) = (0i64, 0u32, false);
-    if i < n && line[i] == b'.' {
-        i += 1;
-        let start = i;
-        while i < n && line[i].is_ascii_digit() {
-            let d = (line[i] - b'0') as i64;
-            if micro_digits < 6 {
-                micro = micro * 10 + d;
-                micro_digits += 1;
-            } else if i - start == 6 {
-                // the seventh decimal decides, as in `seconds_to_us`
-                round_up = d >= 5;
-            }
-            i += 1;
-        }
-        if i == start {
-            return None;
-        }
-    }
-    let t = whole * 1_000_000 + micro * 10i64.pow(6 - micro_digits) + round_up as i64;
-    let (x, i) = space_then_u32(line, i)?;
+    let t = time.microseconds()?;
+    let (x, i) = space_then_u32(line, time.len)?;
     let (y, i) = space_then_u32(line, i)?;
-    if i + 2 != n || line[i] != b' ' {
+    if i + 2 != line.len() || line[i] != b' ' {
         return None;
     }
     let on = match line[i + 1] {

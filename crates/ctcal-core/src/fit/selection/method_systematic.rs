@@ -38,12 +38,11 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>) -> Option<String> {
         if !(lo > 0.0 && v > 0.0 && hi >= v && v >= lo) {
             continue;
         }
-        let (below, above) = ((v / lo).ln().hypot(add), (hi / v).ln().hypot(add));
-        u.ci95 = Some([Some(v * (-below).exp()), Some(v * above.exp())]);
+        let new_lo = v * (-(v / lo).ln().hypot(add)).exp();
+        let new_hi = v * (hi / v).ln().hypot(add).exp();
+        u.ci95 = Some([Some(new_lo), Some(new_hi)]);
         widened.push(format!(
-            "{key} [{lo:.4}, {hi:.4}] -> [{:.4}, {:.4}]",
-            v * (-below).exp(),
-            v * above.exp()
+            "{key} [{lo:.4}, {hi:.4}] -> [{new_lo:.4}, {new_hi:.4}]"
         ));
     }
     (!widened.is_empty()).then(|| {
