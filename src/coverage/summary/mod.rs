@@ -28,6 +28,36 @@ pub struct Detection {
     /// Successful fits of cases without it, and how many added it anyway.
     pub absent: usize,
     pub false_alarms: usize,
+    /// Of the false alarms, how many claimed the effect: its defining parameter
+    /// ([`absent_value`]) reported with an interval that excludes the effect's absence (a
+    /// false alarm whose interval reaches the absence says "perhaps none", which is true).
+    pub false_claims: usize,
+}
+
+/// An effect's defining parameter and the value it takes where the effect is absent (a
+/// cutoff of infinity: no bandwidth limit).
+pub fn absent_value(effect: &str) -> Option<(&'static str, f64)> {
+    Some(match effect {
+        "bandwidth" => ("cutoff_hz", f64::INFINITY),
+        "leak" => ("leak_rate_hz", 0.0),
+        "shot_noise" => ("shot_noise_rate_hz", 0.0),
+        "refractory" => ("refractory_s", 0.0),
+        "hot_pixels" => ("hot_pixel_fraction", 0.0),
+        "timestamp_jitter" => ("timestamp_jitter_s", 0.0),
+        _ => return None,
+    })
+}
+
+/// Whether `fit` reports `effect`'s defining parameter with an interval (or a bare value)
+/// that excludes the effect's absence; a parameter the data do not determine claims nothing.
+fn claims(fit: &RunRecord, effect: &str) -> bool {
+    let Some((parameter, absent)) = absent_value(effect) else {
+        return false;
+    };
+    match fit.reported.get(parameter) {
+        Some(r @ (Reported::Interval { .. } | Reported::NoInterval { .. })) => !r.covers(absent),
+        _ => false,
+    }
 }
 
 /// A reason (failure message or `why`, numbers as `N`) and how often a method gave it.
@@ -91,6 +121,7 @@ fn detection(records: &[RunRecord]) -> Vec<Detection> {
                 detected: 0,
                 absent: 0,
                 false_alarms: 0,
+                false_claims: 0,
             };
             for fit in &fits {
                 let added = fit.effects_added.iter().any(|e| e == effect);
@@ -100,6 +131,7 @@ fn detection(records: &[RunRecord]) -> Vec<Detection> {
                 } else {
                     d.absent += 1;
                     d.false_alarms += added as usize;
+                    d.false_claims += (added && claims(fit, effect)) as usize;
                 }
             }
             d
@@ -230,7 +262,50 @@ impl Summary {
 
 #[cfg(test)]
 mod tests {
-    use super::headline;
+    use super::*;
+    use crate::coverage::record::read_jsonl;
+
+    /// Draw 1018 of the fit on seeds 1001-1080 (2026-11-29): no hot pixels, mismatch and a
+    /// 109 Hz cutoff; the fit named 2 hot pixels, fraction 4.9e-5 [6.0e-6, 1.8e-4].
+    fn draw_1018() -> RunRecord {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
+            "benches/coverage/fit-systematic-2026-11-29/measured-1001-1080/results.compact.jsonl",
+        );
+        read_jsonl(&path)
+            .unwrap()
+            .into_iter()
+            .find(|r| r.case.seed == 1018)
+            .unwrap()
+    }
+
+    #[test]
+    fn a_false_alarm_is_a_claim_only_where_its_interval_excludes_the_absence() {
+        let mut record = draw_1018();
+        let hot = |records: &[RunRecord]| {
+            detection(records)
+                .into_iter()
+                .find(|d| d.effect == "hot_pixels")
+                .unwrap()
+        };
+        let d = hot(std::slice::from_ref(&record));
+        assert_eq!((d.absent, d.false_alarms, d.false_claims), (1, 1, 1));
+        // the same pixels with an interval reaching none: "perhaps none" is no claim
+        record.reported.insert(
+            "hot_pixel_fraction".into(),
+            Reported::Interval {
+                value: 4.9e-5,
+                lo: Some(0.0),
+                hi: Some(1.8e-4),
+            },
+        );
+        let d = hot(std::slice::from_ref(&record));
+        assert_eq!((d.absent, d.false_alarms, d.false_claims), (1, 1, 0));
+        // a bandwidth limit's absence is an infinite cutoff: only an open upper end covers it
+        assert_eq!(
+            absent_value("bandwidth"),
+            Some(("cutoff_hz", f64::INFINITY))
+        );
+    }
 
     #[test]
     fn reasons_drop_the_path_and_the_numbers() {
