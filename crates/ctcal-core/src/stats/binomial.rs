@@ -2,7 +2,9 @@
 //! that stays inside [0, 1] and behaves at 0 and n) and the distribution-free interval of
 //! a median from its order statistics (the number of values below the median is
 //! Binomial(n, 1/2); Conover, *Practical Nonparametric Statistics*, 3rd ed., sec. 3.2),
-//! and the exact interval of a Poisson mean from one count (Garwood, Biometrika 1936).
+//! and the exact interval of a Poisson mean from one count (Garwood, Biometrika 1936), and
+//! the exact conditional test of two Poisson counts over equal exposures (Przyborowski &
+//! Wilenski, Biometrika 1940).
 
 use crate::estimate::interval::z95;
 
@@ -47,6 +49,19 @@ pub fn poisson95(n: usize) -> (f64, f64) {
     (lo, quantile(2.0 * n as f64 + 2.0, 0.975))
 }
 
+/// Whether a Poisson count `n` exceeds a count `m` over an equal exposure beyond chance: the
+/// exact conditional test (given `n + m`, `n` is Binomial(n + m, 1/2) where the means are
+/// equal; Przyborowski & Wilenski, Biometrika 1940), one-sided at 2.5 %, so that it agrees
+/// with the lower end of a 95 % interval. Two named against none is chance (P = 0.25); six
+/// against none is not (P = 0.016).
+pub fn exceeds_by_more_than_chance(n: usize, m: usize) -> bool {
+    use statrs::distribution::{Binomial, DiscreteCDF};
+    if n == 0 {
+        return false;
+    }
+    Binomial::new(0.5, (n + m) as u64).is_ok_and(|b| b.sf(n as u64 - 1) < 0.025)
+}
+
 /// The distribution-free 95 % interval of the median of `values`: `[x_(k), x_(n+1-k)]`
 /// with the largest `k` for which `P(Binomial(n, 1/2) < k) <= 0.025`. `None` under six
 /// values (even `[min, max]` then holds the median with less than 95 %).
@@ -79,6 +94,19 @@ pub fn median_interval95(values: &[f64]) -> Option<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn poisson_counts_exceed_each_other_as_the_binomial_tail_says() {
+        // P(B(2, 1/2) >= 2) = 0.25, P(B(5, 1/2) >= 5) = 0.031, P(B(6, 1/2) >= 6) = 0.0156
+        assert!(!exceeds_by_more_than_chance(2, 0));
+        assert!(!exceeds_by_more_than_chance(5, 0));
+        assert!(exceeds_by_more_than_chance(6, 0));
+        // 20 against 8: P(B(28, 1/2) >= 20) = 0.0178; 19 against 8: 0.0261
+        assert!(exceeds_by_more_than_chance(20, 8));
+        assert!(!exceeds_by_more_than_chance(19, 8));
+        assert!(!exceeds_by_more_than_chance(0, 0));
+        assert!(!exceeds_by_more_than_chance(3, 3));
+    }
 
     #[test]
     fn wilson_matches_the_textbook_values() {

@@ -247,6 +247,7 @@ fn hot_pixels(
     let found = hot_excess::excess(&hot_excess::Counts {
         real_named: &hot,
         model: None,
+        model_at_allowed_spreads: &[],
         width: w,
         height: h,
         duration_s: seconds,

@@ -110,60 +110,6 @@ fn between_blocks(simulation: &Simulation, model: &Simulated) -> [Option<f64>; 2
     })
 }
 
-/// The hot pixels reported: the named ones in excess of the final model's own count
-/// outliers ([`super::hot_excess`]), as a simulator takes them (a fraction of the kept
-/// pixels and a median rate); the assumption that says how they were counted.
-fn hot_pixels(
-    simulation: &Simulation,
-    state: &mut State,
-    input: &FitInput,
-    params: &mut crate::sim::PixelParams,
-) -> String {
-    let g = simulation.geometry;
-    let mut model = state.model.observed.pixels_of(g, Subset::Fit);
-    for (count, kept) in model.iter_mut().zip(&state.kept) {
-        if !kept {
-            *count = 0;
-        }
-    }
-    let mut real = simulation.real.pixels_of(g, Subset::Fit);
-    for (count, kept) in real.iter_mut().zip(&state.kept) {
-        if !kept {
-            *count = 0;
-        }
-    }
-    let found = super::hot_excess::excess(&super::hot_excess::Counts {
-        real_named: &state.hot,
-        model: Some(&model),
-        width: g.sensor.width as usize,
-        height: g.sensor.height as usize,
-        duration_s: g.duration_of(Subset::Fit),
-        kept_pixels: input.excluded.iter().filter(|&&e| !e).count(),
-        real: &real,
-        kept: &state.kept,
-    });
-    params.hot_pixel_fraction = Some(found.fraction.value);
-    params.hot_pixel_rate_hz = found.rate.as_ref().map(|r| r.value);
-    state
-        .uncertainty
-        .insert("hot_pixel_fraction".into(), found.fraction);
-    if let Some(rate) = found.rate {
-        state.uncertainty.insert("hot_pixel_rate_hz".into(), rate);
-    }
-    state.hot_detection = found.detection.clone();
-    let scope = found.detection.as_ref().map(|d| d.detectable_above_hz).map_or(
-        "the search's detection probability not measurable: pixels too weak to stand out from their neighbours are not counted".to_string(),
-        |r| format!("each counted 1 / its detection probability at a random kept pixel (Horvitz-Thompson, at least 1/2), so hot pixels at {r:.1} Hz or faster (the rate the search names at half the kept pixels) are counted in full and a slower one as 2 p(r) of one (hot_pixel_detection.probability): slower hot pixels are not determinable on this recording"),
-    );
-    format!(
-        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms; masked and simulated at their own rates), {} of them in excess of the {} count outliers the final model (mismatch, noise) makes by itself on the same blocks; hot_pixel_fraction and hot_pixel_rate_hz describe those {} (fraction interval: Poisson spread of both counts, Garwood's exact interval when the model makes none; rate: the median of their rates beyond their 8 neighbours' median, its interval reaching down to the rate the search names at 10 % of the kept pixels where it names that median at under 90 %: the named are then the upper tail of a slower kind), {scope}",
-        state.hot.len(),
-        found.hot.len(),
-        found.model_outliers,
-        found.hot.len()
-    )
-}
-
 /// Says so when the ideal model already makes more isolated events than the recording: the
 /// frames' own noise becomes events when they are simulated.
 pub fn read_noise_note(simulation: &Simulation, ideal: &Simulated, assumptions: &mut Vec<String>) {
@@ -190,6 +136,8 @@ pub struct Parts<'a> {
     pub fixed: bool,
     /// The starting thresholds as measured (the intervals widen where the fit disagrees).
     pub start: Option<super::agreement::Measured>,
+    /// The threshold spread event timing measures (value, 95 % interval), if it does.
+    pub measured_spread: Option<(f64, [f64; 2])>,
     /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
     /// miss (the intervals reach up by it).
     pub interpolation_share: Option<[f64; 2]>,
@@ -212,6 +160,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         mut assumptions,
         fixed,
         start,
+        measured_spread,
         interpolation_share,
         frame_quality,
         options,
@@ -250,8 +199,19 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         params.log_eps = Some(1e-6);
     }
     if !state.hot.is_empty() {
-        assumptions.push(hot_pixels(simulation, &mut state, input, &mut params));
+        assumptions.push(super::hot_report::hot_pixels(
+            simulation,
+            &mut state,
+            input,
+            measured_spread,
+            &mut params,
+        ));
     }
+    let undetermined_first = not_identified(&state, fixed);
+    assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
+        &mut state.uncertainty,
+        &undetermined_first,
+    ));
     let not_identified = not_identified(&state, fixed);
     assumptions.extend(super::alternatives::reach_zero_where_not_separated(
         &mut state.uncertainty,

@@ -24,6 +24,7 @@ pub use alternatives::Ambiguity;
 pub(in crate::fit) mod finish;
 mod frame_quality;
 pub(in crate::fit) mod hot_excess;
+mod hot_report;
 pub(in crate::fit) mod keep;
 mod method_systematic;
 mod start;
@@ -166,6 +167,7 @@ pub fn fit(
             assumptions,
             fixed: ideal.fixed,
             start: start.measured,
+            measured_spread: loop_run.known.mismatch,
             interpolation_share: start.interpolation_share,
             frame_quality,
             options,
