@@ -31,7 +31,9 @@
 //! which the model makes more outliers than the recording's `n` beyond Poisson chance
 //! (`m_s - n > 1.96 sqrt(m_s + n)`) is one the recording rules out, even were every named
 //! pixel a low threshold, and is not counted (draw 1076: 73 named, 381 at a spread of 0.22,
-//! the upper end of a fitted 0.054).
+//! the upper end of a fitted 0.054). A model's count is one simulation's, Poisson like the
+//! recording's: where `n` does not exceed it beyond chance (the exact conditional test of
+//! two Poisson counts, Przyborowski & Wilenski, Biometrika 1940) the lower end is 0.
 //!
 //! A slow hot pixel on a busy scene is not named at all. The search's detection
 //! probability at a random kept pixel, `pi(rate)` ([`Detectability`], from the recording's

@@ -61,7 +61,7 @@ pub(super) fn hot_pixels(
     params.hot_pixel_rate_hz = found.rate.as_ref().map(|r| r.value);
     state
         .uncertainty
-        .insert("hot_pixel_fraction".into(), found.fraction.clone());
+        .insert(HOT_FRACTION.into(), found.fraction.clone());
     if let Some(rate) = found.rate.clone() {
         state.uncertainty.insert("hot_pixel_rate_hz".into(), rate);
     }
