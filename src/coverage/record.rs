@@ -142,3 +142,15 @@ pub fn read_jsonl(path: &Path) -> std::io::Result<Vec<RunRecord>> {
     }
     Ok(records)
 }
+
+/// The record of the draw of `seed` in a committed study's results (`benches/coverage/...`,
+/// relative to the crate), for tests that check the tables on real runs.
+#[cfg(test)]
+pub fn committed(results: &str, seed: u64) -> RunRecord {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(results);
+    read_jsonl(&path)
+        .unwrap()
+        .into_iter()
+        .find(|r| r.case.seed == seed)
+        .unwrap_or_else(|| panic!("no draw {seed} in {results}"))
+}

@@ -263,19 +263,15 @@ impl Summary {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coverage::record::read_jsonl;
+    use crate::coverage::record::committed;
 
     /// Draw 1018 of the fit on seeds 1001-1080 (2026-11-29): no hot pixels, mismatch and a
     /// 109 Hz cutoff; the fit named 2 hot pixels, fraction 4.9e-5 [6.0e-6, 1.8e-4].
     fn draw_1018() -> RunRecord {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(
+        committed(
             "benches/coverage/fit-systematic-2026-11-29/measured-1001-1080/results.compact.jsonl",
-        );
-        read_jsonl(&path)
-            .unwrap()
-            .into_iter()
-            .find(|r| r.case.seed == 1018)
-            .unwrap()
+            1018,
+        )
     }
 
     #[test]

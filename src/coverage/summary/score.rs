@@ -95,18 +95,12 @@ fn detected_share(curve: &[[f64; 2]], rate: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::coverage::record::read_jsonl;
+    use crate::coverage::record::committed;
 
     /// Draw 3 of the fit study of 2026-11-28: 17 hot pixels at 9.08 Hz (fraction 6.28e-4)
     /// that the fit did not find, reporting 0 [0, 1.33e-4].
     fn draw_3() -> RunRecord {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("benches/coverage/fit-2026-11-28/results.compact.jsonl");
-        read_jsonl(&path)
-            .unwrap()
-            .into_iter()
-            .find(|r| r.case.seed == 3)
-            .unwrap()
+        committed("benches/coverage/fit-2026-11-28/results.compact.jsonl", 3)
     }
 
     #[test]

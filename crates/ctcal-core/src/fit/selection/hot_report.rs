@@ -100,13 +100,13 @@ fn spreads_around(
     fitted: Option<(f64, [f64; 2])>,
     measured: Option<(f64, [f64; 2])>,
 ) -> (Vec<f64>, &'static str) {
+    let across = |(value, [lo, hi]): (f64, [f64; 2])| {
+        vec![lo.max(value / 2.0), value, (value * hi).sqrt(), hi]
+    };
     let (candidates, source) = match (fitted, measured) {
-        (Some((value, [lo, hi])), _) => (
-            vec![lo.max(value / 2.0), value, (value * hi).sqrt(), hi],
-            "across the fitted spread's 95 % interval",
-        ),
-        (None, Some((value, [lo, hi]))) => (
-            vec![lo.max(value / 2.0), value, (value * hi).sqrt(), hi],
+        (Some(fitted), _) => (across(fitted), "across the fitted spread's 95 % interval"),
+        (None, Some(measured)) => (
+            across(measured),
             "across the 95 % interval of the spread event timing measures",
         ),
         (None, None) => (
