@@ -315,7 +315,7 @@ fn estimate(
                     ctcal_io::window::screen_of(
                         &loaded,
                         &frames,
-                        None,
+                        (None, None),
                         None,
                         &quiet,
                     )

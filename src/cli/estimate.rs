@@ -261,6 +261,10 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         }
         None => None,
     };
+    let response = match common.choose_response() {
+        true => None,
+        false => Some(common.log_map()?.0),
+    };
     let loaded = common.load(None, false, global)?;
     let path = loaded.recording.path.clone();
     let stimulus = match &args.stimulus {
@@ -292,7 +296,13 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
     let frames = stimulus.load_all()?;
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
-    let result = screen_of(&loaded, &frames, screen, args.refresh_hz, &progress);
+    let result = screen_of(
+        &loaded,
+        &frames,
+        (screen, response),
+        args.refresh_hz,
+        &progress,
+    );
     spinner.finish_and_clear();
     let estimate = result.map_err(|e| estimate_failed(&path, &e))?;
     present(&estimate, &loaded, common, &policy)

@@ -11,6 +11,7 @@ use crate::frame_blocks;
 use crate::hint::{Hint, Text};
 use crate::selection::{PixelSelection, Roi};
 use crate::sim::DisplayParams;
+use crate::sim::log_response::LogMap;
 use crate::{InputError, OpenOptions, Recording};
 use std::path::{Path, PathBuf};
 
@@ -667,11 +668,13 @@ pub fn eppps_of(
 }
 
 /// The `screen` estimate of a window recorded while `stimulus` played on `screen` (a
-/// measured screen model; `None`: [`default_screen`], with the gamma of displays in use).
+/// measured screen model; `None`: [`default_screen`], with the gamma of displays in use),
+/// through the sensor's declared log response (`None`: not declared, both candidates
+/// fitted; see [`screen::ResponsePrior`]).
 pub fn screen_of(
     loaded: &Loaded,
     stimulus: &[Frame],
-    screen: Option<DisplayParams>,
+    (screen, response): (Option<DisplayParams>, Option<LogMap>),
     refresh_hz: Option<f64>,
     progress: crate::estimate::Progress,
 ) -> Result<CtEstimate, EstimateError> {
@@ -685,6 +688,10 @@ pub fn screen_of(
                 None => screen::GammaPrior::Displays,
             },
             screen: screen.unwrap_or_else(default_screen),
+            response: match response {
+                Some(log) => screen::ResponsePrior::Declared(log),
+                None => screen::ResponsePrior::Unknown,
+            },
             refresh_hz,
             excluded: &loaded.excluded,
         },

@@ -298,8 +298,13 @@ fn estimates(
     match stimulus {
         Some(list) if list.len() >= 2 => {
             let frames = list.load_all()?;
-            let found =
-                crate::window::screen_of(loaded, &frames, options.screen.clone(), None, &quiet);
+            let found = crate::window::screen_of(
+                loaded,
+                &frames,
+                (options.screen.clone(), None),
+                None,
+                &quiet,
+            );
             methods.push(MethodResult {
                 method: "screen",
                 not_applied: found.as_ref().err().map(|e| e.to_string()),

@@ -3,11 +3,10 @@
 //! change of log intensity over the window, and the sum of its absolute changes at every
 //! refresh, which an ideal pixel turns into `1 / C` times as many events).
 
+use super::register::Through;
 use crate::events::{EventChunk, Frame, TimeUs};
 use crate::sim::display::DisplayModel;
-use crate::sim::log_response::LogMap;
 use crate::sim::screen_geometry::{ScreenWarp, camera_dn};
-use crate::sim::{DisplayParams, LogResponse};
 
 /// Signed and unsigned images of several windows, one size.
 #[derive(Clone, Debug)]
@@ -76,16 +75,17 @@ pub fn of_events(
     stack
 }
 
-/// The prediction of a stimulus through a display: in stimulus coordinates (no warp, no
-/// blur) or on the sensor through `warp` (with the display's blur).
+/// The prediction of a stimulus through a display and the sensor's log response: in
+/// stimulus coordinates (no warp, no blur) or on the sensor through `warp` (with the
+/// display's blur).
 pub fn predicted(
     stimulus: &[Frame],
     bounds: &[(usize, usize)],
-    display: &DisplayParams,
+    through: Through,
     warp: Option<&ScreenWarp>,
 ) -> Stack {
-    let model = DisplayModel::new(display);
-    let log = LogMap::new(LogResponse::V2e, 0.001);
+    let model = DisplayModel::new(through.display);
+    let log = through.log;
     let (w, h) = match warp {
         Some(warp) => warp.sensor_size(),
         None => (stimulus[0].width as usize, stimulus[0].height as usize),

@@ -422,11 +422,11 @@ impl LagProfile {
         );
         match self.cutoff_hz() {
             Some(c) => format!(
-                "pixels without mismatch or noise (v2e lin-log response) whose photoreceptor lags: a cutoff of {c:.0} Hz at 255 camera DN, scaling as (DN + 20) / 275, measured from when the events come (the cutoff of {grid}, refined a quarter decade either side, whose simulated events match best in their phase within the refresh period and in the refresh periods since their region last changed, jitter and a flat share of at most {:.0} % fitted); the display was fitted with ideal pixels and the thresholds matched again through it with this photoreceptor, half the correction taken as a systematic error",
+                "pixels without noise (the thresholds dithered +-5 %; the log response above) whose photoreceptor lags: a cutoff of {c:.0} Hz at 255 camera DN, scaling as (DN + 20) / 275, measured from when the events come (the cutoff of {grid}, refined a quarter decade either side, whose simulated events match best in their phase within the refresh period and in the refresh periods since their region last changed, jitter and a flat share of at most {:.0} % fitted); the display was fitted with ideal pixels and the thresholds matched again through it with this photoreceptor, half the correction taken as a systematic error",
                 100.0 * self.noise_max
             ),
             None => format!(
-                "ideal pixels (no mismatch, noise or photoreceptor lag), v2e lin-log response: when the events come shows no lag (no cutoff of {grid} matches their phase within the refresh period and the refresh periods since their region last changed better than ideal pixels by a factor {:.0}, jitter and a flat share of at most {:.0} % fitted)",
+                "ideal pixels (no noise or photoreceptor lag, the thresholds dithered +-5 %; the log response above): when the events come shows no lag (no cutoff of {grid} matches their phase within the refresh period and the refresh periods since their region last changed better than ideal pixels by a factor {:.0}, jitter and a flat share of at most {:.0} % fitted)",
                 1.0 / DECISIVE,
                 100.0 * self.noise_max
             ),

@@ -15,8 +15,10 @@
 //!    method, reported as `naive_ct`;
 //! 3. display: thresholds, black level, optical blur and the camera DN of white fitted
 //!    together by Nelder-Mead (argmin) on the squared log ratios of every region's count
-//!    over the stimulus, through ctcal's display model ([`crate::sim::display`]); then the
-//!    thresholds refined by the Brent root. The stimulus has three levels (black, grey 128,
+//!    over the stimulus, through ctcal's display model ([`crate::sim::display`]) and the
+//!    sensor's log response (declared, or both candidates: [`ResponsePrior`]), each fit
+//!    started on its black level ([`display_fit`]); then the thresholds refined by the
+//!    Brent root. The stimulus has three levels (black, grey 128,
 //!    white 255): white-grey transitions fix `gamma / C` (a power-law display changes their
 //!    log contrast by `gamma ln(255/128)`), transitions to black fix their log contrast over
 //!    `C`, which depends on how bright white is imaged against the sensor's dark response.
@@ -34,6 +36,7 @@
 //!    through the fitted display with that photoreceptor.
 
 mod coarse;
+mod display_fit;
 pub mod dlt;
 mod images;
 pub mod lag;
@@ -50,14 +53,14 @@ use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::hint::{Hint, Text};
 use crate::sim::display::DisplayModel;
+use crate::sim::log_response::LogMap;
 use crate::sim::pixel::Transition;
 use crate::sim::screen_geometry::ScreenWarp;
 use crate::sim::source::{DisplaySource, MemoryFrames};
-use crate::sim::{DisplayParams, PixelMaps, PixelParams};
-use argmin::core::{CostFunction, Error as ArgminError, Executor};
-use argmin::solver::neldermead::NelderMead;
+use crate::sim::{DisplayParams, LogResponse, PixelMaps, PixelParams};
+use argmin::core::{CostFunction, Error as ArgminError};
+use display_fit::{DisplayFits, Joint, fit_displays};
 use located::Located;
-use nalgebra::DVector;
 use register::Registration;
 use serde_json::json;
 
@@ -81,6 +84,8 @@ pub struct ScreenInput<'a> {
     pub screen: DisplayParams,
     /// What is known of the display's gamma.
     pub gamma_prior: GammaPrior,
+    /// What is known of the sensor's log response in the dark.
+    pub response: ResponsePrior,
     /// The refresh rate, when not the stimulus's frame rate.
     pub refresh_hz: Option<f64>,
     pub excluded: &'a [bool],
@@ -143,6 +148,76 @@ impl GammaPrior {
                 "the display's gamma {g:.2} and the camera DN of white from the screen model, taken as measured (gamma +-0.1, one standard deviation, fitted too; the best fit is reported, and the spread of the fits within 3x its cost is in the intervals)"
             ),
         }
+    }
+}
+
+/// What is known of the sensor's log response, which sets how much log contrast the
+/// stimulus's dark squares carry. v2e's lin-log (linear below 20 DN; Hu, Liu & Delbruck
+/// 2021) gives a transition to a black square of a few camera DN a larger log change than
+/// a photoreceptor's `ln(I + I_dark)` (the dark current is an offset under the log;
+/// Lichtsteiner, Posch & Delbruck 2008) with a small offset; thresholds matched
+/// through the wrong one read up to 3x too high on the coverage study's on-screen draws.
+/// Through a display, `ln(W (b + (1 - b) x^gamma) + offset)` depends on the black level
+/// `b` and the offset only through `(W b + offset) / (W (1 - b))`: the fitted black level
+/// absorbs the dark offset, and the camera DN of white `W` drops out.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ResponsePrior {
+    /// Named by the user: only it is simulated (white and black level fitted as before).
+    Declared(LogMap),
+    /// Not named: both are fitted, v2e's lin-log (white fitted) and a pure log whose dark
+    /// offset the black level absorbs ([`ABSORBED_DARK_OFFSET`]); the better fit is
+    /// reported, and the other's thresholds join the intervals' spread when it explains
+    /// the counts as well ([`display_fit::COMPATIBLE_COST`]).
+    Unknown,
+}
+
+/// The `eps` of the pure log fitted when the response is not named: 2.6e-3 DN at 255 DN
+/// of white, below any black level the fit reaches, so the fitted black level carries
+/// the whole dark offset.
+pub const ABSORBED_DARK_OFFSET: f64 = 1e-5;
+
+impl ResponsePrior {
+    /// The responses fitted, each with whether the camera DN of white is fitted with it
+    /// (not under the pure log whose offset the black level absorbs: white drops out).
+    fn candidates(self) -> Vec<(LogMap, bool)> {
+        match self {
+            ResponsePrior::Declared(log) => vec![(log, true)],
+            ResponsePrior::Unknown => vec![
+                (LogMap::new(LogResponse::V2e, 0.001), true),
+                (LogMap::new(LogResponse::Eps, ABSORBED_DARK_OFFSET), false),
+            ],
+        }
+    }
+
+    fn says(self, chosen: LogMap, others_compatible: bool) -> String {
+        match self {
+            ResponsePrior::Declared(log) => {
+                format!(
+                    "the sensor's log response as declared: {}",
+                    response_name(log)
+                )
+            }
+            ResponsePrior::Unknown => format!(
+                "the sensor's log response is not declared: v2e's lin-log and a pure log with a dark offset (absorbed by the fitted black level) were both fitted; {} explains the counts best{}; declare it (--log-response) to fit only it",
+                response_name(chosen),
+                if others_compatible {
+                    ", the other as well within 3x its cost, and its thresholds are in the intervals' spread"
+                } else {
+                    ", the other at more than 3x its cost"
+                }
+            ),
+        }
+    }
+}
+
+/// A response in words.
+fn response_name(log: LogMap) -> String {
+    match log.response() {
+        LogResponse::V2e => "v2e's lin-log (ln DN above 20 DN, linear below)".into(),
+        LogResponse::Eps if log.eps() <= ABSORBED_DARK_OFFSET * 1.01 => {
+            "a pure log, ln(DN + offset), the offset in the black level".into()
+        }
+        LogResponse::Eps => format!("ln(DN / 255 + {})", log.eps()),
     }
 }
 
@@ -222,6 +297,8 @@ struct Setup<'a> {
     warp: Option<std::sync::Arc<ScreenWarp>>,
     /// The photoreceptor's cutoff at 255 camera DN ([`lag`]; `None`: ideal pixels).
     cutoff_hz: Option<f64>,
+    /// The sensor's log response (the best fit's once the display is fitted).
+    log: LogMap,
     evaluations: std::sync::atomic::AtomicUsize,
 }
 
@@ -233,18 +310,39 @@ impl Setup<'_> {
         ct: (f64, f64),
         display: Option<&DisplayParams>,
     ) -> Result<Counts, EstimateError> {
+        self.counts_through(ct, display, self.log)
+    }
+
+    /// [`Self::counts`] through the log response `log`.
+    fn counts_through(
+        &self,
+        ct: (f64, f64),
+        display: Option<&DisplayParams>,
+        log: LogMap,
+    ) -> Result<Counts, EstimateError> {
         Ok(self
             .cells
-            .count(&self.events_at(ct, display, self.cutoff_hz)?))
+            .count(&self.events_through(ct, display, self.cutoff_hz, log)?))
     }
 
     /// The events simulated with thresholds, a display and the photoreceptor's cutoff at
-    /// 255 camera DN (`None`: ideal pixels).
+    /// 255 camera DN (`None`: ideal pixels), through the setup's log response.
     fn events_at(
         &self,
         ct: (f64, f64),
         display: Option<&DisplayParams>,
         cutoff_hz: Option<f64>,
+    ) -> Result<EventChunk, EstimateError> {
+        self.events_through(ct, display, cutoff_hz, self.log)
+    }
+
+    /// [`Self::events_at`] through the log response `log`.
+    fn events_through(
+        &self,
+        ct: (f64, f64),
+        display: Option<&DisplayParams>,
+        cutoff_hz: Option<f64>,
+        log: LogMap,
     ) -> Result<EventChunk, EstimateError> {
         self.evaluations
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -275,6 +373,8 @@ impl Setup<'_> {
         .map_err(bug)?;
         let params = PixelParams {
             cutoff_hz,
+            log_response: Some(log.response()),
+            log_eps: Some(log.eps()),
             ..PixelParams::ideal(ct.0, ct.1)
         };
         let mut events = EventChunk::default();
@@ -285,14 +385,8 @@ impl Setup<'_> {
         match display {
             None => {
                 let mut source = frames;
-                crate::sim::run(
-                    &mut source,
-                    &params,
-                    PixelMaps::default(),
-                    &mut sink,
-                    |_| {},
-                )
-                .map_err(bug)?;
+                crate::sim::run(&mut source, &params, self.dithered(ct), &mut sink, |_| {})
+                    .map_err(bug)?;
             }
             Some(d) => {
                 let mut d = d.clone();
@@ -302,18 +396,32 @@ impl Setup<'_> {
                 if let Some(warp) = &self.warp {
                     source = source.seen_through(warp.clone());
                 }
-                crate::sim::run(
-                    &mut source,
-                    &params,
-                    PixelMaps::default(),
-                    &mut sink,
-                    |_| {},
-                )
-                .map_err(bug)?;
+                crate::sim::run(&mut source, &params, self.dithered(ct), &mut sink, |_| {})
+                    .map_err(bug)?;
             }
         }
         events.sort_by_time();
         Ok(events)
+    }
+
+    /// Thresholds `ct` spread evenly over +-[`THRESHOLD_DITHER`] across the pixels (a
+    /// golden-ratio sequence in pixel order, so every tile holds the whole spread): a
+    /// region's count then changes in steps of one pixel, not of all its pixels at once,
+    /// as a threshold or the display moves, and the fits' cost is smooth enough for a
+    /// simplex to descend. The same dither in every simulation (common random numbers).
+    fn dithered(&self, ct: (f64, f64)) -> PixelMaps {
+        let n = self.input.sensor.width as usize * self.input.sensor.height as usize;
+        let spread: Vec<f32> = (0..n)
+            .map(|p| {
+                let u = (p as f64 * 0.618_033_988_749_895).fract();
+                (1.0 + THRESHOLD_DITHER * (2.0 * u - 1.0)) as f32
+            })
+            .collect();
+        PixelMaps {
+            ct_on: Some(spread.iter().map(|&f| f * ct.0 as f32).collect()),
+            ct_off: Some(spread.iter().map(|&f| f * ct.1 as f32).collect()),
+            leak_factor: None,
+        }
     }
 
     /// The roots of the ON and OFF median log ratios ([`super::root`]), the display fixed.
@@ -360,6 +468,13 @@ impl Setup<'_> {
     }
 }
 
+/// The half-width of the simulations' threshold dither ([`Setup::dithered`]), relative: a
+/// uniform spread of +-5 % has a standard deviation of 2.9 % of the threshold, below the
+/// mismatch of real sensors (Lichtsteiner, Posch & Delbruck 2008: 2.1 % contrast at a 15 %
+/// threshold, 14 % of it), and moves an ideal pixel's mean count (proportional to the mean
+/// of 1 / threshold) by 0.08 %.
+const THRESHOLD_DITHER: f64 = 0.05;
+
 /// The thresholds the stimulus may be simulated at: below 0.03 a black-white transition
 /// fires some 180 events per pixel (the simulation's cost grows with them), above 6 one
 /// event takes a 400-fold change of light; thresholds in use lie far inside (v2e's presets
@@ -393,55 +508,9 @@ impl CostFunction for Root<'_, '_> {
     }
 }
 
-/// Squared log ratios of all cells, for the joint fit: parameters `ln Cp, ln Cn,
-/// ln black_level, ln blur_px` and, unless the screen model's white is measured,
-/// `ln white_dn`, at the display gamma `gamma`.
-struct Joint<'a, 'b> {
-    setup: &'b Setup<'a>,
-    screen: &'b DisplayParams,
-    gamma: f64,
-}
-
-/// Where a fit's parameters sit in its vector.
-const P_WHITE: usize = 4;
-
-impl Joint<'_, '_> {
-    fn display(&self, p: &DVector<f64>) -> DisplayParams {
-        let mut d = self.screen.clone();
-        d.gamma = self.gamma;
-        d.black_level = p[2].exp().clamp(1e-5, 0.5);
-        d.blur_px = Some(p[3].exp().clamp(0.05, 3.0));
-        if let Some(white) = p.get(P_WHITE) {
-            d.white_dn = white.exp().clamp(2.0, 2000.0);
-        }
-        d
-    }
-}
-
-impl CostFunction for Joint<'_, '_> {
-    type Param = DVector<f64>;
-    type Output = f64;
-    fn cost(&self, p: &DVector<f64>) -> Result<f64, ArgminError> {
-        let display = self.display(p);
-        let simulated = self
-            .setup
-            .counts((p[0].exp(), p[1].exp()), Some(&display))?;
-        let squared = |r: &[u32], s: &[u32]| -> f64 {
-            r.iter()
-                .zip(s)
-                .filter(|(r, s)| **r >= 5 || **s >= 5)
-                .map(|(&r, &s)| ((s as f64 + 1.0) / (r as f64 + 1.0)).ln().powi(2))
-                .sum()
-        };
-        Ok(squared(&self.setup.real.on, &simulated.on)
-            + squared(&self.setup.real.off, &simulated.off))
-    }
-}
-
 /// The total variation of the log intensity a simulation sees (for saying how much the
 /// display changes the contrast).
-fn log_variation(stimulus: &[Frame], display: Option<&DisplayParams>) -> f64 {
-    let log = crate::sim::log_response::LogMap::new(crate::sim::LogResponse::V2e, 0.001);
+fn log_variation(stimulus: &[Frame], display: Option<&DisplayParams>, log: LogMap) -> f64 {
     let model = display.map(DisplayModel::new);
     let camera: Vec<Vec<f32>> = stimulus
         .iter()
@@ -483,6 +552,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         stimulus: input.stimulus,
         offset_us,
         refresh_hz,
+        log: input.response.candidates()[0].0,
     };
     let mut screen_model = input.screen.clone();
     screen_model.refresh_hz = refresh_hz;
@@ -559,6 +629,7 @@ fn counting_setup<'a>(
         refresh_hz,
         warp: located.warp.clone(),
         cutoff_hz: None,
+        log: input.response.candidates()[0].0,
         evaluations: std::sync::atomic::AtomicUsize::new(0),
     };
     (setup, excluded)
@@ -596,19 +667,29 @@ fn matched_thresholds<'a>(
     progress("naive estimate (no display model)", 0.1);
     let naive = setup.thresholds((0.3, 0.3), None)?;
     progress("fitting thresholds, white and black level", 0.3);
-    let fits = fit_displays(&setup, &input.screen, input.gamma_prior, naive)?;
+    let fits = fit_displays(
+        &setup,
+        &input.screen,
+        (input.gamma_prior, input.response),
+        naive,
+    )?;
     let best = fits.best();
     let display = Joint {
         setup: &setup,
         screen: &input.screen,
         gamma: best.gamma,
+        log: best.log,
     }
     .display(&best.param);
+    let setup = Setup {
+        log: best.log,
+        ..setup
+    };
     progress(
         "refining the screen's position through the fitted display",
         0.75,
     );
-    let setup = match reregister(inputs, &display, located) {
+    let setup = match reregister(inputs, &display, best.log, located) {
         Some(warp) => Setup {
             warp: Some(warp),
             ..setup
@@ -720,6 +801,10 @@ fn describe(
             display.gamma,
         ),
         prior.says(),
+        setup
+            .input
+            .response
+            .says(setup.log, m.fits.other_response_compatible()),
         m.lag_profile.says(),
     ]);
     if hot > 0 {
@@ -756,8 +841,8 @@ fn extras(m: &Matched, located: &Located, ct: f64) -> [(&'static str, serde_json
     let (setup, display, naive) = (&m.setup, &m.display, m.naive);
     let stimulus = setup.input.stimulus;
     let naive_ct = 0.5 * (naive.0 + naive.1);
-    let contrast =
-        log_variation(stimulus, Some(display)) / log_variation(stimulus, None).max(1e-12);
+    let contrast = log_variation(stimulus, Some(display), setup.log)
+        / log_variation(stimulus, None, setup.log).max(1e-12);
     let gap = (ct / naive_ct).ln();
     let explained = if gap.abs() > 1e-6 {
         contrast.ln() / gap
@@ -768,6 +853,7 @@ fn extras(m: &Matched, located: &Located, ct: f64) -> [(&'static str, serde_json
         (
             "display",
             json!({
+                "response": response_name(setup.log),
                 "gamma": display.gamma,
                 "black_level": display.black_level,
                 "refresh_hz": setup.refresh_hz,
@@ -815,13 +901,15 @@ fn unregistered(reason: &str) -> CtEstimate {
 fn reregister(
     inputs: &register::Inputs,
     display: &DisplayParams,
+    log: LogMap,
     located: &mut Located,
 ) -> Option<std::sync::Arc<ScreenWarp>> {
     located.warp.as_ref()?;
     let (real, bounds) = register::event_images(inputs);
     let start = located.registration.geometry.clone();
+    let through = register::Through { display, log };
     let again =
-        register::refine(&real, &bounds, inputs.stimulus, display, start.clone(), 3).ok()?;
+        register::refine(&real, &bounds, inputs.stimulus, through, start.clone(), 3).ok()?;
     let change = register::corner_change(&start, &again.geometry);
     located.refined_change_px = Some(change);
     if change <= 0.05 {
@@ -834,171 +922,4 @@ fn reregister(
     };
     located.warp = Some(located.registration.warp.clone());
     located.warp.clone()
-}
-
-/// A fit of the display with the thresholds, at one gamma from one start.
-struct DisplayFit {
-    gamma: f64,
-    white_start_dn: f64,
-    param: DVector<f64>,
-    cost: f64,
-}
-
-/// The display fits from every start (see [`fit_displays`]).
-struct DisplayFits(Vec<DisplayFit>);
-
-impl DisplayFits {
-    fn best(&self) -> &DisplayFit {
-        self.0
-            .iter()
-            .min_by(|a, b| a.cost.total_cmp(&b.cost))
-            .expect("at least one fit")
-    }
-
-    /// The thresholds of the other fits whose cost is within [`COMPATIBLE_COST`] of the
-    /// best's.
-    fn compatible(&self) -> Vec<(f64, f64)> {
-        let best = self.best().cost;
-        self.0
-            .iter()
-            .filter(|f| f.cost <= COMPATIBLE_COST * best)
-            .map(|f| (f.param[0].exp(), f.param[1].exp()))
-            .collect()
-    }
-
-    fn json(&self) -> serde_json::Value {
-        let best = self.best().cost;
-        self.0
-            .iter()
-            .map(|f| {
-                json!({
-                    "gamma": f.gamma,
-                    "white_dn_start": f.white_start_dn,
-                    "ct_on": f.param[0].exp(),
-                    "ct_off": f.param[1].exp(),
-                    "white_dn": f.param.get(P_WHITE).map_or(f.white_start_dn, |w| w.exp()),
-                    "black_level": f.param[2].exp(),
-                    "cost": f.cost,
-                    "compatible": f.cost <= COMPATIBLE_COST * best,
-                })
-            })
-            .collect()
-    }
-}
-
-/// Fits whose cost is at most this multiple of the best's are taken as explaining the counts
-/// as well (the residuals are dominated by what ideal pixels lack -- mismatch, noise --
-/// not by count noise, so a likelihood ratio over the cells would exclude every fit but the
-/// best, and which fit is best along the valley is itself down to that mismatch): on the
-/// coverage study's on-screen cases and the shipped samples the fits along the valley cost
-/// up to 2.6x the best (the truth lying among them), fits stuck away from it 20-50x.
-const COMPATIBLE_COST: f64 = 3.0;
-
-/// The joint fit at the prior's centre from the screen model's white, and at both ends of
-/// the prior from a dim and a bright white ([`WHITE_STARTS_DN`]; from the model's white
-/// when it is measured), two at a time: the counts
-/// do not resolve gamma from the camera DN of white (nor, through the sensor's dark
-/// response, white from the threshold), and each fit ends where its start leads it along
-/// that valley.
-fn fit_displays(
-    setup: &Setup,
-    screen: &DisplayParams,
-    prior: GammaPrior,
-    naive: (f64, f64),
-) -> Result<DisplayFits, EstimateError> {
-    use rayon::prelude::*;
-    let [low, high] = prior.range();
-    let mut starts = vec![(prior.centre(), screen.white_dn)];
-    if prior == GammaPrior::Displays {
-        starts.push((prior.centre(), WHITE_STARTS_DN[0]));
-    }
-    for gamma in [low, high] {
-        match prior {
-            // a measured screen model's white (the camera DN it is imaged at) is kept
-            GammaPrior::Measured(_) => starts.push((gamma, screen.white_dn)),
-            GammaPrior::Displays => starts.extend(WHITE_STARTS_DN.map(|white| (gamma, white))),
-        }
-    }
-    let fits: Vec<Result<DisplayFit, EstimateError>> = starts
-        .par_iter()
-        .map(|&(gamma, white)| {
-            let mut from = vec![
-                naive.0.ln(),
-                naive.1.ln(),
-                screen.black_level.max(1e-4).ln(),
-                screen.blur_px.unwrap_or(0.7).max(0.1).ln(),
-            ];
-            if prior == GammaPrior::Displays {
-                from.push(white.max(2.0).ln());
-            }
-            let from = DVector::from_vec(from);
-            let (param, cost) = fit_display(setup, screen, gamma, &from, 140)?;
-            Ok(DisplayFit {
-                gamma,
-                white_start_dn: white,
-                param,
-                cost,
-            })
-        })
-        .collect();
-    let mut done = Vec::new();
-    let mut failure = None;
-    for fit in fits {
-        match fit {
-            Ok(fit) if fit.cost.is_finite() => done.push(fit),
-            Ok(_) => {}
-            Err(e) => failure = Some(e),
-        }
-    }
-    match (done.is_empty(), failure) {
-        (true, Some(e)) => Err(e),
-        (true, None) => Err(EstimateError::new(
-            "the display fit found no finite cost from any start",
-            "report this as a bug",
-        )),
-        _ => Ok(DisplayFits(done)),
-    }
-}
-
-/// The joint fit of thresholds, white, black level and blur at display `gamma`, by
-/// Nelder-Mead from `from` (see [`Joint`]).
-fn fit_display(
-    setup: &Setup,
-    screen: &DisplayParams,
-    gamma: f64,
-    from: &DVector<f64>,
-    iterations: u64,
-) -> Result<(DVector<f64>, f64), EstimateError> {
-    let steps = [0.15, 0.15, 0.5, 0.3, 0.5];
-    let simplex = simplex_around(from, &steps[..from.len()]);
-    let solver = NelderMead::new(simplex)
-        .with_sd_tolerance(2e-3)
-        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))?;
-    let problem = Joint {
-        setup,
-        screen,
-        gamma,
-    };
-    let result = Executor::new(problem, solver)
-        .configure(|s| s.max_iters(iterations))
-        .run()
-        .map_err(|e| EstimateError::new(format!("display fit: {e}"), "report this as a bug"))?;
-    let cost = result.state.best_cost;
-    Ok((
-        result.state.best_param.unwrap_or_else(|| from.clone()),
-        cost,
-    ))
-}
-
-/// A Nelder-Mead start simplex: `start` and, for each coordinate, `start` moved by its step.
-fn simplex_around(start: &DVector<f64>, steps: &[f64]) -> Vec<DVector<f64>> {
-    (0..=steps.len())
-        .map(|k| {
-            let mut v = start.clone();
-            if k > 0 {
-                v[k - 1] += steps[k - 1];
-            }
-            v
-        })
-        .collect()
 }

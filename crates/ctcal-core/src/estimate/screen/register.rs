@@ -12,6 +12,7 @@ use super::images::{self, Stack};
 use super::{coarse, matching};
 use crate::events::{EventChunk, Frame, TimeUs};
 use crate::sim::DisplayParams;
+use crate::sim::log_response::LogMap;
 use crate::sim::screen_geometry::{ScreenGeometry, ScreenWarp};
 use std::sync::Arc;
 
@@ -32,6 +33,15 @@ pub struct Inputs<'a> {
     pub stimulus: &'a [Frame],
     pub offset_us: TimeUs,
     pub refresh_hz: f64,
+    /// The sensor's log response the predictions are made through.
+    pub log: LogMap,
+}
+
+/// What the stimulus is seen through: the display, then the sensor's log response.
+#[derive(Clone, Copy)]
+pub struct Through<'a> {
+    pub display: &'a DisplayParams,
+    pub log: LogMap,
 }
 
 /// A registered screen.
@@ -157,7 +167,7 @@ pub fn refine(
     real: &Stack,
     bounds: &[(usize, usize)],
     stimulus: &[Frame],
-    display: &DisplayParams,
+    through: Through,
     start: ScreenGeometry,
     first_radius: usize,
 ) -> Result<Registration, String> {
@@ -166,7 +176,7 @@ pub fn refine(
     let mut last = None;
     for iteration in 1..=8 {
         let warp = ScreenWarp::new(&g);
-        let predicted = images::predicted(stimulus, bounds, display, Some(&warp));
+        let predicted = images::predicted(stimulus, bounds, through, Some(&warp));
         let pairs = matching::correspondences(real, &predicted, &warp.on_screen(), &g, radius);
         if pairs.len() < MIN_POINTS {
             return Err(format!(
@@ -223,7 +233,11 @@ pub fn register(inputs: &Inputs, display: &DisplayParams) -> Result<Registration
         inputs.stimulus[0].width as usize,
         inputs.stimulus[0].height as usize,
     );
-    let flat = images::predicted(inputs.stimulus, &bounds, display, None);
+    let through = Through {
+        display,
+        log: inputs.log,
+    };
+    let flat = images::predicted(inputs.stimulus, &bounds, through, None);
     let (pose, score) = coarse::search(&real, &flat)
         .ok_or("no placement of the stimulus on the sensor was tried")?;
     if score < MIN_COARSE_SCORE {
@@ -235,7 +249,7 @@ pub fn register(inputs: &Inputs, display: &DisplayParams) -> Result<Registration
     start.homography = pose.homography(stimulus_size);
     let fine_block = ((inputs.sensor.0 as f64 / 96.0).ceil()).max(1.0);
     let radius = (2.0 * fine_block).ceil() as usize + 3;
-    let mut registration = refine(&real, &bounds, inputs.stimulus, display, start, radius)?;
+    let mut registration = refine(&real, &bounds, inputs.stimulus, through, start, radius)?;
     registration.coarse_score = score;
     Ok(registration)
 }

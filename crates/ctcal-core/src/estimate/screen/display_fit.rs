@@ -1,0 +1,313 @@
+//! The display fitted with the thresholds (step 3 of [`super`]): the squared log ratios of
+//! every region's count over the stimulus ([`Joint`]) minimised by Nelder-Mead (argmin)
+//! from several starts, each first placed on its black level by a coarse profile
+//! ([`black_level_start`]): the counts are steps in the parameters, and a simplex started
+//! far from the black level stalls on their plateaus (on the coverage study's on-screen
+//! draws fits stuck at 20-50x the best cost, their thresholds 1.5-2x the truth).
+
+use super::{GammaPrior, ResponsePrior, Setup, WHITE_STARTS_DN};
+use crate::estimate::EstimateError;
+use crate::sim::DisplayParams;
+use crate::sim::log_response::LogMap;
+use argmin::core::{CostFunction, Error as ArgminError, Executor};
+use argmin::solver::neldermead::NelderMead;
+use nalgebra::DVector;
+use serde_json::json;
+
+/// Squared log ratios of all cells, for the joint fit: parameters `ln Cp, ln Cn,
+/// ln black_level, ln blur_px` and, unless the screen model's white is measured,
+/// `ln white_dn`, at the display gamma `gamma`.
+pub(super) struct Joint<'a, 'b> {
+    pub setup: &'b Setup<'a>,
+    pub screen: &'b DisplayParams,
+    pub gamma: f64,
+    pub log: LogMap,
+}
+
+/// Where a fit's parameters sit in its vector.
+const P_WHITE: usize = 4;
+
+impl Joint<'_, '_> {
+    pub fn display(&self, p: &DVector<f64>) -> DisplayParams {
+        let mut d = self.screen.clone();
+        d.gamma = self.gamma;
+        d.black_level = p[2].exp().clamp(1e-5, 0.5);
+        d.blur_px = Some(p[3].exp().clamp(0.05, 3.0));
+        if let Some(white) = p.get(P_WHITE) {
+            d.white_dn = white.exp().clamp(2.0, 2000.0);
+        }
+        d
+    }
+}
+
+impl CostFunction for Joint<'_, '_> {
+    type Param = DVector<f64>;
+    type Output = f64;
+    fn cost(&self, p: &DVector<f64>) -> Result<f64, ArgminError> {
+        let display = self.display(p);
+        let simulated =
+            self.setup
+                .counts_through((p[0].exp(), p[1].exp()), Some(&display), self.log)?;
+        let squared = |r: &[u32], s: &[u32]| -> f64 {
+            r.iter()
+                .zip(s)
+                .filter(|(r, s)| **r >= 5 || **s >= 5)
+                .map(|(&r, &s)| ((s as f64 + 1.0) / (r as f64 + 1.0)).ln().powi(2))
+                .sum()
+        };
+        Ok(squared(&self.setup.real.on, &simulated.on)
+            + squared(&self.setup.real.off, &simulated.off))
+    }
+}
+
+/// A fit of the display with the thresholds, at one gamma from one start.
+pub(super) struct DisplayFit {
+    /// The sensor's log response the fit simulated.
+    pub log: LogMap,
+    pub gamma: f64,
+    pub white_start_dn: f64,
+    pub param: DVector<f64>,
+    pub cost: f64,
+}
+
+/// The display fits from every start (see [`fit_displays`]).
+pub(super) struct DisplayFits(Vec<DisplayFit>);
+
+impl DisplayFits {
+    pub fn best(&self) -> &DisplayFit {
+        self.0
+            .iter()
+            .min_by(|a, b| a.cost.total_cmp(&b.cost))
+            .expect("at least one fit")
+    }
+
+    /// The thresholds of the other fits whose cost is within [`COMPATIBLE_COST`] of the
+    /// best's.
+    pub fn compatible(&self) -> Vec<(f64, f64)> {
+        let best = self.best().cost;
+        self.0
+            .iter()
+            .filter(|f| f.cost <= COMPATIBLE_COST * best)
+            .map(|f| (f.param[0].exp(), f.param[1].exp()))
+            .collect()
+    }
+
+    /// Whether a fit through another log response than the best's explains the counts as
+    /// well ([`COMPATIBLE_COST`]).
+    pub fn other_response_compatible(&self) -> bool {
+        let best = self.best();
+        self.0
+            .iter()
+            .any(|f| f.log != best.log && f.cost <= COMPATIBLE_COST * best.cost)
+    }
+
+    pub fn json(&self) -> serde_json::Value {
+        let best = self.best().cost;
+        self.0
+            .iter()
+            .map(|f| {
+                json!({
+                    "response": super::response_name(f.log),
+                    "gamma": f.gamma,
+                    "white_dn_start": f.white_start_dn,
+                    "ct_on": f.param[0].exp(),
+                    "ct_off": f.param[1].exp(),
+                    "white_dn": f.param.get(P_WHITE).map_or(f.white_start_dn, |w| w.exp()),
+                    "black_level": f.param[2].exp(),
+                    "cost": f.cost,
+                    "compatible": f.cost <= COMPATIBLE_COST * best,
+                })
+            })
+            .collect()
+    }
+}
+
+/// Fits whose cost is at most this multiple of the best's are taken as explaining the counts
+/// as well (the residuals are dominated by what ideal pixels lack -- mismatch, noise --
+/// not by count noise, so a likelihood ratio over the cells would exclude every fit but the
+/// best, and which fit is best along the valley is itself down to that mismatch): on the
+/// coverage study's on-screen cases and the shipped samples the fits along the valley cost
+/// up to 2.6x the best (the truth lying among them), fits stuck away from it 20-50x.
+pub(super) const COMPATIBLE_COST: f64 = 3.0;
+
+/// The joint fits from every [`display_starts`], two at a time: the counts do not resolve
+/// gamma from the camera DN of white (nor, through the sensor's dark response, white from
+/// the threshold), and each fit ends where its start leads it along that valley.
+pub(super) fn fit_displays(
+    setup: &Setup,
+    screen: &DisplayParams,
+    (gamma_prior, response_prior): (GammaPrior, ResponsePrior),
+    naive: (f64, f64),
+) -> Result<DisplayFits, EstimateError> {
+    use rayon::prelude::*;
+    let starts = display_starts(screen, gamma_prior, response_prior);
+    let fits: Vec<Result<DisplayFit, EstimateError>> = starts
+        .par_iter()
+        .map(|start| {
+            let mut from = vec![
+                naive.0.ln(),
+                naive.1.ln(),
+                screen.black_level.max(1e-4).ln(),
+                screen.blur_px.unwrap_or(0.7).max(0.1).ln(),
+            ];
+            if let Some(white) = start.white_fitted_from {
+                from.push(white.max(2.0).ln());
+            }
+            let problem = Joint {
+                setup,
+                screen,
+                gamma: start.gamma,
+                log: start.log,
+            };
+            let from = black_level_start(&problem, DVector::from_vec(from))?;
+            let (param, cost) = fit_display(&problem, &from, 140)?;
+            Ok(DisplayFit {
+                log: start.log,
+                gamma: start.gamma,
+                white_start_dn: start.white_fitted_from.unwrap_or(screen.white_dn),
+                param,
+                cost,
+            })
+        })
+        .collect();
+    let mut done = Vec::new();
+    let mut failure = None;
+    for fit in fits {
+        match fit {
+            Ok(fit) if fit.cost.is_finite() => done.push(fit),
+            Ok(_) => {}
+            Err(e) => failure = Some(e),
+        }
+    }
+    match (done.is_empty(), failure) {
+        (true, Some(e)) => Err(e),
+        (true, None) => Err(EstimateError::new(
+            "the display fit found no finite cost from any start",
+            "report this as a bug",
+        )),
+        _ => Ok(DisplayFits(done)),
+    }
+}
+
+/// Where one display fit starts.
+struct DisplayStart {
+    log: LogMap,
+    gamma: f64,
+    /// The camera DN of white the fit starts from (`None`: not fitted, the screen model's).
+    white_fitted_from: Option<f64>,
+}
+
+/// The display fits' starts: for each candidate response, the prior's centre from the
+/// screen model's white and both ends from a dim and a bright white
+/// ([`WHITE_STARTS_DN`]; the model's white, kept, when it is measured); under the pure log
+/// whose offset the black level absorbs white drops out and one fit per gamma is made.
+fn display_starts(
+    screen: &DisplayParams,
+    gamma_prior: GammaPrior,
+    response_prior: ResponsePrior,
+) -> Vec<DisplayStart> {
+    let [low, high] = gamma_prior.range();
+    let mut starts = Vec::new();
+    for (log, white_matters) in response_prior.candidates() {
+        let fitted = white_matters && gamma_prior == GammaPrior::Displays;
+        let start = |gamma: f64, white: f64| DisplayStart {
+            log,
+            gamma,
+            white_fitted_from: fitted.then_some(white),
+        };
+        starts.push(start(gamma_prior.centre(), screen.white_dn));
+        if fitted {
+            starts.push(start(gamma_prior.centre(), WHITE_STARTS_DN[0]));
+        }
+        for gamma in [low, high] {
+            if fitted {
+                starts.extend(WHITE_STARTS_DN.map(|white| start(gamma, white)));
+            } else {
+                starts.push(start(gamma, screen.white_dn));
+            }
+        }
+    }
+    starts
+}
+
+/// The joint fit of thresholds, white, black level and blur of `problem`, by Nelder-Mead
+/// from `from` (see [`Joint`]).
+fn fit_display(
+    problem: &Joint,
+    from: &DVector<f64>,
+    iterations: u64,
+) -> Result<(DVector<f64>, f64), EstimateError> {
+    let steps = [0.15, 0.15, 0.5, 0.3, 0.5];
+    let simplex = simplex_around(from, &steps[..from.len()]);
+    let solver = NelderMead::new(simplex)
+        .with_sd_tolerance(2e-3)
+        .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))?;
+    let problem = Joint { ..*problem };
+    let result = Executor::new(problem, solver)
+        .configure(|s| s.max_iters(iterations))
+        .run()
+        .map_err(|e| EstimateError::new(format!("display fit: {e}"), "report this as a bug"))?;
+    let cost = result.state.best_cost;
+    Ok((
+        result.state.best_param.unwrap_or_else(|| from.clone()),
+        cost,
+    ))
+}
+
+/// The black levels a fit's start is chosen among, as fractions of white: from a
+/// 100,000:1 contrast ratio (OLED and local-dimming panels) over 1,000:1 (a typical LCD)
+/// to 3:1 (a projector in a lit room), a factor of about 3 apart. Through a pure log the
+/// black level also carries the sensor's dark offset (see [`super::ResponsePrior`]), which
+/// can lift it to that end.
+const BLACK_LEVELS: [f64; 9] = [1e-5, 1e-4, 3e-4, 1e-3, 3e-3, 0.01, 0.03, 0.1, 0.3];
+
+/// `from` with the black level of [`BLACK_LEVELS`] or the screen model's whose counts match
+/// best, each tried with the thresholds scaled by its ratio of simulated to recorded events
+/// per polarity (an ideal pixel's count is inversely proportional to its threshold): two
+/// simulations a level.
+fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>, EstimateError> {
+    let real = &problem.setup.real;
+    let total = |c: &[u32]| c.iter().map(|&n| n as f64).sum::<f64>();
+    let (real_on, real_off) = (total(&real.on), total(&real.off));
+    let mut best = (f64::INFINITY, from.clone());
+    let model_black = problem.screen.black_level;
+    for black in BLACK_LEVELS.into_iter().chain([model_black]) {
+        let mut p = from.clone();
+        p[2] = black.ln();
+        let simulated = problem.setup.counts_through(
+            (p[0].exp(), p[1].exp()),
+            Some(&problem.display(&p)),
+            problem.log,
+        )?;
+        let (on, off) = (total(&simulated.on), total(&simulated.off));
+        if on > 0.0 && real_on > 0.0 {
+            p[0] += (on / real_on).ln();
+        }
+        if off > 0.0 && real_off > 0.0 {
+            p[1] += (off / real_off).ln();
+        }
+        let [low, high] = super::THRESHOLD_LIMITS.map(f64::ln);
+        p[0] = p[0].clamp(low, high);
+        p[1] = p[1].clamp(low, high);
+        let cost = problem
+            .cost(&p)
+            .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))?;
+        if cost < best.0 {
+            best = (cost, p);
+        }
+    }
+    Ok(best.1)
+}
+
+/// A Nelder-Mead start simplex: `start` and, for each coordinate, `start` moved by its step.
+fn simplex_around(start: &DVector<f64>, steps: &[f64]) -> Vec<DVector<f64>> {
+    (0..=steps.len())
+        .map(|k| {
+            let mut v = start.clone();
+            if k > 0 {
+                v[k - 1] += steps[k - 1];
+            }
+            v
+        })
+        .collect()
+}
