@@ -10,8 +10,8 @@
 # NOT IDENTIFIED: shot_noise_rate_hz: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (not told apart from none: at most 0.0023 Hz (2 standard errors))
 # NOT IDENTIFIED: timestamp_jitter_s: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (timestamp jitter shows against a stimulus of known timing: that needs a screen recording or frames)
 exec "${V2E:-v2e}" \
-  --pos_thres 0.328109 \
-  --neg_thres 0.326728 \
+  --pos_thres 0.325233 \
+  --neg_thres 0.323379 \
   --sigma_thres 0 \
   --cutoff_hz 0 \
   --leak_rate_hz 0 \
