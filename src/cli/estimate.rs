@@ -86,8 +86,9 @@ pub struct CommonArgs {
     /// Only the part up to S seconds after the first event.
     #[arg(long, value_name = "S")]
     pub end: Option<f64>,
-    /// The log response the frames are read through (default: v2e's lin-log, or a pure
-    /// ln(DN + b) where the events' timing says it fits better).
+    /// The sensor's log response (default: v2e's lin-log, or a pure ln(DN + b) where the
+    /// events' timing says it fits better; `estimate screen` fits both and reports the
+    /// better, the other in its intervals when it fits as well).
     #[arg(long, value_enum)]
     pub log_response: Option<LogResponseArg>,
     /// The offset of the `eps` log response.
