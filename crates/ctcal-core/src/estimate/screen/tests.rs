@@ -122,7 +122,8 @@ fn run(truth: &ScreenGeometry) -> (CtEstimate, f64) {
         stimulus: &stimulus,
         screen: display(),
         gamma_prior: super::GammaPrior::Measured(display().gamma),
-        response: super::ResponsePrior::Unknown,
+        // the pixels' response, as recorded (the registration is under test)
+        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
         refresh_hz: None,
         excluded: &excluded,
     };
@@ -228,7 +229,8 @@ fn events_without_the_stimulus_are_not_registered() {
         stimulus: &stimulus,
         screen: display(),
         gamma_prior: super::GammaPrior::Measured(display().gamma),
-        response: super::ResponsePrior::Unknown,
+        // the pixels' response, as recorded (the registration is under test)
+        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
         refresh_hz: None,
         excluded: &excluded,
     };
