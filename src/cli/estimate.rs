@@ -262,10 +262,9 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         }
         None => None,
     };
-    let response = match common.choose_response() {
-        true => None,
-        false => Some(common.log_map()?.0),
-    };
+    // --log-eps is checked whether or not a response is named
+    let (log, _) = common.log_map()?;
+    let response = (!common.choose_response()).then_some(log);
     let loaded = common.load(None, false, global)?;
     let path = loaded.recording.path.clone();
     let stimulus = match &args.stimulus {

@@ -474,8 +474,9 @@ fn estimate_draw(seed: u64, method: &str) -> (ctcal::coverage::CaseSpec, serde_j
 /// its 0.3 start, and it was refused ("too few or too many events for every threshold
 /// tried"), like 13 more of the 45 on-screen draws of the coverage study. The root search
 /// now walks to them ([`ctcal::estimate::root`]). Its board moves 0.16 px a refresh, and
-/// the counts barely constrain the display: ideal pixels recorded alike read 0.42-0.54
-/// with the true response declared, and its interval, 1.12 [0.06, 2.18] before the fits
+/// the counts barely constrain the display: its stimulus simulated with ideal pixels at
+/// the true thresholds and display reads ON 0.42-0.54 with the true response declared,
+/// and its interval, 1.12 [0.06, 2.18] before the fits
 /// started from a black-level profile, is 1.07 [0.74, 1.40] after (the study's held-out
 /// draws are where the intervals' coverage is checked); the values stay within a factor 2.
 #[test]
@@ -497,6 +498,12 @@ fn screen_finds_thresholds_far_from_where_it_starts() {
             .unwrap_or_else(|| panic!("{key}: {}", e["why"]));
         let (lo, hi) = interval(&e[format!("{key}_ci95")]);
         assert!(lo > 0.0 && hi < 2.0 * v, "{key} {v} [{lo}, {hi}]");
+        // OFF is covered; ON's interval ends 0.7 % above the truth: a drift further
+        // away fails here
+        match key {
+            "ct_off" => assert!(lo <= truth && truth <= hi, "{key} {v} [{lo}, {hi}]"),
+            _ => assert!(lo < 1.05 * truth, "{key} {v} [{lo}, {hi}]"),
+        }
         // the display's gamma and white are not measured: within a factor 2
         assert!((v / truth).ln().abs() < 2f64.ln(), "{key} {v} for {truth}");
     }

@@ -256,7 +256,7 @@ fn fit_display(
 
 /// The black levels a fit's start is chosen among, as fractions of white: from a
 /// 100,000:1 contrast ratio (OLED and local-dimming panels) over 1,000:1 (a typical LCD)
-/// to 3:1 (a projector in a lit room), a factor of about 3 apart. Through a pure log the
+/// to 3:1 (a projector in a lit room), a factor of about 3 apart above 1e-4. Through a pure log the
 /// black level also carries the sensor's dark offset (see [`super::ResponsePrior`]), which
 /// can lift it to that end.
 const BLACK_LEVELS: [f64; 9] = [1e-5, 1e-4, 3e-4, 1e-3, 3e-3, 0.01, 0.03, 0.1, 0.3];
@@ -270,8 +270,11 @@ fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>
     let total = |c: &[u32]| c.iter().map(|&n| n as f64).sum::<f64>();
     let (real_on, real_off) = (total(&real.on), total(&real.off));
     let mut best = (f64::INFINITY, from.clone());
-    let model_black = problem.screen.black_level;
-    for black in BLACK_LEVELS.into_iter().chain([model_black]) {
+    // the model's black level where it is not on the grid (a black level of 0 is the
+    // grid's lowest)
+    let model_black = problem.screen.black_level.max(BLACK_LEVELS[0]);
+    let off_grid = (!BLACK_LEVELS.contains(&model_black)).then_some(model_black);
+    for black in BLACK_LEVELS.into_iter().chain(off_grid) {
         let mut p = from.clone();
         p[2] = black.ln();
         let simulated = problem.setup.counts_through(

@@ -171,9 +171,9 @@ pub enum ResponsePrior {
     Unknown,
 }
 
-/// The `eps` of the pure log fitted when the response is not named: 2.6e-3 DN at 255 DN
-/// of white, below any black level the fit reaches, so the fitted black level carries
-/// the whole dark offset.
+/// The `eps` of the pure log fitted when the response is not named: 2.6e-3 DN, about 1e-5
+/// of a white of 220-255 DN, at the lowest black level the fit tries, so the fitted black
+/// level carries the dark offset.
 pub const ABSORBED_DARK_OFFSET: f64 = 1e-5;
 
 impl ResponsePrior {
@@ -210,6 +210,18 @@ impl ResponsePrior {
     }
 }
 
+/// The response the naive simulation (the stimulus values as the camera's) is made
+/// through: the declared one, else v2e's lin-log (the paper's).
+fn naive_response(prior: ResponsePrior) -> LogMap {
+    prior.candidates()[0].0
+}
+
+/// Whether `log` is the undeclared pure log whose dark offset the black level carries
+/// (under which the camera DN of white drops out and is not fitted).
+fn offset_in_black_level(prior: ResponsePrior, log: LogMap) -> bool {
+    prior == ResponsePrior::Unknown && log.response() == LogResponse::Eps
+}
+
 /// A response in words.
 fn response_name(log: LogMap) -> String {
     match log.response() {
@@ -217,7 +229,7 @@ fn response_name(log: LogMap) -> String {
         LogResponse::Eps if log.eps() <= ABSORBED_DARK_OFFSET * 1.01 => {
             "a pure log, ln(DN + offset), the offset in the black level".into()
         }
-        LogResponse::Eps => format!("ln(DN / 255 + {})", log.eps()),
+        LogResponse::Eps => format!("ln(DN / 255 + {})", log.eps() as f32),
     }
 }
 
@@ -665,6 +677,7 @@ fn matched_thresholds<'a>(
 ) -> Result<Matched<'a>, EstimateError> {
     let input = setup.input;
     progress("naive estimate (no display model)", 0.1);
+    // through the setup's first response: `naive_response`
     let naive = setup.thresholds((0.3, 0.3), None)?;
     progress("fitting thresholds, white and black level", 0.3);
     let fits = fit_displays(
@@ -739,8 +752,10 @@ fn matched_thresholds<'a>(
 
 /// ON and OFF with their intervals: the standard error from the cells' spread about the
 /// final simulation (NaN where no cell holds 5 events), and as systematic the largest
-/// change over the display fits as good as the best (the prior's effect, see
-/// [`GammaPrior::ends_in_sigmas`]) with a share of the photoreceptor's correction.
+/// change over the display fits as good as the best (the priors' effect, see
+/// [`GammaPrior::ends_in_sigmas`]; where the other log response is among them, its change
+/// is scaled alike: a two-way choice's standard deviation is half the change, close to
+/// its sqrt(3)rd) with a share of the photoreceptor's correction.
 fn measured(m: &Matched, prior: GammaPrior) -> Result<(Measured, Measured), EstimateError> {
     let variants = m.fits.compatible();
     // the fits were made with ideal pixels: their spread is taken about the ideal pixels'
@@ -783,6 +798,7 @@ fn describe(
     let (setup, display, naive) = (&m.setup, &m.display, m.naive);
     let prior = setup.input.gamma_prior;
     let (offset_us, refresh_hz) = (setup.offset_us, setup.refresh_hz);
+    let absorbed = offset_in_black_level(setup.input.response, setup.log);
     estimate.assumptions.splice(0..0, [
         located.assumption(),
         format!(
@@ -790,11 +806,13 @@ fn describe(
             offset_us as f64 * 1e-6
         ),
         format!(
-            "the display: sample-and-hold at {refresh_hz:.3} Hz; black level ({:.4}) and optical blur ({:.2} px) fitted, the camera DN of white ({:.0}) {}, at gamma {:.2}",
+            "the display: sample-and-hold at {refresh_hz:.3} Hz; black level{} ({:.4}) and optical blur ({:.2} px) fitted, the camera DN of white ({:.0}) {}, at gamma {:.2}",
+            if absorbed { " with the sensor's dark offset" } else { "" },
             display.black_level,
             display.blur_px.unwrap_or(0.0),
             display.white_dn,
             match prior {
+                _ if absorbed => "the screen model's (it drops out under a pure log)",
                 GammaPrior::Displays => "fitted",
                 GammaPrior::Measured(_) => "the screen model's",
             },
@@ -842,7 +860,7 @@ fn extras(m: &Matched, located: &Located, ct: f64) -> [(&'static str, serde_json
     let stimulus = setup.input.stimulus;
     let naive_ct = 0.5 * (naive.0 + naive.1);
     let contrast = log_variation(stimulus, Some(display), setup.log)
-        / log_variation(stimulus, None, setup.log).max(1e-12);
+        / log_variation(stimulus, None, naive_response(setup.input.response)).max(1e-12);
     let gap = (ct / naive_ct).ln();
     let explained = if gap.abs() > 1e-6 {
         contrast.ln() / gap
