@@ -2,8 +2,9 @@
 //! every region's count over the stimulus ([`Joint`]) minimised by Nelder-Mead (argmin)
 //! from several starts, each first placed on its black level by a coarse profile
 //! ([`black_level_start`]): the counts are steps in the parameters, and a simplex started
-//! far from the black level stalls on their plateaus (on the coverage study's on-screen
-//! draws fits stuck at 20-50x the best cost, their thresholds 1.5-2x the truth).
+//! far from the black level stalls on their plateaus (ideal pixels behind the display of
+//! the coverage study's draw 3035: fits stuck at 15-40x the cost of the right black level,
+//! their thresholds 1.5x the truth).
 
 use super::{GammaPrior, ResponsePrior, Setup, WHITE_STARTS_DN};
 use crate::estimate::EstimateError;
@@ -15,8 +16,9 @@ use nalgebra::DVector;
 use serde_json::json;
 
 /// Squared log ratios of all cells, for the joint fit: parameters `ln Cp, ln Cn,
-/// ln black_level, ln blur_px` and, unless the screen model's white is measured,
-/// `ln white_dn`, at the display gamma `gamma`.
+/// ln black_level, ln blur_px` and, where white is fitted (not for a measured screen
+/// model, nor under the pure log whose offset the black level carries), `ln white_dn`, at
+/// the display gamma `gamma`, through the sensor's log response `log`.
 pub(super) struct Joint<'a, 'b> {
     pub setup: &'b Setup<'a>,
     pub screen: &'b DisplayParams,
@@ -198,9 +200,10 @@ struct DisplayStart {
 }
 
 /// The display fits' starts: for each candidate response, the prior's centre from the
-/// screen model's white and both ends from a dim and a bright white
-/// ([`WHITE_STARTS_DN`]; the model's white, kept, when it is measured); under the pure log
-/// whose offset the black level absorbs white drops out and one fit per gamma is made.
+/// screen model's white and from a dim white, and both ends from a dim and a bright white
+/// ([`WHITE_STARTS_DN`]); where white is not fitted (a measured screen model, whose white
+/// is kept, or the pure log whose offset the black level absorbs, under which it drops
+/// out) one fit per gamma.
 fn display_starts(
     screen: &DisplayParams,
     gamma_prior: GammaPrior,
