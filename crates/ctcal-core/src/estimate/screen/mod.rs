@@ -198,7 +198,7 @@ impl ResponsePrior {
                 )
             }
             ResponsePrior::Unknown => format!(
-                "the sensor's log response is not declared: v2e's lin-log and a pure log with a dark offset (absorbed by the fitted black level) were both fitted; {} explains the counts best{}; declare it (--log-response) to fit only it",
+                "the sensor's log response is not declared: v2e's lin-log and a pure log with a dark offset (absorbed by the fitted black level) were both fitted; {} explains the counts best{}; declaring the sensor's response fits only it",
                 response_name(chosen),
                 if others_compatible {
                     ", the other as well within 3x its cost, and its thresholds are in the intervals' spread"
@@ -311,6 +311,8 @@ struct Setup<'a> {
     cutoff_hz: Option<f64>,
     /// The sensor's log response (the best fit's once the display is fitted).
     log: LogMap,
+    /// Each pixel's factor on the thresholds ([`threshold_dither`]).
+    dither: Vec<f32>,
     evaluations: std::sync::atomic::AtomicUsize,
 }
 
@@ -422,16 +424,10 @@ impl Setup<'_> {
     /// as a threshold or the display moves, and the fits' cost is smooth enough for a
     /// simplex to descend. The same dither in every simulation (common random numbers).
     fn dithered(&self, ct: (f64, f64)) -> PixelMaps {
-        let n = self.input.sensor.width as usize * self.input.sensor.height as usize;
-        let spread: Vec<f32> = (0..n)
-            .map(|p| {
-                let u = (p as f64 * 0.618_033_988_749_895).fract();
-                (1.0 + THRESHOLD_DITHER * (2.0 * u - 1.0)) as f32
-            })
-            .collect();
+        let scaled = |c: f64| Some(self.dither.iter().map(|&f| f * c as f32).collect());
         PixelMaps {
-            ct_on: Some(spread.iter().map(|&f| f * ct.0 as f32).collect()),
-            ct_off: Some(spread.iter().map(|&f| f * ct.1 as f32).collect()),
+            ct_on: scaled(ct.0),
+            ct_off: scaled(ct.1),
             leak_factor: None,
         }
     }
@@ -478,6 +474,17 @@ impl Setup<'_> {
         }
         Ok((ct[0], ct[1]))
     }
+}
+
+/// The factors of [`Setup::dithered`] for `pixels` pixels: a golden-ratio sequence over
+/// +-[`THRESHOLD_DITHER`].
+fn threshold_dither(pixels: usize) -> Vec<f32> {
+    (0..pixels)
+        .map(|p| {
+            let u = (p as f64 * 0.618_033_988_749_895).fract();
+            (1.0 + THRESHOLD_DITHER * (2.0 * u - 1.0)) as f32
+        })
+        .collect()
 }
 
 /// The half-width of the simulations' threshold dither ([`Setup::dithered`]), relative: a
@@ -564,7 +571,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         stimulus: input.stimulus,
         offset_us,
         refresh_hz,
-        log: input.response.candidates()[0].0,
+        log: naive_response(input.response),
     };
     let mut screen_model = input.screen.clone();
     screen_model.refresh_hz = refresh_hz;
@@ -641,7 +648,8 @@ fn counting_setup<'a>(
         refresh_hz,
         warp: located.warp.clone(),
         cutoff_hz: None,
-        log: input.response.candidates()[0].0,
+        log: naive_response(input.response),
+        dither: threshold_dither(input.sensor.width as usize * input.sensor.height as usize),
         evaluations: std::sync::atomic::AtomicUsize::new(0),
     };
     (setup, excluded)

@@ -207,12 +207,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
             &mut params,
         ));
     }
-    let undetermined_first = not_identified(&state, fixed);
+    let not_identified = not_identified(&state, fixed);
     assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
         &mut state.uncertainty,
-        &undetermined_first,
+        &not_identified,
     ));
-    let not_identified = not_identified(&state, fixed);
     assumptions.extend(super::alternatives::reach_zero_where_not_separated(
         &mut state.uncertainty,
         &mut ambiguities,
