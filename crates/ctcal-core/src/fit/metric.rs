@@ -108,6 +108,11 @@ pub fn background_rates(o: &Observed, g: &Geometry, subset: Subset) -> Vec<Optio
 /// events per pixel on average), or `None` without such tiles.
 pub fn dispersion(counts: &[u32], g: &Geometry, kept: &[bool]) -> Option<f64> {
     let (w, h) = (g.sensor.width as usize, g.sensor.height as usize);
+    dispersion_in_tiles(counts, w, h, kept)
+}
+
+/// [`dispersion`] of a `w` x `h` sensor's per-pixel `counts`.
+fn dispersion_in_tiles(counts: &[u32], w: usize, h: usize, kept: &[bool]) -> Option<f64> {
     let (mut deviation, mut mean_total) = (0.0, 0.0);
     for ty in (0..h).step_by(TILE_PX) {
         for tx in (0..w).step_by(TILE_PX) {
@@ -128,6 +133,20 @@ pub fn dispersion(counts: &[u32], g: &Geometry, kept: &[bool]) -> Option<f64> {
         }
     }
     (mean_total > 0.0).then(|| deviation / mean_total)
+}
+
+/// Indices of dispersion this far apart near zero are not told apart: a tenth of a Poisson
+/// process's (1). A tile whose pixels all fired equally often (a regular scene crossed
+/// without mismatch: every pixel of a tile meets the same edges) has an index of 0, and the
+/// ratio of two indices would be infinite (coverage draw 3016: the fit's mismatch search
+/// handed the infinite distance to Brent's line search, which stepped to NaN).
+pub const DISPERSION_FLOOR: f64 = 0.1;
+
+/// `ln(simulated / real)` of two [`dispersion`] indices, each with [`DISPERSION_FLOOR`]
+/// added: finite for any indices, and within 2 % of the plain log ratio where both are at
+/// least 5 (a pixel's counts spread by mismatch, as on real sensors).
+pub fn dispersion_log_ratio(real: f64, simulated: f64) -> f64 {
+    ((simulated + DISPERSION_FLOOR) / (real + DISPERSION_FLOOR)).ln()
 }
 
 /// Normalised histogram.
@@ -175,7 +194,7 @@ pub fn distance(
     let active_of = |c: &[u32]| c.iter().zip(kept).filter(|&(&n, &k)| k && n > 0).count() as f64;
     let active = log_ratio(active_of(&sp), active_of(&rp)).abs();
     let dispersion = match (dispersion(&rp, g, kept), dispersion(&sp, g, kept)) {
-        (Some(r), Some(s)) => (s / r).ln().abs(),
+        (Some(r), Some(s)) => dispersion_log_ratio(r, s).abs(),
         _ => 0.0,
     };
     let total = [counts, background, intervals, polarity, active, dispersion]
@@ -237,5 +256,23 @@ mod tests {
         let n = normalised(&[1, 3, 0]);
         assert_eq!(n, vec![0.25, 0.75, 0.0]);
         assert_eq!(normalised(&[0, 0]), vec![0.0, 0.0]);
+    }
+
+    #[test]
+    fn a_tile_without_spread_gives_a_finite_dispersion_ratio() {
+        // one 16 x 16 tile (TILE_PX) whose pixels fired 3 times each: the index is 0
+        let kept = vec![true; 256];
+        let regular = vec![3u32; 256];
+        assert_eq!(dispersion_in_tiles(&regular, 16, 16, &kept), Some(0.0));
+        // a spread of 2 events in every other pixel: variance 1, mean 3 -> index 1/3
+        let spread: Vec<u32> = (0..256).map(|i| if i % 2 == 0 { 2 } else { 4 }).collect();
+        let d = dispersion_in_tiles(&spread, 16, 16, &kept).unwrap();
+        assert!((d - 1.0 / 3.0).abs() < 1e-12, "{d}");
+        // hand computed: ln((0 + 0.1) / (1/3 + 0.1)) = ln(0.3 / 1.3)
+        let ratio = dispersion_log_ratio(d, 0.0);
+        assert!((ratio - (0.3f64 / 1.3).ln()).abs() < 1e-12, "{ratio}");
+        assert_eq!(dispersion_log_ratio(0.0, 0.0), 0.0);
+        // indices of 5 and 10: within 2 % of ln 2
+        assert!((dispersion_log_ratio(5.0, 10.0) / 2f64.ln() - 1.0).abs() < 0.02);
     }
 }

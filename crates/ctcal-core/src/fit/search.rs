@@ -293,12 +293,27 @@ struct Search<'a, 'b> {
     failure: RefCell<Option<EstimateError>>,
 }
 
+impl Search<'_, '_> {
+    /// Records a failure the search cannot go on from (a line search handed something
+    /// not finite would step to NaN) and the error that stops the executor.
+    fn fail(&self, what: String) -> ArgminError {
+        *self.failure.borrow_mut() = Some(EstimateError::new(
+            format!("the {} search failed: {what}", self.effect),
+            "report this as a bug, with the recording",
+        ));
+        ArgminError::msg("the search failed")
+    }
+}
+
 impl CostFunction for Search<'_, '_> {
     type Param = f64;
     type Output = f64;
 
     fn cost(&self, log_value: &f64) -> Result<f64, ArgminError> {
         let value = log_value.exp();
+        if !value.is_finite() {
+            return Err(self.fail(format!("the line search stepped to {value}")));
+        }
         let mut p = self.warm.borrow().clone();
         self.effect.set(&mut p, value);
         let simulated = match self
@@ -315,6 +330,9 @@ impl CostFunction for Search<'_, '_> {
             .simulation
             .distance(&simulated.observed, Subset::Fit, self.kept)
             .total;
+        if !error.is_finite() {
+            return Err(self.fail(format!("the distance at {value} is {error}")));
+        }
         self.evaluations.borrow_mut().push(Evaluation {
             value,
             fit_error: error,

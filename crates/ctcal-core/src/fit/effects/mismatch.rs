@@ -9,7 +9,7 @@
 //! measured spread.
 
 use super::{Context, Effect, Evidence};
-use crate::fit::metric::dispersion;
+use crate::fit::metric::{dispersion, dispersion_log_ratio};
 
 pub fn evidence(c: &Context) -> Evidence {
     if let Some((sigma, [lo, hi])) = c.mismatch_estimate {
@@ -33,7 +33,8 @@ pub fn evidence(c: &Context) -> Evidence {
         dispersion(&s, c.geometry, c.kept),
     ) {
         (Some(dr), Some(ds)) => {
-            let excess = (dr / ds).ln();
+            // ln(recording / model)
+            let excess = -dispersion_log_ratio(dr, ds);
             Evidence {
                 effect: Effect::Mismatch,
                 // the pooled dispersion's relative standard error is about 2 %
