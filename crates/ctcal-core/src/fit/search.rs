@@ -290,7 +290,10 @@ struct Search<'a, 'b> {
     best: RefCell<Option<(f64, Simulated)>>,
     /// The thresholds of the last point (the next starts there).
     warm: RefCell<PixelParams>,
-    failure: RefCell<Option<EstimateError>>,
+    /// Why the search stopped, where a cost could not be computed. Held by the caller: the
+    /// executor drops the problem when a cost fails, and this error (with its fix) is
+    /// what the caller reports.
+    failure: &'b RefCell<Option<EstimateError>>,
 }
 
 impl Search<'_, '_> {
@@ -424,6 +427,7 @@ pub fn search(
     noise: f64,
 ) -> Result<Searched, EstimateError> {
     let range = within_limit(valid_range(range), simulation.upper_limit(effect));
+    let failure = RefCell::new(None);
     let problem = Search {
         simulation,
         effect,
@@ -433,12 +437,15 @@ pub fn search(
         evaluations: RefCell::new(Vec::new()),
         best: RefCell::new(None),
         warm: RefCell::new(base.clone()),
-        failure: RefCell::new(None),
+        failure: &failure,
     };
     let solver = BrentOpt::new(range.0.ln(), range.1.ln()).set_tolerance(0.03, 0.01);
     let result = Executor::new(problem, solver)
         .configure(|s| s.max_iters(16))
         .run();
+    if let Some(e) = failure.take() {
+        return Err(e);
+    }
     let problem = match result {
         Ok(r) => r.problem.problem.expect("the executor keeps its problem"),
         Err(e) => {
@@ -448,9 +455,6 @@ pub fn search(
             ));
         }
     };
-    if let Some(e) = problem.failure.into_inner() {
-        return Err(e);
-    }
     let evaluations = problem.evaluations.into_inner();
     let Some((fit_error, model)) = problem.best.into_inner() else {
         return Err(EstimateError::new(
