@@ -57,13 +57,44 @@ fn run_aps(case: &CaseSpec, dir: &Path) -> RunRecord {
         serde_json::from_slice(&std::fs::read(dir.join("case.json")).unwrap()).unwrap();
     assert_eq!(&written, case, "case.json reproduces the case");
     assert!(truth.events > 0 && truth.aps_frames >= 2, "{truth:?}");
-    let options = RunOptions {
+    let (outcome, seconds) = run_method(&run_options(), Method::Aps, dir, case);
+    RunRecord::new(case.clone(), Some(truth), Method::Aps, seconds, outcome)
+}
+
+/// How the tests run the binary: two threads, at most 5 minutes a command.
+fn run_options() -> RunOptions {
+    RunOptions {
         binary: env!("CARGO_BIN_EXE_ctcal").into(),
         threads: 2,
         timeout: Duration::from_secs(300),
+    }
+}
+
+/// Draw `seed`'s case written under `work` and run through `method`.
+fn run_draw(method: Method, seed: u64, work: &Path) -> RunRecord {
+    let case = CaseSpec::draw(seed);
+    let dir = work.join(&case.id);
+    let truth = write_case(&case, &dir).expect("the case is written");
+    let (outcome, seconds) = run_method(&run_options(), method, &dir, &case);
+    RunRecord::new(case, Some(truth), method, seconds, outcome)
+}
+
+/// The value `record` reports for `key` with its true value, after asserting that it
+/// is an interval (open sides reach 0 and infinity) holding the truth.
+fn covered_value(record: &RunRecord, key: &str) -> (f64, f64) {
+    let id = &record.case.id;
+    let true_value = record.truth.as_ref().expect("the case was written").values[key];
+    let Reported::Interval { value, lo, hi } = record.reported[key].clone() else {
+        panic!(
+            "{id} {key}: {:?} ({:?})",
+            record.reported[key], record.outcome
+        );
     };
-    let (outcome, seconds) = run_method(&options, Method::Aps, dir, case);
-    RunRecord::new(case.clone(), Some(truth), Method::Aps, seconds, outcome)
+    assert!(
+        lo.unwrap_or(0.0) <= true_value && true_value <= hi.unwrap_or(f64::INFINITY),
+        "{id} {key}: {value} [{lo:?}, {hi:?}] for {true_value}"
+    );
+    (value, true_value)
 }
 
 /// A number, or `null` with a reason; a refusal (exit 2) must say why.
@@ -145,36 +176,14 @@ fn aps_intervals_on_a_random_subset_are_scored() {
 #[test]
 fn eppps_intervals_hold_the_truth_on_draws_its_scans_miss() {
     let work = tempfile::tempdir().unwrap();
-    let options = RunOptions {
-        binary: env!("CARGO_BIN_EXE_ctcal").into(),
-        threads: 2,
-        timeout: Duration::from_secs(300),
-    };
     for (seed, read_high) in [(23, true), (46, false)] {
-        let case = CaseSpec::draw(seed);
-        let dir = work.path().join(&case.id);
-        let truth = write_case(&case, &dir).expect("the case is written");
-        let (outcome, seconds) = run_method(&options, Method::Eppps, &dir, &case);
-        let record = RunRecord::new(
-            case.clone(),
-            Some(truth.clone()),
-            Method::Eppps,
-            seconds,
-            outcome,
-        );
+        let record = run_draw(Method::Eppps, seed, work.path());
         for key in ["ct_on", "ct_off"] {
-            let true_value = truth.values[key];
-            let Reported::Interval { value, lo, hi } = record.reported[key].clone() else {
-                panic!("draw {seed} {key}: {:?}", record.reported[key]);
-            };
+            let (value, true_value) = covered_value(&record, key);
             let error = (value / true_value).ln();
             assert!(
                 error.abs() > 0.25 && (error > 0.0) == read_high,
                 "draw {seed} {key}: {value} for {true_value}, the scans' miss this test is about"
-            );
-            assert!(
-                lo.unwrap_or(0.0) <= true_value && true_value <= hi.unwrap_or(f64::INFINITY),
-                "draw {seed} {key}: [{lo:?}, {hi:?}] for {true_value}"
             );
         }
     }
@@ -191,28 +200,9 @@ fn eppps_intervals_hold_the_truth_on_draws_its_scans_miss() {
 #[test]
 fn fit_of_a_regular_rotation_completes_and_holds_the_truth() {
     let work = tempfile::tempdir().unwrap();
-    let case = CaseSpec::draw(3016);
-    let dir = work.path().join(&case.id);
-    let truth = write_case(&case, &dir).expect("the case is written");
-    let options = RunOptions {
-        binary: env!("CARGO_BIN_EXE_ctcal").into(),
-        threads: 2,
-        timeout: Duration::from_secs(300),
-    };
-    let (outcome, seconds) = run_method(&options, Method::Fit, &dir, &case);
-    let record = RunRecord::new(case, Some(truth.clone()), Method::Fit, seconds, outcome);
+    let record = run_draw(Method::Fit, 3016, work.path());
     for key in ["ct_on", "ct_off", "shot_noise_rate_hz"] {
-        let true_value = truth.values[key];
-        let Reported::Interval { value, lo, hi } = record.reported[key].clone() else {
-            panic!(
-                "draw 3016 {key}: {:?} ({:?})",
-                record.reported[key], record.outcome
-            );
-        };
-        assert!(
-            lo.unwrap_or(0.0) <= true_value && true_value <= hi.unwrap_or(f64::INFINITY),
-            "draw 3016 {key}: {value} [{lo:?}, {hi:?}] for {true_value}"
-        );
+        covered_value(&record, key);
     }
 }
 
@@ -228,19 +218,8 @@ fn aps_on_frames_half_clipped_at_white_holds_the_truth() {
     for seed in [3065, 3073] {
         let case = CaseSpec::draw(seed);
         let record = run_aps(&case, &work.path().join(&case.id));
-        let truth = record.truth.clone().unwrap();
         for key in ["ct_on", "ct_off"] {
-            let true_value = truth.values[key];
-            let Reported::Interval { value, lo, hi } = record.reported[key].clone() else {
-                panic!(
-                    "draw {seed} {key}: {:?} ({:?})",
-                    record.reported[key], record.outcome
-                );
-            };
-            assert!(
-                lo.unwrap_or(0.0) <= true_value && true_value <= hi.unwrap_or(f64::INFINITY),
-                "draw {seed} {key}: {value} [{lo:?}, {hi:?}] for {true_value}"
-            );
+            covered_value(&record, key);
         }
     }
 }
