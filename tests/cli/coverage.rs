@@ -223,3 +223,21 @@ fn aps_on_frames_half_clipped_at_white_holds_the_truth() {
         }
     }
 }
+
+/// Draw 4046: a slow rotation (15 px/s) with shot noise at 1.7 Hz a pixel and thresholds
+/// of 0.14 (ON) and 0.77 (OFF). Simulated without its noise the scene makes no OFF event at
+/// all: every OFF event is noise. The support window (100 ms) is longer than the noise's
+/// spacing among 8 neighbours, so 93 % of noise events find support by chance, and eppps
+/// read OFF 0.08 [0.03, 0.20] for 0.77 counting them as signal. The unsupported events,
+/// divided by the chance a noise event goes unsupported, now bound the noise: OFF is not
+/// determinable (the noise may be every OFF event) and ON still holds the truth.
+#[test]
+fn eppps_says_when_the_noise_may_be_every_event_of_a_polarity() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_draw(Method::Eppps, 4046, work.path());
+    covered_value(&record, "ct_on");
+    let Reported::NotDeterminable { why } = &record.reported["ct_off"] else {
+        panic!("OFF: {:?}", record.reported["ct_off"]);
+    };
+    assert!(why.contains("the noise may be every OFF event"), "{why}");
+}

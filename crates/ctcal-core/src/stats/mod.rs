@@ -19,6 +19,7 @@
 //! claimed (or given) far larger than its events costs only what the events need.
 
 pub mod binomial;
+pub mod chance_support;
 pub mod hot_pixels;
 pub mod intervals;
 pub mod jackknife;

@@ -564,7 +564,11 @@ fn measure(
             _ => None,
         })
         .collect();
-    let values = match classify(&inverted, beyond, target, side) {
+    let classified = match &rates.noise_why[side.index()] {
+        Some(why) => Err(why.clone()),
+        None => classify(&inverted, beyond, target, side),
+    };
+    let values = match classified {
         Ok(values) => values,
         Err(why) => {
             return Polarity {
@@ -595,7 +599,7 @@ fn measure(
     let stat = ln_se / slope.abs();
     let travel = rates
         .travel_relative_error
-        .hypot(rates.noise_relative_error)
+        .hypot(rates.noise_relative_error[side.index()])
         / slope.abs();
     let mut measured = Measured::log_normal(
         value,
@@ -652,11 +656,14 @@ fn assumptions(
     if hot > 0 {
         out.push(format!("{hot} hot pixels left out"));
     }
+    let [on, off] = rates.noise_relative_error.map(|e| 100.0 * e * 3f64.sqrt());
     out.push(format!(
-        "noise: events count at pixels with a supported event (a neighbour within {:.0} ms before or after); their unsupported events ({:.1} % of the counted) are split between noise and signal, and that +-{:.1} % is a systematic",
+        "noise: events count at pixels with a supported event (a neighbour within {:.0} ms before or after), {:.1} % of them unsupported; a noise event finds support by chance {:.0} % of the time there, so up to {:.1} % (ON) / {:.1} % (OFF) of the counted events may be noise; the rate is the middle of none and all of that, and +-{on:.1} % (ON) / +-{off:.1} % (OFF) is a systematic",
         rates.support_window_us as f64 / 1e3,
         100.0 * rates.unsupported_share,
-        100.0 * rates.noise_relative_error * 3f64.sqrt()
+        100.0 * rates.chance_support,
+        100.0 * rates.noise_share[0],
+        100.0 * rates.noise_share[1],
     ));
     out.push(format!(
         "travel from the flow of {}: median speed {:.1} px/s; {}",

@@ -12,16 +12,23 @@
 //!
 //! Noise: events count when a neighbour fired within a few pixel-crossings before or after
 //! them (a two-sided support filter: an edge's first event, or an event at the start of a
-//! short recording, is not noise for want of a past). The filter still drops some isolated
-//! signal events (a few per cent of an ideal pixel's over a sparse texture), which no scan
-//! drops, and keeps the rare noise event that lands next to signal; so the unsupported
-//! events of the pixels that have signal are split down the middle: the rate is the
-//! geometric mean of "none of them are signal" and "all of them are", and half that range
-//! (as a uniform spread) is a systematic of the interval.
+//! short recording, is not noise for want of a past). Where the motion is slow that window
+//! is long, and a noise event finds a neighbour by chance: at each pixel with the
+//! probability [`crate::stats::chance_support`] measures (the share of time within the
+//! window of a neighbour's event). The unsupported events are then only the part of the
+//! noise that chance left alone, and the noise they stand for is their count divided by
+//! one minus that probability (pooled over the counted pixels, weighted by how long each
+//! counts: noise fires at one rate across the view). The filter also drops some isolated
+//! signal events (a few per cent of an ideal pixel's over a sparse texture), so that
+//! count is the most the noise can be: per polarity the rate lies between "none of the
+//! events are noise" and "that much of them is", the estimate is the geometric mean of the
+//! two, and half their log range (as a uniform spread) is a systematic of the interval.
+//! Where the noise may be every event of a polarity, its threshold is not determinable.
 
 use crate::estimate::event_flow::{EventFlowOptions, PatchFlow, patch_flows};
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
+use crate::stats::chance_support::covered_time;
 use crate::stats::support::supported_two_sided as supported;
 use rand::{RngExt, SeedableRng};
 
@@ -36,11 +43,18 @@ pub struct RecordingRates {
     pub ln_se_off: f64,
     /// Relative error of the travel (the flow's precision), a systematic of both.
     pub travel_relative_error: f64,
-    /// Relative systematic of the counts: half the log range between supported and all
-    /// events of the pixels with signal, as a uniform spread.
-    pub noise_relative_error: f64,
+    /// Relative systematic of the ON and OFF counts: half the log range between all events
+    /// and all but the most noise they can hold, as a uniform spread.
+    pub noise_relative_error: [f64; 2],
     /// Share of the counted events without support.
     pub unsupported_share: f64,
+    /// The probability that a noise event at a counted pixel finds support by chance
+    /// (mean over the counted pixels, weighted by the time each counts).
+    pub chance_support: f64,
+    /// The most of the counted ON and OFF events that can be noise (shares).
+    pub noise_share: [f64; 2],
+    /// Why a polarity's rate has no lower bound: its noise may be every event.
+    pub noise_why: [Option<String>; 2],
     /// Units that count (8 x 8 tiles with signal, without frames; every reliable pixel,
     /// with frames) and all pixels kept.
     pub counted_units: usize,
@@ -147,6 +161,10 @@ fn support_window(speed: f64) -> TimeUs {
     ((3.0 / speed.max(1e-3)) * 1e6).clamp(10_000.0, 100_000.0) as TimeUs
 }
 
+fn seconds(times: Vec<TimeUs>) -> Vec<f64> {
+    times.into_iter().map(|t| t as f64 * 1e-6).collect()
+}
+
 fn duration_s(events: &EventChunk) -> f64 {
     (events.t[events.len() - 1] - events.t[0]) as f64 * 1e-6
 }
@@ -197,19 +215,24 @@ struct Finish {
     travel_error: f64,
     window: TimeUs,
     bursts: Option<BurstShare>,
+    /// How much of each pixel's counted time lies within the window of a neighbour's
+    /// event, seconds: where a noise event would find support by chance.
+    covered_s: Vec<f64>,
 }
 
-/// Per-pixel travel (px) and flow direction; travel 0: not counted.
+/// Per-pixel travel (px), flow direction and time counted (s); travel 0: not counted.
 struct Paths {
     travel: Vec<f64>,
     direction: Vec<(f32, f32)>,
+    exposure_s: Vec<f64>,
     /// The units pixels are counted in: 8 x 8 tiles of which only those with signal count
     /// (without frames), or single pixels that all count (with frames).
     tile_px: Option<usize>,
 }
 
 /// One counting unit's sums: ON and OFF events (all, and supported), travel (px), pixels,
-/// direction.
+/// direction, the time its pixels count (s) and that time weighted by the chance that a
+/// noise event goes unsupported.
 #[derive(Clone, Copy, Default)]
 struct Unit {
     all: [f64; 2],
@@ -217,10 +240,19 @@ struct Unit {
     travel: f64,
     pixels: usize,
     direction: (f32, f32),
+    exposure_s: f64,
+    unsupported_exposure_s: f64,
 }
 
-/// The counting units of a tally: tiles or pixels.
-fn units(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize) -> Vec<(usize, Unit)> {
+/// The counting units of a tally: tiles or pixels; `covered_s`: each pixel's counted time
+/// within the window of a neighbour's event.
+fn units(
+    tally: &Tally,
+    paths: &Paths,
+    covered_s: &[f64],
+    excluded: &[bool],
+    w: usize,
+) -> Vec<(usize, Unit)> {
     let side = paths.tile_px.unwrap_or(1);
     let tiles_x = w.div_ceil(side);
     let mut out = vec![Unit::default(); tiles_x * (excluded.len() / w).div_ceil(side)];
@@ -236,6 +268,8 @@ fn units(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize) -> Vec<(usiz
         u.travel += paths.travel[pixel];
         u.pixels += 1;
         u.direction = paths.direction[pixel];
+        u.exposure_s += paths.exposure_s[pixel];
+        u.unsupported_exposure_s += (paths.exposure_s[pixel] - covered_s[pixel]).max(0.0);
     }
     // the unit's first pixel, for the bootstrap patch it falls in
     out.into_iter()
@@ -245,8 +279,9 @@ fn units(tally: &Tally, paths: &Paths, excluded: &[bool], w: usize) -> Vec<(usiz
         .collect()
 }
 
-/// Rates from a tally and the pixels' paths: per unit with signal (a supported event), the
-/// geometric mean of its supported and of all its events (see the module docs).
+/// Rates from a tally and the pixels' paths: per polarity, over the units with signal (a
+/// supported event), the geometric mean of all their events and all but the most noise
+/// they can hold (see the module docs).
 fn finish(
     tally: &Tally,
     paths: &Paths,
@@ -257,16 +292,18 @@ fn finish(
     let tiles_x = w.div_ceil(PATCH_PX);
     let mut groups: Groups = vec![[0.0; 3]; tiles_x * (excluded.len() / w).div_ceil(PATCH_PX)];
     let (mut travels, mut directions) = (Vec::new(), Vec::new());
-    let (mut all_total, mut supported_total) = (0.0, 0.0);
-    for (first, u) in units(tally, paths, excluded, w) {
-        let signal = u.supported[0] + u.supported[1] > 0.0;
-        if paths.tile_px.is_some() && !signal {
+    let mut noise = NoiseTally::default();
+    for (first, u) in units(tally, paths, &f.covered_s, excluded, w) {
+        // a tile counts where it has signal (a supported event: blank parts of the view
+        // travel without events); a reliable pixel counts whatever fired there, since
+        // choosing pixels by their own support would choose them by their noise too
+        let counts = paths.tile_px.is_none() || u.supported[0] + u.supported[1] > 0.0;
+        // the noise rate from every unit, its count where the unit counts
+        noise.add(&u, counts);
+        if !counts {
             continue;
         }
-        // unsupported events count only where there is signal
-        let all = if signal { u.all } else { u.supported };
-        all_total += all[0] + all[1];
-        supported_total += u.supported[0] + u.supported[1];
+        let all = u.all;
         let g = &mut groups[(first / w / PATCH_PX) * tiles_x + (first % w) / PATCH_PX];
         *g = [g[0] + all[0], g[1] + all[1], g[2] + u.travel];
         travels.push((u.travel / u.pixels as f64) as f32);
@@ -275,23 +312,25 @@ fn finish(
     let total = groups
         .iter()
         .fold([0.0; 3], |s, g| [s[0] + g[0], s[1] + g[1], s[2] + g[2]]);
+    let supported_total = noise.supported[0] + noise.supported[1];
     if total[2] <= 0.0 || travels.is_empty() || supported_total <= 0.0 {
         return None;
     }
     let groups: Groups = groups.into_iter().filter(|g| g[2] > 0.0).collect();
     let (ln_se_on, ln_se_off) = bootstrap(&groups);
-    // the middle of the bracket [supported, all]: the all-event rates scaled down by half
-    // the log range
-    let half_range = 0.5 * (all_total / supported_total).ln();
-    let middle = (-half_range).exp();
+    let brackets = [0, 1].map(|k| noise.bracket(k, f.window));
+    let all_total = noise.all[0] + noise.all[1];
     Some(RecordingRates {
-        on_per_px: middle * total[0] / total[2],
-        off_per_px: middle * total[1] / total[2],
+        on_per_px: brackets[0].middle * total[0] / total[2],
+        off_per_px: brackets[1].middle * total[1] / total[2],
         ln_se_on,
         ln_se_off,
         travel_relative_error: f.travel_error,
-        noise_relative_error: half_range / 3f64.sqrt(),
+        noise_relative_error: brackets.each_ref().map(|b| b.relative_error),
         unsupported_share: 1.0 - supported_total / all_total.max(1.0),
+        chance_support: 1.0 - noise.unsupported_exposure_s / noise.exposure_s.max(1e-12),
+        noise_share: brackets.each_ref().map(|b| b.noise_share),
+        noise_why: brackets.map(|b| b.why),
         counted_units: travels.len(),
         kept_pixels: f.kept,
         counted_travel_px: total[2],
@@ -305,6 +344,93 @@ fn finish(
         support_window_us: f.window,
         bursts: f.bursts,
     })
+}
+
+/// The units, summed for the noise bracket: of every unit, the ON and OFF events without
+/// support and the time no neighbour's window covers (the noise rate, from units not
+/// chosen by their events); of the units that count, ON and OFF events (all and
+/// supported) and the time counted.
+#[derive(Default)]
+struct NoiseTally {
+    unsupported_anywhere: [f64; 2],
+    uncovered_anywhere_s: f64,
+    all: [f64; 2],
+    supported: [f64; 2],
+    exposure_s: f64,
+    unsupported_exposure_s: f64,
+}
+
+/// One polarity's noise bracket: the factor from all its events to the estimate (the
+/// geometric mean of the bracket's ends over its upper end), half its log range as a
+/// uniform spread, the most of the events that can be noise, and why there is no lower
+/// end where the noise may be every event.
+struct NoiseBracket {
+    middle: f64,
+    relative_error: f64,
+    noise_share: f64,
+    why: Option<String>,
+}
+
+impl NoiseTally {
+    fn add(&mut self, u: &Unit, counts: bool) {
+        for k in 0..2 {
+            self.unsupported_anywhere[k] += u.all[k] - u.supported[k];
+        }
+        self.uncovered_anywhere_s += u.unsupported_exposure_s;
+        if !counts {
+            return;
+        }
+        for k in 0..2 {
+            self.all[k] += u.all[k];
+            self.supported[k] += u.supported[k];
+        }
+        self.exposure_s += u.exposure_s;
+        self.unsupported_exposure_s += u.unsupported_exposure_s;
+    }
+
+    /// Polarity `k`'s bracket: the rate of unsupported events per second no neighbour
+    /// covers, times the time the units with signal count, is the most noise they can
+    /// hold.
+    fn bracket(&self, k: usize, window: TimeUs) -> NoiseBracket {
+        let (all, unsupported) = (self.all[k], self.all[k] - self.supported[k]);
+        let open = self.unsupported_exposure_s / self.exposure_s.max(1e-12);
+        let rate = self.unsupported_anywhere[k] / self.uncovered_anywhere_s.max(1e-12);
+        let noise = if self.unsupported_anywhere[k] > 0.0 {
+            rate * self.exposure_s
+        } else {
+            0.0
+        };
+        let floor = all - noise;
+        if all <= 0.0 {
+            // no events to bracket (the comparison says so)
+            return NoiseBracket {
+                middle: 1.0,
+                relative_error: 0.0,
+                noise_share: 0.0,
+                why: None,
+            };
+        }
+        if floor <= 0.0 || !floor.is_finite() {
+            let polarity = ["ON", "OFF"][k];
+            return NoiseBracket {
+                middle: f64::NAN,
+                relative_error: f64::NAN,
+                noise_share: 1.0,
+                why: Some(format!(
+                    "the noise may be every {polarity} event: {unsupported:.0} of the {all:.0} counted have no neighbour within {:.0} ms, and a noise event finds one by chance {:.0} % of the time at these pixels, so up to {noise:.0} may be noise (the motion is too slow for the support filter to tell noise from signal)",
+                    window as f64 / 1e3,
+                    100.0 * (1.0 - open)
+                )),
+            };
+        }
+        let half_range = 0.5 * (all / floor).ln();
+        NoiseBracket {
+            middle: (-half_range).exp(),
+            relative_error: half_range / 3f64.sqrt(),
+            noise_share: noise / all,
+            why: None,
+        }
+    }
 }
 
 /// The recording's rates with travel from the events' own flow.
@@ -350,10 +476,21 @@ pub fn from_events(
             .map(|f| if f.trusted() { f.speed() } else { median })
     });
     let (patches, travel_error) = patch_paths(&by_patch, median);
+    // the time a patch's events count: its windows with a flow
+    let patch_exposure_s: Vec<f64> = by_patch
+        .iter()
+        .map(|windows| {
+            windows
+                .iter()
+                .map(|f| (f.t_end - f.t_start) as f64 * 1e-6)
+                .sum()
+        })
+        .collect();
     let pixels = sensor.pixels();
     let paths = Paths {
         travel: (0..pixels).map(|q| patches[patch_of(q)].0).collect(),
         direction: (0..pixels).map(|q| patches[patch_of(q)].1).collect(),
+        exposure_s: (0..pixels).map(|q| patch_exposure_s[patch_of(q)]).collect(),
         tile_px: Some(super::scans::TILE_PX),
     };
     let finish_with = Finish {
@@ -365,6 +502,12 @@ pub fn from_events(
         travel_error,
         window,
         bursts: Some(bursts),
+        covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
+            by_patch[patch_of(q)]
+                .iter()
+                .map(|f| (to.min(f.t_end) - from.max(f.t_start)).max(0))
+                .sum()
+        })),
     };
     finish(&tally, &paths, excluded, w, finish_with)
 }
@@ -417,6 +560,7 @@ pub fn from_frames(
     let mut paths = Paths {
         travel: vec![0.0; pixels],
         direction: vec![(1.0, 0.0); pixels],
+        exposure_s: vec![0.0; pixels],
         tile_px: None,
     };
     for (k, flow) in frames.flows.iter().enumerate() {
@@ -426,6 +570,7 @@ pub fn from_frames(
             speeds.push(*m as f64 / dt);
             if frames.reliable(k, pixel) {
                 paths.travel[pixel] += *m as f64;
+                paths.exposure_s[pixel] += dt;
             }
         }
     }
@@ -451,6 +596,81 @@ pub fn from_frames(
         window,
         // the frames measure the scene's contrast: no prior to read at its sharpness
         bursts: None,
+        covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
+            let first = frames
+                .times
+                .partition_point(|&s| s <= from)
+                .saturating_sub(1);
+            (first..frames.times.len().saturating_sub(1))
+                .take_while(|&k| frames.times[k] < to)
+                .filter(|&k| frames.flows[k].is_some() && frames.reliable(k, q))
+                .map(|k| (to.min(frames.times[k + 1]) - from.max(frames.times[k])).max(0))
+                .sum()
+        })),
     };
     finish(&tally, &paths, excluded, w, finish_with)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 100 pixel-seconds counted with signal; 10 ON and 40 OFF events without support over
+    /// 100 s that no neighbour covered (0.1 and 0.4 per second).
+    fn tally(all: [f64; 2], supported: [f64; 2], uncovered_s: f64) -> NoiseTally {
+        NoiseTally {
+            unsupported_anywhere: [10.0, 40.0],
+            uncovered_anywhere_s: 100.0,
+            all,
+            supported,
+            exposure_s: 100.0,
+            unsupported_exposure_s: uncovered_s,
+        }
+    }
+
+    #[test]
+    fn the_bracket_runs_from_all_events_to_all_but_the_most_noise() {
+        let t = tally([100.0, 50.0], [95.0, 30.0], 100.0);
+        // ON: 0.1/s x 100 s = 10 of 100 may be noise: the middle of 90 and 100
+        let on = t.bracket(0, 50_000);
+        assert!((on.middle - 0.9f64.sqrt()).abs() < 1e-12);
+        assert!((on.relative_error - 0.5 * (100.0f64 / 90.0).ln() / 3f64.sqrt()).abs() < 1e-12);
+        assert!((on.noise_share - 0.1).abs() < 1e-12 && on.why.is_none());
+        // OFF: 40 of 50
+        let off = t.bracket(1, 50_000);
+        assert!((off.middle - 0.2f64.sqrt()).abs() < 1e-12);
+        assert!((off.noise_share - 0.8).abs() < 1e-12);
+    }
+
+    #[test]
+    fn without_chance_support_the_bracket_ends_at_the_supported_events() {
+        // every unit counts and no time is covered: the noise is the unsupported events
+        // themselves, and the lower end the supported ones (the bracket before chance
+        // support was measured)
+        let mut t = tally([100.0, 50.0], [90.0, 10.0], 100.0);
+        let on = t.bracket(0, 50_000);
+        assert!((on.middle - (90.0f64 / 100.0).sqrt()).abs() < 1e-12);
+        // with 10 % of the counted time covered by chance the same unsupported events stand
+        // for a ninth more noise
+        t.uncovered_anywhere_s = 90.0;
+        let on = t.bracket(0, 50_000);
+        assert!((on.noise_share - 10.0 / 0.9 / 100.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn noise_that_may_be_every_event_leaves_no_lower_end() {
+        // OFF: 40 unsupported over 100 uncovered seconds stand for 40 noise events where
+        // only 30 were counted
+        let t = tally([100.0, 30.0], [95.0, 25.0], 100.0);
+        let off = t.bracket(1, 80_000);
+        assert!(off.middle.is_nan());
+        let why = off.why.expect("a reason");
+        assert!(
+            why.contains("every OFF event") && why.contains("80 ms"),
+            "{why}"
+        );
+        // no events at all: nothing to bracket, and the comparison says why
+        let none = tally([0.0, 0.0], [0.0, 0.0], 100.0).bracket(0, 80_000);
+        assert_eq!((none.middle, none.why), (1.0, None));
+    }
 }

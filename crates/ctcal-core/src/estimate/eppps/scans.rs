@@ -285,6 +285,14 @@ pub enum Side {
 
 impl Side {
     /// Events of this polarity per pixel of travel at a curve point.
+    /// 0 for ON, 1 for OFF: the index of per-polarity pairs.
+    pub fn index(self) -> usize {
+        match self {
+            Side::On => 0,
+            Side::Off => 1,
+        }
+    }
+
     pub fn rate(self, p: &CurvePoint) -> f64 {
         match self {
             Side::On => p.on_per_px,
