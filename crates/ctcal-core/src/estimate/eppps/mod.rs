@@ -3,7 +3,7 @@
 //! second against simulated scenes), with its two mismatches corrected and its prior made
 //! explicit:
 //!
-//! 1. the recording ([`recording`]): supported events per pixel of scene travel, per
+//! 1. the recording ([`recording`]): events per pixel of scene travel, noise taken out, per
 //!    polarity, over the pixels that fired (events-only) or every reliable pixel (frames):
 //!    dividing by travel removes the speed of the motion, counting only pixels that fired
 //!    removes blank and static parts of the view;
@@ -645,6 +645,31 @@ fn images_read(calibrations: &[Calibration]) -> usize {
     images.len()
 }
 
+/// What the noise bracket assumed and how wide it is, per polarity.
+fn noise_assumption(rates: &RecordingRates, frames: bool) -> String {
+    let polarity = |k: usize| match rates.noise_why[k] {
+        Some(_) => "may be all noise (not determinable)".to_string(),
+        None => format!(
+            "up to {:.1} % noise, +-{:.1} % systematic",
+            100.0 * rates.noise_share[k],
+            100.0 * rates.noise_relative_error[k] * 3f64.sqrt()
+        ),
+    };
+    format!(
+        "noise: an event is supported by a neighbour's within {:.0} ms before or after; {} count, {:.1} % of their events unsupported; a noise event finds support by chance {:.0} % of the time there, so the unsupported events over the time no neighbour covers (97.5 % upper end) bound the noise; the rate is the middle of none and all of it: ON {}, OFF {}",
+        rates.support_window_us as f64 / 1e3,
+        if frames {
+            "the reliable pixels"
+        } else {
+            "the 8 x 8 px tiles with a supported event"
+        },
+        100.0 * rates.unsupported_share,
+        100.0 * rates.chance_support,
+        polarity(0),
+        polarity(1),
+    )
+}
+
 fn assumptions(
     rates: &RecordingRates,
     calibrations: &[Calibration],
@@ -656,15 +681,7 @@ fn assumptions(
     if hot > 0 {
         out.push(format!("{hot} hot pixels left out"));
     }
-    let [on, off] = rates.noise_relative_error.map(|e| 100.0 * e * 3f64.sqrt());
-    out.push(format!(
-        "noise: events count at pixels with a supported event (a neighbour within {:.0} ms before or after), {:.1} % of them unsupported; a noise event finds support by chance {:.0} % of the time there, so up to {:.1} % (ON) / {:.1} % (OFF) of the counted events may be noise; the rate is the middle of none and all of that, and +-{on:.1} % (ON) / +-{off:.1} % (OFF) is a systematic",
-        rates.support_window_us as f64 / 1e3,
-        100.0 * rates.unsupported_share,
-        100.0 * rates.chance_support,
-        100.0 * rates.noise_share[0],
-        100.0 * rates.noise_share[1],
-    ));
+    out.push(noise_assumption(rates, frames));
     out.push(format!(
         "travel from the flow of {}: median speed {:.1} px/s; {}",
         rates.flow_source,
@@ -797,7 +814,7 @@ fn report(
         });
     result.estimators = vec![EstimatorReport {
         name: "events_per_pixel_of_travel",
-        description: "the threshold at which ideal pixels along line scans with the recording's travel make its supported ON (OFF) events per pixel of travel; one per calibration, combined in the logarithm",
+        description: "the threshold at which ideal pixels along line scans with the recording's travel make its ON (OFF) events per pixel of travel, noise taken out; one per calibration, combined in the logarithm",
         ct_on: on.measured.clone(),
         ct_off: off.measured.clone(),
         frame_rate_series_on: Vec::new(),
@@ -832,7 +849,11 @@ fn report(
             "travel_px": rates.counted_travel_px,
             "speed_median_px_s": rates.speed_median_px_s,
             "flow": rates.flow_source,
-            "counted": "events with spatio-temporal support, over the pixels that count, in the windows with a flow; events_per_pixel_per_second is that count per kept pixel per second",
+            "support_window_ms": rates.support_window_us as f64 / 1e3,
+            "unsupported_share": rates.unsupported_share,
+            "chance_support": rates.chance_support,
+            "noise_share_at_most": {"on": rates.noise_share[0], "off": rates.noise_share[1]},
+            "counted": "the events of the units that count (every reliable pixel with frames, 8 x 8 px tiles with a supported event without), in the windows with a flow, with the noise taken out: the middle of all of them and all but the most noise they can hold (unsupported events over the time no neighbour's window covers, 97.5 % upper end; chance_support is how often a noise event finds a neighbour by chance); supported_events_per_pixel_per_second is the supported events per kept pixel per second, events_per_pixel_per_second the compared rate per kept pixel per second",
         }),
     );
 }

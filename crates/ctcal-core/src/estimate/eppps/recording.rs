@@ -35,7 +35,9 @@ use rand::{RngExt, SeedableRng};
 /// The recording's side of the comparison.
 #[derive(Clone, Debug)]
 pub struct RecordingRates {
-    /// Supported ON and OFF events per pixel of travel, over the pixels that count.
+    /// ON and OFF events per pixel of travel over the units that count, with the noise
+    /// taken out (the middle of the noise bracket; all events where the noise may be every
+    /// event, see `noise_why`).
     pub on_per_px: f64,
     pub off_per_px: f64,
     /// Standard errors of the logarithms of the two (bootstrap over 32 px patches).
@@ -371,6 +373,20 @@ struct NoiseBracket {
     why: Option<String>,
 }
 
+impl NoiseBracket {
+    /// A polarity whose noise may be every event: its rate is read at all its events (the
+    /// upper end, for what needs a rate, such as the prior's sharpness), and its threshold
+    /// is not determinable for `why`.
+    fn undetermined(why: String) -> Self {
+        NoiseBracket {
+            middle: 1.0,
+            relative_error: f64::INFINITY,
+            noise_share: 1.0,
+            why: Some(why),
+        }
+    }
+}
+
 impl NoiseTally {
     fn add(&mut self, u: &Unit, counts: bool) {
         for k in 0..2 {
@@ -389,18 +405,11 @@ impl NoiseTally {
     }
 
     /// Polarity `k`'s bracket: the rate of unsupported events per second no neighbour
-    /// covers, times the time the units with signal count, is the most noise they can
-    /// hold.
+    /// covers (Garwood's 97.5 % upper end of their count: no unsupported event does not
+    /// mean no noise where little time is uncovered), times the time the units that count
+    /// are counted, is the most noise they can hold.
     fn bracket(&self, k: usize, window: TimeUs) -> NoiseBracket {
-        let (all, unsupported) = (self.all[k], self.all[k] - self.supported[k]);
-        let open = self.unsupported_exposure_s / self.exposure_s.max(1e-12);
-        let rate = self.unsupported_anywhere[k] / self.uncovered_anywhere_s.max(1e-12);
-        let noise = if self.unsupported_anywhere[k] > 0.0 {
-            rate * self.exposure_s
-        } else {
-            0.0
-        };
-        let floor = all - noise;
+        let all = self.all[k];
         if all <= 0.0 {
             // no events to bracket (the comparison says so)
             return NoiseBracket {
@@ -410,18 +419,24 @@ impl NoiseTally {
                 why: None,
             };
         }
+        let polarity = ["ON", "OFF"][k];
+        let unsupported = self.unsupported_anywhere[k].round().max(0.0) as usize;
+        let ms = window as f64 / 1e3;
+        if self.uncovered_anywhere_s <= 0.0 {
+            return NoiseBracket::undetermined(format!(
+                "no counted time is free of a neighbour's event within {ms:.0} ms, so the support filter cannot tell noise from signal: the noise may be every {polarity} event"
+            ));
+        }
+        let rate = crate::stats::binomial::poisson95(unsupported).1 / self.uncovered_anywhere_s;
+        let noise = rate * self.exposure_s;
+        let floor = all - noise;
         if floor <= 0.0 || !floor.is_finite() {
-            let polarity = ["ON", "OFF"][k];
-            return NoiseBracket {
-                middle: f64::NAN,
-                relative_error: f64::NAN,
-                noise_share: 1.0,
-                why: Some(format!(
-                    "the noise may be every {polarity} event: {unsupported:.0} of the {all:.0} counted have no neighbour within {:.0} ms, and a noise event finds one by chance {:.0} % of the time at these pixels, so up to {noise:.0} may be noise (the motion is too slow for the support filter to tell noise from signal)",
-                    window as f64 / 1e3,
-                    100.0 * (1.0 - open)
-                )),
-            };
+            let open = self.unsupported_exposure_s / self.exposure_s.max(1e-12);
+            return NoiseBracket::undetermined(format!(
+                "the noise may be every {polarity} event: {:.0} of the {all:.0} counted have no neighbour within {ms:.0} ms, and a noise event finds one by chance {:.0} % of the time at these pixels, so up to {noise:.0} may be noise (the motion is too slow for the support filter to tell noise from signal)",
+                all - self.supported[k],
+                100.0 * (1.0 - open)
+            ));
         }
         let half_range = 0.5 * (all / floor).ln();
         NoiseBracket {
@@ -460,6 +475,9 @@ pub fn from_events(
     let mut by_patch: Vec<Vec<&PatchFlow>> = vec![Vec::new(); tiles];
     for f in &flows {
         by_patch[(f.y0 / p) * tiles_x + f.x0 / p].push(f);
+    }
+    for windows in &mut by_patch {
+        windows.sort_by_key(|f| f.t_start);
     }
     let patch_of = |pixel: usize| (pixel / w / p) * tiles_x + (pixel % w) / p;
     let tally = Tally::new(events, sensor, excluded, &support, |i, pixel| {
@@ -502,9 +520,12 @@ pub fn from_events(
         travel_error,
         window,
         bursts: Some(bursts),
+        // a patch's windows are time-sorted and disjoint: only those reaching past `from`
         covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
-            by_patch[patch_of(q)]
+            let windows = &by_patch[patch_of(q)];
+            windows[windows.partition_point(|f| f.t_end <= from)..]
                 .iter()
+                .take_while(|f| f.t_start < to)
                 .map(|f| (to.min(f.t_end) - from.max(f.t_start)).max(0))
                 .sum()
         })),
@@ -614,13 +635,19 @@ pub fn from_frames(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::stats::binomial::poisson95;
 
-    /// 100 pixel-seconds counted with signal; 10 ON and 40 OFF events without support over
-    /// 100 s that no neighbour covered (0.1 and 0.4 per second).
-    fn tally(all: [f64; 2], supported: [f64; 2], uncovered_s: f64) -> NoiseTally {
+    /// 100 pixel-seconds counted in the units that count; `unsupported` ON and OFF events
+    /// without support over `uncovered_s` that no neighbour covered, in every unit.
+    fn tally(
+        all: [f64; 2],
+        supported: [f64; 2],
+        unsupported: [f64; 2],
+        uncovered_s: f64,
+    ) -> NoiseTally {
         NoiseTally {
-            unsupported_anywhere: [10.0, 40.0],
-            uncovered_anywhere_s: 100.0,
+            unsupported_anywhere: unsupported,
+            uncovered_anywhere_s: uncovered_s,
             all,
             supported,
             exposure_s: 100.0,
@@ -630,47 +657,54 @@ mod tests {
 
     #[test]
     fn the_bracket_runs_from_all_events_to_all_but_the_most_noise() {
-        let t = tally([100.0, 50.0], [95.0, 30.0], 100.0);
-        // ON: 0.1/s x 100 s = 10 of 100 may be noise: the middle of 90 and 100
+        // ON: 10 unsupported in 100 uncovered s, at most 18.39 (Garwood's upper end,
+        // chi2(0.975; 22) / 2) per 100 s; 100 s counted: 18.39 of 100 may be noise
+        let t = tally([100.0, 500.0], [95.0, 480.0], [10.0, 40.0], 100.0);
+        let most = poisson95(10).1;
+        assert!((most - 18.39).abs() < 0.01, "{most}");
         let on = t.bracket(0, 50_000);
-        assert!((on.middle - 0.9f64.sqrt()).abs() < 1e-12);
-        assert!((on.relative_error - 0.5 * (100.0f64 / 90.0).ln() / 3f64.sqrt()).abs() < 1e-12);
-        assert!((on.noise_share - 0.1).abs() < 1e-12 && on.why.is_none());
-        // OFF: 40 of 50
-        let off = t.bracket(1, 50_000);
-        assert!((off.middle - 0.2f64.sqrt()).abs() < 1e-12);
-        assert!((off.noise_share - 0.8).abs() < 1e-12);
+        assert!((on.middle - (1.0 - most / 100.0).sqrt()).abs() < 1e-12);
+        let half = 0.5 * (100.0 / (100.0 - most)).ln();
+        assert!((on.relative_error - half / 3f64.sqrt()).abs() < 1e-12);
+        assert!((on.noise_share - most / 100.0).abs() < 1e-12 && on.why.is_none());
+        // with half the time uncovered the same 10 events stand for twice the noise
+        let t = tally([100.0, 500.0], [95.0, 480.0], [10.0, 40.0], 50.0);
+        assert!((t.bracket(0, 50_000).noise_share - 2.0 * most / 100.0).abs() < 1e-12);
     }
 
     #[test]
-    fn without_chance_support_the_bracket_ends_at_the_supported_events() {
-        // every unit counts and no time is covered: the noise is the unsupported events
-        // themselves, and the lower end the supported ones (the bracket before chance
-        // support was measured)
-        let mut t = tally([100.0, 50.0], [90.0, 10.0], 100.0);
+    fn no_unsupported_event_is_not_no_noise_where_little_time_is_uncovered() {
+        // 100 s uncovered and none unsupported: at most 3.69 noise events of 1,000
+        let t = tally([1000.0, 1000.0], [1000.0, 1000.0], [0.0, 0.0], 100.0);
         let on = t.bracket(0, 50_000);
-        assert!((on.middle - (90.0f64 / 100.0).sqrt()).abs() < 1e-12);
-        // with 10 % of the counted time covered by chance the same unsupported events stand
-        // for a ninth more noise
-        t.uncovered_anywhere_s = 90.0;
-        let on = t.bracket(0, 50_000);
-        assert!((on.noise_share - 10.0 / 0.9 / 100.0).abs() < 1e-12);
+        assert!(
+            (on.noise_share - 0.00369).abs() < 1e-4,
+            "{}",
+            on.noise_share
+        );
+        // 0.1 s uncovered: 3.69 in 0.1 s is 3,689 in 100 s, more than the 1,000 counted
+        let t = tally([1000.0, 1000.0], [1000.0, 1000.0], [0.0, 0.0], 0.1);
+        assert!(t.bracket(0, 50_000).why.is_some());
+        // no time uncovered at all
+        let t = tally([1000.0, 1000.0], [1000.0, 1000.0], [0.0, 0.0], 0.0);
+        let why = t.bracket(1, 50_000).why.expect("a reason");
+        assert!(why.contains("no counted time is free"), "{why}");
     }
 
     #[test]
     fn noise_that_may_be_every_event_leaves_no_lower_end() {
-        // OFF: 40 unsupported over 100 uncovered seconds stand for 40 noise events where
-        // only 30 were counted
-        let t = tally([100.0, 30.0], [95.0, 25.0], 100.0);
+        // OFF: 40 unsupported over 100 uncovered seconds stand for up to 54.5 noise events
+        // where only 50 were counted
+        let t = tally([100.0, 50.0], [95.0, 25.0], [10.0, 40.0], 100.0);
         let off = t.bracket(1, 80_000);
-        assert!(off.middle.is_nan());
+        assert!(off.why.is_some() && off.middle == 1.0 && off.noise_share == 1.0);
         let why = off.why.expect("a reason");
         assert!(
             why.contains("every OFF event") && why.contains("80 ms"),
             "{why}"
         );
         // no events at all: nothing to bracket, and the comparison says why
-        let none = tally([0.0, 0.0], [0.0, 0.0], 100.0).bracket(0, 80_000);
+        let none = tally([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], 100.0).bracket(0, 80_000);
         assert_eq!((none.middle, none.why), (1.0, None));
     }
 }

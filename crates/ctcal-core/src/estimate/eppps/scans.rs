@@ -284,7 +284,6 @@ pub enum Side {
 }
 
 impl Side {
-    /// Events of this polarity per pixel of travel at a curve point.
     /// 0 for ON, 1 for OFF: the index of per-polarity pairs.
     pub fn index(self) -> usize {
         match self {
@@ -293,6 +292,7 @@ impl Side {
         }
     }
 
+    /// Events of this polarity per pixel of travel at a curve point.
     pub fn rate(self, p: &CurvePoint) -> f64 {
         match self {
             Side::On => p.on_per_px,
