@@ -16,14 +16,15 @@
 //! is long, and a noise event finds a neighbour by chance: at each pixel with the
 //! probability [`crate::stats::chance_support`] measures (the share of time within the
 //! window of a neighbour's event). The unsupported events are then only the part of the
-//! noise that chance left alone, and the noise they stand for is their count divided by
-//! one minus that probability (pooled over the counted pixels, weighted by how long each
-//! counts: noise fires at one rate across the view). The filter also drops some isolated
-//! signal events (a few per cent of an ideal pixel's over a sparse texture), so that
-//! count is the most the noise can be: per polarity the rate lies between "none of the
-//! events are noise" and "that much of them is", the estimate is the geometric mean of the
-//! two, and half their log range (as a uniform spread) is a systematic of the interval.
-//! Where the noise may be every event of a polarity, its threshold is not determinable.
+//! noise that chance left alone: their count (Garwood's 97.5 % upper end) over the time no
+//! neighbour covers, in every unit, is a noise rate, and that rate over the time the
+//! counted units count is the noise they hold (noise fires at one rate across the view).
+//! The filter also drops some isolated signal events (a few per cent of an ideal pixel's
+//! over a sparse texture), so that is the most the noise can be: per polarity the rate
+//! lies between "none of the events are noise" and "that much of them is", the estimate is
+//! the geometric mean of the two, and half their log range (as a uniform spread) is a
+//! systematic of the interval. Where the noise may be every event of a polarity, its
+//! threshold is not determinable.
 
 use crate::estimate::event_flow::{EventFlowOptions, PatchFlow, patch_flows};
 use crate::estimate::frames::PreparedFrames;
@@ -281,9 +282,9 @@ fn units(
         .collect()
 }
 
-/// Rates from a tally and the pixels' paths: per polarity, over the units with signal (a
-/// supported event), the geometric mean of all their events and all but the most noise
-/// they can hold (see the module docs).
+/// Rates from a tally and the pixels' paths: per polarity, over the units that count
+/// (reliable pixels; tiles with a supported event), the geometric mean of all their events
+/// and all but the most noise they can hold (see the module docs).
 fn finish(
     tally: &Tally,
     paths: &Paths,
