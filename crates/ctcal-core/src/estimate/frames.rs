@@ -12,10 +12,11 @@
 //!
 //! A frame is used when at least a fifth of its pixels are not clipped at white, at most
 //! 30 % are black, and it is about as sharp as the others; an interval when both its
-//! frames are, its motion is small enough to follow, and it holds events. Within a used interval, a pixel that is near black (at most
-//! 3 DN) or clipped (at least 254 DN) in either frame has no reliable log intensity and is
-//! left out of every estimate for that interval ([`PreparedFrames::reliable`]). Frame times are taken as the frames' own timestamps (exposure
-//! midpoints where the file says so).
+//! frames are, its motion is small enough to follow, and it holds events. Within a used
+//! interval, a pixel that is near black (at most 3 DN) or clipped (at least 254 DN) in
+//! either frame has no reliable log intensity and is left out of every estimate for that
+//! interval ([`PreparedFrames::reliable`]). Frame times are taken as the frames' own
+//! timestamps (exposure midpoints where the file says so).
 
 use super::EstimateError;
 use super::flow::{FlowField, FlowOptions, dense_flow, interpolate};

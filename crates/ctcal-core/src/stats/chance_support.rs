@@ -10,26 +10,6 @@
 
 use crate::events::{EventChunk, Sensor, TimeUs};
 
-/// For each pixel (row-major), the share of `[first event, last event]` within
-/// `window_us` before or after an event of one of its 8 neighbours (its own events
-/// excluded, as in the filter). `events` must be time-sorted. Empty or instantaneous
-/// recordings give zeros.
-pub fn chance_support(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<f64> {
-    let (Some(&first), Some(&last)) = (events.t.first(), events.t.last()) else {
-        return vec![0.0; sensor.pixels()];
-    };
-    if last <= first {
-        return vec![0.0; sensor.pixels()];
-    }
-    let span = (last - first) as f64;
-    covered_time(events, sensor, window_us, |_, from, to| {
-        (to.min(last) - from.max(first)).max(0)
-    })
-    .into_iter()
-    .map(|c| c as f64 / span)
-    .collect()
-}
-
 /// For each pixel (row-major), how much of the time it counts lies within `window_us`
 /// before or after an event of one of its 8 neighbours, microseconds: the covered union's
 /// pieces measured by `counted(pixel, from, to)` (how much of `[from, to)` counts at the
@@ -72,6 +52,26 @@ pub fn covered_time(
 mod tests {
     use super::*;
     use crate::events::Event;
+
+    /// For each pixel (row-major), the share of `[first event, last event]` within
+    /// `window_us` before or after an event of one of its 8 neighbours (its own events
+    /// excluded, as in the filter). `events` must be time-sorted. Empty or instantaneous
+    /// recordings give zeros.
+    fn chance_support(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<f64> {
+        let (Some(&first), Some(&last)) = (events.t.first(), events.t.last()) else {
+            return vec![0.0; sensor.pixels()];
+        };
+        if last <= first {
+            return vec![0.0; sensor.pixels()];
+        }
+        let span = (last - first) as f64;
+        covered_time(events, sensor, window_us, |_, from, to| {
+            (to.min(last) - from.max(first)).max(0)
+        })
+        .into_iter()
+        .map(|c| c as f64 / span)
+        .collect()
+    }
 
     fn chunk(events: &[(TimeUs, u16, u16)]) -> EventChunk {
         events

@@ -564,7 +564,7 @@ fn measure(
             _ => None,
         })
         .collect();
-    let classified = match &rates.noise_why[side.index()] {
+    let classified = match &rates.noise[side.index()].why {
         Some(why) => Err(why.clone()),
         None => classify(&inverted, beyond, target, side),
     };
@@ -599,7 +599,7 @@ fn measure(
     let stat = ln_se / slope.abs();
     let travel = rates
         .travel_relative_error
-        .hypot(rates.noise_relative_error[side.index()])
+        .hypot(rates.noise[side.index()].relative_error)
         / slope.abs();
     let mut measured = Measured::log_normal(
         value,
@@ -647,12 +647,12 @@ fn images_read(calibrations: &[Calibration]) -> usize {
 
 /// What the noise bracket assumed and how wide it is, per polarity.
 fn noise_assumption(rates: &RecordingRates, frames: bool) -> String {
-    let polarity = |k: usize| match rates.noise_why[k] {
+    let polarity = |k: usize| match rates.noise[k].why {
         Some(_) => "may be all noise (not determinable)".to_string(),
         None => format!(
             "up to {:.1} % noise, +-{:.1} % systematic",
-            100.0 * rates.noise_share[k],
-            100.0 * rates.noise_relative_error[k] * 3f64.sqrt()
+            100.0 * rates.noise[k].noise_share,
+            100.0 * rates.noise[k].relative_error * 3f64.sqrt()
         ),
     };
     format!(
@@ -852,7 +852,7 @@ fn report(
             "support_window_ms": rates.support_window_us as f64 / 1e3,
             "unsupported_share": rates.unsupported_share,
             "chance_support": rates.chance_support,
-            "noise_share_at_most": {"on": rates.noise_share[0], "off": rates.noise_share[1]},
+            "noise_share_at_most": {"on": rates.noise[0].noise_share, "off": rates.noise[1].noise_share},
             "counted": "the events of the units that count (every reliable pixel with frames, 8 x 8 px tiles with a supported event without), in the windows with a flow, with the noise taken out: the middle of all of them and all but the most noise they can hold (unsupported events over the time no neighbour's window covers, 97.5 % upper end; chance_support is how often a noise event finds a neighbour by chance); supported_events_per_pixel_per_second is the supported events per kept pixel per second, events_per_pixel_per_second the compared rate per kept pixel per second",
         }),
     );

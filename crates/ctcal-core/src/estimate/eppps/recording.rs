@@ -38,7 +38,7 @@ use rand::{RngExt, SeedableRng};
 pub struct RecordingRates {
     /// ON and OFF events per pixel of travel over the units that count, with the noise
     /// taken out (the middle of the noise bracket; all events where the noise may be every
-    /// event, see `noise_why`).
+    /// event, see `noise`).
     pub on_per_px: f64,
     pub off_per_px: f64,
     /// Standard errors of the logarithms of the two (bootstrap over 32 px patches).
@@ -46,18 +46,13 @@ pub struct RecordingRates {
     pub ln_se_off: f64,
     /// Relative error of the travel (the flow's precision), a systematic of both.
     pub travel_relative_error: f64,
-    /// Relative systematic of the ON and OFF counts: half the log range between all events
-    /// and all but the most noise they can hold, as a uniform spread.
-    pub noise_relative_error: [f64; 2],
+    /// The ON and OFF noise brackets.
+    pub noise: [NoiseBracket; 2],
     /// Share of the counted events without support.
     pub unsupported_share: f64,
     /// The probability that a noise event at a counted pixel finds support by chance
     /// (mean over the counted pixels, weighted by the time each counts).
     pub chance_support: f64,
-    /// The most of the counted ON and OFF events that can be noise (shares).
-    pub noise_share: [f64; 2],
-    /// Why a polarity's rate has no lower bound: its noise may be every event.
-    pub noise_why: [Option<String>; 2],
     /// Units that count (8 x 8 tiles with signal, without frames; every reliable pixel,
     /// with frames) and all pixels kept.
     pub counted_units: usize,
@@ -329,11 +324,9 @@ fn finish(
         ln_se_on,
         ln_se_off,
         travel_relative_error: f.travel_error,
-        noise_relative_error: brackets.each_ref().map(|b| b.relative_error),
+        noise: brackets,
         unsupported_share: 1.0 - supported_total / all_total.max(1.0),
         chance_support: 1.0 - noise.unsupported_exposure_s / noise.exposure_s.max(1e-12),
-        noise_share: brackets.each_ref().map(|b| b.noise_share),
-        noise_why: brackets.map(|b| b.why),
         counted_units: travels.len(),
         kept_pixels: f.kept,
         counted_travel_px: total[2],
@@ -367,11 +360,16 @@ struct NoiseTally {
 /// geometric mean of the bracket's ends over its upper end), half its log range as a
 /// uniform spread, the most of the events that can be noise, and why there is no lower
 /// end where the noise may be every event.
-struct NoiseBracket {
-    middle: f64,
-    relative_error: f64,
-    noise_share: f64,
-    why: Option<String>,
+#[derive(Clone, Debug)]
+pub struct NoiseBracket {
+    pub middle: f64,
+    /// Relative systematic of the count: half the log range between all events and all
+    /// but the most noise they can hold, as a uniform spread.
+    pub relative_error: f64,
+    /// The most of the counted events that can be noise (a share).
+    pub noise_share: f64,
+    /// Why the rate has no lower bound: the noise may be every event.
+    pub why: Option<String>,
 }
 
 impl NoiseBracket {
