@@ -652,7 +652,7 @@ fn noise_assumption(rates: &RecordingRates, frames: bool) -> String {
         None => format!(
             "up to {:.1} % noise, +-{:.1} % systematic",
             100.0 * rates.noise[k].noise_share,
-            100.0 * rates.noise[k].relative_error * 3f64.sqrt()
+            100.0 * rates.noise[k].half_range()
         ),
     };
     format!(

@@ -373,6 +373,22 @@ pub struct NoiseBracket {
 }
 
 impl NoiseBracket {
+    /// A polarity without events: nothing to bracket (the comparison says why).
+    fn empty() -> Self {
+        NoiseBracket {
+            middle: 1.0,
+            relative_error: 0.0,
+            noise_share: 0.0,
+            why: None,
+        }
+    }
+
+    /// Half the log range between all events and all but the most noise (the uniform
+    /// spread's half-width, of which `relative_error` is the standard deviation).
+    pub fn half_range(&self) -> f64 {
+        self.relative_error * 3f64.sqrt()
+    }
+
     /// A polarity whose noise may be every event: its rate is read at all its events (the
     /// upper end, for what needs a rate, such as the prior's sharpness), and its threshold
     /// is not determinable for `why`.
@@ -410,13 +426,7 @@ impl NoiseTally {
     fn bracket(&self, k: usize, window: TimeUs) -> NoiseBracket {
         let all = self.all[k];
         if all <= 0.0 {
-            // no events to bracket (the comparison says so)
-            return NoiseBracket {
-                middle: 1.0,
-                relative_error: 0.0,
-                noise_share: 0.0,
-                why: None,
-            };
+            return NoiseBracket::empty();
         }
         let polarity = ["ON", "OFF"][k];
         let unsupported = self.unsupported_anywhere[k].round().max(0.0) as usize;
