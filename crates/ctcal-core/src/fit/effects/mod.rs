@@ -75,6 +75,14 @@ impl Effect {
         self == Effect::Refractory
     }
 
+    /// Whether the search of this effect's parameter profiles the threshold mismatch with
+    /// the thresholds ([`crate::fit::search::search_with_mismatch`]): a refractory period,
+    /// which caps the busiest pixels and so narrows the spread of counts that mismatch
+    /// widens.
+    pub fn searched_with_mismatch(self) -> bool {
+        self == Effect::Refractory
+    }
+
     pub fn parse(name: &str) -> Option<Effect> {
         Effect::ALL.into_iter().find(|e| e.name() == name)
     }

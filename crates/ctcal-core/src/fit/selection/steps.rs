@@ -6,7 +6,7 @@
 use super::super::effects::{self, Effect, hot_pixels::HotTrain};
 use super::super::observe::Subset;
 use super::super::residuals::residuals;
-use super::super::search::{Searched, Simulated, Simulation, search};
+use super::super::search::{Searched, Simulated, Simulation, search, search_with_mismatch};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
 use super::keep::{Verdict, by_signature, judge};
 use super::{Known, LoopRun, State, judging_evidence};
@@ -101,7 +101,12 @@ pub fn try_effect(
                 .parameter()
                 .expect("every other effect has a parameter");
             let start = evidence.start.unwrap_or(1.0);
-            let searched = search(
+            let searcher = if effect.searched_with_mismatch() {
+                search_with_mismatch
+            } else {
+                search
+            };
+            let searched = searcher(
                 simulation,
                 &state.model.params,
                 effect,
@@ -123,7 +128,8 @@ pub fn try_effect(
         effect,
         (&state.model, &candidate),
     );
-    Ok(finish_step(
+    let mismatch_before = state.model.params.ct_sigma;
+    let mut step = finish_step(
         simulation,
         state,
         step,
@@ -131,7 +137,59 @@ pub fn try_effect(
         candidate,
         uncertain,
         count_before,
-    ))
+    );
+    let mismatch_profiled = effect.searched_with_mismatch() && mismatch_before.is_some();
+    if step.kept && mismatch_profiled && state.model.params.ct_sigma != mismatch_before {
+        mismatch_searched_again(simulation, state, &mut step, mismatch_before, run)?;
+    }
+    Ok(step)
+}
+
+/// After an effect kept with the mismatch profiled in its search
+/// ([`search_with_mismatch`]): the mismatch searched once more around its profiled value
+/// with the effect in place, for its standard error (the profile's few secant steps give
+/// none), and its best value taken where it lowers the distance on the fit blocks. The
+/// step records the mismatch it ended with.
+fn mismatch_searched_again(
+    simulation: &Simulation,
+    state: &mut State,
+    step: &mut Step,
+    before: Option<f64>,
+    run: &LoopRun,
+) -> Result<(), FitError> {
+    let Some(profiled) = state.model.params.ct_sigma else {
+        return Ok(());
+    };
+    let count_before = simulation.count.get();
+    let searched = search(
+        simulation,
+        &state.model.params,
+        Effect::Mismatch,
+        (profiled / 1.5, profiled * 1.5),
+        &state.masked,
+        &state.kept,
+        run.fixed,
+        run.noise,
+    )?;
+    let error = simulation
+        .distance(&state.model.observed, Subset::Fit, &state.kept)
+        .total;
+    let (key, mut uncertain, bound) = uncertain_of("ct_sigma", &searched);
+    if searched.fit_error < error {
+        state.model = searched.model;
+    } else {
+        uncertain = Uncertain::positive(profiled, searched.standard_error);
+    }
+    let value = uncertain.value;
+    state.set_uncertain(key, uncertain, bound);
+    step.parameters.insert("ct_sigma".into(), value);
+    step.simulations += simulation.count.get() - count_before;
+    step.reason = format!(
+        "{}; ct_sigma profiled with it: {} -> {value:.6}",
+        step.reason,
+        before.map_or("none".into(), |b| format!("{b:.6}"))
+    );
+    Ok(())
 }
 
 /// The judgement of `effect`'s model `with` against the model `without` it on the
