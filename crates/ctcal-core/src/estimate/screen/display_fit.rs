@@ -264,10 +264,23 @@ fn fit_display(
 /// can lift it to that end.
 const BLACK_LEVELS: [f64; 9] = [1e-5, 1e-4, 3e-4, 1e-3, 3e-3, 0.01, 0.03, 0.1, 0.3];
 
+/// The factor a start threshold is lowered by where it fires no event at a black level
+/// ([`black_level_start`]), and how many times (down to 1/64 of the start). A dim screen
+/// seen through a sensor whose dark offset is large against it (DVS-Voltmeter's
+/// `ln(DN + k2)`, `k2` 20-36 DN, behind a white of 70 DN: about 1.1 in log between white
+/// and black) fires nothing at the naive thresholds once the black level carries that
+/// offset, and no count ratio scales a start that fires nothing: every fit then started
+/// from a black level 10^2-10^4 too low (coverage draw 38 of 2026-11-25, made again with
+/// ctcal's own pixel through that response: 1.82 / 2.71 [1.27, 2.37] / [1.17, 4.26] for
+/// 0.64).
+const SILENT_STEP: f64 = 4.0;
+const SILENT_TRIES: usize = 3;
+
 /// `from` with the black level of [`BLACK_LEVELS`] or the screen model's whose counts match
 /// best, each tried with the thresholds scaled by its ratio of simulated to recorded events
-/// per polarity (an ideal pixel's count is inversely proportional to its threshold): two
-/// simulations a level.
+/// per polarity (an ideal pixel's count is inversely proportional to its threshold), after
+/// lowering a threshold that fires nothing ([`SILENT_STEP`]): two simulations a level where
+/// both fire.
 fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>, EstimateError> {
     let real = &problem.setup.real;
     let total = |c: &[u32]| c.iter().map(|&n| n as f64).sum::<f64>();
@@ -277,14 +290,34 @@ fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>
     // grid's lowest)
     let model_black = problem.screen.black_level.max(BLACK_LEVELS[0]);
     let off_grid = (!BLACK_LEVELS.contains(&model_black)).then_some(model_black);
+    let [low, high] = super::THRESHOLD_LIMITS.map(f64::ln);
     for black in BLACK_LEVELS.into_iter().chain(off_grid) {
         let mut p = from.clone();
         p[2] = black.ln();
-        let simulated = problem.setup.counts_through(
+        let mut simulated = problem.setup.counts_through(
             (p[0].exp(), p[1].exp()),
             Some(&problem.display(&p)),
             problem.log,
         )?;
+        // a threshold above every log step the display makes at this level fires nothing,
+        // and no count ratio scales it: lowered by SILENT_STEP until it fires
+        for _ in 0..SILENT_TRIES {
+            let silent = [
+                total(&simulated.on) == 0.0 && real_on > 0.0,
+                total(&simulated.off) == 0.0 && real_off > 0.0,
+            ];
+            if silent == [false, false] {
+                break;
+            }
+            for k in (0..2).filter(|&k| silent[k]) {
+                p[k] = (p[k] - SILENT_STEP.ln()).max(low);
+            }
+            simulated = problem.setup.counts_through(
+                (p[0].exp(), p[1].exp()),
+                Some(&problem.display(&p)),
+                problem.log,
+            )?;
+        }
         let (on, off) = (total(&simulated.on), total(&simulated.off));
         if on > 0.0 && real_on > 0.0 {
             p[0] += (on / real_on).ln();
@@ -292,7 +325,6 @@ fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>
         if off > 0.0 && real_off > 0.0 {
             p[1] += (off / real_off).ln();
         }
-        let [low, high] = super::THRESHOLD_LIMITS.map(f64::ln);
         p[0] = p[0].clamp(low, high);
         p[1] = p[1].clamp(low, high);
         let cost = problem

@@ -313,3 +313,69 @@ fn a_dark_offset_in_the_log_response_is_fitted_declared_or_not() {
         }
     }
 }
+
+/// A dim screen behind a sensor whose dark offset is large against it: white at 70 DN
+/// through `ln(DN / 255 + 0.14)` (DVS-Voltmeter's `ln(DN + k2)` with `k2` 36 DN, coverage
+/// draw 38 of 2026-11-25 made again with ideal pixels), so that about 1.1 in log lies
+/// between white and black. Neither the response nor gamma given. Once the black level
+/// carries the offset the naive thresholds fire nothing; before their starts were lowered
+/// where they fire nothing ([`super::display_fit`]), every fit began at a black level
+/// 10^2-10^4 too low and the thresholds read 1.82 / 2.71 with intervals [1.27, 2.37] /
+/// [1.17, 4.26] for 0.64. The intervals must hold the truth.
+#[test]
+fn a_dark_offset_large_against_a_dim_screen_is_not_read_as_high_thresholds() {
+    let truth = 0.642642;
+    let display = DisplayParams {
+        refresh_hz: 141.0,
+        gamma: 1.82485,
+        black_level: 0.00335363,
+        white_dn: 69.5395,
+        blur_px: Some(0.42222),
+        time_offset_s: None,
+    };
+    let params = PixelParams {
+        log_response: Some(LogResponse::Eps),
+        log_eps: Some(0.140205),
+        ..PixelParams::ideal(truth, truth)
+    };
+    let spec = StimulusSpec {
+        width: 160,
+        height: 120,
+        refresh_hz: 141.0,
+        duration_s: 0.87,
+        square_px: 13.0,
+        squares: [8, 6],
+        speed_px_s: 116.826,
+    };
+    let stimulus: Vec<Frame> = (0..spec.frame_count()).map(|k| spec.render(k)).collect();
+    let one_to_one = geometry([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 0.0);
+    let events = record_through(&one_to_one, &stimulus, &display, &params);
+    let excluded = vec![false; SENSOR.0 * SENSOR.1];
+    let input = ScreenInput {
+        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
+        events: &events,
+        stimulus: &stimulus,
+        screen: DisplayParams {
+            refresh_hz: 60.0,
+            gamma: 2.2,
+            black_level: 0.001,
+            white_dn: 220.0,
+            blur_px: Some(0.7),
+            time_offset_s: None,
+        },
+        gamma_prior: GammaPrior::Displays,
+        response: ResponsePrior::Unknown,
+        refresh_hz: None,
+        excluded: &excluded,
+    };
+    let e = estimate(&input, &|_, _| {}).unwrap();
+    for (value, ci) in [(e.ct_on, e.ct_on_ci95), (e.ct_off, e.ct_off_ci95)] {
+        let value = value.unwrap_or_else(|| panic!("{:?}", e.why));
+        let [lo, hi] = ci.unwrap();
+        let (lo, hi) = (lo.unwrap_or(0.0), hi.unwrap_or(f64::INFINITY));
+        assert!(
+            lo <= truth && truth <= hi,
+            "{value} [{lo}, {hi}] misses {truth}"
+        );
+    }
+}
