@@ -69,9 +69,8 @@ const MISMATCH_STEPS: usize = 2;
 /// relative standard error is about 2 % (see [`super::effects::mismatch`]).
 const DISPERSION_MATCHED: f64 = 0.02;
 
-/// The range of the threshold mismatch the profile keeps to: [`super::effects::Effect::range`]'s
-/// widest.
-const MISMATCH_RANGE: (f64, f64) = (0.002, 0.3);
+/// The range of the threshold mismatch the profile keeps to.
+const MISMATCH_RANGE: (f64, f64) = super::effects::mismatch::RANGE;
 
 fn threshold_of(p: &PixelParams, polarity: usize) -> f64 {
     if polarity == 1 { p.ct_on } else { p.ct_off }
@@ -711,12 +710,16 @@ mod tests {
         // the model's counts 0.258 less dispersed (log) at 0.043: the first step has slope 1
         let first = mismatch_step(&[(0.043f64.ln(), -0.258)]);
         assert!((first - 0.043 * 0.258f64.exp()).abs() < 1e-12, "{first}");
-        // a measured slope of 2 (0.258 gained over ln 1.138) halves the next step
+        // a point that matched stays where it is, whatever the measured slope (here 2)
         let (x0, x1) = (0.043f64.ln(), 0.043f64.ln() + 0.129);
         let second = mismatch_step(&[(x0, -0.258), (x1, 0.0)]);
         assert!((second - x1.exp()).abs() < 1e-12, "{second}");
-        let half = mismatch_step(&[(x0, -0.258), (x1, -0.129)]);
-        assert!((half - (x1 + 0.129 / 1.0).exp()).abs() < 1e-12, "{half}");
+        // a measured slope of 1 (0.129 gained over 0.129 in ln sigma): the step is the ratio
+        let next = mismatch_step(&[(x0, -0.258), (x1, -0.129)]);
+        assert!((next - (x1 + 0.129).exp()).abs() < 1e-12, "{next}");
+        // a measured slope of 4 (held there from 6): a quarter of the ratio
+        let steep = mismatch_step(&[(x0, -0.9), (x1, -0.126)]);
+        assert!((steep - (x1 + 0.126 / 4.0).exp()).abs() < 1e-12, "{steep}");
         // a step at most doubles the spread, and stays in the mismatch's range
         assert!((mismatch_step(&[(0.01f64.ln(), -5.0)]) - 0.02).abs() < 1e-12);
         assert_eq!(mismatch_step(&[(0.25f64.ln(), -0.5)]), MISMATCH_RANGE.1);

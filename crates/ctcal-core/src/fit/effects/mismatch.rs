@@ -11,6 +11,11 @@
 use super::{Context, Effect, Evidence};
 use crate::fit::metric::{dispersion, dispersion_log_ratio};
 
+/// The bounds of a threshold mismatch search (standard deviation, log units), set wide
+/// around the spreads published for DVS pixels (about 0.02 on the DVS128: Lichtsteiner,
+/// Posch & Delbruck 2008).
+pub const RANGE: (f64, f64) = (0.002, 0.3);
+
 pub fn evidence(c: &Context) -> Evidence {
     if let Some((sigma, [lo, hi])) = c.mismatch_estimate {
         let se = ((hi - lo) / 3.92).max(1e-6);

@@ -146,7 +146,10 @@ impl Effect {
     pub fn range(self, start: f64) -> (f64, f64) {
         match self {
             Effect::Bandwidth => (2.0, 5000.0),
-            Effect::Mismatch => ((start / 3.0).max(0.002), (start * 3.0).min(0.3)),
+            Effect::Mismatch => (
+                (start / 3.0).max(mismatch::RANGE.0),
+                (start * 3.0).min(mismatch::RANGE.1),
+            ),
             Effect::TimestampJitter => (5e-6, 5e-3),
             // started at the recording's shortest intervals, which a period bounds from
             // below and jitter moves below it
