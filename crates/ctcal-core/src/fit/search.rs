@@ -522,41 +522,19 @@ pub fn search(
     )
 }
 
-/// [`search`], with the threshold mismatch profiled at every point as well
+/// [`search`], and with `mismatch` the threshold mismatch profiled at every point as well
 /// ([`Simulation::profile_mismatch`]) where `base` has one: the returned model's `ct_sigma`
 /// is the one profiled at the best point.
-#[allow(clippy::too_many_arguments)]
-pub fn search_with_mismatch(
-    simulation: &Simulation,
-    base: &PixelParams,
-    effect: super::effects::Effect,
-    range: (f64, f64),
-    masked: &[bool],
-    kept: &[bool],
-    fixed_thresholds: bool,
-    noise: f64,
-) -> Result<Searched, EstimateError> {
-    let mismatch_profiled = base.ct_sigma.is_some();
-    search_profiled(
-        simulation,
-        base,
-        effect,
-        range,
-        (masked, kept),
-        (fixed_thresholds, mismatch_profiled),
-        noise,
-    )
-}
-
-fn search_profiled(
+pub fn search_profiled(
     simulation: &Simulation,
     base: &PixelParams,
     effect: super::effects::Effect,
     range: (f64, f64),
     (masked, kept): (&[bool], &[bool]),
-    (fixed_thresholds, mismatch_profiled): (bool, bool),
+    (fixed_thresholds, mismatch): (bool, bool),
     noise: f64,
 ) -> Result<Searched, EstimateError> {
+    let mismatch_profiled = mismatch && base.ct_sigma.is_some();
     let range = within_limit(valid_range(range), simulation.upper_limit(effect));
     let failure = RefCell::new(None);
     let problem = Search {

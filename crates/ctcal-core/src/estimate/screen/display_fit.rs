@@ -294,11 +294,14 @@ fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>
     for black in BLACK_LEVELS.into_iter().chain(off_grid) {
         let mut p = from.clone();
         p[2] = black.ln();
-        let mut simulated = problem.setup.counts_through(
-            (p[0].exp(), p[1].exp()),
-            Some(&problem.display(&p)),
-            problem.log,
-        )?;
+        let simulate = |p: &DVector<f64>| {
+            problem.setup.counts_through(
+                (p[0].exp(), p[1].exp()),
+                Some(&problem.display(p)),
+                problem.log,
+            )
+        };
+        let mut simulated = simulate(&p)?;
         // a threshold above every log step the display makes at this level fires nothing,
         // and no count ratio scales it: lowered by SILENT_STEP until it fires
         for _ in 0..SILENT_TRIES {
@@ -312,11 +315,7 @@ fn black_level_start(problem: &Joint, from: DVector<f64>) -> Result<DVector<f64>
             for k in (0..2).filter(|&k| silent[k]) {
                 p[k] = (p[k] - SILENT_STEP.ln()).max(low);
             }
-            simulated = problem.setup.counts_through(
-                (p[0].exp(), p[1].exp()),
-                Some(&problem.display(&p)),
-                problem.log,
-            )?;
+            simulated = simulate(&p)?;
         }
         let (on, off) = (total(&simulated.on), total(&simulated.off));
         if on > 0.0 && real_on > 0.0 {

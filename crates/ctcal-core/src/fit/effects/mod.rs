@@ -76,7 +76,7 @@ impl Effect {
     }
 
     /// Whether the search of this effect's parameter profiles the threshold mismatch with
-    /// the thresholds ([`crate::fit::search::search_with_mismatch`]): a refractory period,
+    /// the thresholds ([`crate::fit::search::search_profiled`]): a refractory period,
     /// which caps the busiest pixels and so narrows the spread of counts that mismatch
     /// widens.
     pub fn searched_with_mismatch(self) -> bool {

@@ -9,7 +9,7 @@
 //!    blocks) and kept only if the selection error falls by more than chance ([`keep`]);
 //!    a refractory period is searched with the mismatch profiled beside the thresholds,
 //!    since it narrows the spread of counts that mismatch widens
-//!    ([`super::search::search_with_mismatch`]);
+//!    ([`super::search::search_profiled`]);
 //! 4. each searched parameter refitted with all the others in place ([`steps::refit`]),
 //!    then each tested for whether it is still needed, the others searched again
 //!    ([`steps::prune`]);

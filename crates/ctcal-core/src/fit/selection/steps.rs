@@ -6,7 +6,7 @@
 use super::super::effects::{self, Effect, hot_pixels::HotTrain};
 use super::super::observe::Subset;
 use super::super::residuals::residuals;
-use super::super::search::{Searched, Simulated, Simulation, search, search_with_mismatch};
+use super::super::search::{Searched, Simulated, Simulation, search, search_profiled};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
 use super::keep::{Verdict, by_signature, judge};
 use super::{Known, LoopRun, State, judging_evidence};
@@ -101,19 +101,13 @@ pub fn try_effect(
                 .parameter()
                 .expect("every other effect has a parameter");
             let start = evidence.start.unwrap_or(1.0);
-            let searcher = if effect.searched_with_mismatch() {
-                search_with_mismatch
-            } else {
-                search
-            };
-            let searched = searcher(
+            let searched = search_profiled(
                 simulation,
                 &state.model.params,
                 effect,
                 effect.range(start),
-                &state.masked,
-                &state.kept,
-                fixed,
+                (&state.masked, &state.kept),
+                (fixed, effect.searched_with_mismatch()),
                 noise,
             )?;
             step.parameters.insert(key.into(), searched.value);
@@ -146,7 +140,7 @@ pub fn try_effect(
 }
 
 /// After an effect kept with the mismatch profiled in its search
-/// ([`search_with_mismatch`]): the mismatch searched once more around its profiled value
+/// ([`search_profiled`]): the mismatch searched once more around its profiled value
 /// with the effect in place, for its standard error (the profile's few secant steps give
 /// none), and its best value taken where it lowers the distance on the fit blocks. The
 /// step records the mismatch it ended with.
