@@ -113,7 +113,7 @@ pub struct ApsResult {
 }
 
 /// The fewest usable frame intervals the frame-based thresholds rest on.
-const MIN_USED_INTERVALS: usize = 3;
+pub(crate) const MIN_USED_INTERVALS: usize = 3;
 
 /// The support window of the re-simulation counts: a few pixel-crossing times of the
 /// recording's typical motion (10-100 ms).

@@ -41,6 +41,8 @@ pub struct BlockMeasure {
     pub hot_events: Vec<u64>,
     /// Events per kept pixel per second, hot pixels left out.
     pub pixel_rate_hz: f64,
+    /// Supported events (under the shortest window) per kept pixel per second.
+    pub signal_rate_hz: f64,
 }
 
 /// Isolated events at quiet pixels under one support window.
@@ -190,6 +192,8 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
             b.isolated.push(isolated);
             if window == SUPPORT_WINDOWS_US[0] {
                 (b.signal_on, b.signal_off) = signal;
+                b.signal_rate_hz =
+                    (signal.0 + signal.1) as f64 / (kept_pixels as f64 * b.seconds.max(1e-9));
             }
         }
     }

@@ -120,6 +120,8 @@ pub(super) struct FitRun {
     /// OFF/ON of supported events and its standard error over the fit blocks.
     balance: Option<(f64, f64)>,
     quiet_pixel_seconds: f64,
+    /// Supported (scene) events per kept pixel per second over the fit blocks.
+    signal_rate_hz: f64,
 }
 
 /// Fits the pixel model to a recording without frames.
@@ -127,6 +129,18 @@ pub fn fit(
     input: &FitInput,
     options: &FitOptions,
     progress: Progress,
+) -> Result<FitResult, FitError> {
+    fit_from_events(input, options, progress, None)
+}
+
+/// Fits the pixel model to the events alone: of a recording without frames
+/// (`frames_unused` `None`), or of one whose frames cannot be used, and why (said in the
+/// assumptions and in the reasons of what the frames would have measured).
+pub(super) fn fit_from_events(
+    input: &FitInput,
+    options: &FitOptions,
+    progress: Progress,
+    frames_unused: Option<String>,
 ) -> Result<FitResult, FitError> {
     let events = input.events;
     check(events)?;
@@ -174,6 +188,7 @@ pub fn fit(
         thresholds,
         steps,
         model,
+        frames_unused,
     }))
 }
 
@@ -308,6 +323,11 @@ fn fit_run(
         timestamp_step_us,
         balance,
         quiet_pixel_seconds: BlockMeasure::isolated(&fit, window).pixel_seconds,
+        signal_rate_hz: fit
+            .iter()
+            .map(|b| b.signal_rate_hz * b.seconds)
+            .sum::<f64>()
+            / fit.iter().map(|b| b.seconds).sum::<f64>().max(1e-9),
     }
 }
 

@@ -185,6 +185,7 @@ mod tests {
             intervals: vec![500, 1200, 1500, 1900],
             hot_events: vec![200],
             pixel_rate_hz: 1.0,
+            signal_rate_hz: 0.8,
         }
     }
 

@@ -48,6 +48,8 @@ pub(super) struct Parts<'a> {
     pub thresholds: Result<CtEstimate, String>,
     pub steps: Vec<Step>,
     pub model: NoiseModel,
+    /// Why the recording's frames were not used, where it has frames.
+    pub frames_unused: Option<String>,
 }
 
 pub(super) fn result(parts: Parts) -> FitResult {
@@ -60,6 +62,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
         thresholds,
         steps,
         model,
+        frames_unused,
     } = parts;
     let kept = |name: &str| steps.iter().any(|s| s.effect == name && s.kept);
     let mut why = BTreeMap::new();
@@ -67,7 +70,11 @@ pub(super) fn result(parts: Parts) -> FitResult {
     let (on, off) = absolute(&thresholds, &mut why, &mut uncertainties);
     let mut params = PixelParams::ideal(on, off);
     for (key, reason) in NEEDS_BRIGHTNESS {
-        why.insert(key.to_string(), reason.to_string());
+        let reason = match &frames_unused {
+            None => reason.to_string(),
+            Some(_) => format!("{reason}; the recording's frames are not used (see assumptions)"),
+        };
+        why.insert(key.to_string(), reason);
     }
     noise_params(&run, &kept, &mut params, &mut why, &mut uncertainties);
     refractory_param(
@@ -106,7 +113,14 @@ pub(super) fn result(parts: Parts) -> FitResult {
     let mut events_only = details(&run, &thresholds, judging, kept("thresholds"));
     events_only.predicted_error_before = predicted_before;
     events_only.predicted_error_after = predicted_after;
-    let mut assumptions = assumptions(&run, &thresholds, blocks, judging, options);
+    let mut assumptions = assumptions(
+        &run,
+        &thresholds,
+        blocks,
+        judging,
+        options,
+        frames_unused.as_deref(),
+    );
     assumptions.push(match &not_simulated {
         None => format!(
             "error_before and error_after: the ideal pixel and the final model simulated back onto the test blocks' supported events (the scene as recorded) and measured like the recording (isolated rates, hot pixels); intervals and balance from the model's parameters. Read from the parameters alone they are {predicted_before:.4} and {predicted_after:.4}"
@@ -282,13 +296,21 @@ fn noise_params(
     why: &mut BTreeMap<String, String>,
     uncertainties: &mut BTreeMap<String, Uncertain>,
 ) {
+    let scene = super::candidates::scene_like_isolated(run);
     if let Some((rate, se)) = symmetric_rate(run) {
-        if kept("shot_noise") {
-            params.shot_noise_rate_hz = Some(2.0 * rate);
-            uncertainties.insert(
+        if let (Some(scene), false) = (&scene, kept("shot_noise")) {
+            why.insert(
                 "shot_noise_rate_hz".into(),
-                Uncertain::positive(2.0 * rate, Some(2.0 * se)),
+                format!(
+                    "{}: the shot noise lies between {:.4} and {:.4} Hz (2 standard errors); a static stretch of the recording, or grey frames, would tell them apart",
+                    scene.evidence(),
+                    2.0 * scene.noise_at_least_hz,
+                    2.0 * (rate + 2.0 * se)
+                ),
             );
+        } else if kept("shot_noise") {
+            params.shot_noise_rate_hz = Some(2.0 * rate);
+            uncertainties.insert("shot_noise_rate_hz".into(), dark_rate(2.0 * rate, 2.0 * se));
             why.insert(
                 "shot_noise_bright_factor".into(),
                 "how the noise rate depends on brightness needs each pixel's intensity (grey frames); the rate given is the one at the recording's brightness".into(),
@@ -304,7 +326,16 @@ fn noise_params(
         }
     }
     if let Some((excess, se)) = on_excess(run) {
-        if kept("leak") {
+        if let (Some(scene), false) = (&scene, kept("leak")) {
+            why.insert(
+                "leak_rate_hz".into(),
+                format!(
+                    "{}: the leak lies between 0 and {:.4} Hz (the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, with 2 standard errors)",
+                    scene.evidence(),
+                    excess.max(0.0) + 2.0 * se
+                ),
+            );
+        } else if kept("leak") {
             params.leak_rate_hz = Some(excess);
             uncertainties.insert("leak_rate_hz".into(), Uncertain::positive(excess, Some(se)));
         } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
@@ -317,6 +348,22 @@ fn noise_params(
             );
         }
     }
+}
+
+/// The dark shot-noise rate (what `shot_noise_rate_hz` means to v2e and ctcal) from the rate
+/// measured at the recording's brightness, `measured` +- `se`: the rate falls towards white
+/// to [`PixelParams::shot_noise_bright_factor`] of the dark rate (0.25, v2e's), and without
+/// frames the brightness is not known, so the interval runs from the measured rate's lower
+/// end (a dark scene) to its upper end over that factor (a white one); the value is the
+/// measured rate. Without the factor the interval held only the measured rate (coverage
+/// draw 4077, fitted from its events: 1.44 [1.38, 1.50] Hz for a dark rate of 1.79).
+fn dark_rate(measured: f64, se: f64) -> Uncertain {
+    let at_brightness = Uncertain::positive(measured, Some(se));
+    let [lo, hi] = at_brightness
+        .ci95
+        .unwrap_or([Some(measured), Some(measured)]);
+    let white = PixelParams::ideal(1.0, 1.0).shot_noise_bright_factor();
+    Uncertain::with_interval(measured, Some(se), [lo, hi.map(|h| h / white)])
 }
 
 fn refractory_param(
@@ -431,6 +478,7 @@ fn assumptions(
     blocks: &Blocks,
     judging: &Judging,
     options: &FitOptions,
+    frames_unused: Option<&str>,
 ) -> Vec<String> {
     let mut out = Vec::new();
     if let Ok(e) = thresholds {
@@ -446,7 +494,10 @@ fn assumptions(
     }
     let seconds = |r| blocks.seconds(&blocks.of(r));
     out.extend([
-        "no grey frames: the scene is not simulated; the pixel's own effects are measured from the events and checked as a noise model on held-out blocks".to_string(),
+        format!(
+            "{}: the scene is not simulated; the pixel's own effects are measured from the events and checked as a noise model on held-out blocks",
+            frames_unused.map_or("no grey frames".to_string(), |why| format!("grey frames not used ({why})"))
+        ),
         format!(
             "isolated events: no neighbour event within +-{} ms (the shortest of {:?} ms after which a longer window no longer lowers the rate: the scene's slow events are supported by then); their rate counts only the time no neighbour event covered, at pixels left uncovered at least {:.0} % of a block",
             SUPPORT_WINDOWS_US[run.window] / 1000,
@@ -454,7 +505,7 @@ fn assumptions(
             100.0 * super::measure::QUIET_SHARE
         ),
         "shot noise fires ON and OFF equally and leak ON only (v2e, Hu et al. 2021): the OFF rate gives the shot noise (ON + OFF = twice it), the ON excess the leak".to_string(),
-        "noise rates are those at the recording's brightness: v2e and ctcal give shot_noise_rate_hz as the dark rate, falling to 0.25 of it at full white; without frames the brightness is unknown, so the dark rate lies between 1 and 4 times the value given".to_string(),
+        "noise rates are those at the recording's brightness: v2e and ctcal give shot_noise_rate_hz as the dark rate, falling to 0.25 of it at full white; without frames the brightness is unknown, so the dark rate lies between 1 and 4 times the value given, and its interval reaches 4 times the measured rate's upper end".to_string(),
         "Cp/Cn from the ON/OFF balance of supported events assumes brightness at each pixel returns over the fit blocks (net log change zero); the jackknife over fit blocks carries how far it does not".to_string(),
         format!(
             "time in {} blocks over the events' span: fit {:.2} s (the first {:.0} %), selection {:.2} s (judges each effect), test {:.2} s (error_before and error_after only)",
@@ -497,5 +548,26 @@ fn holdout(blocks: &Blocks, options: &FitOptions) -> Holdout {
         held_out_blocks: held,
         selection_blocks: selection,
         test_blocks: test,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Coverage draw 4077 read from its events: 1.44 +- 0.03 Hz of shot noise measured at
+    /// its brightness for a dark rate of 1.79 Hz. The interval reaches the rate over v2e's
+    /// factor at white (0.25), and starts where the measured rate's does.
+    #[test]
+    fn the_dark_shot_noise_rate_spans_the_unknown_brightness() {
+        let u = dark_rate(1.44, 0.03);
+        let [Some(lo), Some(hi)] = u.ci95.unwrap() else {
+            panic!("a closed interval")
+        };
+        let spread = (crate::estimate::interval::z95() * 0.03 / 1.44f64).exp();
+        assert_eq!(u.value, 1.44);
+        assert!((lo - 1.44 / spread).abs() < 1e-9, "{lo}");
+        assert!((hi - 4.0 * 1.44 * spread).abs() < 1e-9, "{hi}");
+        assert!(lo < 1.79 && 1.79 < hi);
     }
 }

@@ -41,6 +41,7 @@ use super::{
     AddedEffect, EffectChoice, FitError, FitInput, FitOptions, FitResult, Step, Uncertain,
 };
 use crate::estimate::aps::{self, ApsInput};
+use crate::estimate::frames::PreparedFrames;
 use crate::estimate::{Progress, dynamics, timestamp_grid};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::PixelParams;
@@ -94,7 +95,12 @@ pub fn fit(
     progress("frames: selection and optical flow", 0.0);
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);
-    let (mut frames, mut assumptions) = prepare_frames(input, &run, options)?;
+    let (mut frames, mut assumptions) = match prepare_frames(input, &run, options)? {
+        Ok(prepared) => prepared,
+        Err(why) => {
+            return super::events_only::fit_from_events(input, options, progress, Some(why));
+        }
+    };
     progress("starting thresholds (estimate aps on the fit run)", 0.05);
     let (start, start_params) = starting_point(input, &run, options, &mut frames, &mut assumptions);
 
@@ -285,12 +291,13 @@ impl Known {
 }
 
 /// The frames as the simulator reads them: the frame-time alignment, the log offset and
-/// the response found on the fit run alone, applied to every frame.
+/// the response found on the fit run alone, applied to every frame; `Ok(Err(why))` where
+/// the flow does not follow them ([`frames_not_followed`]).
 fn prepare_frames(
     input: &FitInput,
     run: &start::FitRun,
     options: &FitOptions,
-) -> Result<(crate::estimate::frames::PreparedFrames, Vec<String>), FitError> {
+) -> Result<Result<(PreparedFrames, Vec<String>), String>, FitError> {
     let found = aps::prepare(&run.aps_input(input), input.excluded, &options.aps)?;
     let fixed = aps::ApsOptions {
         frame_time_offset_s: options
@@ -311,7 +318,44 @@ fn prepare_frames(
         unread: input.unread,
     };
     let prepared = aps::prepare(&all, input.excluded, &fixed)?;
-    Ok((prepared.frames, found.assumptions))
+    if let Some(why) = frames_not_followed(&found.frames, &prepared.frames) {
+        return Ok(Err(why));
+    }
+    Ok(Ok((prepared.frames, found.assumptions)))
+}
+
+/// Why the frames cannot be re-simulated: the optical flow follows fewer than
+/// [`aps::MIN_USED_INTERVALS`] of the fit run's frame intervals, and over the whole
+/// recording the motion between frames is too large on more intervals than it follows
+/// (motion too fast for the frame rate). The fit run sets the thresholds and every search,
+/// and the re-simulation interpolates the scene along that flow: with one followed
+/// interval the fit rested on a few hundredths of a second of the recording, and the
+/// thresholds fitted to it were confidently wrong (coverage draw 6028, a checkerboard at
+/// 337 px/s seen at 10 Hz: ON 0.104 [0.073, 0.150] for a true 0.191, the flow following
+/// one interval of the fit run's seven; draw 6015, 535 px/s: 0.172 / 0.066 for
+/// 0.727 / 0.312, both intervals missing). The fit then reads the events alone, as for a
+/// recording without frames. `None` where the flow follows enough intervals, or where a
+/// short recording's fit run has few frames but the flow follows most of the recording's
+/// (the IJRR slider_depth chunk: one of the fit run's two intervals moves 13.5 px, over
+/// the 12 px limit; three of the four are followed).
+fn frames_not_followed(fit_run: &PreparedFrames, all: &PreparedFrames) -> Option<String> {
+    let used = |f: &PreparedFrames| f.intervals.iter().filter(|i| i.used).count();
+    // intervals whose flow was measured and moved too far (the others fail for want of
+    // events or frames, not for the motion)
+    let too_fast = all
+        .intervals
+        .iter()
+        .filter(|i| !i.used && i.motion_px > 0.0)
+        .count();
+    let (used_fit, used_all) = (used(fit_run), used(all));
+    (used_fit < aps::MIN_USED_INTERVALS && too_fast > used_all).then(|| {
+        format!(
+            "the optical flow follows only {used_fit} of the fit run's {} frame intervals and {used_all} of the recording's {}, the motion between frames too large on {too_fast} (too fast for the frame rate); re-simulating the frames needs {} followed in the fit run",
+            fit_run.intervals.len(),
+            all.intervals.len(),
+            aps::MIN_USED_INTERVALS
+        )
+    })
 }
 
 /// The ideal model with the thresholds profiled, and whether they stay fixed (a static
@@ -629,5 +673,49 @@ fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) ->
         timestamp_grid_us: known.grid.map(|g| g.0),
         shortest_interval_s: known.shortest_interval_s,
         subset: Subset::Fit,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::effects::fixture::static_frames;
+
+    /// Frames every 100 ms over `seconds`, the flow following the intervals `followed` and
+    /// moving too far on the others (but those in `no_events`, dropped for want of events).
+    fn frames(seconds: f64, followed: &[usize], no_events: &[usize]) -> PreparedFrames {
+        let mut f = static_frames(8, 6, seconds, 100.0);
+        for (k, i) in f.intervals.iter_mut().enumerate() {
+            i.used = followed.contains(&k);
+            i.motion_px = match (i.used, no_events.contains(&k)) {
+                (true, _) => 3.0,
+                (false, true) => 0.0,
+                (false, false) => 34.0,
+            };
+        }
+        f
+    }
+
+    /// Coverage draw 6028's frames (a checkerboard at 337 px/s at 10 Hz): one interval of
+    /// the fit run's seven followed, two of the recording's thirteen.
+    #[test]
+    fn frames_the_flow_does_not_follow_are_not_re_simulated() {
+        let fit_run = frames(0.7, &[3], &[]);
+        let all = frames(1.3, &[3, 9], &[]);
+        let why = frames_not_followed(&fit_run, &all).expect("not followed");
+        assert!(why.contains("1 of the fit run's 7") && why.contains("2 of the recording's 13"));
+        // the IJRR slider_depth chunk: one of the fit run's two intervals over the limit,
+        // three of the recording's four followed
+        let fit_run = frames(0.2, &[0], &[]);
+        let all = frames(0.4, &[0, 2, 3], &[]);
+        assert_eq!(frames_not_followed(&fit_run, &all), None);
+        // intervals without events are not the flow failing
+        let fit_run = frames(0.7, &[3], &[0, 1, 2, 4, 5, 6]);
+        let all = frames(1.3, &[3, 9], &[0, 1, 2, 4, 5, 6, 7, 8, 10, 11, 12]);
+        assert_eq!(frames_not_followed(&fit_run, &all), None);
+        // three followed in the fit run: re-simulated
+        let fit_run = frames(0.7, &[1, 3, 5], &[]);
+        let all = frames(1.3, &[1, 3, 5], &[]);
+        assert_eq!(frames_not_followed(&fit_run, &all), None);
     }
 }
