@@ -146,7 +146,10 @@ pub fn estimate(
     let (excluded, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
     check_length(input.events)?;
     progress("flow and travel", 0.0);
-    let frames = input.frames.filter(|_| options.use_frames);
+    let outrun = input.frames.and_then(PreparedFrames::motion_outruns_flow);
+    let frames = input
+        .frames
+        .filter(|_| options.use_frames && outrun.is_none());
     let rates = match frames {
         Some(f) => recording::from_frames(input.events, f, input.sensor, &excluded),
         None => recording::from_events(input.events, input.sensor, &excluded),
@@ -197,6 +200,11 @@ pub fn estimate(
         },
     );
     polarity_notes(&mut result, (&on, &off), calibrations.len());
+    if let Some((followed, too_fast)) = outrun.filter(|_| options.use_frames) {
+        result.assumptions.push(format!(
+            "the frames are not used: the motion between them is too large for the optical flow on {too_fast} intervals and it follows {followed}, so travel and contrast are read from the events, as without frames"
+        ));
+    }
     result
         .assumptions
         .extend(assumptions(&rates, &calibrations, basis.images(), hot));

@@ -339,16 +339,9 @@ fn prepare_frames(
 /// (the IJRR slider_depth chunk: one of the fit run's two intervals moves 13.5 px, over
 /// the 12 px limit; three of the four are followed).
 fn frames_not_followed(fit_run: &PreparedFrames, all: &PreparedFrames) -> Option<String> {
-    let used = |f: &PreparedFrames| f.intervals.iter().filter(|i| i.used).count();
-    // intervals whose flow was measured and moved too far (the others fail for want of
-    // events or frames, not for the motion)
-    let too_fast = all
-        .intervals
-        .iter()
-        .filter(|i| !i.used && i.motion_px > 0.0)
-        .count();
-    let (used_fit, used_all) = (used(fit_run), used(all));
-    (used_fit < aps::MIN_USED_INTERVALS && too_fast > used_all).then(|| {
+    let used_fit = fit_run.intervals.iter().filter(|i| i.used).count();
+    let (used_all, too_fast) = all.motion_outruns_flow()?;
+    (used_fit < aps::MIN_USED_INTERVALS).then(|| {
         format!(
             "the optical flow follows only {used_fit} of the fit run's {} frame intervals and {used_all} of the recording's {}, the motion between frames too large on {too_fast} (too fast for the frame rate); re-simulating the frames needs {} followed in the fit run",
             fit_run.intervals.len(),
