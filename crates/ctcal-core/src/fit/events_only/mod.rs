@@ -1,6 +1,7 @@
 //! The fit of a recording without grey frames (Prophesee EVK3/EVK4/Gen4.1, DVXplorer, a
-//! DAVIS recording without APS): everything the events alone identify, measured on the fit
-//! blocks and checked on held-out blocks like the frame-based fit.
+//! DAVIS recording without APS), or with frames whose motion outruns the optical flow
+//! (see `fit::selection::frames_not_followed`): everything the events alone identify,
+//! measured on the fit blocks and checked on held-out blocks like the frame-based fit.
 //!
 //! - **Hot pixels**, named: far above their neighbours' counts
 //!   ([`crate::stats::hot_pixels`]), each with its rate and ON share.

@@ -3,7 +3,9 @@
 //! 1. the split ([`start`]): time in blocks, the first `1 - holdout` of the frames' span
 //!    fits, the rest is held out as two contiguous runs with a guard interval at each change:
 //!    selection (judges every effect and refit) then test (measures the final error once);
-//! 2. the start: `estimate aps` on the fit run alone, the frames prepared from its events;
+//! 2. the start: `estimate aps` on the fit run alone, the frames prepared from its events
+//!    (frames whose motion outruns the optical flow are not re-simulated: the events alone
+//!    are fitted, [`super::events_only`]);
 //! 3. the loop: from the ideal model, every effect's evidence read from the fit blocks'
 //!    residuals; the strongest tried (its parameter searched with the thresholds on the fit
 //!    blocks) and kept only if the selection error falls by more than chance ([`keep`]);
