@@ -16,6 +16,7 @@
 //! the objective is the same function at every evaluation (common random numbers: the same
 //! pixels draw the same mismatch, leak factors and noise).
 
+use super::effects::mismatch::RANGE as MISMATCH_RANGE;
 use super::metric::{Components, dispersion, dispersion_log_ratio, distance, median_ratios};
 use super::observe::{Geometry, Observed, Subset};
 use crate::estimate::{EstimateError, Interval, quantise, resim};
@@ -68,9 +69,6 @@ const MISMATCH_STEPS: usize = 2;
 /// A dispersion log ratio this close to zero is matched: the pooled within-tile index's
 /// relative standard error is about 2 % (see [`super::effects::mismatch`]).
 const DISPERSION_MATCHED: f64 = 0.02;
-
-/// The range of the threshold mismatch the profile keeps to.
-const MISMATCH_RANGE: (f64, f64) = super::effects::mismatch::RANGE;
 
 fn threshold_of(p: &PixelParams, polarity: usize) -> f64 {
     if polarity == 1 { p.ct_on } else { p.ct_off }

@@ -117,6 +117,15 @@ pub(super) fn on_excess(run: &FitRun) -> Option<(f64, f64)> {
     Some((on - off, (on_se * on_se + off_se * off_se).sqrt()))
 }
 
+/// A noise candidate (shot noise, leak) is not tried where the isolated events are in the
+/// scene's own balance ([`scene_like_isolated`]); its evidence says why.
+fn set_aside_where_scene_like(c: &mut Candidate, run: &FitRun) {
+    if let Some(scene) = scene_like_isolated(run) {
+        c.evidence = format!("{}; {}", c.evidence, scene.evidence());
+        c.relevant = false;
+    }
+}
+
 fn candidate(name: &'static str, model: NoiseModel) -> Candidate {
     Candidate {
         name,
@@ -165,10 +174,7 @@ fn shot_noise(run: &FitRun, current: &NoiseModel) -> Candidate {
         run.noise[0].map_or(0.0, |r| r.0),
     );
     c.relevant = rate > 2.0 * se;
-    if let Some(scene) = scene_like_isolated(run) {
-        c.evidence = format!("{}; {}", c.evidence, scene.evidence());
-        c.relevant = false;
-    }
+    set_aside_where_scene_like(&mut c, run);
     c.parameters = BTreeMap::from([("shot_noise_rate_hz".to_string(), 2.0 * rate)]);
     c.model.noise_on_hz = rate;
     c.model.noise_off_hz = rate;
@@ -186,10 +192,7 @@ fn leak(run: &FitRun, current: &NoiseModel) -> Candidate {
         "isolated ON events exceed OFF by {excess:.4} +- {se:.4} Hz per pixel (leak fires ON only)"
     );
     c.relevant = excess > 2.0 * se;
-    if let Some(scene) = scene_like_isolated(run) {
-        c.evidence = format!("{}; {}", c.evidence, scene.evidence());
-        c.relevant = false;
-    }
+    set_aside_where_scene_like(&mut c, run);
     c.parameters = BTreeMap::from([("leak_rate_hz".to_string(), excess.max(0.0))]);
     c.model.noise_on_hz = current.noise_on_hz + excess.max(0.0);
     c
