@@ -294,13 +294,24 @@ impl Known {
 
 /// The frames as the simulator reads them: the frame-time alignment, the log offset and
 /// the response found on the fit run alone, applied to every frame; `Ok(Err(why))` where
-/// the flow does not follow them ([`frames_not_followed`]).
+/// the flow does not follow them ([`frames_not_followed`]) or where no interval of the fit
+/// run can be used at all (motion beyond the flow's reach on every interval, no events
+/// between the frames, frames with a problem): the events can still be read alone (draw
+/// 6028 cut to its first 0.6 s, none of its five intervals followed, was refused).
 fn prepare_frames(
     input: &FitInput,
     run: &start::FitRun,
     options: &FitOptions,
 ) -> Result<Result<(PreparedFrames, Vec<String>), String>, FitError> {
-    let found = aps::prepare(&run.aps_input(input), input.excluded, &options.aps)?;
+    let found = match aps::prepare(&run.aps_input(input), input.excluded, &options.aps) {
+        Ok(found) => found,
+        Err(unusable) => {
+            return Ok(Err(format!(
+                "no frame interval of the fit run can be re-simulated: {}",
+                unusable.problem
+            )));
+        }
+    };
     let fixed = aps::ApsOptions {
         frame_time_offset_s: options
             .aps
@@ -712,5 +723,64 @@ mod tests {
         let fit_run = frames(0.7, &[1, 3, 5], &[]);
         let all = frames(1.3, &[1, 3, 5], &[]);
         assert_eq!(frames_not_followed(&fit_run, &all), None);
+    }
+
+    /// A smooth pattern moving 30 px a frame at 10 Hz (300 px/s, draw 6028's pace cut to
+    /// its first half second): no interval is followed, so the frames cannot be prepared
+    /// at all; the fit is told why instead of refusing the recording.
+    #[test]
+    fn frames_no_interval_of_which_is_followed_leave_the_events_to_the_fit() {
+        use crate::events::{EventChunk, Frame, Sensor};
+        let (width, height) = (96u16, 64u16);
+        let times = crate::fit::effects::fixture::frame_times(0.6, 0.1);
+        let frames: Vec<Frame> = times
+            .iter()
+            .enumerate()
+            .map(|(k, &t)| Frame {
+                t,
+                width: width as u32,
+                height: height as u32,
+                pixels: (0..width as usize * height as usize)
+                    .map(|p| {
+                        let x = (p % width as usize) as f64 + 30.0 * k as f64;
+                        let y = (p / width as usize) as f64;
+                        let v = (x / 9.0).sin() * (y / 7.0).cos() + 0.5 * (x / 23.0).cos();
+                        (110.0 + 60.0 * v) as u8
+                    })
+                    .collect(),
+                exposure_us: None,
+            })
+            .collect();
+        let mut events = EventChunk::default();
+        for k in 0..6000i64 {
+            let p = (k * 7919) as usize % (width as usize * height as usize);
+            events.push(
+                k * 100,
+                (p % width as usize) as u16,
+                (p / width as usize) as u16,
+                k % 3 != 0,
+            );
+        }
+        let sensor = Sensor::new(width, height);
+        let excluded = vec![false; sensor.pixels()];
+        let input = FitInput {
+            sensor,
+            events: &events,
+            frames: &frames,
+            excluded: &excluded,
+            unread: &[],
+        };
+        let options = FitOptions::default();
+        let run = start::FitRun::new(&input, start::fit_end(&frames, options.holdout));
+        let why = match prepare_frames(&input, &run, &options) {
+            Ok(Err(why)) => why,
+            Ok(Ok(_)) => panic!("frames moving 30 px a frame were re-simulated"),
+            Err(e) => panic!("refused: {e}"),
+        };
+        assert!(
+            why.starts_with("no frame interval of the fit run can be re-simulated")
+                && why.contains("too large to interpolate"),
+            "{why}"
+        );
     }
 }
