@@ -1,7 +1,9 @@
 //! `ctcal estimate aps|eppps|screen`: contrast thresholds three ways (see `ctcal::estimate`).
 
 use super::load::{Loaded, Window, load};
-use super::{BadInput, Global, InputArgs, JsonTarget, SelectionArgs, emit_json, output};
+use super::{
+    BadInput, Global, InputArgs, JsonTarget, SelectionArgs, check_json, emit_json, output,
+};
 use clap::{Args, Subcommand, ValueEnum};
 use ctcal::estimate::CtEstimate;
 use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
@@ -201,6 +203,7 @@ fn run_eppps(args: &EpppsArgs, global: &Global) -> anyhow::Result<()> {
         .into());
     }
     let policy = global.outputs([common.input.input.as_path()]);
+    check_json(common.json.as_deref(), &policy)?;
     let loaded = common.load(
         (!args.ignore_frames).then_some(args.max_frames.max(2)),
         false,
@@ -251,6 +254,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
     inputs.extend(args.stimulus.as_deref());
     inputs.extend(args.screen.as_deref());
     let policy = global.outputs(inputs);
+    check_json(common.json.as_deref(), &policy)?;
     let screen = match &args.screen {
         Some(path) => {
             let text = ctcal::files::read_small_text(path, 1 << 20)
@@ -351,6 +355,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
         return Err(BadInput("--max-frames must be at least 2".into()).into());
     }
     let policy = global.outputs([common.input.input.as_path()]);
+    check_json(common.json.as_deref(), &policy)?;
     if let Some(dir) = &args.maps {
         policy.check_folder(dir)?;
     }

@@ -2,7 +2,7 @@
 //! residuals call for them and the held-out error falls (see `ctcal::fit`).
 
 use super::estimate::{CommonArgs, estimate_failed, stage_spinner};
-use super::{BadInput, Global, JsonTarget, emit_json, output, warn};
+use super::{BadInput, Global, JsonTarget, check_json, emit_json, output, warn};
 use clap::Args;
 use ctcal::estimate::aps::ApsOptions;
 use ctcal::fit::effects::Effect;
@@ -173,6 +173,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     }
     let (log_map, log_name) = common.log_map()?;
     let policy = global.outputs([common.input.input.as_path()]);
+    check_json(common.json.as_deref(), &policy)?;
     let thresholds = args
         .thresholds_from
         .as_deref()

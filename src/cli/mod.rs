@@ -263,4 +263,4 @@ pub fn progress_bar(global: &Global, total: u64, what: &str) -> indicatif::Progr
     bar
 }
 
-pub use output::{JsonTarget, emit_json};
+pub use output::{JsonTarget, check_json, emit_json};

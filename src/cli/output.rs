@@ -46,6 +46,15 @@ pub fn json_text<T: Serialize>(value: &T) -> anyhow::Result<String> {
     Ok(text)
 }
 
+/// Checks, before any work, that `--json PATH` may be written (a file ctcal did not write
+/// is refused now, not after minutes of fitting); `-` and no `--json` always may.
+pub fn check_json(json: Option<&Path>, policy: &OutputPolicy) -> anyhow::Result<()> {
+    if let Some(JsonTarget::File(path)) = json.map(JsonTarget::parse) {
+        policy.check_file(&path)?;
+    }
+    Ok(())
+}
+
 /// Writes `value` as pretty JSON to `target`.
 pub fn emit_json<T: Serialize>(
     value: &T,

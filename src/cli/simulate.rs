@@ -1,6 +1,6 @@
 //! `ctcal simulate`: events from a frame folder or a scene through the pixel model.
 
-use super::{BadInput, Global, JsonTarget, emit_json, output, progress_bar};
+use super::{BadInput, Global, JsonTarget, check_json, emit_json, output, progress_bar};
 use clap::{Args, ValueEnum};
 use ctcal::io::write::{H5Writer, IjrrWriter};
 use ctcal::io::{FrameList, npy};
@@ -230,6 +230,7 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     };
     let params = PixelParams::from_file(&args.params)?;
     let policy = global.outputs(input_paths(args));
+    check_json(args.json.as_deref(), &policy)?;
     let started = std::time::Instant::now();
     let SimInput {
         source,

@@ -1,7 +1,8 @@
 //! `ctcal stats`: event statistics of a recording (see `ctcal::stats`).
 
 use super::{
-    BadInput, Global, InputArgs, JsonTarget, SelectionArgs, emit_json, output, progress_bar, warn,
+    BadInput, Global, InputArgs, JsonTarget, SelectionArgs, check_json, emit_json, output,
+    progress_bar, warn,
 };
 use clap::Args;
 use ctcal::Recording;
@@ -69,6 +70,8 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
         ))
         .into());
     }
+    let policy = global.outputs([args.input.input.as_path()]);
+    check_json(args.json.as_deref(), &policy)?;
     let recording = Recording::open(&args.input.input, &args.input.open_options())?;
     for note in &recording.notes {
         warn(global, note);
@@ -86,11 +89,7 @@ pub fn run(args: &StatsArgs, global: &Global) -> anyhow::Result<()> {
     }
     let target = args.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(
-            &stats,
-            target,
-            &global.outputs([args.input.input.as_path()]),
-        )?;
+        emit_json(&stats, target, &policy)?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) {
         print_human(&stats)?;

@@ -189,6 +189,34 @@ fn an_output_that_holds_or_is_an_input_is_refused() {
     assert!(rec.join("calib.txt").is_file() && inside.is_file());
 }
 
+/// A user's file named by `--json` is refused before the recording is read, not after
+/// the work: the recording here is not a recording at all, and the error is the JSON's
+/// (fit used to read, fit for 11 s and only then refuse).
+#[test]
+fn json_a_command_may_not_write_is_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let mine = dir.path().join("mine.json");
+    std::fs::write(&mine, "{\"mine\": true}").unwrap();
+    let not_a_recording = dir.path().join("notes.txt");
+    std::fs::write(&not_a_recording, "not events").unwrap();
+    let (input, json) = (not_a_recording.to_str().unwrap(), mine.to_str().unwrap());
+    for command in [
+        &["fit", input][..],
+        &["estimate", "aps", input],
+        &["estimate", "eppps", input],
+        &["stats", input],
+    ] {
+        let mut args = command.to_vec();
+        args.extend(["--json", json]);
+        let e = bad_input(&args);
+        assert!(
+            e.contains("mine.json") && e.contains("not written by ctcal"),
+            "{command:?}: {e}"
+        );
+    }
+    assert_eq!(std::fs::read_to_string(&mine).unwrap(), "{\"mine\": true}");
+}
+
 #[test]
 fn json_never_replaces_a_folder_a_users_file_or_a_link() {
     let dir = tempfile::tempdir().unwrap();
