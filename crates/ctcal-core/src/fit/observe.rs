@@ -9,8 +9,9 @@
 //! - the same events per sensor region (a 4 x 3 grid) and polarity (for the residuals);
 //! - events without support per intensity bin and polarity: where noise (shot noise,
 //!   leak) shows;
-//! - the histogram of same-pixel inter-event intervals (log bins, 10 us to 10 s):
-//!   refractory periods and timestamp jitter shape it;
+//! - the histogram of same-pixel inter-event intervals (log bins, 10 us to 10 s), per
+//!   intensity bin of the later event's pixel: refractory periods and timestamp jitter
+//!   shape it alike at every brightness, the photoreceptor's bandwidth more in the dark;
 //! - per-pixel counts: dispersion within tiles (threshold mismatch), hot pixels;
 //! - the event-rate timeline in 1 ms bins (its spectrum shows a display's refresh).
 //!
@@ -38,6 +39,9 @@ pub const REGIONS: usize = REGIONS_X * REGIONS_Y;
 pub const INTERVAL_FIRST_S: f64 = 1e-5;
 pub const INTERVAL_BINS_PER_DECADE: usize = 8;
 pub const INTERVAL_BINS: usize = 6 * INTERVAL_BINS_PER_DECADE + 2;
+/// The interval histograms kept per block: one per intensity bin, and one for the events
+/// of pixels without a reliable intensity (or outside the frames).
+pub const INTERVAL_CLASSES: usize = INTENSITY_BINS + 1;
 /// Support window of the background counts, microseconds.
 pub const SUPPORT_US: TimeUs = 10_000;
 /// Side of the tiles of the dispersion statistic, pixels.
@@ -368,7 +372,8 @@ pub struct Observed {
     pub background: Vec<u32>,
     /// Supported events `[block][region][polarity]`.
     pub by_region: Vec<u32>,
-    /// `[block][interval bin]`.
+    /// `[block][intensity class][interval bin]` (class: the later event's intensity bin,
+    /// [`INTENSITY_BINS`] where it has none).
     pub intervals: Vec<u32>,
     /// Events per pixel, `[block][pixel]`.
     pub pixel_counts: Vec<u32>,
@@ -400,9 +405,22 @@ impl Observed {
 
     /// The same-pixel interval histogram over `subset`.
     pub fn intervals_of(&self, g: &Geometry, subset: Subset) -> Vec<u32> {
-        sum_blocks(&self.intervals, INTERVAL_BINS, self.blocks, |b| {
-            g.in_subset(b, subset)
-        })
+        let by_class = self.intervals_by_intensity_of(g, subset);
+        (0..INTERVAL_BINS)
+            .map(|k| by_class.iter().map(|h| h[k]).sum())
+            .collect()
+    }
+
+    /// The same-pixel interval histogram over `subset` per intensity class (the intensity
+    /// bins, then the events without one).
+    pub fn intervals_by_intensity_of(&self, g: &Geometry, subset: Subset) -> Vec<Vec<u32>> {
+        let all = sum_blocks(
+            &self.intervals,
+            INTERVAL_CLASSES * INTERVAL_BINS,
+            self.blocks,
+            |b| g.in_subset(b, subset),
+        );
+        all.chunks(INTERVAL_BINS).map(<[u32]>::to_vec).collect()
     }
 
     /// The event-rate timeline over `subset`'s time range ([`Geometry::time_range_of`]).

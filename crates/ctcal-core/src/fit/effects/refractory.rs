@@ -6,14 +6,18 @@
 //! local rates): the recording has far fewer intervals below some time than a model
 //! without it, whatever the brightness. Evidence: the largest interval bin below which the
 //! recording holds less than a quarter of the model's share, with the model's share above
-//! 2 %; the difference of the shares in binomial standard errors. Start: the recording's
+//! 2 %; the difference of the shares in binomial standard errors. A gap that moves with
+//! the pixels' brightness is the photoreceptor's bandwidth, not a period
+//! ([`moves_with_brightness`]). Start: the recording's
 //! shortest same-pixel intervals ([`shortest_interval_s`]: no interval is shorter than the
 //! period, and v2e's pile-up puts many exactly at it), else that bin's upper edge.
 
 use super::{Context, Effect, Evidence};
 use crate::events::{EventChunk, TimeUs};
 use crate::fit::metric::normalised;
-use crate::fit::observe::{INTERVAL_BINS, interval_bin_start};
+use crate::fit::observe::{
+    INTENSITY_BINS, INTERVAL_BINS, INTERVAL_BINS_PER_DECADE, interval_bin_start,
+};
 
 /// The recording's shortest same-pixel intervals, seconds: the lower edge of the intervals
 /// between consecutive events of each `kept` pixel of time-sorted `events` on a
@@ -43,43 +47,148 @@ pub fn shortest_interval_s(
 pub fn evidence(c: &Context) -> Evidence {
     let real_counts = c.real.intervals_of(c.geometry, c.subset);
     let n: f64 = real_counts.iter().map(|&v| v as f64).sum();
-    let (real, sim) = (
-        normalised(&real_counts),
-        normalised(&c.sim.intervals_of(c.geometry, c.subset)),
-    );
-    let (mut real_cdf, mut sim_cdf) = (0.0, 0.0);
-    let mut found = None;
-    for k in 0..INTERVAL_BINS - 1 {
-        real_cdf += real[k];
-        sim_cdf += sim[k];
-        if sim_cdf >= 0.02 && real_cdf < 0.25 * sim_cdf {
-            found = Some((k, real_cdf, sim_cdf));
-        } else if found.is_some() {
-            break;
-        }
-    }
-    let Some((k, real_share, sim_share)) = found else {
+    let sim_counts = c.sim.intervals_of(c.geometry, c.subset);
+    let Some(found) = Gap::of(&real_counts, &sim_counts) else {
         return Evidence::none(
             Effect::Refractory,
             "the shortest same-pixel intervals are as common as the model makes them",
         );
     };
-    let edge = interval_bin_start(k + 1);
-    let se = (sim_share * (1.0 - sim_share) / n.max(1.0))
+    let edge = interval_bin_start(found.bin + 1);
+    let se = (found.sim_share * (1.0 - found.sim_share) / n.max(1.0))
         .sqrt()
         .max(1e-9);
+    let text = format!(
+        "{:.1} % of the recording's same-pixel intervals are shorter than {:.3} ms against {:.1} % in the model",
+        100.0 * found.real_share,
+        edge * 1e3,
+        100.0 * found.sim_share
+    );
+    if let Some(moves) = moves_with_brightness(c) {
+        return Evidence {
+            text: format!("{text}; {moves}"),
+            ..Evidence::none(Effect::Refractory, "")
+        };
+    }
     Evidence {
         effect: Effect::Refractory,
-        score: (sim_share - real_share) / se,
-        relevant: sim_share - real_share > 0.02,
-        text: format!(
-            "{:.1} % of the recording's same-pixel intervals are shorter than {:.3} ms against {:.1} % in the model",
-            100.0 * real_share,
-            edge * 1e3,
-            100.0 * sim_share
-        ),
+        score: (found.sim_share - found.real_share) / se,
+        relevant: found.sim_share - found.real_share > 0.02,
+        text,
         start: Some(c.shortest_interval_s.unwrap_or(edge)),
     }
+}
+
+/// A gap in the shortest same-pixel intervals: the largest interval bin below which the
+/// recording holds less than a quarter of the model's share, with the model's share above
+/// 2 % (the bins below it gapped too).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Gap {
+    bin: usize,
+    real_share: f64,
+    sim_share: f64,
+}
+
+impl Gap {
+    fn of(real: &[u32], sim: &[u32]) -> Option<Gap> {
+        let (real, sim) = (normalised(real), normalised(sim));
+        let (mut real_cdf, mut sim_cdf) = (0.0, 0.0);
+        let mut found = None;
+        for k in 0..INTERVAL_BINS - 1 {
+            real_cdf += real[k];
+            sim_cdf += sim[k];
+            if sim_cdf >= 0.02 && real_cdf < 0.25 * sim_cdf {
+                found = Some(Gap {
+                    bin: k,
+                    real_share: real_cdf,
+                    sim_share: sim_cdf,
+                });
+            } else if found.is_some() {
+                break;
+            }
+        }
+        found
+    }
+}
+
+/// Intervals an intensity bin needs in the recording and in the model for its own gap to
+/// be read.
+const MIN_CLASS_INTERVALS: u32 = 300;
+
+/// Interval bins between the gaps of a dimmer and a brighter intensity bin from which the
+/// gap moves with brightness (a factor 1.8, where a refractory period leaves one edge and
+/// the bins' quantisation at most one bin between them).
+const MOVED_BINS: usize = 2;
+
+/// Intervals a brighter intensity bin must hold below the gap's edge (where the model puts
+/// them too) to show that the gap is not there.
+const MIN_UNGAPPED_INTERVALS: u32 = 10;
+
+/// Why the gap is not a refractory period's, where the intensity bins tell: a refractory
+/// period blinds the pixel for one time at every brightness, while the photoreceptor's
+/// low-pass, whose cutoff is proportional to the photocurrent (Lichtsteiner, Posch &
+/// Delbruck, JSSC 2008), thins short intervals out to a time that grows as the light falls
+/// (coverage draw 6006, a 25 DN texture with a 20 Hz cutoff at white and no refractory
+/// period, was given a 20 ms period beside the bandwidth: its pixels under 20 DN had 0.6 %
+/// of their intervals below 32 ms where the model had 3.5 %, those at 40-80 DN 2.4 % for
+/// the model's 3.2 %). Of the intensity bins with enough intervals, the gap moves when
+/// - a brighter bin's gap ends at least [`MOVED_BINS`] bins before a dimmer one's, their
+///   intensities far enough apart for a cutoff proportional to `DN + 20` to move it so far;
+/// - or a bin brighter than every gapped one keeps the short intervals the model gives it:
+///   at least half the model's share (2 % or more) below the brightest gap's edge.
+///
+/// `None`: the gap is alike at every brightness, or the bins cannot tell. Where a period
+/// and a slow photoreceptor are both there, the period is called for once the bandwidth
+/// is in the model and the gap left is alike at every brightness.
+fn moves_with_brightness(c: &Context) -> Option<String> {
+    let real = c.real.intervals_by_intensity_of(c.geometry, c.subset);
+    let sim = c.sim.intervals_by_intensity_of(c.geometry, c.subset);
+    let readable: Vec<usize> = (0..INTENSITY_BINS)
+        .filter(|&i| {
+            real[i].iter().sum::<u32>() >= MIN_CLASS_INTERVALS
+                && sim[i].iter().sum::<u32>() >= MIN_CLASS_INTERVALS
+        })
+        .collect();
+    let gaps: Vec<(usize, Gap)> = readable
+        .iter()
+        .filter_map(|&i| Gap::of(&real[i], &sim[i]).map(|g| (i, g)))
+        .collect();
+    let &(bright, bright_gap) = gaps.last()?;
+    let dn = |i: usize| c.geometry.intensity_centres[i];
+    let edge_ms = |g: &Gap| interval_bin_start(g.bin + 1) * 1e3;
+    let bins_apart = |dim: usize, bright: usize| {
+        ((dn(bright) + 20.0) / (dn(dim) + 20.0)).log10() * INTERVAL_BINS_PER_DECADE as f64
+    };
+    const BANDWIDTH: &str = "as a photoreceptor's bandwidth thins short intervals in the dark (a refractory period leaves one gap at every brightness)";
+    if let Some(&(dim, dim_gap)) = gaps.iter().find(|(i, g)| {
+        bins_apart(*i, bright) >= MOVED_BINS as f64 && g.bin >= bright_gap.bin + MOVED_BINS
+    }) {
+        return Some(format!(
+            "but the gap moves with brightness: below {:.3} ms at about {:.0} DN, below {:.3} ms at about {:.0} DN, {BANDWIDTH}",
+            edge_ms(&dim_gap),
+            dn(dim),
+            edge_ms(&bright_gap),
+            dn(bright)
+        ));
+    }
+    let below = |h: &[u32]| h[..=bright_gap.bin].iter().sum::<u32>();
+    let share = |h: &[u32]| below(h) as f64 / h.iter().sum::<u32>().max(1) as f64;
+    let ungapped = readable
+        .iter()
+        .copied()
+        .filter(|&i| i > bright)
+        .find(|&i| {
+            share(&sim[i]) >= 0.02
+                && share(&real[i]) >= 0.5 * share(&sim[i])
+                && below(&real[i]) >= MIN_UNGAPPED_INTERVALS
+        })?;
+    Some(format!(
+        "but only in dim pixels: at about {:.0} DN {:.1} % of the intervals are below {:.3} ms against the model's {:.1} %, {BANDWIDTH}",
+        dn(ungapped),
+        100.0 * share(&real[ungapped]),
+        edge_ms(&bright_gap),
+        100.0 * share(&sim[ungapped])
+    ))
 }
 
 #[cfg(test)]
@@ -92,11 +201,16 @@ mod tests {
     /// recording is the same changes through a refractory period of `period_s`: a change
     /// inside it fires when it ends (the pile-up).
     fn model_and_refractory(period_s: f64) -> (EventChunk, EventChunk) {
+        model_and_dead_time(|_| period_s)
+    }
+
+    /// [`model_and_refractory`] with a dead time of `period_s(x)` seconds in column `x`.
+    fn model_and_dead_time(period_s: impl Fn(u16) -> f64) -> (EventChunk, EventChunk) {
         let mut rng = rng(11);
         let (mut model, mut recording) = (Vec::new(), Vec::new());
-        let period = (period_s * 1e6) as TimeUs;
         for y in 0..12u16 {
             for x in 0..16u16 {
+                let period = (period_s(x) * 1e6) as TimeUs;
                 let mut free = TimeUs::MIN;
                 for (i, t) in poisson_times(&mut rng, 200.0, 0.0, 1.0)
                     .into_iter()
@@ -123,6 +237,58 @@ mod tests {
         let start = e.start.unwrap();
         // the lower edge of the interval bin holding 2 ms (1.78 ms)
         assert!(start > 2e-3 / 1.5 && start < 2e-3 * 1.5, "{start}");
+    }
+
+    /// The left half of the scene at 15 DN, the right at 200 DN.
+    fn dim_and_bright() -> crate::estimate::frames::PreparedFrames {
+        let times = crate::fit::effects::fixture::frame_times(1.0, 0.1);
+        crate::fit::effects::fixture::frames(
+            16,
+            12,
+            &times,
+            |x, _, _| {
+                if x < 8 { 15.0 } else { 200.0 }
+            },
+        )
+    }
+
+    /// Short intervals thinned out to 8 ms in the dim half and to 8 ms x 35 / 220 (1.3 ms)
+    /// in the bright half, as a cutoff proportional to `DN + 20` would: not a period.
+    #[test]
+    fn a_gap_that_moves_with_brightness_does_not_call_for_refractory() {
+        let (model, recording) =
+            model_and_dead_time(|x| if x < 8 { 8e-3 } else { 8e-3 * 35.0 / 220.0 });
+        let f = Fixture::new(&dim_and_bright(), &recording, &model);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert!(e.text.contains("moves with brightness"), "{e:?}");
+        // thinned out in the dark only (14 of the 16 columns dim, so that the gap shows
+        // over all pixels): the bright columns as the model has them
+        let (model, recording) = model_and_dead_time(|x| if x < 14 { 8e-3 } else { 0.0 });
+        let times = crate::fit::effects::fixture::frame_times(1.0, 0.1);
+        let frames =
+            crate::fit::effects::fixture::frames(
+                16,
+                12,
+                &times,
+                |x, _, _| {
+                    if x < 14 { 15.0 } else { 200.0 }
+                },
+            );
+        let f = Fixture::new(&frames, &recording, &model);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        assert!(e.text.contains("only in dim pixels"), "{e:?}");
+    }
+
+    /// The same 2 ms period at 15 and at 200 DN: a refractory period.
+    #[test]
+    fn a_gap_alike_at_every_brightness_calls_for_refractory() {
+        let (model, recording) = model_and_refractory(2e-3);
+        let f = Fixture::new(&dim_and_bright(), &recording, &model);
+        let e = evidence(&f.context());
+        assert!(e.calls_for(), "{e:?}");
+        assert!(!e.text.contains("brightness"), "{e:?}");
     }
 
     #[test]

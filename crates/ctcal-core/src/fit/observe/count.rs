@@ -6,8 +6,8 @@
 //! events in order (tested against it).
 
 use super::{
-    CELLS, Geometry, INTENSITY_BINS, INTERVAL_BINS, Observed, REGIONS, SUPPORT_US, TIMELINE_BIN_US,
-    cell_index, interval_bin,
+    CELLS, Geometry, INTENSITY_BINS, INTERVAL_BINS, INTERVAL_CLASSES, Observed, REGIONS,
+    SUPPORT_US, TIMELINE_BIN_US, cell_index, interval_bin,
 };
 use crate::estimate::frames::read_block;
 use crate::events::{EventChunk, TimeUs};
@@ -18,12 +18,21 @@ use rayon::prelude::*;
 /// saves).
 const MIN_STRETCH: usize = 1 << 14;
 
+/// A counted event whose pixel had no earlier event in its stretch: its interval is
+/// completed in order afterwards.
+struct FirstOfPixel {
+    pixel: u32,
+    block: u32,
+    class: u8,
+    t: TimeUs,
+}
+
 /// A stretch's counts, and what it leaves to be completed in order: the counted events
-/// whose pixel had no earlier event in the stretch (pixel, block, time), and each pixel's
-/// last event time in the stretch.
+/// whose pixel had no earlier event in the stretch, and each pixel's last event time in
+/// the stretch.
 struct Part {
     observed: Observed,
-    first_of_pixel: Vec<(u32, u32, TimeUs)>,
+    first_of_pixel: Vec<FirstOfPixel>,
     last: Vec<TimeUs>,
 }
 
@@ -49,8 +58,9 @@ impl Observed {
         let mut last = vec![TimeUs::MIN; geometry.sensor.pixels()];
         for part in parts {
             o.add(&part.observed);
-            for &(p, block, t) in &part.first_of_pixel {
-                o.count_interval(geometry, block as usize, last[p as usize], t);
+            for f in &part.first_of_pixel {
+                let previous = last[f.pixel as usize];
+                o.count_interval(geometry, f.block as usize, f.class as usize, previous, f.t);
             }
             for (l, &t) in last.iter_mut().zip(&part.last) {
                 if t != TimeUs::MIN {
@@ -69,7 +79,7 @@ impl Observed {
             cells: vec![0; blocks * CELLS],
             background: vec![0; blocks * INTENSITY_BINS * 2],
             by_region: vec![0; blocks * REGIONS * 2],
-            intervals: vec![0; blocks * INTERVAL_BINS],
+            intervals: vec![0; blocks * INTERVAL_CLASSES * INTERVAL_BINS],
             pixel_counts: vec![0; blocks * g.sensor.pixels()],
             polarity: vec![[0; 2]; blocks],
             timeline: vec![0; ((g.span.1 - g.span.0) / TIMELINE_BIN_US).max(0) as usize + 1],
@@ -91,11 +101,20 @@ impl Observed {
         }
     }
 
-    /// Counts the same-pixel interval `previous -> t` in `block`, unless there is no
-    /// previous event or a span whose events were not read lies between (unknown).
-    fn count_interval(&mut self, g: &Geometry, block: usize, previous: TimeUs, t: TimeUs) {
+    /// Counts the same-pixel interval `previous -> t` in `block` and intensity `class`,
+    /// unless there is no previous event or a span whose events were not read lies between
+    /// (unknown).
+    fn count_interval(
+        &mut self,
+        g: &Geometry,
+        block: usize,
+        class: usize,
+        previous: TimeUs,
+        t: TimeUs,
+    ) {
         if previous != TimeUs::MIN && read_block(&g.unread, previous) == read_block(&g.unread, t) {
-            self.intervals[block * INTERVAL_BINS + interval_bin((t - previous) as f64 * 1e-6)] += 1;
+            let bin = interval_bin((t - previous) as f64 * 1e-6);
+            self.intervals[(block * INTERVAL_CLASSES + class) * INTERVAL_BINS + bin] += 1;
         }
     }
 }
@@ -139,16 +158,22 @@ fn count_stretch(
         let pol = events.on[i] as usize;
         o.pixel_counts[block * pixels + p] += 1;
         o.polarity[block][pol] += 1;
+        let intensity = g.intensity[k][p];
+        let class = (intensity as usize).min(INTENSITY_BINS);
         if previous == TimeUs::MIN {
-            first_of_pixel.push((p as u32, block as u32, t));
+            first_of_pixel.push(FirstOfPixel {
+                pixel: p as u32,
+                block: block as u32,
+                class: class as u8,
+                t,
+            });
         } else {
-            o.count_interval(g, block, previous, t);
+            o.count_interval(g, block, class, previous, t);
         }
         let slot = ((t - g.span.0) / TIMELINE_BIN_US) as usize;
         if let Some(bin) = o.timeline.get_mut(slot) {
             *bin += 1;
         }
-        let intensity = g.intensity[k][p];
         if intensity == u8::MAX {
             continue;
         }

@@ -1,0 +1,24 @@
+import json,sys
+def load(fs):
+    d={}
+    for f in fs:
+        for l in open(f):
+            r=json.loads(l)
+            if r['method']=='fit': d[r['case']['id']]=r
+    return d
+after=load([sys.argv[1]]); before=load(sys.argv[2:])
+keys=('ct_on','ct_off','ct_sigma','cutoff_hz','shot_noise_rate_hz','refractory_s','leak_rate_hz','hot_pixel_fraction')
+for cid,a in after.items():
+    b=before.get(cid); t=a['truth']['values']
+    print(cid, a['case']['family'], 'speed %.0f'%a['case']['speed_px_s'], 'truth', {k:round(t[k],4) for k in keys if t.get(k)})
+    for name,r in (('before',b),('after',a)):
+        if not r: print('  ',name,'-'); continue
+        rep=r.get('reported') or {}
+        o=r['outcome'].get('output') or {}
+        u=o.get('uncertainties',{})
+        parts=[]
+        for k in keys:
+            if k in u:
+                lo,hi=u[k].get("ci95",[None,None]); v=u[k]["value"]; tv=t.get(k,0); lo=lo if lo is not None else float("nan"); hi=hi if hi is not None else float("inf")
+                parts.append('%s %.3g [%.3g,%.3g]%s'%(k,v,lo,hi,'' if (lo<=tv<=hi or (lo!=lo and tv<=hi)) else ' MISS'))
+        print('  ',name,'%.0fs'%r['seconds'], '; '.join(parts), 'added', r.get('effects_added'))
