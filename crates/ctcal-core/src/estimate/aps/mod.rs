@@ -439,7 +439,8 @@ fn alignment_systematic(
     let precision = (a.precision_s * 1e6).round() as TimeUs;
     let mut at = |shift: TimeUs| {
         frames.shift_times(shift);
-        let t = super::timing::estimate(
+        // the thresholds alone: their errors are not needed here
+        let t = super::timing::thresholds(
             input.events,
             frames,
             input.sensor,
@@ -451,8 +452,8 @@ fn alignment_systematic(
     };
     match (at(precision), at(-precision)) {
         (Some(a), Some(b)) => (
-            0.5 * (a.on.ct - b.on.ct).abs(),
-            0.5 * (a.off.ct - b.off.ct).abs(),
+            0.5 * (a.ct_on - b.ct_on).abs(),
+            0.5 * (a.ct_off - b.ct_off).abs(),
         ),
         _ => (0.0, 0.0),
     }
@@ -550,8 +551,9 @@ pub fn prepare(
                 choose_response: options.choose_response,
                 ..options.timing.clone()
             };
+            // the response and the offset alone: the thresholds' errors are not needed here
             let found =
-                super::timing::estimate(input.events, &frames, input.sensor, excluded, &fitting);
+                super::timing::thresholds(input.events, &frames, input.sensor, excluded, &fitting);
             if let Some(t) = &found {
                 if t.log_map != frames.log_map {
                     assumptions.push("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN); used throughout".into());

@@ -198,6 +198,119 @@ const LAG_MASKS_OFFSET: f64 = 0.05;
 /// the frame's range would make no sense).
 const OFFSET_SEARCH: (f32, f32) = (-0.9, 255.0);
 
+/// The thresholds event timing finds, without their errors: what a caller that only
+/// compares thresholds (the alignment's systematic) or only takes the response and offset
+/// (the frames' preparation) needs. The same values [`estimate`] gives, at a fraction of
+/// its cost (no bootstrap, no fits across the offset's range, no blocks' jackknife).
+#[derive(Clone, Debug)]
+pub struct Thresholds {
+    pub log_map: LogMap,
+    pub offset: Offset,
+    pub ct_on: f64,
+    pub ct_off: f64,
+}
+
+/// The thresholds of [`estimate`] alone ([`Thresholds`]); `None` exactly where
+/// [`estimate`] gives none.
+pub fn thresholds(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    excluded: &[bool],
+    options: &TimingOptions,
+) -> Option<Thresholds> {
+    let central = Central::fit(events, frames, sensor, excluded, options)?;
+    let fitted = central.fitted();
+    // the estimate needs each polarity's per-pixel sums; without them it gives none
+    polarity(&fitted, &central.coefficients, true, sensor)?;
+    polarity(&fitted, &central.coefficients, false, sensor)?;
+    Some(Thresholds {
+        ct_on: central.coefficients.c_on,
+        ct_off: central.coefficients.c_off,
+        log_map: central.log_map,
+        offset: central.offset,
+    })
+}
+
+/// The central fit of the pairs: the response and offset chosen, the model fitted there.
+struct Central {
+    pairs: Vec<Pair>,
+    log_map: LogMap,
+    offset: Offset,
+    coefficients: Coefficients,
+    values: model::Values,
+    weights: Vec<f64>,
+    slots: PixelSlots,
+}
+
+impl Central {
+    /// The pairs of `events` against `frames`, the response and offset
+    /// ([`choose_response`], [`with_polarity_offsets`]) and the fit at that offset; `None`
+    /// where the fit fails.
+    fn fit(
+        events: &EventChunk,
+        frames: &PreparedFrames,
+        sensor: Sensor,
+        excluded: &[bool],
+        options: &TimingOptions,
+    ) -> Option<Self> {
+        let pairs = collect(
+            events,
+            frames,
+            0,
+            sensor,
+            excluded,
+            options.support_window_us,
+        );
+        let (log_map, offset) = choose_response(&pairs, frames, options);
+        let (offset, (coefficients, values, weights)) = {
+            let fit = whole_fit(&pairs, &log_map, sensor.pixels(), options);
+            let offset = with_polarity_offsets(offset, &pairs, options, &fit);
+            let at_offset = fit(offset.offset_dn)?;
+            (offset, at_offset)
+        };
+        let slots = PixelSlots::new(&pairs);
+        Some(Self {
+            pairs,
+            log_map,
+            offset,
+            coefficients,
+            values,
+            weights,
+            slots,
+        })
+    }
+
+    fn fitted(&self) -> Fitted<'_> {
+        Fitted {
+            pairs: &self.pairs,
+            slots: &self.slots,
+            values: &self.values,
+            weights: &self.weights,
+        }
+    }
+}
+
+/// [`fit_at`] of `pairs` through `log_map` with the options' window and leak: the whole
+/// fit at an offset.
+fn whole_fit<'a>(
+    pairs: &'a [Pair],
+    log_map: &'a LogMap,
+    pixels: usize,
+    options: &'a TimingOptions,
+) -> impl Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)> + Sync + 'a {
+    move |b: f32| {
+        fit_at(
+            pairs,
+            log_map,
+            b,
+            options.mode_window,
+            pixels,
+            options.fit_leak,
+        )
+    }
+}
+
 /// Estimates per-pixel thresholds from the timing of `events` (time-sorted) against
 /// `frames`. Pixels where `excluded` is set (hot pixels, outside a region) are left out.
 /// `None` when there are too few samples.
@@ -208,29 +321,17 @@ pub fn estimate(
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<TimingEstimate> {
-    let pairs = collect(
-        events,
-        frames,
-        0,
-        sensor,
-        excluded,
-        options.support_window_us,
-    );
+    let Central {
+        pairs,
+        log_map,
+        offset,
+        coefficients,
+        values,
+        weights,
+        slots,
+    } = Central::fit(events, frames, sensor, excluded, options)?;
     let pixels = sensor.pixels();
-    let (log_map, offset) = choose_response(&pairs, frames, options);
-    let fit = |b: f32| {
-        fit_at(
-            &pairs,
-            &log_map,
-            b,
-            options.mode_window,
-            pixels,
-            options.fit_leak,
-        )
-    };
-    let offset = with_polarity_offsets(offset, &pairs, options, &fit);
-    let (coefficients, values, weights) = fit(offset.offset_dn)?;
-    let slots = PixelSlots::new(&pairs);
+    let fit = whole_fit(&pairs, &log_map, pixels, options);
     // the thresholds, and each polarity's per-pixel spread, across the offset's interval
     let (lo, hi) = offset.systematic_range;
     let ends: Vec<(Coefficients, Option<[PolarityEstimate; 2]>)> = [lo, hi]
@@ -332,16 +433,7 @@ fn choose_response(
     let scored: Vec<(LogMap, Offset, f64)> = candidates
         .into_par_iter()
         .map(|map| {
-            let fit = |b: f32| {
-                fit_at(
-                    pairs,
-                    &map,
-                    b,
-                    options.mode_window,
-                    pixels,
-                    options.fit_leak,
-                )
-            };
+            let fit = whole_fit(pairs, &map, pixels, options);
             let offset = find_offset(pairs, frames, options, &fit);
             let score =
                 fit(offset.offset_dn).map_or(f64::INFINITY, |(c, v, w)| scatter(pairs, &c, &v, &w));
@@ -409,7 +501,8 @@ fn find_offset(
         };
     }
     let range = search_range(pairs);
-    let slope = |b: f32| fit(b).map(|f| f.0.level_slope);
+    let slope = model::Memo::new(|b: f32| fit(b).map(|f| f.0.level_slope));
+    let slope = |b: f32| slope.at(b);
     let Some(root) = offset_root(&slope, range) else {
         return not_determined;
     };
@@ -497,15 +590,21 @@ fn polarity_offsets(
     fit: &Fit<'_>,
     range: (f32, f32),
 ) -> [Option<f32>; 2] {
-    let slope = |b: f32, on: bool| {
+    // both polarities' slopes from one whole fit at each offset: their bisections start
+    // at the same ends and halves and part only where the slopes' signs differ
+    let slopes = model::Memo::new(|b: f32| {
         let (_, values, weights) = fit(b)?;
-        let own: Vec<f64> = pairs
-            .iter()
-            .zip(&weights)
-            .map(|(p, &w)| if p.on == on { w } else { 0.0 })
-            .collect();
-        model::fit_one_polarity(pairs, &values, &own, options.fit_leak).map(|c| c.level_slope)
-    };
+        let slope = |on: bool| {
+            let own: Vec<f64> = pairs
+                .iter()
+                .zip(&weights)
+                .map(|(p, &w)| if p.on == on { w } else { 0.0 })
+                .collect();
+            model::fit_one_polarity(pairs, &values, &own, options.fit_leak).map(|c| c.level_slope)
+        };
+        Some([slope(true), slope(false)])
+    });
+    let slope = |b: f32, on: bool| slopes.at(b).and_then(|s| s[usize::from(!on)]);
     let (on, off) = rayon::join(
         || offset_root(&|b| slope(b, true), range),
         || offset_root(&|b| slope(b, false), range),
