@@ -108,7 +108,8 @@ pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
     let span = f64::from(super::samples::RATE_SPAN_S);
     for p in pairs {
         let sign = if p.on { 1.0 } else { -1.0 };
-        y.push(sample(p, log, b));
+        // [`sample`], its two logs taken once
+        y.push(sign * (l(p.dn1) - l(p.dn0)));
         let mid = 0.5 * (p.dn0 + p.dn1);
         level.push(l(mid));
         let r0 = (l(p.around[1]) - l(p.around[0])) / span;
@@ -126,22 +127,26 @@ pub fn values(pairs: &[Pair], log: &LogMap, b: f32) -> Values {
 /// threshold's when the median lay between them (a rotating natural image, OFF: 0.097 for
 /// 0.35, half the samples rejected).
 pub fn mode(values: &[f64], window: f64) -> Option<f64> {
-    let mut sorted: Vec<f64> = values.iter().copied().filter(|v| *v > 0.0).collect();
+    let sorted = sorted_positive(values);
     if sorted.len() < 10 {
         return None;
     }
-    // unstable: values equal under `total_cmp` are the same bits, so the order is the same
-    sorted.sort_unstable_by(f64::total_cmp);
     let within = |m: f64| -> usize {
         let a = sorted.partition_point(|&v| v < m * (1.0 - window));
         let b = sorted.partition_point(|&v| v <= m * (1.0 + window));
         b.saturating_sub(a)
     };
     let n = sorted.len();
-    let starts = std::iter::once(n / 2).chain((1..10).map(|decile| (decile * n / 10).min(n - 1)));
+    // the fifth decile is the median (`5 n / 10 == n / 2`), started from first
+    let starts = std::iter::once(n / 2).chain(
+        (1..10)
+            .filter(|&decile| decile != 5)
+            .map(|decile| (decile * n / 10).min(n - 1)),
+    );
+    let mut sums = WindowSums::default();
     let mut best: Option<(f64, usize)> = None;
     for start in starts {
-        let m = mean_shift(&sorted, sorted[start], window);
+        let m = mean_shift(&sorted, sorted[start], window, &mut sums);
         let held = within(m);
         if best.is_none_or(|(_, most)| held > most) {
             best = Some((m, held));
@@ -150,16 +155,45 @@ pub fn mode(values: &[f64], window: f64) -> Option<f64> {
     best.map(|(m, _)| m)
 }
 
+/// The positive `values` in ascending order. Sorted by their bits: for positive floats the
+/// bits order as the values do (and equal values are the same bits), and integers sort
+/// faster than floats under `total_cmp`.
+fn sorted_positive(values: &[f64]) -> Vec<f64> {
+    let mut bits: Vec<u64> = values
+        .iter()
+        .filter(|v| **v > 0.0)
+        .map(|v| v.to_bits())
+        .collect();
+    bits.sort_unstable();
+    bits.into_iter().map(f64::from_bits).collect()
+}
+
+/// The sums of windows `sorted[a..b]` one [`mode`] has added, by `(a, b)`: every mean shift
+/// ends by summing its last window again (the step that finds it has stopped moving), and
+/// starts climbing to one peak end in the same window. A sum is added in the values' order
+/// whenever it is made, so a remembered one is the one that would be made.
+#[derive(Default)]
+struct WindowSums(std::collections::HashMap<(usize, usize), f64>);
+
+impl WindowSums {
+    fn of(&mut self, sorted: &[f64], a: usize, b: usize) -> f64 {
+        *self
+            .0
+            .entry((a, b))
+            .or_insert_with(|| sorted[a..b].iter().sum())
+    }
+}
+
 /// Mean shift over `sorted` values from `m`: the mean of the values within `m (1 +- window)`
 /// until it stops moving (at most 50 steps).
-fn mean_shift(sorted: &[f64], mut m: f64, window: f64) -> f64 {
+fn mean_shift(sorted: &[f64], mut m: f64, window: f64, sums: &mut WindowSums) -> f64 {
     for _ in 0..50 {
         let a = sorted.partition_point(|&v| v < m * (1.0 - window));
         let b = sorted.partition_point(|&v| v <= m * (1.0 + window));
         if b <= a {
             break;
         }
-        let next = sorted[a..b].iter().sum::<f64>() / (b - a) as f64;
+        let next = sums.of(sorted, a, b) / (b - a) as f64;
         let done = (next - m).abs() < 1e-7 * m;
         m = next;
         if done {
