@@ -65,10 +65,7 @@ pub fn evidence(c: &Context) -> Evidence {
         100.0 * found.sim_share
     );
     if let Some(moves) = moves_with_brightness(c) {
-        return Evidence {
-            text: format!("{text}; {moves}"),
-            ..Evidence::none(Effect::Refractory, "")
-        };
+        return Evidence::none(Effect::Refractory, format!("{text}; {moves}"));
     }
     Evidence {
         effect: Effect::Refractory,
