@@ -1,4 +1,5 @@
 # compare.txt: python3 compare.py AFTER/results.jsonl BEFORE/results.jsonl... (full coverage results, with each fit output)
+# (this study's compare.txt predates the "added" column and the open-ended intervals; ../refractory-brightness-2026-12-02/compare.txt is made by this version)
 import json,sys
 def load(fs):
     d={}
@@ -20,6 +21,9 @@ for cid,a in after.items():
         parts=[]
         for k in keys:
             if k in u:
-                lo,hi=u[k]['ci95']; v=u[k]['value']; tv=t.get(k,0)
-                parts.append('%s %.3g [%.3g,%.3g]%s'%(k,v,lo,hi,'' if lo<=tv<=hi else ' MISS'))
-        print('  ',name,'%.0fs'%r['seconds'], '; '.join(parts))
+                # an open end (null) is printed as nan below and inf above
+                lo,hi=u[k].get('ci95',[None,None]); v=u[k]['value']; tv=t.get(k,0)
+                lo=float('nan') if lo is None else lo; hi=float('inf') if hi is None else hi
+                covered=(lo<=tv or lo!=lo) and tv<=hi
+                parts.append('%s %.3g [%.3g,%.3g]%s'%(k,v,lo,hi,'' if covered else ' MISS'))
+        print('  ',name,'%.0fs'%r['seconds'], '; '.join(parts), 'added', r.get('effects_added'))

@@ -236,17 +236,11 @@ mod tests {
         assert!(start > 2e-3 / 1.5 && start < 2e-3 * 1.5, "{start}");
     }
 
-    /// The left half of the scene at 15 DN, the right at 200 DN.
-    fn dim_and_bright() -> crate::estimate::frames::PreparedFrames {
+    /// The scene's first `dim_columns` of 16 at 15 DN, the others at 200 DN.
+    fn dim_and_bright(dim_columns: usize) -> crate::estimate::frames::PreparedFrames {
         let times = crate::fit::effects::fixture::frame_times(1.0, 0.1);
-        crate::fit::effects::fixture::frames(
-            16,
-            12,
-            &times,
-            |x, _, _| {
-                if x < 8 { 15.0 } else { 200.0 }
-            },
-        )
+        let dn = move |x: usize, _: usize, _: usize| if x < dim_columns { 15.0 } else { 200.0 };
+        crate::fit::effects::fixture::frames(16, 12, &times, dn)
     }
 
     /// Short intervals thinned out to 8 ms in the dim half and to 8 ms x 35 / 220 (1.3 ms)
@@ -255,24 +249,14 @@ mod tests {
     fn a_gap_that_moves_with_brightness_does_not_call_for_refractory() {
         let (model, recording) =
             model_and_dead_time(|x| if x < 8 { 8e-3 } else { 8e-3 * 35.0 / 220.0 });
-        let f = Fixture::new(&dim_and_bright(), &recording, &model);
+        let f = Fixture::new(&dim_and_bright(8), &recording, &model);
         let e = evidence(&f.context());
         assert!(!e.calls_for(), "{e:?}");
         assert!(e.text.contains("moves with brightness"), "{e:?}");
         // thinned out in the dark only (14 of the 16 columns dim, so that the gap shows
         // over all pixels): the bright columns as the model has them
         let (model, recording) = model_and_dead_time(|x| if x < 14 { 8e-3 } else { 0.0 });
-        let times = crate::fit::effects::fixture::frame_times(1.0, 0.1);
-        let frames =
-            crate::fit::effects::fixture::frames(
-                16,
-                12,
-                &times,
-                |x, _, _| {
-                    if x < 14 { 15.0 } else { 200.0 }
-                },
-            );
-        let f = Fixture::new(&frames, &recording, &model);
+        let f = Fixture::new(&dim_and_bright(14), &recording, &model);
         let e = evidence(&f.context());
         assert!(!e.calls_for(), "{e:?}");
         assert!(e.text.contains("only in dim pixels"), "{e:?}");
@@ -282,7 +266,7 @@ mod tests {
     #[test]
     fn a_gap_alike_at_every_brightness_calls_for_refractory() {
         let (model, recording) = model_and_refractory(2e-3);
-        let f = Fixture::new(&dim_and_bright(), &recording, &model);
+        let f = Fixture::new(&dim_and_bright(8), &recording, &model);
         let e = evidence(&f.context());
         assert!(e.calls_for(), "{e:?}");
         assert!(!e.text.contains("brightness"), "{e:?}");
