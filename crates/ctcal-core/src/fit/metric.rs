@@ -21,7 +21,7 @@ use super::observe::{Geometry, INTENSITY_BINS, Observed, Subset, TILE_PX};
 use serde::Serialize;
 
 /// The name of the distance, as reported.
-pub const ERROR_METRIC: &str = "root sum of squares of: event-weighted RMS log count ratio over intensity x rate-of-change x polarity cells (supported events); event-weighted RMS log ratio of unsupported-event rates per intensity and polarity (floor 0.01 Hz/pixel); total-variation distance of same-pixel interval histograms; |ln(ON/OFF)| difference; |log ratio| of active pixels; |log ratio| of the within-tile index of dispersion of per-pixel counts";
+pub const ERROR_METRIC: &str = "root sum of squares of: event-weighted RMS log count ratio over intensity x rate-of-change x polarity cells (supported events; a pixel's rate over as many frame intervals, up to 8 a side, as 2 grey levels of change need); event-weighted RMS log ratio of unsupported-event rates per intensity and polarity (floor 0.01 Hz/pixel); total-variation distance of same-pixel interval histograms; |ln(ON/OFF)| difference; |log ratio| of active pixels; |log ratio| of the within-tile index of dispersion of per-pixel counts";
 
 /// The components of the distance and their total.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]

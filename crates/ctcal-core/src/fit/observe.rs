@@ -4,7 +4,8 @@
 //! - counts of events with spatio-temporal support (an 8-neighbour event in the preceding
 //!   10 ms: the background-activity filter of Delbruck 2008) per cell of scene intensity
 //!   (six bins of the frames' DN) x local rate of log-intensity change (seven bins, from the
-//!   frames) x polarity: large cells, so that systematic residuals dominate the Poisson
+//!   frames, over as many intervals as the frames' grey levels need: [`change`]) x
+//!   polarity: large cells, so that systematic residuals dominate the Poisson
 //!   noise of the counts, along the two axes the pixel's dynamics depend on;
 //! - the same events per sensor region (a 4 x 3 grid) and polarity (for the residuals);
 //! - events without support per intensity bin and polarity: where noise (shot noise,
@@ -22,6 +23,7 @@
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{Sensor, TimeUs};
 
+mod change;
 mod count;
 
 /// Upper edges of the intensity bins (frame DN; the last bin holds the rest).
@@ -189,6 +191,15 @@ impl Geometry {
             .collect();
         let mut intensity = vec![Vec::new(); frames.flows.len()];
         let mut change = vec![Vec::new(); frames.flows.len()];
+        for (first, end) in frames.runs() {
+            let bins = change::run_change_bins(frames, first, end);
+            for (k, bins) in (first..end).zip(bins) {
+                // guard intervals have no block
+                if interval_block[k].is_some() {
+                    change[k] = bins;
+                }
+            }
+        }
         let mut exposure = vec![[0.0; INTENSITY_BINS]; blocks];
         for &k in &used {
             // guard intervals have no block
@@ -198,12 +209,7 @@ impl Geometry {
             let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
             let (a, b) = (&frames.dn[k].data, &frames.dn[k + 1].data);
             let mut bins = vec![u8::MAX; pixels];
-            let mut rates = vec![0u8; pixels];
             for p in 0..pixels {
-                rates[p] = bin_of(
-                    &CHANGE_EDGES,
-                    ((frames.log(b[p]) - frames.log(a[p])).abs() as f64 / dt.max(1e-6)) as f32,
-                );
                 if frames.reliable(k, p) {
                     let bin = bin_of(&INTENSITY_EDGES, 0.5 * (a[p] + b[p]));
                     bins[p] = bin;
@@ -213,7 +219,6 @@ impl Geometry {
                 }
             }
             intensity[k] = bins;
-            change[k] = rates;
         }
         let span = match (used.first(), used.last()) {
             (Some(&a), Some(&b)) => (frames.times[a], frames.times[b + 1]),
