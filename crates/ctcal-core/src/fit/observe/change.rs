@@ -39,11 +39,11 @@ pub fn run_change_bins(frames: &PreparedFrames, first: usize, end: usize) -> Vec
     let seconds: Vec<f32> = (first..end)
         .map(|k| ((frames.times[k + 1] - frames.times[k]) as f32 * 1e-6).max(1e-6))
         .collect();
-    // row by row on every core, each row's bins for the whole run
-    let rows: Vec<Vec<Vec<u8>>> = (0..h)
+    // row by row on every core, each row's bins for the whole run (`[interval * w + x]`)
+    let rows: Vec<Vec<u8>> = (0..h)
         .into_par_iter()
         .map(|y| {
-            let mut bins = vec![vec![0u8; w]; end - first];
+            let mut bins = vec![0u8; (end - first) * w];
             let mut changes = vec![0.0f32; end - first];
             for x in 0..w {
                 let p = y * w + x;
@@ -55,14 +55,18 @@ pub fn run_change_bins(frames: &PreparedFrames, first: usize, end: usize) -> Vec
                     let middle = 0.5 * (frames.dn[k].data[p] + frames.dn[k + 1].data[p]);
                     let enough = STEPS * grey_level_step(frames, middle);
                     let rate = windowed_rate(&changes, &seconds, i, enough);
-                    bins[i][x] = bin_of(&CHANGE_EDGES, rate);
+                    bins[i * w + x] = bin_of(&CHANGE_EDGES, rate);
                 }
             }
             bins
         })
         .collect();
     (0..end - first)
-        .map(|i| rows.iter().flat_map(|row| row[i].iter().copied()).collect())
+        .map(|i| {
+            rows.iter()
+                .flat_map(|row| row[i * w..(i + 1) * w].iter().copied())
+                .collect()
+        })
         .collect()
 }
 
