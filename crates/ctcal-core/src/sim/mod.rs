@@ -18,6 +18,7 @@ pub mod rng;
 mod row;
 pub mod scene;
 pub mod screen_geometry;
+pub mod simd;
 pub mod simulator;
 pub mod source;
 

@@ -16,6 +16,8 @@
 use super::effects::bandwidth;
 use super::log_response::LogMap;
 use super::pixel::{EventSink, PixelModel, PixelState, Transition};
+#[cfg(target_arch = "x86_64")]
+use super::simd::use_avx2;
 use crate::events::{Event, TimeUs};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -337,16 +339,4 @@ impl Row {
 fn select(quiet: u32, new: f32, old: f32) -> f32 {
     let mask = 0u32.wrapping_sub(quiet);
     f32::from_bits((new.to_bits() & mask) | (old.to_bits() & !mask))
-}
-
-/// Whether the AVX2 code path runs: when the CPU has AVX2, unless the environment variable
-/// `CTCAL_SIMD=scalar` asks for the portable path (to check that both give identical
-/// events).
-#[cfg(target_arch = "x86_64")]
-fn use_avx2() -> bool {
-    static AVX2: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-    *AVX2.get_or_init(|| {
-        std::arch::is_x86_feature_detected!("avx2")
-            && std::env::var("CTCAL_SIMD").map_or(true, |v| v != "scalar")
-    })
 }

@@ -349,18 +349,7 @@ unsafe fn cells(_: &[f64], _: usize, _: usize, _: &mut Cells) {
 
 /// Whether [`Canvas::sample_many`] takes its vectorised path: when the CPU has AVX2, unless
 /// `CTCAL_SIMD=scalar` asks for the portable path (as the simulator's pixel pass does).
-pub(super) fn use_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        static AVX2: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
-        *AVX2.get_or_init(|| {
-            std::arch::is_x86_feature_detected!("avx2")
-                && std::env::var("CTCAL_SIMD").map_or(true, |v| v != "scalar")
-        })
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    false
-}
+pub(super) use crate::sim::simd::use_avx2;
 
 #[cfg(test)]
 mod tests {
