@@ -13,6 +13,8 @@
 //! screen at an angle.
 
 use super::params::DisplayParams;
+#[cfg(target_arch = "x86_64")]
+use super::simd::use_avx2;
 
 /// The display transform with its blur kernel precomputed.
 #[derive(Clone, Debug)]
@@ -33,6 +35,14 @@ fn reflect_101(i: isize, n: usize) -> usize {
         i = period - i;
     }
     i as usize
+}
+
+/// The table index of a screen DN: the DN truncated where it lies in 0..=255, else 0 (NaN
+/// too); the DN is whole and in the table exactly when the index converts back to it.
+#[inline(always)]
+fn table_index(dn: f32) -> u8 {
+    let inside = if (0.0..=255.0).contains(&dn) { dn } else { 0.0 };
+    inside as u8
 }
 
 impl DisplayModel {
@@ -82,19 +92,42 @@ impl DisplayModel {
     /// Camera DN of each screen pixel, before the optics (for a screen seen at an angle,
     /// [`super::screen_geometry`] resamples these onto the sensor before [`Self::blur`]).
     pub fn lit(&self, screen: &[f32]) -> Vec<f32> {
-        screen
-            .iter()
-            .map(|&dn| {
-                // whole screen DN (every 8-bit stimulus) read from the table; the cast
-                // saturates, so anything else fails the comparison
-                let index = dn as usize;
-                if index < 256 && index as f32 == dn {
-                    self.lut[index]
-                } else {
-                    self.luminance_dn(dn)
+        #[cfg(target_arch = "x86_64")]
+        if use_avx2() {
+            // SAFETY: use_avx2() is true only when the CPU has AVX2.
+            return unsafe { self.lit_avx2(screen) };
+        }
+        self.lit_portable(screen)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn lit_avx2(&self, screen: &[f32]) -> Vec<f32> {
+        self.lit_portable(screen)
+    }
+
+    /// Whole screen DN (every 8-bit stimulus) are read from the table in a loop without
+    /// branches or calls, which the compiler vectorises (each simulation through the
+    /// display lights every stimulus frame: a tenth of `estimate screen` when the loop
+    /// branched per pixel); any other value is computed after, as [`Self::luminance_dn`].
+    #[inline(always)]
+    fn lit_portable(&self, screen: &[f32]) -> Vec<f32> {
+        let lut: &[f32; 256] = self.lut[..].try_into().expect("256 entries");
+        let mut out = vec![0f32; screen.len()];
+        let mut all_whole = true;
+        for (o, &dn) in out.iter_mut().zip(screen) {
+            let index = table_index(dn);
+            *o = lut[index as usize];
+            all_whole &= index as f32 == dn;
+        }
+        if !all_whole {
+            for (o, &dn) in out.iter_mut().zip(screen) {
+                if table_index(dn) as f32 != dn {
+                    *o = self.luminance_dn(dn);
                 }
-            })
-            .collect()
+            }
+        }
+        out
     }
 
     /// The optical blur of a camera-DN image (W x H).
@@ -102,13 +135,31 @@ impl DisplayModel {
         if self.kernel.len() == 1 {
             return lit;
         }
-        // separable: along rows, then across rows; both passes run over contiguous rows
-        self.blur_columns(&self.blur_rows(&lit, width, height), width, height)
+        #[cfg(target_arch = "x86_64")]
+        if use_avx2() {
+            // SAFETY: use_avx2() is true only when the CPU has AVX2.
+            return unsafe { self.blur_avx2(&lit, width, height) };
+        }
+        self.blur_portable(&lit, width, height)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn blur_avx2(&self, lit: &[f32], width: usize, height: usize) -> Vec<f32> {
+        self.blur_portable(lit, width, height)
+    }
+
+    /// Separable: along rows, then across rows; both passes run over contiguous rows (and
+    /// are inlined into the AVX2 copy: [`super::simd`]).
+    #[inline(always)]
+    fn blur_portable(&self, lit: &[f32], width: usize, height: usize) -> Vec<f32> {
+        self.blur_columns(&self.blur_rows(lit, width, height), width, height)
     }
 
     /// The blur along each row (interior samples read directly, only the border reflects).
     /// The interior is summed tap by tap over whole row slices (which the compiler
     /// vectorises); each sample's terms are added in the kernel's order, as at the border.
+    #[inline(always)]
     fn blur_rows(&self, input: &[f32], width: usize, height: usize) -> Vec<f32> {
         let radius = self.kernel.len() / 2;
         let mut out = vec![0f32; input.len()];
@@ -140,6 +191,7 @@ impl DisplayModel {
     }
 
     /// The blur across rows: each output row is the weighted sum of whole input rows.
+    #[inline(always)]
     fn blur_columns(&self, input: &[f32], width: usize, height: usize) -> Vec<f32> {
         let radius = self.kernel.len() / 2;
         let mut out = vec![0f32; input.len()];
@@ -168,6 +220,45 @@ mod tests {
             "lcd_75hz_gamma2.toml",
         )
         .unwrap()
+    }
+
+    /// Whole DN from the table, anything else computed: the values the per-pixel branch
+    /// gave, on whole, fractional, negative, too large and NaN screen DN.
+    #[test]
+    fn lit_reads_whole_dn_from_the_table_and_computes_the_rest() {
+        let d = DisplayModel::new(&params());
+        let screen = [
+            0.0,
+            -0.0,
+            1.0,
+            128.0,
+            254.0,
+            255.0,
+            0.5,
+            127.25,
+            -0.5,
+            -3.0,
+            255.5,
+            256.0,
+            1e9,
+            f32::NAN,
+        ];
+        let expected: Vec<f32> = screen
+            .iter()
+            .map(|&dn| {
+                let index = dn as usize;
+                if index < 256 && index as f32 == dn {
+                    d.lut[index]
+                } else {
+                    d.luminance_dn(dn)
+                }
+            })
+            .collect();
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&d.lit(&screen)), bits(&expected));
+        assert_eq!(bits(&d.lit_portable(&screen)), bits(&expected));
+        let whole: Vec<f32> = (0..256).map(|v| v as f32).collect();
+        assert_eq!(bits(&d.lit(&whole)), bits(&d.lut));
     }
 
     #[test]
