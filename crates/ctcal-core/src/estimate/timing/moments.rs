@@ -362,10 +362,8 @@ fn drawn_sums(slots: &[[Moments; 2]], weight: &[f64], times: &[u32]) -> ([[f64; 
         }
     }
     // the cross products below the diagonal: the same terms in the same order as above it
-    for a in 2..8 {
-        for b in a + 1..8 {
-            xtx[b][a] = xtx[a][b];
-        }
+    for (a, b) in (2..8).flat_map(|a| (a + 1..8).map(move |b| (a, b))) {
+        xtx[b][a] = xtx[a][b];
     }
     (xtx, xty)
 }
