@@ -258,6 +258,25 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
 /// interval). Wider, the value is a model setting the data do not pin down.
 pub const UNMEASURED_SPAN: f64 = 50.0;
 
+/// Why a fitted value is not a measurement, where its 95 % interval says so: it spans more
+/// than [`UNMEASURED_SPAN`], or it bounds the value on neither side (from 0, or open
+/// below, to open above: no effect and as much as the search allowed both explain the
+/// recording within chance, as for draw 6029's shot noise, [0, open] beside a value of
+/// 1.86 Hz where the draw has none). An interval with one side bounded is a bound, kept.
+fn unmeasured(u: &Uncertain) -> Option<String> {
+    match u.ci95? {
+        [Some(lo), Some(hi)] if lo > 0.0 && hi / lo > UNMEASURED_SPAN => Some(format!(
+            "its 95 % interval, {lo:.4e} to {hi:.4e}, spans more than a factor {UNMEASURED_SPAN:.0}: the fit error changes by no more than chance over that range, so the recording does not measure it (the model keeps the effect at {:.4e})",
+            u.value
+        )),
+        [lo, None] if lo.is_none_or(|lo| lo <= 0.0) => Some(format!(
+            "its 95 % interval reaches 0 and is open above: the fit error changes by no more than chance from none of the effect to the end of its searched range, so the recording does not measure it (the model keeps the effect at {:.4e})",
+            u.value
+        )),
+        _ => None,
+    }
+}
+
 /// Parameters the data do not identify, and why.
 fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
     let mut why = BTreeMap::new();
@@ -286,16 +305,8 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
         }
     }
     for (key, u) in &state.uncertainty {
-        if let Some([Some(lo), Some(hi)]) = u.ci95
-            && lo > 0.0
-            && hi / lo > UNMEASURED_SPAN
-        {
-            why.entry(key.clone()).or_insert_with(|| {
-                format!(
-                    "its 95 % interval, {lo:.4e} to {hi:.4e}, spans more than a factor {UNMEASURED_SPAN:.0}: the fit error changes by no more than chance over that range, so the recording does not measure it (the model keeps the effect at {:.4e})",
-                    u.value
-                )
-            });
+        if let Some(reason) = unmeasured(u) {
+            why.entry(key.clone()).or_insert(reason);
         }
     }
     if !fixed {
@@ -518,6 +529,34 @@ mod tests {
         assert_eq!(found.len(), 1);
         assert_eq!(found[0].0, "cutoff_hz");
         assert!(found[0].1.contains("ct_off") && found[0].1.contains("3.7000e0"));
+    }
+
+    /// An interval that bounds neither side, or spans more than a factor 50, is not a
+    /// measurement; one bounded on one side is a bound, and a narrow one a value.
+    #[test]
+    fn a_value_whose_interval_bounds_neither_side_is_not_a_measurement() {
+        let open = |lo: Option<f64>, hi: Option<f64>| {
+            unmeasured(&Uncertain::with_interval(1.86, None, [lo, hi]))
+        };
+        assert!(
+            open(Some(0.0), None)
+                .unwrap()
+                .contains("reaches 0 and is open above")
+        );
+        assert!(
+            open(None, None)
+                .unwrap()
+                .contains("reaches 0 and is open above")
+        );
+        assert!(
+            open(Some(0.01), Some(0.6))
+                .unwrap()
+                .contains("more than a factor 50")
+        );
+        assert_eq!(open(Some(0.0), Some(3.0)), None);
+        assert_eq!(open(Some(0.5), None), None);
+        assert_eq!(open(Some(1.2), Some(2.9)), None);
+        assert_eq!(unmeasured(&Uncertain::positive(1.86, None)), None);
     }
 
     /// Draw 59's single named pixel (a fraction spanning a factor 200) and draw 94's five
