@@ -116,16 +116,21 @@ struct Correction {
     products: [[f64; OWN]; OWN],
 }
 
+/// The correction of each of the rest columns (the level's is 0: it is not corrected).
+fn rest_corrections(c: &Coefficients) -> [f64; REST] {
+    [
+        0.0,
+        c.lag,
+        c.interp_on,
+        c.interp_off,
+        c.drift,
+        c.drift_per_dn,
+    ]
+}
+
 impl Correction {
     fn new(c: &Coefficients, on: bool) -> Self {
-        let rest = [
-            0.0,
-            c.lag,
-            c.interp_on,
-            c.interp_off,
-            c.drift,
-            c.drift_per_dn,
-        ];
+        let rest = rest_corrections(c);
         let beta = OWN_COLUMNS[on as usize].map(|col| rest[col]);
         Self {
             beta,
@@ -536,14 +541,7 @@ mod tests {
             interp_on: -0.021,
             interp_off: 0.034,
         };
-        let beta = [
-            0.0,
-            c.lag,
-            c.interp_on,
-            c.interp_off,
-            c.drift,
-            c.drift_per_dn,
-        ];
+        let beta = rest_corrections(&c);
         for polarity in [0, 1] {
             let by = Correction::new(&c, polarity == 1);
             for (m, f) in own.iter().zip(&full) {

@@ -45,11 +45,15 @@ pub fn run_change_bins(frames: &PreparedFrames, first: usize, end: usize) -> Vec
         .map(|y| {
             let mut bins = vec![0u8; (end - first) * w];
             let mut changes = vec![0.0f32; end - first];
+            let mut logs = vec![0.0f32; end - first + 1];
             for x in 0..w {
                 let p = y * w + x;
-                for (i, k) in (first..end).enumerate() {
-                    let (a, b) = (frames.dn[k].data[p], frames.dn[k + 1].data[p]);
-                    changes[i] = (frames.log(b) - frames.log(a)).abs();
+                // each frame's log once (it ends one interval and starts the next)
+                for (log, k) in logs.iter_mut().zip(first..=end) {
+                    *log = frames.log(frames.dn[k].data[p]);
+                }
+                for (change, pair) in changes.iter_mut().zip(logs.windows(2)) {
+                    *change = (pair[1] - pair[0]).abs();
                 }
                 for (i, k) in (first..end).enumerate() {
                     let middle = 0.5 * (frames.dn[k].data[p] + frames.dn[k + 1].data[p]);
