@@ -289,7 +289,7 @@ structs! {
     StepResiduals { by_intensity, by_rate_of_change }
     Step { effect, evidence, score, parameters, error_before, error_after, components_after,
         chance, kept, reason, simulations, residuals_before, residuals_after }
-    Components { counts, background, intervals, polarity, active, dispersion, hot_pixels,
+    Components { counts, background, intervals, polarity, active, dispersion, lag, hot_pixels,
         total }
     Bin { label, x, real, simulated, log_ratio }
     BackgroundBin { intensity_dn, real_on_hz, simulated_on_hz, real_off_hz, simulated_off_hz }

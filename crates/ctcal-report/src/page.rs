@@ -38,7 +38,7 @@ pub(super) const GLOSSARY: [(&str, &str); 5] = [
     ),
     (
         "distance components",
-        "the parts of the sim-to-real distance: counts (log ratio of events per intensity, rate of change and polarity), background (events no scene change explains), intervals (same-pixel interval histograms), polarity (ON/OFF balance), active (share of pixels with events) and dispersion (how unevenly pixels fire); the total is their root sum of squares",
+        "the parts of the sim-to-real distance: counts (log ratio of events per intensity, rate of change and polarity), background (events no scene change explains), intervals (same-pixel interval histograms), polarity (ON/OFF balance), active (share of pixels with events), dispersion (how unevenly pixels fire) and, with frames, lag (how much later the recording's events come than the simulation's in some intensity bins than in others, in frame intervals); the total is their root sum of squares",
     ),
     (
         "95 % interval",

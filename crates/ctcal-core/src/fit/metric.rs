@@ -12,7 +12,14 @@
 //! - `polarity`: `|ln(ON/OFF)|` difference;
 //! - `active`: log ratio of the numbers of pixels that fired;
 //! - `dispersion`: log ratio of the pooled within-tile index of dispersion of per-pixel
-//!   counts (variance over mean), which threshold mismatch raises.
+//!   counts (variance over mean), which threshold mismatch raises;
+//! - `lag`: root mean square over intensity bins of the recording's median lag behind the
+//!   simulation ([`super::observe::lag`]: each supported recorded event's signed offset from
+//!   the nearest simulated event of its pixel and polarity) about its mean over the bins, in
+//!   median frame intervals (the time the frames resolve a change to), over bins with at
+//!   least 50 paired events. A photoreceptor bandwidth the model lacks makes the recording
+//!   lag more in the dark; a lag alike at every intensity (frame timestamps at another point
+//!   of the exposure than the events assume) is not a pixel's and is left out.
 //!
 //! The total is the root sum of squares. Every component is dimensionless and about as
 //! large as the relative error it measures, so none needs a weight.
@@ -21,7 +28,7 @@ use super::observe::{Geometry, INTENSITY_BINS, Observed, Subset, TILE_PX};
 use serde::Serialize;
 
 /// The name of the distance, as reported.
-pub const ERROR_METRIC: &str = "root sum of squares of: event-weighted RMS log count ratio over intensity x rate-of-change x polarity cells (supported events; a pixel's rate over as many frame intervals, up to 8 a side, as 2 grey levels of change need); event-weighted RMS log ratio of unsupported-event rates per intensity and polarity (floor 0.01 Hz/pixel); total-variation distance of same-pixel interval histograms; |ln(ON/OFF)| difference; |log ratio| of active pixels; |log ratio| of the within-tile index of dispersion of per-pixel counts";
+pub const ERROR_METRIC: &str = "root sum of squares of: event-weighted RMS log count ratio over intensity x rate-of-change x polarity cells (supported events; a pixel's rate over as many frame intervals, up to 8 a side, as 2 grey levels of change need); event-weighted RMS log ratio of unsupported-event rates per intensity and polarity (floor 0.01 Hz/pixel); total-variation distance of same-pixel interval histograms; |ln(ON/OFF)| difference; |log ratio| of active pixels; |log ratio| of the within-tile index of dispersion of per-pixel counts; RMS over intensity bins of the recording's median signed offset from the nearest simulated event of the same pixel and polarity (supported events, within 100 ms), about its mean over the bins, in median frame intervals";
 
 /// The components of the distance and their total.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
@@ -32,6 +39,9 @@ pub struct Components {
     pub polarity: f64,
     pub active: f64,
     pub dispersion: f64,
+    /// The recording's lag behind the simulation (fit with frames only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub lag: Option<f64>,
     /// The named hot pixels' rates (fit without frames only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hot_pixels: Option<f64>,
@@ -197,11 +207,20 @@ pub fn distance(
         (Some(r), Some(s)) => dispersion_log_ratio(r, s).abs(),
         _ => 0.0,
     };
-    let total = [counts, background, intervals, polarity, active, dispersion]
-        .iter()
-        .map(|v| v * v)
-        .sum::<f64>()
-        .sqrt();
+    let lag = lag_component(sim, g, subset);
+    let total = [
+        counts,
+        background,
+        intervals,
+        polarity,
+        active,
+        dispersion,
+        lag.unwrap_or(0.0),
+    ]
+    .iter()
+    .map(|v| v * v)
+    .sum::<f64>()
+    .sqrt();
     Components {
         counts,
         background,
@@ -209,9 +228,30 @@ pub fn distance(
         polarity,
         active,
         dispersion,
+        lag,
         hot_pixels: None,
         total,
     }
+}
+
+/// The `lag` component of `sim` (paired with the recording) over `subset`: `None` when it
+/// was not paired, 0 when fewer than two intensity bins have enough paired events.
+fn lag_component(sim: &Observed, g: &Geometry, subset: Subset) -> Option<f64> {
+    if sim.lag.is_empty() || g.frame_interval_s <= 0.0 {
+        return None;
+    }
+    let lags: Vec<f64> = sim
+        .lag_of(g, subset)
+        .iter()
+        .flatten()
+        .map(|l| l.median_s / g.frame_interval_s)
+        .collect();
+    if lags.len() < 2 {
+        return Some(0.0);
+    }
+    let n = lags.len() as f64;
+    let mean = lags.iter().sum::<f64>() / n;
+    Some((lags.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / n).sqrt())
 }
 
 /// The median count-cell log ratio of each polarity over `subset` (OFF, ON): where the

@@ -25,6 +25,7 @@ use crate::events::{Sensor, TimeUs};
 
 mod change;
 mod count;
+pub mod lag;
 
 /// Upper edges of the intensity bins (frame DN; the last bin holds the rest).
 pub const INTENSITY_EDGES: [f32; 5] = [10.0, 20.0, 40.0, 80.0, 160.0];
@@ -141,6 +142,9 @@ pub struct Geometry {
     pub exposure: Vec<[f64; INTENSITY_BINS]>,
     /// First and last time of the used intervals.
     pub span: (TimeUs, TimeUs),
+    /// Median duration of the used frame intervals, seconds: the unit of the recording's
+    /// lag behind a simulation ([`lag`]; the frames resolve a change's time to about it).
+    pub frame_interval_s: f64,
     /// Spans between blocks of frames read whose events were not read.
     unread: Vec<(TimeUs, TimeUs)>,
     /// Representative DN of each intensity bin (geometric middle).
@@ -168,6 +172,11 @@ impl Geometry {
             .map(|&k| (frames.times[k + 1] - frames.times[k]) as f64)
             .collect();
         let total: f64 = durations.iter().sum();
+        let frame_interval_s = {
+            let mut sorted = durations.clone();
+            sorted.sort_by(f64::total_cmp);
+            sorted.get(sorted.len() / 2).map_or(0.0, |d| d * 1e-6)
+        };
         let mut interval_block = vec![None; frames.flows.len()];
         let mut elapsed = 0.0;
         for (i, &k) in used.iter().enumerate() {
@@ -255,6 +264,7 @@ impl Geometry {
             change,
             exposure,
             span,
+            frame_interval_s,
             intensity_centres: centres,
         }
     }
@@ -386,6 +396,9 @@ pub struct Observed {
     pub polarity: Vec<[u64; 2]>,
     /// Events per 1 ms bin from the start of the used span.
     pub timeline: Vec<u32>,
+    /// A simulation's only: the recording's offsets from it, `[block][intensity][offset
+    /// bin]` ([`lag`]); empty for the recording itself.
+    pub lag: Vec<u32>,
 }
 
 impl Observed {
@@ -454,6 +467,25 @@ impl Observed {
         sum_blocks(&self.pixel_counts, pixels, self.blocks, |b| {
             g.in_subset(b, subset)
         })
+    }
+
+    /// The recording's median offset from this simulation per intensity bin over
+    /// `subset` (seconds, and the paired events), where [`lag::MIN_LAG_EVENTS`] were paired.
+    pub fn lag_of(&self, g: &Geometry, subset: Subset) -> [Option<lag::BinLag>; INTENSITY_BINS] {
+        let mut out = [None; INTENSITY_BINS];
+        if self.lag.is_empty() {
+            return out;
+        }
+        let all = sum_blocks(
+            &self.lag,
+            INTENSITY_BINS * lag::LAG_BINS,
+            self.blocks,
+            |b| g.in_subset(b, subset),
+        );
+        for (bin, hist) in all.chunks(lag::LAG_BINS).enumerate() {
+            out[bin] = lag::bin_lag(hist).filter(|l| l.events >= lag::MIN_LAG_EVENTS);
+        }
+        out
     }
 
     /// Events over `subset`.

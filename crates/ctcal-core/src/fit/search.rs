@@ -18,13 +18,14 @@
 
 use super::effects::mismatch::RANGE as MISMATCH_RANGE;
 use super::metric::{Components, dispersion, dispersion_log_ratio, distance, median_ratios};
+use super::observe::lag::LagKeys;
 use super::observe::{Geometry, Observed, Subset};
 use crate::estimate::{EstimateError, Interval, quantise, resim};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::{PixelParams, Sample};
 use argmin::core::{CostFunction, Error as ArgminError, Executor};
 use argmin::solver::brent::BrentOpt;
-use std::cell::{Cell, RefCell};
+use std::cell::{Cell, OnceCell, RefCell};
 
 /// The recording's frames as simulator input, with what every comparison needs.
 pub struct Simulation<'a> {
@@ -44,6 +45,9 @@ pub struct Simulation<'a> {
     /// share, measured on the fit blocks), added to every simulation so that the model and
     /// the recording are compared on the same pixels.
     pub hot_events: EventChunk,
+    /// The recording's side of its lag behind each simulation
+    /// ([`super::observe::lag`]), grouped on first use.
+    pub lag_keys: OnceCell<LagKeys>,
 }
 
 /// How far above the recording's shortest intervals a refractory period may lie: a
@@ -144,7 +148,10 @@ impl Simulation<'_> {
         if !self.hot_events.is_empty() {
             events = EventChunk::merged(&events, &self.hot_events);
         }
-        Ok(Observed::new(&events, self.geometry, masked))
+        let keys = self
+            .lag_keys
+            .get_or_init(|| Observed::lag_keys(self.events, self.geometry));
+        Ok(Observed::paired(&events, self.geometry, masked, keys))
     }
 
     /// `params` with its thresholds profiled (see the module docs), unless `fixed`.

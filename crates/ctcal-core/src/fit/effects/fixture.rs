@@ -122,7 +122,8 @@ impl Fixture {
         let geometry = Geometry::new(frames, &vec![false; pixels], BLOCKS, TimeUs::MAX);
         let no_mask = vec![false; pixels];
         let real = Observed::new(recording, &geometry, &no_mask);
-        let sim = Observed::new(model, &geometry, &no_mask);
+        let keys = Observed::lag_keys(recording, &geometry);
+        let sim = Observed::paired(model, &geometry, &no_mask, &keys);
         Self {
             geometry,
             real,

@@ -5,6 +5,7 @@
 //! for each pixel's first event of a stretch. The counts are those of one pass over the
 //! events in order (tested against it).
 
+use super::lag::LagKeys;
 use super::{
     CELLS, Geometry, INTENSITY_BINS, INTERVAL_BINS, INTERVAL_CLASSES, Observed, REGIONS,
     SUPPORT_US, TIMELINE_BIN_US, cell_index, interval_bin,
@@ -40,20 +41,58 @@ impl Observed {
     /// The statistics of the time-sorted `events`, leaving out the pixels `masked` flags
     /// (hot pixels) besides the geometry's own exclusions.
     pub fn new(events: &EventChunk, geometry: &Geometry, masked: &[bool]) -> Self {
-        Self::counted(events, geometry, masked, rayon::current_num_threads())
+        let support = supported(events, geometry.sensor, SUPPORT_US);
+        Self::counted(
+            events,
+            &support,
+            geometry,
+            masked,
+            rayon::current_num_threads(),
+        )
     }
 
-    /// [`Self::new`] in at most `threads` stretches.
-    fn counted(events: &EventChunk, geometry: &Geometry, masked: &[bool], threads: usize) -> Self {
+    /// [`Self::new`] of a simulation, with the recording's lag behind it ([`super::lag`]; the
+    /// recording's side in `real`).
+    pub fn paired(
+        events: &EventChunk,
+        geometry: &Geometry,
+        masked: &[bool],
+        real: &LagKeys,
+    ) -> Self {
+        let support = supported(events, geometry.sensor, SUPPORT_US);
+        let mut o = Self::counted(
+            events,
+            &support,
+            geometry,
+            masked,
+            rayon::current_num_threads(),
+        );
+        o.lag = real.histogram(events, &support, geometry, masked);
+        o
+    }
+
+    /// The recording's side of [`Self::paired`]: its supported events, grouped.
+    pub fn lag_keys(events: &EventChunk, geometry: &Geometry) -> LagKeys {
+        let support = supported(events, geometry.sensor, SUPPORT_US);
+        LagKeys::new(events, &support, geometry)
+    }
+
+    /// [`Self::new`] in at most `threads` stretches, with the events' `support` flags.
+    fn counted(
+        events: &EventChunk,
+        support: &[bool],
+        geometry: &Geometry,
+        masked: &[bool],
+        threads: usize,
+    ) -> Self {
         let mut o = Self::empty(geometry);
         if events.is_empty() {
             return o;
         }
-        let support = supported(events, geometry.sensor, SUPPORT_US);
         let parts: Vec<Part> = events
             .time_stretches(threads, MIN_STRETCH)
             .into_par_iter()
-            .map(|range| count_stretch(events, &support, range, geometry, masked))
+            .map(|range| count_stretch(events, support, range, geometry, masked))
             .collect();
         let mut last = vec![TimeUs::MIN; geometry.sensor.pixels()];
         for part in parts {
@@ -83,6 +122,7 @@ impl Observed {
             pixel_counts: vec![0; blocks * g.sensor.pixels()],
             polarity: vec![[0; 2]; blocks],
             timeline: vec![0; ((g.span.1 - g.span.0) / TIMELINE_BIN_US).max(0) as usize + 1],
+            lag: Vec::new(),
         }
     }
 
@@ -230,6 +270,7 @@ mod tests {
             ],
             exposure: vec![[0.0; INTENSITY_BINS]; 3],
             span: (0, 40_000),
+            frame_interval_s: 0.01,
             unread: vec![(33_000, 34_000)],
             intensity_centres: [0.0; INTENSITY_BINS],
             change_centres: [0.0; CHANGE_BINS],
@@ -254,11 +295,12 @@ mod tests {
                 }
             })
             .collect();
-        let one = Observed::counted(&events, &g, &masked, 1);
+        let support = supported(&events, g.sensor, SUPPORT_US);
+        let one = Observed::counted(&events, &support, &g, &masked, 1);
         assert!(one.polarity.iter().map(|p| p[0] + p[1]).sum::<u64>() > 150_000);
         assert!(one.intervals.iter().sum::<u32>() > 150_000);
         for threads in [2, 3, 4] {
-            let many = Observed::counted(&events, &g, &masked, threads);
+            let many = Observed::counted(&events, &support, &g, &masked, threads);
             assert_eq!(events.time_stretches(threads, MIN_STRETCH).len(), threads);
             assert_eq!(many.cells, one.cells);
             assert_eq!(many.background, one.background);

@@ -149,6 +149,7 @@ fn profiled_on(
         seed: fine.seed,
         count: Cell::new(0),
         hot_events: fine.hot_events.clone(),
+        lag_keys: Default::default(),
     };
     let profiled = coarse.profile(&model.params, check.masked, false).ok()?;
     let count = coarse.count.get();

@@ -124,6 +124,7 @@ pub fn fit(
         seed: options.seed,
         count: Cell::new(0),
         hot_events: EventChunk::default(),
+        lag_keys: Default::default(),
     };
     let ideal = Ideal::measure(
         &simulation,

@@ -1,0 +1,259 @@
+//! The recording's lag behind a simulation of it: for every recorded event with support
+//! (a real change, not noise), the signed offset `t_recorded - t_simulated` to the nearest
+//! simulated event of the same pixel and polarity, kept as a histogram per block and
+//! intensity bin of the pixel.
+//!
+//! A photoreceptor low-pass of time constant `tau` delays a pixel's response to a ramp by
+//! `tau` (a first-order filter's lag to a ramp input), and its cutoff is proportional to the
+//! photocurrent (Lichtsteiner, Posch & Delbruck, JSSC 2008), so a bandwidth the model lacks
+//! puts the recording's events behind the model's, more in the dark. A bandwidth that only
+//! delays events, without thinning them, leaves the count cells as they are and shows here
+//! alone. The frames' 8-bit quantisation moves simulated events either way, so it leaves
+//! the median offset near zero (pilot on coverage draws 6006 and 6017:
+//! `benches/coverage/bandwidth-lag-pilot-2026-12-02/`).
+//!
+//! The statistic pairs the recording's events with a simulation's; it is computed for
+//! simulations only ([`LagKeys`] holds the recording's side once).
+
+use super::{Geometry, INTENSITY_BINS};
+use crate::events::{EventChunk, TimeUs};
+use rayon::prelude::*;
+
+/// Offsets beyond this (either sign) are not paired: the nearest simulated event is then
+/// another change, not this one.
+pub const LAG_WINDOW_US: TimeUs = 100_000;
+/// Width of the offset histogram's bins, microseconds.
+pub const LAG_BIN_US: TimeUs = 250;
+/// Bins of the offset histogram, from `-LAG_WINDOW_US` to `+LAG_WINDOW_US`.
+pub const LAG_BINS: usize = (2 * LAG_WINDOW_US / LAG_BIN_US) as usize;
+/// Paired events an intensity bin needs for its median offset to count.
+pub const MIN_LAG_EVENTS: u32 = 50;
+
+/// The recording's supported events in used blocks with a reliable intensity, grouped by
+/// pixel and polarity (in time order within each group).
+pub struct LagKeys {
+    /// Start of each `pixel * 2 + polarity` group in `t` and `slot` (one more than groups).
+    start: Vec<u32>,
+    t: Vec<TimeUs>,
+    /// `block * INTENSITY_BINS + intensity bin` of each event.
+    slot: Vec<u32>,
+}
+
+/// The `(pixel * 2 + polarity)` group of event `i`.
+#[inline]
+fn group_of(events: &EventChunk, i: usize, width: usize) -> usize {
+    (events.y[i] as usize * width + events.x[i] as usize) * 2 + events.on[i] as usize
+}
+
+/// Stable counting sort of the selected events by group: each group's start and the
+/// selected indices in group order.
+fn by_group(
+    events: &EventChunk,
+    groups: usize,
+    width: usize,
+    selected: impl Fn(usize) -> bool,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut start = vec![0u32; groups + 1];
+    for i in (0..events.len()).filter(|&i| selected(i)) {
+        start[group_of(events, i, width) + 1] += 1;
+    }
+    for g in 0..groups {
+        start[g + 1] += start[g];
+    }
+    let mut next = start.clone();
+    let mut order = vec![0u32; start[groups] as usize];
+    for i in (0..events.len()).filter(|&i| selected(i)) {
+        let g = group_of(events, i, width);
+        order[next[g] as usize] = i as u32;
+        next[g] += 1;
+    }
+    (start, order)
+}
+
+impl LagKeys {
+    /// The recording's side: its time-sorted `events` with their `support` flags.
+    pub fn new(events: &EventChunk, support: &[bool], g: &Geometry) -> Self {
+        let width = g.sensor.width as usize;
+        let groups = g.sensor.pixels() * 2;
+        // each event's slot, u32::MAX where it is not paired
+        let mut k = 0usize;
+        let slots: Vec<u32> = (0..events.len())
+            .map(|i| {
+                let t = events.t[i];
+                while k + 1 < g.times.len() && g.times[k + 1] <= t {
+                    k += 1;
+                }
+                if !support[i] || t < g.times[0] || k + 1 >= g.times.len() {
+                    return u32::MAX;
+                }
+                let p = events.y[i] as usize * width + events.x[i] as usize;
+                match (g.interval_block[k], g.intensity[k].get(p)) {
+                    (Some(block), Some(&bin)) if bin != u8::MAX && !g.excluded[p] => {
+                        (block * INTENSITY_BINS + bin as usize) as u32
+                    }
+                    _ => u32::MAX,
+                }
+            })
+            .collect();
+        let (start, order) = by_group(events, groups, width, |i| slots[i] != u32::MAX);
+        Self {
+            start,
+            t: order.iter().map(|&i| events.t[i as usize]).collect(),
+            slot: order.iter().map(|&i| slots[i as usize]).collect(),
+        }
+    }
+
+    /// The offset histogram `[block][intensity][offset bin]` of the recording against the
+    /// time-sorted simulated `events` (their `support` flags), leaving out `masked` pixels.
+    pub fn histogram(
+        &self,
+        events: &EventChunk,
+        support: &[bool],
+        g: &Geometry,
+        masked: &[bool],
+    ) -> Vec<u32> {
+        let width = g.sensor.width as usize;
+        let groups = self.start.len() - 1;
+        let (sim_start, order) = by_group(events, groups, width, |i| support[i]);
+        let sim_t: Vec<TimeUs> = order.iter().map(|&i| events.t[i as usize]).collect();
+        let size = g.blocks * INTENSITY_BINS * LAG_BINS;
+        let chunk = groups
+            .div_ceil(4 * rayon::current_num_threads().max(1))
+            .max(1);
+        (0..groups)
+            .into_par_iter()
+            .with_min_len(chunk)
+            .fold(
+                || vec![0u32; size],
+                |mut hist, group| {
+                    if masked[group / 2] {
+                        return hist;
+                    }
+                    let real = self.start[group] as usize..self.start[group + 1] as usize;
+                    let sim = &sim_t[sim_start[group] as usize..sim_start[group + 1] as usize];
+                    pair_group(&self.t[real.clone()], &self.slot[real], sim, &mut hist);
+                    hist
+                },
+            )
+            .reduce(
+                || vec![0u32; size],
+                |mut a, b| {
+                    a.iter_mut().zip(&b).for_each(|(a, b)| *a += b);
+                    a
+                },
+            )
+    }
+}
+
+/// Adds the offsets of one group's recorded events (`real`, sorted, with their slots) from
+/// the nearest of its simulated events (`sim`, sorted) to `hist`.
+fn pair_group(real: &[TimeUs], slots: &[u32], sim: &[TimeUs], hist: &mut [u32]) {
+    if sim.is_empty() {
+        return;
+    }
+    let mut j = 0usize;
+    for (&t, &slot) in real.iter().zip(slots) {
+        while j < sim.len() && sim[j] < t {
+            j += 1;
+        }
+        let after = sim.get(j).map(|&s| t - s);
+        let before = j.checked_sub(1).map(|b| t - sim[b]);
+        let offset = match (before, after) {
+            (Some(b), Some(a)) => {
+                if b <= -a {
+                    b
+                } else {
+                    a
+                }
+            }
+            (Some(b), None) => b,
+            (None, Some(a)) => a,
+            (None, None) => continue,
+        };
+        if offset.abs() < LAG_WINDOW_US {
+            let bin = ((offset + LAG_WINDOW_US) / LAG_BIN_US) as usize;
+            hist[slot as usize * LAG_BINS + bin] += 1;
+        }
+    }
+}
+
+/// One intensity bin's offsets: their median, its standard error, and how many.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BinLag {
+    pub median_s: f64,
+    /// The sample median's standard error, `1.2533 sigma / sqrt(n)`, with `sigma` from the
+    /// interquartile range (`IQR / 1.349`), at least the histogram's own resolution (a bin
+    /// over `sqrt(12)`).
+    pub standard_error_s: f64,
+    pub events: u32,
+}
+
+/// The `q` quantile of an offset histogram, seconds (linear within its bin).
+fn quantile_s(hist: &[u32], n: u32, q: f64) -> f64 {
+    let target = n as f64 * q;
+    let mut below = 0.0;
+    for (k, &c) in hist.iter().enumerate() {
+        let c = c as f64;
+        if below + c >= target && c > 0.0 {
+            let within = (target - below) / c;
+            return (-(LAG_WINDOW_US as f64) + (k as f64 + within) * LAG_BIN_US as f64) * 1e-6;
+        }
+        below += c;
+    }
+    LAG_WINDOW_US as f64 * 1e-6
+}
+
+/// The [`BinLag`] of an offset histogram, `None` when it is empty.
+pub fn bin_lag(hist: &[u32]) -> Option<BinLag> {
+    let n: u32 = hist.iter().sum();
+    if n == 0 {
+        return None;
+    }
+    let iqr = quantile_s(hist, n, 0.75) - quantile_s(hist, n, 0.25);
+    let sigma = (iqr / 1.349).max(LAG_BIN_US as f64 * 1e-6 / 12f64.sqrt());
+    Some(BinLag {
+        median_s: quantile_s(hist, n, 0.5),
+        standard_error_s: 1.2533 * sigma / (n as f64).sqrt(),
+        events: n,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_recorded_event_is_paired_with_the_nearest_simulated_one() {
+        // simulated at 10, 20, 40 ms; recorded at 9 (-1 ms from 10), 16 (-4 from 20, the
+        // nearer), 31 (-9 from 40, nearer than +11 from 20) and 200 (160 ms after the last:
+        // beyond the window, not paired)
+        let sim = [10_000, 20_000, 40_000];
+        let real = [9_000, 16_000, 31_000, 200_000];
+        let mut hist = vec![0u32; 2 * LAG_BINS];
+        pair_group(&real, &[0, 0, 1, 1], &sim, &mut hist);
+        let bin = |us: TimeUs| ((us + LAG_WINDOW_US) / LAG_BIN_US) as usize;
+        assert_eq!(hist[bin(-1_000)], 1);
+        assert_eq!(hist[bin(-4_000)], 1);
+        assert_eq!(hist[LAG_BINS + bin(-9_000)], 1);
+        assert_eq!(hist.iter().sum::<u32>(), 3);
+    }
+
+    #[test]
+    fn the_median_offset_interpolates_within_its_bin() {
+        let mut hist = vec![0u32; LAG_BINS];
+        let bin = |us: TimeUs| ((us + LAG_WINDOW_US) / LAG_BIN_US) as usize;
+        // 10 events in the bin [+2.0, +2.25) ms, 5 at -3 ms, 5 at +8 ms
+        hist[bin(2_000)] = 10;
+        hist[bin(-3_000)] = 5;
+        hist[bin(8_000)] = 5;
+        let lag = bin_lag(&hist).unwrap();
+        assert_eq!(lag.events, 20);
+        // half (10) reached halfway through the 10 events: 2.0 + 0.125 ms
+        assert!((lag.median_s - 2.125e-3).abs() < 1e-9, "{lag:?}");
+        // quartiles: 5 of 5 through the -3 ms bin (its top, -2.75 ms) and 10 of 10 through
+        // the +2 ms bin (its top, +2.25 ms): sigma 5 / 1.349 ms, over sqrt(20)
+        let se = 1.2533 * 5e-3 / 1.349 / 20f64.sqrt();
+        assert!((lag.standard_error_s - se).abs() < 1e-9, "{lag:?}");
+        assert_eq!(bin_lag(&vec![0; LAG_BINS]), None);
+    }
+}
