@@ -4,12 +4,12 @@
 #   sh v2e_args.sh -i video.mp4 --output_folder out
 # (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)
 exec "${V2E:-v2e}" \
-  --pos_thres 0.344556 \
-  --neg_thres 0.467532 \
+  --pos_thres 0.343904 \
+  --neg_thres 0.463052 \
   --sigma_thres 0 \
   --cutoff_hz 0 \
   --leak_rate_hz 0 \
-  --shot_noise_rate_hz 1.176851 \
+  --shot_noise_rate_hz 1.063939 \
   --refractory_period 0 \
   --leak_jitter_fraction 0.100000 \
   --noise_rate_cov_decades 0.100000 \
