@@ -396,8 +396,8 @@ pub struct Observed {
     pub polarity: Vec<[u64; 2]>,
     /// Events per 1 ms bin from the start of the used span.
     pub timeline: Vec<u32>,
-    /// A simulation's only: the recording's offsets from it, `[block][intensity][offset
-    /// bin]` ([`lag`]); empty for the recording itself.
+    /// A simulation's only: the recording's offsets from it, `[block][intensity][polarity]
+    /// [offset bin]` ([`lag`]); empty for the recording itself.
     pub lag: Vec<u32>,
 }
 
@@ -470,20 +470,42 @@ impl Observed {
     }
 
     /// The recording's median offset from this simulation per intensity bin over
-    /// `subset` (seconds, and the paired events), where [`lag::MIN_LAG_EVENTS`] were paired.
+    /// `subset`, both polarities pooled (seconds, and the paired events), where
+    /// [`lag::MIN_LAG_EVENTS`] were paired.
     pub fn lag_of(&self, g: &Geometry, subset: Subset) -> [Option<lag::BinLag>; INTENSITY_BINS] {
+        self.per_lag_bin(g, subset, |hist| {
+            let (off, on) = hist.split_at(lag::LAG_BINS);
+            let pooled: Vec<u32> = off.iter().zip(on).map(|(a, b)| a + b).collect();
+            lag::bin_lag(&pooled).filter(|l| l.events >= lag::MIN_LAG_EVENTS)
+        })
+    }
+
+    /// The recording's delay behind this simulation per intensity bin over `subset`
+    /// ([`lag::delay_of`]: the mean of the ON and OFF median offsets, seconds), where each
+    /// polarity has [`lag::MIN_LAG_EVENTS`] paired events.
+    pub fn delay_of(&self, g: &Geometry, subset: Subset) -> [Option<lag::BinLag>; INTENSITY_BINS] {
+        self.per_lag_bin(g, subset, lag::delay_of)
+    }
+
+    /// `read` of each intensity bin's offset histograms (OFF then ON) over `subset`.
+    fn per_lag_bin(
+        &self,
+        g: &Geometry,
+        subset: Subset,
+        read: impl Fn(&[u32]) -> Option<lag::BinLag>,
+    ) -> [Option<lag::BinLag>; INTENSITY_BINS] {
         let mut out = [None; INTENSITY_BINS];
         if self.lag.is_empty() {
             return out;
         }
         let all = sum_blocks(
             &self.lag,
-            INTENSITY_BINS * lag::LAG_BINS,
+            INTENSITY_BINS * 2 * lag::LAG_BINS,
             self.blocks,
             |b| g.in_subset(b, subset),
         );
-        for (bin, hist) in all.chunks(lag::LAG_BINS).enumerate() {
-            out[bin] = lag::bin_lag(hist).filter(|l| l.events >= lag::MIN_LAG_EVENTS);
+        for (bin, hist) in all.chunks(2 * lag::LAG_BINS).enumerate() {
+            out[bin] = read(hist);
         }
         out
     }

@@ -1,7 +1,7 @@
 //! The recording's lag behind a simulation of it: for every recorded event with support
 //! (a real change, not noise), the signed offset `t_recorded - t_simulated` to the nearest
-//! simulated event of the same pixel and polarity, kept as a histogram per block and
-//! intensity bin of the pixel.
+//! simulated event of the same pixel and polarity, kept as a histogram per block, intensity
+//! bin of the pixel and polarity.
 //!
 //! A photoreceptor low-pass of time constant `tau` delays a pixel's response to a ramp by
 //! `tau` (a first-order filter's lag to a ramp input), and its cutoff is proportional to the
@@ -11,6 +11,20 @@
 //! alone. The frames' 8-bit quantisation moves simulated events either way, so it leaves
 //! the median offset near zero (pilot on coverage draws 6006 and 6017:
 //! `benches/coverage/bandwidth-lag-pilot-2026-12-02/`).
+//!
+//! A delay is the same for both polarities; a level the model puts its thresholds at
+//! wrongly is not. A pixel fires at its reference level plus whole thresholds, so a
+//! threshold a few per cent off moves the level of the k-th crossing from the reference by
+//! k times that, and the event by the level error over the log's rate of change: earlier on
+//! a rising ramp (ON) and later on a falling one (OFF) for the same level error. The error
+//! grows with the distance from the reference, so it is largest in the intensity bins far
+//! from the scene's typical level, and a median over both polarities follows the bin's mix
+//! of ON and OFF events (coverage draw 6014, thresholds 3 % and 1 % off: ON +3.9 ms and OFF
+//! -5.4 ms at 113 DN, pooled +3.0 ms, read as a bandwidth). The delay of a bin
+//! ([`delay_of`]), which the bandwidth's evidence reads, is therefore the mean of its ON
+//! and OFF median offsets, in which the level error cancels. The distance's `lag`
+//! component keeps the pooled median: it measures any difference between model and
+//! recording, and a level error is one (it vanishes at the right thresholds).
 //!
 //! The statistic pairs the recording's events with a simulation's; it is computed for
 //! simulations only ([`LagKeys`] holds the recording's side once).
@@ -35,7 +49,7 @@ pub struct LagKeys {
     /// Start of each `pixel * 2 + polarity` group in `t` and `slot` (one more than groups).
     start: Vec<u32>,
     t: Vec<TimeUs>,
-    /// `block * INTENSITY_BINS + intensity bin` of each event.
+    /// `(block * INTENSITY_BINS + intensity bin) * 2 + polarity` of each event.
     slot: Vec<u32>,
 }
 
@@ -89,7 +103,7 @@ impl LagKeys {
                 let p = events.y[i] as usize * width + events.x[i] as usize;
                 match (g.interval_block[k], g.intensity[k].get(p)) {
                     (Some(block), Some(&bin)) if bin != u8::MAX && !g.excluded[p] => {
-                        (block * INTENSITY_BINS + bin as usize) as u32
+                        ((block * INTENSITY_BINS + bin as usize) * 2 + events.on[i] as usize) as u32
                     }
                     _ => u32::MAX,
                 }
@@ -103,7 +117,7 @@ impl LagKeys {
         }
     }
 
-    /// The offset histogram `[block][intensity][offset bin]` of the recording against the
+    /// The offset histogram `[block][intensity][polarity][offset bin]` of the recording against the
     /// time-sorted simulated `events` (their `support` flags), leaving out `masked` pixels.
     pub fn histogram(
         &self,
@@ -116,7 +130,7 @@ impl LagKeys {
         let groups = self.start.len() - 1;
         let (sim_start, order) = by_group(events, groups, width, |i| support[i]);
         let sim_t: Vec<TimeUs> = order.iter().map(|&i| events.t[i as usize]).collect();
-        let size = g.blocks * INTENSITY_BINS * LAG_BINS;
+        let size = g.blocks * INTENSITY_BINS * 2 * LAG_BINS;
         let chunk = groups
             .div_ceil(4 * rayon::current_num_threads().max(1))
             .max(1);
@@ -218,6 +232,21 @@ pub fn bin_lag(hist: &[u32]) -> Option<BinLag> {
     })
 }
 
+/// The delay of one intensity bin from its offset histograms, OFF then ON (`2 *
+/// LAG_BINS` counts): the mean of the two polarities' median offsets, with the standard
+/// error of that mean; `None` unless each polarity has [`MIN_LAG_EVENTS`] paired events (a
+/// bin of one polarity cannot tell a delay from a level error, see the module docs).
+pub fn delay_of(hist: &[u32]) -> Option<BinLag> {
+    let (off, on) = hist.split_at(LAG_BINS);
+    let enough = |h: &[u32]| bin_lag(h).filter(|l| l.events >= MIN_LAG_EVENTS);
+    let (off, on) = (enough(off)?, enough(on)?);
+    Some(BinLag {
+        median_s: 0.5 * (off.median_s + on.median_s),
+        standard_error_s: 0.5 * off.standard_error_s.hypot(on.standard_error_s),
+        events: off.events + on.events,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -255,5 +284,26 @@ mod tests {
         let se = 1.2533 * 5e-3 / 1.349 / 20f64.sqrt();
         assert!((lag.standard_error_s - se).abs() < 1e-9, "{lag:?}");
         assert_eq!(bin_lag(&vec![0; LAG_BINS]), None);
+    }
+
+    #[test]
+    fn a_delay_shows_in_both_polarities_and_a_level_error_cancels() {
+        let bin = |us: TimeUs| ((us + LAG_WINDOW_US) / LAG_BIN_US) as usize;
+        // OFF then ON: 60 events each, OFF 5 ms early and ON 3 ms late (a level error
+        // with a 1 ms delay on top)
+        let mut hist = vec![0u32; 2 * LAG_BINS];
+        hist[bin(-5_000)] = 60;
+        hist[LAG_BINS + bin(3_000)] = 60;
+        let delay = delay_of(&hist).unwrap();
+        // each median half-way through its 0.25 ms bin: (-4.875 + 3.125) / 2 ms
+        assert!((delay.median_s + 0.875e-3).abs() < 1e-9, "{delay:?}");
+        assert_eq!(delay.events, 120);
+        // the standard error of the mean of two medians: each IQR half a bin (linear
+        // within it), sigma 125 us / 1.349, over sqrt(60)
+        let each = 1.2533 * 125e-6 / 1.349 / 60f64.sqrt();
+        assert!((delay.standard_error_s - 0.5 * each * 2f64.sqrt()).abs() < 1e-12);
+        // too few OFF events: no delay
+        hist[bin(-5_000)] = MIN_LAG_EVENTS - 1;
+        assert_eq!(delay_of(&hist), None);
     }
 }
