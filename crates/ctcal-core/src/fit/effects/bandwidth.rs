@@ -23,9 +23,10 @@
 //! brightest seen whose lag, on its own or over the brightest bin's (which lags too when
 //! the whole scene is dim), is largest in standard errors; it matters when the lag is
 //! above a fifth of a frame interval ([`LAG_RELEVANT`]). The search starts at the cutoff
-//! that explains it, `tau_1(dark) / lag` or `(tau_1(dark) - tau_1(bright)) / excess`. The brightest bin lagging alone is not read
-//! as a bandwidth, and a lag alike at every intensity (a frame timestamp offset) that calls
-//! for the search is not kept by it: the distance's `lag` component is taken about its mean.
+//! that explains it, `tau_1(dark) / lag` or `(tau_1(dark) - tau_1(bright)) / excess`. The
+//! brightest bin lagging alone is not read as a bandwidth, and a lag alike at every
+//! intensity (a frame timestamp offset) that calls for the search is not kept by it: the
+//! distance's `lag` component is taken about its mean.
 //! A lag beyond half a pixel's time between events pairs with the next event and reads
 //! smaller (coverage draw 6006: the darkest bin lagged least), so the lag's shape is not
 //! fitted here. The evidence is the stronger of the two.

@@ -20,7 +20,8 @@
 //! grows with the distance from the reference, so it is largest in the intensity bins far
 //! from the scene's typical level, and a median over both polarities follows the bin's mix
 //! of ON and OFF events (coverage draw 6014, thresholds 3 % and 1 % off: ON +3.9 ms and OFF
-//! -5.4 ms at 113 DN, pooled +3.0 ms, read as a bandwidth). The delay of a bin
+//! -5.4 ms at 113 DN against a re-simulation with them; the fit read the pooled median as a
+//! lag of +4.0 ms at 113 DN and added a 1437 Hz bandwidth). The delay of a bin
 //! ([`delay_of`]), which the bandwidth's evidence reads, is therefore the mean of its ON
 //! and OFF median offsets, in which the level error cancels. The distance's `lag`
 //! component keeps the pooled median: it measures any difference between model and
@@ -117,8 +118,8 @@ impl LagKeys {
         }
     }
 
-    /// The offset histogram `[block][intensity][polarity][offset bin]` of the recording against the
-    /// time-sorted simulated `events` (their `support` flags), leaving out `masked` pixels.
+    /// The offset histogram `[block][intensity][polarity][offset bin]` of the recording
+    /// against the time-sorted simulated `events` (their `support` flags), leaving out `masked` pixels.
     pub fn histogram(
         &self,
         events: &EventChunk,
