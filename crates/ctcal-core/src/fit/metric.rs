@@ -237,7 +237,7 @@ pub fn distance(
 /// The `lag` component of `sim` (paired with the recording) over `subset`: `None` when it
 /// was not paired, 0 when fewer than two intensity bins have enough paired events.
 fn lag_component(sim: &Observed, g: &Geometry, subset: Subset) -> Option<f64> {
-    if sim.lag.is_empty() || g.frame_interval_s <= 0.0 {
+    if sim.lag.every_event.is_empty() || g.frame_interval_s <= 0.0 {
         return None;
     }
     let lags: Vec<f64> = sim

@@ -397,8 +397,8 @@ pub struct Observed {
     /// Events per 1 ms bin from the start of the used span.
     pub timeline: Vec<u32>,
     /// A simulation's only: the recording's offsets from it, `[block][intensity][polarity]
-    /// [offset bin]` ([`lag`]); empty for the recording itself.
-    pub lag: Vec<u32>,
+    /// [offset bin]` for each pairing ([`lag`]); empty for the recording itself.
+    pub lag: lag::LagHistograms,
 }
 
 impl Observed {
@@ -470,10 +470,11 @@ impl Observed {
     }
 
     /// The recording's median offset from this simulation per intensity bin over
-    /// `subset`, both polarities pooled (seconds, and the paired events), where
+    /// `subset`, every supported event paired, both polarities pooled (seconds, and the
+    /// paired events), where
     /// [`lag::MIN_LAG_EVENTS`] were paired.
     pub fn lag_of(&self, g: &Geometry, subset: Subset) -> [Option<lag::BinLag>; INTENSITY_BINS] {
-        self.per_lag_bin(g, subset, |hist| {
+        self.per_lag_bin(g, subset, lag::Pairing::EveryEvent, |hist| {
             let (off, on) = hist.split_at(lag::LAG_BINS);
             let pooled: Vec<u32> = off.iter().zip(on).map(|(a, b)| a + b).collect();
             lag::bin_lag(&pooled).filter(|l| l.events >= lag::MIN_LAG_EVENTS)
@@ -481,25 +482,32 @@ impl Observed {
     }
 
     /// The recording's delay behind this simulation per intensity bin over `subset`
-    /// ([`lag::delay_of`]: the mean of the ON and OFF median offsets, seconds), where each
-    /// polarity has [`lag::MIN_LAG_EVENTS`] paired events.
-    pub fn delay_of(&self, g: &Geometry, subset: Subset) -> [Option<lag::BinLag>; INTENSITY_BINS] {
-        self.per_lag_bin(g, subset, lag::delay_of)
-    }
-
-    /// `read` of each intensity bin's offset histograms (OFF then ON) over `subset`.
-    fn per_lag_bin(
+    /// ([`lag::delay_of`] of the burst starts: the delay both the ON and OFF median offsets
+    /// show, seconds),
+    /// where each polarity has [`lag::MIN_LAG_EVENTS`] paired events.
+    pub fn delay_of(
         &self,
         g: &Geometry,
         subset: Subset,
-        read: impl Fn(&[u32]) -> Option<lag::BinLag>,
-    ) -> [Option<lag::BinLag>; INTENSITY_BINS] {
+    ) -> [Option<lag::BinDelay>; INTENSITY_BINS] {
+        self.per_lag_bin(g, subset, lag::Pairing::BurstStarts, lag::delay_of)
+    }
+
+    /// `read` of each intensity bin's offset histograms (OFF then ON) over `subset`.
+    fn per_lag_bin<T: Copy>(
+        &self,
+        g: &Geometry,
+        subset: Subset,
+        pairing: lag::Pairing,
+        read: impl Fn(&[u32]) -> Option<T>,
+    ) -> [Option<T>; INTENSITY_BINS] {
         let mut out = [None; INTENSITY_BINS];
-        if self.lag.is_empty() {
+        let histograms = self.lag.of(pairing);
+        if histograms.is_empty() {
             return out;
         }
         let all = sum_blocks(
-            &self.lag,
+            histograms,
             INTENSITY_BINS * 2 * lag::LAG_BINS,
             self.blocks,
             |b| g.in_subset(b, subset),

@@ -17,24 +17,26 @@
 //! the model ([`crate::fit::observe::lag`]). A first-order low-pass lags a ramp by its time
 //! constant `1 / (2 pi fc)`, and under the cutoff law above that is `tau_1(DN) / cutoff_hz`
 //! with `tau_1 = 275 / (2 pi (DN + 20))` seconds, so the recording lags more in the dark.
-//! The lag of a bin is the mean of its ON and OFF median lags: a threshold the model puts a
-//! few per cent off moves ON and OFF events in opposite directions, a delay moves both
-//! alike ([`crate::fit::observe::lag`]). Evidence: a darker intensity bin than the
-//! brightest seen whose lag, on its own or over the brightest bin's (which lags too when
-//! the whole scene is dim), is largest in standard errors; it matters when the lag is
+//! The lag of a bin is the lag both its ON and OFF events show (the smaller median lag
+//! where the two have one sign, none where they differ): a threshold the model puts off
+//! moves one polarity's events and not the other's, a delay moves both alike
+//! ([`crate::fit::observe::lag`], which pairs the starts of bursts, so that a delay of
+//! tens of milliseconds does not pair with the next event). Evidence: a darker intensity
+//! bin than the brightest seen whose lag, on its own or over the brightest bin's where
+//! that lags too (the whole scene dim), is largest in standard errors; it matters when the lag is
 //! above a fifth of a frame interval ([`LAG_RELEVANT`]). The search starts at the cutoff
 //! that explains it, `tau_1(dark) / lag` or `(tau_1(dark) - tau_1(bright)) / excess`. The
 //! brightest bin lagging alone is not read as a bandwidth, and a lag alike at every
 //! intensity (a frame timestamp offset) that calls for the search is not kept by it: the
 //! distance's `lag` component is taken about its mean.
-//! A lag beyond half a pixel's time between events pairs with the next event and reads
-//! smaller (coverage draw 6006: the darkest bin lagged least), so the lag's shape is not
-//! fitted here. The evidence is the stronger of the two.
+//! A lag beyond half the burst gap pairs with the next burst and reads smaller (coverage
+//! draw 6006: the darkest bin, whose time constant is 85 ms, lagged least), so the lag's
+//! shape is not fitted here. The evidence is the stronger of the two.
 
 use super::{Context, Effect, Evidence};
 use crate::fit::metric::cell_ratios;
 use crate::fit::observe::cell_of;
-use crate::fit::observe::lag::BinLag;
+use crate::fit::observe::lag::BinDelay;
 
 /// The evidence of the counts or of the lag, whichever is stronger.
 pub fn evidence(c: &Context) -> Evidence {
@@ -63,8 +65,9 @@ fn tau_of_1_hz(dn: f64) -> f64 {
 /// OFF; pooled it read 0.21, a threshold level error); a 117 Hz cutoff in a 30 DN scene
 /// (6023) lags 0.24, a 20 Hz one (6006) 2.7. In fast motion the re-simulation's timing
 /// error is larger than this and not yet measured: draw 6029 (a rotation at 570 px/s, 7 px
-/// a frame, no bandwidth) lags 0.76 of an interval more at 57 DN than at 113 DN, and the
-/// search keeps a 194 Hz cutoff.
+/// a frame, no bandwidth) lagged 0.76 of an interval more at 57 DN than at 113 DN in the
+/// mean of its polarities, the OFF events alone late (its OFF threshold fitted 31 % low),
+/// and the search kept a 194 Hz cutoff; the lag both polarities show is none.
 pub const LAG_RELEVANT: f64 = 0.2;
 
 /// One reading of the lag: a darker bin's lag, on its own or over the brightest bin's.
@@ -74,12 +77,14 @@ struct LagReading {
     z: f64,
     cutoff_hz: f64,
     against: Option<usize>,
+    /// The dark bin's OFF and ON median lags, seconds.
+    polarities_s: (f64, f64),
 }
 
 /// The lag part (see the module docs); `None` without two intensity bins of paired events.
 fn lag_evidence(c: &Context) -> Option<Evidence> {
     let g = c.geometry;
-    let bins: Vec<(usize, BinLag)> = c
+    let bins: Vec<(usize, BinDelay)> = c
         .sim
         .delay_of(g, c.subset)
         .iter()
@@ -91,23 +96,29 @@ fn lag_evidence(c: &Context) -> Option<Evidence> {
     let relevant_s = LAG_RELEVANT * g.frame_interval_s;
     let best = bins[..bins.len() - 1]
         .iter()
-        .flat_map(|&(dark, l)| {
+        .flat_map(|&(dark, d)| {
+            let (l, reference) = (d.common, reference.common);
+            let polarities_s = (d.off_s, d.on_s);
             let own = LagReading {
                 dark,
                 excess_s: l.median_s,
                 z: l.median_s / l.standard_error_s,
                 cutoff_hz: tau(dark) / l.median_s,
                 against: None,
+                polarities_s,
             };
+            // over the brightest bin only where it lags too (a dim scene): a brightest bin
+            // ahead of the model would add its lead to the dark bin's lag
             let excess_s = l.median_s - reference.median_s;
-            let over = LagReading {
+            let over = (reference.median_s > 0.0).then_some(LagReading {
                 dark,
                 excess_s,
                 z: excess_s / l.standard_error_s.hypot(reference.standard_error_s),
                 cutoff_hz: (tau(dark) - tau(bright)) / excess_s,
                 against: Some(bright),
-            };
-            [own, over]
+                polarities_s,
+            });
+            std::iter::once(own).chain(over)
         })
         .max_by(|a, b| {
             (a.excess_s > relevant_s)
@@ -116,19 +127,30 @@ fn lag_evidence(c: &Context) -> Option<Evidence> {
         })?;
     let centre = |bin: usize| g.intensity_centres[bin];
     let text = match best.against {
+        _ if best.excess_s <= 0.0 => format!(
+            "no lag that the recording's ON and OFF events both show (at {:.0} DN OFF {:+.2} ms, ON {:+.2} ms: a delay moves both, a threshold the model puts off one)",
+            centre(best.dark),
+            best.polarities_s.0 * 1e3,
+            best.polarities_s.1 * 1e3,
+        ),
         Some(bright) => format!(
-            "the recording lags the model by {:.2} ms more at {:.0} DN than at {:.0} DN ({:.1} standard errors), as a cutoff of {:.0} Hz at white would",
+            "the recording's ON and OFF events both lag the model by {:.2} ms more at {:.0} DN than at {:.0} DN ({:.1} standard errors; OFF {:+.2} ms, ON {:+.2} ms at {:.0} DN), as a cutoff of {:.0} Hz at white would",
             best.excess_s * 1e3,
             centre(best.dark),
             centre(bright),
             best.z,
+            best.polarities_s.0 * 1e3,
+            best.polarities_s.1 * 1e3,
+            centre(best.dark),
             best.cutoff_hz
         ),
         None => format!(
-            "the recording lags the model by {:.2} ms at {:.0} DN ({:.1} standard errors), as a cutoff of {:.0} Hz at white would",
+            "the recording's ON and OFF events both lag the model by {:.2} ms at {:.0} DN ({:.1} standard errors; OFF {:+.2} ms, ON {:+.2} ms), as a cutoff of {:.0} Hz at white would",
             best.excess_s * 1e3,
             centre(best.dark),
             best.z,
+            best.polarities_s.0 * 1e3,
+            best.polarities_s.1 * 1e3,
             best.cutoff_hz
         ),
     };
@@ -336,7 +358,11 @@ mod tests {
         let f = Fixture::new(&scene(), &recording, &model);
         let e = evidence(&f.context());
         assert!(e.calls_for(), "{e:?}");
-        assert!(e.text.starts_with("the recording lags the model"), "{e:?}");
+        assert!(
+            e.text
+                .starts_with("the recording's ON and OFF events both lag"),
+            "{e:?}"
+        );
         // the start: 1 / slope, within the offsets' 0.25 ms bins
         let start = e.start.unwrap();
         assert!((start - 150.0).abs() < 8.0, "{start}");
@@ -398,24 +424,45 @@ mod tests {
                 .delay_of(&f.geometry, Subset::Fit)
                 .iter()
                 .flatten()
-                .map(|l| l.median_s)
+                .map(|l| l.common.median_s)
                 .collect()
         };
         let read = delays(&delayed_events(|_, _| 1.0, level));
         assert_eq!(read.len(), 4, "{read:?}");
         // within the offsets' 0.25 ms bins
         assert!(read.iter().all(|d| d.abs() < 0.25e-3), "{read:?}");
-        // the ON events' delays alone are a delay growing with brightness, half of them in
-        // each bin's mean: 3 ms at 202 DN
-        let f = Fixture::new(
-            &scene(),
-            &delayed_events(|_, _| 1.0, |dn, on| if on { level(dn, on) } else { 0.0 }),
-            &model,
-        );
-        let brightest = f.sim.delay_of(&f.geometry, Subset::Fit)[5]
-            .unwrap()
-            .median_s;
-        assert!((brightest - 3e-3).abs() < 0.25e-3, "{brightest}");
+        // the ON events' delays alone are not a delay both polarities show: none beyond
+        // the OFF events' own (on time, within the offsets' 0.25 ms bins), and no bandwidth
+        let on_late = delayed_events(|_, _| 1.0, |dn, on| if on { level(dn, on) } else { 0.0 });
+        let f = Fixture::new(&scene(), &on_late, &model);
+        assert!(!evidence(&f.context()).calls_for());
+        let brightest = f.sim.delay_of(&f.geometry, Subset::Fit)[5].unwrap();
+        assert!((brightest.on_s - 6e-3).abs() < 0.25e-3, "{brightest:?}");
+        assert!(brightest.common.median_s.abs() < 0.25e-3, "{brightest:?}");
+    }
+
+    #[test]
+    fn a_lag_of_one_polarity_alone_is_not_a_bandwidth() {
+        // OFF events 6 ms late at 28 DN and 1.5 ms from 112 DN, ON events 1 ms early (the
+        // model's OFF threshold off, coverage draw 6029): no lag both polarities show
+        let model = events(|_, _| 1.0);
+        let off_late = |dn: f64, on: bool| {
+            if on {
+                -0.001
+            } else {
+                0.006 * 28.0 / dn.min(112.0)
+            }
+        };
+        let f = Fixture::new(&scene(), &delayed_events(|_, _| 1.0, off_late), &model);
+        let e = evidence(&f.context());
+        assert!(!e.calls_for(), "{e:?}");
+        let none = "no lag that the recording's ON and OFF events both show";
+        assert!(e.text.contains(none), "{e:?}");
+        // the same lags in both polarities are a bandwidth's
+        let both = |dn: f64, _| 0.006 * 28.0 / dn.min(112.0);
+        let f = Fixture::new(&scene(), &delayed_events(|_, _| 1.0, both), &model);
+        let e = evidence(&f.context());
+        assert!(e.calls_for() && e.score > 20.0, "{e:?}");
     }
 
     #[test]

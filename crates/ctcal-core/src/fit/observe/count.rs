@@ -67,7 +67,7 @@ impl Observed {
             masked,
             rayon::current_num_threads(),
         );
-        o.lag = real.histogram(events, &support, geometry, masked);
+        o.lag = real.histograms(events, &support, geometry, masked);
         o
     }
 
@@ -122,7 +122,7 @@ impl Observed {
             pixel_counts: vec![0; blocks * g.sensor.pixels()],
             polarity: vec![[0; 2]; blocks],
             timeline: vec![0; ((g.span.1 - g.span.0) / TIMELINE_BIN_US).max(0) as usize + 1],
-            lag: Vec::new(),
+            lag: Default::default(),
         }
     }
 
