@@ -23,15 +23,16 @@
 //! ([`crate::fit::observe::lag`], which pairs the starts of bursts, so that a delay of
 //! tens of milliseconds does not pair with the next event). Evidence: a darker intensity
 //! bin than the brightest seen whose lag, on its own or over the brightest bin's where
-//! that lags too (the whole scene dim), is largest in standard errors; it matters when the lag is
-//! above a fifth of a frame interval ([`LAG_RELEVANT`]). The search starts at the cutoff
+//! that lags too (the whole scene dim), is largest in standard errors; it matters when the
+//! lag is above a fifth of a frame interval ([`LAG_RELEVANT`]). The search starts at the cutoff
 //! that explains it, `tau_1(dark) / lag` or `(tau_1(dark) - tau_1(bright)) / excess`. The
 //! brightest bin lagging alone is not read as a bandwidth, and a lag alike at every
 //! intensity (a frame timestamp offset) that calls for the search is not kept by it: the
 //! distance's `lag` component is taken about its mean.
-//! A lag beyond half the burst gap pairs with the next burst and reads smaller (coverage
-//! draw 6006: the darkest bin, whose time constant is 85 ms, lagged least), so the lag's
-//! shape is not fitted here. The evidence is the stronger of the two.
+//! A filter lags a ramp by its time constant only where the ramp is long against it, and a
+//! lag near half the burst gap (100 ms) can pair with the next burst: coverage draw 6006's
+//! darkest bin (time constant 85 ms) reads 38 to 44 ms. So the lag's shape is not fitted
+//! here. The evidence is the stronger of the two.
 
 use super::{Context, Effect, Evidence};
 use crate::fit::metric::cell_ratios;
@@ -63,11 +64,10 @@ fn tau_of_1_hz(dn: f64) -> f64 {
 /// timing error between frames. Fitted models without a bandwidth on coverage draws that
 /// have none left 0.08 (draw 6017, pooled polarities) and 0.04 (6014, the mean of ON and
 /// OFF; pooled it read 0.21, a threshold level error); a 117 Hz cutoff in a 30 DN scene
-/// (6023) lags 0.24, a 20 Hz one (6006) 2.7. In fast motion the re-simulation's timing
-/// error is larger than this and not yet measured: draw 6029 (a rotation at 570 px/s, 7 px
-/// a frame, no bandwidth) lagged 0.76 of an interval more at 57 DN than at 113 DN in the
-/// mean of its polarities, the OFF events alone late (its OFF threshold fitted 31 % low),
-/// and the search kept a 194 Hz cutoff; the lag both polarities show is none.
+/// (6023) lags 0.24, a 20 Hz one (6006) 2.7. Draw 6029 (a rotation at 570 px/s, 7 px a
+/// frame, no bandwidth) lagged 0.76 of an interval more at 57 DN than at 113 DN in the mean
+/// of its polarities, its OFF events alone late (its OFF threshold fitted 31 % low), and the
+/// search kept a 194 Hz cutoff; the lag both polarities show is none.
 pub const LAG_RELEVANT: f64 = 0.2;
 
 /// One reading of the lag: a darker bin's lag, on its own or over the brightest bin's.

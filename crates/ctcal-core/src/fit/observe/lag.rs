@@ -37,12 +37,12 @@
 //! lag of +4.0 ms at 113 DN and added a 1437 Hz bandwidth). The ON and OFF thresholds'
 //! level errors are separate, and one can be tens of per cent where the other is right
 //! (draw 6029, a rotation at 572 px/s whose OFF threshold was fitted 0.466 for 0.678:
-//! OFF burst starts +33 to +39 ms against the fitted model, ON ones -5 to +1 ms). The delay of
-//! a bin ([`delay_of`]), which the bandwidth's evidence reads, is therefore the delay both
-//! polarities show: the smaller of their median offsets where the two have one sign, none
-//! where they differ. The distance's `lag` component keeps the pooled median: it measures
-//! any difference between model and recording, and a level error is one (it vanishes at
-//! the right thresholds).
+//! OFF burst starts +33 to +39 ms against the fitted model, ON ones -5 to +1 ms). The
+//! delay of a bin ([`delay_of`]), which the bandwidth's evidence reads, is therefore the
+//! delay both polarities show: the smaller of their median offsets where the two have one
+//! sign, none where they differ. The distance's `lag` component keeps the pooled median:
+//! it measures any difference between model and recording, and a level error is one (it
+//! vanishes at the right thresholds).
 //!
 //! The statistic pairs the recording's events with a simulation's; it is computed for
 //! simulations only ([`LagKeys`] holds the recording's side once).
@@ -62,9 +62,9 @@ pub const LAG_BIN_US: TimeUs = 250;
 pub const LAG_BINS: usize = (2 * LAG_WINDOW_US / LAG_BIN_US) as usize;
 /// Paired events an intensity bin needs for its median offset to count.
 pub const MIN_LAG_EVENTS: u32 = 50;
-/// A burst of a pixel's events of one polarity starts after this long without one; only
-/// burst starts are paired (see the module docs). Twice the largest delay paired without
-/// ambiguity.
+/// A burst of a pixel's events of one polarity starts after this long without one
+/// ([`Pairing::BurstStarts`], see the module docs): twice the largest delay it pairs
+/// without ambiguity.
 pub const ONSET_GAP_US: TimeUs = LAG_WINDOW_US;
 
 /// Whether each of the time-sorted `events` starts a burst: its pixel gave no event of its
