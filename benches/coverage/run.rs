@@ -80,13 +80,15 @@ pub fn run_method(
 /// (the IJRR text a case is written in has no field for it).
 pub fn command_line(method: Method, input: &Path, case: &CaseSpec) -> Vec<OsString> {
     let mut args: Vec<OsString> = match method {
-        Method::Fit => vec!["fit".into()],
+        Method::Fit | Method::FitEvents => vec!["fit".into()],
         Method::EpppsEvents => vec!["estimate".into(), "eppps".into()],
         estimate => vec!["estimate".into(), estimate.name().into()],
     };
     args.push(input.as_os_str().to_owned());
-    if method == Method::EpppsEvents {
-        args.push("--ignore-frames".into());
+    match method {
+        Method::EpppsEvents => args.push("--ignore-frames".into()),
+        Method::FitEvents => args.push("--no-frames".into()),
+        _ => {}
     }
     let exposure_s = match &case.recording {
         RecordingSpec::Scene { scene } => scene.aps.as_ref().map(|a| a.exposure_s),

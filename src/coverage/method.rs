@@ -20,6 +20,9 @@ pub enum Method {
     Screen,
     /// `ctcal fit`: every simulator parameter.
     Fit,
+    /// `ctcal fit --no-frames`: the same from the events alone (what a sensor without
+    /// frames gets: thresholds through eppps' natural-image prior, no scene simulated).
+    FitEvents,
 }
 
 /// The parameters an estimator reports.
@@ -40,12 +43,13 @@ const FITTED: [&str; 10] = [
 ];
 
 impl Method {
-    pub const ALL: [Method; 5] = [
+    pub const ALL: [Method; 6] = [
         Method::Aps,
         Method::Eppps,
         Method::EpppsEvents,
         Method::Screen,
         Method::Fit,
+        Method::FitEvents,
     ];
 
     pub fn name(self) -> &'static str {
@@ -55,6 +59,7 @@ impl Method {
             Method::EpppsEvents => "eppps_events",
             Method::Screen => "screen",
             Method::Fit => "fit",
+            Method::FitEvents => "fit_events",
         }
     }
 
@@ -68,10 +73,13 @@ impl Method {
     }
 
     pub fn parameters(self) -> &'static [&'static str] {
-        match self {
-            Method::Fit => &FITTED,
-            _ => &THRESHOLDS,
-        }
+        if self.is_fit() { &FITTED } else { &THRESHOLDS }
+    }
+
+    /// `fit`, with or without the frames: reports every simulator parameter and the
+    /// effects it added.
+    pub fn is_fit(self) -> bool {
+        matches!(self, Method::Fit | Method::FitEvents)
     }
 }
 

@@ -136,9 +136,10 @@ pub fn extract(method: Method, output: &Value) -> BTreeMap<String, Reported> {
         .parameters()
         .iter()
         .map(|&key| {
-            let reported = match method {
-                Method::Fit => fit_parameter(output, key),
-                _ => estimate_parameter(output, key),
+            let reported = if method.is_fit() {
+                fit_parameter(output, key)
+            } else {
+                estimate_parameter(output, key)
             };
             (key.to_string(), reported)
         })

@@ -115,13 +115,19 @@ fn detection(s: &Summary, out: &mut String) {
         return;
     }
     out.push_str("\n## Effect detection by the fit\n\n");
-    out.push_str("| effect | cases with it | added | cases without it | added anyway | of those, claimed (interval excludes none) |\n");
-    out.push_str("|---|---|---|---|---|---|\n");
+    out.push_str("| method | effect | cases with it | added | cases without it | added anyway | of those, claimed (interval excludes none) |\n");
+    out.push_str("|---|---|---|---|---|---|---|\n");
     for d in &s.detection {
         let _ = writeln!(
             out,
-            "| {} | {} | {} | {} | {} | {} |",
-            d.effect, d.present, d.detected, d.absent, d.false_alarms, d.false_claims
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            d.method.name(),
+            d.effect,
+            d.present,
+            d.detected,
+            d.absent,
+            d.false_alarms,
+            d.false_claims
         );
     }
 }

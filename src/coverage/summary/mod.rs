@@ -18,9 +18,11 @@ use super::reported::Reported;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
-/// How often the fit added an effect that was there, and one that was not.
+/// How often a fit (with frames, or `fit_events` without) added an effect that was there,
+/// and one that was not.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Detection {
+    pub method: Method,
     pub effect: String,
     /// Successful fits of cases with the effect, and how many added it.
     pub present: usize,
@@ -108,14 +110,22 @@ fn methods(records: &[RunRecord]) -> Vec<Method> {
 }
 
 fn detection(records: &[RunRecord]) -> Vec<Detection> {
+    [Method::Fit, Method::FitEvents]
+        .into_iter()
+        .flat_map(|method| detection_of(records, method))
+        .collect()
+}
+
+fn detection_of(records: &[RunRecord], method: Method) -> Vec<Detection> {
     let fits: Vec<&RunRecord> = records
         .iter()
-        .filter(|r| r.method == Method::Fit && r.failure().is_none() && r.truth.is_some())
+        .filter(|r| r.method == method && r.failure().is_none() && r.truth.is_some())
         .collect();
     DETECTED
         .iter()
         .map(|&effect| {
             let mut d = Detection {
+                method,
                 effect: effect.to_string(),
                 present: 0,
                 detected: 0,
@@ -295,6 +305,12 @@ mod tests {
             },
         );
         let d = hot(std::slice::from_ref(&record));
+        assert_eq!((d.absent, d.false_alarms, d.false_claims), (1, 1, 0));
+        // the same run without frames counts in its own rows
+        record.method = Method::FitEvents;
+        let rows = detection(std::slice::from_ref(&record));
+        assert!(rows.iter().all(|d| d.method == Method::FitEvents));
+        let d = rows.iter().find(|d| d.effect == "hot_pixels").unwrap();
         assert_eq!((d.absent, d.false_alarms, d.false_claims), (1, 1, 0));
         // a bandwidth limit's absence is an infinite cutoff: only an open upper end covers it
         assert_eq!(

@@ -1,7 +1,7 @@
 //! Scoring one parameter of one run against the truth: which population it belongs to,
 //! and whether its interval covered the true value.
 
-use crate::coverage::method::{Method, effect_of};
+use crate::coverage::method::effect_of;
 use crate::coverage::record::RunRecord;
 use crate::coverage::reported::Reported;
 use crate::coverage::truth::Truth;
@@ -31,7 +31,7 @@ pub fn in_population(record: &RunRecord, parameter: &str) -> bool {
     let Some(truth) = &record.truth else {
         return true;
     };
-    let effect_needed = record.method == Method::Fit && parameter != "ct_sigma";
+    let effect_needed = record.method.is_fit() && parameter != "ct_sigma";
     truth.value(parameter).is_some()
         && (!effect_needed || effect_of(parameter).is_none_or(|e| truth.has_effect(e)))
 }
