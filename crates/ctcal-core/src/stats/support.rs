@@ -60,6 +60,102 @@ pub fn supported_two_sided(events: &EventChunk, sensor: Sensor, window_us: TimeU
     flags
 }
 
+/// [`supported_two_sided`] over a wider neighbourhood: the `(2 radius + 1)^2 - 1` pixels
+/// within `radius` (Chebyshev distance) of the event's own. Radius 1 is the 8-neighbourhood
+/// above; a wider one also supports the scene's events that fire without any of their 8
+/// neighbours (an edge whose change crosses a pixel's threshold but not its neighbours',
+/// at high thresholds and under mismatch), which a noise event, independent of its
+/// surroundings, is not more likely to have near it than any moment of its pixel.
+pub fn supported_two_sided_within(
+    events: &EventChunk,
+    sensor: Sensor,
+    window_us: TimeUs,
+    radius: usize,
+) -> Vec<bool> {
+    if radius == 1 {
+        return supported_two_sided(events, sensor, window_us);
+    }
+    wide_support(events, sensor, window_us, radius)
+}
+
+/// [`supported_two_sided_within`] by one pass each way over a grid with a `radius` border,
+/// looking at every neighbour (the 8-neighbourhood's passes are tuned, this one is not).
+fn wide_support(
+    events: &EventChunk,
+    sensor: Sensor,
+    window_us: TimeUs,
+    radius: usize,
+) -> Vec<bool> {
+    let grid = WideGrid::new(events, sensor, radius);
+    let mut flags = vec![false; events.len()];
+    let n = events.len();
+    grid.sweep(
+        &events.t,
+        0..n,
+        TimeUs::MIN,
+        |mark, t| mark >= t - window_us,
+        &mut flags,
+    );
+    grid.sweep(
+        &events.t,
+        (0..n).rev(),
+        TimeUs::MAX,
+        |mark, t| mark <= t + window_us,
+        &mut flags,
+    );
+    flags
+}
+
+/// Every event's cell in a grid with a `radius` border, and the offsets of the cells
+/// around a cell (its own left out).
+struct WideGrid {
+    cells: Vec<usize>,
+    offsets: Vec<isize>,
+    size: usize,
+}
+
+impl WideGrid {
+    fn new(events: &EventChunk, sensor: Sensor, radius: usize) -> Self {
+        let stride = sensor.width as usize + 2 * radius;
+        let r = radius as isize;
+        Self {
+            cells: events
+                .x
+                .iter()
+                .zip(&events.y)
+                .map(|(&x, &y)| (y as usize + radius) * stride + x as usize + radius)
+                .collect(),
+            offsets: (-r..=r)
+                .flat_map(|dy| (-r..=r).map(move |dx| (dy, dx)))
+                .filter(|&d| d != (0, 0))
+                .map(|(dy, dx)| dy * stride as isize + dx)
+                .collect(),
+            size: stride * (sensor.height as usize + 2 * radius),
+        }
+    }
+
+    /// Walks the events in `order`, flagging one where a neighbour cell's mark (the time of
+    /// its last event walked, `never` before any) is `near` its time; then marks its cell.
+    fn sweep(
+        &self,
+        times: &[TimeUs],
+        order: impl Iterator<Item = usize>,
+        never: TimeUs,
+        near: impl Fn(TimeUs, TimeUs) -> bool,
+        flags: &mut [bool],
+    ) {
+        let mut marks = vec![never; self.size];
+        for i in order {
+            let (t, c) = (times[i], self.cells[i]);
+            flags[i] |= self
+                .offsets
+                .iter()
+                .any(|&o| near(marks[c.wrapping_add_signed(o)], t));
+            marks[c] = t;
+        }
+    }
+}
+
 /// Which way a pass walks the events: backwards it reads them from the last, with times
 /// negated (so that they still grow).
 #[derive(Clone, Copy, PartialEq)]
@@ -188,6 +284,44 @@ mod tests {
     use crate::events::Event;
     use rand::{RngExt, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
+
+    #[test]
+    fn a_wider_neighbourhood_supports_what_the_eight_neighbours_do_and_more() {
+        let sensor = Sensor::new(30, 20);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let mut t = 0;
+        let events: EventChunk = (0..4000)
+            .map(|_| {
+                t += rng.random_range(0..400);
+                Event {
+                    t,
+                    x: rng.random_range(0..30),
+                    y: rng.random_range(0..20),
+                    on: rng.random(),
+                }
+            })
+            .collect();
+        let eight = supported_two_sided(&events, sensor, 3_000);
+        assert_eq!(wide_support(&events, sensor, 3_000, 1), eight);
+        let wider = supported_two_sided_within(&events, sensor, 3_000, 2);
+        assert!(eight.iter().zip(&wider).all(|(&a, &b)| !a || b));
+        let (n8, n24) = (
+            eight.iter().filter(|&&s| s).count(),
+            wider.iter().filter(|&&s| s).count(),
+        );
+        assert!(n24 > n8 + 200, "{n8} -> {n24}");
+        // a neighbour two pixels away supports at radius 2 only, before or after
+        let pair: EventChunk = [(0, 5, 5), (2_000, 7, 3), (50_000, 0, 0)]
+            .into_iter()
+            .map(|(t, x, y)| Event { t, x, y, on: true })
+            .collect();
+        let s = Sensor::new(10, 10);
+        assert_eq!(supported_two_sided_within(&pair, s, 3_000, 1), [false; 3]);
+        assert_eq!(
+            supported_two_sided_within(&pair, s, 3_000, 2),
+            [true, true, false]
+        );
+    }
 
     #[test]
     fn a_neighbour_within_the_window_supports_an_event() {

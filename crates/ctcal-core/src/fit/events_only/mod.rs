@@ -5,8 +5,10 @@
 //!
 //! - **Hot pixels**, named: far above their neighbours' counts
 //!   ([`crate::stats::hot_pixels`]), each with its rate and ON share.
-//! - **Shot noise and leak**: isolated events (no neighbour within ±10 ms) over the time
-//!   their pixel was not covered by a neighbour's event ([`measure`]). Shot noise is
+//! - **Shot noise and leak**: isolated events (no event within ±10-300 ms at the pixels
+//!   within 1-3 px, the narrowest support after which a wider one no longer lowers the
+//!   rate) over the time their pixel was not covered by a neighbour's event ([`measure`]):
+//!   an upper bound where the rate was still falling. Shot noise is
 //!   symmetric in polarity (v2e, Hu et al. 2021), leak fires ON only (the reference drifts),
 //!   so the OFF rate gives the shot noise and the ON excess the leak.
 //! - **Refractory period**: the lower edge of the same-pixel intervals ([`refractory`]).
@@ -41,7 +43,7 @@ use crate::estimate::{CtEstimate, Interval, Progress};
 use crate::stats::hot_pixels::{HotPixel, find_hot_pixels};
 use crate::stats::robust::sample_std_dev;
 use blocks::Blocks;
-use measure::{BlockMeasure, Measuring};
+use measure::{BlockMeasure, Isolation, Measuring};
 use model::Reference;
 use serde::Serialize;
 use steps::Judging;
@@ -79,9 +81,11 @@ pub struct EventsOnly {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub simulated_back_why: Option<String>,
     /// Pixel-seconds of quiet, uncovered time the rates rest on (fit blocks), and the
-    /// support window that leaves the scene's own events out.
+    /// support window and radius that leave the scene's own events out.
     pub quiet_pixel_seconds: f64,
     pub support_window_ms: f64,
+    /// The neighbourhood's radius (Chebyshev, px) within which an event counts as support.
+    pub support_radius_px: usize,
     /// The timestamps' common step, µs.
     pub timestamp_step_us: u32,
     /// The lower edge of the same-pixel intervals (fit blocks), µs.
@@ -110,10 +114,11 @@ pub(super) struct FitRun {
     trains: Vec<HotTrain>,
     /// The fraction and median rate of the named hot pixels, with their intervals.
     hot_found: hot_excess::HotExcess,
-    /// Isolated-event rates (OFF, ON) under the chosen support window.
+    /// Isolated-event rates (OFF, ON) under the chosen support.
     noise: [Option<(f64, f64)>; 2],
-    window: usize,
-    /// The rate was still falling with the window where quiet time ran out: an upper bound.
+    isolation: Isolation,
+    /// The rate was still falling with the window or the radius where quiet time ran out
+    /// (or at the widest radius): an upper bound.
     noise_still_falling: bool,
     edge: Option<refractory::Edge>,
     /// The timestamps' common step, µs (1: no grid).
@@ -164,7 +169,7 @@ pub(super) fn fit_from_events(
         role: &blocks.role,
         reference: Reference {
             edge_us: None,
-            window: 0,
+            isolation: Isolation::default(),
         },
     };
     let step = refractory::timestamp_step(events);
@@ -172,7 +177,7 @@ pub(super) fn fit_from_events(
     let judging = Judging {
         reference: Reference {
             edge_us: run.edge.as_ref().map(|e| e.edge_us),
-            window: run.window,
+            isolation: run.isolation,
         },
         ..judging
     };
@@ -286,7 +291,7 @@ fn fit_run(
         .flat_map(|b| b.intervals.iter().copied())
         .collect();
     let edge = refractory::edge(&mut intervals, timestamp_step_us);
-    let (window, noise_still_falling) = measure::choose_window(&fit);
+    let (isolation, noise_still_falling) = measure::choose_isolation(&fit);
     let ratio = |b: &[&BlockMeasure]| {
         let (on, off) = b.iter().fold((0u64, 0u64), |(a, c), m| {
             (a + m.signal_on, c + m.signal_off)
@@ -315,15 +320,15 @@ fn fit_run(
         trains,
         hot_found,
         noise: [
-            BlockMeasure::isolated_rate(&fit, window, false),
-            BlockMeasure::isolated_rate(&fit, window, true),
+            BlockMeasure::isolated_rate(&fit, isolation, false),
+            BlockMeasure::isolated_rate(&fit, isolation, true),
         ],
-        window,
+        isolation,
         noise_still_falling,
         edge,
         timestamp_step_us,
         balance,
-        quiet_pixel_seconds: BlockMeasure::isolated(&fit, window).pixel_seconds,
+        quiet_pixel_seconds: BlockMeasure::isolated(&fit, isolation).pixel_seconds,
         signal_rate_hz: fit
             .iter()
             .map(|b| b.signal_rate_hz * b.seconds)

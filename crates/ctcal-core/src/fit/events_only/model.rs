@@ -7,7 +7,7 @@
 //! predicts no isolated events, no hot pixels, a smooth interval density down to zero and
 //! balanced polarities.
 
-use super::measure::BlockMeasure;
+use super::measure::{BlockMeasure, Isolation};
 use crate::fit::metric::{BACKGROUND_FLOOR_HZ, Components};
 
 /// The distance's name, as reported.
@@ -48,8 +48,8 @@ impl NoiseModel {
 #[derive(Clone, Copy, Debug)]
 pub struct Reference {
     pub edge_us: Option<f64>,
-    /// The support window the noise is measured under ([`super::measure::choose_window`]).
-    pub window: usize,
+    /// The support the noise is measured under ([`super::measure::choose_isolation`]).
+    pub isolation: Isolation,
 }
 
 /// What a model says the blocks measure: the isolated-event rates, the named hot pixels'
@@ -94,8 +94,8 @@ pub fn compare(
 ) -> Components {
     let log = |p: f64, m: f64, floor: f64| ((p + floor) / (m + floor)).ln();
     let background = match (
-        BlockMeasure::isolated_rate(blocks, reference.window, true),
-        BlockMeasure::isolated_rate(blocks, reference.window, false),
+        BlockMeasure::isolated_rate(blocks, reference.isolation, true),
+        BlockMeasure::isolated_rate(blocks, reference.isolation, false),
     ) {
         (Some((on, on_se)), Some((off, off_se))) => {
             // rates are told apart down to twice their standard error on these blocks
@@ -194,7 +194,7 @@ mod tests {
         let b = block();
         let reference = Reference {
             edge_us: Some(1000.0),
-            window: 0,
+            isolation: Isolation::default(),
         };
         let exact = NoiseModel {
             noise_on_hz: 3.0,

@@ -5,7 +5,7 @@
 use super::blocks::Blocks;
 use super::candidates::{on_excess, symmetric_rate};
 use super::measure::Measuring;
-use super::measure::{BlockMeasure, SUPPORT_WINDOWS_US};
+use super::measure::{BlockMeasure, SUPPORT_RADII_PX, SUPPORT_WINDOWS_US};
 use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, compare, distance};
 use super::simulate_back::{Replaying, simulated};
 use super::steps::Judging;
@@ -218,7 +218,7 @@ fn test_errors(t: &TestBlocks, model: &NoiseModel) -> TestErrors {
     let replaying = Replaying {
         measuring: &t.measuring,
         spans: &t.spans,
-        window: t.run.window,
+        isolation: t.run.isolation,
         trains: &t.run.trains,
         edge_us: reference.edge_us,
         seed: t.seed,
@@ -310,7 +310,8 @@ fn noise_params(
             );
         } else if kept("shot_noise") {
             params.shot_noise_rate_hz = Some(2.0 * rate);
-            uncertainties.insert("shot_noise_rate_hz".into(), dark_rate(2.0 * rate, 2.0 * se));
+            let dark = dark_rate(2.0 * rate, 2.0 * se);
+            uncertainties.insert("shot_noise_rate_hz".into(), down_to_none(dark, run));
             why.insert(
                 "shot_noise_bright_factor".into(),
                 "how the noise rate depends on brightness needs each pixel's intensity (grey frames); the rate given is the one at the recording's brightness".into(),
@@ -337,7 +338,8 @@ fn noise_params(
             );
         } else if kept("leak") {
             params.leak_rate_hz = Some(excess);
-            uncertainties.insert("leak_rate_hz".into(), Uncertain::positive(excess, Some(se)));
+            let leak = Uncertain::positive(excess, Some(se));
+            uncertainties.insert("leak_rate_hz".into(), down_to_none(leak, run));
         } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
             why.insert(
                 "leak_rate_hz".into(),
@@ -347,6 +349,17 @@ fn noise_params(
                 ),
             );
         }
+    }
+}
+
+/// A noise rate whose isolated events were still falling as the support grew
+/// ([`FitRun::noise_still_falling`]) is an upper bound: its interval reaches down to none.
+fn down_to_none(rate: Uncertain, run: &FitRun) -> Uncertain {
+    match rate.ci95 {
+        Some([_, hi]) if run.noise_still_falling => {
+            Uncertain::with_interval(rate.value, rate.standard_error, [Some(0.0), hi])
+        }
+        _ => rate,
     }
 }
 
@@ -451,14 +464,15 @@ fn details(
         ct_ratio_why,
         noise_on_hz: rate(run.noise[1]),
         noise_off_hz: rate(run.noise[0]),
-        noise_on_test_hz: BlockMeasure::isolated_rate(&test, run.window, true).map(|r| r.0),
+        noise_on_test_hz: BlockMeasure::isolated_rate(&test, run.isolation, true).map(|r| r.0),
         noise_upper_bound: run.noise_still_falling,
-        noise_off_test_hz: BlockMeasure::isolated_rate(&test, run.window, false).map(|r| r.0),
+        noise_off_test_hz: BlockMeasure::isolated_rate(&test, run.isolation, false).map(|r| r.0),
         predicted_error_before: f64::NAN,
         predicted_error_after: f64::NAN,
         simulated_back_why: None,
         quiet_pixel_seconds: run.quiet_pixel_seconds,
-        support_window_ms: SUPPORT_WINDOWS_US[run.window] as f64 / 1e3,
+        support_window_ms: run.isolation.window_us() as f64 / 1e3,
+        support_radius_px: run.isolation.radius_px(),
         timestamp_step_us: run.timestamp_step_us,
         interval_edge: run.edge.as_ref().map(|e| IntervalEdge {
             edge_us: e.edge_us,
@@ -499,9 +513,12 @@ fn assumptions(
             frames_unused.map_or("no grey frames".to_string(), |why| format!("grey frames not used ({why})"))
         ),
         format!(
-            "isolated events: no neighbour event within +-{} ms (the shortest of {:?} ms after which a longer window no longer lowers the rate: the scene's slow events are supported by then); their rate counts only the time no neighbour event covered, at pixels left uncovered at least {:.0} % of a block",
-            SUPPORT_WINDOWS_US[run.window] / 1000,
+            "isolated events: no event within +-{} ms at the {} pixels within {} px (the shortest of {:?} ms after which a longer window no longer lowers the rate: the scene's slow events are supported by then; then the narrowest of radii {:?} px after which a wider one no longer lowers it: the scene's events that fire without their 8 neighbours, an edge crossing one pixel's threshold and not theirs, are supported by then, while noise, independent of its surroundings, keeps its rate); their rate counts only the time no neighbour event covered, at pixels left uncovered at least {:.0} % of a block",
+            run.isolation.window_us() / 1000,
+            (2 * run.isolation.radius_px() + 1).pow(2) - 1,
+            run.isolation.radius_px(),
             SUPPORT_WINDOWS_US.map(|w| w / 1000),
+            SUPPORT_RADII_PX,
             100.0 * super::measure::QUIET_SHARE
         ),
         "shot noise fires ON and OFF equally and leak ON only (v2e, Hu et al. 2021): the OFF rate gives the shot noise (ON + OFF = twice it), the ON excess the leak".to_string(),
@@ -522,8 +539,9 @@ fn assumptions(
     ]);
     if run.noise_still_falling {
         out.push(format!(
-            "the isolated-event rate was still falling as the support window grew ({} ms) when the scene's events left too little quiet time: part of the isolated events are the scene's own slow events, so the shot-noise (and leak) rates are upper bounds",
-            SUPPORT_WINDOWS_US[run.window] / 1000
+            "the isolated-event rate was still falling as the support grew ({} ms, {} px) when the scene's events left too little quiet time or the widest neighbourhood was reached: part of the isolated events are the scene's own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
+            run.isolation.window_us() / 1000,
+            run.isolation.radius_px()
         ));
     }
     if judging.reference.edge_us.is_none() {

@@ -18,7 +18,7 @@
 //! are the recording's own here: for those two components the model's prediction
 //! ([`super::model::Prediction::of`]) stands.
 
-use super::measure::{BlockMeasure, Measuring, SUPPORT_WINDOWS_US, measure};
+use super::measure::{BlockMeasure, Isolation, Measuring, SUPPORT_WINDOWS_US, measure};
 use super::model::{NoiseModel, Prediction};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::fit::effects::hot_pixels::{self, HotTrain};
@@ -36,8 +36,8 @@ pub struct Replaying<'a> {
     pub measuring: &'a Measuring<'a>,
     /// The held-out blocks, in time order.
     pub spans: &'a [(TimeUs, TimeUs)],
-    /// The support window the noise is measured under (index into [`SUPPORT_WINDOWS_US`]).
-    pub window: usize,
+    /// The support the noise is measured under.
+    pub isolation: Isolation,
     /// The named hot pixels' trains (positions and ON shares; rates from the model).
     pub trains: &'a [HotTrain],
     /// The refractory period the model applies, µs.
@@ -60,7 +60,7 @@ pub fn simulated(r: &Replaying, model: &NoiseModel) -> Result<Prediction, String
         r.spans,
     );
     let blocks: Vec<&BlockMeasure> = blocks.iter().collect();
-    let rate = |on| BlockMeasure::isolated_rate(&blocks, r.window, on).map_or(0.0, |v| v.0);
+    let rate = |on| BlockMeasure::isolated_rate(&blocks, r.isolation, on).map_or(0.0, |v| v.0);
     let seconds: f64 = blocks.iter().map(|b| b.seconds).sum();
     let hot_rates = (0..r.trains.len())
         .map(|k| blocks.iter().map(|b| b.hot_events[k]).sum::<u64>() as f64 / seconds)
@@ -106,8 +106,12 @@ fn scene(r: &Replaying, ranges: &[(TimeUs, TimeUs)]) -> EventChunk {
             }
         }
     }
-    let support =
-        crate::stats::support::supported_two_sided(&all, m.sensor, SUPPORT_WINDOWS_US[r.window]);
+    let support = crate::stats::support::supported_two_sided_within(
+        &all,
+        m.sensor,
+        r.isolation.window_us(),
+        r.isolation.radius_px(),
+    );
     let mut out = EventChunk::with_capacity(all.len());
     for (i, _) in support.iter().enumerate().filter(|(_, s)| **s) {
         out.push(all.t[i], all.x[i], all.y[i], all.on[i]);
@@ -277,12 +281,12 @@ mod tests {
         let spans = [(10_000_000, 20_000_000)];
         let real = measure(&measuring, &spans);
         let real: Vec<&BlockMeasure> = real.iter().collect();
-        let (on, _) = BlockMeasure::isolated_rate(&real, 0, true).unwrap();
-        let (off, _) = BlockMeasure::isolated_rate(&real, 0, false).unwrap();
+        let (on, _) = BlockMeasure::isolated_rate(&real, Isolation::default(), true).unwrap();
+        let (off, _) = BlockMeasure::isolated_rate(&real, Isolation::default(), false).unwrap();
         let replaying = Replaying {
             measuring: &measuring,
             spans: &spans,
-            window: 0,
+            isolation: Isolation::default(),
             trains: &[],
             edge_us: None,
             seed: 3,
