@@ -61,6 +61,8 @@ pub const QUIET_SHARE: f64 = 0.5;
 #[derive(Clone, Debug, Default)]
 pub struct BlockMeasure {
     pub seconds: f64,
+    /// Kept pixels times seconds.
+    pub pixel_seconds: f64,
     /// Isolated events at quiet pixels, per support window and radius ([`Isolation`]).
     pub isolated: Vec<Isolated>,
     /// Supported events, ON and OFF (kept pixels).
@@ -129,61 +131,125 @@ fn falls(from: (f64, f64, f64), to: (f64, f64, f64)) -> bool {
     to.0 < from.0 - 2.0 * (from.1 * from.1 + to.1 * to.1).sqrt()
 }
 
+/// A wider support is judged only where it keeps this share of the first support's quiet
+/// time (less, and its rate is too uncertain to tell a fall from none).
+const JUDGED_QUIET: f64 = 0.2;
+
+/// Below this share of the fit blocks' pixel time left quiet, isolated events that no wider
+/// support could check are not taken for noise. Noise alone leaves a pixel uncovered
+/// `exp(-16 r W)` of the time (8 neighbours, ±W, `r` Hz ON + OFF), so quiet pixels (uncovered
+/// half the time) stay most of the sensor up to `r = ln 2 / (16 W)`, 4.3 Hz at 10 ms, and
+/// their share falls below a tenth only for noise of some 7 Hz; a scene that covers nearly
+/// every pixel nearly all the time leaves quiet only where its activity thins out, and the
+/// isolated events there are mostly its own: coverage draw 6024 (61 events per pixel per
+/// second, 0.2 % of the pixel time quiet) read 0.84 Hz a polarity where the shot noise is
+/// 0.025 Hz a polarity and the leak 0.80 Hz ON.
+pub const CONFIRMING_QUIET_SHARE: f64 = 0.1;
+
+/// Why the isolated-event rate is only an upper bound on the noise.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum UpperBound {
+    /// It was still falling as the support grew, where quiet time ran out or at the widest
+    /// radius.
+    StillFalling,
+    /// The scene left only `quiet_share` of the pixel time quiet, and no wider support kept
+    /// enough of it to check the rate ([`CONFIRMING_QUIET_SHARE`]).
+    Unconfirmed { quiet_share: f64 },
+}
+
+/// The support the noise is measured under, and whether a wider one confirmed it (was
+/// judged and did not lower the rate).
+struct Chosen {
+    index: usize,
+    still_falling: bool,
+    confirmed: bool,
+}
+
 /// The support window the noise is measured under (8 neighbours): the shortest after which
 /// a longer one no longer lowers the rate significantly (the scene's slow events are
 /// supported by then) while keeping a fifth of the shortest window's quiet time.
 /// `still_falling` when the rate was still falling where the quiet time ran out: the rate
 /// is then an upper bound.
-pub fn choose_window(fit: &[&BlockMeasure]) -> (usize, bool) {
+fn choose_window(fit: &[&BlockMeasure]) -> Chosen {
     let at = |window| Isolation { window, radius: 0 };
+    let mut chosen = Chosen {
+        index: 0,
+        still_falling: false,
+        confirmed: false,
+    };
     let Some(mut rate) = total_rate(fit, at(0)) else {
-        return (0, false);
+        return chosen;
     };
     let first = rate.2;
-    let mut chosen = 0;
     for k in 1..SUPPORT_WINDOWS_US.len() {
         let Some(next) = total_rate(fit, at(k)) else {
-            return (chosen, true);
+            chosen.still_falling = true;
+            return chosen;
         };
         if !falls(rate, next) {
-            return (chosen, false);
+            chosen.confirmed = next.2 >= JUDGED_QUIET * first;
+            return chosen;
         }
-        if next.2 < 0.2 * first {
-            return (chosen, true);
+        if next.2 < JUDGED_QUIET * first {
+            chosen.still_falling = true;
+            return chosen;
         }
-        (chosen, rate) = (k, next);
+        (chosen.index, rate) = (k, next);
     }
-    (chosen, false)
+    chosen
 }
 
 /// The support the noise is measured under: the window of [`choose_window`], then the
 /// narrowest neighbourhood after which a wider one no longer lowers the rate by two
-/// standard errors, keeping a fifth of the 8-neighbourhood's quiet time. `still_falling`
-/// (an upper bound) when the window's was, or when the rate fell at the last step that
-/// could be judged: at the widest radius, or where a wider one left too little quiet time.
+/// standard errors, keeping a fifth of the 8-neighbourhood's quiet time. An upper bound
+/// ([`UpperBound`]) when the window's rate was still falling, when the rate fell at the last
+/// step that could be judged (at the widest radius, or where a wider one left too little
+/// quiet time), or when no wider support could check it and the scene left less than
+/// [`CONFIRMING_QUIET_SHARE`] of the pixel time quiet.
 /// Coverage draw 6035 (no noise; a dim texture at 550 px/s, thresholds 0.54 / 0.61 under
 /// mismatch), fitted from its events, read 0.16 Hz of shot noise [0.15, 0.65] from events
 /// its 8 neighbours did not support: 0.21, 0.05 and 0.02 Hz per pixel (ON + OFF) at radii
 /// 1, 2 and 3, where draw 6016 (0.45 Hz of shot noise) reads 0.39 at radii 1 and 3.
-pub fn choose_isolation(fit: &[&BlockMeasure]) -> (Isolation, bool) {
-    let (window, still_falling) = choose_window(fit);
-    let mut chosen = Isolation { window, radius: 0 };
-    let Some(mut rate) = total_rate(fit, chosen).filter(|_| !still_falling) else {
-        return (chosen, still_falling);
+pub fn choose_isolation(fit: &[&BlockMeasure]) -> (Isolation, Option<UpperBound>) {
+    let window = choose_window(fit);
+    let mut chosen = Isolation {
+        window: window.index,
+        radius: 0,
+    };
+    if window.still_falling {
+        return (chosen, Some(UpperBound::StillFalling));
+    }
+    let Some(mut rate) = total_rate(fit, chosen) else {
+        return (chosen, None);
     };
     let first = rate.2;
+    let mut confirmed = window.confirmed;
     let mut fell = false;
     for radius in 1..SUPPORT_RADII_PX.len() {
-        let wider = Isolation { window, radius };
-        let Some(next) = total_rate(fit, wider).filter(|r| r.2 >= 0.2 * first) else {
-            return (chosen, fell);
+        let wider = Isolation {
+            window: window.index,
+            radius,
+        };
+        let Some(next) = total_rate(fit, wider).filter(|r| r.2 >= JUDGED_QUIET * first) else {
+            break;
         };
         if !falls(rate, next) {
-            return (chosen, false);
+            confirmed = true;
+            fell = false;
+            break;
         }
         (chosen, rate, fell) = (wider, next, true);
     }
-    (chosen, fell)
+    if fell {
+        return (chosen, Some(UpperBound::StillFalling));
+    }
+    let pixel_seconds: f64 = fit.iter().map(|b| b.pixel_seconds).sum();
+    let quiet_share = rate.2 / pixel_seconds.max(1e-12);
+    let unconfirmed = !confirmed && quiet_share < CONFIRMING_QUIET_SHARE;
+    (
+        chosen,
+        unconfirmed.then_some(UpperBound::Unconfirmed { quiet_share }),
+    )
 }
 
 /// The recording, split for measuring.
@@ -247,6 +313,7 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
             let seconds = (span.1 - span.0) as f64 * 1e-6;
             BlockMeasure {
                 seconds,
+                pixel_seconds: kept_pixels as f64 * seconds,
                 hot_events,
                 pixel_rate_hz: range.len() as f64 / (kept_pixels as f64 * seconds),
                 ..BlockMeasure::default()
@@ -415,7 +482,7 @@ mod tests {
         );
         let refs: Vec<&BlockMeasure> = blocks.iter().collect();
         let (iso, still_falling) = choose_isolation(&refs);
-        assert_eq!((iso, still_falling), (Isolation::default(), false));
+        assert_eq!((iso, still_falling), (Isolation::default(), None));
         let (on, on_se) = BlockMeasure::isolated_rate(&refs, iso, true).unwrap();
         let (off, off_se) = BlockMeasure::isolated_rate(&refs, iso, false).unwrap();
         // ~1090 quiet pixels x 20 s: 2 Hz +- 0.01, 1 Hz +- 0.007
@@ -482,7 +549,7 @@ mod tests {
         let blocks = measure(&m, &spans);
         let refs: Vec<&BlockMeasure> = blocks.iter().collect();
         let (iso, still_falling) = choose_isolation(&refs);
-        assert_eq!((iso.radius_px(), still_falling), (2, false), "{iso:?}");
+        assert_eq!((iso.radius_px(), still_falling), (2, None), "{iso:?}");
         let eight = Isolation { radius: 0, ..iso };
         let (narrow, _) = BlockMeasure::isolated_rate(&refs, eight, true).unwrap();
         let (on, on_se) = BlockMeasure::isolated_rate(&refs, iso, true).unwrap();
@@ -490,5 +557,52 @@ mod tests {
         assert!(narrow > 0.3, "{narrow}");
         assert!((on - 0.2).abs() < 4.0 * on_se, "{on} +- {on_se}");
         assert!((off - 0.2).abs() < 4.0 * off_se, "{off} +- {off_se}");
+    }
+
+    /// One block of 1,000 pixel-seconds whose isolated events are `rates` (ON + OFF, Hz)
+    /// over `quiet` pixel-seconds at each support (window-major, as [`Isolation::index`]).
+    fn block(rates: [f64; 12], quiet: [f64; 12]) -> BlockMeasure {
+        BlockMeasure {
+            seconds: 1.0,
+            pixel_seconds: 1000.0,
+            isolated: rates
+                .iter()
+                .zip(quiet)
+                .map(|(&r, q)| Isolated {
+                    on: (r * q / 2.0).round() as u64,
+                    off: (r * q / 2.0).round() as u64,
+                    pixel_seconds: q,
+                })
+                .collect(),
+            ..BlockMeasure::default()
+        }
+    }
+
+    /// A scene that leaves 0.3 % of the pixel time quiet (2 Hz of isolated events there)
+    /// and no wider support enough quiet time to check them: an upper bound. The same rates
+    /// over half the pixel time are the noise; and over 0.3 % they are too where a longer
+    /// window keeps enough quiet time and does not lower them.
+    #[test]
+    fn isolated_events_that_no_wider_support_checks_in_a_busy_scene_are_an_upper_bound() {
+        let rates = [2.0; 12];
+        let busy = [3.0, 0.3, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1];
+        let (iso, bound) = choose_isolation(&[&block(rates, busy)]);
+        assert_eq!(iso, Isolation::default());
+        match bound {
+            Some(UpperBound::Unconfirmed { quiet_share }) => {
+                assert!((quiet_share - 0.003).abs() < 1e-12, "{quiet_share}")
+            }
+            other => panic!("{other:?}"),
+        }
+        let calm = busy.map(|q| q * 500.0 / 3.0);
+        assert_eq!(
+            choose_isolation(&[&block(rates, calm)]),
+            (Isolation::default(), None)
+        );
+        let checked = [3.0, 0.3, 0.1, 1.0, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1, 0.1];
+        assert_eq!(
+            choose_isolation(&[&block(rates, checked)]),
+            (Isolation::default(), None)
+        );
     }
 }

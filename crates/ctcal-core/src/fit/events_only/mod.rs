@@ -83,6 +83,8 @@ pub struct EventsOnly {
     /// Pixel-seconds of quiet, uncovered time the rates rest on (fit blocks), and the
     /// support window and radius that leave the scene's own events out.
     pub quiet_pixel_seconds: f64,
+    /// Their share of the fit blocks' pixel time (kept pixels times seconds).
+    pub quiet_share: f64,
     pub support_window_ms: f64,
     /// The neighbourhood's radius (Chebyshev, px) within which an event counts as support.
     pub support_radius_px: usize,
@@ -117,15 +119,17 @@ pub(super) struct FitRun {
     /// Isolated-event rates (OFF, ON) under the chosen support.
     noise: [Option<(f64, f64)>; 2],
     isolation: Isolation,
-    /// The rate was still falling with the window or the radius where quiet time ran out
-    /// (or at the widest radius): an upper bound.
-    noise_still_falling: bool,
+    /// Why the isolated rate is only an upper bound on the noise, if it is one
+    /// ([`measure::choose_isolation`]).
+    noise_bound: Option<measure::UpperBound>,
     edge: Option<refractory::Edge>,
     /// The timestamps' common step, µs (1: no grid).
     timestamp_step_us: u32,
     /// OFF/ON of supported events and its standard error over the fit blocks.
     balance: Option<(f64, f64)>,
     quiet_pixel_seconds: f64,
+    /// Kept pixels times seconds of the fit blocks.
+    pixel_seconds: f64,
     /// Supported (scene) events per kept pixel per second over the fit blocks.
     signal_rate_hz: f64,
 }
@@ -291,7 +295,7 @@ fn fit_run(
         .flat_map(|b| b.intervals.iter().copied())
         .collect();
     let edge = refractory::edge(&mut intervals, timestamp_step_us);
-    let (isolation, noise_still_falling) = measure::choose_isolation(&fit);
+    let (isolation, noise_bound) = measure::choose_isolation(&fit);
     let ratio = |b: &[&BlockMeasure]| {
         let (on, off) = b.iter().fold((0u64, 0u64), |(a, c), m| {
             (a + m.signal_on, c + m.signal_off)
@@ -324,11 +328,12 @@ fn fit_run(
             BlockMeasure::isolated_rate(&fit, isolation, true),
         ],
         isolation,
-        noise_still_falling,
+        noise_bound,
         edge,
         timestamp_step_us,
         balance,
         quiet_pixel_seconds: BlockMeasure::isolated(&fit, isolation).pixel_seconds,
+        pixel_seconds: fit.iter().map(|b| b.pixel_seconds).sum(),
         signal_rate_hz: fit
             .iter()
             .map(|b| b.signal_rate_hz * b.seconds)

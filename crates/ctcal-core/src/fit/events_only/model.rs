@@ -175,6 +175,7 @@ mod tests {
     fn block() -> BlockMeasure {
         BlockMeasure {
             seconds: 2.0,
+            pixel_seconds: 200.0,
             isolated: vec![super::super::measure::Isolated {
                 on: 300,
                 off: 100,

@@ -5,7 +5,9 @@
 use super::blocks::Blocks;
 use super::candidates::{on_excess, symmetric_rate};
 use super::measure::Measuring;
-use super::measure::{BlockMeasure, SUPPORT_RADII_PX, SUPPORT_WINDOWS_US};
+use super::measure::{
+    BlockMeasure, CONFIRMING_QUIET_SHARE, SUPPORT_RADII_PX, SUPPORT_WINDOWS_US, UpperBound,
+};
 use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, compare, distance};
 use super::simulate_back::{Replaying, simulated};
 use super::steps::Judging;
@@ -353,10 +355,10 @@ fn noise_params(
 }
 
 /// A noise rate whose isolated events were still falling as the support grew
-/// ([`FitRun::noise_still_falling`]) is an upper bound: its interval reaches down to none.
+/// or unconfirmed ([`FitRun::noise_bound`]) is an upper bound: its interval reaches down to none.
 fn down_to_none(rate: Uncertain, run: &FitRun) -> Uncertain {
     match rate.ci95 {
-        Some([_, hi]) if run.noise_still_falling => {
+        Some([_, hi]) if run.noise_bound.is_some() => {
             Uncertain::with_interval(rate.value, rate.standard_error, [Some(0.0), hi])
         }
         _ => rate,
@@ -465,12 +467,13 @@ fn details(
         noise_on_hz: rate(run.noise[1]),
         noise_off_hz: rate(run.noise[0]),
         noise_on_test_hz: BlockMeasure::isolated_rate(&test, run.isolation, true).map(|r| r.0),
-        noise_upper_bound: run.noise_still_falling,
+        noise_upper_bound: run.noise_bound.is_some(),
         noise_off_test_hz: BlockMeasure::isolated_rate(&test, run.isolation, false).map(|r| r.0),
         predicted_error_before: f64::NAN,
         predicted_error_after: f64::NAN,
         simulated_back_why: None,
         quiet_pixel_seconds: run.quiet_pixel_seconds,
+        quiet_share: run.quiet_pixel_seconds / run.pixel_seconds.max(1e-12),
         support_window_ms: run.isolation.window_us() as f64 / 1e3,
         support_radius_px: run.isolation.radius_px(),
         timestamp_step_us: run.timestamp_step_us,
@@ -537,12 +540,20 @@ fn assumptions(
             100.0 * PARSIMONY
         ),
     ]);
-    if run.noise_still_falling {
-        out.push(format!(
+    match run.noise_bound {
+        Some(UpperBound::StillFalling) => out.push(format!(
             "the isolated-event rate was still falling as the support grew ({} ms, {} px) when the scene's events left too little quiet time or the widest neighbourhood was reached: part of the isolated events are the scene's own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
             run.isolation.window_us() / 1000,
             run.isolation.radius_px()
-        ));
+        )),
+        Some(UpperBound::Unconfirmed { quiet_share }) => out.push(format!(
+            "the scene left {:.2} % of the pixel time quiet (below {:.0} %, which noise alone leaves only above some 7 Hz) and no wider support kept enough of it to check the isolated-event rate ({} ms, {} px): the quiet pixels are where the scene's activity thins out and their isolated events may be its own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
+            100.0 * quiet_share,
+            100.0 * CONFIRMING_QUIET_SHARE,
+            run.isolation.window_us() / 1000,
+            run.isolation.radius_px()
+        )),
+        None => {}
     }
     if judging.reference.edge_us.is_none() {
         out.push("too few same-pixel intervals for the interval component of the distance".into());
