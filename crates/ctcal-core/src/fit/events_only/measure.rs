@@ -137,9 +137,10 @@ const JUDGED_QUIET: f64 = 0.2;
 
 /// Below this share of the fit blocks' pixel time left quiet, isolated events that no wider
 /// support could check are not taken for noise. Noise alone leaves a pixel uncovered
-/// `exp(-16 r W)` of the time (8 neighbours, ±W, `r` Hz ON + OFF), so quiet pixels (uncovered
-/// half the time) stay most of the sensor up to `r = ln 2 / (16 W)`, 4.3 Hz at 10 ms, and
-/// their share falls below a tenth only for noise of some 7 Hz; a scene that covers nearly
+/// `exp(-16 r W)` of the time (8 neighbours, ±W, `r` Hz ON + OFF), so the quiet share is
+/// still a half at `r = ln 2 / (16 W)`, 4.3 Hz at 10 ms, and falls below a tenth only at
+/// `ln 10 / (16 W)`, 14 Hz at 10 ms (noise alone is measured under the shortest window, which
+/// a longer one does not lower); a scene that covers nearly
 /// every pixel nearly all the time leaves quiet only where its activity thins out, and the
 /// isolated events there are mostly its own: coverage draw 6024 (61 events per pixel per
 /// second, 0.2 % of the pixel time quiet) read 0.84 Hz a polarity where the shot noise is

@@ -6,7 +6,8 @@ use super::blocks::Blocks;
 use super::candidates::{on_excess, symmetric_rate};
 use super::measure::Measuring;
 use super::measure::{
-    BlockMeasure, CONFIRMING_QUIET_SHARE, SUPPORT_RADII_PX, SUPPORT_WINDOWS_US, UpperBound,
+    BlockMeasure, CONFIRMING_QUIET_SHARE, Isolation, SUPPORT_RADII_PX, SUPPORT_WINDOWS_US,
+    UpperBound,
 };
 use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, compare, distance};
 use super::simulate_back::{Replaying, simulated};
@@ -547,9 +548,10 @@ fn assumptions(
             run.isolation.radius_px()
         )),
         Some(UpperBound::Unconfirmed { quiet_share }) => out.push(format!(
-            "the scene left {:.2} % of the pixel time quiet (below {:.0} %, which noise alone leaves only above some 7 Hz) and no wider support kept enough of it to check the isolated-event rate ({} ms, {} px): the quiet pixels are where the scene's activity thins out and their isolated events may be its own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
+            "the scene left {:.2} % of the pixel time quiet (below {:.0} %, which noise alone leaves under this support only above {:.2} Hz a pixel, ON + OFF) and no wider support kept enough of it to check the isolated-event rate ({} ms, {} px): the quiet pixels are where the scene's activity thins out and their isolated events may be its own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
             100.0 * quiet_share,
             100.0 * CONFIRMING_QUIET_SHARE,
+            noise_leaving_share(CONFIRMING_QUIET_SHARE, run.isolation),
             run.isolation.window_us() / 1000,
             run.isolation.radius_px()
         )),
@@ -580,9 +582,33 @@ fn holdout(blocks: &Blocks, options: &FitOptions) -> Holdout {
     }
 }
 
+/// The noise rate (Hz a pixel, ON + OFF) at which noise alone leaves `share` of the pixel
+/// time uncovered under `support`: `exp(-2 N r W) = share` with `N` the neighbours within its
+/// radius and `±W` its window.
+fn noise_leaving_share(share: f64, support: Isolation) -> f64 {
+    let side = 2 * support.radius_px() + 1;
+    let neighbours = (side * side - 1) as f64;
+    let window_s = support.window_us() as f64 * 1e-6;
+    -share.ln() / (2.0 * neighbours * window_s)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn noise_alone_leaves_a_tenth_quiet_at_a_rate_set_by_the_support() {
+        // 8 neighbours within ±10 ms: exp(-16 r 0.01) = 0.1 at r = ln 10 / 0.16 = 14.39 Hz,
+        // a half at 4.33 Hz; 48 neighbours (7 x 7) within ±300 ms: ln 10 / 28.8 = 0.080 Hz
+        let narrow = Isolation::default();
+        assert!((noise_leaving_share(0.1, narrow) - 14.391).abs() < 1e-3);
+        assert!((noise_leaving_share(0.5, narrow) - 4.332).abs() < 1e-3);
+        let wide = Isolation {
+            window: 3,
+            radius: 2,
+        };
+        assert!((noise_leaving_share(0.1, wide) - 0.0799).abs() < 1e-4);
+    }
 
     /// Coverage draw 4077 read from its events: 1.44 +- 0.03 Hz of shot noise measured at
     /// its brightness for a dark rate of 1.79 Hz. The interval reaches the rate over v2e's
