@@ -280,8 +280,8 @@ structs! {
     HotPixelDetection { detectable_above_hz, probability, meaning }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,
-        predicted_error_before, predicted_error_after, simulated_back_why, quiet_pixel_seconds, quiet_share, support_window_ms, support_radius_px, timestamp_step_us,
-        interval_edge }
+        predicted_error_before, predicted_error_after, simulated_back_why, quiet_pixel_seconds,
+        quiet_share, support_window_ms, support_radius_px, timestamp_step_us, interval_edge }
     IntervalEdge { edge_us, range_us, found, not_refractory, below, above, intervals }
     Uncertain { value, standard_error, ci95 }
     AddedEffect { effect, evidence, error_after }
