@@ -136,11 +136,13 @@ fn falls(from: (f64, f64, f64), to: (f64, f64, f64)) -> bool {
 const JUDGED_QUIET: f64 = 0.2;
 
 /// Below this share of the fit blocks' pixel time left quiet, isolated events that no wider
-/// support could check are not taken for noise. Noise alone leaves a pixel uncovered
-/// `exp(-16 r W)` of the time (8 neighbours, ±W, `r` Hz ON + OFF), so the quiet share is
-/// still a half at `r = ln 2 / (16 W)`, 4.3 Hz at 10 ms, and falls below a tenth only at
-/// `ln 10 / (16 W)`, 14 Hz at 10 ms (noise alone is measured under the shortest window, which
-/// a longer one does not lower); a scene that covers nearly
+/// support could check are not taken for noise. Noise of `r` Hz a pixel (ON + OFF) leaves a
+/// pixel uncovered `exp(-2 N r W)` of the time (`N` neighbours within the support's radius,
+/// ±W its window), and a pixel is quiet when uncovered at least [`QUIET_SHARE`] of a block,
+/// so quiet pixels stay most of the sensor up to `r = ln 2 / (2 N W)` (4.3 Hz under 3 x 3 and
+/// ±10 ms, where noise alone is measured) and their share of the pixel time falls below a
+/// tenth at 1.2-1.6 times that (Poisson noise simulated: 5 Hz with 1 s blocks, 7 Hz with
+/// 0.1 s blocks, whose uncovered fractions spread more); a scene that covers nearly
 /// every pixel nearly all the time leaves quiet only where its activity thins out, and the
 /// isolated events there are mostly its own: coverage draw 6024 (61 events per pixel per
 /// second, 0.2 % of the pixel time quiet) read 0.84 Hz a polarity where the shot noise is

@@ -6,8 +6,8 @@ use super::blocks::Blocks;
 use super::candidates::{on_excess, symmetric_rate};
 use super::measure::Measuring;
 use super::measure::{
-    BlockMeasure, CONFIRMING_QUIET_SHARE, Isolation, SUPPORT_RADII_PX, SUPPORT_WINDOWS_US,
-    UpperBound,
+    BlockMeasure, CONFIRMING_QUIET_SHARE, Isolation, QUIET_SHARE, SUPPORT_RADII_PX,
+    SUPPORT_WINDOWS_US, UpperBound,
 };
 use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, compare, distance};
 use super::simulate_back::{Replaying, simulated};
@@ -548,10 +548,10 @@ fn assumptions(
             run.isolation.radius_px()
         )),
         Some(UpperBound::Unconfirmed { quiet_share }) => out.push(format!(
-            "the scene left {:.2} % of the pixel time quiet (below {:.0} %, which noise alone leaves under this support only above {:.2} Hz a pixel, ON + OFF) and no wider support kept enough of it to check the isolated-event rate ({} ms, {} px): the quiet pixels are where the scene's activity thins out and their isolated events may be its own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
+            "the scene left {:.2} % of the pixel time quiet (below {:.0} %; noise alone keeps quiet pixels, uncovered half the time, on most of the sensor under this support up to {:.2} Hz a pixel, ON + OFF, and leaves under a tenth of the time quiet at 1.2-1.6 times that) and no wider support kept enough of it to check the isolated-event rate ({} ms, {} px): the quiet pixels are where the scene's activity thins out and their isolated events may be its own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
             100.0 * quiet_share,
             100.0 * CONFIRMING_QUIET_SHARE,
-            noise_leaving_share(CONFIRMING_QUIET_SHARE, run.isolation),
+            noise_leaving_share(QUIET_SHARE, run.isolation),
             run.isolation.window_us() / 1000,
             run.isolation.radius_px()
         )),
@@ -582,9 +582,9 @@ fn holdout(blocks: &Blocks, options: &FitOptions) -> Holdout {
     }
 }
 
-/// The noise rate (Hz a pixel, ON + OFF) at which noise alone leaves `share` of the pixel
-/// time uncovered under `support`: `exp(-2 N r W) = share` with `N` the neighbours within its
-/// radius and `±W` its window.
+/// The noise rate (Hz a pixel, ON + OFF) at which noise alone leaves a pixel uncovered
+/// `share` of the time under `support`: `exp(-2 N r W) = share` with `N` the neighbours
+/// within its radius and `±W` its window (the pixel's own events do not cover it).
 fn noise_leaving_share(share: f64, support: Isolation) -> f64 {
     let side = 2 * support.radius_px() + 1;
     let neighbours = (side * side - 1) as f64;
@@ -597,7 +597,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn noise_alone_leaves_a_tenth_quiet_at_a_rate_set_by_the_support() {
+    fn noise_alone_leaves_a_pixel_uncovered_at_a_rate_set_by_the_support() {
         // 8 neighbours within ±10 ms: exp(-16 r 0.01) = 0.1 at r = ln 10 / 0.16 = 14.39 Hz,
         // a half at 4.33 Hz; 48 neighbours (7 x 7) within ±300 ms: ln 10 / 28.8 = 0.080 Hz
         let narrow = Isolation::default();
