@@ -236,35 +236,41 @@ fn sorted_from_bits(mut bits: Vec<u64>) -> Vec<f64> {
 /// summed before, and at least as close as adding the window's values one by one.
 struct PrefixSums {
     running: Vec<i128>,
-    scale: f64,
+    scale: [f64; 2],
 }
 
 impl PrefixSums {
     fn of(sorted: &[f64]) -> Self {
         let largest = sorted.last().copied().unwrap_or(1.0);
-        // the running total stays below 2^126: n values of at most 2^(e + 1) each
-        let headroom = 126
+        // the running total stays below 2^126: n values of at most 2^(e + 1) each; the
+        // shift (about -900 to 1200 over the finite floats) applied as two powers of two,
+        // each finite, so that scaling stays exact at both ends of the range
+        let shift = 126
             - (largest.log2().floor() as i32 + 1)
             - (sorted.len() as f64 + 1.0).log2().ceil() as i32;
-        let shift = headroom.clamp(-1000, 1000);
-        let up = 2f64.powi(shift);
+        let up = powers_of_two(shift);
         let mut running = Vec::with_capacity(sorted.len() + 1);
         let mut total = 0i128;
         running.push(0);
         for &v in sorted {
-            total += (v * up) as i128;
+            total += (v * up[0] * up[1]) as i128;
             running.push(total);
         }
         Self {
             running,
-            scale: 2f64.powi(-shift),
+            scale: powers_of_two(-shift),
         }
     }
 
     /// The sum of `values[a..b]`.
     fn window(&self, a: usize, b: usize) -> f64 {
-        (self.running[b] - self.running[a]) as f64 * self.scale
+        (self.running[b] - self.running[a]) as f64 * self.scale[0] * self.scale[1]
     }
+}
+
+/// `2^e` as two factors whose product it is.
+fn powers_of_two(e: i32) -> [f64; 2] {
+    [2f64.powi(e / 2), 2f64.powi(e - e / 2)]
 }
 
 /// Mean shift over `sorted` values from `m`: the mean of the values within `m (1 +- window)`
@@ -646,6 +652,17 @@ mod tests {
         assert_eq!(sums.window(1, 3), 1001.0);
         assert_eq!(sums.window(0, 1), 1e-9);
         assert_eq!(sums.window(2, 2), 0.0);
+    }
+
+    #[test]
+    fn the_mode_of_values_near_the_ends_of_the_floats_is_found() {
+        // twenty values 0.1 % apart at 1e-305 and at 1e300 (a shift beyond 1000 binary
+        // places either way): the mode is their mean, not a sum lost to the scaling
+        for scale in [1e-305, 1e300] {
+            let values: Vec<f64> = (0..20).map(|k| scale * (1.0 + 0.001 * k as f64)).collect();
+            let m = mode(&values, 0.25).expect("twenty values");
+            assert!((m / scale - 1.0095).abs() < 1e-9, "{m:e}");
+        }
     }
 
     #[test]
