@@ -246,13 +246,19 @@ pub fn choose_isolation(fit: &[&BlockMeasure]) -> (Isolation, Option<UpperBound>
     if fell {
         return (chosen, Some(UpperBound::StillFalling));
     }
-    let pixel_seconds: f64 = fit.iter().map(|b| b.pixel_seconds).sum();
-    let quiet_share = rate.2 / pixel_seconds.max(1e-12);
+    let quiet_share = quiet_share(fit, chosen);
     let unconfirmed = !confirmed && quiet_share < CONFIRMING_QUIET_SHARE;
     (
         chosen,
         unconfirmed.then_some(UpperBound::Unconfirmed { quiet_share }),
     )
+}
+
+/// The share of the blocks' pixel time (kept pixels times seconds) left quiet under
+/// `support`: the time the noise rate rests on.
+pub fn quiet_share(fit: &[&BlockMeasure], support: Isolation) -> f64 {
+    let pixel_seconds: f64 = fit.iter().map(|b| b.pixel_seconds).sum();
+    BlockMeasure::isolated(fit, support).pixel_seconds / pixel_seconds.max(1e-12)
 }
 
 /// The recording, split for measuring.

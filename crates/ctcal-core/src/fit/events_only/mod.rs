@@ -128,8 +128,8 @@ pub(super) struct FitRun {
     /// OFF/ON of supported events and its standard error over the fit blocks.
     balance: Option<(f64, f64)>,
     quiet_pixel_seconds: f64,
-    /// Kept pixels times seconds of the fit blocks.
-    pixel_seconds: f64,
+    /// Its share of the fit blocks' pixel time ([`measure::quiet_share`]).
+    quiet_share: f64,
     /// Supported (scene) events per kept pixel per second over the fit blocks.
     signal_rate_hz: f64,
 }
@@ -333,7 +333,7 @@ fn fit_run(
         timestamp_step_us,
         balance,
         quiet_pixel_seconds: BlockMeasure::isolated(&fit, isolation).pixel_seconds,
-        pixel_seconds: fit.iter().map(|b| b.pixel_seconds).sum(),
+        quiet_share: measure::quiet_share(&fit, isolation),
         signal_rate_hz: fit
             .iter()
             .map(|b| b.signal_rate_hz * b.seconds)

@@ -474,7 +474,7 @@ fn details(
         predicted_error_after: f64::NAN,
         simulated_back_why: None,
         quiet_pixel_seconds: run.quiet_pixel_seconds,
-        quiet_share: run.quiet_pixel_seconds / run.pixel_seconds.max(1e-12),
+        quiet_share: run.quiet_share,
         support_window_ms: run.isolation.window_us() as f64 / 1e3,
         support_radius_px: run.isolation.radius_px(),
         timestamp_step_us: run.timestamp_step_us,
