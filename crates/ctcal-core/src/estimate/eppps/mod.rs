@@ -698,9 +698,8 @@ fn assumptions(
             format!("{} reliable pixels of the {} kept count", rates.counted_units, rates.kept_pixels)
         } else {
             format!(
-                "{} of the {} 8 x 8 px tiles have signal and count (blank or static parts of the view do not)",
-                rates.counted_units,
-                rates.kept_pixels.div_ceil(scans::TILE_PX * scans::TILE_PX)
+                "{} of the {} 8 x 8 px tiles the flow moves have signal and count (blank parts of the view do not; static ones have no travel)",
+                rates.counted_units, rates.units
             )
         },
     ));

@@ -54,8 +54,10 @@ pub struct RecordingRates {
     /// (mean over the counted pixels, weighted by the time each counts).
     pub chance_support: f64,
     /// Units that count (8 x 8 tiles with signal, without frames; every reliable pixel,
-    /// with frames) and all pixels kept.
+    /// with frames), the units that moved (tiles with a kept pixel the flow moves, partial
+    /// ones at the view's edges included; reliable pixels that moved) and all pixels kept.
     pub counted_units: usize,
+    pub units: usize,
     pub kept_pixels: usize,
     /// Total travel of the counted pixels, pixels; and the time it took, seconds.
     pub counted_travel_px: f64,
@@ -291,7 +293,9 @@ fn finish(
     let mut groups: Groups = vec![[0.0; 3]; tiles_x * (excluded.len() / w).div_ceil(PATCH_PX)];
     let (mut travels, mut directions) = (Vec::new(), Vec::new());
     let mut noise = NoiseTally::default();
+    let mut unit_count = 0;
     for (first, u) in units(tally, paths, &f.covered_s, excluded, w) {
+        unit_count += 1;
         // a tile counts where it has signal (a supported event: blank parts of the view
         // travel without events); a reliable pixel counts whatever fired there, since
         // choosing pixels by their own support would choose them by their noise too
@@ -328,6 +332,7 @@ fn finish(
         unsupported_share: 1.0 - supported_total / all_total.max(1.0),
         chance_support: 1.0 - noise.unsupported_exposure_s / noise.exposure_s.max(1e-12),
         counted_units: travels.len(),
+        units: unit_count,
         kept_pixels: f.kept,
         counted_travel_px: total[2],
         duration_s: f.duration,
