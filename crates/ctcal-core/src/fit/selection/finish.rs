@@ -207,6 +207,10 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
             &mut params,
         ));
     }
+    // after the hot pixels, whose excess is counted across the profile's own interval
+    assumptions.extend(super::method_systematic::widen_spread(
+        &mut state.uncertainty,
+    ));
     let not_identified = not_identified(&state, fixed);
     assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
         &mut state.uncertainty,
