@@ -142,6 +142,19 @@ fn shot_noise_is_added_to_noisy_recordings_at_its_rate() {
             (rate / truth - 1.0).abs() < 0.5,
             "{case}: {rate} vs {truth}"
         );
+        // the v2e leak of 0.1 Hz fires its first event a period after the start, so it
+        // is not added here; the rate at which it would have been is above it (0.48-0.51
+        // Hz today), and shot noise, in the model, has no limit
+        let limits = &f["noise_detection"]["limits"];
+        let leak = limits["leak_rate_hz"]["called_for_above_hz"]
+            .as_f64()
+            .unwrap();
+        let leak_truth = emulator(case, "leak_rate_hz");
+        assert!(
+            !added(&f).contains(&"leak".to_string()) && leak > leak_truth && leak < 5.0,
+            "{case}: leak called for above {leak} Hz, truth {leak_truth}"
+        );
+        assert!(limits.get("shot_noise_rate_hz").is_none(), "{limits:#}");
     }
 }
 
@@ -266,6 +279,14 @@ fn ideal_recordings_get_no_effect_and_their_thresholds() {
             let v = param(&f, key).unwrap();
             assert!((v / truth - 1.0).abs() < 0.03, "{case} {key} {v}");
         }
+        // shot noise at the 1 Hz that c_noisy_texture's fit finds would show on these
+        // textures (0.06-0.12 Hz would, today), and a simulation at the rate given does
+        // add isolated events of both polarities
+        let shot = &f["noise_detection"]["limits"]["shot_noise_rate_hz"];
+        let rate = shot["called_for_above_hz"].as_f64().unwrap();
+        assert!(rate > 0.01 && rate < 1.0, "{case}: {shot}");
+        let [off, on] = [0, 1].map(|k| shot["isolated_hz_per_hz"][k].as_f64().unwrap());
+        assert!(off > 0.05 && on > 0.05, "{case}: {shot}");
         assert_eq!(f["error_before"], f["error_after"]);
     }
 }

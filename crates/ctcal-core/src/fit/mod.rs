@@ -317,6 +317,10 @@ pub struct FitResult {
     /// Which hot pixels `hot_pixel_fraction` counts: those fast enough to be found.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hot_pixel_detection: Option<HotPixelDetection>,
+    /// Which noise rates the recording would show, for the noise effects the final model
+    /// lacks (a fit with frames).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_detection: Option<NoiseDetection>,
     /// Residuals of the ideal model and of the final one (fit blocks; a fit without
     /// frames simulates no scene and has none).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -334,6 +338,34 @@ pub struct FitResult {
     /// come from, the noise rates, the interval edge, the threshold ratio).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub events_only: Option<events_only::EventsOnly>,
+}
+
+/// Which noise rates a fit with frames would have seen
+/// (`fit::selection::noise_detection`): per noise effect the final model lacks, the rate at
+/// which the recording's isolated events would have called for it.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NoiseDetection {
+    /// By parameter (`shot_noise_rate_hz`, `leak_rate_hz`).
+    pub limits: BTreeMap<String, NoiseLimit>,
+    /// The rate the effect was simulated at to measure its isolated events, Hz.
+    pub probe_hz: f64,
+    pub meaning: &'static str,
+}
+
+/// One noise effect's detection limit.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NoiseLimit {
+    /// The rate at which the evidence would call for the effect; `null` with `why` where
+    /// no rate would, or the recording already calls for it.
+    pub called_for_above_hz: Option<f64>,
+    /// Isolated OFF and ON events the effect adds per pixel-second of the fit blocks, per
+    /// Hz of its rate, at the last rate simulated (how much of it stays isolated in this
+    /// scene).
+    pub isolated_hz_per_hz: Option<[f64; 2]>,
+    /// The effect was called for and tried, and not kept.
+    pub tried: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why: Option<String>,
 }
 
 /// Which hot pixels the hot-pixel search sees ([`crate::stats::hot_pixels::Detectability`])

@@ -20,21 +20,32 @@ pub fn evidence(c: &Context) -> Evidence {
     }
     let excess_on = r_on - s_on;
     let excess_off = (r_off - s_off).max(0.0);
-    let leak = excess_on - excess_off;
-    let sigma = (r_on + s_on + r_off + s_off + 1.0).sqrt();
-    let rate = leak / exposure;
+    let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
     Evidence {
         effect: Effect::Leak,
-        score: leak / sigma,
-        relevant: rate > 0.005,
+        score,
+        relevant: rate > RELEVANT_HZ,
         text: format!(
-            "isolated ON events exceed the model's by {:.4} Hz per pixel beyond the OFF excess ({:.4} Hz): {:.1} standard errors",
+            "isolated ON events exceed the model's by {:.4} Hz per pixel beyond the OFF excess ({:.4} Hz): {score:.1} standard errors",
             excess_on / exposure,
             excess_off / exposure,
-            leak / sigma
         ),
         start: Some((rate / 0.9).max(1e-3)),
     }
+}
+
+/// The ON excess rate (beyond any OFF excess) below which leak does not matter, events per
+/// pixel-second.
+pub const RELEVANT_HZ: f64 = 0.005;
+
+/// The evidence's score (the ON excess over the model beyond any OFF excess, in Poisson
+/// standard errors of all four counts) and the excess rate it stands for, from the
+/// isolated events `[real OFF, real ON, model OFF, model ON]` over `exposure`
+/// pixel-seconds.
+pub fn score([r_off, r_on, s_off, s_on]: [f64; 4], exposure: f64) -> (f64, f64) {
+    let leak = (r_on - s_on) - (r_off - s_off).max(0.0);
+    let sigma = (r_on + s_on + r_off + s_off + 1.0).sqrt();
+    (leak / sigma, leak / exposure)
 }
 
 #[cfg(test)]

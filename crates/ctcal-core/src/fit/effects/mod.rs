@@ -236,9 +236,19 @@ pub fn evidence(effect: Effect, context: &Context) -> Evidence {
 /// Unsupported events of the fit blocks, summed over intensity: (real OFF, real ON,
 /// simulated OFF, simulated ON), and the pixel-seconds they came from.
 pub(crate) fn background_totals(c: &Context) -> ([f64; 4], f64) {
+    isolated_totals(c.real, c.sim, c.geometry, c.subset)
+}
+
+/// [`background_totals`] of a recording `real` and a model `sim` over `subset`.
+pub(crate) fn isolated_totals(
+    real: &Observed,
+    sim: &Observed,
+    geometry: &Geometry,
+    subset: Subset,
+) -> ([f64; 4], f64) {
     let (r, s) = (
-        c.real.background_of(c.geometry, c.subset),
-        c.sim.background_of(c.geometry, c.subset),
+        real.background_of(geometry, subset),
+        sim.background_of(geometry, subset),
     );
     let mut totals = [0.0; 4];
     for i in 0..r.len() {
@@ -246,7 +256,7 @@ pub(crate) fn background_totals(c: &Context) -> ([f64; 4], f64) {
         totals[2 + i % 2] += s[i] as f64;
     }
     let exposure = (0..super::observe::INTENSITY_BINS)
-        .map(|b| c.geometry.exposure_of(b, c.subset))
+        .map(|b| geometry.exposure_of(b, subset))
         .sum();
     (totals, exposure)
 }

@@ -21,9 +21,7 @@ pub fn evidence(c: &Context) -> Evidence {
         );
     }
     let (excess_on, excess_off) = (r_on - s_on, r_off - s_off);
-    let both = excess_on.min(excess_off);
-    let sigma = (r_on + s_on + r_off + s_off + 1.0).sqrt();
-    let rate = 2.0 * both / exposure;
+    let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
     // the dark rate: the observed rate is the dark rate times the brightness factor
     let bright = c.model.shot_noise_bright_factor() as f32;
     let factor = (0..INTENSITY_BINS)
@@ -35,16 +33,29 @@ pub fn evidence(c: &Context) -> Evidence {
         / exposure;
     Evidence {
         effect: Effect::ShotNoise,
-        score: 2.0 * both / sigma,
-        relevant: rate > 0.005,
+        score,
+        relevant: rate > RELEVANT_HZ,
         text: format!(
-            "isolated ON and OFF events exceed the model's by {:.4} and {:.4} Hz per pixel: {:.1} standard errors",
+            "isolated ON and OFF events exceed the model's by {:.4} and {:.4} Hz per pixel: {score:.1} standard errors",
             excess_on / exposure,
             excess_off / exposure,
-            2.0 * both / sigma
         ),
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
     }
+}
+
+/// The isolated-event rate (ON + OFF excess over the model) below which shot noise does
+/// not matter, events per pixel-second.
+pub const RELEVANT_HZ: f64 = 0.005;
+
+/// The evidence's score (the smaller of the ON and OFF excesses, doubled, in Poisson
+/// standard errors of all four counts) and the excess rate it stands for, from the
+/// isolated events `[real OFF, real ON, model OFF, model ON]` over `exposure`
+/// pixel-seconds.
+pub fn score([r_off, r_on, s_off, s_on]: [f64; 4], exposure: f64) -> (f64, f64) {
+    let both = (r_on - s_on).min(r_off - s_off);
+    let sigma = (r_on + s_on + r_off + s_off + 1.0).sqrt();
+    (2.0 * both / sigma, 2.0 * both / exposure)
 }
 
 #[cfg(test)]

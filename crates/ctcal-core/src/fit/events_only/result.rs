@@ -156,6 +156,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
         ambiguities: Vec::new(),
         hot_pixels_masked: hot,
         hot_pixel_detection: None,
+        noise_detection: None,
         residuals_before: None,
         residuals_after: None,
         assumptions,

@@ -211,6 +211,11 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::method_systematic::widen_spread(
         &mut state.uncertainty,
     ));
+    let noise_detection =
+        super::noise_detection::detect(simulation, &state, &steps).map(|(d, note)| {
+            assumptions.push(note);
+            d
+        });
     let not_identified = not_identified(&state, fixed);
     assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
         &mut state.uncertainty,
@@ -247,6 +252,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         ambiguities,
         hot_pixels_masked: state.hot,
         hot_pixel_detection: state.hot_detection,
+        noise_detection,
         residuals_before: Some(residuals_before),
         residuals_after: Some(residuals_after),
         events_only: None,

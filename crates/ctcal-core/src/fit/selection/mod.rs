@@ -32,6 +32,7 @@ pub(in crate::fit) mod hot_excess;
 mod hot_report;
 pub(in crate::fit) mod keep;
 mod method_systematic;
+mod noise_detection;
 mod start;
 mod steps;
 
