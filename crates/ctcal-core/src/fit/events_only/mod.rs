@@ -27,6 +27,7 @@
 
 mod blocks;
 mod candidates;
+mod leak_onset;
 mod measure;
 mod model;
 pub mod refractory;
@@ -122,6 +123,9 @@ pub(super) struct FitRun {
     /// Why the isolated rate is only an upper bound on the noise, if it is one
     /// ([`measure::choose_isolation`]).
     noise_bound: Option<measure::UpperBound>,
+    /// The ON excess rising from the fit blocks to the selection blocks: leak events that
+    /// start a period after a reset ([`leak_onset`]).
+    leak_onset: Option<leak_onset::Onset>,
     edge: Option<refractory::Edge>,
     /// The timestamps' common step, µs (1: no grid).
     timestamp_step_us: u32,
@@ -329,6 +333,7 @@ fn fit_run(
         ],
         isolation,
         noise_bound,
+        leak_onset: leak_onset::onset(&fit, &judging.of(Role::Selection), isolation),
         edge,
         timestamp_step_us,
         balance,

@@ -331,7 +331,25 @@ fn noise_params(
         }
     }
     if let Some((excess, se)) = on_excess(run) {
-        if let (Some(scene), false) = (&scene, kept("leak")) {
+        if let Some(onset) = &run.leak_onset {
+            // a lower bound, whether or not the loop kept leak: the model simulates the
+            // measured excess, the JSON says it is at least that
+            if kept("leak") {
+                params.leak_rate_hz = Some(excess);
+            }
+            let lo = (excess - 2.0 * se).max(0.0);
+            why.insert(
+                "leak_rate_hz".into(),
+                format!(
+                    "{}: at least {lo:.4} Hz (2 standard errors), upper end not determined",
+                    onset.evidence()
+                ),
+            );
+            uncertainties.insert(
+                "leak_rate_hz".into(),
+                Uncertain::with_interval(excess.max(0.0), Some(se), [Some(lo), None]),
+            );
+        } else if let (Some(scene), false) = (&scene, kept("leak")) {
             why.insert(
                 "leak_rate_hz".into(),
                 format!(
@@ -348,7 +366,7 @@ fn noise_params(
             why.insert(
                 "leak_rate_hz".into(),
                 format!(
-                    "the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, is not told apart from none: at most {:.4} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden)",
+                    "the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, is not told apart from none: at most {:.4} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden; and where the recording starts at a reset, a simulator's first frame or a camera's start, a leak whose period is longer than the time since fires no event yet: the bound holds for leak phases spread at random, as in a camera that has been running)",
                     excess.max(0.0) + 2.0 * se
                 ),
             );
