@@ -3,6 +3,7 @@
 # input and output arguments after it:
 #   sh v2e_args.sh -i video.mp4 --output_folder out
 # (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)
+# NOT IDENTIFIED: ct_sigma: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (the recording does not show a threshold spread: event timing measured none and the fit blocks have too few events per pixel to compare the counts' dispersion with the model's; the model has no mismatch, which is not a measurement)
 exec "${V2E:-v2e}" \
   --pos_thres 0.343904 \
   --neg_thres 0.463052 \

@@ -16,6 +16,9 @@ use crate::fit::metric::{dispersion, dispersion_log_ratio};
 /// Posch & Delbruck 2008).
 pub const RANGE: (f64, f64) = (0.002, 0.3);
 
+/// The evidence's text where neither event timing nor the counts can show a spread.
+pub const TOO_FEW_TO_COMPARE: &str = "too few events per pixel to compare dispersion";
+
 pub fn evidence(c: &Context) -> Evidence {
     if let Some((sigma, [lo, hi])) = c.mismatch_estimate {
         let se = ((hi - lo) / 3.92).max(1e-6);
@@ -52,10 +55,7 @@ pub fn evidence(c: &Context) -> Evidence {
                 start: Some(0.03),
             }
         }
-        _ => Evidence::none(
-            Effect::Mismatch,
-            "too few events per pixel to compare dispersion",
-        ),
+        _ => Evidence::none(Effect::Mismatch, TOO_FEW_TO_COMPARE),
     }
 }
 
