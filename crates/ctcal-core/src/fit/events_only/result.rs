@@ -331,7 +331,9 @@ fn noise_params(
         }
     }
     if let Some((excess, se)) = on_excess(run) {
-        if let Some(onset) = &run.leak_onset {
+        // an onset only where the isolated events are not the scene's own: a scene whose
+        // unsupported events turn ON-heavy later would rise the same way
+        if let (Some(onset), None) = (&run.leak_onset, &scene) {
             // a lower bound, whether or not the loop kept leak: the model simulates the
             // measured excess, the JSON says it is at least that
             if kept("leak") {
