@@ -22,7 +22,7 @@
 //! rate given.
 
 use super::super::effects::{EVIDENCE_THRESHOLD, Effect, isolated_totals, leak, shot_noise};
-use super::super::observe::{Observed, Subset};
+use super::super::observe::Subset;
 use super::super::search::Simulation;
 use super::super::{NoiseDetection, NoiseLimit, Step};
 use super::State;
@@ -134,11 +134,11 @@ impl Probe<'_> {
             .simulation
             .observe(&params, &self.state.masked)
             .map_err(|e| format!("the probe simulation failed: {e}"))?;
-        Ok(added_isolated(
-            self.simulation,
-            &self.state.model.observed,
-            &observed,
-        ))
+        // the final model's own isolated events are in the evidence's base already
+        let g = self.simulation.geometry;
+        let (with, _) = isolated_totals(&self.simulation.real, &observed, g, Subset::Fit);
+        let base = self.evidence.base;
+        Ok([with[2] - base[2], with[3] - base[3]])
     }
 
     fn per_hz(&self, added: [f64; 2], rate_hz: f64) -> [f64; 2] {
@@ -244,14 +244,6 @@ pub fn detect(
 }
 
 const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it";
-
-/// The model's isolated events `[OFF, ON]` on the fit blocks that `probe` adds to `model`.
-fn added_isolated(simulation: &Simulation, model: &Observed, probe: &Observed) -> [f64; 2] {
-    let g = simulation.geometry;
-    let (base, _) = isolated_totals(&simulation.real, model, g, Subset::Fit);
-    let (with, _) = isolated_totals(&simulation.real, probe, g, Subset::Fit);
-    [with[2] - base[2], with[3] - base[3]]
-}
 
 fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
     let parts: Vec<String> = limits
