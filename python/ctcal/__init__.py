@@ -163,6 +163,7 @@ def fit(
     end: Optional[float] = None,
     max_frames: int = 120,
     max_pixels: int = 346 * 260,
+    max_events: int = 1_000_000,
     seed: int = 2020,
     roi: Optional[str] = None,
     mask: Optional[PathLike] = None,
@@ -171,7 +172,8 @@ def fit(
 ) -> Dict[str, Any]:
     """``ctcal fit PATH --json -`` with the command's defaults: every simulator parameter
     fitted, the effects the residuals call for added. A sensor with more than ``max_pixels``
-    pixels is fitted on its busiest region of that size (0: the whole sensor)."""
+    pixels is fitted on its busiest region of that size, a window with more than
+    ``max_events`` events on its busiest region holding about that many (0: no limit)."""
     return json.loads(
         _ctcal.fit(
             _path(path),
@@ -179,6 +181,7 @@ def fit(
             end,
             max_frames,
             max_pixels,
+            max_events,
             seed,
             roi,
             None if mask is None else _path(mask),
@@ -234,7 +237,7 @@ _Input = Tuple[str, str, Optional[str], str]
 
 
 def _report_options(opts: Mapping[str, Any], fit: bool) -> str:
-    known = {"start", "end", "max_frames", "max_pixels", "seed", "screen", "roi", "mask", "force"}
+    known = {"start", "end", "max_frames", "max_pixels", "max_events", "seed", "screen", "roi", "mask", "force"}
     unknown = set(opts) - known
     if unknown:
         raise CtcalError(
@@ -265,7 +268,7 @@ def report(
     folders of them; ``datasets`` names more: ``{name: folder}``), returned as the dict of
     its ``results.json``.
 
-    Options as the command's: ``start``, ``end``, ``max_frames``, ``max_pixels``, ``seed``, ``screen`` (a
+    Options as the command's: ``start``, ``end``, ``max_frames``, ``max_pixels``, ``max_events``, ``seed``, ``screen`` (a
     screen model TOML), ``roi``, ``mask``, ``force``; ``fit=False`` leaves the fit out.
 
     ``client``: a ``dask.distributed.Client``; each recording is then one task on its workers

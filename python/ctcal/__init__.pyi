@@ -58,6 +58,7 @@ def fit(
     end: Optional[float] = ...,
     max_frames: int = ...,
     max_pixels: int = ...,
+    max_events: int = ...,
     seed: int = ...,
     roi: Optional[str] = ...,
     mask: Optional[PathLike] = ...,

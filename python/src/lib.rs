@@ -340,7 +340,7 @@ fn estimate(
 
 /// `ctcal fit` of `path` with the default options, as JSON.
 #[pyfunction]
-#[pyo3(signature = (path, start=None, end=None, max_frames=120, max_pixels=ctcal_io::fit_region::FIT_PIXELS, seed=2020, roi=None, mask=None, format=None, sensor=None))]
+#[pyo3(signature = (path, start=None, end=None, max_frames=120, max_pixels=ctcal_io::fit_region::FIT_PIXELS, max_events=ctcal_io::fit_region::FIT_EVENTS, seed=2020, roi=None, mask=None, format=None, sensor=None))]
 #[allow(clippy::too_many_arguments)]
 fn fit(
     py: Python<'_>,
@@ -349,6 +349,7 @@ fn fit(
     end: Option<f64>,
     max_frames: usize,
     max_pixels: usize,
+    max_events: usize,
     seed: u64,
     roi: Option<&str>,
     mask: Option<PathBuf>,
@@ -365,7 +366,10 @@ fn fit(
                     seed,
                     ..Default::default()
                 },
-                max_pixels,
+                ctcal_io::fit_region::FitBudget {
+                    max_pixels,
+                    max_events,
+                },
                 &|_: &str, _: f64| {},
             )
             .map_err(|e| format!("{}: {e}", path.display()))
@@ -374,7 +378,7 @@ fn fit(
     json(&result)
 }
 
-/// The pipeline's options from the skin's JSON (`start`, `end`, `max_frames`, `max_pixels`, `seed`,
+/// The pipeline's options from the skin's JSON (`start`, `end`, `max_frames`, `max_pixels`, `max_events`, `seed`,
 /// `fit`, `screen` (a TOML file), `roi`, `mask`, `force`).
 fn report_options(text: &str) -> PyResult<Options> {
     let v: serde_json::Value = serde_json::from_str(text).map_err(err)?;
@@ -387,7 +391,10 @@ fn report_options(text: &str) -> PyResult<Options> {
         o.max_frames = n as usize;
     }
     if let Some(n) = v["max_pixels"].as_u64() {
-        o.fit_max_pixels = n as usize;
+        o.fit_budget.max_pixels = n as usize;
+    }
+    if let Some(n) = v["max_events"].as_u64() {
+        o.fit_budget.max_events = n as usize;
     }
     if let Some(s) = v["seed"].as_u64() {
         o.seed = s;

@@ -34,6 +34,12 @@ pub struct FitArgs {
     /// frames hundreds of times.
     #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_PIXELS)]
     pub max_pixels: usize,
+    /// Re-simulate about this many events at most (0: no limit). A window with more is
+    /// fitted on the rectangle of the sensor's aspect where its events are densest, holding
+    /// about this many (named in `assumptions`): each of the fit's 150-300 simulations
+    /// makes as many events as the recording.
+    #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_EVENTS)]
+    pub max_events: usize,
     /// Exposure time of the frames, where the file does not say.
     #[arg(long, value_name = "S")]
     pub exposure_s: Option<f64>,
@@ -208,7 +214,15 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
         seed: args.seed,
         ..FitOptions::default()
     };
-    let result = ctcal::fit_region::fit(&loaded, &options, args.max_pixels, &progress);
+    let result = ctcal::fit_region::fit(
+        &loaded,
+        &options,
+        ctcal::fit_region::FitBudget {
+            max_pixels: args.max_pixels,
+            max_events: args.max_events,
+        },
+        &progress,
+    );
     spinner.finish_and_clear();
     let mut result = result.map_err(|e| estimate_failed(&path, &e))?;
     if on_screen {

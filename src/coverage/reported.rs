@@ -3,7 +3,9 @@
 //! determined (`null` with a reason under `why`), or nothing.
 //!
 //! Intervals are read as `KEY_ci95` (`estimate`) or, for `fit`, `uncertainties.KEY.ci95`
-//! when present, else `value ± 1.96 standard_error`.
+//! when present, else `value ± 1.96 standard_error`. A fit's `null` beside an interval under
+//! `uncertainties` (a spread the model lacks but event timing measured, a leak read as a
+//! lower bound) is scored as that interval: the JSON states it.
 
 use super::method::Method;
 use serde::{Deserialize, Serialize};
@@ -124,9 +126,18 @@ fn fit_parameter(output: &Value, key: &str) -> Reported {
     let Some(value) = params.get(key) else {
         return Reported::NotReported;
     };
-    let ci = value
-        .as_f64()
-        .and_then(|v| fit_interval(&output["uncertainties"][key], v));
+    let uncertainty = &output["uncertainties"][key];
+    if value.is_null()
+        && let Some(stated) = uncertainty.get("value").and_then(Value::as_f64)
+        && let Some((lo, hi)) = uncertainty.get("ci95").and_then(interval)
+    {
+        return Reported::Interval {
+            value: stated,
+            lo,
+            hi,
+        };
+    }
+    let ci = value.as_f64().and_then(|v| fit_interval(uncertainty, v));
     classify(value, ci, why(output, params, key))
 }
 
@@ -181,5 +192,19 @@ mod tests {
         assert!(r["ct_off"].is_open());
         assert_eq!(r["leak_rate_hz"], Reported::NoInterval { value: 0.1 });
         assert_eq!(r["cutoff_hz"], Reported::NotReported);
+    }
+
+    #[test]
+    fn a_fit_s_null_beside_an_interval_is_scored_as_the_interval() {
+        let out = json!({"params": {"ct_on": 0.3, "ct_sigma": null, "leak_rate_hz": null},
+            "why": {"ct_sigma": "the model has none; event timing measures 0.035",
+                "leak_rate_hz": "too few isolated events"},
+            "uncertainties": {"ct_sigma": {"value": 0.035, "ci95": [0.006, 0.065]}}});
+        let r = extract(Method::Fit, &out);
+        assert!(r["ct_sigma"].covers(0.047) && !r["ct_sigma"].covers(0.07));
+        assert!(matches!(
+            r["leak_rate_hz"],
+            Reported::NotDeterminable { .. }
+        ));
     }
 }

@@ -1,8 +1,15 @@
 //! The fit of a window, on the region of the sensor it can afford: a sensor with more
-//! pixels than a 346x260 one is fitted on the rectangle of that many pixels where its events
-//! are densest ([`ctcal_core::region`]), the hot pixels it names given in the sensor's
-//! coordinates and the region named in `assumptions`. The `ctcal fit` command, the report
-//! and the Python package all fit through here.
+//! pixels than a 346x260 one, or a window with more events than [`FIT_EVENTS`], is fitted
+//! on the rectangle where its events are densest ([`ctcal_core::region`]), the hot pixels
+//! it names given in the sensor's coordinates and the region named in `assumptions`. The
+//! `ctcal fit` command, the report and the Python package all fit through here.
+//!
+//! The events bound it because the fit's cost is its simulations (150-300 of them), each
+//! as long as the recording's changes are many: coverage draw 7034 (a 240x180 texture
+//! turning fast, 4.2 M events in 1.46 s) ran 296 simulations in 886 s on one thread, its
+//! busiest 117x87 region (10,179 pixels) 145 in 60 s with every interval still covering
+//! the truth; draw 6024 (3.9 M events) 50 s on 11,000 pixels against 120 s wall on two
+//! threads whole.
 
 use crate::estimate::{EstimateError, Progress};
 use crate::frame_blocks::LIMIT_PIXELS;
@@ -13,6 +20,81 @@ use ctcal_core::fit::{FitInput, FitOptions, FitResult};
 /// The most pixels a fit simulates unless told otherwise: a 346x260 sensor's (the frame
 /// limit's sensor, [`LIMIT_PIXELS`]).
 pub const FIT_PIXELS: usize = LIMIT_PIXELS;
+
+/// The most events a fit re-simulates unless told otherwise (each of its simulations makes
+/// about as many): a window with more is fitted on a region of its sensor of about this
+/// many events. The shared v2e cases and IJRR chunks hold 20,000-540,000.
+pub const FIT_EVENTS: usize = 1_000_000;
+
+/// The smallest region the event budget cuts to (64 x 48 pixels' worth): below it the
+/// optical flow's pyramid and the 8 x 8 px tiles of the statistics have too little room.
+pub const MIN_REGION_PIXELS: usize = 64 * 48;
+
+/// What a fit may simulate: pixels and events (0: no limit).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FitBudget {
+    pub max_pixels: usize,
+    pub max_events: usize,
+}
+
+impl Default for FitBudget {
+    fn default() -> Self {
+        Self {
+            max_pixels: FIT_PIXELS,
+            max_events: FIT_EVENTS,
+        }
+    }
+}
+
+/// The region a fit of `loaded` measures on within `budget`, and the pixel limit it was
+/// cut to, where it is cut; `None` where the whole sensor fits.
+fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
+    let pixels = loaded.sensor.pixels();
+    let by_pixels = if budget.max_pixels == 0 {
+        pixels
+    } else {
+        budget.max_pixels.min(pixels)
+    };
+    let events = loaded.events.len();
+    let by_events = |events_in: usize| -> usize {
+        if budget.max_events == 0 || events_in <= budget.max_events {
+            return usize::MAX;
+        }
+        let share = budget.max_events as f64 / events_in as f64;
+        ((pixels as f64 * share) as usize).max(MIN_REGION_PIXELS)
+    };
+    let busiest = |limit: usize| {
+        ctcal_core::region::busiest_region(&loaded.events, loaded.sensor, &loaded.excluded, limit)
+    };
+    let mut limit = by_pixels.min(by_events(events));
+    let mut roi = busiest(limit)?;
+    // the densest region holds more than its share of the events: shrunk in proportion
+    // (twice at most) while it holds over a tenth more than the budget
+    for _ in 0..2 {
+        let inside = events_within(&loaded.events, roi);
+        if budget.max_events == 0 || inside * 10 <= budget.max_events * 11 {
+            break;
+        }
+        let next = ((limit as f64 * budget.max_events as f64 / inside as f64) as usize)
+            .max(MIN_REGION_PIXELS);
+        if next >= limit {
+            break;
+        }
+        limit = next;
+        roi = busiest(limit)?;
+    }
+    Some((roi, limit))
+}
+
+/// The events inside `roi`.
+fn events_within(events: &ctcal_core::events::EventChunk, roi: Roi) -> usize {
+    events
+        .x
+        .iter()
+        .zip(&events.y)
+        .filter(|&(&x, &y)| x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1)
+        .count()
+}
 
 impl Loaded {
     /// The same window on the pixels of `roi` only, as a sensor of the region's size.
@@ -34,26 +116,20 @@ impl Loaded {
     }
 }
 
-/// `ctcal fit` of `loaded` with `options`, on its busiest region of at most `max_pixels`
-/// pixels where it has frames and more pixels than that (0: the whole sensor); the window's
-/// notes and the recording's biases added.
+/// `ctcal fit` of `loaded` with `options`, on its busiest region within `budget` (at
+/// most `max_pixels` pixels, about `max_events` events; 0: no limit) where it has frames
+/// and more pixels or events than that; the window's notes and the recording's biases
+/// added.
 pub fn fit(
     loaded: &Loaded,
     options: &FitOptions,
-    max_pixels: usize,
+    budget: FitBudget,
     progress: Progress,
 ) -> Result<FitResult, EstimateError> {
     let region = (loaded.frames.len() >= 2)
-        .then(|| {
-            ctcal_core::region::busiest_region(
-                &loaded.events,
-                loaded.sensor,
-                &loaded.excluded,
-                max_pixels,
-            )
-        })
+        .then(|| region_within(loaded, budget))
         .flatten();
-    let cut = region.map(|roi| loaded.within(roi));
+    let cut = region.map(|(roi, _)| loaded.within(roi));
     let input = cut.as_ref().unwrap_or(loaded);
     let mut result = ctcal_core::fit::fit(
         &FitInput {
@@ -66,24 +142,41 @@ pub fn fit(
         options,
         progress,
     )?;
-    if let Some(roi) = region {
+    if let Some((roi, limit)) = region {
         for p in &mut result.hot_pixels_masked {
             (p.x, p.y) = (p.x + roi.x0, p.y + roi.y0);
         }
+        let inside = input.events.len();
         result
             .assumptions
-            .push(region_note(roi, loaded, max_pixels));
+            .push(region_note(roi, loaded, budget, (limit, inside)));
     }
     result.assumptions.extend(loaded.notes.iter().cloned());
     result.biases = loaded.recording.biases();
     Ok(result)
 }
 
-/// What a fit on a region says in `assumptions`.
-fn region_note(roi: Roi, loaded: &Loaded, max_pixels: usize) -> String {
+/// What a fit on a region says in `assumptions` (`limit` the pixels it was cut to,
+/// `inside` the events in it).
+fn region_note(
+    roi: Roi,
+    loaded: &Loaded,
+    budget: FitBudget,
+    (limit, inside): (usize, usize),
+) -> String {
     let (rw, rh) = (roi.width() as usize, roi.height() as usize);
+    let pixels_bind = budget.max_pixels != 0 && limit >= budget.max_pixels;
+    let why = if pixels_bind {
+        format!("at most {} are simulated", budget.max_pixels)
+    } else {
+        format!(
+            "the window's {} events are more than the {} a fit re-simulates, each of its simulations making as many: {inside} events here",
+            loaded.events.len(),
+            budget.max_events
+        )
+    };
     format!(
-        "fitted on the region x {}..{}, y {}..{} of the {} sensor ({} of {} pixels; at most {max_pixels} are simulated, the frames cut to it): the {rw}x{rh} rectangle, of the sensor's aspect, where the events are densest (each pixel counted up to the 99th percentile of the pixels' counts, so that hot pixels do not choose it); thresholds, mismatch and noise rates are per-pixel and measured there; a variation of the thresholds across the sensor beyond the per-pixel mismatch, and hot pixels outside the region, are not seen",
+        "fitted on the region x {}..{}, y {}..{} of the {} sensor ({} of {} pixels; {why}; the frames cut to it): the {rw}x{rh} rectangle, of the sensor's aspect, where the events are densest (each pixel counted up to the 99th percentile of the pixels' counts, so that hot pixels do not choose it); thresholds, mismatch and noise rates are per-pixel and measured there, their intervals from these pixels alone; a variation of the thresholds across the sensor beyond the per-pixel mismatch, and hot pixels outside the region, are not seen",
         roi.x0,
         roi.x1,
         roi.y0,

@@ -50,9 +50,9 @@ pub struct Options {
     pub seed: u64,
     /// `None`: fit every recording; else leave the fit out, with this reason in the report.
     pub fit_left_out: Option<String>,
-    /// The fit simulates at most this many pixels: a larger sensor is fitted on its
-    /// busiest region of that size (`ctcal_io::fit_region`; 0: the whole sensor).
-    pub fit_max_pixels: usize,
+    /// The pixels and events the fit simulates at most: a larger sensor or a denser window
+    /// is fitted on its busiest region within them (`ctcal_io::fit_region`; 0: no limit).
+    pub fit_budget: fit_region::FitBudget,
     /// The pixels to analyse.
     pub selection: SelectionSpec,
     /// Run work beyond the memory budgets.
@@ -68,7 +68,7 @@ impl Default for Options {
             screen: None,
             seed: ctcal_core::DEFAULT_SEED,
             fit_left_out: None,
-            fit_max_pixels: fit_region::FIT_PIXELS,
+            fit_budget: fit_region::FitBudget::default(),
             selection: SelectionSpec::default(),
             force: false,
         }

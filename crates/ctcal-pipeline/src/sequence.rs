@@ -339,7 +339,7 @@ fn fit_of(
                 thresholds: screen.cloned(),
                 ..FitOptions::default()
             },
-            options.fit_max_pixels,
+            options.fit_budget,
             &quiet,
         ) {
             Ok(f) => (Some(f), None),

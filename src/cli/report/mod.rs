@@ -55,6 +55,10 @@ pub struct ReportArgs {
     /// region of that size (as `fit --max-pixels`; 0: the whole sensor).
     #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_PIXELS)]
     pub max_pixels: usize,
+    /// The fit re-simulates about this many events at most: a window with more is fitted on
+    /// its busiest region holding about that many (as `fit --max-events`; 0: no limit).
+    #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_EVENTS)]
+    pub max_events: usize,
     /// The screen model for recordings of an on-screen stimulus (default: a typical 60 Hz
     /// LCD).
     #[arg(long, value_name = "SCREEN.toml")]
@@ -117,7 +121,10 @@ fn options(args: &ReportArgs, global: &Global) -> anyhow::Result<pipeline::Optio
         screen: screen_of(args)?,
         seed: args.seed,
         fit_left_out: args.no_fit.then(|| "left out (--no-fit)".to_string()),
-        fit_max_pixels: args.max_pixels,
+        fit_budget: ctcal::fit_region::FitBudget {
+            max_pixels: args.max_pixels,
+            max_events: args.max_events,
+        },
         selection: args.selection.spec(),
         force: global.force,
     })

@@ -217,7 +217,18 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
             d
         });
     let mut not_identified = not_identified(&state, fixed);
-    not_identified.extend(spread_unseen(&state, &steps));
+    not_identified.extend(super::spread_report::unseen(
+        state.model.params.ct_sigma,
+        &steps,
+    ));
+    if let Some((why, measured)) = super::spread_report::measured_not_modelled(
+        state.model.params.ct_sigma,
+        &steps,
+        measured_spread,
+    ) {
+        not_identified.insert("ct_sigma".into(), why);
+        state.uncertainty.insert("ct_sigma".into(), measured);
+    }
     assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
         &mut state.uncertainty,
         &not_identified,
@@ -341,26 +352,6 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
         why.insert(HOT_RATE.into(), reason);
     }
     why
-}
-
-/// `ct_sigma` where the model has no mismatch because the recording could not show one:
-/// event timing measured no spread and the fit blocks have too few events per pixel to
-/// compare the counts' dispersion with the model's. The model's spread of none is then not
-/// a measurement, and the configurations write the simulator's default with the reason.
-fn spread_unseen(state: &State, steps: &[Step]) -> Option<(String, String)> {
-    if state.model.params.ct_sigma.is_some_and(|s| s > 0.0) {
-        return None;
-    }
-    let unseen = steps.iter().any(|s| {
-        s.effect == Effect::Mismatch.name()
-            && s.evidence == super::super::effects::mismatch::TOO_FEW_TO_COMPARE
-    });
-    unseen.then(|| {
-        (
-            "ct_sigma".to_string(),
-            "the recording does not show a threshold spread: event timing measured none and the fit blocks have too few events per pixel to compare the counts' dispersion with the model's; the model has no mismatch, which is not a measurement".to_string(),
-        )
-    })
 }
 
 /// The effects whose parameters trade against the thresholds in the counts: a slow

@@ -33,6 +33,7 @@ mod hot_report;
 pub(in crate::fit) mod keep;
 mod method_systematic;
 mod noise_detection;
+mod spread_report;
 mod start;
 mod steps;
 
