@@ -145,7 +145,8 @@ impl Roi {
         Sensor::new(self.width(), self.height())
     }
 
-    fn holds(&self, x: u16, y: u16) -> bool {
+    /// Whether pixel `(x, y)` lies inside the region.
+    pub fn holds(&self, x: u16, y: u16) -> bool {
         (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
     }
 }

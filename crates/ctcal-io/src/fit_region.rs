@@ -55,28 +55,27 @@ fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
     } else {
         budget.max_pixels.min(pixels)
     };
-    let events = loaded.events.len();
-    let by_events = |events_in: usize| -> usize {
-        if budget.max_events == 0 || events_in <= budget.max_events {
-            return usize::MAX;
+    // `of` pixels scaled to hold the budget where they hold `events` above it
+    let within_events = |of: usize, events: usize| -> usize {
+        if budget.max_events == 0 || events <= budget.max_events {
+            return of;
         }
-        let share = budget.max_events as f64 / events_in as f64;
-        ((pixels as f64 * share) as usize).max(MIN_REGION_PIXELS)
+        let share = budget.max_events as f64 / events as f64;
+        ((of as f64 * share) as usize).max(MIN_REGION_PIXELS)
     };
     let busiest = |limit: usize| {
         ctcal_core::region::busiest_region(&loaded.events, loaded.sensor, &loaded.excluded, limit)
     };
-    let mut limit = by_pixels.min(by_events(events));
+    let mut limit = by_pixels.min(within_events(pixels, loaded.events.len()));
     let mut roi = busiest(limit)?;
     // the densest region holds more than its share of the events: shrunk in proportion
     // (twice at most) while it holds over a tenth more than the budget
     for _ in 0..2 {
         let inside = events_within(&loaded.events, roi);
-        if budget.max_events == 0 || inside * 10 <= budget.max_events * 11 {
+        if inside * 10 <= budget.max_events * 11 {
             break;
         }
-        let next = ((limit as f64 * budget.max_events as f64 / inside as f64) as usize)
-            .max(MIN_REGION_PIXELS);
+        let next = within_events(limit, inside);
         if next >= limit {
             break;
         }
@@ -92,7 +91,7 @@ fn events_within(events: &ctcal_core::events::EventChunk, roi: Roi) -> usize {
         .x
         .iter()
         .zip(&events.y)
-        .filter(|&(&x, &y)| x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1)
+        .filter(|&(&x, &y)| roi.holds(x, y))
         .count()
 }
 

@@ -288,25 +288,78 @@ pub fn count_refractory_over(
     c_off: f32,
     refractory_s: f64,
 ) -> ScanCount {
-    let (v, t) = (&profile.values, &profile.times_s);
-    let n = v.len().min(t.len());
-    let Some(&first) = v.first() else {
+    let Some(mut pixel) = RefractoryPixel::new(profile, c_on, c_off, refractory_s) else {
         return ScanCount::default();
     };
-    let mut reference = first;
-    let mut ready = f64::NEG_INFINITY;
-    let mut out = ScanCount::default();
-    let mut last = [None, None];
-    // samples are STEP_PX of travel apart, evenly in time
-    let px_per_s = match t.as_slice() {
-        [a, b, ..] if b > a => STEP_PX / (b - a),
-        _ => 0.0,
-    };
+    let n = pixel.samples();
     let mut run = 0;
     let mut i = 1;
     while i < n {
-        let (t0, t1, v0, v1) = (t[i - 1], t[i], v[i - 1], v[i]);
-        let counted = i > profile.burn;
+        let fired = pixel.stretch(i);
+        // ready through the whole stretch (unchanged where it fired nothing)
+        let ready = pixel.t[i - 1] >= pixel.ready;
+        while runs.ends[run] as usize <= i {
+            run += 1;
+        }
+        let end = (runs.ends[run] as usize).min(n);
+        i += 1;
+        // a ready stretch that fired nothing, inside its run: skip to the first that may
+        // (times rising, so that a stretch's level at its start is its first sample's)
+        if !fired && ready && pixel.px_per_s > 0.0 && i < end {
+            i = pixel.first_that_may_fire(i..end, runs.rising[run]);
+        }
+    }
+    pixel.out
+}
+
+/// A refractory pixel along a profile ([`count_refractory`]): the memorised level, when it
+/// is ready again, and what it fired.
+struct RefractoryPixel<'a> {
+    v: &'a [f32],
+    t: &'a [f64],
+    burn: usize,
+    c_on: f32,
+    c_off: f32,
+    refractory_s: f64,
+    /// Travel per second (samples are [`STEP_PX`] of travel apart, evenly in time).
+    px_per_s: f64,
+    reference: f32,
+    ready: f64,
+    out: ScanCount,
+    last: [Option<f64>; 2],
+}
+
+impl<'a> RefractoryPixel<'a> {
+    /// At the profile's first sample; `None` without one.
+    fn new(profile: &'a Profile, c_on: f32, c_off: f32, refractory_s: f64) -> Option<Self> {
+        let (v, t) = (&profile.values[..], &profile.times_s[..]);
+        Some(Self {
+            reference: *v.first()?,
+            px_per_s: match t {
+                [a, b, ..] if b > a => STEP_PX / (b - a),
+                _ => 0.0,
+            },
+            v,
+            t,
+            burn: profile.burn,
+            c_on,
+            c_off,
+            refractory_s,
+            ready: f64::NEG_INFINITY,
+            out: ScanCount::default(),
+            last: [None, None],
+        })
+    }
+
+    fn samples(&self) -> usize {
+        self.v.len().min(self.t.len())
+    }
+
+    /// The events of the stretch from sample `i - 1` to `i` (the level interpolated
+    /// linearly in time between them); whether it fired any.
+    fn stretch(&mut self, i: usize) -> bool {
+        let (t0, t1, v0, v1) = (self.t[i - 1], self.t[i], self.v[i - 1], self.v[i]);
+        let counted = i > self.burn;
         let level_at = |s: f64| {
             if t1 > t0 {
                 v0 + (v1 - v0) * ((s - t0) / (t1 - t0)) as f32
@@ -314,14 +367,16 @@ pub fn count_refractory_over(
                 v1
             }
         };
+        let (c_on, c_off) = (self.c_on, self.c_off);
         let mut from = t0;
         let mut fired_here = false;
         loop {
-            let start = from.max(ready);
+            let start = from.max(self.ready);
             if start > t1 {
                 break;
             }
             let level = level_at(start);
+            let reference = self.reference;
             let fired = if level - reference >= c_on {
                 Some((start, true))
             } else if reference - level >= c_off {
@@ -342,45 +397,41 @@ pub fn count_refractory_over(
             };
             let Some((at, up)) = fired else { break };
             fired_here = true;
-            reference += if up { c_on } else { -c_off };
+            self.reference += if up { c_on } else { -c_off };
             if counted {
-                out.event(up, (at - t[0]) * px_per_s, &mut last);
+                let travel = (at - self.t[0]) * self.px_per_s;
+                self.out.event(up, travel, &mut self.last);
             }
-            ready = at + refractory_s;
+            self.ready = at + self.refractory_s;
             from = at;
         }
-        while runs.ends[run] as usize <= i {
-            run += 1;
-        }
-        let end = (runs.ends[run] as usize).min(n);
-        i += 1;
-        // a ready stretch that fired nothing, inside its run: skip to the first that may
-        // (times rising, so that a stretch's level at its start is its first sample's)
-        if !fired_here && t0 >= ready && px_per_s > 0.0 && i < end {
-            let r = reference;
-            let rising = runs.rising[run];
-            let quiet = |k: usize| {
-                let (from_level, to_level) = (v[k - 1], v[k]);
-                if rising {
-                    !(from_level - r >= c_on || to_level >= r + c_on)
-                } else {
-                    !(r - from_level >= c_off || to_level <= r - c_off)
-                }
-            };
-            // the first stretch of i..end that is not quiet (end: none)
-            let (mut lo, mut hi) = (i, end);
-            while lo < hi {
-                let mid = lo + (hi - lo) / 2;
-                if quiet(mid) {
-                    lo = mid + 1;
-                } else {
-                    hi = mid;
-                }
-            }
-            i = lo;
-        }
+        fired_here
     }
-    out
+
+    /// The first stretch of `stretches` (within one run, rising or not, the pixel ready
+    /// and nothing fired before them) that may fire, by bisection; the range's end where
+    /// none may (see [`count_refractory_over`]).
+    fn first_that_may_fire(&self, stretches: std::ops::Range<usize>, rising: bool) -> usize {
+        let (v, r, c_on, c_off) = (self.v, self.reference, self.c_on, self.c_off);
+        let quiet = |k: usize| {
+            let (from_level, to_level) = (v[k - 1], v[k]);
+            if rising {
+                !(from_level - r >= c_on || to_level >= r + c_on)
+            } else {
+                !(r - from_level >= c_off || to_level <= r - c_off)
+            }
+        };
+        let (mut lo, mut hi) = (stretches.start, stretches.end);
+        while lo < hi {
+            let mid = lo + (hi - lo) / 2;
+            if quiet(mid) {
+                lo = mid + 1;
+            } else {
+                hi = mid;
+            }
+        }
+        lo
+    }
 }
 
 /// Which polarity a calibration curve is read for.
@@ -668,61 +719,11 @@ mod tests {
         c_off: f32,
         refractory_s: f64,
     ) -> ScanCount {
-        let (v, t) = (&profile.values, &profile.times_s);
-        let mut reference = v[0];
-        let mut ready = f64::NEG_INFINITY;
-        let mut out = ScanCount::default();
-        let mut last = [None, None];
-        // samples are STEP_PX of travel apart, evenly in time
-        let px_per_s = match t.as_slice() {
-            [a, b, ..] if b > a => STEP_PX / (b - a),
-            _ => 0.0,
-        };
-        for i in 1..v.len().min(t.len()) {
-            let (t0, t1, v0, v1) = (t[i - 1], t[i], v[i - 1], v[i]);
-            let counted = i > profile.burn;
-            let level_at = |s: f64| {
-                if t1 > t0 {
-                    v0 + (v1 - v0) * ((s - t0) / (t1 - t0)) as f32
-                } else {
-                    v1
-                }
-            };
-            let mut from = t0;
-            loop {
-                let start = from.max(ready);
-                if start > t1 {
-                    break;
-                }
-                let level = level_at(start);
-                let fired = if level - reference >= c_on {
-                    Some((start, true))
-                } else if reference - level >= c_off {
-                    Some((start, false))
-                } else {
-                    // the next crossing later in this stretch, if the level gets there
-                    let up = v1 > level;
-                    let target = if up {
-                        reference + c_on
-                    } else {
-                        reference - c_off
-                    };
-                    let reached = if up { v1 >= target } else { v1 <= target };
-                    (reached && v1 != level && t1 > start).then(|| {
-                        let f = f64::from((target - level) / (v1 - level));
-                        (start + f * (t1 - start), up)
-                    })
-                };
-                let Some((at, up)) = fired else { break };
-                reference += if up { c_on } else { -c_off };
-                if counted {
-                    out.event(up, (at - t[0]) * px_per_s, &mut last);
-                }
-                ready = at + refractory_s;
-                from = at;
-            }
+        let mut pixel = RefractoryPixel::new(profile, c_on, c_off, refractory_s).unwrap();
+        for i in 1..pixel.samples() {
+            pixel.stretch(i);
         }
-        out
+        pixel.out
     }
 
     #[test]
