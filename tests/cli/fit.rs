@@ -124,6 +124,14 @@ fn bandwidth_is_added_where_pixels_are_slow_and_only_there() {
         added(&control)
     );
     assert!(param(&control, "cutoff_hz").is_none());
+    // the control's detection limit: its scene with v2e's 30 Hz cutoff (the case above)
+    // called for bandwidth and kept it, so a 30 Hz cutoff lies below the limit; a fit that
+    // keeps a cutoff gives none
+    let limit = control["bandwidth_detection"]["called_for_below_hz"]
+        .as_f64()
+        .unwrap();
+    assert!(limit > 30.0 && limit < 2000.0, "{limit}");
+    assert!(f.get("bandwidth_detection").is_none(), "{f:#}");
 }
 
 #[test]

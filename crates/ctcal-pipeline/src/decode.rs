@@ -16,8 +16,8 @@ use crate::fit::events_only::{EventsOnly, IntervalEdge};
 use crate::fit::metric::Components;
 use crate::fit::residuals::{BackgroundBin, Bin, IntervalDistributions, Residuals, Spectrum};
 use crate::fit::{
-    AddedEffect, Ambiguity, FitResult, FittedParams, Holdout, HotPixelDetection, NoiseDetection,
-    NoiseLimit, Step, StepResiduals, Uncertain,
+    AddedEffect, Ambiguity, BandwidthDetection, FitResult, FittedParams, Holdout,
+    HotPixelDetection, NoiseDetection, NoiseLimit, Step, StepResiduals, Uncertain,
 };
 use crate::model::{
     InputFile, MethodResult, PlotEntry, PresetLevel, SequenceOutputs, SequenceReport, Truth,
@@ -275,11 +275,12 @@ structs! {
     IntervalInfo { t_start_s, t_end_s, used, reason, motion_px }
     FitResult { biases, params, identified, why, uncertainties, effects_added, error_metric,
         error_before, error_after, components_before, components_after, steps, ambiguities,
-        hot_pixels_masked, hot_pixel_detection, noise_detection, residuals_before,
+        hot_pixels_masked, hot_pixel_detection, noise_detection, bandwidth_detection, residuals_before,
         residuals_after, assumptions,
         holdout, simulations, frame_exposure_us, events_only }
     HotPixelDetection { detectable_above_hz, probability, meaning }
     NoiseDetection { limits, probe_hz, meaning }
+    BandwidthDetection { called_for_below_hz, evidence, recording_evidence, tried, why, meaning }
     NoiseLimit { called_for_above_hz, isolated_hz_per_hz, tried, why }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,

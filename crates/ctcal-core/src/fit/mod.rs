@@ -321,6 +321,10 @@ pub struct FitResult {
     /// lacks (a fit with frames).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_detection: Option<NoiseDetection>,
+    /// Which photoreceptor cutoff the recording would show, where the final model has none
+    /// (a fit with frames).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bandwidth_detection: Option<BandwidthDetection>,
     /// Residuals of the ideal model and of the final one (fit blocks; a fit without
     /// frames simulates no scene and has none).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -349,6 +353,25 @@ pub struct NoiseDetection {
     pub limits: BTreeMap<String, NoiseLimit>,
     /// The rate the effect was simulated at to measure its isolated events, Hz.
     pub probe_hz: f64,
+    pub meaning: &'static str,
+}
+
+/// Which photoreceptor cutoff a fit with frames would have seen
+/// (`fit::selection::bandwidth_detection`), where the final model has none.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BandwidthDetection {
+    /// The highest cutoff at white at which a recording of this scene would have called
+    /// for the effect in about 95 % of such recordings; `null` with `why` where none
+    /// would, or the recording already calls for it.
+    pub called_for_below_hz: Option<f64>,
+    /// `[cutoff_hz, standard errors]`: the evidence of every cutoff simulated.
+    pub evidence: Vec<[f64; 2]>,
+    /// The recording's own bandwidth evidence beside the final model, standard errors.
+    pub recording_evidence: f64,
+    /// The effect was called for and tried, and not kept.
+    pub tried: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why: Option<String>,
     pub meaning: &'static str,
 }
 

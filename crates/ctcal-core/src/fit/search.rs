@@ -136,9 +136,19 @@ impl Simulation<'_> {
         params: &PixelParams,
         masked: &[bool],
     ) -> Result<Observed, EstimateError> {
+        let events = self.events_of(params, self.seed)?;
+        let keys = self
+            .lag_keys
+            .get_or_init(|| Observed::lag_keys(self.events, self.geometry));
+        Ok(Observed::paired(&events, self.geometry, masked, keys))
+    }
+
+    /// The events of `params` simulated on the frames with `seed`, on the recording's
+    /// timestamp grid and with the named hot pixels' trains (never simulated hot pixels).
+    pub fn events_of(&self, params: &PixelParams, seed: u64) -> Result<EventChunk, EstimateError> {
         self.count.set(self.count.get() + 1);
         let mut p = params.clone();
-        p.seed = Some(self.seed);
+        p.seed = Some(seed);
         p.hot_pixel_fraction = None;
         p.hot_pixel_rate_hz = None;
         let mut events = resim::simulate(self.runs, self.width, self.height, &p)?;
@@ -148,10 +158,7 @@ impl Simulation<'_> {
         if !self.hot_events.is_empty() {
             events = EventChunk::merged(&events, &self.hot_events);
         }
-        let keys = self
-            .lag_keys
-            .get_or_init(|| Observed::lag_keys(self.events, self.geometry));
-        Ok(Observed::paired(&events, self.geometry, masked, keys))
+        Ok(events)
     }
 
     /// `params` with its thresholds profiled (see the module docs), unless `fixed`.

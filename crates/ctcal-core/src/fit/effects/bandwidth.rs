@@ -36,13 +36,50 @@
 
 use super::{Context, Effect, Evidence};
 use crate::fit::metric::cell_ratios;
-use crate::fit::observe::cell_of;
 use crate::fit::observe::lag::BinDelay;
+use crate::fit::observe::{INTENSITY_BINS, cell_of};
 
 /// The evidence of the counts or of the lag, whichever is stronger.
 pub fn evidence(c: &Context) -> Evidence {
-    let counts = count_evidence(c);
-    match lag_evidence(c) {
+    evidence_over(c, &NoiseFloor::default())
+}
+
+/// The standard errors the evidence divides by, held at least at another comparison's: a
+/// detection limit judges the signal a simulated cutoff leaves in a simulated recording
+/// against the noise of the real one beside the model, which holds what the model misses
+/// (the fit's bandwidth detection, `fit::selection::bandwidth_detection`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NoiseFloor {
+    /// The count part's standard error of the slope (infinite where the other comparison
+    /// has too few cells for one).
+    pub count_slope: f64,
+    /// The lag part's standard error of each intensity bin's median lag, seconds; infinite
+    /// where the other comparison has no lag in the bin (too few paired events): a
+    /// recording like it has none to read there either.
+    pub lag_s: [f64; INTENSITY_BINS],
+}
+
+/// The standard errors of `c`'s evidence, as a floor for another's.
+pub fn noise_of(c: &Context) -> NoiseFloor {
+    let mut floor = NoiseFloor {
+        count_slope: f64::INFINITY,
+        lag_s: [f64::INFINITY; INTENSITY_BINS],
+    };
+    if let Some((_, se, _)) = weighted_slope(&count_points(c)) {
+        floor.count_slope = se;
+    }
+    for (bin, delay) in c.sim.delay_of(c.geometry, c.subset).iter().enumerate() {
+        if let Some(d) = delay {
+            floor.lag_s[bin] = d.common.standard_error_s;
+        }
+    }
+    floor
+}
+
+/// [`evidence`] with its standard errors held at least at `floor`.
+pub fn evidence_over(c: &Context, floor: &NoiseFloor) -> Evidence {
+    let counts = count_evidence(c, floor);
+    match lag_evidence(c, floor) {
         Some(lag) if lag.relevant && (lag.score > counts.score || !counts.relevant) => Evidence {
             text: format!("{}; {}", lag.text, counts.text),
             ..lag
@@ -82,14 +119,20 @@ struct LagReading {
 }
 
 /// The lag part (see the module docs); `None` without two intensity bins of paired events.
-fn lag_evidence(c: &Context) -> Option<Evidence> {
+fn lag_evidence(c: &Context, floor: &NoiseFloor) -> Option<Evidence> {
     let g = c.geometry;
     let bins: Vec<(usize, BinDelay)> = c
         .sim
         .delay_of(g, c.subset)
         .iter()
         .enumerate()
-        .filter_map(|(bin, lag)| lag.map(|l| (bin, l)))
+        .filter_map(|(bin, lag)| {
+            lag.map(|mut l| {
+                let se = &mut l.common.standard_error_s;
+                *se = se.max(floor.lag_s[bin]);
+                (bin, l)
+            })
+        })
         .collect();
     let &(bright, reference) = bins.last()?;
     let tau = |bin: usize| tau_of_1_hz(g.intensity_centres[bin]);
@@ -167,20 +210,11 @@ fn lag_evidence(c: &Context) -> Option<Evidence> {
 }
 
 /// The count part (see the module docs).
-fn count_evidence(c: &Context) -> Evidence {
-    let cells = cell_ratios(c.real, c.sim, c.geometry, c.subset);
-    let points: Vec<(f64, f64, f64)> = cells
-        .iter()
-        .map(|&(ratio, real, index)| {
-            let (intensity, change, _) = cell_of(index);
-            let g = c.geometry;
-            let x = (g.change_centres[change] / g.intensity_centres[intensity]).ln();
-            (x, ratio, real as f64 + 0.5)
-        })
-        .collect();
-    let Some((slope, se, spread)) = weighted_slope(&points) else {
+fn count_evidence(c: &Context, floor: &NoiseFloor) -> Evidence {
+    let Some((slope, se, spread)) = weighted_slope(&count_points(c)) else {
         return Evidence::none(Effect::Bandwidth, "too few intensity levels to compare");
     };
+    let se = se.max(floor.count_slope);
     let change = slope * spread;
     Evidence {
         effect: Effect::Bandwidth,
@@ -192,6 +226,19 @@ fn count_evidence(c: &Context) -> Evidence {
         ),
         start: Some(100.0),
     }
+}
+
+/// The count cells as `(ln(change rate / intensity), ln(simulated / real), weight)`.
+fn count_points(c: &Context) -> Vec<(f64, f64, f64)> {
+    let g = c.geometry;
+    cell_ratios(c.real, c.sim, g, c.subset)
+        .iter()
+        .map(|&(ratio, real, index)| {
+            let (intensity, change, _) = cell_of(index);
+            let x = (g.change_centres[change] / g.intensity_centres[intensity]).ln();
+            (x, ratio, real as f64 + 0.5)
+        })
+        .collect()
 }
 
 /// Weighted least-squares slope of `y` on `x` (points `(x, y, weight)`), its standard
@@ -346,6 +393,46 @@ mod tests {
         assert_eq!(e.start, Some(100.0));
         let (lo, hi) = crate::fit::effects::Effect::Bandwidth.range(100.0);
         assert!(lo < 20.0 && 20.0 < hi);
+    }
+
+    #[test]
+    fn a_noise_floor_divides_the_signal_by_the_larger_standard_error() {
+        let model = events(|_, _| 1.0);
+        let recording = events(low_pass(20.0));
+        let f = Fixture::new(&scene(), &recording, &model);
+        let context = f.context();
+        let own = noise_of(&context);
+        let plain = evidence(&context);
+        // a floor below the comparison's own standard errors changes nothing
+        assert_eq!(evidence_over(&context, &own), plain);
+        // twice the count part's standard error halves its score; the lag part (no lag in
+        // these events) stays below it
+        let doubled = NoiseFloor {
+            count_slope: 2.0 * own.count_slope,
+            ..own
+        };
+        let e = evidence_over(&context, &doubled);
+        assert!(own.count_slope > 0.0, "{own:?}");
+        assert!(
+            (e.score - plain.score / 2.0).abs() < 1e-9,
+            "{e:?} {plain:?}"
+        );
+        assert!(!e.calls_for(), "{e:?}");
+        // a lag floor raises each bin's standard error alike
+        let delayed = delayed_events(|_, _| 1.0, |dn, _| tau_of_1_hz(dn) / 150.0);
+        let f = Fixture::new(&scene(), &delayed, &model);
+        let context = f.context();
+        let lag = evidence(&context);
+        let own = noise_of(&context);
+        let floor = NoiseFloor {
+            lag_s: own.lag_s.map(|s| 4.0 * s),
+            ..own
+        };
+        let e = evidence_over(&context, &floor);
+        assert!(
+            (e.score - lag.score / 4.0).abs() < 0.05 * lag.score,
+            "{e:?} {lag:?}"
+        );
     }
 
     #[test]

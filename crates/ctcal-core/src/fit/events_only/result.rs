@@ -157,6 +157,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
         hot_pixels_masked: hot,
         hot_pixel_detection: None,
         noise_detection: None,
+        bandwidth_detection: None,
         residuals_before: None,
         residuals_after: None,
         assumptions,

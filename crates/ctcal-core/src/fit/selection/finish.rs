@@ -136,8 +136,9 @@ pub struct Parts<'a> {
     pub fixed: bool,
     /// The starting thresholds as measured (the intervals widen where the fit disagrees).
     pub start: Option<super::agreement::Measured>,
-    /// The threshold spread event timing measures (value, 95 % interval), if it does.
-    pub measured_spread: Option<(f64, [f64; 2])>,
+    /// What the fit run told before any effect was tried (the threshold spread event
+    /// timing measures, the timestamp grid, the shortest same-pixel interval).
+    pub known: super::Known,
     /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
     /// miss (the intervals reach up by it).
     pub interpolation_share: Option<[f64; 2]>,
@@ -160,12 +161,13 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         mut assumptions,
         fixed,
         start,
-        measured_spread,
+        known,
         interpolation_share,
         frame_quality,
         options,
         input,
     } = parts;
+    let measured_spread = known.mismatch;
     let after = simulation.distance(&state.model.observed, g.testing(), &state.kept);
     let residuals_after = residuals(&simulation.real, &state.model.observed, g, Subset::Fit);
     state
@@ -216,6 +218,16 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
             assumptions.push(note);
             d
         });
+    let bandwidth_detection = super::bandwidth_detection::detect(
+        simulation,
+        &super::context_of(&state, simulation, known),
+        &state.masked,
+        &steps,
+    )
+    .map(|(d, note)| {
+        assumptions.push(note);
+        d
+    });
     let mut not_identified = not_identified(&state, fixed);
     not_identified.extend(super::spread_report::unseen(
         state.model.params.ct_sigma,
@@ -265,6 +277,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         hot_pixels_masked: state.hot,
         hot_pixel_detection: state.hot_detection,
         noise_detection,
+        bandwidth_detection,
         residuals_before: Some(residuals_before),
         residuals_after: Some(residuals_after),
         events_only: None,

@@ -25,6 +25,7 @@
 
 mod agreement;
 mod alternatives;
+mod bandwidth_detection;
 pub use alternatives::Ambiguity;
 pub(in crate::fit) mod finish;
 mod frame_quality;
@@ -56,7 +57,7 @@ use std::collections::BTreeMap;
 /// What is known besides the residuals: the estimators' mismatch (value, 95 % interval),
 /// the recording's timestamp grid and its shortest same-pixel intervals on the fit run.
 #[derive(Clone, Copy)]
-struct Known {
+pub(super) struct Known {
     mismatch: Option<(f64, [f64; 2])>,
     grid: Option<(i64, i64)>,
     shortest_interval_s: Option<f64>,
@@ -181,7 +182,7 @@ pub fn fit(
             assumptions,
             fixed: ideal.fixed,
             start: start.measured,
-            measured_spread: loop_run.known.mismatch,
+            known: loop_run.known,
             interpolation_share: start.interpolation_share,
             frame_quality,
             options,
