@@ -37,7 +37,7 @@
 pub use ctcal_core::*;
 pub use ctcal_io as io;
 pub use ctcal_io::{Format, InputError, OpenOptions, Recording};
-pub use ctcal_io::{fit_region, window};
+pub use ctcal_io::{aps_region, fit_region, window};
 
 /// The report ([`ctcal_report`]) with its pipeline ([`ctcal_pipeline`]) under the path they
 /// had in one crate, `ctcal::report::pipeline`.

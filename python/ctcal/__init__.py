@@ -40,6 +40,11 @@ __version__: str = _ctcal.__version__
 
 PathLike = Union[str, "os.PathLike[str]"]
 
+#: The most pixels ``fit`` and ``estimate(method="aps")`` measure unless told otherwise (a
+#: 346x260 sensor's), and the most events (``ctcal_io::fit_region``).
+FIT_PIXELS = 346 * 260
+FIT_EVENTS = 1_000_000
+
 #: The events' dtype: time in microseconds, pixel column and row, polarity (1 = ON), as
 #: tonic and faery use it.
 EVENT_DTYPE = np.dtype([("t", "<i8"), ("x", "<u2"), ("y", "<u2"), ("p", "u1")])
@@ -128,6 +133,8 @@ def estimate(
     start: Optional[float] = None,
     end: Optional[float] = None,
     max_frames: int = 120,
+    max_pixels: int = FIT_PIXELS,
+    max_events: int = FIT_EVENTS,
     seed: int = 2020,
     roi: Optional[str] = None,
     mask: Optional[PathLike] = None,
@@ -138,7 +145,9 @@ def estimate(
     """``ctcal estimate METHOD PATH --json -`` with the command's defaults: contrast
     thresholds from grey frames (``aps``), event rate (``eppps``) or a recording of an
     on-screen stimulus (``screen``; ``stimulus`` is its folder, else ``stimulus.txt``
-    beside the recording)."""
+    beside the recording). ``aps`` of a window with more than ``max_events`` events (or
+    a sensor of more than ``max_pixels`` pixels) is measured on its busiest region of
+    that many, named in ``assumptions`` (0: no limit)."""
     return json.loads(
         _ctcal.estimate(
             _path(path),
@@ -146,6 +155,8 @@ def estimate(
             start,
             end,
             max_frames,
+            max_pixels,
+            max_events,
             seed,
             roi,
             None if mask is None else _path(mask),
@@ -162,8 +173,8 @@ def fit(
     start: Optional[float] = None,
     end: Optional[float] = None,
     max_frames: int = 120,
-    max_pixels: int = 346 * 260,
-    max_events: int = 1_000_000,
+    max_pixels: int = FIT_PIXELS,
+    max_events: int = FIT_EVENTS,
     seed: int = 2020,
     roi: Optional[str] = None,
     mask: Optional[PathLike] = None,

@@ -44,6 +44,8 @@ def estimate(
     start: Optional[float] = ...,
     end: Optional[float] = ...,
     max_frames: int = ...,
+    max_pixels: int = ...,
+    max_events: int = ...,
     seed: int = ...,
     roi: Optional[str] = ...,
     mask: Optional[PathLike] = ...,

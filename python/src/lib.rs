@@ -5,7 +5,7 @@
 //! carrying the library's message.
 
 use ctcal_core::Sensor;
-use ctcal_core::estimate::aps::{self, ApsInput, ApsOptions};
+use ctcal_core::estimate::aps::ApsOptions;
 use ctcal_core::sim::PixelParams;
 use ctcal_core::stats::{StatsAccumulator, StatsOptions};
 use ctcal_io::window::{Loaded, SelectionSpec, Window};
@@ -239,7 +239,7 @@ fn load(
 /// A threshold estimate of `path` (`aps`, `eppps` or `screen`), as the JSON of
 /// `ctcal estimate METHOD --json`.
 #[pyfunction]
-#[pyo3(signature = (path, method, start=None, end=None, max_frames=120, seed=2020, roi=None, mask=None, format=None, sensor=None, stimulus=None))]
+#[pyo3(signature = (path, method, start=None, end=None, max_frames=120, max_pixels=ctcal_io::fit_region::FIT_PIXELS, max_events=ctcal_io::fit_region::FIT_EVENTS, seed=2020, roi=None, mask=None, format=None, sensor=None, stimulus=None))]
 #[allow(clippy::too_many_arguments)]
 fn estimate(
     py: Python<'_>,
@@ -248,6 +248,8 @@ fn estimate(
     start: Option<f64>,
     end: Option<f64>,
     max_frames: usize,
+    max_pixels: usize,
+    max_events: usize,
     seed: u64,
     roi: Option<&str>,
     mask: Option<PathBuf>,
@@ -272,23 +274,13 @@ fn estimate(
                             if loaded.frames.len() == 1 { "only one" } else { "none" }
                         ));
                     }
-                    let mut result = aps::estimate(
-                        &ApsInput {
-                            sensor: loaded.sensor,
-                            events: &loaded.events,
-                            frames: &loaded.frames,
-                            excluded: &loaded.excluded,
-                            unread: &loaded.unread,
-                        },
-                        &ApsOptions::default(),
-                        &quiet,
-                    )
-                    .map_err(named)?;
-                    result
+                    let budget = ctcal_io::fit_region::FitBudget {
+                        max_pixels,
+                        max_events,
+                    };
+                    ctcal_io::aps_region::aps(&loaded, &ApsOptions::default(), budget, &quiet)
+                        .map_err(named)?
                         .estimate
-                        .assumptions
-                        .extend(loaded.notes.iter().cloned());
-                    result.estimate
                 }
                 "eppps" => ctcal_io::window::eppps_of(
                     &loaded,

@@ -139,6 +139,15 @@ def test_estimate_equals_the_command(method: str) -> None:
     assert ctcal.estimate(path, method) == cli("estimate", method, str(path))
 
 
+def test_estimate_aps_on_a_region_equals_the_command() -> None:
+    # an event budget under the 44,920 events between its frames: a region of about 20,000
+    path = REAL / "ijrr_slider_depth_50k"
+    sparse = ctcal.estimate(path, "aps", max_events=20000)
+    assert sparse == cli("estimate", "aps", str(path), "--max-events", "20000")
+    notes = [a for a in sparse["assumptions"] if a.startswith("measured by `estimate aps` on the region")]
+    assert len(notes) == 1 and "44920 events are more than the 20000" in notes[0]
+
+
 def test_fit_equals_the_command() -> None:
     path = REAL / "ijrr_slider_depth_50k"
     assert ctcal.fit(path) == cli("fit", str(path))

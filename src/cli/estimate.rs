@@ -6,7 +6,7 @@ use super::{
 };
 use clap::{Args, Subcommand, ValueEnum};
 use ctcal::estimate::CtEstimate;
-use ctcal::estimate::aps::{self, ApsInput, ApsOptions};
+use ctcal::estimate::aps::ApsOptions;
 use ctcal::estimate::eppps;
 use ctcal::estimate::timing::ThresholdMaps;
 use ctcal::sim::DisplayParams;
@@ -172,6 +172,17 @@ pub struct ApsArgs {
     /// estimated when frames have pixels clipped at 0.
     #[arg(long, value_name = "DN")]
     pub frame_offset_dn: Option<f64>,
+    /// Measure at most this many pixels (0: the whole sensor). A larger sensor is measured
+    /// on the rectangle of this many pixels, of its aspect, where its events are densest
+    /// (named in `assumptions`; the maps NaN outside it).
+    #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_PIXELS)]
+    pub max_pixels: usize,
+    /// Read about this many events at most (0: no limit). A window with more is measured on
+    /// the rectangle of the sensor's aspect where its events are densest, holding about
+    /// this many (named in `assumptions`): the timing and the re-simulations of the frames
+    /// grow with the events.
+    #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_EVENTS)]
+    pub max_events: usize,
 }
 
 /// An estimate's error for `path`, its fix in the command's flags.
@@ -399,25 +410,18 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
         frame_time_offset_s: args.frame_time_offset_s,
         ..ApsOptions::default()
     };
-    let excluded = loaded.excluded.clone();
     let spinner = stage_spinner(global);
-    let result = aps::estimate(
-        &ApsInput {
-            sensor: loaded.sensor,
-            events: &loaded.events,
-            frames: &loaded.frames,
-            excluded: &excluded,
-            unread: &loaded.unread,
-        },
+    let result = ctcal::aps_region::aps(
+        &loaded,
         &options,
+        ctcal::fit_region::FitBudget {
+            max_pixels: args.max_pixels,
+            max_events: args.max_events,
+        },
         &|stage, _| spinner.set_message(stage.to_string()),
     );
     spinner.finish_and_clear();
-    let mut result = result.map_err(|e| estimate_failed(&path, &e))?;
-    result
-        .estimate
-        .assumptions
-        .extend(loaded.notes.iter().cloned());
+    let result = result.map_err(|e| estimate_failed(&path, &e))?;
     if let Some(dir) = &args.maps {
         write_maps(dir, &result.maps, &policy)?;
     }

@@ -160,3 +160,41 @@ pub fn strings(value: &serde_json::Value) -> Vec<&str> {
         .map(|a| a.as_str().expect("a string"))
         .collect()
 }
+
+/// The region note in `output`'s `assumptions` that starts with `verb` ("fitted on the
+/// region x X0..X1, y Y0..Y1 of ..."), and its bounds `[x0, x1, y0, y1]`.
+pub fn region_of(output: &serde_json::Value, verb: &str) -> (String, [u64; 4]) {
+    let note = output["assumptions"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter_map(|a| a.as_str())
+        .find(|a| a.starts_with(verb) && a.contains(" on the region x "))
+        .expect("the region is named in the assumptions")
+        .to_string();
+    let bounds = &note[note.find(" on the region x ").unwrap()..];
+    let numbers: Vec<u64> = bounds
+        .split(|c: char| !c.is_ascii_digit())
+        .filter(|s| !s.is_empty())
+        .take(4)
+        .map(|s| s.parse().unwrap())
+        .collect();
+    let [x0, x1, y0, y1] = numbers[..] else {
+        panic!("{note}")
+    };
+    (note, [x0, x1, y0, y1])
+}
+
+/// The events of an oracle case's `events.txt` inside `[x0, x1, y0, y1]` (ends exclusive).
+pub fn events_inside(case: &Path, [x0, x1, y0, y1]: [u64; 4]) -> usize {
+    let text = std::fs::read_to_string(case.join("events.txt")).unwrap();
+    text.lines()
+        .filter_map(|line| {
+            let mut fields = line.split_whitespace().skip(1);
+            let x: u64 = fields.next()?.parse().ok()?;
+            let y: u64 = fields.next()?.parse().ok()?;
+            Some((x0..x1).contains(&x) && (y0..y1).contains(&y))
+        })
+        .filter(|&inside| inside)
+        .count()
+}

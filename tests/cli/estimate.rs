@@ -84,6 +84,60 @@ fn aps_on_the_ideal_case_finds_no_mismatch() {
     }
 }
 
+/// `estimate aps` of a window with more events than `--max-events` reads its busiest region
+/// of about that many: the region named with its events, the intervals holding v2e's
+/// thresholds, the maps in the sensor's coordinates with values inside the region only.
+#[test]
+fn aps_of_a_window_denser_than_the_event_budget_reads_its_busiest_region() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    let case = oracle("b_asym_texture");
+    let e = json(&[
+        "estimate",
+        "aps",
+        case.to_str().unwrap(),
+        "--max-events",
+        "40000",
+        "--maps",
+        maps.to_str().unwrap(),
+    ]);
+    let (note, [x0, x1, y0, y1]) = region_of(&e, "measured by `estimate aps`");
+    let inside = events_inside(&case, [x0, x1, y0, y1]);
+    assert!(
+        note.contains(&format!(": {inside} events here")) && inside <= 44_000,
+        "{inside}: {note}"
+    );
+    let (on, off) = true_thresholds("b_asym_texture");
+    for (key, truth) in [("ct_on", on), ("ct_off", off)] {
+        let (lo, hi) = interval(&e[format!("{key}_ci95")]);
+        assert!(
+            lo <= truth && truth <= hi,
+            "{key} [{lo}, {hi}] misses {truth}"
+        );
+    }
+    let ct_on: ndarray::Array2<f32> = ndarray_npy::read_npy(maps.join("ct_on.npy")).unwrap();
+    let counts: ndarray::Array2<u32> = ndarray_npy::read_npy(maps.join("ct_count.npy")).unwrap();
+    assert_eq!(ct_on.dim(), (180, 240));
+    let within =
+        |x: usize, y: usize| (x0..x1).contains(&(x as u64)) && (y0..y1).contains(&(y as u64));
+    let mut valued = 0;
+    for ((y, x), v) in ct_on.indexed_iter() {
+        if within(x, y) {
+            valued += v.is_finite() as usize;
+        } else {
+            assert!(
+                v.is_nan() && counts[(y, x)] == 0,
+                "({x}, {y}) outside the region"
+            );
+        }
+    }
+    let region = ((x1 - x0) * (y1 - y0)) as usize;
+    assert!(
+        valued * 10 > region * 9,
+        "{valued} of {region} pixels valued"
+    );
+}
+
 #[test]
 fn aps_recovers_asymmetric_thresholds_mismatch_and_per_pixel_maps() {
     let dir = tempfile::tempdir().unwrap();

@@ -199,29 +199,6 @@ fn exactly_the_injected_hot_pixels_are_masked() {
     assert!(param(&f, "hot_pixel_fraction").unwrap() > 0.0);
 }
 
-/// The region a fit was cut to, from its `assumptions`: the note and `[x0, x1, y0, y1]`.
-fn region_of(f: &serde_json::Value) -> (String, [u64; 4]) {
-    let note = f["assumptions"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .filter_map(|a| a.as_str())
-        .find(|a| a.starts_with("fitted on the region"))
-        .expect("the region is named in the assumptions")
-        .to_string();
-    // "fitted on the region x X0..X1, y Y0..Y1 of ..."
-    let numbers: Vec<u64> = note
-        .split(|c: char| !c.is_ascii_digit())
-        .filter(|s| !s.is_empty())
-        .take(4)
-        .map(|s| s.parse().unwrap())
-        .collect();
-    let [x0, x1, y0, y1] = numbers[..] else {
-        panic!("{note}")
-    };
-    (note, [x0, x1, y0, y1])
-}
-
 /// A sensor larger than `--max-pixels` is fitted on its busiest region (`dev_hot_pixels`,
 /// 240x180, at most 12,000 pixels: a 126x94 rectangle): the region is named, the hot pixels
 /// inside it are found at their sensor coordinates and none outside it, and the thresholds'
@@ -230,7 +207,7 @@ fn region_of(f: &serde_json::Value) -> (String, [u64; 4]) {
 fn a_sensor_larger_than_the_pixel_limit_is_fitted_on_its_busiest_region() {
     let f = fit(&oracle("dev_hot_pixels"), &["--max-pixels", "12000"]);
     check_contract(&f);
-    let (note, [x0, x1, y0, y1]) = region_of(&f);
+    let (note, [x0, x1, y0, y1]) = region_of(&f, "fitted");
     assert!(
         (x1 - x0) * (y1 - y0) <= 12_000 && x1 - x0 == 126 && y1 - y0 == 94,
         "{note}"
@@ -262,24 +239,14 @@ fn a_window_denser_than_the_event_budget_is_fitted_on_a_region_of_that_many_even
     let case = oracle("e_ct060_texture");
     let f = fit(&case, &["--max-events", "30000"]);
     check_contract(&f);
-    let (note, [x0, x1, y0, y1]) = region_of(&f);
+    let (note, [x0, x1, y0, y1]) = region_of(&f, "fitted");
     assert!(
         note.contains("the window's 109375 events are more than the 30000"),
         "{note}"
     );
     let pixels = (x1 - x0) * (y1 - y0);
     assert!((10_000..=11_850).contains(&pixels), "{note}");
-    let text = std::fs::read_to_string(case.join("events.txt")).unwrap();
-    let inside = text
-        .lines()
-        .filter_map(|line| {
-            let mut fields = line.split_whitespace().skip(1);
-            let x: u64 = fields.next()?.parse().ok()?;
-            let y: u64 = fields.next()?.parse().ok()?;
-            Some((x0..x1).contains(&x) && (y0..y1).contains(&y))
-        })
-        .filter(|&inside| inside)
-        .count();
+    let inside = events_inside(&case, [x0, x1, y0, y1]);
     assert!(
         note.contains(&format!(": {inside} events here")),
         "{inside}: {note}"

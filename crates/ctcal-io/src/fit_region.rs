@@ -46,9 +46,9 @@ impl Default for FitBudget {
     }
 }
 
-/// The region a fit of `loaded` measures on within `budget`, and the pixel limit it was
-/// cut to, where it is cut; `None` where the whole sensor fits.
-fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
+/// The region a fit (or `estimate aps`) of `loaded` measures on within `budget`, and the
+/// pixel limit it was cut to, where it is cut; `None` where the whole sensor fits.
+pub(crate) fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
     let pixels = loaded.sensor.pixels();
     let by_pixels = if budget.max_pixels == 0 {
         pixels
@@ -146,18 +146,59 @@ pub fn fit(
             (p.x, p.y) = (p.x + roi.x0, p.y + roi.y0);
         }
         let inside = input.events.len();
-        result
-            .assumptions
-            .push(region_note(roi, loaded, budget, (limit, inside)));
+        result.assumptions.push(region_note(
+            Measured::Fit,
+            roi,
+            loaded,
+            budget,
+            (limit, inside),
+        ));
     }
     result.assumptions.extend(loaded.notes.iter().cloned());
     result.biases = loaded.recording.biases();
     Ok(result)
 }
 
-/// What a fit on a region says in `assumptions` (`limit` the pixels it was cut to,
+/// What measures on a region: its verb, the cost the events bound, and what it measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Measured {
+    Fit,
+    Aps,
+}
+
+impl Measured {
+    fn verb(self) -> &'static str {
+        match self {
+            Measured::Fit => "fitted",
+            Measured::Aps => "measured by `estimate aps`",
+        }
+    }
+
+    fn cost(self) -> &'static str {
+        match self {
+            Measured::Fit => "a fit re-simulates, each of its simulations making as many",
+            Measured::Aps => {
+                "`estimate aps` reads, its per-event timing and its re-simulations of the frames growing with them"
+            }
+        }
+    }
+
+    fn what(self) -> &'static str {
+        match self {
+            Measured::Fit => {
+                "thresholds, mismatch and noise rates are per-pixel and measured there, their intervals from these pixels alone"
+            }
+            Measured::Aps => {
+                "thresholds and their spread are per-pixel and measured there, their intervals from these pixels alone; the threshold maps are NaN outside it"
+            }
+        }
+    }
+}
+
+/// What a measurement on a region says in `assumptions` (`limit` the pixels it was cut to,
 /// `inside` the events in it).
-fn region_note(
+pub(crate) fn region_note(
+    measured: Measured,
     roi: Roi,
     loaded: &Loaded,
     budget: FitBudget,
@@ -169,19 +210,22 @@ fn region_note(
         format!("at most {} are simulated", budget.max_pixels)
     } else {
         format!(
-            "the window's {} events are more than the {} a fit re-simulates, each of its simulations making as many: {inside} events here",
+            "the window's {} events are more than the {} {}: {inside} events here",
             loaded.events.len(),
-            budget.max_events
+            budget.max_events,
+            measured.cost()
         )
     };
     format!(
-        "fitted on the region x {}..{}, y {}..{} of the {} sensor ({} of {} pixels; {why}; the frames cut to it): the {rw}x{rh} rectangle, of the sensor's aspect, where the events are densest (each pixel counted up to the 99th percentile of the pixels' counts, so that hot pixels do not choose it); thresholds, mismatch and noise rates are per-pixel and measured there, their intervals from these pixels alone; a variation of the thresholds across the sensor beyond the per-pixel mismatch, and hot pixels outside the region, are not seen",
+        "{} on the region x {}..{}, y {}..{} of the {} sensor ({} of {} pixels; {why}; the frames cut to it): the {rw}x{rh} rectangle, of the sensor's aspect, where the events are densest (each pixel counted up to the 99th percentile of the pixels' counts, so that hot pixels do not choose it); {}; a variation of the thresholds across the sensor beyond the per-pixel mismatch, and hot pixels outside the region, are not seen",
+        measured.verb(),
         roi.x0,
         roi.x1,
         roi.y0,
         roi.y1,
         loaded.sensor,
         rw * rh,
-        loaded.sensor.pixels()
+        loaded.sensor.pixels(),
+        measured.what()
     )
 }

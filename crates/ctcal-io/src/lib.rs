@@ -15,6 +15,7 @@
 //! selection, the estimators a window feeds), and never on the report or the command line.
 
 pub mod aedat4;
+pub mod aps_region;
 pub mod bag;
 pub mod biases;
 mod blocks;

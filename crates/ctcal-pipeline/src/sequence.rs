@@ -4,7 +4,7 @@
 
 use super::inputs::Input;
 use super::{Event, Observer, Options, SequenceError, Stage};
-use crate::estimate::aps::{self, ApsInput, ApsOptions};
+use crate::estimate::aps::ApsOptions;
 use crate::fit::{FitOptions, FitResult};
 use crate::model::{InputFile, MethodResult, PixelData, PixelMaps, SequenceReport, Truth};
 use crate::sim::PixelParams;
@@ -227,22 +227,8 @@ fn estimates(
     } else if let Ok(framed) = framed
         && framed.frames.len() >= 2
     {
-        match aps::estimate(
-            &ApsInput {
-                sensor: framed.sensor,
-                events: &framed.events,
-                frames: &framed.frames,
-                excluded: &framed.excluded,
-                unread: &framed.unread,
-            },
-            &aps_options,
-            &quiet,
-        ) {
-            Ok(mut result) => {
-                result
-                    .estimate
-                    .assumptions
-                    .extend(framed.notes.iter().cloned());
+        match ctcal_io::aps_region::aps(framed, &aps_options, options.fit_budget, &quiet) {
+            Ok(result) => {
                 maps = Some(PixelMaps {
                     width: result.maps.width,
                     height: result.maps.height,
