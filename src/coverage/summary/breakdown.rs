@@ -24,6 +24,43 @@ fn mean_dn(r: &RunRecord) -> f64 {
     r.truth.as_ref().map_or(r.case.brightness_dn, |t| t.mean_dn)
 }
 
+/// The log-intensity standard deviation of a case's procedural texture (a texture or
+/// rotation scene drawn from [`crate::sim::scene::canvas::TextureParams`]); `None` for a
+/// photograph, objects, a checkerboard or a screen.
+fn texture_log_std(r: &RunRecord) -> Option<f64> {
+    let crate::coverage::RecordingSpec::Scene { scene } = &r.case.recording else {
+        return None;
+    };
+    let texture = scene.texture.as_ref()?;
+    texture.image.is_none().then_some(texture.texture.log_std)
+}
+
+/// The lowest log-luminance standard deviation of `estimate eppps`' prior photographs at
+/// any floor it scans (`rocket` at a floor of 52 % of its mean: 0.50): a texture below it
+/// is less contrasty than every scene the prior stands for, and events alone read its
+/// thresholds high in proportion (`benches/coverage/eppps-rotation-2026-12-04`).
+fn below_prior(log_std: f64) -> bool {
+    log_std < crate::estimate::eppps::prior::log_std_range().0
+}
+
+/// The mean light below which `estimate eppps` without frames leaves its scope: its scans
+/// are of ideal pixels, and under about 20 DN of a DAVIS's frames (the light where v2e's
+/// response turns linear and DVS-Voltmeter's ln(DN + 20-23) flattens, the dark current
+/// as large as the photocurrent) the photoreceptor's cutoff, proportional to the light,
+/// thins the events of a scene's changes, and leak events weigh against few signal ones
+/// (the coverage draws' misses, `benches/coverage/eppps-scope-2026-12-04`).
+pub const PRIOR_DIMMEST_DN: f64 = 20.0;
+
+/// Whether a case lies in the scope of the prior of `estimate eppps` without frames: a
+/// scene seen directly (not a screen), as contrasty as the prior's photographs or more
+/// (a photograph, objects, a checkerboard, a texture of log std >= their lowest), with a
+/// mean light of [`PRIOR_DIMMEST_DN`] or more.
+fn in_prior_scope(r: &RunRecord) -> bool {
+    !r.case.is_screen()
+        && !texture_log_std(r).is_some_and(below_prior)
+        && mean_dn(r) >= PRIOR_DIMMEST_DN
+}
+
 fn thresholds(r: &RunRecord) -> (f64, f64) {
     (r.case.params.ct_on, r.case.params.ct_off)
 }
@@ -58,6 +95,21 @@ pub fn groups(records: &[RunRecord]) -> Vec<Group> {
             .iter()
             .all(|e| e == "mismatch" || e == "display")
     }));
+    all.push(group(
+        "procedural texture less contrasty than eppps' prior (log std < 0.50)",
+        |r| texture_log_std(r).is_some_and(below_prior),
+    ));
+    all.push(group("procedural texture, log std >= 0.50", |r| {
+        texture_log_std(r).is_some_and(|s| !below_prior(s))
+    }));
+    all.push(group(
+        "in the scope of eppps' prior (contrast of its photographs or more, >= 20 DN)",
+        in_prior_scope,
+    ));
+    all.push(group(
+        "outside it (a less contrasty texture, or < 20 DN; not a screen)",
+        |r| !r.case.is_screen() && !in_prior_scope(r),
+    ));
     all.push(group("dim (mean < 30 DN)", |r| mean_dn(r) < 30.0));
     all.push(group("mid (30-100 DN)", |r| {
         (30.0..=100.0).contains(&mean_dn(r))

@@ -127,6 +127,23 @@ pub fn images(n: usize) -> Vec<PriorImage> {
         .collect()
 }
 
+/// The lowest and highest log-luminance standard deviation of the prior's photographs
+/// over the floors scanned (unblurred): the contrast the prior stands for. A scene `k`
+/// times less contrasty than these makes the events they make at a threshold `k` times
+/// lower, so events alone read its threshold `k` times high.
+pub fn log_std_range() -> (f64, f64) {
+    static RANGE: std::sync::OnceLock<(f64, f64)> = std::sync::OnceLock::new();
+    *RANGE.get_or_init(|| {
+        IMAGES
+            .iter()
+            .filter_map(|(_, bytes)| decode(bytes))
+            .flat_map(|linear| FLOORS_OF_MEAN.map(|floor| linear.log_above(floor).std()))
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), s| {
+                (lo.min(s), hi.max(s))
+            })
+    })
+}
+
 /// A prior image in linear luminance (fraction of white), row-major.
 struct LinearImage {
     width: usize,
@@ -276,6 +293,15 @@ mod tests {
                 "{floor} vs {expected}"
             );
         }
+    }
+
+    #[test]
+    fn the_prior_s_contrast_spans_its_photographs_over_the_floors() {
+        // computed independently with NumPy from the PGMs (sRGB decoded, ln(Y + f mean)):
+        // rocket at the highest floor 0.497, grace_hopper at the lowest 1.580
+        let (lo, hi) = log_std_range();
+        assert!((lo - 0.497).abs() < 0.005, "{lo}");
+        assert!((hi - 1.580).abs() < 0.005, "{hi}");
     }
 
     #[test]

@@ -42,6 +42,19 @@ pub struct LogImage {
 }
 
 impl LogImage {
+    /// The standard deviation of its log values.
+    pub fn std(&self) -> f64 {
+        let n = self.data.len().max(1) as f64;
+        let mean = self.data.iter().map(|&v| v as f64).sum::<f64>() / n;
+        (self
+            .data
+            .iter()
+            .map(|&v| (v as f64 - mean).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt()
+    }
+
     /// Bilinear sample at (x, y), clamped to the image.
     pub fn sample(&self, x: f64, y: f64) -> f32 {
         let x = x.clamp(0.0, (self.width - 1) as f64);
