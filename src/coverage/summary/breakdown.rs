@@ -200,3 +200,26 @@ impl Breakdown {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::record::committed;
+
+    const SCOPE: &str = "benches/coverage/eppps-scope-2026-12-04/results-8001-8030.compact.jsonl";
+
+    #[test]
+    fn the_prior_s_scope_leaves_out_less_contrasty_textures_and_dim_scenes() {
+        // 8014: a rotating texture of log std 0.242 at 40 DN, below the photographs' 0.497
+        let texture = committed(SCOPE, 8014);
+        assert_eq!(texture_log_std(&texture), Some(0.241752));
+        assert!(!in_prior_scope(&texture));
+        // 8022: a photograph at 15 DN, under the 20 DN the scans' ideal pixels reach
+        let dim = committed(SCOPE, 8022);
+        assert_eq!(texture_log_std(&dim), None);
+        assert!(mean_dn(&dim) < PRIOR_DIMMEST_DN && !in_prior_scope(&dim));
+        // 8002: objects at 55 DN are in it
+        let objects = committed(SCOPE, 8002);
+        assert!(mean_dn(&objects) >= PRIOR_DIMMEST_DN && in_prior_scope(&objects));
+    }
+}
