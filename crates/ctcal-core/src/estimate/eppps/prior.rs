@@ -21,9 +21,13 @@ use super::scans::LogImage;
 /// lenses, ISO 9358, are 1-3 % of the scene's light) to a dark current as large as the
 /// mean photocurrent in a dim one. Real DVS cameras measured in the log domain lie inside:
 /// DVS-Voltmeter (Lin et al., ECCV 2022) calibrated `ln(DN + k2)` with k2 = 20 DN
-/// (DAVIS346) and 23 DN (DVS240), 13-58 % of the mean at frame levels of 40-150 DN; v2e
-/// (Hu, Liu & Delbruck, CVPRW 2021) makes the response linear below 20 DN for the same
-/// reason; ESIM's default `ln(I + 0.001)` is the ideal end.
+/// (DAVIS346) and 23 DN (DVS240), 13-58 % of the mean at frame levels of 40-150 DN; ESIM's
+/// default `ln(I + 0.001)` is the ideal end. v2e (Hu, Liu & Delbruck, CVPRW 2021) makes
+/// the response linear below 20 DN to avoid the log's steep end, but through zero
+/// (`I ln(20) / 20`), which is steeper than the log between 6.7 and 20 DN (up to 3x just
+/// below 20): a scene that dim, made by v2e or by ctcal's simulator under v2e's
+/// conventions, makes more events than any floor here allows, and its thresholds read low
+/// (coverage draws 7023 at 11 DN and 8022 at 15 DN, `benches/coverage/eppps-scope-2026-12-04`).
 pub const FLOOR_RANGE_OF_MEAN: (f32, f32) = (0.02, 1.0);
 
 /// The floors the scans use: the 1/6, 1/2 and 5/6 quantiles of [`FLOOR_RANGE_OF_MEAN`]
