@@ -28,12 +28,14 @@ pub enum Method {
 /// The parameters an estimator reports.
 const THRESHOLDS: [&str; 3] = ["ct_on", "ct_off", "ct_sigma"];
 
-/// The parameters the fit reports (the PARAMS.toml keys the study has truth for).
-const FITTED: [&str; 10] = [
+/// The parameters the fit reports (the PARAMS.toml keys the study has truth for), and
+/// [`CUTOFF_LIMIT`].
+const FITTED: [&str; 11] = [
     "ct_on",
     "ct_off",
     "ct_sigma",
     "cutoff_hz",
+    CUTOFF_LIMIT,
     "leak_rate_hz",
     "shot_noise_rate_hz",
     "refractory_s",
@@ -92,11 +94,25 @@ pub fn label(parameter: &str) -> &str {
     }
 }
 
+/// A fit's `bandwidth_detection.called_for_below_hz` where it kept no cutoff, scored as the
+/// interval `[limit, open)` against the true cutoff: the fit says a cutoff at or below the
+/// limit would have been called for, so a silent fit's true cutoff lies above it.
+pub const CUTOFF_LIMIT: &str = "cutoff_hz_limit";
+
+/// The truth a parameter is scored against: its own, but [`CUTOFF_LIMIT`]'s is the cutoff.
+pub fn truth_key(parameter: &str) -> &str {
+    if parameter == CUTOFF_LIMIT {
+        "cutoff_hz"
+    } else {
+        parameter
+    }
+}
+
 /// The effect a parameter belongs to (the fit's effect names); thresholds have none.
 pub fn effect_of(parameter: &str) -> Option<&'static str> {
     Some(match parameter {
         "ct_sigma" => "mismatch",
-        "cutoff_hz" => "bandwidth",
+        "cutoff_hz" | CUTOFF_LIMIT => "bandwidth",
         "leak_rate_hz" => "leak",
         "shot_noise_rate_hz" => "shot_noise",
         "refractory_s" => "refractory",

@@ -7,7 +7,7 @@
 //! `uncertainties` (a spread the model lacks but event timing measured, a leak read as a
 //! lower bound) is scored as that interval: the JSON states it.
 
-use super::method::Method;
+use super::method::{CUTOFF_LIMIT, Method};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -121,7 +121,31 @@ fn fit_interval(uncertainty: &Value, value: f64) -> Option<(Option<f64>, Option<
     Some((Some(value - Z95 * se), Some(value + Z95 * se)))
 }
 
+/// A fit's bandwidth detection limit as `[limit, open)`: absent where the fit has a cutoff
+/// (or no frames), `null` with its reason where there is no limit.
+fn cutoff_limit(output: &Value) -> Reported {
+    let Some(detection) = output.get("bandwidth_detection") else {
+        return Reported::NotReported;
+    };
+    match detection["called_for_below_hz"].as_f64() {
+        Some(limit) => Reported::Interval {
+            value: limit,
+            lo: Some(limit),
+            hi: None,
+        },
+        None => Reported::NotDeterminable {
+            why: detection["why"]
+                .as_str()
+                .unwrap_or("null without a reason")
+                .to_string(),
+        },
+    }
+}
+
 fn fit_parameter(output: &Value, key: &str) -> Reported {
+    if key == CUTOFF_LIMIT {
+        return cutoff_limit(output);
+    }
     let params = &output["params"];
     let Some(value) = params.get(key) else {
         return Reported::NotReported;
@@ -192,6 +216,7 @@ mod tests {
         assert!(r["ct_off"].is_open());
         assert_eq!(r["leak_rate_hz"], Reported::NoInterval { value: 0.1 });
         assert_eq!(r["cutoff_hz"], Reported::NotReported);
+        assert_eq!(r[CUTOFF_LIMIT], Reported::NotReported);
     }
 
     #[test]
@@ -206,5 +231,24 @@ mod tests {
             r["leak_rate_hz"],
             Reported::NotDeterminable { .. }
         ));
+    }
+
+    #[test]
+    fn a_silent_fit_s_bandwidth_limit_is_scored_as_the_cutoffs_above_it() {
+        let out = json!({"params": {"ct_on": 0.3},
+            "bandwidth_detection": {"called_for_below_hz": 84.0, "evidence": [[2000.0, 0.1]]}});
+        let r = extract(Method::Fit, &out);
+        // a true cutoff of 101.6 Hz (draw 6001) lies above the limit: covered; 53 Hz would
+        // have been called for, and was not: missed
+        assert!(r[CUTOFF_LIMIT].covers(101.6) && !r[CUTOFF_LIMIT].covers(53.0));
+        assert!(r[CUTOFF_LIMIT].is_open());
+        let out = json!({"params": {"ct_on": 0.3},
+            "bandwidth_detection": {"called_for_below_hz": null, "why": "no cutoff would"}});
+        assert_eq!(
+            extract(Method::Fit, &out)[CUTOFF_LIMIT],
+            Reported::NotDeterminable {
+                why: "no cutoff would".into()
+            }
+        );
     }
 }

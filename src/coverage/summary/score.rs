@@ -1,7 +1,7 @@
 //! Scoring one parameter of one run against the truth: which population it belongs to,
 //! and whether its interval covered the true value.
 
-use crate::coverage::method::effect_of;
+use crate::coverage::method::{effect_of, truth_key};
 use crate::coverage::record::RunRecord;
 use crate::coverage::reported::Reported;
 use crate::coverage::truth::Truth;
@@ -32,7 +32,7 @@ pub fn in_population(record: &RunRecord, parameter: &str) -> bool {
         return true;
     };
     let effect_needed = record.method.is_fit() && parameter != "ct_sigma";
-    truth.value(parameter).is_some()
+    truth.value(truth_key(parameter)).is_some()
         && (!effect_needed || effect_of(parameter).is_none_or(|e| truth.has_effect(e)))
 }
 
@@ -63,7 +63,7 @@ pub fn score<'a>(record: &'a RunRecord, parameter: &str) -> Option<Score<'a>> {
 /// `hot_pixel_detection.probability`, interpolated in the rate's logarithm): the truth's
 /// fraction times that share of its pixels (all of one rate).
 fn scored_truth(record: &RunRecord, truth: &Truth, parameter: &str) -> Option<f64> {
-    let value = truth.value(parameter)?;
+    let value = truth.value(truth_key(parameter))?;
     let (Some(curve), "hot_pixel_fraction") = (&record.hot_detection, parameter) else {
         return Some(value);
     };
