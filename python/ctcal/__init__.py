@@ -25,6 +25,8 @@ from ._ctcal import CtcalError
 __all__ = [
     "CtcalError",
     "EVENT_DTYPE",
+    "FIT_PIXELS",
+    "FIT_EVENTS",
     "read",
     "read_frames",
     "info",
@@ -41,9 +43,9 @@ __version__: str = _ctcal.__version__
 PathLike = Union[str, "os.PathLike[str]"]
 
 #: The most pixels ``fit`` and ``estimate(method="aps")`` measure unless told otherwise (a
-#: 346x260 sensor's), and the most events (``ctcal_io::fit_region``).
-FIT_PIXELS = 346 * 260
-FIT_EVENTS = 1_000_000
+#: 346x260 sensor's), and the most events: the command's defaults (``ctcal_io::fit_region``).
+FIT_PIXELS: int = _ctcal.FIT_PIXELS
+FIT_EVENTS: int = _ctcal.FIT_EVENTS
 
 #: The events' dtype: time in microseconds, pixel column and row, polarity (1 = ON), as
 #: tonic and faery use it.

@@ -10,6 +10,8 @@ PathLike = Union[str, os.PathLike[str]]
 
 __version__: str
 EVENT_DTYPE: np.dtype[Any]
+FIT_PIXELS: int
+FIT_EVENTS: int
 
 class CtcalError(ValueError): ...
 

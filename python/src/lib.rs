@@ -881,6 +881,8 @@ fn config(text: &str, format: &str) -> PyResult<String> {
 fn _ctcal(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CtcalError", m.py().get_type::<CtcalError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add("FIT_PIXELS", ctcal_io::fit_region::FIT_PIXELS)?;
+    m.add("FIT_EVENTS", ctcal_io::fit_region::FIT_EVENTS)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(read_frames, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;

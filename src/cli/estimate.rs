@@ -172,15 +172,15 @@ pub struct ApsArgs {
     /// estimated when frames have pixels clipped at 0.
     #[arg(long, value_name = "DN")]
     pub frame_offset_dn: Option<f64>,
-    /// Measure at most this many pixels (0: the whole sensor). A larger sensor is measured
-    /// on the rectangle of this many pixels, of its aspect, where its events are densest
-    /// (named in `assumptions`; the maps NaN outside it).
+    /// Measure at most this many pixels (0: no pixel limit; at least 64 x 48). A larger
+    /// sensor is measured on the rectangle of this many pixels, of its aspect, where its
+    /// events are densest (named in `assumptions`; the maps NaN outside it).
     #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_PIXELS)]
     pub max_pixels: usize,
-    /// Read about this many events at most (0: no limit). A window with more is measured on
-    /// the rectangle of the sensor's aspect where its events are densest, holding about
-    /// this many (named in `assumptions`): the timing and the re-simulations of the frames
-    /// grow with the events.
+    /// Measure about this many events (0: no limit). A window with more is measured on the
+    /// rectangle of the sensor's aspect where its events are densest, holding about this
+    /// many (at least 64 x 48 pixels; named in `assumptions`): the timing and the
+    /// re-simulations of the frames grow with the events.
     #[arg(long, value_name = "N", default_value_t = ctcal::fit_region::FIT_EVENTS)]
     pub max_events: usize,
 }

@@ -28,7 +28,7 @@ pub struct FitArgs {
     /// has the most events (only their frames and events are read).
     #[arg(long, value_name = "N", default_value_t = 120)]
     pub max_frames: usize,
-    /// Simulate at most this many pixels (0: the whole sensor). A larger sensor is fitted on
+    /// Simulate at most this many pixels (0: no pixel limit; at least 64 x 48). A larger sensor is fitted on
     /// the rectangle of this many pixels, of its aspect, where its events are densest (named
     /// in `assumptions`): thresholds and noise are per-pixel, and the fit re-simulates the
     /// frames hundreds of times.

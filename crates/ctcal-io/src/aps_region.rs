@@ -12,7 +12,7 @@
 //! 1.46 s) took 265 s whole on one thread in the coverage study.
 
 use crate::estimate::{EstimateError, Progress};
-use crate::fit_region::{FitBudget, Measured, region_note, region_within};
+use crate::fit_region::{FitBudget, Measured, on_region};
 use crate::selection::Roi;
 use crate::window::Loaded;
 use ctcal_core::estimate::aps::{self, ApsInput, ApsOptions, ApsResult};
@@ -26,35 +26,23 @@ pub fn aps(
     budget: FitBudget,
     progress: Progress,
 ) -> Result<ApsResult, EstimateError> {
-    let region = region_within(loaded, budget);
-    let cut = region.map(|(roi, _)| loaded.within(roi));
-    let input = cut.as_ref().unwrap_or(loaded);
-    let mut result = aps::estimate(
-        &ApsInput {
-            sensor: input.sensor,
-            events: &input.events,
-            frames: &input.frames,
-            excluded: &input.excluded,
-            unread: &input.unread,
-        },
-        options,
-        progress,
-    )?;
-    if let Some((roi, limit)) = region {
-        result.maps = embedded(
-            &result.maps,
-            roi,
-            loaded.sensor.width as usize,
-            loaded.sensor.height as usize,
-        );
-        let inside = input.events.len();
-        result.estimate.assumptions.push(region_note(
-            Measured::Aps,
-            roi,
-            loaded,
-            budget,
-            (limit, inside),
-        ));
+    let (mut result, region) = on_region(loaded, budget, (Measured::Aps, true), |input| {
+        aps::estimate(
+            &ApsInput {
+                sensor: input.sensor,
+                events: &input.events,
+                frames: &input.frames,
+                excluded: &input.excluded,
+                unread: &input.unread,
+            },
+            options,
+            progress,
+        )
+    })?;
+    if let Some((roi, note)) = region {
+        let (w, h) = (loaded.sensor.width as usize, loaded.sensor.height as usize);
+        result.maps = embedded(&result.maps, roi, w, h);
+        result.estimate.assumptions.push(note);
     }
     result
         .estimate

@@ -26,11 +26,14 @@ pub const FIT_PIXELS: usize = LIMIT_PIXELS;
 /// many events. The shared v2e cases and IJRR chunks hold 20,000-540,000.
 pub const FIT_EVENTS: usize = 1_000_000;
 
-/// The smallest region the event budget cuts to (64 x 48 pixels' worth): below it the
-/// optical flow's pyramid and the 8 x 8 px tiles of the statistics have too little room.
+/// The smallest region either budget cuts to (64 x 48 pixels' worth, or the whole of a
+/// smaller sensor): below it the optical flow's pyramid and the 8 x 8 px tiles of the
+/// statistics have too little room.
 pub const MIN_REGION_PIXELS: usize = 64 * 48;
 
-/// What a fit may simulate: pixels and events (0: no limit).
+/// What a fit simulates, and `estimate aps` reads: pixels and events (0: no limit); a
+/// window beyond either is measured on its busiest region within them (at least
+/// [`MIN_REGION_PIXELS`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FitBudget {
     pub max_pixels: usize,
@@ -48,12 +51,12 @@ impl Default for FitBudget {
 
 /// The region a fit (or `estimate aps`) of `loaded` measures on within `budget`, and the
 /// pixel limit it was cut to, where it is cut; `None` where the whole sensor fits.
-pub(crate) fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
+fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
     let pixels = loaded.sensor.pixels();
     let by_pixels = if budget.max_pixels == 0 {
         pixels
     } else {
-        budget.max_pixels.min(pixels)
+        budget.max_pixels.max(MIN_REGION_PIXELS).min(pixels)
     };
     // `of` pixels scaled to hold the budget where they hold `events` above it
     let within_events = |of: usize, events: usize| -> usize {
@@ -115,6 +118,26 @@ impl Loaded {
     }
 }
 
+/// `measure` of `loaded`, or of its busiest region within `budget` where `allowed` and it
+/// has more pixels or events than that; with the region and the note that names it.
+pub(crate) fn on_region<T>(
+    loaded: &Loaded,
+    budget: FitBudget,
+    (measured, allowed): (Measured, bool),
+    measure: impl FnOnce(&Loaded) -> Result<T, EstimateError>,
+) -> Result<(T, Option<(Roi, String)>), EstimateError> {
+    let region = allowed.then(|| region_within(loaded, budget)).flatten();
+    let cut = region.map(|(roi, _)| loaded.within(roi));
+    let input = cut.as_ref().unwrap_or(loaded);
+    let result = measure(input)?;
+    let named = region.map(|(roi, limit)| {
+        let inside = input.events.len();
+        let note = region_note(measured, roi, loaded, budget, (limit, inside));
+        (roi, note)
+    });
+    Ok((result, named))
+}
+
 /// `ctcal fit` of `loaded` with `options`, on its busiest region within `budget` (at
 /// most `max_pixels` pixels, about `max_events` events; 0: no limit) where it has frames
 /// and more pixels or events than that; the window's notes and the recording's biases
@@ -125,34 +148,25 @@ pub fn fit(
     budget: FitBudget,
     progress: Progress,
 ) -> Result<FitResult, EstimateError> {
-    let region = (loaded.frames.len() >= 2)
-        .then(|| region_within(loaded, budget))
-        .flatten();
-    let cut = region.map(|(roi, _)| loaded.within(roi));
-    let input = cut.as_ref().unwrap_or(loaded);
-    let mut result = ctcal_core::fit::fit(
-        &FitInput {
-            sensor: input.sensor,
-            events: &input.events,
-            frames: &input.frames,
-            excluded: &input.excluded,
-            unread: &input.unread,
-        },
-        options,
-        progress,
-    )?;
-    if let Some((roi, limit)) = region {
+    let framed = loaded.frames.len() >= 2;
+    let (mut result, region) = on_region(loaded, budget, (Measured::Fit, framed), |input| {
+        ctcal_core::fit::fit(
+            &FitInput {
+                sensor: input.sensor,
+                events: &input.events,
+                frames: &input.frames,
+                excluded: &input.excluded,
+                unread: &input.unread,
+            },
+            options,
+            progress,
+        )
+    })?;
+    if let Some((roi, note)) = region {
         for p in &mut result.hot_pixels_masked {
             (p.x, p.y) = (p.x + roi.x0, p.y + roi.y0);
         }
-        let inside = input.events.len();
-        result.assumptions.push(region_note(
-            Measured::Fit,
-            roi,
-            loaded,
-            budget,
-            (limit, inside),
-        ));
+        result.assumptions.push(note);
     }
     result.assumptions.extend(loaded.notes.iter().cloned());
     result.biases = loaded.recording.biases();
@@ -171,6 +185,13 @@ impl Measured {
         match self {
             Measured::Fit => "fitted",
             Measured::Aps => "measured by `estimate aps`",
+        }
+    }
+
+    fn handles(self) -> &'static str {
+        match self {
+            Measured::Fit => "simulated",
+            Measured::Aps => "measured",
         }
     }
 
@@ -197,7 +218,7 @@ impl Measured {
 
 /// What a measurement on a region says in `assumptions` (`limit` the pixels it was cut to,
 /// `inside` the events in it).
-pub(crate) fn region_note(
+fn region_note(
     measured: Measured,
     roi: Roi,
     loaded: &Loaded,
@@ -207,7 +228,11 @@ pub(crate) fn region_note(
     let (rw, rh) = (roi.width() as usize, roi.height() as usize);
     let pixels_bind = budget.max_pixels != 0 && limit >= budget.max_pixels;
     let why = if pixels_bind {
-        format!("at most {} are simulated", budget.max_pixels)
+        format!(
+            "at most {} are {}",
+            budget.max_pixels.max(MIN_REGION_PIXELS),
+            measured.handles()
+        )
     } else {
         format!(
             "the window's {} events are more than the {} {}: {inside} events here",

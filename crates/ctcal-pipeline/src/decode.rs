@@ -280,7 +280,8 @@ structs! {
         holdout, simulations, frame_exposure_us, events_only }
     HotPixelDetection { detectable_above_hz, probability, meaning }
     NoiseDetection { limits, probe_hz, meaning }
-    BandwidthDetection { called_for_below_hz, evidence, recording_evidence, tried, why, meaning }
+    BandwidthDetection { called_for_below_hz, evidence, recording_evidence, simulations, tried,
+        why, meaning }
     NoiseLimit { called_for_above_hz, isolated_hz_per_hz, tried, why }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,

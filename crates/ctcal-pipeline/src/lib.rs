@@ -50,8 +50,9 @@ pub struct Options {
     pub seed: u64,
     /// `None`: fit every recording; else leave the fit out, with this reason in the report.
     pub fit_left_out: Option<String>,
-    /// The pixels and events the fit simulates at most: a larger sensor or a denser window
-    /// is fitted on its busiest region within them (`ctcal_io::fit_region`; 0: no limit).
+    /// The pixels and events the fit simulates and `estimate aps` reads at most: a larger
+    /// sensor or a denser window is measured on its busiest region within them
+    /// (`ctcal_io::fit_region`, `ctcal_io::aps_region`; 0: no limit).
     pub fit_budget: fit_region::FitBudget,
     /// The pixels to analyse.
     pub selection: SelectionSpec,

@@ -35,8 +35,8 @@ fn texture_log_std(r: &RunRecord) -> Option<f64> {
     texture.image.is_none().then_some(texture.texture.log_std)
 }
 
-/// The lowest log-luminance standard deviation of `estimate eppps`' prior photographs at
-/// any floor it scans (`rocket` at a floor of 52 % of its mean: 0.50): a texture below it
+/// Whether a texture's log std is below the lowest of `estimate eppps`' prior photographs
+/// at any floor it scans (`rocket` at a floor of 52 % of its mean: 0.497): a texture below it
 /// is less contrasty than every scene the prior stands for, and events alone read its
 /// thresholds high in proportion (`benches/coverage/eppps-rotation-2026-12-04`).
 fn below_prior(log_std: f64) -> bool {
@@ -95,19 +95,23 @@ pub fn groups(records: &[RunRecord]) -> Vec<Group> {
             .iter()
             .all(|e| e == "mismatch" || e == "display")
     }));
+    let lowest = crate::estimate::eppps::prior::log_std_range().0;
     all.push(group(
-        "procedural texture less contrasty than eppps' prior (log std < 0.50)",
+        format!("procedural texture less contrasty than eppps' prior (log std < {lowest:.3})"),
         |r| texture_log_std(r).is_some_and(below_prior),
     ));
-    all.push(group("procedural texture, log std >= 0.50", |r| {
-        texture_log_std(r).is_some_and(|s| !below_prior(s))
-    }));
     all.push(group(
-        "in the scope of eppps' prior (contrast of its photographs or more, >= 20 DN)",
+        format!("procedural texture, log std >= {lowest:.3}"),
+        |r| texture_log_std(r).is_some_and(|s| !below_prior(s)),
+    ));
+    all.push(group(
+        format!(
+            "in the scope of eppps' prior (contrast of its photographs or more, >= {PRIOR_DIMMEST_DN} DN)"
+        ),
         in_prior_scope,
     ));
     all.push(group(
-        "outside it (a less contrasty texture, or < 20 DN; not a screen)",
+        format!("outside it (a less contrasty texture, or < {PRIOR_DIMMEST_DN} DN; not a screen)"),
         |r| !r.case.is_screen() && !in_prior_scope(r),
     ));
     all.push(group("dim (mean < 30 DN)", |r| mean_dn(r) < 30.0));

@@ -366,8 +366,11 @@ pub struct BandwidthDetection {
     pub called_for_below_hz: Option<f64>,
     /// `[cutoff_hz, standard errors]`: the evidence of every cutoff simulated.
     pub evidence: Vec<[f64; 2]>,
-    /// The recording's own bandwidth evidence beside the final model, standard errors.
-    pub recording_evidence: f64,
+    /// The recording's own bandwidth evidence beside the final model, standard errors;
+    /// `null` where the recording has nothing the evidence reads.
+    pub recording_evidence: Option<f64>,
+    /// The simulations the detection ran (the final model once, then one per cutoff).
+    pub simulations: usize,
     /// The effect was called for and tried, and not kept.
     pub tried: bool,
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -59,6 +59,14 @@ pub struct NoiseFloor {
     pub lag_s: [f64; INTENSITY_BINS],
 }
 
+impl NoiseFloor {
+    /// Whether the comparison it was read from had nothing the evidence reads: no count
+    /// slope and no lag in any intensity bin (every floor infinite).
+    pub fn reads_nothing(&self) -> bool {
+        self.count_slope.is_infinite() && self.lag_s.iter().all(|s| s.is_infinite())
+    }
+}
+
 /// The standard errors of `c`'s evidence, as a floor for another's.
 pub fn noise_of(c: &Context) -> NoiseFloor {
     let mut floor = NoiseFloor {

@@ -17,9 +17,14 @@
 //! the effect where that evidence reaches [`EVIDENCE_THRESHOLD`] plus [`MARGIN_Z`] standard
 //! errors (the evidence of one recording scatters by about one standard error, so chance
 //! leaves it below the threshold in about 5 %) and matters (the rule's relevance). Cutoffs
-//! are scanned down from [`HIGHEST_HZ`], [`PER_DECADE`] a decade, to the effect's lowest;
-//! between the first that calls for it and the one before, [`BISECTIONS`] halvings in the
-//! logarithm.
+//! are scanned down from the highest the fit searches, [`PER_DECADE`] a decade, to its
+//! lowest ([`highest_calling`]); between the first that calls for it and the one before,
+//! [`BISECTIONS`] halvings in the logarithm. Where the recording has nothing the evidence
+//! reads (too few count cells for a slope, and no lag in any intensity bin) there is no
+//! noise to judge a signal against, and no limit; nor where the final model holds a
+//! refractory period, bandwidth's look-alike ([`super::alternatives`]), which takes up a
+//! cutoff's signal when it is fitted (the limit is read against a model the recording would
+//! have moved).
 
 use super::super::effects::bandwidth::{self, NoiseFloor};
 use super::super::effects::{Context, EVIDENCE_THRESHOLD, Effect, Evidence};
@@ -29,10 +34,6 @@ use super::super::{BandwidthDetection, Step};
 use super::noise_detection::MARGIN_Z;
 use crate::estimate::EstimateError;
 use crate::events::EventChunk;
-
-/// The highest cutoff at white tried, Hz: at 2 kHz the filter's time constant is under
-/// 0.3 ms at 20 DN, below a frame interval's resolution of the lag.
-pub const HIGHEST_HZ: f64 = 2000.0;
 
 /// Cutoffs scanned per decade.
 pub const PER_DECADE: f64 = 4.0;
@@ -60,27 +61,86 @@ pub fn detect(
         .iter()
         .any(|s| s.effect == Effect::Bandwidth.name() && s.simulations > 0);
     let own = bandwidth::evidence(context);
-    let (limit, evidence) = if own.calls_for() {
+    let floor = bandwidth::noise_of(context);
+    let before = simulation.count.get();
+    let look_alike = Effect::Refractory
+        .value(context.model)
+        .is_some_and(|r| r > 0.0);
+    let (limit, evidence) = if look_alike {
+        (Err(LOOK_ALIKE.to_string()), Vec::new())
+    } else if floor.reads_nothing() {
+        (Err(NOTHING.to_string()), Vec::new())
+    } else if own.calls_for() {
         (Err(ALREADY.to_string()), Vec::new())
     } else {
         let probes = Probes {
             simulation,
             context,
             masked,
-            floor: bandwidth::noise_of(context),
+            floor,
         };
         probes.scan()
     };
+    let (called_for_below_hz, why) = match limit {
+        Ok(Limit::Below(hz)) => (Some(hz), None),
+        Ok(Limit::AtLeast(hz)) => (Some(hz), Some(format!("{AT_LEAST} ({hz:.0} Hz)"))),
+        Err(why) => (None, Some(why)),
+    };
     let detection = BandwidthDetection {
-        called_for_below_hz: limit.as_ref().ok().copied(),
+        called_for_below_hz,
         evidence,
-        recording_evidence: own.score,
+        recording_evidence: (!floor.reads_nothing()).then_some(own.score),
+        simulations: simulation.count.get() - before,
         tried,
-        why: limit.err(),
+        why,
         meaning: MEANING,
     };
     let note = assumption(&detection);
     Some((detection, note))
+}
+
+/// What the scan found.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Limit {
+    /// The highest cutoff that calls for the effect, below one that does not.
+    Below(f64),
+    /// The highest cutoff scanned already calls for it: the limit is that or higher.
+    AtLeast(f64),
+}
+
+/// The highest cutoff of `range` (Hz, low to high) at which `calls` holds: scanned down
+/// from the top, [`PER_DECADE`] a decade, to the first that calls, then [`BISECTIONS`]
+/// halvings in the logarithm between it and the one above; `None` where none down to the
+/// bottom does. The evidence rises as the cutoff falls, so the first that calls from the
+/// top is the limit.
+pub fn highest_calling<E>(
+    range: (f64, f64),
+    mut calls: impl FnMut(f64) -> Result<bool, E>,
+) -> Result<Option<Limit>, E> {
+    let (lowest, highest) = range;
+    let step = 10f64.powf(1.0 / PER_DECADE);
+    let mut above: Option<f64> = None;
+    let mut cutoff = highest;
+    while cutoff >= lowest * (1.0 - 1e-9) {
+        if calls(cutoff)? {
+            let Some(mut not) = above else {
+                return Ok(Some(Limit::AtLeast(cutoff)));
+            };
+            let mut called = cutoff;
+            for _ in 0..BISECTIONS {
+                let mid = (called * not).sqrt();
+                if calls(mid)? {
+                    called = mid;
+                } else {
+                    not = mid;
+                }
+            }
+            return Ok(Some(Limit::Below(called)));
+        }
+        above = Some(cutoff);
+        cutoff /= step;
+    }
+    Ok(None)
 }
 
 /// Simulated recordings with a cutoff, against the final model.
@@ -121,66 +181,107 @@ impl Probes<'_> {
 
     /// The highest cutoff that calls for the effect, or why there is none, with every
     /// cutoff tried.
-    fn scan(&self) -> (Result<f64, String>, Tried) {
+    fn scan(&self) -> (Result<Limit, String>, Tried) {
         let mut tried = Vec::new();
-        let found = self.search(&mut tried).unwrap_or_else(|e| {
-            Err(format!(
+        let range = Effect::Bandwidth.range(1.0);
+        let found = self.model_events().and_then(|model| {
+            highest_calling(range, |cutoff| {
+                let e = self.evidence(&model, cutoff)?;
+                tried.push([cutoff, e.score]);
+                Ok(e.relevant && e.score >= EVIDENCE_THRESHOLD + MARGIN_Z)
+            })
+        });
+        let found = match found {
+            Ok(Some(limit)) => Ok(limit),
+            Ok(None) => Err(format!(
+                "no cutoff from {:.0} down to {:.0} Hz at white would: the scene's changes are too slow, or its pixels too bright, for the photoreceptor's filter to thin or delay its events beyond the recording's noise",
+                range.1, range.0
+            )),
+            Err(e) => Err(format!(
                 "a simulation with a cutoff failed: {} ({})",
                 e.problem, e.fix
-            ))
-        });
-        (found, tried)
-    }
-
-    fn search(&self, tried: &mut Tried) -> Result<Result<f64, String>, EstimateError> {
-        let model = self.model_events()?;
-        let mut calls = |cutoff: f64| -> Result<bool, EstimateError> {
-            let e = self.evidence(&model, cutoff)?;
-            tried.push([cutoff, e.score]);
-            Ok(e.relevant && e.score >= EVIDENCE_THRESHOLD + MARGIN_Z)
+            )),
         };
-        let lowest = Effect::Bandwidth.range(HIGHEST_HZ).0;
-        let step = 10f64.powf(1.0 / PER_DECADE);
-        let mut above: Option<f64> = None;
-        let mut cutoff = HIGHEST_HZ;
-        while cutoff >= lowest * (1.0 - 1e-9) {
-            if calls(cutoff)? {
-                let Some(mut not) = above else {
-                    return Ok(Ok(cutoff));
-                };
-                let mut called: f64 = cutoff;
-                for _ in 0..BISECTIONS {
-                    let mid = (called * not).sqrt();
-                    if calls(mid)? {
-                        called = mid;
-                    } else {
-                        not = mid;
-                    }
-                }
-                return Ok(Ok(called));
-            }
-            above = Some(cutoff);
-            cutoff /= step;
-        }
-        Ok(Err(format!(
-            "no cutoff from {HIGHEST_HZ:.0} down to {lowest:.0} Hz at white would: the scene's changes are too slow, or its pixels too bright, for the photoreceptor's filter to thin or delay its events beyond the recording's noise"
-        )))
+        (found, tried)
     }
 }
 
+const LOOK_ALIKE: &str = "the final model holds a refractory period, bandwidth's look-alike (both thin the events of fast changes): a cutoff may stand in its place, its signal taken up by the period, so the recording does not bound it (coverage draw 9007: a true 69 Hz cutoff fitted as a refractory period, where a limit read against that model said 200 Hz)";
+
+const NOTHING: &str = "the recording has nothing the bandwidth evidence reads (too few count cells of different intensity for a slope, and no intensity bin with enough paired ON and OFF events for a lag): no noise to judge a cutoff's signal against";
+
+const AT_LEAST: &str =
+    "the highest cutoff the fit searches already calls for the effect: the limit is that or higher";
+
 const ALREADY: &str = "the recording's own evidence calls for bandwidth beside the final model (it was tried and not kept, or an effect that explains the same residual was preferred): a cutoff may be present; the recording does not determine it";
 
-const MEANING: &str = "where the final model has no photoreceptor cutoff: called_for_below_hz, the highest cutoff at white (v2e's law: the cutoff scales with DN + 20) at which a recording of this scene would have made the bandwidth evidence call for the effect in about 95 % of such recordings (5 + 1.645 standard errors), found by simulating the final model with the cutoff and an independent seed and comparing it with the final model as the recording is, each standard error held at least at the real recording's beside the final model; cutoffs scanned down from 2 kHz, four a decade, then two bisections; evidence: [cutoff_hz, standard errors] of every cutoff simulated; recording_evidence: the recording's own bandwidth evidence beside the final model (standard errors); tried: the effect was called for and tried, and not kept; a faster photoreceptor (a higher cutoff) may be present and is not determinable from this recording";
+const MEANING: &str = "where the final model has no photoreceptor cutoff: called_for_below_hz, the highest cutoff at white (v2e's law: the cutoff scales with DN + 20) at which a recording of this scene would have made the bandwidth evidence call for the effect in about 95 % of such recordings (5 + 1.645 standard errors), found by simulating the final model with the cutoff and an independent seed and comparing it with the final model as the recording is, each standard error held at least at the real recording's beside the final model; cutoffs scanned down from 5 kHz (the highest the fit searches), four a decade, then two bisections; evidence: [cutoff_hz, standard errors] of every cutoff simulated; recording_evidence: the recording's own bandwidth evidence beside the final model (standard errors; null where it has nothing the evidence reads); simulations: how many this took (the final model once, then one per cutoff); tried: the effect was called for and tried, and not kept; a faster photoreceptor (a higher cutoff) may be present and is not determinable from this recording";
 
 fn assumption(d: &BandwidthDetection) -> String {
     let tried = if d.tried { "; tried and not kept" } else { "" };
     match (d.called_for_below_hz, &d.why) {
         (Some(hz), _) => format!(
-            "photoreceptor bandwidth the recording would show: a cutoff at white of {hz:.0} Hz or lower would have made the bandwidth evidence call for the effect in about 95 % of recordings of this scene (the final model simulated with the cutoff and an independent seed, {} simulations; the recording's own evidence {:.1} standard errors{tried}); a faster photoreceptor may be present, which this recording does not determine",
-            d.evidence.len(),
-            d.recording_evidence,
+            "photoreceptor bandwidth the recording would show: a cutoff at white of {hz:.0} Hz or lower would have made the bandwidth evidence call for the effect in about 95 % of recordings of this scene (the final model simulated with the cutoff and an independent seed, {} simulations; the recording's own evidence {}{tried}{}); a faster photoreceptor may be present, which this recording does not determine",
+            d.simulations,
+            d.recording_evidence
+                .map_or("not read".to_string(), |z| format!(
+                    "{z:.1} standard errors"
+                )),
+            d.why.as_ref().map_or(String::new(), |w| format!("; {w}")),
         ),
         (None, Some(why)) => format!("photoreceptor bandwidth: no detection limit ({why}{tried})"),
         (None, None) => format!("photoreceptor bandwidth: no detection limit{tried}"),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scan against an evidence that calls for the effect at and below `limit`,
+    /// recording every cutoff tried.
+    fn scan(limit: f64) -> (Option<Limit>, Vec<f64>) {
+        let mut tried = Vec::new();
+        let found = highest_calling::<()>((2.0, 5000.0), |c| {
+            tried.push(c);
+            Ok(c <= limit)
+        })
+        .unwrap();
+        (found, tried)
+    }
+
+    #[test]
+    fn the_scan_steps_down_four_a_decade_then_bisects_twice_towards_the_limit() {
+        // 5000, 2812, 1581, 889, 500, 281, 158.1 (not at or below 150), 88.9 (below): then
+        // sqrt(88.9 x 158.1) = 118.6 (below), sqrt(118.6 x 158.1) = 136.9 (below)
+        let (found, tried) = scan(150.0);
+        let Some(Limit::Below(hz)) = found else {
+            panic!("{found:?}")
+        };
+        assert_eq!(tried.len(), 8 + BISECTIONS, "{tried:?}");
+        assert!((tried[7] - 5000.0 / 10f64.powf(7.0 / 4.0)).abs() < 1e-9);
+        assert!(
+            (hz - 5000.0 * 10f64.powf(-7.0 / 4.0 + 3.0 / 16.0)).abs() < 1e-9,
+            "{hz}"
+        );
+        assert!(hz <= 150.0 && hz > 150.0 / 10f64.powf(1.0 / 16.0), "{hz}");
+    }
+
+    #[test]
+    fn a_top_that_already_calls_is_a_lower_bound_and_none_down_to_the_bottom_is_none() {
+        let (found, tried) = scan(1e6);
+        assert_eq!(found, Some(Limit::AtLeast(5000.0)));
+        assert_eq!(tried, [5000.0]);
+        // 5000 down to 2 Hz four a decade: 14 cutoffs, the last 2.81 Hz
+        let (found, tried) = scan(1.0);
+        assert_eq!(found, None);
+        assert_eq!(tried.len(), 14, "{tried:?}");
+        assert!((tried[13] - 5000.0 / 10f64.powf(13.0 / 4.0)).abs() < 1e-9);
+        // an error stops the scan and is passed on
+        let failed = highest_calling(
+            (2.0, 5000.0),
+            |c| if c < 1000.0 { Err("x") } else { Ok(false) },
+        );
+        assert_eq!(failed, Err("x"));
     }
 }

@@ -193,6 +193,9 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     if !fixed {
         assumptions.extend(super::method_systematic::widen(&mut state.uncertainty));
     }
+    assumptions.extend(super::method_systematic::widen_cutoff(
+        &mut state.uncertainty,
+    ));
     let mut params = state.model.params.clone();
     params.seed = None;
     // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml
