@@ -24,7 +24,7 @@ for d in open(out+'/list.txt').read().split():
             s='no limit: '+bd['why'][:70]
         elif tc is None: s=f'limit {lim:.0f} (no cutoff)'
         else: s=f"limit {lim:.0f}: truth {'above (consistent)' if tc>lim else 'BELOW (limit wrong)'}"
-        rows.append(f"{c} {tc} | silent; {s}; own {bd['recording_evidence']:.1f}; tried {bd['tried']}; probes {len(bd['evidence'])} | {tm[0]} s")
+        rows.append(f"{c} {tc} | silent; {s}; own {'-' if bd['recording_evidence'] is None else round(bd['recording_evidence'],1)}; tried {bd['tried']}; probes {len(bd['evidence'])} | {tm[0]} s")
     else:
         rows.append(f"{c} {tc} | silent, no detection (events only?) | {tm[0]} s")
 print("\n".join(rows))
