@@ -138,6 +138,35 @@ fn aps_of_a_window_denser_than_the_event_budget_reads_its_busiest_region() {
     );
 }
 
+/// The event budget counts the events of the pixels measured: a `--roi` of 600 pixels
+/// holding about 4,000 of the window's 243,000 events is within a budget of 5,000, and is
+/// measured as it is (found by a hostile-input run, where it was cut to a region around it).
+#[test]
+fn the_event_budget_counts_the_events_of_the_roi_alone() {
+    let case = oracle("b_asym_texture");
+    let run = |budget: &str| {
+        json(&[
+            "estimate",
+            "aps",
+            case.to_str().unwrap(),
+            "--roi",
+            "100,80,130,100",
+            "--max-events",
+            budget,
+        ])
+    };
+    let (within, unlimited) = (run("5000"), run("0"));
+    let notes = within["assumptions"].as_array().unwrap();
+    assert!(
+        !notes
+            .iter()
+            .any(|a| a.as_str().unwrap().contains("on the region x ")),
+        "{notes:?}"
+    );
+    assert_eq!(within["ct_on"], unlimited["ct_on"]);
+    assert_eq!(within["ct_off"], unlimited["ct_off"]);
+}
+
 #[test]
 fn aps_recovers_asymmetric_thresholds_mismatch_and_per_pixel_maps() {
     let dir = tempfile::tempdir().unwrap();

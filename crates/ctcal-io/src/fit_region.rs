@@ -69,12 +69,12 @@ fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
     let busiest = |limit: usize| {
         ctcal_core::region::busiest_region(&loaded.events, loaded.sensor, &loaded.excluded, limit)
     };
-    let mut limit = by_pixels.min(within_events(pixels, loaded.events.len()));
+    let mut limit = by_pixels.min(within_events(pixels, kept_events(loaded, None)));
     let mut roi = busiest(limit)?;
     // the densest region holds more than its share of the events: shrunk in proportion
     // (twice at most) while it holds over a tenth more than the budget
     for _ in 0..2 {
-        let inside = events_within(&loaded.events, roi);
+        let inside = kept_events(loaded, Some(roi));
         if inside * 10 <= budget.max_events * 11 {
             break;
         }
@@ -88,13 +88,20 @@ fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
     Some((roi, limit))
 }
 
-/// The events inside `roi`.
-fn events_within(events: &ctcal_core::events::EventChunk, roi: Roi) -> usize {
-    events
-        .x
-        .iter()
-        .zip(&events.y)
-        .filter(|&(&x, &y)| roi.holds(x, y))
+/// The events of `loaded` at the pixels it keeps (a `--roi` or mask leaves the others
+/// out), inside `roi` where given: what the budget counts.
+fn kept_events(loaded: &Loaded, roi: Option<Roi>) -> usize {
+    let width = loaded.sensor.width as usize;
+    let e = &loaded.events;
+    e.x.iter()
+        .zip(&e.y)
+        .filter(|&(&x, &y)| {
+            let kept = loaded
+                .excluded
+                .get(y as usize * width + x as usize)
+                .is_some_and(|&excluded| !excluded);
+            kept && roi.is_none_or(|r| r.holds(x, y))
+        })
         .count()
 }
 
@@ -131,7 +138,7 @@ pub(crate) fn on_region<T>(
     let input = cut.as_ref().unwrap_or(loaded);
     let result = measure(input)?;
     let named = region.map(|(roi, limit)| {
-        let inside = input.events.len();
+        let inside = kept_events(input, None);
         let note = region_note(measured, roi, loaded, budget, (limit, inside));
         (roi, note)
     });
@@ -236,7 +243,7 @@ fn region_note(
     } else {
         format!(
             "the window's {} events are more than the {} {}: {inside} events here",
-            loaded.events.len(),
+            kept_events(loaded, None),
             budget.max_events,
             measured.cost()
         )
