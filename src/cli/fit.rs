@@ -19,7 +19,8 @@ pub struct FitArgs {
     #[arg(long, value_name = "auto|none|LIST", default_value = "auto")]
     pub effects: String,
     /// Fraction of the recording held out of the fit, at its end: the first half judges
-    /// each effect, the second measures the final error.
+    /// each effect, the second measures the final error (0.2 to 0.7: at least one
+    /// selection and one test block of the 10).
     #[arg(long, value_name = "FRACTION", default_value_t = 0.4)]
     pub holdout: f64,
     /// Use at most this many frames (of a sensor up to 346x260; a larger sensor's frames
@@ -162,10 +163,18 @@ fn effect_choice(text: &str) -> Result<EffectChoice, BadInput> {
 pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     let common = &args.common;
     let effects = effect_choice(&args.effects)?;
-    if !(args.holdout.is_finite() && (0.0..=0.7).contains(&args.holdout)) {
+    let split = FitOptions {
+        holdout: args.holdout,
+        ..FitOptions::default()
+    };
+    if let Err(e) = split.check() {
+        let range = split.holdout_range();
         return Err(BadInput(format!(
-            "--holdout {} must be a fraction between 0 and 0.7",
-            args.holdout
+            "--holdout {}: {}; give --holdout between {} and {}",
+            args.holdout,
+            e.problem,
+            range.start(),
+            range.end()
         ))
         .into());
     }

@@ -390,6 +390,18 @@ fn effect_choices_and_bad_input() {
         "0.9",
     ]);
     assert!(e.contains("--holdout"), "{e}");
+    // 0.1 of 10 blocks leaves one held-out block, a test block and no selection block
+    let e = bad_input(&[
+        "fit",
+        oracle("a_ideal_texture").to_str().unwrap(),
+        "--holdout",
+        "0.1",
+    ]);
+    assert!(
+        e.contains("leaves 9 fit, 0 selection and 1 test blocks of 10")
+            && e.contains("between 0.2 and 0.7"),
+        "{e}"
+    );
 }
 
 /// A recording ctcal simulates itself: a translating 1/f texture of 160 x 120 pixels seen

@@ -84,6 +84,54 @@ impl Default for FitOptions {
     }
 }
 
+impl FitOptions {
+    /// The held-out fractions whose split of the `blocks` keeps at least 3 fit blocks (0.7
+    /// of 10) and leaves at least one selection and one test block: `2 / blocks` to 0.7 (the
+    /// selection blocks judge the effects and the test blocks alone measure
+    /// `error_before`/`error_after`; a smaller fraction would leave the errors measured on
+    /// blocks that chose the model).
+    pub fn holdout_range(&self) -> std::ops::RangeInclusive<f64> {
+        let smallest = 2.0 / self.blocks.max(1) as f64;
+        smallest..=MAX_HOLDOUT.max(smallest)
+    }
+
+    /// Refuses a held-out fraction outside [`Self::holdout_range`].
+    pub fn check(&self) -> Result<(), FitError> {
+        let range = self.holdout_range();
+        if self.holdout.is_finite() && range.contains(&self.holdout) {
+            return Ok(());
+        }
+        let held = if self.holdout.is_finite() {
+            let fitting = ((1.0 - self.holdout.clamp(0.0, 1.0)) * self.blocks as f64).round();
+            let role = observe::roles(fitting as usize, self.blocks);
+            let count = |r| role.iter().filter(|&&x| x == r).count();
+            format!(
+                "leaves {} fit, {} selection and {} test blocks of {}",
+                count(observe::Role::Fit),
+                count(observe::Role::Selection),
+                count(observe::Role::Test),
+                self.blocks
+            )
+        } else {
+            "is not a number".to_string()
+        };
+        Err(FitError::new(
+            format!(
+                "a held-out fraction of {} {held}: the fit needs at least 3 blocks to fit (its starting thresholds and their spread over blocks), one selection block (to judge the effects) and one test block (for the errors no decision has seen)",
+                self.holdout
+            ),
+            format!(
+                "hold out a fraction between {} and {}",
+                range.start(),
+                range.end()
+            ),
+        ))
+    }
+}
+
+/// The largest held-out fraction: 3 of 10 blocks left to fit.
+pub const MAX_HOLDOUT: f64 = 0.7;
+
 /// What a fit reads.
 pub struct FitInput<'a> {
     pub sensor: Sensor,

@@ -489,7 +489,7 @@ fn split_assumptions(simulation: &Simulation, options: &FitOptions) -> Vec<Strin
             100.0 * UNMEASURED_CHANCE
         )
     };
-    vec![
+    let mut out = vec![
         format!(
             "the frames simulated after upsampling along the optical flow (0.5 px steps); {} simulations, one seed ({}) for all",
             simulation.count.get(),
@@ -506,7 +506,18 @@ fn split_assumptions(simulation: &Simulation, options: &FitOptions) -> Vec<Strin
             g.kept_pixels()
         ),
         chance,
-    ]
+    ];
+    if g.judging() == Subset::Fit {
+        out.push("the frames' span left no selection block (too few frame intervals): effects were judged on the fit blocks they were fitted on".into());
+    }
+    match g.testing() {
+        Subset::Test => {}
+        subset => out.push(format!(
+            "the frames' span left no test block (too few frame intervals): error_before and error_after are measured on the {} blocks, which chose the model, not on unseen data",
+            if subset == Subset::Selection { "selection" } else { "fit" }
+        )),
+    }
+    out
 }
 
 fn holdout(simulation: &Simulation, options: &FitOptions) -> Holdout {

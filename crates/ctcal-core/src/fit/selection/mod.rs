@@ -94,6 +94,7 @@ pub fn fit(
     options: &FitOptions,
     progress: Progress,
 ) -> Result<FitResult, FitError> {
+    options.check()?;
     if input.frames.len() < 2 {
         return super::events_only::fit(input, options, progress);
     }
