@@ -64,6 +64,17 @@ fn a_sensor_over_4096_pixels_needs_sensor_given() {
     );
     let s = json(&["stats", &text, "--sensor", "5000x100"]);
     assert_eq!(s["events"], 2);
+    // a `width height` line of no sensor is refused unless the size is given
+    let zero = write(dir.path(), "zero.txt", b"0 0\n0.1 1 1 1\n0.2 2 2 0\n");
+    let e = bad_input(&["stats", &zero]);
+    assert!(
+        e.contains("zero.txt: line 1")
+            && e.contains("`0 0` gives no sensor")
+            && e.contains("--sensor WxH"),
+        "{e}"
+    );
+    let s = json(&["stats", &zero, "--sensor", "4x4"]);
+    assert_eq!(s["events"], 2);
     // from a Prophesee header
     let mut raw = b"% evt 3.0\n% geometry 8000x8000\n% end\n".to_vec();
     raw.extend_from_slice(&[0x00, 0x80, 0x00, 0x60, 0x05, 0x20]);

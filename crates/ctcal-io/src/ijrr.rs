@@ -13,6 +13,7 @@ use super::order::OrderCheck;
 use super::text;
 use super::{EventDecoder, Progress};
 use crate::events::{CHUNK_EVENTS, EventChunk, Sensor};
+use crate::hint::{Hint, Text};
 use std::path::{Path, PathBuf};
 
 mod split;
@@ -57,9 +58,12 @@ impl IjrrFiles {
 }
 
 /// What the head of `events.txt` says: an optional `width height` line.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Debug, Default)]
 pub struct TextHeader {
     pub sensor: Option<Sensor>,
+    /// A `width height` line that gives no sensor (`0 0`, a side over 65535): an error
+    /// unless the sensor size is given.
+    pub unusable: Option<InputError>,
 }
 
 /// Reads the optional `width height` first data line.
@@ -68,13 +72,13 @@ pub fn read_header(events: &Path) -> Result<TextHeader, InputError> {
     let mut reader = std::io::BufReader::new(file);
     let mut line = Vec::new();
     use std::io::BufRead;
-    loop {
+    for number in 1.. {
         line.clear();
         let n = reader
             .read_until(b'\n', &mut line)
             .map_err(|e| InputError::io(events, e))?;
         if n == 0 {
-            return Ok(TextHeader::default());
+            break;
         }
         let trimmed = line.trim_ascii();
         if trimmed.is_empty() || trimmed[0] == b'#' {
@@ -83,16 +87,30 @@ pub fn read_header(events: &Path) -> Result<TextHeader, InputError> {
         let mut fields = [&b""[..]; 3];
         if text::split_fields(trimmed, &mut fields) == 2
             && let (Some(w), Some(h)) = (text::parse_u32(fields[0]), text::parse_u32(fields[1]))
-            && let (Ok(w), Ok(h)) = (u16::try_from(w), u16::try_from(h))
-            && w > 0
-            && h > 0
         {
-            return Ok(TextHeader {
-                sensor: Some(Sensor::new(w, h)),
+            return Ok(match (u16::try_from(w), u16::try_from(h)) {
+                (Ok(w), Ok(h)) if w > 0 && h > 0 => TextHeader {
+                    sensor: Some(Sensor::new(w, h)),
+                    unusable: None,
+                },
+                _ => TextHeader {
+                    sensor: None,
+                    unusable: Some(InputError::corrupt(
+                    events,
+                    format!("line {number}"),
+                    format!(
+                        "the `width height` line `{}` gives no sensor (each side 1 to 65535 pixels)",
+                        text::excerpt(trimmed)
+                    ),
+                    Text::from("write the sensor's real size there (e.g. `240 180`), or delete the line and ")
+                        .act(Hint::Sensor(None)),
+                    )),
+                },
             });
         }
-        return Ok(TextHeader::default());
+        break;
     }
+    Ok(TextHeader::default())
 }
 
 /// Streaming decoder of `events.txt`.

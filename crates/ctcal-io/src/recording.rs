@@ -77,9 +77,15 @@ pub struct ResolvedSensor {
 }
 
 /// An IJRR folder's files and the sensor size its first line, frames or stimulus give.
-fn ijrr_source(path: &Path) -> Result<(Source, Option<(Sensor, String)>), InputError> {
+/// A `width height` line that gives no sensor is an error unless the size is `given`.
+fn ijrr_source(path: &Path, given: bool) -> Result<(Source, Option<(Sensor, String)>), InputError> {
     let files = ijrr::IjrrFiles::locate(path)?;
     let header = ijrr::read_header(&files.events)?;
+    if let Some(e) = header.unusable
+        && !given
+    {
+        return Err(e);
+    }
     let mut sensor = header
         .sensor
         .map(|s| (s, "the `width height` first line of events.txt".to_string()));
@@ -166,7 +172,7 @@ impl Recording {
         notes: &mut Vec<String>,
     ) -> Result<(Source, Option<(Sensor, String)>), InputError> {
         Ok(match format {
-            Format::Ijrr => ijrr_source(path)?,
+            Format::Ijrr => ijrr_source(path, options.sensor.is_some())?,
             Format::Bag => {
                 let info = bag::probe(
                     path,
