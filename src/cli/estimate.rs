@@ -369,6 +369,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     check_json(common.json.as_deref(), &policy)?;
     if let Some(dir) = &args.maps {
         policy.check_folder(dir)?;
+        check_json_beside_maps(common.json.as_deref(), dir)?;
     }
     let loaded = common.load(Some(args.max_frames), true, global)?;
     let path = loaded.recording.path.clone();
@@ -428,6 +429,41 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     present(&result.estimate, &loaded, common, &policy)
 }
 
+/// The files `--maps` writes into its folder.
+const MAP_FILES: [&str; 3] = ["ct_on.npy", "ct_off.npy", "ct_count.npy"];
+
+/// Refuses a `--json` path that is the `--maps` folder or one of its maps, before anything
+/// is written (the maps are written first).
+fn check_json_beside_maps(json: Option<&Path>, dir: &Path) -> anyhow::Result<()> {
+    let Some(JsonTarget::File(path)) = json.map(JsonTarget::parse) else {
+        return Ok(());
+    };
+    let is_map = path.parent().is_some_and(|p| same_path(p, dir))
+        && path
+            .file_name()
+            .is_some_and(|n| MAP_FILES.iter().any(|m| n == *m));
+    if same_path(&path, dir) || is_map {
+        return Err(BadInput(format!(
+            "{}: --json names {}, which --maps {} writes\n  fix: give --json another path",
+            path.display(),
+            if is_map {
+                "a map file"
+            } else {
+                "the maps folder"
+            },
+            dir.display()
+        ))
+        .into());
+    }
+    Ok(())
+}
+
+/// Whether `a` and `b` name one path (compared as given, and resolved where both exist).
+fn same_path(a: &Path, b: &Path) -> bool {
+    let clean = |p: &Path| p.components().collect::<PathBuf>();
+    clean(a) == clean(b) || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
 /// Writes the threshold maps as NumPy arrays (H x W): `ct_on.npy`, `ct_off.npy` (float32,
 /// NaN without evidence) and `ct_count.npy` (uint32, samples per pixel).
 fn write_maps(
@@ -439,7 +475,8 @@ fn write_maps(
     let staged = policy.folder(dir)?;
     let shape = (maps.height, maps.width);
     let write = |name: &str, bytes: Vec<u8>| staged.write(name, &bytes);
-    for (name, values) in [("ct_on.npy", &maps.ct_on), ("ct_off.npy", &maps.ct_off)] {
+    let [on, off, count] = MAP_FILES;
+    for (name, values) in [(on, &maps.ct_on), (off, &maps.ct_off)] {
         let array = ndarray::Array2::from_shape_vec(shape, values.clone())?;
         let mut bytes = Vec::new();
         array.write_npy(&mut bytes)?;
@@ -448,7 +485,7 @@ fn write_maps(
     let counts = ndarray::Array2::from_shape_vec(shape, maps.count.clone())?;
     let mut bytes = Vec::new();
     counts.write_npy(&mut bytes)?;
-    write("ct_count.npy", bytes)?;
+    write(count, bytes)?;
     staged.commit()?;
     Ok(())
 }

@@ -22,6 +22,7 @@ pub fn flag(hint: &Hint) -> String {
         Hint::RefreshHz => "--refresh-hz HZ".into(),
         Hint::Stimulus => "--stimulus DIR".into(),
         Hint::Roi(roi) => format!("--roi {roi}"),
+        Hint::Budget => "a larger --max-events N and --max-pixels N (0: no limit)".into(),
         Hint::Analysis(Analysis::Eppps) => "`ctcal estimate eppps` (no frames needed)".into(),
         Hint::Analysis(Analysis::Fit) => "`ctcal fit`".into(),
         Hint::Analysis(Analysis::Stats) => "`ctcal stats`".into(),

@@ -167,6 +167,110 @@ fn the_event_budget_counts_the_events_of_the_roi_alone() {
     assert_eq!(within["ct_off"], unlimited["ct_off"]);
 }
 
+/// A region the budget cut that cannot be measured is refused with the region and the
+/// budget named and a larger budget as a fix (slider_depth's busiest 20,000 events leave
+/// two usable frame intervals; its whole sensor has the intervals aps needs).
+#[test]
+fn a_refusal_of_the_budget_s_region_names_the_budget() {
+    let e = bad_input(&[
+        "estimate",
+        "aps",
+        real("ijrr_slider_depth_50k").to_str().unwrap(),
+        "--max-events",
+        "20000",
+    ]);
+    assert!(
+        e.contains("on the busiest region x 0..129, y 83..180")
+            && e.contains("beyond the budget of 20000 events")
+            && e.contains("a larger --max-events N and --max-pixels N (0: no limit)"),
+        "{e}"
+    );
+}
+
+/// The pixel budget's floor is a whole 64 x 48 px: a DAVIS346's region of 3,072 pixels
+/// of its aspect rounds down to 63 x 48 unless raised.
+#[test]
+fn the_smallest_region_keeps_3072_pixels() {
+    let r = json(&[
+        "estimate",
+        "aps",
+        real("davis346_faery.aedat4").to_str().unwrap(),
+        "--max-pixels",
+        "100",
+    ]);
+    let notes = strings(&r["assumptions"]);
+    assert!(
+        notes.iter().any(|a| a.contains("(3072 of 89960 pixels")),
+        "{notes:#?}"
+    );
+}
+
+/// A sensor no larger than the smallest region is measured whole beyond the event budget,
+/// and `assumptions` says so: a 64 x 48 texture of ~4,000 events under a budget of 1,000.
+#[test]
+fn a_budget_the_sensor_is_too_small_to_meet_is_said() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("scene.toml");
+    let text = std::fs::read_to_string("calib/scenes/sample_texture_davis240c.toml").unwrap();
+    let small = text
+        .replace("width = 240", "width = 64")
+        .replace("height = 180", "height = 48")
+        .replace("duration_s = 0.6", "duration_s = 0.4");
+    std::fs::write(&scene, small).unwrap();
+    let rec = dir.path().join("rec");
+    succeeded(
+        ctcal()
+            .args(["simulate", "--params", "calib/params/ideal.toml", "--quiet"])
+            .args([
+                "--scene",
+                scene.to_str().unwrap(),
+                "--out",
+                rec.to_str().unwrap(),
+            ])
+            .output(),
+    );
+    let r = json(&[
+        "estimate",
+        "aps",
+        rec.to_str().unwrap(),
+        "--max-events",
+        "1000",
+    ]);
+    let notes = strings(&r["assumptions"]);
+    assert!(
+        notes.iter().any(|a| a
+            .starts_with("measured by `estimate aps` on the whole 64x48 sensor although its")
+            && a.contains("more than the budget of 1000")),
+        "{notes:#?}"
+    );
+    let on = r["ct_on"].as_f64().unwrap();
+    assert!((on - 0.3).abs() < 0.05, "{on}");
+}
+
+/// A `--json` path that `--maps` would write over is refused before anything is written.
+#[test]
+fn json_into_the_maps_is_refused_before_writing() {
+    let dir = tempfile::tempdir().unwrap();
+    let maps = dir.path().join("maps");
+    let case = oracle("b_asym_texture");
+    for json_path in [maps.clone(), maps.join("ct_on.npy")] {
+        let e = bad_input(&[
+            "estimate",
+            "aps",
+            case.to_str().unwrap(),
+            "--maps",
+            maps.to_str().unwrap(),
+            "--json",
+            json_path.to_str().unwrap(),
+        ]);
+        assert!(
+            e.contains("which --maps") && e.contains("give --json another path"),
+            "{e}"
+        );
+        assert!(!maps.exists(), "nothing written");
+    }
+}
+
 #[test]
 fn aps_recovers_asymmetric_thresholds_mismatch_and_per_pixel_maps() {
     let dir = tempfile::tempdir().unwrap();

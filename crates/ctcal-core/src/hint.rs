@@ -41,6 +41,9 @@ pub enum Hint {
     Roi(Roi),
     /// Another analysis that answers where this one cannot.
     Analysis(Analysis),
+    /// The events and pixels a measurement may afford before it is cut to a region of the
+    /// sensor (0: no limit).
+    Budget,
 }
 
 /// The analyses a fix can point to (the binary names their commands).
@@ -84,6 +87,7 @@ impl Hint {
             Hint::Stimulus => "the stimulus folder".into(),
             Hint::Roi(roi) => format!("the region {roi}"),
             Hint::Analysis(analysis) => analysis.name().into(),
+            Hint::Budget => "a larger budget of events and pixels (0: no limit)".into(),
         }
     }
 

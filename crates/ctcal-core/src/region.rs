@@ -44,7 +44,7 @@ pub fn region_size(sensor: Sensor, max_pixels: usize) -> Option<(u16, u16)> {
 
 /// The region of [`region_size`] whose kept pixels (`excluded` false) hold the most events,
 /// each pixel's count capped at the [`COUNT_CAP_QUANTILE`] of the counts of the pixels with
-/// events; of equal regions, the one nearest the sensor's centre. `None` where the sensor
+/// events and at twice its busiest neighbour's; of equal regions, the one nearest the sensor's centre. `None` where the sensor
 /// has no more than `max_pixels` pixels.
 pub fn busiest_region(
     events: &EventChunk,
@@ -66,6 +66,7 @@ pub fn busiest_region(
         }
     }
     let cap = cap_of(&counts);
+    let counts = neighbour_capped(&counts, w, h);
     let table = SummedArea::new(&counts, w, h, cap);
     let centre = ((w - rw as usize) / 2, (h - rh as usize) / 2);
     // every POSITION_STEP-th position, the last and the centred one
@@ -103,6 +104,28 @@ fn cap_of(counts: &[u64]) -> u64 {
     }
     let k = ((busy.len() - 1) as f64 * COUNT_CAP_QUANTILE).round() as usize;
     *busy.select_nth_unstable(k).1
+}
+
+/// Each count capped at twice the busiest of its 8 neighbours' (at least 1): the scene's
+/// events come from edges spanning neighbouring pixels, a hot pixel fires alone. The
+/// quantile cap alone misses hot pixels where under 1 % of the pixels have events.
+fn neighbour_capped(counts: &[u64], w: usize, h: usize) -> Vec<u64> {
+    let at = |x: usize, y: usize| counts[y * w + x];
+    let mut out = Vec::with_capacity(counts.len());
+    for y in 0..h {
+        for x in 0..w {
+            let mut busiest = 0;
+            for ny in y.saturating_sub(1)..(y + 2).min(h) {
+                for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                    if (nx, ny) != (x, y) {
+                        busiest = busiest.max(at(nx, ny));
+                    }
+                }
+            }
+            out.push(at(x, y).min((2 * busiest).max(1)));
+        }
+    }
+    out
 }
 
 /// A summed-area table of capped counts: any rectangle's sum in four reads.
@@ -243,6 +266,35 @@ mod tests {
         let quiet = EventChunk::default();
         let centred = busiest_region(&quiet, sensor, &excluded, 200).unwrap();
         assert_eq!((centred.x0, centred.y0), (10, 5));
+    }
+
+    /// A 200 x 100 sensor where 0.72 % of the pixels see the scene (a 12 x 12 patch at
+    /// x 20..32, y 40..52, 3 events a pixel) and five hot pixels of 10,000 events sit
+    /// apart in the far corner: 149 active pixels, the 99th percentile a hot pixel's count,
+    /// so the quantile cap alone lets them choose; capped by their silent neighbours, the
+    /// 400-pixel region holds the patch.
+    #[test]
+    fn hot_pixels_do_not_choose_the_region_of_a_sparse_scene() {
+        let sensor = Sensor::new(200, 100);
+        let mut events = EventChunk::default();
+        for y in 40..52 {
+            for x in 20..32 {
+                for t in 0..3 {
+                    events.push(t, x, y, false);
+                }
+            }
+        }
+        for (x, y) in [(180, 85), (184, 88), (188, 91), (192, 86), (186, 94)] {
+            for t in 0..10_000 {
+                events.push(t, x, y, true);
+            }
+        }
+        let excluded = vec![false; 20_000];
+        let roi = busiest_region(&events, sensor, &excluded, 400).unwrap();
+        assert!(
+            roi.x0 <= 20 && roi.x1 >= 32 && roi.y0 <= 40 && roi.y1 >= 52,
+            "{roi}"
+        );
     }
 
     #[test]

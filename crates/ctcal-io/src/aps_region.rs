@@ -26,29 +26,32 @@ pub fn aps(
     budget: FitBudget,
     progress: Progress,
 ) -> Result<ApsResult, EstimateError> {
-    let (mut result, region) = on_region(loaded, budget, (Measured::Aps, true), |input| {
-        aps::estimate(
-            &ApsInput {
-                sensor: input.sensor,
-                events: &input.events,
-                frames: &input.frames,
-                excluded: &input.excluded,
-                unread: &input.unread,
-            },
-            options,
-            progress,
-        )
+    let (mut result, placed) = on_region(loaded, budget, (Measured::Aps, true), |input| {
+        aps::estimate(&input.aps_input(), options, progress)
     })?;
-    if let Some((roi, note)) = region {
+    if let Some(roi) = placed.roi {
         let (w, h) = (loaded.sensor.width as usize, loaded.sensor.height as usize);
         result.maps = embedded(&result.maps, roi, w, h);
-        result.estimate.assumptions.push(note);
     }
+    result.estimate.assumptions.extend(placed.note);
     result
         .estimate
         .assumptions
         .extend(loaded.notes.iter().cloned());
     Ok(result)
+}
+
+impl Loaded {
+    /// The window as `estimate aps` reads it.
+    pub fn aps_input(&self) -> ApsInput<'_> {
+        ApsInput {
+            sensor: self.sensor,
+            events: &self.events,
+            frames: &self.frames,
+            excluded: &self.excluded,
+            unread: &self.unread,
+        }
+    }
 }
 
 /// The maps of a region placed in a `width` x `height` sensor: NaN thresholds and no

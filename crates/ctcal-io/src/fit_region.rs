@@ -13,8 +13,10 @@
 
 use crate::estimate::{EstimateError, Progress};
 use crate::frame_blocks::LIMIT_PIXELS;
+use crate::hint::Hint;
 use crate::selection::Roi;
 use crate::window::Loaded;
+use ctcal_core::events::Sensor;
 use ctcal_core::fit::{FitInput, FitOptions, FitResult};
 
 /// The most pixels a fit simulates unless told otherwise: a 346x260 sensor's (the frame
@@ -67,6 +69,7 @@ fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
         ((of as f64 * share) as usize).max(MIN_REGION_PIXELS)
     };
     let busiest = |limit: usize| {
+        let limit = at_least_the_floor(loaded.sensor, limit);
         ctcal_core::region::busiest_region(&loaded.events, loaded.sensor, &loaded.excluded, limit)
     };
     let mut limit = by_pixels.min(within_events(pixels, kept_events(loaded, None)));
@@ -88,6 +91,20 @@ fn region_within(loaded: &Loaded, budget: FitBudget) -> Option<(Roi, usize)> {
     Some((roi, limit))
 }
 
+/// `limit` raised where the region of the sensor's aspect it gives would hold fewer than
+/// [`MIN_REGION_PIXELS`] (a 346x260 sensor's region of 3,072 pixels rounds down to 63x48).
+fn at_least_the_floor(sensor: Sensor, limit: usize) -> usize {
+    let area = |limit| {
+        ctcal_core::region::region_size(sensor, limit)
+            .map_or(sensor.pixels(), |(w, h)| w as usize * h as usize)
+    };
+    let mut raised = limit;
+    while raised < sensor.pixels() && area(raised) < MIN_REGION_PIXELS.min(sensor.pixels()) {
+        raised += 1;
+    }
+    raised
+}
+
 /// The events of `loaded` at the pixels it keeps (a `--roi` or mask leaves the others
 /// out), inside `roi` where given: what the budget counts.
 fn kept_events(loaded: &Loaded, roi: Option<Roi>) -> usize {
@@ -106,6 +123,17 @@ fn kept_events(loaded: &Loaded, roi: Option<Roi>) -> usize {
 }
 
 impl Loaded {
+    /// The window as the fit reads it.
+    pub fn fit_input(&self) -> FitInput<'_> {
+        FitInput {
+            sensor: self.sensor,
+            events: &self.events,
+            frames: &self.frames,
+            excluded: &self.excluded,
+            unread: &self.unread,
+        }
+    }
+
     /// The same window on the pixels of `roi` only, as a sensor of the region's size.
     pub fn within(&self, roi: Roi) -> Loaded {
         let selection = self.selection.within(roi);
@@ -125,24 +153,85 @@ impl Loaded {
     }
 }
 
+/// Where a measurement within a budget was made: the region it was cut to, and what
+/// `assumptions` says of it (the region, or a budget the whole sensor could not be cut to).
+pub(crate) struct Placed {
+    pub roi: Option<Roi>,
+    pub note: Option<String>,
+}
+
 /// `measure` of `loaded`, or of its busiest region within `budget` where `allowed` and it
-/// has more pixels or events than that; with the region and the note that names it.
+/// has more pixels or events than that; with where it was measured.
 pub(crate) fn on_region<T>(
     loaded: &Loaded,
     budget: FitBudget,
     (measured, allowed): (Measured, bool),
     measure: impl FnOnce(&Loaded) -> Result<T, EstimateError>,
-) -> Result<(T, Option<(Roi, String)>), EstimateError> {
+) -> Result<(T, Placed), EstimateError> {
     let region = allowed.then(|| region_within(loaded, budget)).flatten();
     let cut = region.map(|(roi, _)| loaded.within(roi));
     let input = cut.as_ref().unwrap_or(loaded);
-    let result = measure(input)?;
-    let named = region.map(|(roi, limit)| {
-        let inside = kept_events(input, None);
-        let note = region_note(measured, roi, loaded, budget, (limit, inside));
-        (roi, note)
-    });
-    Ok((result, named))
+    let result = measure(input).map_err(|e| match region {
+        Some((roi, _)) => on_region_refused(e, roi, input, budget),
+        None => e,
+    })?;
+    let placed = match region {
+        Some((roi, limit)) => {
+            let inside = kept_events(input, None);
+            Placed {
+                roi: Some(roi),
+                note: Some(region_note(measured, roi, loaded, budget, (limit, inside))),
+            }
+        }
+        None => Placed {
+            roi: None,
+            note: allowed
+                .then(|| unmet_budget(measured, loaded, budget))
+                .flatten(),
+        },
+    };
+    Ok((result, placed))
+}
+
+/// What `assumptions` says where the window holds over a tenth more events than the budget
+/// and no region was cut (the sensor is no larger than the smallest region).
+fn unmet_budget(measured: Measured, loaded: &Loaded, budget: FitBudget) -> Option<String> {
+    let events = kept_events(loaded, None);
+    (budget.max_events != 0 && events * 10 > budget.max_events * 11).then(|| {
+        format!(
+            "{} on the whole {} sensor although its {events} events are more than the budget of {}: a region must keep {MIN_REGION_PIXELS} pixels at least (below that the optical flow's pyramid and the statistics' 8 x 8 px tiles have too little room), which this sensor does not exceed",
+            measured.verb(),
+            loaded.sensor,
+            budget.max_events
+        )
+    })
+}
+
+/// A refusal of the region the budget cut `input` to: the region and the budget named,
+/// with a larger budget as a further fix (the whole sensor may hold what the region lacks).
+fn on_region_refused(
+    e: EstimateError,
+    roi: Roi,
+    input: &Loaded,
+    budget: FitBudget,
+) -> EstimateError {
+    let problem = format!(
+        "{} (on the busiest region x {}..{}, y {}..{}: {} pixels and {} events, where the window is beyond the budget of {} events and {} pixels)",
+        e.problem,
+        roi.x0,
+        roi.x1,
+        roi.y0,
+        roi.y1,
+        input.sensor.pixels(),
+        kept_events(input, None),
+        budget.max_events,
+        budget.max_pixels
+    );
+    let fix = e
+        .fix
+        .words("; or, to measure more of the sensor, ")
+        .act(Hint::Budget);
+    EstimateError::new(problem, fix)
 }
 
 /// `ctcal fit` of `loaded` with `options`, on its busiest region within `budget` (at
@@ -156,25 +245,15 @@ pub fn fit(
     progress: Progress,
 ) -> Result<FitResult, EstimateError> {
     let framed = loaded.frames.len() >= 2;
-    let (mut result, region) = on_region(loaded, budget, (Measured::Fit, framed), |input| {
-        ctcal_core::fit::fit(
-            &FitInput {
-                sensor: input.sensor,
-                events: &input.events,
-                frames: &input.frames,
-                excluded: &input.excluded,
-                unread: &input.unread,
-            },
-            options,
-            progress,
-        )
+    let (mut result, placed) = on_region(loaded, budget, (Measured::Fit, framed), |input| {
+        ctcal_core::fit::fit(&input.fit_input(), options, progress)
     })?;
-    if let Some((roi, note)) = region {
+    if let Some(roi) = placed.roi {
         for p in &mut result.hot_pixels_masked {
             (p.x, p.y) = (p.x + roi.x0, p.y + roi.y0);
         }
-        result.assumptions.push(note);
     }
+    result.assumptions.extend(placed.note);
     result.assumptions.extend(loaded.notes.iter().cloned());
     result.biases = loaded.recording.biases();
     Ok(result)
@@ -249,7 +328,7 @@ fn region_note(
         )
     };
     format!(
-        "{} on the region x {}..{}, y {}..{} of the {} sensor ({} of {} pixels; {why}; the frames cut to it): the {rw}x{rh} rectangle, of the sensor's aspect, where the events are densest (each pixel counted up to the 99th percentile of the pixels' counts, so that hot pixels do not choose it); {}; a variation of the thresholds across the sensor beyond the per-pixel mismatch, and hot pixels outside the region, are not seen",
+        "{} on the region x {}..{}, y {}..{} of the {} sensor ({} of {} pixels; {why}; the frames cut to it): the {rw}x{rh} rectangle, of the sensor's aspect, where the events are densest (each pixel counted up to the 99th percentile of the pixels' counts and to twice its busiest neighbour's, so that hot pixels do not choose it); {}; a variation of the thresholds across the sensor beyond the per-pixel mismatch, and hot pixels outside the region, are not seen",
         measured.verb(),
         roi.x0,
         roi.x1,

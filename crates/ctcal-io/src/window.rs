@@ -4,7 +4,7 @@
 //! the caller's callbacks; errors are typed ([`LoadError`]) and name no command-line flag,
 //! so that the `ctcal` binary and the Python package each word the fix in their own terms.
 
-use crate::estimate::aps::{self, ApsInput, ApsOptions};
+use crate::estimate::aps::{self, ApsOptions};
 use crate::estimate::{CtEstimate, EstimateError, eppps, screen};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs, us_to_s};
 use crate::frame_blocks;
@@ -629,14 +629,7 @@ pub fn eppps_of(
     let mut notes = loaded.notes.clone();
     // frames, when there are and they are wanted, prepared as for `aps`
     let prepared = if loaded.frames.len() >= 2 {
-        let input = ApsInput {
-            sensor: loaded.sensor,
-            events: &loaded.events,
-            frames: &loaded.frames,
-            excluded,
-            unread: &loaded.unread,
-        };
-        match aps::prepare(&input, excluded, options) {
+        match aps::prepare(&loaded.aps_input(), excluded, options) {
             Ok(p) => {
                 notes.extend(p.assumptions.iter().cloned());
                 let known = !options.choose_response
