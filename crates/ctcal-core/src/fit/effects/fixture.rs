@@ -144,6 +144,7 @@ impl Fixture {
             mismatch_estimate: None,
             timestamp_grid_us: None,
             shortest_interval_s: None,
+            quiet_off: None,
             subset: Subset::Fit,
         }
     }

@@ -181,6 +181,9 @@ pub struct Context<'a> {
     /// The recording's shortest same-pixel intervals on the fit blocks, seconds
     /// ([`refractory::shortest_interval_s`]), when there are enough.
     pub shortest_interval_s: Option<f64>,
+    /// The recording's OFF isolated-event rate at quiet pixels on the fit run
+    /// ([`crate::fit::events_only::QuietOff`]), where measured.
+    pub quiet_off: Option<crate::fit::events_only::QuietOff>,
     pub subset: Subset,
 }
 

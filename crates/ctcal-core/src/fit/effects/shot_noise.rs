@@ -20,6 +20,9 @@ pub fn evidence(c: &Context) -> Evidence {
             "no reliable pixel-time to count isolated events",
         );
     }
+    if let Some(why) = crate::fit::selection::quiet_noise::rules_out(c, RELEVANT_HZ) {
+        return Evidence::none(Effect::ShotNoise, why);
+    }
     let (excess_on, excess_off) = (r_on - s_on, r_off - s_off);
     let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
     // the dark rate: the observed rate is the dark rate times the brightness factor

@@ -206,6 +206,52 @@ pub(super) fn fit_from_events(
     }))
 }
 
+/// The OFF isolated-event rate at quiet pixels of a stretch of a recording, measured as a
+/// fit without frames measures it ([`measure`]: hot pixels taken out, the support chosen
+/// by [`measure::choose_isolation`]). Noise is Poisson and independent of its neighbours,
+/// so this is shot noise's OFF rate there whatever the scene; leak fires ON only.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuietOff {
+    /// OFF isolated events per quiet pixel-second, and its Poisson standard error.
+    pub rate_hz: f64,
+    pub se_hz: f64,
+    pub pixel_seconds: f64,
+    pub support_window_ms: f64,
+    pub support_radius_px: usize,
+    /// The rate may hold the scene's own slow events: an upper bound.
+    pub upper_bound: bool,
+}
+
+/// [`QuietOff`] of `events` (a time-sorted stretch of `input`'s recording, cut into six
+/// blocks for the support's choice); `None` where they are too few or too short.
+pub(crate) fn quiet_off(events: &crate::events::EventChunk, input: &FitInput) -> Option<QuietOff> {
+    check(events).ok()?;
+    let blocks = Blocks::split(events, 6, 0.0);
+    let stretch = FitInput { events, ..*input };
+    let (hot, _, _) = hot_pixels(&stretch, &blocks);
+    let named: Vec<(u16, u16)> = hot.iter().map(|h| (h.x, h.y)).collect();
+    let measures = measure::measure(
+        &Measuring {
+            events,
+            sensor: input.sensor,
+            excluded: input.excluded,
+            hot: &named,
+        },
+        &blocks.spans,
+    );
+    let all: Vec<&BlockMeasure> = measures.iter().collect();
+    let (isolation, bound) = measure::choose_isolation(&all);
+    let (rate_hz, se_hz) = BlockMeasure::isolated_rate(&all, isolation, false)?;
+    Some(QuietOff {
+        rate_hz,
+        se_hz,
+        pixel_seconds: BlockMeasure::isolated(&all, isolation).pixel_seconds,
+        support_window_ms: isolation.window_us() as f64 / 1e3,
+        support_radius_px: isolation.radius_px(),
+        upper_bound: bound.is_some(),
+    })
+}
+
 fn check(events: &crate::events::EventChunk) -> Result<(), FitError> {
     if events.len() < MIN_EVENTS {
         return Err(FitError::new(

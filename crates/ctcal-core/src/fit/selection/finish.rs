@@ -196,6 +196,12 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::method_systematic::widen_cutoff(
         &mut state.uncertainty,
     ));
+    assumptions.extend(super::quiet_noise::widen(
+        &mut state.uncertainty,
+        known.quiet_off,
+        g,
+        &state.model.params,
+    ));
     let mut params = state.model.params.clone();
     params.seed = None;
     // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml

@@ -34,6 +34,7 @@ mod hot_report;
 pub(in crate::fit) mod keep;
 mod method_systematic;
 mod noise_detection;
+pub(crate) mod quiet_noise;
 mod spread_report;
 mod start;
 mod steps;
@@ -61,6 +62,8 @@ pub(super) struct Known {
     mismatch: Option<(f64, [f64; 2])>,
     grid: Option<(i64, i64)>,
     shortest_interval_s: Option<f64>,
+    /// The OFF isolated-event rate at quiet pixels of the fit run.
+    quiet_off: Option<super::events_only::QuietOff>,
 }
 
 /// The fit's state between steps.
@@ -293,6 +296,7 @@ impl Known {
                 &state.kept,
                 grid.map_or(1, |g| g.0.clamp(1, u32::MAX as i64) as u32),
             ),
+            quiet_off: super::events_only::quiet_off(&run.events, input),
         }
     }
 }
@@ -728,6 +732,7 @@ fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) ->
         mismatch_estimate: known.mismatch,
         timestamp_grid_us: known.grid.map(|g| g.0),
         shortest_interval_s: known.shortest_interval_s,
+        quiet_off: known.quiet_off,
         subset: Subset::Fit,
     }
 }
