@@ -458,10 +458,18 @@ fn check_json_beside_maps(json: Option<&Path>, dir: &Path) -> anyhow::Result<()>
     Ok(())
 }
 
-/// Whether `a` and `b` name one path (compared as given, and resolved where both exist).
+/// Whether `a` and `b` name one path: made absolute against the working folder (`.`
+/// dropped), and resolved where both exist (links).
 fn same_path(a: &Path, b: &Path) -> bool {
-    let clean = |p: &Path| p.components().collect::<PathBuf>();
-    clean(a) == clean(b) || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+    let clean = |p: &Path| {
+        std::path::absolute(p).map(|p| {
+            p.components()
+                .filter(|c| *c != std::path::Component::CurDir)
+                .collect::<PathBuf>()
+        })
+    };
+    matches!((clean(a), clean(b)), (Ok(x), Ok(y)) if x == y)
+        || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
 }
 
 /// Writes the threshold maps as NumPy arrays (H x W): `ct_on.npy`, `ct_off.npy` (float32,

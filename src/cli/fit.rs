@@ -19,8 +19,8 @@ pub struct FitArgs {
     #[arg(long, value_name = "auto|none|LIST", default_value = "auto")]
     pub effects: String,
     /// Fraction of the recording held out of the fit, at its end: the first half judges
-    /// each effect, the second measures the final error (0.2 to 0.7: at least one
-    /// selection and one test block of the 10).
+    /// each effect, the second measures the final error (0.16 to 0.75: at least 3 fit,
+    /// one selection and one test block of the 10).
     #[arg(long, value_name = "FRACTION", default_value_t = 0.4)]
     pub holdout: f64,
     /// Use at most this many frames (of a sensor up to 346x260; a larger sensor's frames
@@ -168,13 +168,9 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
         ..FitOptions::default()
     };
     if let Err(e) = split.check() {
-        let range = split.holdout_range();
         return Err(BadInput(format!(
-            "--holdout {}: {}; give --holdout between {} and {}",
-            args.holdout,
-            e.problem,
-            range.start(),
-            range.end()
+            "--holdout {}: {}\n  fix: {}",
+            args.holdout, e.problem, e.fix
         ))
         .into());
     }

@@ -253,7 +253,12 @@ fn json_into_the_maps_is_refused_before_writing() {
     let dir = tempfile::tempdir().unwrap();
     let maps = dir.path().join("maps");
     let case = oracle("b_asym_texture");
-    for json_path in [maps.clone(), maps.join("ct_on.npy")] {
+    // the folder, a map, and a map named through `.` from the working folder
+    let dotted = std::path::absolute(&maps)
+        .unwrap()
+        .join(".")
+        .join("ct_off.npy");
+    for json_path in [maps.clone(), maps.join("ct_on.npy"), dotted] {
         let e = bad_input(&[
             "estimate",
             "aps",

@@ -399,7 +399,7 @@ fn effect_choices_and_bad_input() {
     ]);
     assert!(
         e.contains("leaves 9 fit, 0 selection and 1 test blocks of 10")
-            && e.contains("between 0.2 and 0.7"),
+            && e.contains("hold out a fraction between 0.16 and 0.75"),
         "{e}"
     );
 }

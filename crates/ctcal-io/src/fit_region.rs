@@ -215,8 +215,12 @@ fn on_region_refused(
     input: &Loaded,
     budget: FitBudget,
 ) -> EstimateError {
+    let limit = |n: usize, what: &str| match n {
+        0 => format!("no limit of {what}"),
+        n => format!("{n} {what}"),
+    };
     let problem = format!(
-        "{} (on the busiest region x {}..{}, y {}..{}: {} pixels and {} events, where the window is beyond the budget of {} events and {} pixels)",
+        "{} (on the busiest region x {}..{}, y {}..{}: {} pixels and {} events, where the window is beyond the budget of {} and {})",
         e.problem,
         roi.x0,
         roi.x1,
@@ -224,8 +228,8 @@ fn on_region_refused(
         roi.y1,
         input.sensor.pixels(),
         kept_events(input, None),
-        budget.max_events,
-        budget.max_pixels
+        limit(budget.max_events, "events"),
+        limit(budget.max_pixels, "pixels")
     );
     let fix = e
         .fix
@@ -244,6 +248,8 @@ pub fn fit(
     budget: FitBudget,
     progress: Progress,
 ) -> Result<FitResult, EstimateError> {
+    // a bad option is the caller's, not the region's: refused before any cut
+    options.check()?;
     let framed = loaded.frames.len() >= 2;
     let (mut result, placed) = on_region(loaded, budget, (Measured::Fit, framed), |input| {
         ctcal_core::fit::fit(&input.fit_input(), options, progress)

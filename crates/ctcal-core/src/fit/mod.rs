@@ -85,31 +85,47 @@ impl Default for FitOptions {
 }
 
 impl FitOptions {
-    /// The held-out fractions whose split of the `blocks` keeps at least 3 fit blocks (0.7
-    /// of 10) and leaves at least one selection and one test block: `2 / blocks` to 0.7 (the
-    /// selection blocks judge the effects and the test blocks alone measure
-    /// `error_before`/`error_after`; a smaller fraction would leave the errors measured on
-    /// blocks that chose the model).
-    pub fn holdout_range(&self) -> std::ops::RangeInclusive<f64> {
-        let smallest = 2.0 / self.blocks.max(1) as f64;
-        smallest..=MAX_HOLDOUT.max(smallest)
+    /// The blocks a held-out fraction `holdout` leaves to fit, select and test (the split
+    /// the fit makes of its time blocks, [`observe::roles`]).
+    fn split_of(&self, holdout: f64) -> [usize; 3] {
+        let fitting = ((1.0 - holdout.clamp(0.0, 1.0)) * self.blocks as f64).round();
+        let role = observe::roles(fitting as usize, self.blocks);
+        let count = |r| role.iter().filter(|&&x| x == r).count();
+        [
+            count(observe::Role::Fit),
+            count(observe::Role::Selection),
+            count(observe::Role::Test),
+        ]
     }
 
-    /// Refuses a held-out fraction outside [`Self::holdout_range`].
+    /// Whether `holdout` keeps at least 3 fit blocks (the starting thresholds and their
+    /// spread over blocks) and leaves at least one selection block (to judge the effects)
+    /// and one test block (`error_before`/`error_after`, which no decision has seen).
+    fn splits(&self, holdout: f64) -> bool {
+        let [fit, selection, test] = self.split_of(holdout);
+        (0.0..1.0).contains(&holdout) && fit >= 3 && selection >= 1 && test >= 1
+    }
+
+    /// The held-out fractions, in hundredths, that [`Self::check`] accepts for these
+    /// blocks (0.16 to 0.75 of 10); `None` where no fraction splits them (under 5 blocks).
+    pub fn holdout_range(&self) -> Option<(f64, f64)> {
+        let accepted: Vec<f64> = (0..100)
+            .map(|h| h as f64 / 100.0)
+            .filter(|&h| self.splits(h))
+            .collect();
+        Some((*accepted.first()?, *accepted.last()?))
+    }
+
+    /// Refuses a held-out fraction that does not split the blocks into at least 3 fit, one
+    /// selection and one test block.
     pub fn check(&self) -> Result<(), FitError> {
-        let range = self.holdout_range();
-        if self.holdout.is_finite() && range.contains(&self.holdout) {
+        if self.holdout.is_finite() && self.splits(self.holdout) {
             return Ok(());
         }
         let held = if self.holdout.is_finite() {
-            let fitting = ((1.0 - self.holdout.clamp(0.0, 1.0)) * self.blocks as f64).round();
-            let role = observe::roles(fitting as usize, self.blocks);
-            let count = |r| role.iter().filter(|&&x| x == r).count();
+            let [fit, selection, test] = self.split_of(self.holdout);
             format!(
-                "leaves {} fit, {} selection and {} test blocks of {}",
-                count(observe::Role::Fit),
-                count(observe::Role::Selection),
-                count(observe::Role::Test),
+                "leaves {fit} fit, {selection} selection and {test} test blocks of {}",
                 self.blocks
             )
         } else {
@@ -120,17 +136,13 @@ impl FitOptions {
                 "a held-out fraction of {} {held}: the fit needs at least 3 blocks to fit (its starting thresholds and their spread over blocks), one selection block (to judge the effects) and one test block (for the errors no decision has seen)",
                 self.holdout
             ),
-            format!(
-                "hold out a fraction between {} and {}",
-                range.start(),
-                range.end()
-            ),
+            match self.holdout_range() {
+                Some((lo, hi)) => format!("hold out a fraction between {lo} and {hi}"),
+                None => format!("cut the time into 5 blocks or more ({} now)", self.blocks),
+            },
         ))
     }
 }
-
-/// The largest held-out fraction: 3 of 10 blocks left to fit.
-pub const MAX_HOLDOUT: f64 = 0.7;
 
 /// What a fit reads.
 pub struct FitInput<'a> {
@@ -490,3 +502,39 @@ pub struct Holdout {
 }
 
 pub use selection::{Ambiguity, fit};
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ten blocks: 0.16 (0.15 leaves 8.5, rounded to 9 fit blocks and one held out) to 0.75
+    /// (2.5 rounds to 3); eight: 0.19 to 0.68 (at least 3 of 8 fit, 2 held out); four cannot split.
+    #[test]
+    fn a_holdout_must_leave_fit_selection_and_test_blocks() {
+        let with = |blocks, holdout| FitOptions {
+            blocks,
+            holdout,
+            ..FitOptions::default()
+        };
+        assert_eq!(with(10, 0.4).holdout_range(), Some((0.16, 0.75)));
+        assert_eq!(with(8, 0.4).holdout_range(), Some((0.19, 0.68)));
+        assert_eq!(with(4, 0.4).holdout_range(), None);
+        assert!(with(10, 0.4).check().is_ok());
+        let e = with(10, 0.1).check().unwrap_err();
+        assert!(
+            e.problem
+                .contains("leaves 9 fit, 0 selection and 1 test blocks of 10"),
+            "{e}"
+        );
+        assert!(with(8, 0.7).check().is_err());
+        assert!(with(10, f64::NAN).check().is_err());
+        assert!(with(1, 2.0).check().is_err());
+        assert!(
+            with(4, 0.5)
+                .check()
+                .unwrap_err()
+                .to_string()
+                .contains("5 blocks or more")
+        );
+    }
+}

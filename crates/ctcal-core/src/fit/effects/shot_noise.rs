@@ -139,6 +139,32 @@ mod tests {
         assert!(start > 0.5 / 2.0 && start < 0.5 * 2.0, "{start}");
     }
 
+    /// The same excess with the recording's quiet pixels holding no isolated OFF event in
+    /// 10,000 pixel-s: shot noise is at most 3.69 / 10,000 / 0.5 = 0.0007 Hz there, and the
+    /// excess is another effect's.
+    #[test]
+    fn no_isolated_off_event_at_quiet_pixels_rules_shot_noise_out() {
+        let model = chunk(leak_floor());
+        let recording = chunk(with(leak_floor(), shot_noise(0.5)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, DN), &recording, &model);
+        let mut c = f.context();
+        c.quiet_off = Some(crate::fit::events_only::QuietOff {
+            rate_hz: 0.0,
+            se_hz: 1e-4,
+            pixel_seconds: 10_000.0,
+            support_window_ms: 30.0,
+            support_radius_px: 1,
+            upper_bound: false,
+        });
+        let e = evidence(&c);
+        assert!(!e.calls_for(), "{e:?}");
+        assert!(
+            e.text
+                .contains("quiet pixels hold 0.0000 isolated OFF events"),
+            "{e:?}"
+        );
+    }
+
     #[test]
     fn the_model_as_the_recording_does_not_call_for_shot_noise() {
         let recording = chunk(with(leak_floor(), shot_noise(0.5)));

@@ -304,15 +304,20 @@ fn noise_params(
     let scene = super::candidates::scene_like_isolated(run);
     if let Some((rate, se)) = symmetric_rate(run) {
         if let (Some(scene), false) = (&scene, kept("shot_noise")) {
-            // the lower end, from the OFF excess over the scene's balance, cannot pass the
+            // the lower end, from the OFF excess over the scene's balance, may pass the
             // upper (draw 8002: 3 OFF and 1 ON isolated events read 0.0004 to 0.0003 Hz)
             let upper = 2.0 * (rate + 2.0 * se);
+            let lower = 2.0 * scene.noise_at_least_hz;
+            let range = if lower < upper {
+                format!("lies between {lower:.4} and {upper:.4} Hz")
+            } else {
+                format!("is at most {upper:.4} Hz")
+            };
             why.insert(
                 "shot_noise_rate_hz".into(),
                 format!(
-                    "{}: the shot noise lies between {:.4} and {upper:.4} Hz (2 standard errors); a static stretch of the recording, or grey frames, would tell them apart",
+                    "{}: the shot noise {range} (2 standard errors); a static stretch of the recording, or grey frames, would tell them apart",
                     scene.evidence(),
-                    (2.0 * scene.noise_at_least_hz).min(upper),
                 ),
             );
         } else if kept("shot_noise") {

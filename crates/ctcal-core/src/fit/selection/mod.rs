@@ -142,7 +142,13 @@ pub fn fit(
     )?;
     let mut state = ideal.state;
     let loop_run = LoopRun {
-        known: Known::of(&run, input, &state, start.mismatch, simulation.grid),
+        known: Known::of(
+            &run,
+            input,
+            &state,
+            (start.mismatch, simulation.grid),
+            planned(options).contains(&Effect::ShotNoise),
+        ),
         fixed: ideal.fixed,
         noise: ideal.noise,
         fit_events: &run.events,
@@ -279,13 +285,14 @@ impl Ideal {
 
 impl Known {
     /// What the fit run tells before any effect is tried: the mismatch's evidence, the
-    /// timestamp grid and the shortest same-pixel interval of the kept pixels.
+    /// timestamp grid, the shortest same-pixel interval of the kept pixels and, where shot
+    /// noise may be tried, the isolated OFF events at quiet pixels.
     fn of(
         run: &start::FitRun,
         input: &FitInput,
         state: &State,
-        mismatch: Option<(f64, [f64; 2])>,
-        grid: Option<(TimeUs, TimeUs)>,
+        (mismatch, grid): (Option<(f64, [f64; 2])>, Option<(TimeUs, TimeUs)>),
+        shot_noise_planned: bool,
     ) -> Self {
         Known {
             mismatch,
@@ -296,7 +303,9 @@ impl Known {
                 &state.kept,
                 grid.map_or(1, |g| g.0.clamp(1, u32::MAX as i64) as u32),
             ),
-            quiet_off: super::events_only::quiet_off(&run.events, input),
+            quiet_off: shot_noise_planned
+                .then(|| super::events_only::quiet_off(&run.events, input))
+                .flatten(),
         }
     }
 }

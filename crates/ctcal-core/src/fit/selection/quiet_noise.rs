@@ -24,34 +24,20 @@ use crate::fit::events_only::QuietOff;
 use crate::fit::observe::{Geometry, INTENSITY_BINS, Subset};
 use crate::sim::PixelParams;
 use crate::sim::effects::shot_noise::brightness_factor;
+use crate::stats::binomial::poisson95;
 use std::collections::BTreeMap;
 
-/// Intensity bins holding less than this share of the fit blocks' pixel time do not set
-/// the range of brightness the quiet pixels may have.
-const MIN_BIN_SHARE: f64 = 0.01;
-
-/// The share of shot noise that is OFF: each polarity's rate goes as the inverse of its
-/// threshold ([`crate::sim::effects::shot_noise::pixel_rates`]), `Cp / (Cp + Cn)`; the
-/// range from that of `model` to 1/2 (the thresholds may be wrong where noise dominates).
-fn off_share(model: &PixelParams) -> [f64; 2] {
-    let share = model.ct_on / (model.ct_on + model.ct_off);
-    if share.is_finite() && share > 0.0 {
-        [share.min(0.5), share.max(0.5)]
-    } else {
-        [0.5, 0.5]
-    }
-}
+/// The share of shot noise that is OFF: each polarity's rate goes as its nominal threshold
+/// over the pixel's ([`crate::sim::effects::shot_noise::pixel_rates`], as v2e), so a
+/// nominal pixel fires OFF half the time whatever Cp and Cn are.
+const OFF_SHARE: f64 = 0.5;
 
 /// The smallest and largest brightness factor (observed over dark rate) of the intensity
-/// bins with [`MIN_BIN_SHARE`] of the fit blocks' pixel time.
+/// bins with pixel time on the fit blocks: the quiet pixels' own brightness lies within.
 fn factor_range(geometry: &Geometry, model: &PixelParams) -> Option<[f64; 2]> {
     let bright = model.shot_noise_bright_factor() as f32;
-    let exposure: Vec<f64> = (0..INTENSITY_BINS)
-        .map(|b| geometry.exposure_of(b, Subset::Fit))
-        .collect();
-    let total: f64 = exposure.iter().sum();
     let factors: Vec<f64> = (0..INTENSITY_BINS)
-        .filter(|&b| total > 0.0 && exposure[b] >= MIN_BIN_SHARE * total)
+        .filter(|&b| geometry.exposure_of(b, Subset::Fit) > 0.0)
         .map(|b| brightness_factor(geometry.intensity_centres[b] as f32, bright) as f64)
         .filter(|&f| f > 0.0)
         .collect();
@@ -60,23 +46,29 @@ fn factor_range(geometry: &Geometry, model: &PixelParams) -> Option<[f64; 2]> {
     (hi > 0.0).then_some([lo, hi])
 }
 
-/// The most shot noise (ON + OFF events per pixel-second, averaged over the recording's
-/// brightness) the quiet OFF rate allows at two standard errors: the OFF rate over the
-/// smallest OFF share, times how much brighter the quiet pixels may be than the rest.
-pub(crate) fn most_observed_hz(c: &Context, quiet: &QuietOff) -> Option<f64> {
-    let [lo, hi] = factor_range(c.geometry, c.model)?;
-    Some((quiet.rate_hz + 2.0 * quiet.se_hz) / off_share(c.model)[0] * hi / lo)
+/// Garwood's exact 95 % interval of the quiet OFF rate, events per pixel-second.
+fn off_rate95(quiet: &QuietOff) -> (f64, f64) {
+    let n = (quiet.rate_hz * quiet.pixel_seconds).round().max(0.0) as usize;
+    let (lo, hi) = poisson95(n);
+    (lo / quiet.pixel_seconds, hi / quiet.pixel_seconds)
 }
 
-/// Why shot noise is not tried, where the quiet OFF rate keeps it below `relevant_hz`.
+/// The most shot noise (ON + OFF events per pixel-second, averaged over the recording's
+/// brightness) the quiet OFF count allows: the upper end of its exact 95 % interval over
+/// the OFF share, times how much brighter the quiet pixels may be than the rest.
+pub(crate) fn most_observed_hz(c: &Context, quiet: &QuietOff) -> Option<f64> {
+    let [lo, hi] = factor_range(c.geometry, c.model)?;
+    Some(off_rate95(quiet).1 / OFF_SHARE * hi / lo)
+}
+
+/// Why shot noise is not tried, where the quiet OFF count keeps it below `relevant_hz`.
 pub(crate) fn rules_out(c: &Context, relevant_hz: f64) -> Option<String> {
     let quiet = c.quiet_off?;
     let most = most_observed_hz(c, &quiet)?;
     (most < relevant_hz).then(|| {
         format!(
-            "the recording's quiet pixels hold {:.4} +- {:.4} isolated OFF events per pixel-second ({:.0} pixel-s without a neighbour event within {:.0} ms and {} px): shot noise, which fires OFF as often as ON at every pixel, is below {most:.4} Hz, under the {relevant_hz} Hz that matters; the model's missing isolated events are another effect's (leak fires ON only; a photoreceptor lagging the scene, or thresholds off at sparse edges, leave scene events no neighbour supports)",
+            "the recording's quiet pixels hold {:.4} isolated OFF events per pixel-second ({:.0} pixel-s without a neighbour event within {:.0} ms and {} px): shot noise, which fires OFF as often as ON at every pixel, is below {most:.4} Hz (95 %), under the {relevant_hz} Hz that matters; the model's missing isolated events are another effect's (leak fires ON only; a photoreceptor lagging the scene, or thresholds off at sparse edges, leave scene events no neighbour supports)",
             quiet.rate_hz,
-            quiet.se_hz,
             quiet.pixel_seconds,
             quiet.support_window_ms,
             quiet.support_radius_px
@@ -84,24 +76,22 @@ pub(crate) fn rules_out(c: &Context, relevant_hz: f64) -> Option<String> {
     })
 }
 
-/// The dark shot-noise rate (the simulator's `shot_noise_rate_hz`) the quiet OFF rate
-/// gives, 95 %: the OFF rate +- 2 standard errors over the OFF share's range and the
-/// brightness factor's (the quiet pixels' own brightness unknown within the frames').
-/// Open above where the count is an upper bound only with its lower end at 0.
+/// The dark shot-noise rate (the simulator's `shot_noise_rate_hz`) the quiet OFF count
+/// gives, 95 %: its exact interval over the OFF share and the brightness factor's range
+/// (the quiet pixels' own brightness unknown within the frames'). `None` where the count
+/// is an upper bound only (it may hold the scene's slow events) or the frames give no
+/// brightness.
 pub(crate) fn direct_dark_rate(
     quiet: &QuietOff,
     geometry: &Geometry,
     model: &PixelParams,
-) -> Option<Interval> {
+) -> Option<[f64; 2]> {
+    if quiet.upper_bound {
+        return None;
+    }
     let [f_lo, f_hi] = factor_range(geometry, model)?;
-    let [s_lo, s_hi] = off_share(model);
-    let hi = (quiet.rate_hz + 2.0 * quiet.se_hz) / s_lo / f_lo;
-    let lo = if quiet.upper_bound {
-        0.0
-    } else {
-        (quiet.rate_hz - 2.0 * quiet.se_hz).max(0.0) / s_hi / f_hi
-    };
-    Some([Some(lo), Some(hi)])
+    let (lo, hi) = off_rate95(quiet);
+    Some([lo / OFF_SHARE / f_hi, hi / OFF_SHARE / f_lo])
 }
 
 /// Widens the fitted shot-noise rate's interval to hold [`direct_dark_rate`], where they
@@ -115,9 +105,7 @@ pub(crate) fn widen(
     let quiet = quiet?;
     model.shot_noise_rate_hz?;
     let u = uncertainty.get_mut("shot_noise_rate_hz")?;
-    let [Some(lo), Some(hi)] = direct_dark_rate(&quiet, geometry, model)? else {
-        return None;
-    };
+    let [lo, hi] = direct_dark_rate(&quiet, geometry, model)?;
     let [search_lo, search_hi] = u.ci95.unwrap_or([Some(u.value), Some(u.value)]);
     let widened = [search_lo.map(|s| s.min(lo)), search_hi.map(|s| s.max(hi))];
     if Some(widened) == u.ci95 {
@@ -128,17 +116,11 @@ pub(crate) fn widen(
         format!("{} to {}", side(i[0]), side(i[1]))
     };
     let note = format!(
-        "shot_noise_rate_hz: its interval holds the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} +- {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px{}, over an OFF share from Cp / (Cp + Cn) to 1/2 and the brightness factors of the frames' intensities), beside the simulation search's {} Hz: the search reads every isolated event the model lacks as noise, and where another effect leaves such events (a lagging photoreceptor, leak) it does not hold the truth (coverage draw 8007: 4.05 [3.68, 4.27] for 2.78)",
+        "shot_noise_rate_hz: its interval holds the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px, exact Poisson 95 %, half the noise OFF, over the brightness factors of the frames' intensities), beside the simulation search's {} Hz: the search reads every isolated event the model lacks as noise, and where another effect leaves such events (a lagging photoreceptor, leak) it does not hold the truth (coverage draw 8007: 4.05 [3.68, 4.27] for 2.78)",
         quiet.rate_hz,
-        quiet.se_hz,
         quiet.pixel_seconds,
         quiet.support_window_ms,
         quiet.support_radius_px,
-        if quiet.upper_bound {
-            "; an upper bound, the scene's slow events possibly among them"
-        } else {
-            ""
-        },
         said(u.ci95.unwrap_or([None, None]))
     );
     u.ci95 = Some(widened);
@@ -169,22 +151,18 @@ mod tests {
         Fixture::new(&static_frames(16, 12, 2.0, 15.0), &none, &none)
     }
 
-    /// Hand-computed on draw 8007's numbers: its quiet OFF count 1.264 +- 0.0355 Hz, its
-    /// fitted Cp 0.6121 and Cn 0.8469 (OFF share 0.41953 to 1/2): 1.193 / 0.5 / 0.90689 =
-    /// 2.6310 to 1.335 / 0.41953 / 0.90689 = 3.5089; the search's [3.68, 4.27] widened
-    /// to [2.6310, 4.27], which holds the true 2.78.
+    /// Hand-computed on draw 8007's numbers: 1,264 quiet OFF events in 1,000 pixel-s,
+    /// Garwood's 95 % interval [1194.9, 1335.9] (chi2(0.025; 2528) / 2, chi2(0.975; 2530) / 2),
+    /// half the noise OFF: 1.1949 / 0.5 / 0.90689 = 2.6352 to 1.3359 / 0.5 / 0.90689 = 2.9461;
+    /// the search's [3.68, 4.27] widened to [2.6352, 4.27], which holds the true 2.78.
     #[test]
     fn the_quiet_count_widens_the_searched_rate_to_the_dark_rate_it_gives() {
         let f = dim();
         let mut model = PixelParams::ideal(0.6121, 0.8469);
         model.shot_noise_rate_hz = Some(4.05);
-        let [Some(lo), Some(hi)] =
-            direct_dark_rate(&quiet(1.264, 0.0355, false), &f.geometry, &model).unwrap()
-        else {
-            panic!("closed");
-        };
+        let [lo, hi] = direct_dark_rate(&quiet(1.264, 0.0355, false), &f.geometry, &model).unwrap();
         assert!(
-            (lo - 2.6310).abs() < 1e-3 && (hi - 3.5089).abs() < 1e-3,
+            (lo - 2.6352).abs() < 2e-3 && (hi - 2.9461).abs() < 2e-3,
             "{lo} {hi}"
         );
         let mut u = BTreeMap::from([(
@@ -200,12 +178,12 @@ mod tests {
         assert!(note.unwrap().contains("3.6800 to 4.2700"));
         let ci = u["shot_noise_rate_hz"].ci95.unwrap();
         assert!(
-            (ci[0].unwrap() - 2.6310).abs() < 1e-3 && ci[1] == Some(4.27),
+            (ci[0].unwrap() - 2.6352).abs() < 2e-3 && ci[1] == Some(4.27),
             "{ci:?}"
         );
-        // an upper bound reaches down to none
-        let bounded = direct_dark_rate(&quiet(1.264, 0.0355, true), &f.geometry, &model);
-        assert_eq!(bounded.unwrap()[0], Some(0.0));
+        // an upper bound says nothing of the dark rate: no widening (the oracle
+        // c_noisy_static's [0.90, 1.12] was widened to [0, 1.60] by one)
+        assert!(direct_dark_rate(&quiet(1.264, 0.0355, true), &f.geometry, &model).is_none());
         // within the search's interval: nothing to widen
         let mut inside = BTreeMap::from([(
             "shot_noise_rate_hz".to_string(),
@@ -223,8 +201,9 @@ mod tests {
     }
 
     /// No isolated OFF event in 7,546 quiet pixel-seconds (draw 8027): at most
-    /// 2 / 7546 / 0.5 = 0.00053 Hz of shot noise, under the 0.005 that matters; 0.003 Hz
-    /// of OFF events would allow 0.0031 / 0.5 = 0.0062 and is not ruled out.
+    /// chi2(0.975; 2) / 2 / 7546 / 0.5 = 3.6889 / 7546 / 0.5 = 0.00098 Hz of shot noise,
+    /// under the 0.005 that matters; zero in 1,000 pixel-s allows 0.0074 and is not ruled out
+    /// (two expected events show none 13.5 % of the time).
     #[test]
     fn no_quiet_off_event_rules_shot_noise_out() {
         let f = dim();
@@ -235,9 +214,9 @@ mod tests {
         };
         c.quiet_off = Some(none);
         let most = most_observed_hz(&c, &none).unwrap();
-        assert!((most - 0.00053).abs() < 1e-5, "{most}");
+        assert!((most - 0.000978).abs() < 1e-5, "{most}");
         assert!(rules_out(&c, 0.005).unwrap().contains("7546 pixel-s"));
-        c.quiet_off = Some(quiet(0.003, 0.00005, false));
+        c.quiet_off = Some(quiet(0.0, 0.001, false));
         assert!(rules_out(&c, 0.005).is_none());
         c.quiet_off = None;
         assert!(rules_out(&c, 0.005).is_none());
