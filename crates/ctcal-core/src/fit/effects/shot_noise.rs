@@ -20,9 +20,6 @@ pub fn evidence(c: &Context) -> Evidence {
             "no reliable pixel-time to count isolated events",
         );
     }
-    if let Some(why) = crate::fit::selection::quiet_noise::rules_out(c, RELEVANT_HZ) {
-        return Evidence::none(Effect::ShotNoise, why);
-    }
     let (excess_on, excess_off) = (r_on - s_on, r_off - s_off);
     let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
     // the dark rate: the observed rate is the dark rate times the brightness factor
@@ -34,7 +31,7 @@ pub fn evidence(c: &Context) -> Evidence {
         })
         .sum::<f64>()
         / exposure;
-    Evidence {
+    let evidence = Evidence {
         effect: Effect::ShotNoise,
         score,
         relevant: rate > RELEVANT_HZ,
@@ -44,6 +41,16 @@ pub fn evidence(c: &Context) -> Evidence {
             excess_off / exposure,
         ),
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
+    };
+    // ruled out by the quiet pixels: not called for, its start kept for a listed try
+    match crate::fit::selection::quiet_noise::rules_out(c, RELEVANT_HZ) {
+        Some(why) => Evidence {
+            score: 0.0,
+            relevant: false,
+            text: why,
+            ..evidence
+        },
+        None => evidence,
     }
 }
 
