@@ -84,6 +84,18 @@ impl DisplayModel {
         (p.white_dn * l) as f32
     }
 
+    /// Camera DN of one screen DN before blur, as [`Self::lit`] gives it (the same bits):
+    /// whole DN from the table, any other value computed.
+    #[inline(always)]
+    pub fn lit_value(&self, screen_dn: f32) -> f32 {
+        let index = table_index(screen_dn);
+        if index as f32 == screen_dn {
+            self.lut[index as usize]
+        } else {
+            self.luminance_dn(screen_dn)
+        }
+    }
+
     /// Camera DN of a screen frame (W x H), blurred.
     pub fn camera_dn(&self, screen: &[f32], width: usize, height: usize) -> Vec<f32> {
         self.blur(self.lit(screen), width, height)

@@ -10,6 +10,7 @@ pub mod budget;
 pub mod display;
 pub mod effects;
 pub mod fast_math;
+pub mod footprints;
 pub mod log_response;
 pub mod params;
 pub mod peers;

@@ -318,15 +318,25 @@ impl ScreenWarp {
     pub fn apply(&self, lit: &[f32], ambient: f32) -> Vec<f32> {
         debug_assert_eq!(lit.len(), self.stimulus.0 * self.stimulus.1);
         (0..self.coverage.len())
-            .map(|p| {
-                let range = self.starts[p] as usize..self.starts[p + 1] as usize;
-                let on: f32 = self.entries[range]
-                    .iter()
-                    .map(|&(i, w)| w * lit[i as usize])
-                    .sum();
-                on + (1.0 - self.coverage[p]).max(0.0) * ambient
-            })
+            .map(|p| self.sensor_value(p, |i| lit[i], ambient))
             .collect()
+    }
+
+    /// The stimulus pixels sensor pixel `p`'s footprint overlaps, with their weights.
+    pub(super) fn footprint(&self, p: usize) -> &[(u32, f32)] {
+        &self.entries[self.starts[p] as usize..self.starts[p + 1] as usize]
+    }
+
+    /// Sensor pixel `p`'s value in [`Self::apply`], the stimulus pixel `i` at `lit(i)`: every
+    /// caller sums the same terms in the same order, so the same value has the same bits.
+    #[inline(always)]
+    pub(super) fn sensor_value(&self, p: usize, lit: impl Fn(usize) -> f32, ambient: f32) -> f32 {
+        let on: f32 = self
+            .footprint(p)
+            .iter()
+            .map(|&(i, w)| w * lit(i as usize))
+            .sum();
+        on + (1.0 - self.coverage[p]).max(0.0) * ambient
     }
 }
 

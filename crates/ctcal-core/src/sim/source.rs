@@ -4,6 +4,7 @@
 
 use super::SimError;
 use super::display::DisplayModel;
+use super::footprints::{self, Footprints, Uniform};
 use super::pixel::Transition;
 use super::screen_geometry::{self, ScreenWarp};
 use crate::events::{Frame, TimeUs};
@@ -194,6 +195,11 @@ pub struct DisplaySource<S> {
     inner: S,
     model: DisplayModel,
     warp: Option<std::sync::Arc<ScreenWarp>>,
+    /// The inner frames' footprints through `warp`, in order ([`Self::seen_with`]), and
+    /// the display's uniform images; how many inner frames were taken.
+    footprints: Option<std::sync::Arc<[Footprints]>>,
+    uniform: Uniform,
+    taken: usize,
     shown: Option<Vec<f32>>,
     pending: Option<Sample>,
     refresh: u64,
@@ -209,6 +215,9 @@ impl<S: FrameSource> DisplaySource<S> {
             inner,
             model,
             warp: None,
+            footprints: None,
+            uniform: Uniform::default(),
+            taken: 0,
             shown: None,
             pending: None,
             refresh: 0,
@@ -222,6 +231,28 @@ impl<S: FrameSource> DisplaySource<S> {
     pub fn seen_through(mut self, warp: std::sync::Arc<ScreenWarp>) -> Self {
         self.warp = Some(warp);
         self
+    }
+
+    /// [`Self::seen_through`], with the footprints of the inner source's frames through
+    /// `warp`, frame by frame ([`Footprints::of_frames`]): the same samples, each frame's
+    /// uniform footprints rendered once per DN ([`footprints`]).
+    pub fn seen_with(
+        mut self,
+        warp: std::sync::Arc<ScreenWarp>,
+        footprints: std::sync::Arc<[Footprints]>,
+    ) -> Self {
+        self.footprints = Some(footprints);
+        self.seen_through(warp)
+    }
+
+    /// The camera DN of the inner source's next frame `dn` through the display and `warp`.
+    fn warped(&mut self, warp: &ScreenWarp, dn: &[f32]) -> Vec<f32> {
+        let index = self.taken;
+        self.taken += 1;
+        match self.footprints.as_ref().and_then(|f| f.get(index)) {
+            Some(f) => footprints::camera_dn(&self.model, warp, dn, f, &mut self.uniform),
+            None => screen_geometry::camera_dn(&self.model, warp, dn),
+        }
     }
 
     fn refresh_time(&self, k: u64) -> TimeUs {
@@ -260,10 +291,8 @@ impl<S: FrameSource> FrameSource for DisplaySource<S> {
             }
             let (w, h) = self.inner.size();
             let p = self.pending.take().expect("checked");
-            self.shown = Some(match &self.warp {
-                Some(warp) if warp.stimulus_size() == (w, h) => {
-                    screen_geometry::camera_dn(&self.model, warp, &p.dn)
-                }
+            self.shown = Some(match self.warp.clone() {
+                Some(warp) if warp.stimulus_size() == (w, h) => self.warped(&warp, &p.dn),
                 Some(warp) => {
                     return Err(SimError::Invalid(format!(
                         "the screen geometry is for a {}x{} stimulus, the frames are {w}x{h}",

@@ -53,6 +53,7 @@ use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
 use crate::hint::{Hint, Text};
 use crate::sim::display::DisplayModel;
+use crate::sim::footprints::Footprints;
 use crate::sim::log_response::LogMap;
 use crate::sim::pixel::Transition;
 use crate::sim::screen_geometry::ScreenWarp;
@@ -306,7 +307,7 @@ struct Setup<'a> {
     offset_us: TimeUs,
     refresh_hz: f64,
     /// The screen seen at an angle (`None`: 1:1).
-    warp: Option<std::sync::Arc<ScreenWarp>>,
+    warp: Option<Seen>,
     /// The photoreceptor's cutoff at 255 camera DN ([`lag`]; `None`: ideal pixels).
     cutoff_hz: Option<f64>,
     /// The sensor's log response (the best fit's once the display is fitted).
@@ -407,8 +408,8 @@ impl Setup<'_> {
                 d.refresh_hz = self.refresh_hz;
                 d.time_offset_s = Some(self.offset_us as f64 * 1e-6);
                 let mut source = DisplaySource::new(frames, DisplayModel::new(&d));
-                if let Some(warp) = &self.warp {
-                    source = source.seen_through(warp.clone());
+                if let Some(seen) = &self.warp {
+                    source = source.seen_with(seen.warp.clone(), seen.footprints.clone());
                 }
                 crate::sim::run(&mut source, &params, self.dithered(ct), &mut sink, |_| {})
                     .map_err(bug)?;
@@ -473,6 +474,20 @@ impl Setup<'_> {
             };
         }
         Ok((ct[0], ct[1]))
+    }
+}
+
+/// The screen seen at an angle, with the stimulus frames' footprints through it (each
+/// simulation renders their uniform footprints once per DN: [`crate::sim::footprints`]).
+struct Seen {
+    warp: std::sync::Arc<ScreenWarp>,
+    footprints: std::sync::Arc<[Footprints]>,
+}
+
+impl Seen {
+    fn new(warp: std::sync::Arc<ScreenWarp>, stimulus: &[Frame]) -> Self {
+        let footprints = Footprints::of_frames(&warp, stimulus).into();
+        Self { warp, footprints }
     }
 }
 
@@ -646,7 +661,7 @@ fn counting_setup<'a>(
         real,
         offset_us,
         refresh_hz,
-        warp: located.warp.clone(),
+        warp: located.warp.clone().map(|w| Seen::new(w, input.stimulus)),
         cutoff_hz: None,
         log: naive_response(input.response),
         dither: threshold_dither(input.sensor.width as usize * input.sensor.height as usize),
@@ -712,7 +727,7 @@ fn matched_thresholds<'a>(
     );
     let setup = match reregister(inputs, &display, best.log, located) {
         Some(warp) => Setup {
-            warp: Some(warp),
+            warp: Some(Seen::new(warp, input.stimulus)),
             ..setup
         },
         None => setup,
