@@ -255,6 +255,18 @@ impl<S: FrameSource> DisplaySource<S> {
         }
     }
 
+    /// The frame shown at the refresh just made: moved out when the next frame replaces it
+    /// by the next refresh (the screen's frames come at its refresh rate), else copied.
+    fn shown_now(&mut self) -> Vec<f32> {
+        let next = self.refresh_time(self.refresh);
+        let replaced = self.pending.as_ref().is_some_and(|p| p.t <= next);
+        match &mut self.shown {
+            Some(shown) if replaced => std::mem::take(shown),
+            Some(shown) => shown.clone(),
+            None => Vec::new(),
+        }
+    }
+
     fn refresh_time(&self, k: u64) -> TimeUs {
         self.first_t.unwrap_or(0)
             + (k as f64 * 1e6 / self.model.params().refresh_hz).round() as TimeUs
@@ -309,13 +321,13 @@ impl<S: FrameSource> FrameSource for DisplaySource<S> {
             // the stimulus ended: the last frame is shown for one more refresh, then stop
             self.done = true;
         }
-        let Some(shown) = &self.shown else {
+        if self.shown.is_none() {
             return Ok(None);
-        };
+        }
         self.refresh += 1;
         Ok(Some(Sample {
             t: t + self.offset_us,
-            dn: shown.clone(),
+            dn: self.shown_now(),
             transition: Transition::Hold,
         }))
     }

@@ -64,6 +64,7 @@ use display_fit::{DisplayFits, Joint, fit_displays};
 use located::Located;
 use register::Registration;
 use serde_json::json;
+use std::sync::atomic::Ordering::Relaxed;
 
 /// The camera DN of white the fits start from beside the screen model's: a dim and a bright
 /// exposure of the screen (the fit moves white along a valley whose end it reaches from
@@ -315,6 +316,8 @@ struct Setup<'a> {
     /// Each pixel's factor on the thresholds ([`threshold_dither`]).
     dither: Vec<f32>,
     evaluations: std::sync::atomic::AtomicUsize,
+    /// The events of the latest simulation (room made for as many in the next: a hint).
+    latest_events: std::sync::atomic::AtomicUsize,
 }
 
 impl Setup<'_> {
@@ -392,7 +395,7 @@ impl Setup<'_> {
             log_eps: Some(log.eps()),
             ..PixelParams::ideal(ct.0, ct.1)
         };
-        let mut events = EventChunk::default();
+        let mut events = EventChunk::with_capacity(self.latest_events.load(Relaxed));
         let mut sink = |chunk: &EventChunk| -> Result<(), crate::sim::SimError> {
             events.extend_from(chunk);
             Ok(())
@@ -416,6 +419,7 @@ impl Setup<'_> {
             }
         }
         events.sort_by_time();
+        self.latest_events.store(events.len(), Relaxed);
         Ok(events)
     }
 
@@ -666,6 +670,7 @@ fn counting_setup<'a>(
         log: naive_response(input.response),
         dither: threshold_dither(input.sensor.width as usize * input.sensor.height as usize),
         evaluations: std::sync::atomic::AtomicUsize::new(0),
+        latest_events: std::sync::atomic::AtomicUsize::new(input.events.len()),
     };
     (setup, excluded)
 }
