@@ -11,7 +11,7 @@ name=${NAME:-$(basename "$case")}
 mkdir -p "$out"
 stem="$out/$label-t$threads-$name"
 nice -n 5 /usr/bin/time -v "$bin" --quiet --threads "$threads" estimate screen "$case" "$@" \
-    --json "$stem.json" 2> "$stem.time"
+    --json "$stem.json" 2> "$stem.time" > /dev/null
 wall=$(awk -F': ' '/Elapsed \(wall clock\)/ {n = split($2, p, ":"); s = 0;
     for (i = 1; i <= n; i++) s = s * 60 + p[i]; print s}' "$stem.time")
 cpu=$(awk -F': ' '/User time/ {u = $2} /System time/ {s = $2} END {print u + s}' "$stem.time")
