@@ -22,6 +22,7 @@ pub mod hot_pixels;
 pub mod jitter;
 pub mod leak;
 pub mod mismatch;
+pub(crate) mod quiet_noise;
 pub mod refractory;
 pub mod shot_noise;
 

@@ -43,7 +43,7 @@ pub fn evidence(c: &Context) -> Evidence {
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
     };
     // ruled out by the quiet pixels: not called for, its start kept for a listed try
-    match crate::fit::selection::quiet_noise::rules_out(c, RELEVANT_HZ) {
+    match super::quiet_noise::rules_out(c, RELEVANT_HZ) {
         Some(why) => Evidence {
             score: 0.0,
             relevant: false,

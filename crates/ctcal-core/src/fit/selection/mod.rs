@@ -34,7 +34,6 @@ mod hot_report;
 pub(in crate::fit) mod keep;
 mod method_systematic;
 mod noise_detection;
-pub(crate) mod quiet_noise;
 mod spread_report;
 mod start;
 mod steps;
