@@ -145,7 +145,8 @@ pub fn fit(
             &run,
             input,
             &state,
-            (start.mismatch, simulation.grid),
+            start.mismatch,
+            simulation.grid,
             planned(options).contains(&Effect::ShotNoise),
         ),
         fixed: ideal.fixed,
@@ -290,7 +291,8 @@ impl Known {
         run: &start::FitRun,
         input: &FitInput,
         state: &State,
-        (mismatch, grid): (Option<(f64, [f64; 2])>, Option<(TimeUs, TimeUs)>),
+        mismatch: Option<(f64, [f64; 2])>,
+        grid: Option<(TimeUs, TimeUs)>,
         shot_noise_planned: bool,
     ) -> Self {
         Known {
