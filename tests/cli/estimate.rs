@@ -2,6 +2,7 @@
 //! on real recordings: values, intervals that contain the truth, per-pixel maps.
 
 use crate::common::*;
+use std::path::{Path, PathBuf};
 
 /// The truth of an oracle case: (pos_thres, neg_thres).
 fn true_thresholds(case: &str) -> (f64, f64) {
@@ -210,25 +211,11 @@ fn the_smallest_region_keeps_3072_pixels() {
 #[test]
 fn a_budget_the_sensor_is_too_small_to_meet_is_said() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("scene.toml");
-    let text = std::fs::read_to_string("calib/scenes/sample_texture_davis240c.toml").unwrap();
-    let small = text
-        .replace("width = 240", "width = 64")
-        .replace("height = 180", "height = 48")
-        .replace("duration_s = 0.6", "duration_s = 0.4");
-    std::fs::write(&scene, small).unwrap();
-    let rec = dir.path().join("rec");
-    succeeded(
-        ctcal()
-            .args(["simulate", "--params", "calib/params/ideal.toml", "--quiet"])
-            .args([
-                "--scene",
-                scene.to_str().unwrap(),
-                "--out",
-                rec.to_str().unwrap(),
-            ])
-            .output(),
-    );
+    let rec = sample_texture_recording(dir.path(), |text| {
+        text.replace("width = 240", "width = 64")
+            .replace("height = 180", "height = 48")
+            .replace("duration_s = 0.6", "duration_s = 0.4")
+    });
     let r = json(&[
         "estimate",
         "aps",
@@ -880,21 +867,9 @@ fn aps_refuses_a_static_scene_whose_events_are_noise() {
 #[test]
 fn a_long_recording_is_measured_on_blocks_of_consecutive_frames() {
     let dir = tempfile::tempdir().unwrap();
-    let scene = dir.path().join("scene.toml");
-    let text = std::fs::read_to_string("calib/scenes/sample_texture_davis240c.toml").unwrap();
-    std::fs::write(&scene, text.replace("duration_s = 0.6", "duration_s = 3.0")).unwrap();
-    let rec = dir.path().join("rec");
-    succeeded(
-        ctcal()
-            .args(["simulate", "--params", "calib/params/ideal.toml", "--quiet"])
-            .args([
-                "--scene",
-                scene.to_str().unwrap(),
-                "--out",
-                rec.to_str().unwrap(),
-            ])
-            .output(),
-    );
+    let rec = sample_texture_recording(dir.path(), |text| {
+        text.replace("duration_s = 0.6", "duration_s = 3.0")
+    });
     let r = json(&[
         "estimate",
         "aps",
@@ -940,4 +915,25 @@ fn a_long_recording_is_measured_on_blocks_of_consecutive_frames() {
         let value = r[polarity].as_f64().unwrap();
         assert!((value - 0.3).abs() < 0.03, "{polarity} {value}");
     }
+}
+
+/// The sample texture scene (`calib/scenes/sample_texture_davis240c.toml`) as `edit` changes
+/// it, simulated through ideal pixels into `dir/rec`.
+fn sample_texture_recording(dir: &Path, edit: impl Fn(String) -> String) -> PathBuf {
+    let scene = dir.join("scene.toml");
+    let text = std::fs::read_to_string("calib/scenes/sample_texture_davis240c.toml").unwrap();
+    std::fs::write(&scene, edit(text)).unwrap();
+    let rec = dir.join("rec");
+    succeeded(
+        ctcal()
+            .args(["simulate", "--params", "calib/params/ideal.toml", "--quiet"])
+            .args([
+                "--scene",
+                scene.to_str().unwrap(),
+                "--out",
+                rec.to_str().unwrap(),
+            ])
+            .output(),
+    );
+    rec
 }

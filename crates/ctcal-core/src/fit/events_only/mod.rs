@@ -162,16 +162,7 @@ pub(super) fn fit_from_events(
     progress("hot pixels", 0.05);
     let (hot, trains, hot_found) = hot_pixels(input, &blocks);
     progress("noise, intervals and balance per block", 0.15);
-    let named: Vec<(u16, u16)> = hot.iter().map(|h| (h.x, h.y)).collect();
-    let measures = measure::measure(
-        &Measuring {
-            events,
-            sensor: input.sensor,
-            excluded: input.excluded,
-            hot: &named,
-        },
-        &blocks.spans,
-    );
+    let measures = measure_blocks(input, &blocks, &hot);
     let judging = Judging {
         measures: &measures,
         role: &blocks.role,
@@ -229,16 +220,7 @@ pub(crate) fn quiet_off(events: &crate::events::EventChunk, input: &FitInput) ->
     let blocks = Blocks::split(events, 6, 0.0);
     let stretch = FitInput { events, ..*input };
     let (hot, _, _) = hot_pixels(&stretch, &blocks);
-    let named: Vec<(u16, u16)> = hot.iter().map(|h| (h.x, h.y)).collect();
-    let measures = measure::measure(
-        &Measuring {
-            events,
-            sensor: input.sensor,
-            excluded: input.excluded,
-            hot: &named,
-        },
-        &blocks.spans,
-    );
+    let measures = measure_blocks(&stretch, &blocks, &hot);
     let all: Vec<&BlockMeasure> = measures.iter().collect();
     let (isolation, bound) = measure::choose_isolation(&all);
     let (rate_hz, se_hz) = BlockMeasure::isolated_rate(&all, isolation, false)?;
@@ -250,6 +232,20 @@ pub(crate) fn quiet_off(events: &crate::events::EventChunk, input: &FitInput) ->
         support_radius_px: isolation.radius_px(),
         upper_bound: bound.is_some(),
     })
+}
+
+/// Each block of `input`'s events measured ([`measure`]), the `hot` pixels' events left out.
+fn measure_blocks(input: &FitInput, blocks: &Blocks, hot: &[HotPixel]) -> Vec<BlockMeasure> {
+    let named: Vec<(u16, u16)> = hot.iter().map(|h| (h.x, h.y)).collect();
+    measure::measure(
+        &Measuring {
+            events: input.events,
+            sensor: input.sensor,
+            excluded: input.excluded,
+            hot: &named,
+        },
+        &blocks.spans,
+    )
 }
 
 fn check(events: &crate::events::EventChunk) -> Result<(), FitError> {
