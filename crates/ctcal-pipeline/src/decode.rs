@@ -282,7 +282,7 @@ structs! {
     NoiseDetection { limits, probe_hz, meaning }
     BandwidthDetection { called_for_below_hz, evidence, recording_evidence, simulations, tried,
         why, meaning }
-    NoiseLimit { called_for_above_hz, isolated_hz_per_hz, tried, why }
+    NoiseLimit { called_for_above_hz, isolated_hz_per_hz, tried, why, at_most_hz }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,
         predicted_error_before, predicted_error_after, simulated_back_why, quiet_pixel_seconds,

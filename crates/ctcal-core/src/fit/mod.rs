@@ -452,6 +452,11 @@ pub struct NoiseLimit {
     pub tried: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub why: Option<String>,
+    /// Shot noise only: the most dark rate (95 %) the recording's isolated OFF events at
+    /// quiet pixels allow ([`effects::quiet_noise::at_most_dark_hz`]), a limit on the noise
+    /// present whatever the scene hides; absent where they were not counted.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub at_most_hz: Option<f64>,
 }
 
 /// Which hot pixels the hot-pixel search sees ([`crate::stats::hot_pixels::Detectability`])

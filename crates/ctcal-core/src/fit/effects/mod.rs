@@ -70,10 +70,12 @@ impl Effect {
     }
 
     /// Whether a candidate of this effect is also judged on its own signature
-    /// ([`crate::fit::selection`]'s keep rule): a refractory period, whose gap in the
-    /// shortest intervals the distance barely sees.
+    /// ([`crate::fit::selection`]'s keep rule, [`signature`]): a refractory period, whose
+    /// gap in the shortest intervals the distance barely sees, and shot noise, whose
+    /// isolated events are one component of the distance's seven and in a busy scene move
+    /// it less than its block-to-block chance (coverage draws 7033, 8014, 9030).
     pub fn judged_by_signature(self) -> bool {
-        self == Effect::Refractory
+        matches!(self, Effect::Refractory | Effect::ShotNoise)
     }
 
     /// Whether the search of this effect's parameter profiles the threshold mismatch with
@@ -234,6 +236,30 @@ pub fn evidence(effect: Effect, context: &Context) -> Evidence {
         Effect::Mismatch => mismatch::evidence(context),
         Effect::Display => display::evidence(context),
         Effect::TimestampJitter => jitter::evidence(context),
+    }
+}
+
+/// The signature `effect` is judged by ([`Effect::judged_by_signature`]): shot noise's is
+/// the quiet pixels' count alone ([`quiet_noise::signature`]); every other effect's is its
+/// evidence.
+pub fn signature(effect: Effect, context: &Context) -> Evidence {
+    match effect {
+        Effect::ShotNoise => quiet_noise::signature(context, shot_noise::RELEVANT_HZ),
+        _ => evidence(effect, context),
+    }
+}
+
+/// Why `effect` is measured absent, where a direct measure says so (shot noise: the quiet
+/// pixels' isolated OFF events, [`quiet_noise::rules_out`]); such an effect is not tried
+/// and takes no other's place. Not leak: its quiet pixels' ON events bound only a leak
+/// faster than one event in the recording's length, since the simulator's leak (as v2e's)
+/// fires its first event one period after the first frame, while a slower one still
+/// quickens the ON events of every pixel the scene resets (coverage draw 8027: 0.54 Hz over
+/// 1.5 s, no quiet ON excess, lost to such a rule).
+pub fn ruled_out(effect: Effect, context: &Context) -> Option<String> {
+    match effect {
+        Effect::ShotNoise => quiet_noise::rules_out(context, shot_noise::RELEVANT_HZ),
+        _ => None,
     }
 }
 

@@ -19,9 +19,9 @@
 
 use crate::estimate::Interval;
 use crate::fit::Uncertain;
-use crate::fit::effects::Context;
+use crate::fit::effects::{Context, Effect, Evidence};
 use crate::fit::events_only::QuietOff;
-use crate::fit::observe::{Geometry, INTENSITY_BINS, Subset};
+use crate::fit::observe::{Geometry, INTENSITY_BINS, INTENSITY_EDGES, Subset};
 use crate::sim::PixelParams;
 use crate::sim::effects::shot_noise::brightness_factor;
 use crate::stats::binomial::poisson95;
@@ -33,12 +33,17 @@ use std::collections::BTreeMap;
 const OFF_SHARE: f64 = 0.5;
 
 /// The smallest and largest brightness factor (observed over dark rate) of the intensity
-/// bins with pixel time on the fit blocks: the quiet pixels' own brightness lies within.
-fn factor_range(geometry: &Geometry, model: &PixelParams) -> Option<[f64; 2]> {
+/// bins with pixel time on `subset`, at the bins' edges: the quiet pixels' own brightness
+/// lies within.
+fn factor_range(geometry: &Geometry, model: &PixelParams, subset: Subset) -> Option<[f64; 2]> {
     let bright = model.shot_noise_bright_factor() as f32;
     let factors: Vec<f64> = (0..INTENSITY_BINS)
-        .filter(|&b| geometry.exposure_of(b, Subset::Fit) > 0.0)
-        .map(|b| brightness_factor(geometry.intensity_centres[b] as f32, bright) as f64)
+        .filter(|&b| geometry.exposure_of(b, subset) > 0.0)
+        .flat_map(|b| {
+            let lower = b.checked_sub(1).map_or(0.0, |e| INTENSITY_EDGES[e]);
+            let upper = INTENSITY_EDGES.get(b).copied().unwrap_or(255.0);
+            [lower, upper].map(|dn| brightness_factor(dn, bright) as f64)
+        })
         .filter(|&f| f > 0.0)
         .collect();
     let lo = factors.iter().copied().fold(f64::INFINITY, f64::min);
@@ -57,7 +62,7 @@ fn off_rate95(quiet: &QuietOff) -> (f64, f64) {
 /// brightness) the quiet OFF count allows: the upper end of its exact 95 % interval over
 /// the OFF share, times how much brighter the quiet pixels may be than the rest.
 pub(crate) fn most_observed_hz(c: &Context, quiet: &QuietOff) -> Option<f64> {
-    let [lo, hi] = factor_range(c.geometry, c.model)?;
+    let [lo, hi] = factor_range(c.geometry, c.model, c.subset)?;
     Some(off_rate95(quiet).1 / OFF_SHARE * hi / lo)
 }
 
@@ -76,6 +81,123 @@ pub(crate) fn rules_out(c: &Context, relevant_hz: f64) -> Option<String> {
     })
 }
 
+/// Shot noise the quiet OFF count finds beyond the model's: its strength, the least excess
+/// it allows and where a search starts.
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Found {
+    /// The count's excess over the most the model's shot noise makes there, over the
+    /// count's Poisson standard error.
+    pub z: f64,
+    /// The least observed shot noise beyond the model's (ON + OFF events per
+    /// pixel-second over the recording's brightness) the count allows: the lower end of
+    /// its exact 95 % interval over the OFF share, less the model's rate at the brightest
+    /// factor, times the smallest-to-largest brightness-factor ratio.
+    pub least_hz: f64,
+    /// The dark rate the count gives at the geometric mean of the brightness factors.
+    pub start_hz: f64,
+    pub text: String,
+}
+
+/// Shot noise called for by the quiet pixels: more than the model has, by a rate that
+/// matters even at the count's lower 95 % end, where the count is noise (not an upper bound
+/// that may hold the scene's slow events). The simulation's evidence
+/// ([`super::shot_noise::evidence`]) compares the isolated events of all pixels, where a
+/// busy scene covers most noise events and the model's own isolated events (the frames'
+/// read noise simulated as change) offset the rest; and the distance, of which noise is one
+/// component of seven, moves by less than its block-to-block chance: coverage draws 7033,
+/// 8014 and 9030 (2.09, 0.53 and 0.14 Hz of shot noise) tried it and did not keep it.
+pub(crate) fn finds(c: &Context, relevant_hz: f64) -> Option<Found> {
+    let quiet = c.quiet_off?;
+    if quiet.upper_bound {
+        return None;
+    }
+    let [f_lo, f_hi] = factor_range(c.geometry, c.model, c.subset)?;
+    let model_hz = c.model.shot_noise_rate_hz.unwrap_or(0.0).max(0.0);
+    let n = (quiet.rate_hz * quiet.pixel_seconds).round().max(0.0);
+    // the most isolated OFF events the model's own shot noise makes at the quiet pixels
+    let expected = model_hz * f_hi * OFF_SHARE * quiet.pixel_seconds;
+    let (lo, _) = off_rate95(&quiet);
+    let least_hz = (lo / OFF_SHARE - model_hz * f_hi) * f_lo / f_hi;
+    let beyond = if model_hz > 0.0 {
+        format!(" beyond the model's {model_hz:.4} Hz")
+    } else {
+        " where the model has none".to_string()
+    };
+    let (_, hi) = off_rate95(&quiet);
+    let dark = [lo / OFF_SHARE / f_hi, hi / OFF_SHARE / f_lo];
+    (least_hz > relevant_hz).then(|| Found {
+        z: (n - expected) / (n + 1.0).sqrt(),
+        least_hz,
+        start_hz: quiet.rate_hz / OFF_SHARE / (f_lo * f_hi).sqrt(),
+        text: format!(
+            "the recording's quiet pixels hold {:.4} isolated OFF events per pixel-second ({n:.0} in {:.0} pixel-s without a neighbour event within {:.0} ms and {} px; a wider support does not lower it): shot noise, which fires OFF as often as ON at every pixel, of at least {least_hz:.4} Hz (95 %){beyond}, a dark rate of {:.4} to {:.4} Hz",
+            quiet.rate_hz,
+            quiet.pixel_seconds,
+            quiet.support_window_ms,
+            quiet.support_radius_px,
+            dark[0],
+            dark[1]
+        ),
+    })
+}
+
+/// The range a shot-noise search covers: `range` within the dark rate the quiet count
+/// gives ([`direct_dark_rate`]), or that rate's interval where the two do not meet;
+/// `None` where the count gives none. The count measures the noise directly; the search's
+/// distance also reads other effects' misses as noise (coverage draw 8014: the count
+/// gives 0.37-0.64 Hz, a search over the effect's own range 0.18, for 0.53 true).
+pub(crate) fn searched_range(
+    range: (f64, f64),
+    quiet: Option<QuietOff>,
+    geometry: &Geometry,
+    model: &PixelParams,
+) -> Option<(f64, f64)> {
+    let [lo, hi] = direct_dark_rate(&quiet?, geometry, model)?;
+    if !(lo > 0.0 && hi > lo) {
+        return None;
+    }
+    let within = (range.0.max(lo), range.1.min(hi));
+    Some(if within.0 < within.1 {
+        within
+    } else {
+        (lo, hi)
+    })
+}
+
+/// Shot noise's own signature ([`crate::fit::effects::Effect::judged_by_signature`]): what
+/// the quiet OFF count says of it beside the model, and nothing else (the isolated events
+/// of all pixels are also the misses of other effects). Calls for it where the count
+/// [`finds`] more than the model has; not where it [`rules_out`] any that matters or where
+/// there is no count of noise alone.
+pub(crate) fn signature(c: &Context, relevant_hz: f64) -> Evidence {
+    if let Some(why) = rules_out(c, relevant_hz) {
+        return Evidence::none(Effect::ShotNoise, why);
+    }
+    if let Some(found) = finds(c, relevant_hz) {
+        return Evidence {
+            effect: Effect::ShotNoise,
+            score: found.z,
+            relevant: true,
+            text: found.text,
+            start: Some(found.start_hz),
+        };
+    }
+    let why = match c.quiet_off {
+        None => "no count of isolated OFF events at quiet pixels (too few events)".to_string(),
+        Some(q) if q.upper_bound => format!(
+            "the quiet pixels' {:.4} isolated OFF events per pixel-second may hold the scene's slow events (a wider support could not check them): an upper bound, not a measure of noise",
+            q.rate_hz
+        ),
+        Some(q) => format!(
+            "the quiet pixels' {:.4} isolated OFF events per pixel-second ({:.0} pixel-s) hold no shot noise beyond the model's {:.4} Hz that matters",
+            q.rate_hz,
+            q.pixel_seconds,
+            c.model.shot_noise_rate_hz.unwrap_or(0.0)
+        ),
+    };
+    Evidence::none(Effect::ShotNoise, why)
+}
+
 /// The dark shot-noise rate (the simulator's `shot_noise_rate_hz`) the quiet OFF count
 /// gives, 95 %: its exact interval over the OFF share and the brightness factor's range
 /// (the quiet pixels' own brightness unknown within the frames'). `None` where the count
@@ -89,13 +211,30 @@ pub(crate) fn direct_dark_rate(
     if quiet.upper_bound {
         return None;
     }
-    let [f_lo, f_hi] = factor_range(geometry, model)?;
+    let [f_lo, f_hi] = factor_range(geometry, model, Subset::Fit)?;
     let (lo, hi) = off_rate95(quiet);
     Some([lo / OFF_SHARE / f_hi, hi / OFF_SHARE / f_lo])
 }
 
-/// Widens the fitted shot-noise rate's interval to hold [`direct_dark_rate`], where they
-/// differ; the note says both.
+/// The most dark shot-noise rate the quiet OFF count allows, 95 %: the upper end of its
+/// exact interval over the OFF share and the smallest brightness factor of the frames'
+/// intensities. Holds for a count that is only an upper bound too (the scene's slow events
+/// only add to it).
+pub(crate) fn at_most_dark_hz(
+    quiet: Option<QuietOff>,
+    geometry: &Geometry,
+    model: &PixelParams,
+) -> Option<f64> {
+    let quiet = quiet?;
+    let [f_lo, _] = factor_range(geometry, model, Subset::Fit)?;
+    Some(off_rate95(&quiet).1 / OFF_SHARE / f_lo)
+}
+
+/// Gives the fitted shot-noise rate the interval of the dark rate the quiet count gives
+/// ([`direct_dark_rate`]), within which it was searched ([`searched_range`]): the count
+/// measures the noise directly, while the search's own interval is read off how the
+/// distance moves, which other effects' misses move too (coverage draw 9030: [0.008,
+/// 12.6] Hz beside the count's [0.13, 0.36], for 0.137). The note says both.
 pub(crate) fn widen(
     uncertainty: &mut BTreeMap<String, Uncertain>,
     quiet: Option<QuietOff>,
@@ -106,9 +245,8 @@ pub(crate) fn widen(
     model.shot_noise_rate_hz?;
     let u = uncertainty.get_mut("shot_noise_rate_hz")?;
     let [lo, hi] = direct_dark_rate(&quiet, geometry, model)?;
-    let [search_lo, search_hi] = u.ci95.unwrap_or([Some(u.value), Some(u.value)]);
-    let widened = [search_lo.map(|s| s.min(lo)), search_hi.map(|s| s.max(hi))];
-    if Some(widened) == u.ci95 {
+    let counted = [Some(lo.min(u.value)), Some(hi.max(u.value))];
+    if Some(counted) == u.ci95 {
         return None;
     }
     let said = |i: Interval| {
@@ -116,14 +254,15 @@ pub(crate) fn widen(
         format!("{} to {}", side(i[0]), side(i[1]))
     };
     let note = format!(
-        "shot_noise_rate_hz: its interval holds the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px, exact Poisson 95 %, half the noise OFF, over the brightness factors of the frames' intensities), beside the simulation search's {} Hz: the search reads every isolated event the model lacks as noise, and where another effect leaves such events (a lagging photoreceptor, leak) it does not hold the truth (coverage draw 8007: 4.05 [3.68, 4.27] for 2.78)",
+        "shot_noise_rate_hz: its interval is the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px, exact Poisson 95 %, half the noise OFF, over the brightness factors at the edges of the frames' intensity bins), within which it was searched; the search's own interval, from how the distance moves, was {} Hz: the distance reads every isolated event the model lacks as noise, where another effect (a lagging photoreceptor, leak) leaves such events too",
         quiet.rate_hz,
         quiet.pixel_seconds,
         quiet.support_window_ms,
         quiet.support_radius_px,
         said(u.ci95.unwrap_or([None, None]))
     );
-    u.ci95 = Some(widened);
+    u.ci95 = Some(counted);
+    u.standard_error = None;
     Some(note)
 }
 
@@ -144,25 +283,26 @@ mod tests {
         }
     }
 
-    /// A static scene at 15 DN: one intensity bin, centred at sqrt(10 x 20) = 14.14 DN,
-    /// brightness factor 1 - 0.75 x 34.14 / 275 = 0.90689.
+    /// A static scene at 15 DN: one intensity bin, 10 to 20 DN, brightness factors
+    /// 1 - 0.75 x 30 / 275 = 0.918182 and 1 - 0.75 x 40 / 275 = 0.890909 at its edges.
     fn dim() -> Fixture {
         let none = EventChunk::default();
         Fixture::new(&static_frames(16, 12, 2.0, 15.0), &none, &none)
     }
 
     /// Hand-computed on draw 8007's numbers: 1,264 quiet OFF events in 1,000 pixel-s,
-    /// Garwood's 95 % interval [1194.9, 1335.9] (chi2(0.025; 2528) / 2, chi2(0.975; 2530) / 2),
-    /// half the noise OFF: 1.1949 / 0.5 / 0.90689 = 2.6352 to 1.3359 / 0.5 / 0.90689 = 2.9461;
-    /// the search's [3.68, 4.27] widened to [2.6352, 4.27], which holds the true 2.78.
+    /// Garwood's 95 % interval [1195.27, 1335.65] (chi2(0.025; 2528) / 2, chi2(0.975; 2530)
+    /// / 2), half the noise OFF: 1.19527 / 0.5 / 0.918182 = 2.6036 to 1.33565 / 0.5 /
+    /// 0.890909 = 2.9984; the search's [3.68, 4.27] (at 4.05) gives way to [2.6036, 4.05],
+    /// which holds the true 2.78.
     #[test]
-    fn the_quiet_count_widens_the_searched_rate_to_the_dark_rate_it_gives() {
+    fn the_searched_rate_takes_the_dark_rate_the_quiet_count_gives() {
         let f = dim();
         let mut model = PixelParams::ideal(0.6121, 0.8469);
         model.shot_noise_rate_hz = Some(4.05);
         let [lo, hi] = direct_dark_rate(&quiet(1.264, 0.0355, false), &f.geometry, &model).unwrap();
         assert!(
-            (lo - 2.6352).abs() < 2e-3 && (hi - 2.9461).abs() < 2e-3,
+            (lo - 2.6036).abs() < 2e-4 && (hi - 2.9984).abs() < 2e-4,
             "{lo} {hi}"
         );
         let mut u = BTreeMap::from([(
@@ -175,19 +315,20 @@ mod tests {
             &f.geometry,
             &model,
         );
-        assert!(note.unwrap().contains("3.6800 to 4.2700"));
+        assert!(note.unwrap().contains("was 3.6800 to 4.2700 Hz"));
         let ci = u["shot_noise_rate_hz"].ci95.unwrap();
         assert!(
-            (ci[0].unwrap() - 2.6352).abs() < 2e-3 && ci[1] == Some(4.27),
+            (ci[0].unwrap() - 2.6036).abs() < 2e-4 && ci[1] == Some(4.05),
             "{ci:?}"
         );
+        assert_eq!(u["shot_noise_rate_hz"].standard_error, None);
         // an upper bound says nothing of the dark rate: no widening (the oracle
         // c_noisy_static's [0.90, 1.12] was widened to [0, 1.60] by one)
         assert!(direct_dark_rate(&quiet(1.264, 0.0355, true), &f.geometry, &model).is_none());
-        // within the search's interval: nothing to widen
+        // the count's interval already: nothing to change
         let mut inside = BTreeMap::from([(
             "shot_noise_rate_hz".to_string(),
-            Uncertain::with_interval(3.0, None, [Some(2.0), Some(4.0)]),
+            Uncertain::with_interval(2.8, None, [Some(lo), Some(hi)]),
         )]);
         assert!(
             widen(
@@ -201,7 +342,7 @@ mod tests {
     }
 
     /// No isolated OFF event in 7,546 quiet pixel-seconds (draw 8027): at most
-    /// chi2(0.975; 2) / 2 / 7546 / 0.5 = 3.6889 / 7546 / 0.5 = 0.00098 Hz of shot noise,
+    /// chi2(0.975; 2) / 2 / 7546 / 0.5 x 0.918182 / 0.890909 = 0.0010076 Hz of shot noise,
     /// under the 0.005 that matters; zero in 1,000 pixel-s allows 0.0074 and is not ruled out
     /// (two expected events show none 13.5 % of the time).
     #[test]
@@ -214,11 +355,79 @@ mod tests {
         };
         c.quiet_off = Some(none);
         let most = most_observed_hz(&c, &none).unwrap();
-        assert!((most - 0.000978).abs() < 1e-5, "{most}");
+        assert!((most - 0.0010076).abs() < 1e-6, "{most}");
         assert!(rules_out(&c, 0.005).unwrap().contains("7546 pixel-s"));
         c.quiet_off = Some(quiet(0.0, 0.001, false));
         assert!(rules_out(&c, 0.005).is_none());
         c.quiet_off = None;
         assert!(rules_out(&c, 0.005).is_none());
+    }
+
+    /// 100 isolated OFF events in 1,000 quiet pixel-s at 10-20 DN: Garwood's lower end
+    /// 81.364, so at least 0.081364 / 0.5 x 0.890909 / 0.918182 = 0.157894 Hz of observed
+    /// shot noise where the model has none, z = 100 / sqrt(101) = 9.950, the search started
+    /// at 0.1 / 0.5 / sqrt(0.918182 x 0.890909) = 0.221131 Hz. Beside a model with 0.1 Hz
+    /// (at most 45.909 of the events), at least (0.162728 - 0.091818) x 0.970297 = 0.068804
+    /// Hz more, z = 54.091 / sqrt(101) = 5.3822; beside 0.2 Hz nothing that matters is left,
+    /// and the signature says so.
+    #[test]
+    fn quiet_off_events_call_for_shot_noise_beyond_the_model_s() {
+        let f = dim();
+        let mut c = f.context();
+        c.quiet_off = Some(quiet(0.1, 0.01, false));
+        let found = finds(&c, 0.005).unwrap();
+        assert!((found.least_hz - 0.157894).abs() < 1e-5, "{found:?}");
+        assert!((found.z - 9.950).abs() < 1e-3, "{found:?}");
+        assert!((found.start_hz - 0.221131).abs() < 1e-5, "{found:?}");
+        assert!(signature(&c, 0.005).calls_for());
+        let mut model = PixelParams::ideal(0.3, 0.3);
+        model.shot_noise_rate_hz = Some(0.1);
+        c.model = &model;
+        let found = finds(&c, 0.005).unwrap();
+        assert!((found.least_hz - 0.068804).abs() < 1e-5, "{found:?}");
+        assert!((found.z - 5.3822).abs() < 1e-3, "{found:?}");
+        assert!(
+            found.text.contains("beyond the model's 0.1000 Hz"),
+            "{found:?}"
+        );
+        let mut more = model.clone();
+        more.shot_noise_rate_hz = Some(0.2);
+        c.model = &more;
+        assert!(finds(&c, 0.005).is_none());
+        let s = signature(&c, 0.005);
+        assert!(
+            !s.calls_for() && s.text.contains("beyond the model's 0.2000 Hz"),
+            "{s:?}"
+        );
+        // an upper bound may hold the scene's slow events: it calls for nothing
+        c.model = &f.model;
+        c.quiet_off = Some(quiet(0.1, 0.01, true));
+        assert!(finds(&c, 0.005).is_none());
+        assert!(signature(&c, 0.005).text.contains("upper bound"));
+    }
+
+    /// The search stays within the count's dark rate, 2.6036 to 2.9984 Hz (draw 8007's
+    /// count, as above): a range reaching into it is cut to it, one that misses it gives
+    /// way to it, and an upper bound leaves the range as it is.
+    #[test]
+    fn shot_noise_is_searched_within_the_dark_rate_the_count_gives() {
+        let f = dim();
+        let model = PixelParams::ideal(0.6121, 0.8469);
+        let count = Some(quiet(1.264, 0.0355, false));
+        let (lo, hi) = searched_range((2.0, 2.8), count, &f.geometry, &model).unwrap();
+        assert!((lo - 2.6036).abs() < 2e-4 && hi == 2.8, "{lo} {hi}");
+        let (lo, hi) = searched_range((0.05, 1.25), count, &f.geometry, &model).unwrap();
+        assert!(
+            (lo - 2.6036).abs() < 2e-4 && (hi - 2.9984).abs() < 2e-4,
+            "{lo} {hi}"
+        );
+        let bound = Some(quiet(1.264, 0.0355, true));
+        assert_eq!(
+            searched_range((0.05, 1.25), bound, &f.geometry, &model),
+            None
+        );
+        // the most the count allows holds for an upper bound too: 2.9984
+        let most = at_most_dark_hz(bound, &f.geometry, &model).unwrap();
+        assert!((most - 2.9984).abs() < 2e-4, "{most}");
     }
 }

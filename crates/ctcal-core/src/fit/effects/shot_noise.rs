@@ -7,6 +7,13 @@
 //! (shot noise makes both alike; leak only ON), in Poisson standard errors; it matters
 //! above 0.005 events per pixel-second. Start: twice that excess rate, divided by the
 //! simulator's brightness factor averaged over the recording's intensities.
+//!
+//! The isolated events of all pixels are also the misses of other effects (a lagging
+//! photoreceptor, a leak, thresholds off at sparse edges), so the count of isolated OFF
+//! events at the recording's quiet pixels ([`super::quiet_noise`]) rules shot noise out
+//! where it finds none that matters, calls for it where it finds more than the model has
+//! (starting the search at the dark rate it gives), and is the effect's signature when the
+//! keep rule judges it on the selection blocks.
 
 use super::{Context, Effect, Evidence, background_totals};
 use crate::fit::observe::INTENSITY_BINS;
@@ -43,11 +50,26 @@ pub fn evidence(c: &Context) -> Evidence {
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
     };
     // ruled out by the quiet pixels: not called for, its start kept for a listed try
-    match super::quiet_noise::rules_out(c, RELEVANT_HZ) {
-        Some(why) => Evidence {
+    if let Some(why) = super::quiet_noise::rules_out(c, RELEVANT_HZ) {
+        return Evidence {
             score: 0.0,
             relevant: false,
             text: why,
+            ..evidence
+        };
+    }
+    // found at the quiet pixels, whatever the isolated events of all pixels show: the
+    // stronger of the two, searched from the count's dark rate
+    match super::quiet_noise::finds(c, RELEVANT_HZ) {
+        Some(found) => Evidence {
+            score: found.z.max(if evidence.relevant {
+                evidence.score
+            } else {
+                0.0
+            }),
+            relevant: true,
+            text: format!("{}; {}", found.text, evidence.text),
+            start: Some(found.start_hz),
             ..evidence
         },
         None => evidence,
@@ -179,6 +201,32 @@ mod tests {
         let e = evidence(&f.context());
         assert!(!e.calls_for(), "{e:?}");
         assert_eq!(e.score, 0.0);
+    }
+
+    /// The model's isolated events as the recording's (a busy scene's own isolated events
+    /// offsetting the noise), while the quiet pixels hold 0.1 isolated OFF events per
+    /// pixel-second over 1,000 pixel-s: the count calls for shot noise (z 9.95) and starts
+    /// its search at the dark rate it gives, 0.33 Hz.
+    #[test]
+    fn isolated_off_events_at_quiet_pixels_call_for_shot_noise_the_comparison_misses() {
+        let recording = chunk(with(leak_floor(), shot_noise(0.5)));
+        let f = Fixture::new(&static_frames(16, 12, 10.0, DN), &recording, &recording);
+        let mut c = f.context();
+        c.quiet_off = Some(crate::fit::events_only::QuietOff {
+            rate_hz: 0.1,
+            se_hz: 0.01,
+            pixel_seconds: 1000.0,
+            support_window_ms: 30.0,
+            support_radius_px: 1,
+            upper_bound: false,
+        });
+        let e = evidence(&c);
+        assert!(e.calls_for(), "{e:?}");
+        assert!((e.score - 100.0 / 101f64.sqrt()).abs() < 1e-9, "{e:?}");
+        // the one intensity bin, 80 to 160 DN: brightness factors 0.727273 and 0.509091
+        // at its edges, the search started at 0.1 / 0.5 / sqrt(0.727273 x 0.509091)
+        assert!((e.start.unwrap() - 0.328688).abs() < 1e-5, "{e:?}");
+        assert!(e.text.contains("quiet pixels hold 0.1000"), "{e:?}");
     }
 
     #[test]

@@ -223,7 +223,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         &mut state.uncertainty,
     ));
     let noise_detection =
-        super::noise_detection::detect(simulation, &state, &steps).map(|(d, note)| {
+        super::noise_detection::detect(simulation, &state, &steps, known).map(|(d, note)| {
             assumptions.push(note);
             d
         });

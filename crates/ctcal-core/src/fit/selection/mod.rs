@@ -63,6 +63,8 @@ pub(super) struct Known {
     shortest_interval_s: Option<f64>,
     /// The OFF isolated-event rate at quiet pixels of the fit run.
     quiet_off: Option<super::events_only::QuietOff>,
+    /// The same on the judging blocks' events, for shot noise's signature there.
+    quiet_off_judging: Option<super::events_only::QuietOff>,
 }
 
 /// The fit's state between steps.
@@ -147,7 +149,7 @@ pub fn fit(
             &state,
             start.mismatch,
             simulation.grid,
-            planned(options).contains(&Effect::ShotNoise),
+            (&geometry, planned(options).contains(&Effect::ShotNoise)),
         ),
         fixed: ideal.fixed,
         noise: ideal.noise,
@@ -286,15 +288,20 @@ impl Ideal {
 impl Known {
     /// What the fit run tells before any effect is tried: the mismatch's evidence, the
     /// timestamp grid, the shortest same-pixel interval of the kept pixels and, where shot
-    /// noise may be tried, the isolated OFF events at quiet pixels.
+    /// noise may be tried, the isolated OFF events at quiet pixels (on the fit run and on
+    /// the judging blocks).
     fn of(
         run: &start::FitRun,
         input: &FitInput,
         state: &State,
         mismatch: Option<(f64, [f64; 2])>,
         grid: Option<(TimeUs, TimeUs)>,
-        shot_noise_planned: bool,
+        (geometry, shot_noise_planned): (&Geometry, bool),
     ) -> Self {
+        let judging = || {
+            let (from, to) = geometry.time_range_of(geometry.judging())?;
+            super::events_only::quiet_off(&input.events.between(from, to), input)
+        };
         Known {
             mismatch,
             grid,
@@ -307,6 +314,7 @@ impl Known {
             quiet_off: shot_noise_planned
                 .then(|| super::events_only::quiet_off(&run.events, input))
                 .flatten(),
+            quiet_off_judging: shot_noise_planned.then(judging).flatten(),
         }
     }
 }
@@ -665,7 +673,7 @@ fn refit_together(
     }
     progress("refitting the effects together", 0.9);
     for effect in searched {
-        let step = steps::refit(simulation, state, effect, run.fixed, run.noise)?;
+        let step = steps::refit(simulation, state, effect, run)?;
         if step.kept
             && let Some(entry) = added.iter_mut().find(|a| a.effect == effect)
         {
@@ -714,8 +722,8 @@ fn searched_together(added: &[AddedEffect]) -> Vec<Effect> {
 }
 
 /// The evidence context of the current state (fit blocks).
-/// The evidence for `effect` on the judging blocks against `model` (for the keep rule by
-/// signature, [`keep::by_signature`]).
+/// The signature of `effect` on the judging blocks against `model` (for the keep rule by
+/// signature, [`keep::by_signature`]), the quiet pixels counted there.
 fn judging_evidence(
     state: &State,
     simulation: &Simulation,
@@ -727,9 +735,40 @@ fn judging_evidence(
         sim: &model.observed,
         model: &model.params,
         subset: simulation.geometry.judging(),
+        quiet_off: known.quiet_off_judging,
         ..context_of(state, simulation, known)
     };
-    effects::evidence(effect, &context)
+    effects::signature(effect, &context)
+}
+
+/// The range `effect`'s parameter is searched over, from `range` (the effect's own about a
+/// start) beside the model `params`: shot noise's within the dark rate the fit run's quiet
+/// pixels give ([`effects::quiet_noise::searched_range`]); `true` where the count set it
+/// (an end of its interval is a measured limit, not a bound of the search's choosing).
+fn search_range(
+    effect: Effect,
+    range: (f64, f64),
+    known: Known,
+    geometry: &Geometry,
+    params: &PixelParams,
+) -> ((f64, f64), bool) {
+    if effect != Effect::ShotNoise {
+        return (range, false);
+    }
+    match effects::quiet_noise::searched_range(range, known.quiet_off, geometry, params) {
+        Some(within) => (within, true),
+        None => (range, false),
+    }
+}
+
+/// [`search_range`]'s search result: a value at an end of the quiet count's interval is
+/// within what the count measured, and the interval the count gives is added to it
+/// ([`effects::quiet_noise::widen`]).
+fn within_count(mut searched: super::search::Searched, by_count: bool) -> super::search::Searched {
+    if by_count {
+        searched.at_bound = None;
+    }
+    searched
 }
 
 fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) -> Context<'a> {

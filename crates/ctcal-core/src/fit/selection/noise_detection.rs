@@ -21,6 +21,7 @@
 //! up to [`CHECKS`] simulations. A noise effect not in the model may be present below the
 //! rate given.
 
+use super::super::effects::quiet_noise::at_most_dark_hz;
 use super::super::effects::{EVIDENCE_THRESHOLD, Effect, isolated_totals, leak, shot_noise};
 use super::super::observe::Subset;
 use super::super::search::Simulation;
@@ -186,6 +187,7 @@ pub fn detect(
     simulation: &Simulation,
     state: &State,
     steps: &[Step],
+    known: super::Known,
 ) -> Option<(NoiseDetection, String)> {
     let params = &state.model.params;
     let g = simulation.geometry;
@@ -226,6 +228,9 @@ pub fn detect(
             isolated_hz_per_hz: isolated,
             tried,
             why: found.err(),
+            at_most_hz: (effect == Effect::ShotNoise)
+                .then(|| at_most_dark_hz(known.quiet_off, g, params))
+                .flatten(),
         };
         limits.insert(key.to_string(), limit);
     }
@@ -243,7 +248,7 @@ pub fn detect(
     ))
 }
 
-const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it";
+const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz (shot noise): the most dark rate, 95 %, that the recording's isolated OFF events at quiet pixels allow (their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), whatever the scene hides";
 
 fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
     let parts: Vec<String> = limits
@@ -255,15 +260,18 @@ fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
                 "leak"
             };
             let tried = if l.tried { "; tried and not kept" } else { "" };
+            let at_most = l.at_most_hz.map_or(String::new(), |m| {
+                format!(", and the quiet pixels' isolated OFF events allow at most {m:.3} Hz (95 %)")
+            });
             match (l.called_for_above_hz, &l.why) {
                 (Some(r), _) => {
                     let [off, on] = l.isolated_hz_per_hz.unwrap_or([0.0; 2]);
                     format!(
-                        "{name} at {r:.3} Hz (isolated OFF / ON events {off:.3} / {on:.3} per pixel-second per Hz{tried})"
+                        "{name} at {r:.3} Hz (isolated OFF / ON events {off:.3} / {on:.3} per pixel-second per Hz{tried}){at_most}"
                     )
                 }
-                (None, Some(why)) => format!("{name}: no rate ({why}{tried})"),
-                (None, None) => format!("{name}: no rate{tried}"),
+                (None, Some(why)) => format!("{name}: no rate ({why}{tried}){at_most}"),
+                (None, None) => format!("{name}: no rate{tried}{at_most}"),
             }
         })
         .collect();

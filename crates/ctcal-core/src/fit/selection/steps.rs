@@ -9,7 +9,7 @@ use super::super::residuals::residuals;
 use super::super::search::{Searched, Simulated, Simulation, search, search_profiled};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
 use super::keep::{Verdict, by_signature, judge};
-use super::{Known, LoopRun, State, judging_evidence};
+use super::{Known, LoopRun, State, judging_evidence, search_range, within_count};
 use crate::stats::hot_pixels::HotPixel;
 use std::collections::BTreeMap;
 
@@ -101,15 +101,25 @@ pub fn try_effect(
                 .parameter()
                 .expect("every other effect has a parameter");
             let start = evidence.start.unwrap_or(1.0);
-            let searched = search_profiled(
-                simulation,
-                &state.model.params,
+            let (range, by_count) = search_range(
                 effect,
                 effect.range(start),
-                (&state.masked, &state.kept),
-                (fixed, effect.searched_with_mismatch()),
-                noise,
-            )?;
+                run.known,
+                simulation.geometry,
+                &state.model.params,
+            );
+            let searched = within_count(
+                search_profiled(
+                    simulation,
+                    &state.model.params,
+                    effect,
+                    range,
+                    (&state.masked, &state.kept),
+                    (fixed, effect.searched_with_mismatch()),
+                    noise,
+                )?,
+                by_count,
+            );
             step.parameters.insert(key.into(), searched.value);
             let uncertain = uncertain_of(key, &searched);
             (searched.model, Some(uncertain))
@@ -238,24 +248,33 @@ pub fn refit(
     simulation: &Simulation,
     state: &mut State,
     effect: Effect,
-    fixed: bool,
-    noise: f64,
+    run: &LoopRun,
 ) -> Result<Step, FitError> {
     let key = effect.parameter().expect("a searched effect");
     let current = effect
         .value(&state.model.params)
         .expect("a kept effect has its parameter");
     let count_before = simulation.count.get();
-    let searched = search(
-        simulation,
-        &state.model.params,
+    let (range, by_count) = search_range(
         effect,
         (current / 3.0, current * 3.0),
-        &state.masked,
-        &state.kept,
-        fixed,
-        noise,
-    )?;
+        run.known,
+        simulation.geometry,
+        &state.model.params,
+    );
+    let searched = within_count(
+        search(
+            simulation,
+            &state.model.params,
+            effect,
+            range,
+            &state.masked,
+            &state.kept,
+            run.fixed,
+            run.noise,
+        )?,
+        by_count,
+    );
     let verdict = judge(
         simulation,
         &state.model.observed,
@@ -302,12 +321,11 @@ pub fn prune(
     others: &[Effect],
     run: &LoopRun,
 ) -> Result<Step, FitError> {
-    let (fixed, noise) = (run.fixed, run.noise);
     let key = effect.parameter().expect("a searched effect");
     let count_before = simulation.count.get();
     let mut reduced = state.model.params.clone();
     effect.clear(&mut reduced);
-    let (without, refitted) = best_without(simulation, state, &reduced, others, fixed, noise)?;
+    let (without, refitted) = best_without(simulation, state, &reduced, others, run)?;
     let verdict = judge_effect(
         simulation,
         state,
@@ -363,9 +381,9 @@ fn best_without(
     state: &State,
     reduced: &crate::sim::PixelParams,
     others: &[Effect],
-    fixed: bool,
-    noise: f64,
+    run: &LoopRun,
 ) -> Result<(Simulated, Vec<Refitted>), FitError> {
+    let (fixed, noise) = (run.fixed, run.noise);
     let mut best = simulation.profile(reduced, &state.masked, fixed)?;
     let mut error = simulation
         .distance(&best.observed, Subset::Fit, &state.kept)
@@ -375,16 +393,26 @@ fn best_without(
         let (Some(key), Some(current)) = (other.parameter(), other.value(&best.params)) else {
             continue;
         };
-        let searched = search(
-            simulation,
-            &best.params,
+        let (range, by_count) = search_range(
             other,
             other.range(current),
-            &state.masked,
-            &state.kept,
-            fixed,
-            noise,
-        )?;
+            run.known,
+            simulation.geometry,
+            &best.params,
+        );
+        let searched = within_count(
+            search(
+                simulation,
+                &best.params,
+                other,
+                range,
+                &state.masked,
+                &state.kept,
+                fixed,
+                noise,
+            )?,
+            by_count,
+        );
         if searched.fit_error < error {
             error = searched.fit_error;
             refitted.push(uncertain_of(key, &searched));
