@@ -10,12 +10,20 @@
 //! (by sample, then time, row, column; a pixel's events in generation order). The result
 //! is the same events, bit for bit, as `start` + `step` per sample + `finish` (tested
 //! below).
+//!
+//! The merge of a batch's events (a sort) and their release (through the jitter buffer)
+//! take one thread; they run beside the advance of the next batch's rows, which depends
+//! only on the rows, so that the pool's other thread does not wait on them.
 
 use super::SimError;
-use super::row::Step;
+use super::effects::jitter::JitterBuffer;
+use super::log_response::LogMap;
+use super::pixel::PixelModel;
+use super::row::{Row, Step};
 use super::simulator::Simulator;
 use super::source::Sample;
-use crate::events::{Event, EventChunk};
+use crate::events::{Event, EventChunk, TimeUs};
+use rand_xoshiro::Xoshiro256PlusPlus;
 use rayon::prelude::*;
 
 /// Samples a row is advanced through per task: enough work to keep every thread busy,
@@ -26,7 +34,7 @@ impl Simulator {
     /// Simulates `samples` (times non-decreasing, each frame `width x height`): the
     /// events of [`Self::start`] on the first sample, [`Self::step`] on each later one and
     /// [`Self::finish`], with each row advanced through 32 samples at a time on the
-    /// pool.
+    /// pool, beside the merge and release of the previous batch's events.
     pub fn run_all(&mut self, samples: &[Sample]) -> Result<EventChunk, SimError> {
         let Some((first, rest)) = samples.split_first() else {
             return Err(SimError::Invalid("the input has no frames".into()));
@@ -43,14 +51,45 @@ impl Simulator {
         self.start(first.t, &first.dn);
         let windows = self.windows(first, rest)?;
         let mut out = EventChunk::default();
+        let mut pending: Option<(&[Sample], RowEvents)> = None;
         for (batch, spans) in rest.chunks(BATCH).zip(windows.chunks(BATCH)) {
-            let merged = self.advance_rows(batch, spans);
-            self.emit(batch, &merged, &mut out);
+            let (mut rows, jitter) = self.rows_and_jitter();
+            let (per_row, ()) = rayon::join(
+                || rows.advance(batch, spans),
+                || {
+                    if let Some((previous, events)) = pending.take() {
+                        emit(jitter, previous, &sort_merged(events.concat()), &mut out);
+                    }
+                },
+            );
+            pending = Some((batch, per_row));
+        }
+        if let Some((previous, events)) = pending {
+            emit(
+                &mut self.jitter,
+                previous,
+                &sort_merged(events.concat()),
+                &mut out,
+            );
         }
         if let Some((buffer, _)) = &mut self.jitter {
             buffer.flush(&mut out);
         }
         Ok(out)
+    }
+
+    /// The rows with what advancing them reads, and apart from them the jitter buffer
+    /// that releases their events: the two halves of a batch's work in [`Self::run_all`].
+    fn rows_and_jitter(&mut self) -> (Rows<'_>, &mut Jitter) {
+        let rows = Rows {
+            rows: &mut self.rows,
+            log_frame: &mut self.log_frame,
+            width: self.width,
+            model: &self.model,
+            log_map: self.log_map,
+            origin: self.origin.expect("started"),
+        };
+        (rows, &mut self.jitter)
     }
 
     /// Each later sample's interval `(t0, t1]` in microseconds since the origin, as
@@ -73,15 +112,31 @@ impl Simulator {
         }
         Ok(windows)
     }
+}
 
-    /// Every row through the samples of `batch`, one row a task; the events tagged with
-    /// their sample's index in the batch and sorted as `step` sorts each sample's (a pixel's
-    /// events keep their generation order when times tie: [`sort_merged`]).
-    fn advance_rows(&mut self, batch: &[Sample], spans: &[(f64, f64)]) -> Vec<(u32, Event)> {
-        let origin = self.origin.expect("started");
-        let (width, model, log_map) = (self.width, &self.model, self.log_map);
-        let per_row: Vec<Vec<(u32, Event)>> = self
-            .rows
+/// Each row's events of a batch, tagged with their sample's index in the batch.
+type RowEvents = Vec<Vec<(u32, Event)>>;
+
+/// The timestamp-jitter buffer and its generator, where the simulation has jitter.
+type Jitter = Option<(JitterBuffer, Xoshiro256PlusPlus)>;
+
+/// A simulator's rows and what advancing them reads.
+struct Rows<'a> {
+    rows: &'a mut [Row],
+    log_frame: &'a mut [f32],
+    width: usize,
+    model: &'a PixelModel,
+    log_map: LogMap,
+    origin: TimeUs,
+}
+
+impl Rows<'_> {
+    /// Every row through the samples of `batch`, one row a task: each row's events (in
+    /// generation order) tagged with their sample's index in the batch, to be merged by
+    /// [`sort_merged`].
+    fn advance(&mut self, batch: &[Sample], spans: &[(f64, f64)]) -> RowEvents {
+        let (width, model, log_map, origin) = (self.width, self.model, self.log_map, self.origin);
+        self.rows
             .par_iter_mut()
             .zip(self.log_frame.par_chunks_mut(width))
             .enumerate()
@@ -102,29 +157,28 @@ impl Simulator {
                 }
                 events
             })
-            .collect();
-        sort_merged(per_row.concat())
+            .collect()
     }
+}
 
-    /// Appends the merged events of `batch` to `out` as `step` emits them: as they are,
-    /// or through the timestamp-jitter buffer one sample at a time.
-    fn emit(&mut self, batch: &[Sample], merged: &[(u32, Event)], out: &mut EventChunk) {
-        let Some((buffer, rng)) = &mut self.jitter else {
-            for &(_, e) in merged {
-                out.push_event(e);
-            }
-            return;
-        };
-        let mut staged = EventChunk::default();
-        let mut next = 0;
-        for (k, sample) in batch.iter().enumerate() {
-            staged.clear();
-            while let Some(&(_, e)) = merged.get(next).filter(|(s, _)| *s == k as u32) {
-                staged.push_event(e);
-                next += 1;
-            }
-            buffer.push(&staged, sample.t, rng, out);
+/// Appends the merged events of `batch` to `out` as `step` emits them: as they are,
+/// or through the timestamp-jitter buffer one sample at a time.
+fn emit(jitter: &mut Jitter, batch: &[Sample], merged: &[(u32, Event)], out: &mut EventChunk) {
+    let Some((buffer, rng)) = jitter else {
+        for &(_, e) in merged {
+            out.push_event(e);
         }
+        return;
+    };
+    let mut staged = EventChunk::default();
+    let mut next = 0;
+    for (k, sample) in batch.iter().enumerate() {
+        staged.clear();
+        while let Some(&(_, e)) = merged.get(next).filter(|(s, _)| *s == k as u32) {
+            staged.push_event(e);
+            next += 1;
+        }
+        buffer.push(&staged, sample.t, rng, out);
     }
 }
 
