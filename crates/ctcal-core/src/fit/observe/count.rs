@@ -52,7 +52,8 @@ impl Observed {
     }
 
     /// [`Self::new`] of a simulation, with the recording's lag behind it ([`super::lag`]; the
-    /// recording's side in `real`).
+    /// recording's side in `real`). The counts and the lag are made side by side: each has
+    /// a part on one thread (the stretches' merge, the grouping of the events).
     pub fn paired(
         events: &EventChunk,
         geometry: &Geometry,
@@ -60,14 +61,12 @@ impl Observed {
         real: &LagKeys,
     ) -> Self {
         let support = supported(events, geometry.sensor, SUPPORT_US);
-        let mut o = Self::counted(
-            events,
-            &support,
-            geometry,
-            masked,
-            rayon::current_num_threads(),
+        let threads = rayon::current_num_threads();
+        let (mut o, lag) = rayon::join(
+            || Self::counted(events, &support, geometry, masked, threads),
+            || real.histograms(events, &support, geometry, masked),
         );
-        o.lag = real.histograms(events, &support, geometry, masked);
+        o.lag = lag;
         o
     }
 

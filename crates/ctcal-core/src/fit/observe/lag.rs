@@ -198,7 +198,8 @@ impl LagKeys {
     }
 
     /// The offset histograms of the recording against the time-sorted simulated `events`
-    /// (their `support` flags), leaving out `masked` pixels.
+    /// (their `support` flags), leaving out `masked` pixels; the two pairings side by side
+    /// (each groups the events on one thread before pairing them on the pool).
     pub fn histograms(
         &self,
         events: &EventChunk,
@@ -207,22 +208,25 @@ impl LagKeys {
         masked: &[bool],
     ) -> LagHistograms {
         let width = g.sensor.width as usize;
-        let starts = burst_starts(events, self.every.start.len() - 1, width);
+        let (every_event, burst_starts) = rayon::join(
+            || {
+                self.every
+                    .histogram(events, |i| support[i], g, masked, EVERY_EVENT_WINDOW_US)
+            },
+            || {
+                let starts = burst_starts(events, self.every.start.len() - 1, width);
+                self.starts.histogram(
+                    events,
+                    |i| support[i] && starts[i],
+                    g,
+                    masked,
+                    LAG_WINDOW_US,
+                )
+            },
+        );
         LagHistograms {
-            every_event: self.every.histogram(
-                events,
-                |i| support[i],
-                g,
-                masked,
-                EVERY_EVENT_WINDOW_US,
-            ),
-            burst_starts: self.starts.histogram(
-                events,
-                |i| support[i] && starts[i],
-                g,
-                masked,
-                LAG_WINDOW_US,
-            ),
+            every_event,
+            burst_starts,
         }
     }
 }
