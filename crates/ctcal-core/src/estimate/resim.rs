@@ -366,7 +366,12 @@ pub fn simulate(
             .map_err(|e| {
                 EstimateError::new(format!("re-simulation failed: {e}"), "report this as a bug")
             })?;
-        all.extend_from(&events);
+        if all.is_empty() {
+            // the first run's events are taken as they are, not copied
+            all = events;
+        } else {
+            all.extend_from(&events);
+        }
     }
     all.sort_by_time();
     Ok(all)
