@@ -1,8 +1,11 @@
 """Before/after table of the fit with frames on the draws of this study.
 
 Before: each draw's row in `quiet-noise-2026-12-04` (the 33 draws with shot noise in the
-truth or the fit), else in its fresh study. After: this study's `results.compact.jsonl`.
-Run from the repository root: `python3 benches/coverage/quiet-noise-signature-2026-12-04/compare.py`.
+truth or the fit, binary de9f988), else in `before-extra.results.compact.jsonl` (the other
+22, run here with the parent's behaviour: 19ee8b8, whose JSON is byte-identical to
+d5f5824's). After: this study's `results.compact.jsonl`. Then every parameter whose
+reported value or interval changed, per draw. Run from the repository root:
+`python3 benches/coverage/quiet-noise-signature-2026-12-04/compare.py`.
 """
 import json
 
@@ -21,10 +24,8 @@ def rows(path):
 
 
 new = rows(f'{HERE}/results.compact.jsonl')
-old = {}
-for study in ['fresh-7001-7040-2026-12-04', 'fresh-8001-8030-2026-12-04',
-              'fresh-9001-9030-2026-12-04', 'quiet-noise-2026-12-04']:
-    old.update(rows(f'benches/coverage/{study}/results.compact.jsonl'))
+old = rows(f'{HERE}/before-extra.results.compact.jsonl')
+old.update(rows('benches/coverage/quiet-noise-2026-12-04/results.compact.jsonl'))
 
 
 def show(v):
@@ -87,3 +88,14 @@ for s in sorted(new):
           '| LK %.3f' % t.get('leak_rate_hz', 0), show(o.get('leak_rate_hz')), '->',
           show(n.get('leak_rate_hz')), '|', new[s]['outcome']['status'],
           round(old.get(s, {}).get('seconds', 0)), '->', round(new[s]['seconds']))
+
+print()
+print('every reported parameter that changed (truth: before -> after):')
+for s in sorted(new):
+    t = new[s]['truth']['values']
+    o = old.get(s, {}).get('reported', {})
+    n = new[s]['reported']
+    for k in KEYS:
+        if show(o.get(k)) != show(n.get(k)):
+            mark = {True: 'covers', False: 'MISSES', None: ''}[covers(n.get(k), t.get(k, 0.0))]
+            print(s, k, '%.4g:' % t.get(k, 0.0), show(o.get(k)), '->', show(n.get(k)), mark)

@@ -11,11 +11,20 @@
 //! isolated OFF event. Shot noise fires OFF and ON alike at every pixel, moving or not; leak
 //! only ON. So:
 //!
-//! - shot noise is not tried where the quiet OFF rate bounds it below the rate that
-//!   matters ([`rules_out`]);
-//! - a fitted shot-noise rate's interval holds the dark rate the quiet OFF rate gives
-//!   ([`direct_dark_rate`], [`widen`]): on draw 8007 (2.78 Hz) the search's 4.05
-//!   [3.68, 4.27] against the count's 2.5-3.8.
+//! - shot noise is not tried, and takes no other effect's place, where the quiet OFF count
+//!   bounds it below the rate that matters ([`rules_out`]);
+//! - it is called for where the count's lower end exceeds what the model makes there by a
+//!   rate that matters ([`finds`]), at 5 standard errors as every effect;
+//! - every search of its rate stays within the dark rate the count gives, and the fitted
+//!   rate's interval is that interval ([`searched_range`], [`direct_dark_rate`],
+//!   [`take_count_interval`]): on draw 8007 (2.78 Hz) the search's 4.05 [3.68, 4.27]
+//!   beside the count's [2.60, 3.00];
+//! - the same count on the selection blocks is its signature for the keep rule
+//!   ([`signature`]).
+//!
+//! The count is read through the simulator's noise model (v2e's): the brightness factor
+//! `1 - 0.75 (DN + 20) / 275` over the range of the frames' intensity bins, and each
+//! polarity's rate scaled by its nominal threshold over the pixel's ([`off_share`]).
 
 use crate::estimate::Interval;
 use crate::fit::Uncertain;
@@ -23,14 +32,34 @@ use crate::fit::effects::{Context, Effect, Evidence};
 use crate::fit::events_only::QuietOff;
 use crate::fit::observe::{Geometry, INTENSITY_BINS, INTENSITY_EDGES, Subset};
 use crate::sim::PixelParams;
+use crate::sim::effects::mismatch::MIN_THRESHOLD;
 use crate::sim::effects::shot_noise::brightness_factor;
 use crate::stats::binomial::poisson95;
 use std::collections::BTreeMap;
 
-/// The share of shot noise that is OFF: each polarity's rate goes as its nominal threshold
-/// over the pixel's ([`crate::sim::effects::shot_noise::pixel_rates`], as v2e), so a
-/// nominal pixel fires OFF half the time whatever Cp and Cn are.
-const OFF_SHARE: f64 = 0.5;
+/// The share of shot noise the simulator fires OFF, averaged over its pixels: each
+/// polarity's rate goes as its nominal threshold over the pixel's
+/// ([`crate::sim::effects::shot_noise::pixel_rates`], as v2e), so a nominal pixel fires OFF
+/// half the time whatever Cp and Cn are, and under threshold mismatch (`theta ~ N(Cn,
+/// sigma)`, at least [`MIN_THRESHOLD`]) the mean OFF rate is `E[Cn / theta]` times that
+/// (1.032 at a spread of 17 % of Cn, 1.42 at 37 %): a midpoint sum over the normal, 16,000
+/// steps over 8 standard deviations either side.
+pub(crate) fn off_share(model: &PixelParams) -> f64 {
+    let (ct, sigma) = (model.ct_off, model.ct_sigma.unwrap_or(0.0));
+    if !(sigma > 0.0 && ct > 0.0) {
+        return 0.5;
+    }
+    const STEPS: usize = 16_000;
+    let dz = 16.0 / STEPS as f64;
+    let (mut sum, mut weights) = (0.0, 0.0);
+    for k in 0..STEPS {
+        let z = -8.0 + (k as f64 + 0.5) * dz;
+        let w = (-0.5 * z * z).exp();
+        sum += w * ct / (ct + sigma * z).max(MIN_THRESHOLD as f64);
+        weights += w;
+    }
+    0.5 * sum / weights
+}
 
 /// The smallest and largest brightness factor (observed over dark rate) of the intensity
 /// bins with pixel time on `subset`, at the bins' edges: the quiet pixels' own brightness
@@ -63,7 +92,7 @@ fn off_rate95(quiet: &QuietOff) -> (f64, f64) {
 /// the OFF share, times how much brighter the quiet pixels may be than the rest.
 pub(crate) fn most_observed_hz(c: &Context, quiet: &QuietOff) -> Option<f64> {
     let [lo, hi] = factor_range(c.geometry, c.model, c.subset)?;
-    Some(off_rate95(quiet).1 / OFF_SHARE * hi / lo)
+    Some(off_rate95(quiet).1 / off_share(c.model) * hi / lo)
 }
 
 /// Why shot noise is not tried, where the quiet OFF count keeps it below `relevant_hz`.
@@ -112,23 +141,23 @@ pub(crate) fn finds(c: &Context, relevant_hz: f64) -> Option<Found> {
         return None;
     }
     let [f_lo, f_hi] = factor_range(c.geometry, c.model, c.subset)?;
+    let share = off_share(c.model);
     let model_hz = c.model.shot_noise_rate_hz.unwrap_or(0.0).max(0.0);
     let n = (quiet.rate_hz * quiet.pixel_seconds).round().max(0.0);
     // the most isolated OFF events the model's own shot noise makes at the quiet pixels
-    let expected = model_hz * f_hi * OFF_SHARE * quiet.pixel_seconds;
-    let (lo, _) = off_rate95(&quiet);
-    let least_hz = (lo / OFF_SHARE - model_hz * f_hi) * f_lo / f_hi;
+    let expected = model_hz * f_hi * share * quiet.pixel_seconds;
+    let (lo, hi) = off_rate95(&quiet);
+    let least_hz = (lo / share - model_hz * f_hi) * f_lo / f_hi;
     let beyond = if model_hz > 0.0 {
         format!(" beyond the model's {model_hz:.4} Hz")
     } else {
         " where the model has none".to_string()
     };
-    let (_, hi) = off_rate95(&quiet);
-    let dark = [lo / OFF_SHARE / f_hi, hi / OFF_SHARE / f_lo];
+    let dark = [lo / share / f_hi, hi / share / f_lo];
     (least_hz > relevant_hz).then(|| Found {
         z: (n - expected) / (n + 1.0).sqrt(),
         least_hz,
-        start_hz: quiet.rate_hz / OFF_SHARE / (f_lo * f_hi).sqrt(),
+        start_hz: quiet.rate_hz / share / (f_lo * f_hi).sqrt(),
         text: format!(
             "the recording's quiet pixels hold {:.4} isolated OFF events per pixel-second ({n:.0} in {:.0} pixel-s without a neighbour event within {:.0} ms and {} px; a wider support does not lower it): shot noise, which fires OFF as often as ON at every pixel, of at least {least_hz:.4} Hz (95 %){beyond}, a dark rate of {:.4} to {:.4} Hz",
             quiet.rate_hz,
@@ -145,7 +174,7 @@ pub(crate) fn finds(c: &Context, relevant_hz: f64) -> Option<Found> {
 /// gives ([`direct_dark_rate`]), or that rate's interval where the two do not meet;
 /// `None` where the count gives none. The count measures the noise directly; the search's
 /// distance also reads other effects' misses as noise (coverage draw 8014: the count
-/// gives 0.37-0.64 Hz, a search over the effect's own range 0.18, for 0.53 true).
+/// gives 0.46-0.66 Hz, a search over the effect's own range 0.18, for 0.53 true).
 pub(crate) fn searched_range(
     range: (f64, f64),
     quiet: Option<QuietOff>,
@@ -153,14 +182,15 @@ pub(crate) fn searched_range(
     model: &PixelParams,
 ) -> Option<(f64, f64)> {
     let [lo, hi] = direct_dark_rate(&quiet?, geometry, model)?;
-    if !(lo > 0.0 && hi > lo) {
+    if hi.is_nan() || lo.is_nan() || hi <= lo {
         return None;
     }
+    // no quiet OFF event: the count bounds the rate from above only
     let within = (range.0.max(lo), range.1.min(hi));
     Some(if within.0 < within.1 {
         within
     } else {
-        (lo, hi)
+        (lo.max(hi * 1e-3), hi)
     })
 }
 
@@ -213,7 +243,8 @@ pub(crate) fn direct_dark_rate(
     }
     let [f_lo, f_hi] = factor_range(geometry, model, Subset::Fit)?;
     let (lo, hi) = off_rate95(quiet);
-    Some([lo / OFF_SHARE / f_hi, hi / OFF_SHARE / f_lo])
+    let share = off_share(model);
+    Some([lo / share / f_hi, hi / share / f_lo])
 }
 
 /// The most dark shot-noise rate the quiet OFF count allows, 95 %: the upper end of its
@@ -227,15 +258,15 @@ pub(crate) fn at_most_dark_hz(
 ) -> Option<f64> {
     let quiet = quiet?;
     let [f_lo, _] = factor_range(geometry, model, Subset::Fit)?;
-    Some(off_rate95(&quiet).1 / OFF_SHARE / f_lo)
+    Some(off_rate95(&quiet).1 / off_share(model) / f_lo)
 }
 
 /// Gives the fitted shot-noise rate the interval of the dark rate the quiet count gives
 /// ([`direct_dark_rate`]), within which it was searched ([`searched_range`]): the count
 /// measures the noise directly, while the search's own interval is read off how the
 /// distance moves, which other effects' misses move too (coverage draw 9030: [0.008,
-/// 12.6] Hz beside the count's [0.13, 0.36], for 0.137). The note says both.
-pub(crate) fn widen(
+/// 12.6] Hz beside the count's, for 0.137). The note says both.
+pub(crate) fn take_count_interval(
     uncertainty: &mut BTreeMap<String, Uncertain>,
     quiet: Option<QuietOff>,
     geometry: &Geometry,
@@ -246,19 +277,17 @@ pub(crate) fn widen(
     let u = uncertainty.get_mut("shot_noise_rate_hz")?;
     let [lo, hi] = direct_dark_rate(&quiet, geometry, model)?;
     let counted = [Some(lo.min(u.value)), Some(hi.max(u.value))];
-    if Some(counted) == u.ci95 {
-        return None;
-    }
     let said = |i: Interval| {
         let side = |v: Option<f64>| v.map_or("open".to_string(), |v| format!("{v:.4}"));
         format!("{} to {}", side(i[0]), side(i[1]))
     };
     let note = format!(
-        "shot_noise_rate_hz: its interval is the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px, exact Poisson 95 %, half the noise OFF, over the brightness factors at the edges of the frames' intensity bins), within which it was searched; the search's own interval, from how the distance moves, was {} Hz: the distance reads every isolated event the model lacks as noise, where another effect (a lagging photoreceptor, leak) leaves such events too",
+        "shot_noise_rate_hz: its interval is the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px, exact Poisson 95 %, OFF share {:.4} under the model's threshold mismatch, over the brightness factors at the edges of the frames' intensity bins), within which it was searched; the search's own interval, from how the distance moves, was {} Hz: the distance reads every isolated event the model lacks as noise, where another effect (a lagging photoreceptor, leak) leaves such events too",
         quiet.rate_hz,
         quiet.pixel_seconds,
         quiet.support_window_ms,
         quiet.support_radius_px,
+        off_share(model),
         said(u.ci95.unwrap_or([None, None]))
     );
     u.ci95 = Some(counted);
@@ -309,7 +338,7 @@ mod tests {
             "shot_noise_rate_hz".to_string(),
             Uncertain::with_interval(4.05, None, [Some(3.68), Some(4.27)]),
         )]);
-        let note = widen(
+        let note = take_count_interval(
             &mut u,
             Some(quiet(1.264, 0.0355, false)),
             &f.geometry,
@@ -325,19 +354,23 @@ mod tests {
         // an upper bound says nothing of the dark rate: no widening (the oracle
         // c_noisy_static's [0.90, 1.12] was widened to [0, 1.60] by one)
         assert!(direct_dark_rate(&quiet(1.264, 0.0355, true), &f.geometry, &model).is_none());
-        // the count's interval already: nothing to change
+        // the count's interval already: kept, and still said
         let mut inside = BTreeMap::from([(
             "shot_noise_rate_hz".to_string(),
             Uncertain::with_interval(2.8, None, [Some(lo), Some(hi)]),
         )]);
         assert!(
-            widen(
+            take_count_interval(
                 &mut inside,
                 Some(quiet(1.264, 0.0355, false)),
                 &f.geometry,
                 &model
             )
-            .is_none()
+            .is_some()
+        );
+        assert_eq!(
+            inside["shot_noise_rate_hz"].ci95,
+            Some([Some(lo), Some(hi)])
         );
     }
 
@@ -429,5 +462,28 @@ mod tests {
         // the most the count allows holds for an upper bound too: 2.9984
         let most = at_most_dark_hz(bound, &f.geometry, &model).unwrap();
         assert!((most - 2.9984).abs() < 2e-4, "{most}");
+    }
+
+    /// The simulator's OFF share under threshold mismatch, against a sum by hand over the
+    /// normal (numpy, 16,000 steps): Cn 0.3 with sigma 0.051 fires OFF 1.03187 times as often
+    /// as nominal pixels, Cn 0.4 with sigma 0.148 1.41755 times (the clamp at 0.01 holding
+    /// the tail); none without mismatch.
+    #[test]
+    fn mismatch_raises_the_share_of_noise_fired_off() {
+        let mut model = PixelParams::ideal(0.3, 0.3);
+        assert_eq!(off_share(&model), 0.5);
+        model.ct_sigma = Some(0.051);
+        assert!(
+            (off_share(&model) / 0.5 - 1.031871).abs() < 1e-4,
+            "{}",
+            off_share(&model)
+        );
+        let mut wide = PixelParams::ideal(0.4, 0.4);
+        wide.ct_sigma = Some(0.148);
+        assert!(
+            (off_share(&wide) / 0.5 - 1.417547).abs() < 1e-3,
+            "{}",
+            off_share(&wide)
+        );
     }
 }

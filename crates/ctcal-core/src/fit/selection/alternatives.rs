@@ -222,8 +222,8 @@ fn not_compared((kept, other): (Effect, Effect), why: String) -> Step {
 
 /// Two effects the selection error does not separate: the one whose own signature names
 /// it is kept ([`signature_choice`]), else the model with the lower selection error; both
-/// are named as an [`Ambiguity`] in `found`, unless shot noise's signature named one
-/// (a direct count, the quiet pixels' isolated OFF events: the data separate them).
+/// are named as an [`Ambiguity`] in `found`, unless shot noise's signature (a direct count,
+/// the quiet pixels' isolated OFF events) keeps it where it is.
 /// Returns whether the look-alike `other` takes the kept effect's place.
 fn settle(
     (simulation, state, known): (&Simulation, &State, Known),
@@ -244,7 +244,10 @@ fn settle(
         }
         None => after < before,
     };
-    let counted = signature.is_some() && [kept, other].contains(&Effect::ShotNoise);
+    // shot noise kept where the count names it: measured, not a look-alike's stand-in (a
+    // count that names shot noise in another effect's place says nothing of that effect's
+    // absence, and the pair stays named)
+    let counted = signature.is_some() && kept == Effect::ShotNoise && !lower;
     if !counted {
         let (named, alternative, value) = if lower {
             (other, kept, kept_value(kept, state))
@@ -359,7 +362,7 @@ fn compare_one(
     };
     let evidence = effects::evidence(other, &context);
     let start = evidence.start.unwrap_or_else(|| typical_start(other));
-    let (range, by_count) = super::search_range(
+    let (range, counted) = super::search_range(
         other,
         other.range(start),
         known,
@@ -377,7 +380,7 @@ fn compare_one(
             fixed,
             noise,
         )?,
-        by_count,
+        counted,
     );
     let key = other.parameter().expect("a searched effect");
     let wins = judge(

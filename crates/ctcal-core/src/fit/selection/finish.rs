@@ -196,7 +196,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::method_systematic::widen_cutoff(
         &mut state.uncertainty,
     ));
-    assumptions.extend(crate::fit::effects::quiet_noise::widen(
+    assumptions.extend(crate::fit::effects::quiet_noise::take_count_interval(
         &mut state.uncertainty,
         known.quiet_off,
         g,

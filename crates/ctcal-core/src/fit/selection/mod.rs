@@ -298,7 +298,11 @@ impl Known {
         grid: Option<(TimeUs, TimeUs)>,
         (geometry, shot_noise_planned): (&Geometry, bool),
     ) -> Self {
+        // without selection blocks the signature would be the count that called for it
         let judging = || {
+            if geometry.judging() == Subset::Fit {
+                return None;
+            }
             let (from, to) = geometry.time_range_of(geometry.judging())?;
             super::events_only::quiet_off(&input.events.between(from, to), input)
         };
@@ -721,7 +725,6 @@ fn searched_together(added: &[AddedEffect]) -> Vec<Effect> {
         .collect()
 }
 
-/// The evidence context of the current state (fit blocks).
 /// The signature of `effect` on the judging blocks against `model` (for the keep rule by
 /// signature, [`keep::by_signature`]), the quiet pixels counted there.
 fn judging_evidence(
@@ -743,29 +746,41 @@ fn judging_evidence(
 
 /// The range `effect`'s parameter is searched over, from `range` (the effect's own about a
 /// start) beside the model `params`: shot noise's within the dark rate the fit run's quiet
-/// pixels give ([`effects::quiet_noise::searched_range`]); `true` where the count set it
-/// (an end of its interval is a measured limit, not a bound of the search's choosing).
+/// pixels give ([`effects::quiet_noise::searched_range`]), with that rate's interval where
+/// the count set the range (an end of it is a measured limit, not a bound of the search's
+/// choosing).
 fn search_range(
     effect: Effect,
     range: (f64, f64),
     known: Known,
     geometry: &Geometry,
     params: &PixelParams,
-) -> ((f64, f64), bool) {
+) -> ((f64, f64), Option<[f64; 2]>) {
     if effect != Effect::ShotNoise {
-        return (range, false);
+        return (range, None);
     }
-    match effects::quiet_noise::searched_range(range, known.quiet_off, geometry, params) {
-        Some(within) => (within, true),
-        None => (range, false),
-    }
+    let Some(within) =
+        effects::quiet_noise::searched_range(range, known.quiet_off, geometry, params)
+    else {
+        return (range, None);
+    };
+    let counted = known
+        .quiet_off
+        .and_then(|q| effects::quiet_noise::direct_dark_rate(&q, geometry, params));
+    (within, counted)
 }
 
 /// [`search_range`]'s search result: a value at an end of the quiet count's interval is
-/// within what the count measured, and the interval the count gives is added to it
-/// ([`effects::quiet_noise::widen`]).
-fn within_count(mut searched: super::search::Searched, by_count: bool) -> super::search::Searched {
-    if by_count {
+/// within what the count measured (the interval reported is the count's,
+/// [`effects::quiet_noise::take_count_interval`]); an end of the search's own range stays a
+/// bound.
+fn within_count(
+    mut searched: super::search::Searched,
+    counted: Option<[f64; 2]>,
+) -> super::search::Searched {
+    let at_count_end =
+        |b: f64| counted.is_some_and(|c| c.iter().any(|&e| (b / e).ln().abs() < 0.05));
+    if searched.at_bound.is_some_and(at_count_end) {
         searched.at_bound = None;
     }
     searched

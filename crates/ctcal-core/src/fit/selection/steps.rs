@@ -101,7 +101,7 @@ pub fn try_effect(
                 .parameter()
                 .expect("every other effect has a parameter");
             let start = evidence.start.unwrap_or(1.0);
-            let (range, by_count) = search_range(
+            let (range, counted) = search_range(
                 effect,
                 effect.range(start),
                 run.known,
@@ -118,7 +118,7 @@ pub fn try_effect(
                     (fixed, effect.searched_with_mismatch()),
                     noise,
                 )?,
-                by_count,
+                counted,
             );
             step.parameters.insert(key.into(), searched.value);
             let uncertain = uncertain_of(key, &searched);
@@ -255,7 +255,7 @@ pub fn refit(
         .value(&state.model.params)
         .expect("a kept effect has its parameter");
     let count_before = simulation.count.get();
-    let (range, by_count) = search_range(
+    let (range, counted) = search_range(
         effect,
         (current / 3.0, current * 3.0),
         run.known,
@@ -273,7 +273,7 @@ pub fn refit(
             run.fixed,
             run.noise,
         )?,
-        by_count,
+        counted,
     );
     let verdict = judge(
         simulation,
@@ -393,7 +393,7 @@ fn best_without(
         let (Some(key), Some(current)) = (other.parameter(), other.value(&best.params)) else {
             continue;
         };
-        let (range, by_count) = search_range(
+        let (range, counted) = search_range(
             other,
             other.range(current),
             run.known,
@@ -411,7 +411,7 @@ fn best_without(
                 fixed,
                 noise,
             )?,
-            by_count,
+            counted,
         );
         if searched.fit_error < error {
             error = searched.fit_error;
