@@ -196,12 +196,18 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::method_systematic::widen_cutoff(
         &mut state.uncertainty,
     ));
-    assumptions.extend(crate::fit::effects::quiet_noise::take_count_interval(
+    let counted = crate::fit::effects::quiet_noise::take_count_interval(
         &mut state.uncertainty,
         known.quiet_off,
         g,
         &state.model.params,
-    ));
+    );
+    let measured: &[&str] = if counted.is_some() {
+        &["shot_noise_rate_hz"]
+    } else {
+        &[]
+    };
+    assumptions.extend(counted);
     let mut params = state.model.params.clone();
     params.seed = None;
     // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml
@@ -257,7 +263,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::alternatives::reach_zero_where_not_separated(
         &mut state.uncertainty,
         &mut ambiguities,
-        &not_identified,
+        (&not_identified, measured),
     ));
     for k in ["ct_on", "ct_off"] {
         if not_identified.contains_key(k) {
