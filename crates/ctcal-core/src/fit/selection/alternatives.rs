@@ -15,7 +15,7 @@
 //!   separated, with what data would separate them.
 
 use super::super::effects::{self, Context, Effect};
-use super::super::search::{Simulated, Simulation, search};
+use super::super::search::{Simulated, Simulation};
 use super::super::{AddedEffect, FitError, Step};
 use super::keep::judge;
 use super::{Known, State, context_of};
@@ -356,26 +356,13 @@ fn compare_one(
     };
     let evidence = effects::evidence(other, &context);
     let start = evidence.start.unwrap_or_else(|| typical_start(other));
-    let (range, counted) = super::search_range(
-        other,
-        other.range(start),
+    let searched = super::search_counted(
+        simulation,
+        (&without.params, other, other.range(start)),
+        state,
         known,
-        simulation.geometry,
-        &without.params,
-    );
-    let searched = super::within_count(
-        search(
-            simulation,
-            &without.params,
-            other,
-            range,
-            &state.masked,
-            &state.kept,
-            fixed,
-            noise,
-        )?,
-        counted,
-    );
+        (fixed, noise),
+    )?;
     let key = other.parameter().expect("a searched effect");
     let wins = judge(
         simulation,

@@ -786,6 +786,29 @@ fn within_count(
     searched
 }
 
+/// [`search`](super::search::search) of `effect` from `params` over `range` (the effect's
+/// own), shot noise's within the quiet count ([`search_range`], [`within_count`]).
+fn search_counted(
+    simulation: &Simulation,
+    (params, effect, range): (&PixelParams, Effect, (f64, f64)),
+    state: &State,
+    known: Known,
+    (fixed, noise): (bool, f64),
+) -> Result<super::search::Searched, FitError> {
+    let (range, counted) = search_range(effect, range, known, simulation.geometry, params);
+    let searched = super::search::search(
+        simulation,
+        params,
+        effect,
+        range,
+        &state.masked,
+        &state.kept,
+        fixed,
+        noise,
+    )?;
+    Ok(within_count(searched, counted))
+}
+
 fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) -> Context<'a> {
     Context {
         real: &simulation.real,

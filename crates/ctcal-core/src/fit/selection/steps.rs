@@ -9,7 +9,7 @@ use super::super::residuals::residuals;
 use super::super::search::{Searched, Simulated, Simulation, search, search_profiled};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
 use super::keep::{Verdict, by_signature, judge};
-use super::{Known, LoopRun, State, judging_evidence, search_range, within_count};
+use super::{Known, LoopRun, State, judging_evidence, search_counted, search_range, within_count};
 use crate::stats::hot_pixels::HotPixel;
 use std::collections::BTreeMap;
 
@@ -255,26 +255,13 @@ pub fn refit(
         .value(&state.model.params)
         .expect("a kept effect has its parameter");
     let count_before = simulation.count.get();
-    let (range, counted) = search_range(
-        effect,
-        (current / 3.0, current * 3.0),
+    let searched = search_counted(
+        simulation,
+        (&state.model.params, effect, (current / 3.0, current * 3.0)),
+        state,
         run.known,
-        simulation.geometry,
-        &state.model.params,
-    );
-    let searched = within_count(
-        search(
-            simulation,
-            &state.model.params,
-            effect,
-            range,
-            &state.masked,
-            &state.kept,
-            run.fixed,
-            run.noise,
-        )?,
-        counted,
-    );
+        (run.fixed, run.noise),
+    )?;
     let verdict = judge(
         simulation,
         &state.model.observed,
@@ -393,26 +380,13 @@ fn best_without(
         let (Some(key), Some(current)) = (other.parameter(), other.value(&best.params)) else {
             continue;
         };
-        let (range, counted) = search_range(
-            other,
-            other.range(current),
+        let searched = search_counted(
+            simulation,
+            (&best.params, other, other.range(current)),
+            state,
             run.known,
-            simulation.geometry,
-            &best.params,
-        );
-        let searched = within_count(
-            search(
-                simulation,
-                &best.params,
-                other,
-                range,
-                &state.masked,
-                &state.kept,
-                fixed,
-                noise,
-            )?,
-            counted,
-        );
+            (fixed, noise),
+        )?;
         if searched.fit_error < error {
             error = searched.fit_error;
             refitted.push(uncertain_of(key, &searched));

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Self time of `perf script` samples (DWARF call graphs) by function, iterator adapters
 and closures charged to the nearest ctcal function that called them, and where those
-are called from. Usage: perf script -i DATA | hot.py [TOP]"""
+are called from. Usage: perf script -i DATA | benches/scripts/hot.py [TOP]"""
 import re
 import sys
 from collections import Counter
