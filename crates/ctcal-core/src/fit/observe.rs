@@ -140,6 +140,10 @@ pub struct Geometry {
     change: Vec<Vec<u8>>,
     /// Pixel-seconds per block and intensity bin (reliable, kept pixels).
     pub exposure: Vec<[f64; INTENSITY_BINS]>,
+    /// Pixel-seconds per block of still pixels (reliable, kept, in the slowest change bin:
+    /// the frames show less than [`CHANGE_EDGES`]`[0]` log units per second), where leak's
+    /// ON drift shows without the scene ([`crate::fit::effects::leak::StillBalance`]).
+    pub still_exposure: Vec<f64>,
     /// First and last time of the used intervals.
     pub span: (TimeUs, TimeUs),
     /// Median duration of the used frame intervals, seconds: the unit of the recording's
@@ -210,6 +214,7 @@ impl Geometry {
             }
         }
         let mut exposure = vec![[0.0; INTENSITY_BINS]; blocks];
+        let mut still_exposure = vec![0.0; blocks];
         for &k in &used {
             // guard intervals have no block
             let Some(block) = interval_block[k] else {
@@ -224,6 +229,9 @@ impl Geometry {
                     bins[p] = bin;
                     if !excluded[p] {
                         exposure[block][bin as usize] += dt;
+                        if change[k].get(p) == Some(&0) {
+                            still_exposure[block] += dt;
+                        }
                     }
                 }
             }
@@ -263,6 +271,7 @@ impl Geometry {
             intensity,
             change,
             exposure,
+            still_exposure,
             span,
             frame_interval_s,
             intensity_centres: centres,
@@ -394,6 +403,9 @@ pub struct Observed {
     pub pixel_counts: Vec<u32>,
     /// `[block][polarity]`.
     pub polarity: Vec<[u64; 2]>,
+    /// Events at still pixels (the slowest change bin, reliable intensity), supported or
+    /// not, `[block][polarity]`.
+    pub still: Vec<[u64; 2]>,
     /// Events per 1 ms bin from the start of the used span.
     pub timeline: Vec<u32>,
     /// A simulation's only: the recording's offsets from it, `[block][intensity][polarity]
@@ -457,6 +469,16 @@ impl Observed {
         for b in (0..self.blocks).filter(|&b| g.in_subset(b, subset)) {
             out[0] += self.polarity[b][0];
             out[1] += self.polarity[b][1];
+        }
+        out
+    }
+
+    /// ON and OFF events at still pixels over `subset` ([`Geometry::still_exposure`]).
+    pub fn still_of(&self, g: &Geometry, subset: Subset) -> [u64; 2] {
+        let mut out = [0; 2];
+        for b in (0..self.blocks).filter(|&b| g.in_subset(b, subset)) {
+            out[0] += self.still[b][0];
+            out[1] += self.still[b][1];
         }
         out
     }

@@ -120,6 +120,7 @@ impl Observed {
             intervals: vec![0; blocks * INTERVAL_CLASSES * INTERVAL_BINS],
             pixel_counts: vec![0; blocks * g.sensor.pixels()],
             polarity: vec![[0; 2]; blocks],
+            still: vec![[0; 2]; blocks],
             timeline: vec![0; ((g.span.1 - g.span.0) / TIMELINE_BIN_US).max(0) as usize + 1],
             lag: Default::default(),
         }
@@ -135,6 +136,10 @@ impl Observed {
         sum(&mut self.pixel_counts, &other.pixel_counts);
         sum(&mut self.timeline, &other.timeline);
         for (a, b) in self.polarity.iter_mut().zip(&other.polarity) {
+            a[0] += b[0];
+            a[1] += b[1];
+        }
+        for (a, b) in self.still.iter_mut().zip(&other.still) {
             a[0] += b[0];
             a[1] += b[1];
         }
@@ -217,8 +222,11 @@ fn count_stretch(
             continue;
         }
         let intensity = intensity as usize;
+        let change = g.change[k][p] as usize;
+        if change == 0 {
+            o.still[block][pol] += 1;
+        }
         if support[i] {
-            let change = g.change[k][p] as usize;
             o.cells[block * CELLS + cell_index(intensity, change, pol)] += 1;
             o.by_region[(block * REGIONS + g.region[p] as usize) * 2 + pol] += 1;
         } else {
@@ -268,6 +276,7 @@ mod tests {
                 bins(CHANGE_BINS),
             ],
             exposure: vec![[0.0; INTENSITY_BINS]; 3],
+            still_exposure: vec![0.0; 3],
             span: (0, 40_000),
             frame_interval_s: 0.01,
             unread: vec![(33_000, 34_000)],
@@ -298,6 +307,9 @@ mod tests {
         let one = Observed::counted(&events, &support, &g, &masked, 1);
         assert!(one.polarity.iter().map(|p| p[0] + p[1]).sum::<u64>() > 150_000);
         assert!(one.intervals.iter().sum::<u32>() > 150_000);
+        // pixels 0, 7, 14, ... are still (change bin 0): about a seventh of the events
+        let still: u64 = one.still.iter().map(|p| p[0] + p[1]).sum();
+        assert!(still > 15_000 && still < 45_000, "{still}");
         for threads in [2, 3, 4] {
             let many = Observed::counted(&events, &support, &g, &masked, threads);
             assert_eq!(events.time_stretches(threads, MIN_STRETCH).len(), threads);
@@ -307,6 +319,7 @@ mod tests {
             assert_eq!(many.intervals, one.intervals);
             assert_eq!(many.pixel_counts, one.pixel_counts);
             assert_eq!(many.polarity, one.polarity);
+            assert_eq!(many.still, one.still);
             assert_eq!(many.timeline, one.timeline);
         }
     }

@@ -244,6 +244,16 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         d
     });
     let mut not_identified = not_identified(&state, fixed);
+    if let Some((note, unmeasured)) = super::leak_report::check(simulation, &state) {
+        assumptions.push(note);
+        if let Some(why) = unmeasured {
+            not_identified
+                .entry("leak_rate_hz".into())
+                .and_modify(|w| *w = format!("{w}; and {why}"))
+                .or_insert(why);
+            state.uncertainty.remove("leak_rate_hz");
+        }
+    }
     not_identified.extend(super::spread_report::unseen(
         state.model.params.ct_sigma,
         &steps,

@@ -15,6 +15,7 @@
 //! the distance does not rise by more than chance ([`by_signature`]).
 
 use super::super::effects::Evidence;
+use super::super::effects::leak::StillBalance;
 use super::super::metric::Components;
 use super::super::observe::{Observed, Role, Subset};
 use super::super::search::Simulation;
@@ -166,6 +167,24 @@ pub fn by_signature(verdict: Verdict, before: &Evidence, after: &Evidence) -> Ve
         ),
         ..verdict
     }
+}
+
+/// A leak the distance keeps is not kept where the still pixels contradict it
+/// ([`StillBalance::contradicted`]: the candidate fires ON events at pixels whose light
+/// does not change, and the recording lacks them); the counts are said either way.
+pub fn by_still_pixels(verdict: Verdict, still: &StillBalance) -> Verdict {
+    if verdict.kept && still.contradicted() {
+        return Verdict {
+            kept: false,
+            reason: format!(
+                "{}; not kept: the recording lacks its signature: {}",
+                verdict.reason,
+                still.text()
+            ),
+            ..verdict
+        };
+    }
+    verdict
 }
 
 /// Why the signature does not agree with the candidate: it does not replicate on the
@@ -327,5 +346,30 @@ mod tests {
         // a verdict the distance keeps beyond measured chance stands as it is
         let v = judged((2.0, 1.0, Some(0.2), true), 0.0, 0.0);
         assert_eq!(v.reason, "error on the selection blocks");
+    }
+
+    #[test]
+    fn a_leak_the_still_pixels_contradict_is_not_kept_whatever_the_distance() {
+        // the leak adds 100 ON events at still pixels, the recording shows none
+        let still = |recording| StillBalance {
+            recording,
+            without: [100, 100],
+            with: [100, 200],
+            pixel_seconds: 500.0,
+        };
+        let kept = || Verdict {
+            kept: true,
+            ..verdict(1.6, 1.0, Some(0.1))
+        };
+        let v = by_still_pixels(kept(), &still([100, 100]));
+        assert!(
+            !v.kept && v.reason.contains("lacks its signature"),
+            "{}",
+            v.reason
+        );
+        // shown: the distance's verdict stands, as does a candidate it did not keep
+        assert!(by_still_pixels(kept(), &still([100, 195])).kept);
+        let not = verdict(1.6, 1.55, Some(0.1));
+        assert!(!by_still_pixels(not, &still([100, 195])).kept);
     }
 }

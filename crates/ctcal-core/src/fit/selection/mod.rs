@@ -32,6 +32,7 @@ mod frame_quality;
 pub(in crate::fit) mod hot_excess;
 mod hot_report;
 pub(in crate::fit) mod keep;
+mod leak_report;
 mod method_systematic;
 mod noise_detection;
 mod spread_report;

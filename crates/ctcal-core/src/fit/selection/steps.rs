@@ -3,17 +3,18 @@
 //! selection blocks ([`super::keep`]); an added effect refitted with all the others in
 //! place; and the record of effects not called for.
 
+use super::super::effects::leak::StillBalance;
 use super::super::effects::{self, Effect, hot_pixels::HotTrain};
 use super::super::observe::Subset;
 use super::super::residuals::residuals;
 use super::super::search::{Searched, Simulated, Simulation, search, search_profiled};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
-use super::keep::{Verdict, by_signature, judge};
+use super::keep::{Verdict, by_signature, by_still_pixels, judge};
 use super::{Known, LoopRun, State, judging_evidence, search_counted, search_range, within_count};
 use crate::stats::hot_pixels::HotPixel;
 use std::collections::BTreeMap;
 
-fn thresholds_of(model: &Simulated) -> BTreeMap<String, f64> {
+pub(super) fn thresholds_of(model: &Simulated) -> BTreeMap<String, f64> {
     BTreeMap::from([
         ("ct_on".to_string(), model.params.ct_on),
         ("ct_off".to_string(), model.params.ct_off),
@@ -29,7 +30,7 @@ fn fit_residuals(simulation: &Simulation, model: &Simulated) -> StepResiduals {
     ))
 }
 
-fn record(step: &mut Step, verdict: Verdict) {
+pub(super) fn record(step: &mut Step, verdict: Verdict) {
     step.error_before = Some(verdict.before.total);
     step.error_after = Some(verdict.after.total);
     step.components_after = Some(verdict.after);
@@ -197,9 +198,10 @@ fn mismatch_searched_again(
 }
 
 /// The judgement of `effect`'s model `with` against the model `without` it on the
-/// judging blocks: by the distance ([`judge`]), and for an effect the distance barely sees
-/// also by its signature ([`by_signature`]).
-fn judge_effect(
+/// judging blocks: by the distance ([`judge`]), for an effect the distance barely sees
+/// also by its signature ([`by_signature`]), and a leak also at the still pixels
+/// ([`by_still_pixels`]).
+pub(super) fn judge_effect(
     simulation: &Simulation,
     state: &State,
     known: Known,
@@ -207,6 +209,16 @@ fn judge_effect(
     (without, with): (&Simulated, &Simulated),
 ) -> Verdict {
     let verdict = judge(simulation, &without.observed, &with.observed, &state.kept);
+    if effect == Effect::Leak {
+        let g = simulation.geometry;
+        let still = StillBalance::of(
+            &simulation.real,
+            (&without.observed, &with.observed),
+            g,
+            g.judging(),
+        );
+        return by_still_pixels(verdict, &still);
+    }
     if !effect.judged_by_signature() {
         return verdict;
     }
