@@ -59,7 +59,7 @@ for k in KEYS:
                 n += 1
         cells.append('%d/%d' % (hit, n))
     print('| `%s` intervals covering | %s | %s |' % (k, cells[0], cells[1]))
-for k in ['shot_noise_rate_hz', 'leak_rate_hz']:
+for k in ['shot_noise_rate_hz', 'leak_rate_hz', 'refractory_s', 'cutoff_hz']:
     cells = []
     for d in (old, new):
         bad = [s for s in sorted(new) if s in d and claimed_where_none(

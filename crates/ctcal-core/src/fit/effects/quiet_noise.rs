@@ -22,6 +22,10 @@
 //! - the same count on the selection blocks is its signature for the keep rule
 //!   ([`signature`]).
 //!
+//! The count holds the scene's own events where low thresholds fire isolated events at
+//! uncovered pixels, so the same count on the ideal model's events (no shot noise) comes off
+//! its lower end ([`noise_rate95`], [`crate::fit::events_only::SceneFloor`]).
+//!
 //! The count is read through the simulator's noise model (v2e's): the brightness factor
 //! `1 - 0.75 (DN + 20) / 275` over the range of the frames' intensity bins, and each
 //! polarity's rate scaled by its nominal threshold over the pixel's ([`off_share`]).
@@ -87,6 +91,41 @@ fn off_rate95(quiet: &QuietOff) -> (f64, f64) {
     (lo / quiet.pixel_seconds, hi / quiet.pixel_seconds)
 }
 
+/// The quiet OFF rate the scene itself makes, as the model without shot noise makes it
+/// ([`QuietOff::scene`]): its point rate and the upper end of its exact 95 % interval,
+/// events per pixel-second (none where not simulated).
+fn scene_rate(quiet: &QuietOff) -> (f64, f64) {
+    quiet.scene.map_or((0.0, 0.0), |s| {
+        let (_, hi) = poisson95(s.events as usize);
+        (s.events as f64 / s.pixel_seconds, hi / s.pixel_seconds)
+    })
+}
+
+/// [`off_rate95`] with the scene's own quiet OFF events taken from its lower end (at their
+/// most, [`scene_rate`]): the count's lower end is noise only beyond what the scene makes
+/// there. Thresholds low enough for a scene's slow changes to fire isolated events at
+/// pixels their neighbours leave uncovered put scene events in the count (coverage draws
+/// 9021 and 7009, 0.12 / 0.21 and 0.57 / 0.13: 0.18 [0.13, 0.29] and 0.50 [0.38, 0.67] Hz
+/// for 0.093 and 0.26). The upper end is left as it is: the scene only adds to the count,
+/// and a model that makes more scene events than the recording must not rule noise out.
+fn noise_rate95(quiet: &QuietOff) -> (f64, f64) {
+    let (lo, hi) = off_rate95(quiet);
+    ((lo - scene_rate(quiet).1).max(0.0), hi)
+}
+
+/// The scene floor in words, for the evidence and the interval's note.
+fn scene_said(quiet: &QuietOff) -> String {
+    quiet.scene.map_or(String::new(), |s| {
+        format!(
+            ", of which the scene itself makes {:.4} as the model without shot noise makes it ({} events in {:.0} pixel-s; at most {:.4}, taken from the count's lower end)",
+            s.events as f64 / s.pixel_seconds,
+            s.events,
+            s.pixel_seconds,
+            scene_rate(quiet).1
+        )
+    })
+}
+
 /// The most shot noise (ON + OFF events per pixel-second, averaged over the recording's
 /// brightness) the quiet OFF count allows: the upper end of its exact 95 % interval over
 /// the OFF share, times how much brighter the quiet pixels may be than the rest.
@@ -144,9 +183,11 @@ pub(crate) fn finds(c: &Context, relevant_hz: f64) -> Option<Found> {
     let share = off_share(c.model);
     let model_hz = c.model.shot_noise_rate_hz.unwrap_or(0.0).max(0.0);
     let n = (quiet.rate_hz * quiet.pixel_seconds).round().max(0.0);
-    // the most isolated OFF events the model's own shot noise makes at the quiet pixels
-    let expected = model_hz * f_hi * share * quiet.pixel_seconds;
-    let (lo, hi) = off_rate95(&quiet);
+    // the most isolated OFF events the model's own shot noise makes at the quiet pixels,
+    // beside those the scene makes there
+    let scene = scene_rate(&quiet).0 * quiet.pixel_seconds;
+    let expected = model_hz * f_hi * share * quiet.pixel_seconds + scene;
+    let (lo, hi) = noise_rate95(&quiet);
     let least_hz = (lo / share - model_hz * f_hi) * f_lo / f_hi;
     let beyond = if model_hz > 0.0 {
         format!(" beyond the model's {model_hz:.4} Hz")
@@ -155,15 +196,16 @@ pub(crate) fn finds(c: &Context, relevant_hz: f64) -> Option<Found> {
     };
     let dark = [lo / share / f_hi, hi / share / f_lo];
     (least_hz > relevant_hz).then(|| Found {
-        z: (n - expected) / (n + 1.0).sqrt(),
+        z: (n - expected) / (n + scene + 1.0).sqrt(),
         least_hz,
-        start_hz: quiet.rate_hz / share / (f_lo * f_hi).sqrt(),
+        start_hz: (quiet.rate_hz - scene_rate(&quiet).0).max(lo) / share / (f_lo * f_hi).sqrt(),
         text: format!(
-            "the recording's quiet pixels hold {:.4} isolated OFF events per pixel-second ({n:.0} in {:.0} pixel-s without a neighbour event within {:.0} ms and {} px; a wider support does not lower it): shot noise, which fires OFF as often as ON at every pixel, of at least {least_hz:.4} Hz (95 %){beyond}, a dark rate of {:.4} to {:.4} Hz",
+            "the recording's quiet pixels hold {:.4} isolated OFF events per pixel-second ({n:.0} in {:.0} pixel-s without a neighbour event within {:.0} ms and {} px; a wider support does not lower it){}: shot noise, which fires OFF as often as ON at every pixel, of at least {least_hz:.4} Hz (95 %){beyond}, a dark rate of {:.4} to {:.4} Hz",
             quiet.rate_hz,
             quiet.pixel_seconds,
             quiet.support_window_ms,
             quiet.support_radius_px,
+            scene_said(&quiet),
             dark[0],
             dark[1]
         ),
@@ -242,7 +284,7 @@ pub(crate) fn direct_dark_rate(
         return None;
     }
     let [f_lo, f_hi] = factor_range(geometry, model, Subset::Fit)?;
-    let (lo, hi) = off_rate95(quiet);
+    let (lo, hi) = noise_rate95(quiet);
     let share = off_share(model);
     Some([lo / share / f_hi, hi / share / f_lo])
 }
@@ -282,11 +324,12 @@ pub(crate) fn take_count_interval(
         format!("{} to {}", side(i[0]), side(i[1]))
     };
     let note = format!(
-        "shot_noise_rate_hz: its interval is the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px, exact Poisson 95 %, OFF share {:.4} under the model's threshold mismatch, over the brightness factors at the edges of the frames' intensity bins), within which it was searched; the search's own interval, from how the distance moves, was {} Hz: the distance reads every isolated event the model lacks as noise, where another effect (a lagging photoreceptor, leak) leaves such events too",
+        "shot_noise_rate_hz: its interval is the dark rate the recording's quiet pixels give ({lo:.4} to {hi:.4} Hz: {:.4} isolated OFF events per pixel-second over {:.0} pixel-s without a neighbour event within {:.0} ms and {} px{}, exact Poisson 95 %, OFF share {:.4} under the model's threshold mismatch, over the brightness factors at the edges of the frames' intensity bins), within which it was searched; the search's own interval, from how the distance moves, was {} Hz: the distance reads every isolated event the model lacks as noise, where another effect (a lagging photoreceptor, leak) leaves such events too",
         quiet.rate_hz,
         quiet.pixel_seconds,
         quiet.support_window_ms,
         quiet.support_radius_px,
+        scene_said(&quiet),
         off_share(model),
         said(u.ci95.unwrap_or([None, None]))
     );
@@ -309,6 +352,7 @@ mod tests {
             support_window_ms: 30.0,
             support_radius_px: 1,
             upper_bound,
+            ..Default::default()
         }
     }
 
@@ -371,6 +415,42 @@ mod tests {
         assert_eq!(
             inside["shot_noise_rate_hz"].ci95,
             Some([Some(lo), Some(hi)])
+        );
+    }
+
+    /// Draw 8007's count beside a scene that itself makes 100 isolated OFF events in 2,000
+    /// quiet pixel-s (as a model without shot noise makes them): their Garwood upper end,
+    /// 121.6268 (mpmath), is 0.060813 Hz taken from the count's lower end, 1.195270 - 0.060813
+    /// = 1.134457, a dark rate of 2.47109 Hz; the upper end stays 2.9984. The count calls
+    /// for shot noise with the scene's 0.05 Hz in what the model makes: (1264 - 50) /
+    /// sqrt(1264 + 50 + 1) = 33.48 standard errors.
+    #[test]
+    fn the_scene_s_own_quiet_events_come_off_the_count_s_lower_end() {
+        let f = dim();
+        let model = PixelParams::ideal(0.6121, 0.8469);
+        let floor = QuietOff {
+            scene: Some(crate::fit::events_only::SceneFloor {
+                events: 100,
+                pixel_seconds: 2000.0,
+            }),
+            ..quiet(1.264, 0.0355, false)
+        };
+        let [lo, hi] = direct_dark_rate(&floor, &f.geometry, &model).unwrap();
+        assert!(
+            (lo - 2.47109).abs() < 2e-4 && (hi - 2.9984).abs() < 2e-4,
+            "{lo} {hi}"
+        );
+        let mut c = f.context();
+        c.model = &model;
+        c.quiet_off = Some(floor);
+        let found = finds(&c, 0.005).unwrap();
+        assert!(
+            (found.z - 1214.0 / 1315f64.sqrt()).abs() < 1e-9,
+            "{found:?}"
+        );
+        assert!(
+            found.text.contains("the scene itself makes 0.0500"),
+            "{found:?}"
         );
     }
 

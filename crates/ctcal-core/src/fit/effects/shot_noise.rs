@@ -184,6 +184,7 @@ mod tests {
             support_window_ms: 30.0,
             support_radius_px: 1,
             upper_bound: false,
+            ..Default::default()
         });
         let e = evidence(&c);
         assert!(!e.calls_for(), "{e:?}");
@@ -219,6 +220,7 @@ mod tests {
             support_window_ms: 30.0,
             support_radius_px: 1,
             upper_bound: false,
+            ..Default::default()
         });
         let e = evidence(&c);
         assert!(e.calls_for(), "{e:?}");

@@ -201,7 +201,7 @@ pub(super) fn fit_from_events(
 /// fit without frames measures it ([`measure`]: hot pixels taken out, the support chosen
 /// by [`measure::choose_isolation`]). Noise is Poisson and independent of its neighbours,
 /// so this is shot noise's OFF rate there whatever the scene; leak fires ON only.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct QuietOff {
     /// OFF isolated events per quiet pixel-second, and its Poisson standard error.
     pub rate_hz: f64,
@@ -211,16 +211,26 @@ pub struct QuietOff {
     pub support_radius_px: usize,
     /// The rate may hold the scene's own slow events: an upper bound.
     pub upper_bound: bool,
+    /// The support chosen (to count a model's events the same way).
+    pub isolation: measure::Isolation,
+    /// The same count on the events of a model without shot noise over the same stretch
+    /// (the scene's own isolated OFF events at quiet pixels, as the model makes them),
+    /// where simulated.
+    pub scene: Option<SceneFloor>,
+}
+
+/// A model's isolated OFF events at its quiet pixels, under a recording's support
+/// ([`QuietOff::scene`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SceneFloor {
+    pub events: u64,
+    pub pixel_seconds: f64,
 }
 
 /// [`QuietOff`] of `events` (a time-sorted stretch of `input`'s recording, cut into six
 /// blocks for the support's choice); `None` where they are too few or too short.
 pub(crate) fn quiet_off(events: &crate::events::EventChunk, input: &FitInput) -> Option<QuietOff> {
-    check(events).ok()?;
-    let blocks = Blocks::split(events, 6, 0.0);
-    let stretch = FitInput { events, ..*input };
-    let (hot, _, _) = hot_pixels(&stretch, &blocks);
-    let measures = measure_blocks(&stretch, &blocks, &hot);
+    let measures = quiet_measures(events, input)?;
     let all: Vec<&BlockMeasure> = measures.iter().collect();
     let (isolation, bound) = measure::choose_isolation(&all);
     let (rate_hz, se_hz) = BlockMeasure::isolated_rate(&all, isolation, false)?;
@@ -231,7 +241,38 @@ pub(crate) fn quiet_off(events: &crate::events::EventChunk, input: &FitInput) ->
         support_window_ms: isolation.window_us() as f64 / 1e3,
         support_radius_px: isolation.radius_px(),
         upper_bound: bound.is_some(),
+        isolation,
+        scene: None,
     })
+}
+
+/// The isolated OFF events at quiet pixels of a model's `events` under the support
+/// `isolation` a recording's count chose ([`QuietOff::scene`]); `None` where they are too
+/// few or too short to measure.
+pub(crate) fn scene_floor(
+    events: &crate::events::EventChunk,
+    input: &FitInput,
+    isolation: measure::Isolation,
+) -> Option<SceneFloor> {
+    let measures = quiet_measures(events, input)?;
+    let all: Vec<&BlockMeasure> = measures.iter().collect();
+    let i = BlockMeasure::isolated(&all, isolation);
+    (i.pixel_seconds > 0.0).then_some(SceneFloor {
+        events: i.off,
+        pixel_seconds: i.pixel_seconds,
+    })
+}
+
+/// The blocks of a stretch measured for the quiet count: six blocks, hot pixels out.
+fn quiet_measures(
+    events: &crate::events::EventChunk,
+    input: &FitInput,
+) -> Option<Vec<BlockMeasure>> {
+    check(events).ok()?;
+    let blocks = Blocks::split(events, 6, 0.0);
+    let stretch = FitInput { events, ..*input };
+    let (hot, _, _) = hot_pixels(&stretch, &blocks);
+    Some(measure_blocks(&stretch, &blocks, &hot))
 }
 
 /// Each block of `input`'s events measured ([`measure`]), the `hot` pixels' events left out.

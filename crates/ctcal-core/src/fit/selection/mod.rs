@@ -149,8 +149,7 @@ pub fn fit(
             input,
             &state,
             start.mismatch,
-            simulation.grid,
-            (&geometry, planned(options).contains(&Effect::ShotNoise)),
+            (&simulation, planned(options).contains(&Effect::ShotNoise)),
         ),
         fixed: ideal.fixed,
         noise: ideal.noise,
@@ -296,17 +295,37 @@ impl Known {
         input: &FitInput,
         state: &State,
         mismatch: Option<(f64, [f64; 2])>,
-        grid: Option<(TimeUs, TimeUs)>,
-        (geometry, shot_noise_planned): (&Geometry, bool),
+        (simulation, shot_noise_planned): (&Simulation, bool),
     ) -> Self {
+        let geometry = simulation.geometry;
+        let grid = simulation.grid;
+        // the scene's own quiet OFF events, as the ideal model (no shot noise) makes them
+        let scene = std::cell::OnceCell::new();
+        let scene_events = || {
+            scene
+                .get_or_init(|| {
+                    simulation
+                        .events_of(&state.model.params, simulation.seed)
+                        .ok()
+                })
+                .as_ref()
+        };
+        let counted = |events: &EventChunk, (from, to): (TimeUs, TimeUs)| {
+            let mut quiet = super::events_only::quiet_off(events, input)?;
+            quiet.scene = scene_events().and_then(|model| {
+                super::events_only::scene_floor(&model.between(from, to), input, quiet.isolation)
+            });
+            Some(quiet)
+        };
         // without selection blocks the signature would be the count that called for it
         let judging = || {
             if geometry.judging() == Subset::Fit {
                 return None;
             }
             let (from, to) = geometry.time_range_of(geometry.judging())?;
-            super::events_only::quiet_off(&input.events.between(from, to), input)
+            counted(&input.events.between(from, to), (from, to))
         };
+        let fit_end = run.events.t.last().map_or(TimeUs::MIN, |&t| t + 1);
         Known {
             mismatch,
             grid,
@@ -317,7 +336,7 @@ impl Known {
                 grid.map_or(1, |g| g.0.clamp(1, u32::MAX as i64) as u32),
             ),
             quiet_off: shot_noise_planned
-                .then(|| super::events_only::quiet_off(&run.events, input))
+                .then(|| counted(&run.events, (TimeUs::MIN, fit_end)))
                 .flatten(),
             quiet_off_judging: shot_noise_planned.then(judging).flatten(),
         }
