@@ -5,12 +5,12 @@
 # (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)
 # NOT IDENTIFIED: ct_sigma: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (the recording does not show a threshold spread: event timing measured none and the fit blocks have too few events per pixel to compare the counts' dispersion with the model's; the model has no mismatch, which is not a measurement)
 exec "${V2E:-v2e}" \
-  --pos_thres 0.348702 \
-  --neg_thres 0.470234 \
+  --pos_thres 0.347131 \
+  --neg_thres 0.473899 \
   --sigma_thres 0 \
   --cutoff_hz 0 \
   --leak_rate_hz 0 \
-  --shot_noise_rate_hz 1.263254 \
+  --shot_noise_rate_hz 1.199974 \
   --refractory_period 0 \
   --leak_jitter_fraction 0.100000 \
   --noise_rate_cov_decades 0.100000 \
