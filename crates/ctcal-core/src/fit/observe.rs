@@ -465,22 +465,12 @@ impl Observed {
 
     /// ON and OFF events over `subset`.
     pub fn polarity_of(&self, g: &Geometry, subset: Subset) -> [u64; 2] {
-        let mut out = [0; 2];
-        for b in (0..self.blocks).filter(|&b| g.in_subset(b, subset)) {
-            out[0] += self.polarity[b][0];
-            out[1] += self.polarity[b][1];
-        }
-        out
+        sum_polarities(&self.polarity, g, subset)
     }
 
     /// ON and OFF events at still pixels over `subset` ([`Geometry::still_exposure`]).
     pub fn still_of(&self, g: &Geometry, subset: Subset) -> [u64; 2] {
-        let mut out = [0; 2];
-        for b in (0..self.blocks).filter(|&b| g.in_subset(b, subset)) {
-            out[0] += self.still[b][0];
-            out[1] += self.still[b][1];
-        }
-        out
+        sum_polarities(&self.still, g, subset)
     }
 
     /// Per-pixel counts over `subset`.
@@ -545,6 +535,18 @@ impl Observed {
         let [off, on] = self.polarity_of(g, subset);
         on + off
     }
+}
+
+/// Per-block `[OFF, ON]` counts summed over `subset`.
+fn sum_polarities(per_block: &[[u64; 2]], g: &Geometry, subset: Subset) -> [u64; 2] {
+    let mut out = [0; 2];
+    for (b, counts) in per_block.iter().enumerate() {
+        if g.in_subset(b, subset) {
+            out[0] += counts[0];
+            out[1] += counts[1];
+        }
+    }
+    out
 }
 
 fn sum_blocks(

@@ -87,6 +87,12 @@ fn total([off, on]: [u64; 2]) -> f64 {
 }
 
 impl StillBalance {
+    /// The balance on the blocks that judge effects ([`Geometry::judging`]), where every
+    /// leak decision reads it.
+    pub fn judged(real: &Observed, models: (&Observed, &Observed), geometry: &Geometry) -> Self {
+        Self::of(real, models, geometry, geometry.judging())
+    }
+
     pub fn of(
         real: &Observed,
         (without, with): (&Observed, &Observed),

@@ -474,14 +474,12 @@ fn compare_one(
         &state.kept,
     );
     // a leak takes no place its still pixels contradict, whatever the distance
-    let g = simulation.geometry;
     let contradicted = (other == Effect::Leak)
         .then(|| {
-            StillBalance::of(
+            StillBalance::judged(
                 &simulation.real,
                 (&state.model.observed, &searched.model.observed),
-                g,
-                g.judging(),
+                simulation.geometry,
             )
         })
         .filter(StillBalance::contradicted);

@@ -25,12 +25,10 @@ pub fn check(simulation: &Simulation, state: &State) -> Option<(String, Option<S
             return Some((why.clone(), Some(why)));
         }
     };
-    let g = simulation.geometry;
-    let still = StillBalance::of(
+    let still = StillBalance::judged(
         &simulation.real,
         (&observed, &state.model.observed),
-        g,
-        g.judging(),
+        simulation.geometry,
     );
     let note = format!(
         "leak_rate_hz {rate:.4} Hz checked where only leak makes events, on the judging blocks: {}; a leak is a measurement only where these counts show it ({} standard errors) and the recording does not lack it",

@@ -210,12 +210,10 @@ pub(super) fn judge_effect(
 ) -> Verdict {
     let verdict = judge(simulation, &without.observed, &with.observed, &state.kept);
     if effect == Effect::Leak {
-        let g = simulation.geometry;
-        let still = StillBalance::of(
+        let still = StillBalance::judged(
             &simulation.real,
             (&without.observed, &with.observed),
-            g,
-            g.judging(),
+            simulation.geometry,
         );
         return by_still_pixels(verdict, &still);
     }
