@@ -388,22 +388,32 @@ fn prepare_frames(
     Ok(Ok((prepared.frames, found.assumptions)))
 }
 
-/// Why the frames cannot be re-simulated: the optical flow follows fewer than
-/// [`aps::MIN_USED_INTERVALS`] of the fit run's frame intervals, and over the whole
-/// recording the motion between frames is too large on more intervals than it follows
-/// (motion too fast for the frame rate). The fit run sets the thresholds and every search,
-/// and the re-simulation interpolates the scene along that flow: with one followed
-/// interval the fit rested on a few hundredths of a second of the recording, and the
-/// thresholds fitted to it were confidently wrong (coverage draw 6028, a checkerboard at
-/// 337 px/s seen at 10 Hz: ON 0.104 [0.073, 0.150] for a true 0.191, the flow following
-/// one interval of the fit run's seven; draw 6015, 535 px/s: 0.172 / 0.066 for
-/// 0.727 / 0.312, both intervals missing). The fit then reads the events alone, as for a
-/// recording without frames. `None` where the flow follows enough intervals, or where a
-/// short recording's fit run has few frames but the flow follows most of the recording's
-/// (the IJRR slider_depth chunk: one of the fit run's two intervals moves 13.5 px, over
-/// the 12 px limit; three of the four are followed).
+/// Why the frames cannot be re-simulated. Either the motion outruns the fit run's frames:
+/// the optical flow moves too far on more of its intervals than it follows, which is where
+/// `estimate aps` on the fit run refuses (those it follows may be the few it happened to
+/// match, or a periodic pattern aliased to a smaller step); re-simulated from them, the
+/// thresholds were confidently wrong (coverage draw 7035, a texture at 521 px/s, 5 of 69
+/// intervals followed: ON 0.186 [0.089, 0.391] and OFF 0.150 [0.069, 0.324] for a true
+/// 0.695 / 0.408; an ESIM draw at 486 px/s, 6 of 25 followed in the fit run: ON 0.055
+/// [0.021, 0.147] for 0.309, with a bandwidth limit ESIM does not have). Or the flow
+/// follows fewer than [`aps::MIN_USED_INTERVALS`] of the fit run's intervals while over
+/// the whole recording the motion outruns it: with one followed interval the fit rested on
+/// a few hundredths of a second (draw 6028, a checkerboard at 337 px/s seen at 10 Hz: ON
+/// 0.104 [0.073, 0.150] for a true 0.191; draw 6015, 535 px/s: 0.172 / 0.066 for
+/// 0.727 / 0.312). The fit then reads the events alone, as for a recording without frames
+/// (draw 7035 so: ON 0.43 [0.056, 3.3], OFF 0.30 [0.095, 0.92]). `None` where the flow
+/// follows enough intervals, or where a short recording's fit run has few frames but the
+/// flow follows as many of them as it loses and most of the recording's (the IJRR
+/// slider_depth chunk: one of the fit run's two intervals moves 13.5 px, over the 12 px
+/// limit; three of the four are followed).
 fn frames_not_followed(fit_run: &PreparedFrames, all: &PreparedFrames) -> Option<String> {
     let used_fit = fit_run.intervals.iter().filter(|i| i.used).count();
+    if let Some((followed, too_fast)) = fit_run.motion_outruns_flow() {
+        return Some(format!(
+            "the motion outruns the fit run's frames: the optical flow moves too far on {too_fast} of its {} frame intervals and follows only {followed} (too fast for the frame rate; those it follows may be the few it happened to match, or a periodic pattern aliased to a smaller step), so the scene between the frames is not known well enough to re-simulate",
+            fit_run.intervals.len()
+        ));
+    }
     let (used_all, too_fast) = all.motion_outruns_flow()?;
     (used_fit < aps::MIN_USED_INTERVALS).then(|| {
         format!(
@@ -871,7 +881,13 @@ mod tests {
         let fit_run = frames(0.7, &[3], &[]);
         let all = frames(1.3, &[3, 9], &[]);
         let why = frames_not_followed(&fit_run, &all).expect("not followed");
-        assert!(why.contains("1 of the fit run's 7") && why.contains("2 of the recording's 13"));
+        assert!(why.contains("too far on 6 of its 7") && why.contains("follows only 1"));
+        // the motion outruns the whole recording, not the fit run: one of its two
+        // intervals followed, under the three needed
+        let fit_run = frames(0.2, &[0], &[]);
+        let all = frames(1.3, &[0, 9], &[]);
+        let why = frames_not_followed(&fit_run, &all).expect("not followed");
+        assert!(why.contains("1 of the fit run's 2") && why.contains("2 of the recording's 13"));
         // the IJRR slider_depth chunk: one of the fit run's two intervals over the limit,
         // three of the recording's four followed
         let fit_run = frames(0.2, &[0], &[]);
@@ -881,9 +897,13 @@ mod tests {
         let fit_run = frames(0.7, &[3], &[0, 1, 2, 4, 5, 6]);
         let all = frames(1.3, &[3, 9], &[0, 1, 2, 4, 5, 6, 7, 8, 10, 11, 12]);
         assert_eq!(frames_not_followed(&fit_run, &all), None);
-        // three followed in the fit run: re-simulated
+        // three followed in the fit run, four too fast: the motion outruns its frames
         let fit_run = frames(0.7, &[1, 3, 5], &[]);
-        let all = frames(1.3, &[1, 3, 5], &[]);
+        let all = frames(1.3, &[1, 3, 5, 7, 8, 9, 10, 11, 12], &[]);
+        let why = frames_not_followed(&fit_run, &all).expect("outrun in the fit run");
+        assert!(why.contains("too far on 4 of its 7") && why.contains("follows only 3"));
+        // four followed, three too fast: re-simulated
+        let fit_run = frames(0.7, &[0, 1, 3, 5], &[]);
         assert_eq!(frames_not_followed(&fit_run, &all), None);
     }
 
