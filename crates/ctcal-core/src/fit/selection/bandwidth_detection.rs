@@ -25,15 +25,27 @@
 //! refractory period, bandwidth's look-alike ([`super::alternatives`]), which takes up a
 //! cutoff's signal when it is fitted (the limit is read against a model the recording would
 //! have moved).
+//!
+//! Where the frames' times were aligned to the recording's events
+//! ([`crate::estimate::align`]: the shift within a quarter of a frame interval at which the
+//! events agree best with the frames), a lag every pixel shares was taken up by that shift:
+//! a photoreceptor that lags the whole scene alike looks like frames stamped late. Each
+//! simulated recording is aligned the same way before it is compared: moved earlier by the
+//! lag its paired events show, the median over the intensity bins weighted by their events,
+//! within the alignment's reach. Without it the probes read a lag the recording could not
+//! show: coverage draws 10006 (a 16 Hz cutoff at white, frames shifted +6.6 ms) and 10022
+//! (241 Hz in a 16 DN scene, +3.2 ms) were given limits of 77 and 500 Hz, above their own
+//! cutoffs, which the fit had not found.
 
 use super::super::effects::bandwidth::{self, NoiseFloor};
 use super::super::effects::{Context, EVIDENCE_THRESHOLD, Effect, Evidence};
-use super::super::observe::Observed;
+use super::super::observe::lag::BinDelay;
+use super::super::observe::{Observed, Subset};
 use super::super::search::Simulation;
 use super::super::{BandwidthDetection, Step};
 use super::noise_detection::MARGIN_Z;
 use crate::estimate::EstimateError;
-use crate::events::EventChunk;
+use crate::events::{EventChunk, TimeUs};
 
 /// Cutoffs scanned per decade.
 pub const PER_DECADE: f64 = 4.0;
@@ -53,6 +65,7 @@ pub fn detect(
     context: &Context,
     masked: &[bool],
     steps: &[Step],
+    frames_aligned: bool,
 ) -> Option<(BandwidthDetection, String)> {
     if context.model.cutoff_hz.is_some() {
         return None;
@@ -73,11 +86,13 @@ pub fn detect(
     } else if own.calls_for() {
         (Err(ALREADY.to_string()), Vec::new())
     } else {
+        let quarter_us = (simulation.geometry.frame_interval_s * 0.25e6).round() as TimeUs;
         let probes = Probes {
             simulation,
             context,
             masked,
             floor,
+            alignment_reach_us: frames_aligned.then_some(quarter_us),
         };
         probes.scan()
     };
@@ -149,6 +164,9 @@ struct Probes<'a> {
     context: &'a Context<'a>,
     masked: &'a [bool],
     floor: NoiseFloor,
+    /// Where the frames' times were aligned to the recording's events: how far the
+    /// alignment reaches (a quarter of the frame interval), microseconds.
+    alignment_reach_us: Option<TimeUs>,
 }
 
 /// `[cutoff_hz, evidence]` of every cutoff simulated, in the order tried.
@@ -167,7 +185,17 @@ impl Probes<'_> {
         let mut params = self.context.model.clone();
         Effect::Bandwidth.set(&mut params, cutoff_hz);
         let seed = self.simulation.seed.wrapping_add(RECORDING_SEED);
-        let recording = self.simulation.events_of(&params, seed)?;
+        let mut recording = self.simulation.events_of(&params, seed)?;
+        if let Some(reach_us) = self.alignment_reach_us {
+            let keys = Observed::lag_keys(&recording, g);
+            let paired = Observed::paired(model, g, self.masked, &keys);
+            let lag_us = alignment_shift_us(&paired.delay_of(g, Subset::Fit), reach_us);
+            let step = self.simulation.grid.map_or(1, |(period, _)| period.max(1));
+            let shift = (lag_us as f64 / step as f64).round() as TimeUs * step;
+            for t in &mut recording.t {
+                *t -= shift;
+            }
+        }
         let real = Observed::new(&recording, g, self.masked);
         let keys = Observed::lag_keys(&recording, g);
         let sim = Observed::paired(model, g, self.masked, &keys);
@@ -206,6 +234,28 @@ impl Probes<'_> {
     }
 }
 
+/// The shift the frame-time alignment takes from a recording whose events lag a model's
+/// by `delays` (per intensity bin, [`Observed::delay_of`]), microseconds: the median of the
+/// bins' lags weighted by their paired events (the alignment weighs every event alike),
+/// within `reach_us` either way; 0 where no bin has a lag.
+fn alignment_shift_us(delays: &[Option<BinDelay>], reach_us: TimeUs) -> TimeUs {
+    let mut lags: Vec<(f64, u32)> = delays
+        .iter()
+        .flatten()
+        .map(|d| (d.common.median_s, d.common.events))
+        .collect();
+    lags.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: u64 = lags.iter().map(|l| l.1 as u64).sum();
+    let mut below = 0u64;
+    let median_s = lags.iter().find_map(|&(lag, events)| {
+        below += events as u64;
+        (2 * below >= total).then_some(lag)
+    });
+    median_s.map_or(0, |lag| {
+        ((lag * 1e6).round() as TimeUs).clamp(-reach_us, reach_us)
+    })
+}
+
 const LOOK_ALIKE: &str = "the final model holds a refractory period, bandwidth's look-alike (both thin the events of fast changes): a cutoff may stand in its place, its signal taken up by the period, so the recording does not bound it (coverage draw 9007: a true 69 Hz cutoff fitted as a refractory period, where a limit read against that model said 200 Hz)";
 
 const NOTHING: &str = "the recording has nothing the bandwidth evidence reads (too few count cells of different intensity for a slope, and no intensity bin with enough paired ON and OFF events for a lag): no noise to judge a cutoff's signal against";
@@ -215,7 +265,7 @@ const AT_LEAST: &str =
 
 const ALREADY: &str = "the recording's own evidence calls for bandwidth beside the final model (it was tried and not kept, or an effect that explains the same residual was preferred): a cutoff may be present; the recording does not determine it";
 
-const MEANING: &str = "where the final model has no photoreceptor cutoff: called_for_below_hz, the highest cutoff at white (v2e's law: the cutoff scales with DN + 20) at which a recording of this scene would have made the bandwidth evidence call for the effect in about 95 % of such recordings (5 + 1.645 standard errors), found by simulating the final model with the cutoff and an independent seed and comparing it with the final model as the recording is, each standard error held at least at the real recording's beside the final model; cutoffs scanned down from 5 kHz (the highest the fit searches), four a decade, then two bisections; evidence: [cutoff_hz, standard errors] of every cutoff simulated; recording_evidence: the recording's own bandwidth evidence beside the final model (standard errors; null where it has nothing the evidence reads); simulations: how many this took (the final model once, then one per cutoff); tried: the effect was called for and tried, and not kept; a faster photoreceptor (a higher cutoff) may be present and is not determinable from this recording";
+const MEANING: &str = "where the final model has no photoreceptor cutoff: called_for_below_hz, the highest cutoff at white (v2e's law: the cutoff scales with DN + 20) at which a recording of this scene would have made the bandwidth evidence call for the effect in about 95 % of such recordings (5 + 1.645 standard errors), found by simulating the final model with the cutoff and an independent seed and comparing it with the final model as the recording is (moved in time as the frames' alignment moved the recording's, where it did: a lag every pixel shares is taken up by it), each standard error held at least at the real recording's beside the final model; cutoffs scanned down from 5 kHz (the highest the fit searches), four a decade, then two bisections; evidence: [cutoff_hz, standard errors] of every cutoff simulated; recording_evidence: the recording's own bandwidth evidence beside the final model (standard errors; null where it has nothing the evidence reads); simulations: how many this took (the final model once, then one per cutoff); tried: the effect was called for and tried, and not kept; a faster photoreceptor (a higher cutoff) may be present and is not determinable from this recording";
 
 fn assumption(d: &BandwidthDetection) -> String {
     let tried = if d.tried { "; tried and not kept" } else { "" };
@@ -237,6 +287,32 @@ fn assumption(d: &BandwidthDetection) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::fit::observe::lag::BinLag;
+
+    fn delay(median_ms: f64, events: u32) -> Option<BinDelay> {
+        Some(BinDelay {
+            common: BinLag {
+                median_s: median_ms * 1e-3,
+                standard_error_s: 1e-4,
+                events,
+            },
+            off_s: median_ms * 1e-3,
+            on_s: median_ms * 1e-3,
+        })
+    }
+
+    /// Lags of 9, 4 and 1 ms in bins of 100, 300 and 250 paired events: the weighted
+    /// median is the 4 ms bin's (100 + 300 of 650 events reach half); within a reach of
+    /// 3 ms it is 3 ms; no bin, no shift.
+    #[test]
+    fn the_alignment_takes_the_event_weighted_median_lag_within_its_reach() {
+        let delays = [delay(9.0, 100), None, delay(4.0, 300), delay(1.0, 250)];
+        assert_eq!(alignment_shift_us(&delays, 10_000), 4_000);
+        assert_eq!(alignment_shift_us(&delays, 3_000), 3_000);
+        let ahead = [delay(-5.0, 10), delay(2.0, 5)];
+        assert_eq!(alignment_shift_us(&ahead, 10_000), -5_000);
+        assert_eq!(alignment_shift_us(&[None, None], 10_000), 0);
+    }
 
     /// The scan against an evidence that calls for the effect at and below `limit`,
     /// recording every cutoff tried.

@@ -145,6 +145,9 @@ pub struct Parts<'a> {
     /// The thresholds at coarser frame rates and a doubled exposure (their systematics
     /// join the intervals).
     pub frame_quality: super::frame_quality::FrameQuality,
+    /// Whether the frames' times were aligned to the fit run's events (a lag common to
+    /// every pixel is then taken up by the alignment).
+    pub frames_aligned: bool,
     pub options: &'a FitOptions,
     pub input: &'a FitInput<'a>,
 }
@@ -164,6 +167,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         known,
         interpolation_share,
         frame_quality,
+        frames_aligned,
         options,
         input,
     } = parts;
@@ -238,6 +242,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         &super::context_of(&state, simulation, known),
         &state.masked,
         &steps,
+        frames_aligned,
     )
     .map(|(d, note)| {
         assumptions.push(note);

@@ -106,7 +106,8 @@ pub fn fit(
     progress("frames: selection and optical flow", 0.0);
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);
-    let (mut frames, mut assumptions) = match prepare_frames(input, &run, options)? {
+    let (mut frames, mut assumptions, frames_aligned) = match prepare_frames(input, &run, options)?
+    {
         Ok(prepared) => prepared,
         Err(why) => {
             return super::events_only::fit_from_events(input, options, progress, Some(why));
@@ -197,6 +198,7 @@ pub fn fit(
             known: loop_run.known,
             interpolation_share: start.interpolation_share,
             frame_quality,
+            frames_aligned,
             options,
             input,
         },
@@ -348,12 +350,14 @@ impl Known {
 /// the flow does not follow them ([`frames_not_followed`]) or where no interval of the fit
 /// run can be used at all (motion beyond the flow's reach on every interval, no events
 /// between the frames, frames with a problem): the events can still be read alone (draw
-/// 6028 cut to its first 0.6 s, none of its five intervals followed, was refused).
+/// 6028 cut to its first 0.6 s, none of its five intervals followed, was refused). With
+/// the frames, whether their times were aligned to the fit run's events (no offset given,
+/// and the alignment found one).
 fn prepare_frames(
     input: &FitInput,
     run: &start::FitRun,
     options: &FitOptions,
-) -> Result<Result<(PreparedFrames, Vec<String>), String>, FitError> {
+) -> Result<Result<(PreparedFrames, Vec<String>, bool), String>, FitError> {
     let found = match aps::prepare(&run.aps_input(input), input.excluded, &options.aps) {
         Ok(found) => found,
         Err(unusable) => {
@@ -385,7 +389,8 @@ fn prepare_frames(
     if let Some(why) = frames_not_followed(&found.frames, &prepared.frames) {
         return Ok(Err(why));
     }
-    Ok(Ok((prepared.frames, found.assumptions)))
+    let aligned = options.aps.frame_time_offset_s.is_none() && found.alignment.is_some();
+    Ok(Ok((prepared.frames, found.assumptions, aligned)))
 }
 
 /// Why the frames cannot be re-simulated. Either the motion outruns the fit run's frames:
