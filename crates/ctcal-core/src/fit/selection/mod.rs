@@ -106,8 +106,11 @@ pub fn fit(
     progress("frames: selection and optical flow", 0.0);
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);
-    let (mut frames, mut assumptions, frames_aligned) = match prepare_frames(input, &run, options)?
-    {
+    let FramesToSimulate {
+        mut frames,
+        mut assumptions,
+        aligned: frames_aligned,
+    } = match prepare_frames(input, &run, options)? {
         Ok(prepared) => prepared,
         Err(why) => {
             return super::events_only::fit_from_events(input, options, progress, Some(why));
@@ -357,7 +360,7 @@ fn prepare_frames(
     input: &FitInput,
     run: &start::FitRun,
     options: &FitOptions,
-) -> Result<Result<(PreparedFrames, Vec<String>, bool), String>, FitError> {
+) -> Result<Result<FramesToSimulate, String>, FitError> {
     let found = match aps::prepare(&run.aps_input(input), input.excluded, &options.aps) {
         Ok(found) => found,
         Err(unusable) => {
@@ -389,8 +392,20 @@ fn prepare_frames(
     if let Some(why) = frames_not_followed(&found.frames, &prepared.frames) {
         return Ok(Err(why));
     }
-    let aligned = options.aps.frame_time_offset_s.is_none() && found.alignment.is_some();
-    Ok(Ok((prepared.frames, found.assumptions, aligned)))
+    Ok(Ok(FramesToSimulate {
+        frames: prepared.frames,
+        assumptions: found.assumptions,
+        aligned: options.aps.frame_time_offset_s.is_none() && found.alignment.is_some(),
+    }))
+}
+
+/// The frames the fit re-simulates ([`prepare_frames`]).
+struct FramesToSimulate {
+    frames: PreparedFrames,
+    /// What preparing them on the fit run assumed.
+    assumptions: Vec<String>,
+    /// Whether their times were aligned to the fit run's events.
+    aligned: bool,
 }
 
 /// Why the frames cannot be re-simulated. Either the motion outruns the fit run's frames:
