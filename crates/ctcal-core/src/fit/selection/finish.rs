@@ -212,6 +212,13 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         &[]
     };
     assumptions.extend(counted);
+    let noise_share = (!fixed)
+        .then(|| super::noise_share::check(simulation, &mut state))
+        .flatten();
+    let noise_undetermined = noise_share.map_or(Vec::new(), |share| {
+        assumptions.push(share.note);
+        share.undetermined
+    });
     let mut params = state.model.params.clone();
     params.seed = None;
     // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml
@@ -258,6 +265,9 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
                 .or_insert(why);
             state.uncertainty.remove("leak_rate_hz");
         }
+    }
+    for (key, why) in noise_undetermined {
+        not_identified.entry(key).or_insert(why);
     }
     not_identified.extend(super::spread_report::unseen(
         state.model.params.ct_sigma,

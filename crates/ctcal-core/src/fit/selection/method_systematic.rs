@@ -50,7 +50,7 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>) -> Option<String> {
 /// logarithm) in quadrature on each side in the logarithm: a lower end at 0 stays there and
 /// an open side stays open. Returns `key [lo, hi] -> [lo', hi']`, or `None` where there is
 /// no interval about a positive value.
-fn widen_ln(
+pub(super) fn widen_ln(
     uncertainty: &mut BTreeMap<String, Uncertain>,
     key: &str,
     ln_sd: f64,

@@ -35,6 +35,7 @@ pub(in crate::fit) mod keep;
 mod leak_report;
 mod method_systematic;
 mod noise_detection;
+mod noise_share;
 mod spread_report;
 mod start;
 mod steps;
