@@ -26,6 +26,22 @@ pub fn median(values: &[f64]) -> Option<f64> {
     Some(*v.select_nth_unstable_by(mid, f64::total_cmp).1)
 }
 
+/// The bin holding the median of a histogram (`counts[k]` values in bin `k`): the first bin
+/// at which the running count reaches half the total; `None` when the histogram is empty.
+pub fn histogram_median(counts: &[u64]) -> Option<usize> {
+    let total: u64 = counts.iter().sum();
+    let mut seen = 0;
+    (total > 0).then(|| {
+        counts
+            .iter()
+            .position(|&n| {
+                seen += n;
+                2 * seen >= total
+            })
+            .unwrap_or(counts.len() - 1)
+    })
+}
+
 /// The median absolute deviation times 1.4826 (a normal's sigma); `None` when empty.
 pub fn mad_sigma(values: &[f64]) -> Option<f64> {
     let m = median(values)?;
@@ -36,6 +52,15 @@ pub fn mad_sigma(values: &[f64]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_histogram_s_median_is_the_bin_where_half_the_count_is_reached() {
+        // 3 + 1 of 8 values by bin 2: not half; bin 3 reaches 4
+        assert_eq!(histogram_median(&[3, 0, 0, 1, 4]), Some(3));
+        assert_eq!(histogram_median(&[0, 5, 0]), Some(1));
+        assert_eq!(histogram_median(&[1, 1, 1, 1, 1]), Some(2));
+        assert_eq!(histogram_median(&[0, 0]), None);
+    }
 
     #[test]
     fn hand_computed() {

@@ -62,12 +62,31 @@ pub const METHOD_LN_SYSTEMATIC: f64 = 0.37;
 /// (`benches/coverage/eppps-2026-11-27`).
 pub const METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES: f64 = 0.10;
 
-/// The method systematic of an estimate from `calibrations` (with frames or a prior).
-fn method_systematic(calibrations: &[Calibration]) -> f64 {
-    if images_read(calibrations) == 0 {
-        METHOD_LN_SYSTEMATIC
-    } else {
+/// Frames whose median is below this many DN show a dim scene (`estimate eppps` with
+/// frames, [`METHOD_LN_SYSTEMATIC_DIM`]). A photoreceptor's cutoff is proportional to its
+/// photocurrent (Lichtsteiner, Posch & Delbruck, JSSC 2008): in the dark it falls to a few
+/// hertz, slower than a moving edge, and thins the events the ideal scans count, while
+/// leak and noise weigh more against the fewer events of a dim scene. The same 20 DN
+/// bounds the scope of the reading without frames (`benches/coverage/eppps-scope-2026-12-04`).
+pub const DIM_FRAMES_DN: f64 = 20.0;
+
+/// The method's systematic error with frames whose median is under [`DIM_FRAMES_DN`], in
+/// ln C, in place of [`METHOD_LN_SYSTEMATIC`]: the smallest term that covers 95 % of such
+/// polarity-cases of the coverage study (`benches/coverage/eppps-dim-frames-2026-12-05`:
+/// with 0.37 the dim ones were covered 79 %, the others 94 %, of 404 polarity-cases read
+/// through their frames; their misses read 2-4 times high, a photoreceptor slowed by the
+/// dark).
+pub const METHOD_LN_SYSTEMATIC_DIM: f64 = 0.46;
+
+/// The method systematic of an estimate from `calibrations` (with frames or a prior) of a
+/// recording whose frames' median brightness is `frames_median_dn`.
+fn method_systematic(calibrations: &[Calibration], frames_median_dn: Option<f64>) -> f64 {
+    if images_read(calibrations) > 0 {
         METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES
+    } else if frames_median_dn.is_some_and(|dn| dn < DIM_FRAMES_DN) {
+        METHOD_LN_SYSTEMATIC_DIM
+    } else {
+        METHOD_LN_SYSTEMATIC
     }
 }
 
@@ -614,7 +633,7 @@ fn measure(
         stat,
         prior_ln_sd
             .hypot(travel)
-            .hypot(method_systematic(calibrations)),
+            .hypot(method_systematic(calibrations, rates.frames_median_dn)),
     );
     if beyond.above > 0 {
         measured.ci95[1] = f64::INFINITY;
@@ -741,7 +760,9 @@ fn assumptions(
         scans::BURN_IN_PX
     ));
     out.push(
-        if frames {
+        if let Some(dn) = rates.frames_median_dn.filter(|&dn| frames && dn < DIM_FRAMES_DN) {
+            format!("method systematic: {:.0} % (in ln C) in every interval, for frames under {DIM_FRAMES_DN:.0} DN (median {dn:.0} DN): a dim scene, where a photoreceptor whose cutoff falls with the light thins the events the ideal scans count and leak and noise weigh more; the smallest term that covers 95 % of such polarity-cases of simulated recordings with random scenes and sensor effects read through their frames (coverage study, benches/coverage/eppps-dim-frames-2026-12-05; the {:.0} % of brighter frames covered 79 % of them); a frame's DN depends on exposure and gain, so short exposures of a bright scene are held to this wider term too", 100.0 * METHOD_LN_SYSTEMATIC_DIM, 100.0 * METHOD_LN_SYSTEMATIC)
+        } else if frames {
             format!("method systematic: {:.0} % (in ln C) in every interval, the scans' error beyond their own intervals on simulated recordings with known thresholds, random scenes and random sensor effects read through their frames (coverage study, 262 polarity-cases: the smallest term that covers 95 % of them; 90 % of 80 draws it was not measured on); a sensor whose bandwidth, refractory period, leak or noise lies far outside that study's range moves the count further", 100.0 * METHOD_LN_SYSTEMATIC)
         } else {
             format!("method systematic: {:.0} % (in ln C) in every interval beside the prior's spread, the scans' error on simulated recordings with known thresholds and no other effect (six polarity-cases); bandwidth or a refractory period, which thin the events further, is not in it. Scope, from 55 coverage draws read without frames: the intervals held 27 of 27 ON and 26 of 27 OFF thresholds of scenes as contrasty as the prior's photographs and at 20 DN or more of their frames, and 15 of 18 and 12 of 18 of the rest: a texture 1.8-2.4 times less contrasty than the least contrasty photograph read 3-5 times high, and under 20 DN a photoreceptor slowed by the dark thinned the events (read 3-5 times high) or leak added to few (read 4-5 times low) (benches/coverage/eppps-scope-2026-12-04)", 100.0 * METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES)
@@ -835,6 +856,7 @@ fn report(
             "prior_ln_sd_on": on.prior_ln_sd,
             "prior_ln_sd_off": off.prior_ln_sd,
             "prior_prediction_scale": prediction_scale(calibrations),
+            "frames_median_dn": rates.frames_median_dn,
             "z95": z95(),
         }),
     }];
@@ -878,6 +900,24 @@ mod tests {
             top: 9.49,
             bottom: 0.03,
         }
+    }
+
+    #[test]
+    fn dim_frames_widen_the_method_systematic_and_a_prior_keeps_its_own() {
+        let calibration = |image| Calibration {
+            name: String::new(),
+            image,
+            curve: Vec::new(),
+        };
+        let frames = [calibration(None)];
+        assert_eq!(method_systematic(&frames, Some(19.0)), METHOD_LN_SYSTEMATIC_DIM);
+        assert_eq!(method_systematic(&frames, Some(20.0)), METHOD_LN_SYSTEMATIC);
+        assert_eq!(method_systematic(&frames, None), METHOD_LN_SYSTEMATIC);
+        let prior = [calibration(Some(0)), calibration(Some(1))];
+        assert_eq!(
+            method_systematic(&prior, Some(5.0)),
+            METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES
+        );
     }
 
     #[test]

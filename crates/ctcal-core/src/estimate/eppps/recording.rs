@@ -75,6 +75,10 @@ pub struct RecordingRates {
     /// How the recording's events follow each other at a pixel (without frames: how sharp
     /// its scene is, to read the prior at).
     pub bursts: Option<BurstShare>,
+    /// The frames' median brightness, DN, over the reliable pixels of the intervals the
+    /// travel was measured on (`None` without frames): how dim the scene is, where a
+    /// photoreceptor's bandwidth and leak weigh most.
+    pub frames_median_dn: Option<f64>,
 }
 
 /// Of a recording's consecutive supported events of one polarity at a pixel, how many
@@ -215,6 +219,7 @@ struct Finish {
     travel_error: f64,
     window: TimeUs,
     bursts: Option<BurstShare>,
+    frames_median_dn: Option<f64>,
     /// How much of each pixel's counted time lies within the window of a neighbour's
     /// event, seconds: where a noise event would find support by chance.
     covered_s: Vec<f64>,
@@ -344,6 +349,7 @@ fn finish(
         directions,
         support_window_us: f.window,
         bursts: f.bursts,
+        frames_median_dn: f.frames_median_dn,
     })
 }
 
@@ -534,6 +540,7 @@ pub fn from_events(
         travel_error,
         window,
         bursts: Some(bursts),
+        frames_median_dn: None,
         // a patch's windows are time-sorted and disjoint: only those reaching past `from`
         covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
             let windows = &by_patch[patch_of(q)];
@@ -580,6 +587,23 @@ fn patch_paths(by_patch: &[Vec<&PatchFlow>], median: f64) -> (Vec<PatchPath>, f6
         })
         .collect();
     (paths, weighted / weight.max(1.0))
+}
+
+/// The median DN of the frames over the reliable pixels of the intervals with a flow (both
+/// frames of each interval), from a histogram of whole DN; `None` where no pixel is
+/// reliable.
+fn median_reliable_dn(frames: &PreparedFrames) -> Option<f64> {
+    let mut histogram = [0u64; 256];
+    for k in (0..frames.flows.len()).filter(|&k| frames.flows[k].is_some()) {
+        for pixel in 0..frames.width * frames.height {
+            if frames.reliable(k, pixel) {
+                for dn in [&frames.dn[k], &frames.dn[k + 1]] {
+                    histogram[(dn.data[pixel].round() as usize).min(255)] += 1;
+                }
+            }
+        }
+    }
+    crate::stats::robust::histogram_median(&histogram).map(|dn| dn as f64)
 }
 
 /// The recording's rates with travel from the frames' flow: every reliable pixel of every
@@ -631,6 +655,7 @@ pub fn from_frames(
         window,
         // the frames measure the scene's contrast: no prior to read at its sharpness
         bursts: None,
+        frames_median_dn: median_reliable_dn(frames),
         covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
             let first = frames
                 .times
