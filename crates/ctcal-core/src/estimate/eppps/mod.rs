@@ -52,8 +52,8 @@ use sharpness::{PriorTag, Reading, Selection};
 /// show a cause: draws whose events lag their frames (a slow photoreceptor's signature)
 /// need 0.26 in the first study, the others 0.29; draws without an effect that changes the
 /// counts 0.26; strongly asymmetric thresholds (|ln(Cn/Cp)| > 0.7) 0.37, the others 0.33.
-/// So the term is one, in every interval with frames. It replaces 0.10 measured on six
-/// clean polarity-cases.
+/// So the term is one, in every interval with frames of 20 DN or more (dimmer frames carry
+/// [`METHOD_LN_SYSTEMATIC_DIM`]). It replaces 0.10 measured on six clean polarity-cases.
 pub const METHOD_LN_SYSTEMATIC: f64 = 0.37;
 
 /// The method's own systematic error without frames, in ln C, beside the prior's spread
@@ -910,7 +910,10 @@ mod tests {
             curve: Vec::new(),
         };
         let frames = [calibration(None)];
-        assert_eq!(method_systematic(&frames, Some(19.0)), METHOD_LN_SYSTEMATIC_DIM);
+        assert_eq!(
+            method_systematic(&frames, Some(19.0)),
+            METHOD_LN_SYSTEMATIC_DIM
+        );
         assert_eq!(method_systematic(&frames, Some(20.0)), METHOD_LN_SYSTEMATIC);
         assert_eq!(method_systematic(&frames, None), METHOD_LN_SYSTEMATIC);
         let prior = [calibration(Some(0)), calibration(Some(1))];
