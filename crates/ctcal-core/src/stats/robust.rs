@@ -55,7 +55,7 @@ mod tests {
 
     #[test]
     fn a_histogram_s_median_is_the_bin_where_half_the_count_is_reached() {
-        // 3 + 1 of 8 values by bin 2: not half; bin 3 reaches 4
+        // 3 of 8 values up to bin 2, under half; bin 3 brings the count to 4
         assert_eq!(histogram_median(&[3, 0, 0, 1, 4]), Some(3));
         assert_eq!(histogram_median(&[0, 5, 0]), Some(1));
         assert_eq!(histogram_median(&[1, 1, 1, 1, 1]), Some(2));

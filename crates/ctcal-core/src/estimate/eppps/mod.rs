@@ -78,12 +78,17 @@ pub const DIM_FRAMES_DN: f64 = 20.0;
 /// dark).
 pub const METHOD_LN_SYSTEMATIC_DIM: f64 = 0.46;
 
+/// The frames' median brightness where it is under [`DIM_FRAMES_DN`] (a dim scene).
+fn dim_frames_dn(frames_median_dn: Option<f64>) -> Option<f64> {
+    frames_median_dn.filter(|&dn| dn < DIM_FRAMES_DN)
+}
+
 /// The method systematic of an estimate from `calibrations` (with frames or a prior) of a
 /// recording whose frames' median brightness is `frames_median_dn`.
 fn method_systematic(calibrations: &[Calibration], frames_median_dn: Option<f64>) -> f64 {
     if images_read(calibrations) > 0 {
         METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES
-    } else if frames_median_dn.is_some_and(|dn| dn < DIM_FRAMES_DN) {
+    } else if dim_frames_dn(frames_median_dn).is_some() {
         METHOD_LN_SYSTEMATIC_DIM
     } else {
         METHOD_LN_SYSTEMATIC
@@ -760,7 +765,7 @@ fn assumptions(
         scans::BURN_IN_PX
     ));
     out.push(
-        if let Some(dn) = rates.frames_median_dn.filter(|&dn| frames && dn < DIM_FRAMES_DN) {
+        if let Some(dn) = dim_frames_dn(rates.frames_median_dn).filter(|_| frames) {
             format!("method systematic: {:.0} % (in ln C) in every interval, for frames under {DIM_FRAMES_DN:.0} DN (median {dn:.0} DN): a dim scene, where a photoreceptor whose cutoff falls with the light thins the events the ideal scans count and leak and noise weigh more; the smallest term that covers 95 % of such polarity-cases of simulated recordings with random scenes and sensor effects read through their frames (coverage study, benches/coverage/eppps-dim-frames-2026-12-05; the {:.0} % of brighter frames covered 79 % of them); a frame's DN depends on exposure and gain, so short exposures of a bright scene are held to this wider term too", 100.0 * METHOD_LN_SYSTEMATIC_DIM, 100.0 * METHOD_LN_SYSTEMATIC)
         } else if frames {
             format!("method systematic: {:.0} % (in ln C) in every interval, the scans' error beyond their own intervals on simulated recordings with known thresholds, random scenes and random sensor effects read through their frames (coverage study, 262 polarity-cases: the smallest term that covers 95 % of them; 90 % of 80 draws it was not measured on); a sensor whose bandwidth, refractory period, leak or noise lies far outside that study's range moves the count further", 100.0 * METHOD_LN_SYSTEMATIC)
