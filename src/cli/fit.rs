@@ -304,8 +304,10 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
     for (key, why) in r.why.iter().filter(|(k, _)| !k.starts_with("ct_o")) {
         rows.push((key.clone(), format!("not identified: {why}")));
     }
+    // a parameter not identified is shown by its why alone, as on the report page: its
+    // interval (kept in the JSON) is the model's setting, not a result
     for (key, u) in &r.uncertainties {
-        if key.starts_with("ct_o") {
+        if key.starts_with("ct_o") || r.why.contains_key(key) {
             continue;
         }
         rows.push((

@@ -186,9 +186,34 @@ fn leak_is_added_to_a_static_scene_at_its_rate() {
     );
 }
 
+/// Also the human table: a parameter the data leave undetermined shows its why, never its
+/// interval as if it were a result (the JSON keeps the model's setting in `uncertainties`).
 #[test]
 fn exactly_the_injected_hot_pixels_are_masked() {
-    let f = fit(&oracle("dev_hot_pixels"), &[]);
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("fit.json");
+    let case = oracle("dev_hot_pixels");
+    let output = succeeded(
+        ctcal()
+            .args(["fit", case.to_str().unwrap(), "--json"])
+            .arg(&file)
+            .output(),
+    );
+    let f: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&file).unwrap()).expect("the file is JSON");
+    let table = String::from_utf8(output.stdout).unwrap();
+    let why = f["why"].as_object().expect("why is an object");
+    assert!(!why.is_empty(), "this fit leaves something undetermined");
+    for key in why.keys().filter(|k| !k.starts_with("ct_o")) {
+        let rows: Vec<&str> = table
+            .lines()
+            .filter(|l| l.split_whitespace().next() == Some(key.as_str()))
+            .collect();
+        assert!(
+            rows.iter().all(|r| r.contains("not identified")) && !rows.is_empty(),
+            "{key}: {rows:?}"
+        );
+    }
     check_contract(&f);
     assert!(added(&f).contains(&"hot_pixels".to_string()));
     let masked = pixel_positions(&f["hot_pixels_masked"]);

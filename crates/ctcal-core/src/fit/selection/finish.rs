@@ -152,7 +152,9 @@ pub struct Parts<'a> {
     pub input: &'a FitInput<'a>,
 }
 
-/// The result of the fit.
+/// The result of the fit, in stages: the final model's error on the test blocks, the
+/// thresholds' intervals, the noise intervals, hot pixels and the detections, then what the
+/// data leave undetermined. Each stage appends its assumptions in this order.
 pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitResult {
     let g = simulation.geometry;
     let Parts {
@@ -171,67 +173,23 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         options,
         input,
     } = parts;
-    let measured_spread = known.mismatch;
     let after = simulation.distance(&state.model.observed, g.testing(), &state.kept);
     let residuals_after = residuals(&simulation.real, &state.model.observed, g, Subset::Fit);
-    state
-        .uncertainty
-        .extend(threshold_uncertainty(simulation, &state.model));
-    if !fixed && g.blocks_of(Role::Fit).len() >= 3 {
-        assumptions.push("the thresholds' standard errors are the larger of the count cells' spread on the fit blocks (cells taken as independent) and the delete-one-block jackknife of the median cell log ratio over the fit blocks (scaled by t(0.975, blocks - 1) / 1.96): a model that matches some stretches of the recording and not others widens them".into());
-    }
-    assumptions.extend(super::frame_quality::widen(
-        &mut state.uncertainty,
-        &frame_quality,
-    ));
-    if let Some(share) = interpolation_share
-        && let Some(note) = super::agreement::reach_for_interpolation(&mut state.uncertainty, share)
-    {
-        assumptions.push(note);
-    }
-    if let Some(start) = &start
-        && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
-    {
-        assumptions.push(note);
-    }
-    if !fixed {
-        assumptions.extend(super::method_systematic::widen(&mut state.uncertainty));
-    }
-    assumptions.extend(super::method_systematic::widen_cutoff(
-        &mut state.uncertainty,
-    ));
-    let counted = crate::fit::effects::quiet_noise::take_count_interval(
-        &mut state.uncertainty,
-        known.quiet_off,
-        g,
-        &state.model.params,
-    );
-    let measured: &[&str] = if counted.is_some() {
-        &["shot_noise_rate_hz"]
-    } else {
-        &[]
+    let widening = Widening {
+        fixed,
+        frame_quality: &frame_quality,
+        interpolation_share,
+        start: start.as_ref(),
     };
-    assumptions.extend(counted);
-    let noise_share = (!fixed)
-        .then(|| super::noise_share::check(simulation, &mut state))
-        .flatten();
-    let noise_undetermined = noise_share.map_or(Vec::new(), |share| {
-        assumptions.push(share.note);
-        share.undetermined
-    });
-    let mut params = state.model.params.clone();
-    params.seed = None;
-    // a pure ln(DN) response (offset 0) is written with the smallest offset a PARAMS.toml
-    // takes (1e-6 of white: < 3e-4 log units at DN 1); only pixels at DN 0 differ
-    if params.log_eps == Some(0.0) {
-        params.log_eps = Some(1e-6);
-    }
+    assumptions.extend(threshold_intervals(simulation, &mut state, widening));
+    let noise = noise_intervals(simulation, &mut state, fixed, known, &mut assumptions);
+    let mut params = params_to_write(&state);
     if !state.hot.is_empty() {
         assumptions.push(super::hot_report::hot_pixels(
             simulation,
             &mut state,
             input,
-            measured_spread,
+            known.mismatch,
             &mut params,
         ));
     }
@@ -239,62 +197,26 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::method_systematic::widen_spread(
         &mut state.uncertainty,
     ));
-    let noise_detection =
-        super::noise_detection::detect(simulation, &state, &steps, known).map(|(d, note)| {
-            assumptions.push(note);
-            d
-        });
-    let bandwidth_detection = super::bandwidth_detection::detect(
+    let (noise_detection, bandwidth_detection) = detections(
         simulation,
-        &super::context_of(&state, simulation, known),
-        &state.masked,
+        &state,
         &steps,
+        known,
         frames_aligned,
-    )
-    .map(|(d, note)| {
-        assumptions.push(note);
-        d
-    });
-    let mut not_identified = not_identified(&state, fixed);
-    if let Some((note, unmeasured)) = super::leak_report::check(simulation, &state) {
-        assumptions.push(note);
-        if let Some(why) = unmeasured {
-            not_identified
-                .entry("leak_rate_hz".into())
-                .and_modify(|w| *w = format!("{w}; and {why}"))
-                .or_insert(why);
-            state.uncertainty.remove("leak_rate_hz");
-        }
-    }
-    for (key, why) in noise_undetermined {
-        not_identified.entry(key).or_insert(why);
-    }
-    not_identified.extend(super::spread_report::unseen(
-        state.model.params.ct_sigma,
-        &steps,
-    ));
-    if let Some((why, measured)) = super::spread_report::measured_not_modelled(
-        state.model.params.ct_sigma,
-        &steps,
-        measured_spread,
-    ) {
-        not_identified.insert("ct_sigma".into(), why);
-        state.uncertainty.insert("ct_sigma".into(), measured);
-    }
-    assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
-        &mut state.uncertainty,
-        &not_identified,
-    ));
-    assumptions.extend(super::alternatives::reach_zero_where_not_separated(
-        &mut state.uncertainty,
+        &mut assumptions,
+    );
+    let not_identified = undetermined(
+        simulation,
+        &mut state,
+        Undetermined {
+            fixed,
+            steps: &steps,
+            measured_spread: known.mismatch,
+            noise,
+        },
         &mut ambiguities,
-        (&not_identified, measured),
-    ));
-    for k in ["ct_on", "ct_off"] {
-        if not_identified.contains_key(k) {
-            state.uncertainty.remove(k);
-        }
-    }
+        &mut assumptions,
+    );
     assumptions.extend(split_assumptions(simulation, options));
     let identified = super::super::identified(&params, &not_identified);
     FitResult {
@@ -326,6 +248,197 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         simulations: simulation.count.get(),
         frame_exposure_us: exposure_of(input.frames, options.aps.exposure_us),
     }
+}
+
+/// What widens the thresholds' intervals beyond their standard errors.
+struct Widening<'a> {
+    /// Thresholds held at given values (no standard errors, no method systematic).
+    fixed: bool,
+    frame_quality: &'a super::frame_quality::FrameQuality,
+    interpolation_share: Option<[f64; 2]>,
+    start: Option<&'a super::agreement::Measured>,
+}
+
+/// The thresholds' intervals: their standard errors on the fit blocks, widened by the
+/// frames' quality checks, the interpolation the frames miss, the start's disagreement and
+/// the method systematics (thresholds and cutoff); returns the assumptions each adds.
+fn threshold_intervals(
+    simulation: &Simulation,
+    state: &mut State,
+    widening: Widening,
+) -> Vec<String> {
+    let mut assumptions = Vec::new();
+    state
+        .uncertainty
+        .extend(threshold_uncertainty(simulation, &state.model));
+    if !widening.fixed && simulation.geometry.blocks_of(Role::Fit).len() >= 3 {
+        assumptions.push("the thresholds' standard errors are the larger of the count cells' spread on the fit blocks (cells taken as independent) and the delete-one-block jackknife of the median cell log ratio over the fit blocks (scaled by t(0.975, blocks - 1) / 1.96): a model that matches some stretches of the recording and not others widens them".into());
+    }
+    assumptions.extend(super::frame_quality::widen(
+        &mut state.uncertainty,
+        widening.frame_quality,
+    ));
+    if let Some(share) = widening.interpolation_share
+        && let Some(note) = super::agreement::reach_for_interpolation(&mut state.uncertainty, share)
+    {
+        assumptions.push(note);
+    }
+    if let Some(start) = widening.start
+        && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
+    {
+        assumptions.push(note);
+    }
+    if !widening.fixed {
+        assumptions.extend(super::method_systematic::widen(&mut state.uncertainty));
+    }
+    assumptions.extend(super::method_systematic::widen_cutoff(
+        &mut state.uncertainty,
+    ));
+    assumptions
+}
+
+/// The noise parameters' intervals and what they leave undetermined.
+struct NoiseIntervals {
+    /// Parameters measured directly (by counting), kept out of the look-alikes' reach to 0.
+    measured: &'static [&'static str],
+    /// Parameters the noise share leaves undetermined, with why.
+    undetermined: Vec<(String, String)>,
+}
+
+/// Shot noise's interval from the quiet pixels' count, and the check that the model's
+/// noise does not take up the thresholds' share of the events.
+fn noise_intervals(
+    simulation: &Simulation,
+    state: &mut State,
+    fixed: bool,
+    known: super::Known,
+    assumptions: &mut Vec<String>,
+) -> NoiseIntervals {
+    let counted = crate::fit::effects::quiet_noise::take_count_interval(
+        &mut state.uncertainty,
+        known.quiet_off,
+        simulation.geometry,
+        &state.model.params,
+    );
+    let measured: &'static [&'static str] = if counted.is_some() {
+        &["shot_noise_rate_hz"]
+    } else {
+        &[]
+    };
+    assumptions.extend(counted);
+    let noise_share = (!fixed)
+        .then(|| super::noise_share::check(simulation, state))
+        .flatten();
+    let undetermined = noise_share.map_or(Vec::new(), |share| {
+        assumptions.push(share.note);
+        share.undetermined
+    });
+    NoiseIntervals {
+        measured,
+        undetermined,
+    }
+}
+
+/// The final model's parameters as written (no seed; a pure ln(DN) response, offset 0, as
+/// the smallest offset a PARAMS.toml takes: 1e-6 of white, < 3e-4 log units at DN 1; only
+/// pixels at DN 0 differ).
+fn params_to_write(state: &State) -> crate::sim::params::PixelParams {
+    let mut params = state.model.params.clone();
+    params.seed = None;
+    if params.log_eps == Some(0.0) {
+        params.log_eps = Some(1e-6);
+    }
+    params
+}
+
+/// The two detections the final model is checked with: sensor noise below what the loop
+/// could add, and a photoreceptor cutoff the loop did not add (with its limit).
+fn detections(
+    simulation: &Simulation,
+    state: &State,
+    steps: &[Step],
+    known: super::Known,
+    frames_aligned: bool,
+    assumptions: &mut Vec<String>,
+) -> (
+    Option<crate::fit::NoiseDetection>,
+    Option<crate::fit::BandwidthDetection>,
+) {
+    let noise = super::noise_detection::detect(simulation, state, steps, known).map(|(d, note)| {
+        assumptions.push(note);
+        d
+    });
+    let bandwidth = super::bandwidth_detection::detect(
+        simulation,
+        &super::context_of(state, simulation, known),
+        &state.masked,
+        steps,
+        frames_aligned,
+    )
+    .map(|(d, note)| {
+        assumptions.push(note);
+        d
+    });
+    (noise, bandwidth)
+}
+
+/// What decides which parameters are undetermined.
+struct Undetermined<'a> {
+    fixed: bool,
+    steps: &'a [Step],
+    /// The threshold spread event timing measured (value, interval), if it did.
+    measured_spread: Option<(f64, [f64; 2])>,
+    noise: NoiseIntervals,
+}
+
+/// The parameters the data do not identify, with why: the model's unidentified settings,
+/// leak the recording cannot measure, the noise share's, a spread unseen or measured but
+/// not modelled; intervals reach 0 where a look-alike or an undetermined threshold leaves
+/// a parameter free, and an undetermined threshold loses its interval.
+fn undetermined(
+    simulation: &Simulation,
+    state: &mut State,
+    from: Undetermined,
+    ambiguities: &mut [super::Ambiguity],
+    assumptions: &mut Vec<String>,
+) -> BTreeMap<String, String> {
+    let mut not_identified = not_identified(state, from.fixed);
+    if let Some((note, unmeasured)) = super::leak_report::check(simulation, state) {
+        assumptions.push(note);
+        if let Some(why) = unmeasured {
+            not_identified
+                .entry("leak_rate_hz".into())
+                .and_modify(|w| *w = format!("{w}; and {why}"))
+                .or_insert(why);
+            state.uncertainty.remove("leak_rate_hz");
+        }
+    }
+    for (key, why) in from.noise.undetermined {
+        not_identified.entry(key).or_insert(why);
+    }
+    let spread = state.model.params.ct_sigma;
+    not_identified.extend(super::spread_report::unseen(spread, from.steps));
+    if let Some((why, measured)) =
+        super::spread_report::measured_not_modelled(spread, from.steps, from.measured_spread)
+    {
+        not_identified.insert("ct_sigma".into(), why);
+        state.uncertainty.insert("ct_sigma".into(), measured);
+    }
+    assumptions.extend(super::hot_report::reach_zero_where_thresholds_undetermined(
+        &mut state.uncertainty,
+        &not_identified,
+    ));
+    assumptions.extend(super::alternatives::reach_zero_where_not_separated(
+        &mut state.uncertainty,
+        ambiguities,
+        (&not_identified, from.noise.measured),
+    ));
+    for k in ["ct_on", "ct_off"] {
+        if not_identified.contains_key(k) {
+            state.uncertainty.remove(k);
+        }
+    }
+    not_identified
 }
 
 /// The widest 95 % interval (hi / lo) a measured parameter may have: a standard error of
