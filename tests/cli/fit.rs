@@ -407,6 +407,18 @@ fn effect_choices_and_bad_input() {
     if refits.is_empty() {
         assert!(kept.len() <= 1, "{kept:?}");
     }
+    // a one-pixel region holds no count cell: refused, not fitted from the search's start
+    // (it wrote error_before = error_after = 0 and two start values as thresholds)
+    let e = bad_input(&[
+        "fit",
+        real("ijrr_slider_depth_50k").to_str().unwrap(),
+        "--roi",
+        "0,0,1,1",
+    ]);
+    assert!(
+        e.contains("too few to fit") && e.contains("a fit needs 1000"),
+        "{e}"
+    );
     let e = bad_input(&[
         "fit",
         oracle("a_ideal_texture").to_str().unwrap(),

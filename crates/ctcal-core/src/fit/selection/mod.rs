@@ -95,12 +95,34 @@ impl State {
 }
 
 /// Fits the simulator to `input` (see the module docs of [`crate::fit`]).
+/// Refuses a fit whose kept pixels (the region, less the mask) hold fewer events than
+/// [`super::events_only::MIN_EVENTS`]: too few for any count cell to fix a threshold, so
+/// every number would be the search's start (a one-pixel region of slider_depth held 14).
+fn check_events(input: &FitInput) -> Result<(), FitError> {
+    let w = input.sensor.width as usize;
+    let events = input.events;
+    let kept = (0..events.len())
+        .filter(|&i| !input.excluded[events.y[i] as usize * w + events.x[i] as usize])
+        .count();
+    let least = super::events_only::MIN_EVENTS;
+    if kept < least {
+        return Err(FitError::new(
+            format!(
+                "{kept} events at the pixels fitted: too few to fit thresholds and effects (a fit needs {least})"
+            ),
+            "fit a larger region or a longer part of the recording",
+        ));
+    }
+    Ok(())
+}
+
 pub fn fit(
     input: &FitInput,
     options: &FitOptions,
     progress: Progress,
 ) -> Result<FitResult, FitError> {
     options.check()?;
+    check_events(input)?;
     if input.frames.len() < 2 {
         return super::events_only::fit(input, options, progress);
     }
