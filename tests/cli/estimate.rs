@@ -776,6 +776,42 @@ fn screen_without_a_stimulus_names_the_fix() {
     );
 }
 
+/// A stimulus shorter than what the screen showed: the oracle checkerboard's first 0.3 s of
+/// events with only its first 12 stimulus frames (0.15 s). The alignment could land on any
+/// stretch resembling them and read 0.21 [0.15, 0.26] for 0.3; the recording's events
+/// beyond the stimulus's span, at the rate within it, are now refused with the fix.
+#[test]
+fn screen_refuses_a_stimulus_shorter_than_the_recording() {
+    let case = oracle("dev_screen_checker");
+    let dir = tempfile::tempdir().unwrap();
+    let events = std::fs::read_to_string(case.join("events.txt")).unwrap();
+    let kept: String = events
+        .lines()
+        .filter(|l| {
+            let mut fields = l.split_whitespace();
+            let first = fields.next().and_then(|t| t.parse::<f64>().ok());
+            fields.count() != 3 || first.is_some_and(|t| t <= 0.3)
+        })
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(dir.path().join("events.txt"), kept).unwrap();
+    let stimulus = std::fs::read_to_string(case.join("stimulus.txt")).unwrap();
+    std::fs::create_dir(dir.path().join("stimulus")).unwrap();
+    let mut index = String::new();
+    for line in stimulus.lines().take(12) {
+        let name = line.split_whitespace().nth(1).unwrap();
+        std::fs::copy(case.join(name), dir.path().join(name)).unwrap();
+        index.push_str(&format!("{line}\n"));
+    }
+    std::fs::write(dir.path().join("stimulus.txt"), index).unwrap();
+    let e = bad_input(&["estimate", "screen", dir.path().to_str().unwrap()]);
+    assert!(
+        e.contains("goes on changing beyond the stimulus given")
+            && e.contains("give the whole stimulus"),
+        "{e}"
+    );
+}
+
 /// An IJRR folder with `events` (lines `t x y p`) and grey frames of `size`, each filled by
 /// `value(frame, x, y)`, at 20 ms spacing.
 fn small_recording(

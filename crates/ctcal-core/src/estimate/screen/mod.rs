@@ -43,6 +43,7 @@ pub mod lag;
 pub mod located;
 mod matching;
 pub mod register;
+pub mod span;
 #[cfg(test)]
 mod tests;
 
@@ -581,6 +582,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
             Text::from("check that this recording shows this stimulus").aside(Hint::Stimulus),
         )
     })?;
+    span::check(input.events, input.stimulus, offset_us, refresh_hz)?;
     let (hot_mask, hot) = super::exclude_hot_pixels(input.events, input.sensor, input.excluded);
     progress("finding the screen on the sensor", 0.05);
     let inputs = register::Inputs {
