@@ -104,3 +104,31 @@ fn a_failed_conversion_leaves_nothing_under_the_output_name() {
         .collect();
     assert_eq!(leftovers.len(), 1, "only the input remains: {leftovers:?}");
 }
+
+/// EVT3 counts time in loops of a 24-bit clock from 0: a recording that starts late (the
+/// Gen3 sample at 913.7 s, 54 loops) is written with the loops up to its first event, and
+/// reads back with every time as it was (it wrapped to 7.7 s before); a start decoders could
+/// only reach through hundreds of millions of words (the DAVIS346 sample, timed from the
+/// Unix epoch) is refused with the formats that keep it.
+#[test]
+fn evt3_keeps_a_late_start_and_refuses_one_it_cannot_count_to() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = real("gen3_faery_evt2.raw");
+    let out = dir.path().join("late.raw");
+    convert(&input, &out, "evt3");
+    let original = read_events(&input);
+    assert!(original.t[0] > 1 << 24, "{}", original.t[0]);
+    assert!(read_events(&out) == original, "times changed");
+    let refused = dir.path().join("epoch.raw");
+    let e = bad_input(&[
+        "convert",
+        real("davis346_faery.aedat4").to_str().unwrap(),
+        "--out",
+        refused.to_str().unwrap(),
+    ]);
+    assert!(
+        e.contains("counts time from 0") && e.contains("write HDF5 or IJRR"),
+        "{e}"
+    );
+    assert!(!refused.exists());
+}

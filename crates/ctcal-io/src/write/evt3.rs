@@ -1,8 +1,9 @@
 //! Prophesee RAW EVT 3.0 encoding (the inverse of [`crate::evt3`]): a `%` header with
 //! the geometry, then 16-bit words. Each event costs an `EVT_ADDR_X` word, plus
 //! `EVT_ADDR_Y` when the row changes and `EVT_TIME_LOW`/`EVT_TIME_HIGH` when the time does;
-//! across long gaps the high word is repeated every 1024 steps so that a decoder can count
-//! the 24-bit clock's loops. Used to write large test recordings and for `convert --to evt3`.
+//! across long gaps, and from time 0 up to the first event, the high word is repeated every
+//! 1024 steps so that a decoder can count the 24-bit clock's loops (a file whose first
+//! event lies beyond 51 days is refused). Used to write large test recordings and for `convert --to evt3`.
 
 use super::{OutputPolicy, Staged};
 use crate::error::InputError;
@@ -10,6 +11,10 @@ use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::hint::{Hint, Text};
 use std::io::Write;
 use std::path::Path;
+
+/// The most steps of 1024 high-word units (4.2 s each) written before the first event: a
+/// start up to 51 days after time 0 (2 MB of steps).
+const MAX_START_STEPS: u64 = 1 << 20;
 
 /// Writes an EVT3 file.
 pub struct Evt3Writer {
@@ -82,8 +87,21 @@ impl Evt3Writer {
             self.last_t = t;
             let (high, low) = ((t as u64) >> 12, (t as u64) & 0xfff);
             if self.high != Some(high) {
-                // step through long gaps so a decoder sees every loop of the 12-bit high word
-                let mut at = self.high.unwrap_or(high);
+                if self.high.is_none() && high / 1024 > MAX_START_STEPS {
+                    return Err(InputError::invalid(
+                        &self.staged.shown,
+                        format!(
+                            "the first event is at {t} us ({:.1} days): EVT3 counts time from 0 in loops of its 24-bit clock (16.8 s), and a decoder would need {} words to count up to it",
+                            t as f64 / 86_400e6,
+                            high / 1024
+                        ),
+                        "write HDF5 or IJRR, which keep any time, or shift the times to start near 0",
+                    ));
+                }
+                // step through long gaps, and from 0 up to the first event, so a decoder
+                // sees every loop of the 12-bit high word (it counts a loop where the word
+                // steps back by more than half its range)
+                let mut at = self.high.unwrap_or(0);
                 while high > at + 1024 {
                     at += 1024;
                     self.word(0x8, (at & 0xfff) as u16);
