@@ -26,6 +26,7 @@ pub mod prior;
 pub mod recording;
 pub mod scans;
 pub mod sharpness;
+pub mod still;
 
 use super::interval::{Measured, z95};
 use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
@@ -699,6 +700,36 @@ fn noise_assumption(rates: &RecordingRates, frames: bool) -> String {
         100.0 * rates.chance_support,
         polarity(0),
         polarity(1),
+    ) + &still_assumption(rates)
+}
+
+/// What the frames' still pixels showed of the sensor's background (with frames), and
+/// where it decided the noise bracket.
+fn still_assumption(rates: &RecordingRates) -> String {
+    let Some(still) = rates.still.filter(|s| s.pixels > 0) else {
+        return String::new();
+    };
+    let decided: Vec<&str> = (0..2)
+        .filter(|&k| rates.still_decides[k])
+        .map(|k| ["ON", "OFF"][k])
+        .collect();
+    format!(
+        "; the sensor's background where the frames show a still scene (log range under {:.2} along the pixel's path): {} pixels, {:.0} pixel-s, {:.0} ON and {:.0} OFF events ({:.4} and {:.4} per pixel-second; an ideal pixel there fires none); {}",
+        still::STILL_LN,
+        still.pixels,
+        still.exposure_s,
+        still.events[0],
+        still.events[1],
+        still.events[0] / still.exposure_s,
+        still.events[1] / still.exposure_s,
+        if decided.is_empty() {
+            "within the support filter's bound".to_string()
+        } else {
+            format!(
+                "beyond the support filter's bound for {}, so that many events per pixel-second (95 % interval) come off the counted ones there: between half its lower end (leak delays OFF events while the light falls, instead of adding ON ones) and all its upper end",
+                decided.join(" and ")
+            )
+        }
     )
 }
 
@@ -862,6 +893,12 @@ fn report(
             "prior_ln_sd_off": off.prior_ln_sd,
             "prior_prediction_scale": prediction_scale(calibrations),
             "frames_median_dn": rates.frames_median_dn,
+            "still_pixels": rates.still.map(|s| json!({
+                "pixels": s.pixels,
+                "pixel_seconds": s.exposure_s,
+                "events": {"on": s.events[0], "off": s.events[1]},
+                "decides_noise": {"on": rates.still_decides[0], "off": rates.still_decides[1]},
+            })),
             "z95": z95(),
         }),
     }];

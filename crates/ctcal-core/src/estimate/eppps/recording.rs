@@ -26,6 +26,7 @@
 //! systematic of the interval. Where the noise may be every event of a polarity, its
 //! threshold is not determinable.
 
+use super::still::StillPixels;
 use crate::estimate::event_flow::{EventFlowOptions, PatchFlow, patch_flows};
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
@@ -79,6 +80,10 @@ pub struct RecordingRates {
     /// travel was measured on (`None` without frames): how dim the scene is, where a
     /// photoreceptor's bandwidth and leak weigh most.
     pub frames_median_dn: Option<f64>,
+    /// The pixels whose frames show a still scene, and their events (with frames only),
+    /// and per polarity (ON, OFF) whether their rate decided the noise bracket.
+    pub still: Option<StillPixels>,
+    pub still_decides: [bool; 2],
 }
 
 /// Of a recording's consecutive supported events of one polarity at a pixel, how many
@@ -220,6 +225,7 @@ struct Finish {
     window: TimeUs,
     bursts: Option<BurstShare>,
     frames_median_dn: Option<f64>,
+    still: Option<StillPixels>,
     /// How much of each pixel's counted time lies within the window of a neighbour's
     /// event, seconds: where a noise event would find support by chance.
     covered_s: Vec<f64>,
@@ -325,7 +331,15 @@ fn finish(
     }
     let groups: Groups = groups.into_iter().filter(|g| g[2] > 0.0).collect();
     let (ln_se_on, ln_se_off) = bootstrap(&groups);
-    let brackets = [0, 1].map(|k| noise.bracket(k, f.window));
+    let mut brackets = [0, 1].map(|k| noise.bracket(k, f.window));
+    let mut still_decides = [false; 2];
+    if let Some(still) = &f.still {
+        for k in 0..2 {
+            if let Some(b) = still.bracket(k, &brackets[k], noise.all[k], noise.exposure_s) {
+                (brackets[k], still_decides[k]) = (b, true);
+            }
+        }
+    }
     let all_total = noise.all[0] + noise.all[1];
     Some(RecordingRates {
         on_per_px: brackets[0].middle * total[0] / total[2],
@@ -350,6 +364,8 @@ fn finish(
         support_window_us: f.window,
         bursts: f.bursts,
         frames_median_dn: f.frames_median_dn,
+        still: f.still,
+        still_decides,
     })
 }
 
@@ -403,7 +419,7 @@ impl NoiseBracket {
     /// A polarity whose noise may be every event: its rate is read at all its events (the
     /// upper end, for what needs a rate, such as the prior's sharpness), and its threshold
     /// is not determinable for `why`.
-    fn undetermined(why: String) -> Self {
+    pub(super) fn undetermined(why: String) -> Self {
         NoiseBracket {
             middle: 1.0,
             relative_error: f64::INFINITY,
@@ -541,6 +557,7 @@ pub fn from_events(
         window,
         bursts: Some(bursts),
         frames_median_dn: None,
+        still: None,
         // a patch's windows are time-sorted and disjoint: only those reaching past `from`
         covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
             let windows = &by_patch[patch_of(q)];
@@ -656,6 +673,12 @@ pub fn from_frames(
         // the frames measure the scene's contrast: no prior to read at its sharpness
         bursts: None,
         frames_median_dn: median_reliable_dn(frames),
+        still: Some(StillPixels::measure(
+            frames,
+            &tally.all,
+            &paths.exposure_s,
+            excluded,
+        )),
         covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
             let first = frames
                 .times
