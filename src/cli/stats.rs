@@ -306,6 +306,15 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
         ("hot pixels".into(), s.hot_pixels.len().to_string()),
         output::biases_row(s.biases.as_ref()),
     ];
+    if let Some(repeated) = s.inter_event_interval_s.zero.filter(|&n| n > 0) {
+        rows.push((
+            "same-microsecond events".into(),
+            format!(
+                "{} events come in the same microsecond as their pixel's previous one: a camera's pixel cannot fire twice so fast (its refractory period), so these were made by a simulator that gives a step's events one time, or duplicated by a writer or converter; every count and estimate takes them as real",
+                repeated
+            ),
+        ));
+    }
     for h in s.hot_pixels.iter().take(10) {
         rows.push((
             format!("  ({}, {})", h.x, h.y),

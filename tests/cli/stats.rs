@@ -237,3 +237,39 @@ fn human_output_is_a_table_and_json_to_stdout_is_pure() {
         .unwrap();
     let _: serde_json::Value = serde_json::from_slice(&out.stdout).expect("only JSON on stdout");
 }
+
+/// Every event of slider_depth written twice (a converter's bug): 50,000 events come in the
+/// same microsecond as their pixel's previous one, counted under
+/// `inter_event_interval_s.zero` and named in the table; the recording as recorded has none.
+#[test]
+fn duplicated_events_are_counted_and_said() {
+    let source = real("ijrr_slider_depth_50k");
+    let dir = tempfile::tempdir().unwrap();
+    let doubled: String = std::fs::read_to_string(source.join("events.txt"))
+        .unwrap()
+        .lines()
+        .flat_map(|l| {
+            let times = if l.split_whitespace().count() == 4 {
+                2
+            } else {
+                1
+            };
+            std::iter::repeat_n(format!("{l}\n"), times)
+        })
+        .collect();
+    std::fs::write(dir.path().join("events.txt"), doubled).unwrap();
+    let s = json(&["stats", dir.path().to_str().unwrap()]);
+    assert_eq!(s["inter_event_interval_s"]["zero"], 50_000);
+    let original = json(&["stats", source.to_str().unwrap()]);
+    assert_eq!(original["inter_event_interval_s"]["zero"], 0);
+    let table = succeeded(
+        ctcal()
+            .args(["stats", dir.path().to_str().unwrap()])
+            .output(),
+    );
+    let table = String::from_utf8(table.stdout).unwrap();
+    assert!(
+        table.contains("50000 events come in the same microsecond as their pixel's previous one"),
+        "{table}"
+    );
+}

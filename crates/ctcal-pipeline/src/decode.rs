@@ -266,7 +266,7 @@ structs! {
         inter_event_interval_s, frames, pixels_kept, selection, excluded_hot_pixels, why }
     RateWindow { t_s, window_s, events, events_per_pixel_per_second }
     HotPixel { x, y, events, rate_hz, z }
-    IntervalSummary { p5, median, count, resolution }
+    IntervalSummary { p5, median, count, zero, resolution }
     FrameSummary { count, median_interval_s }
     EstimatorReport { name, description, ct_on, ct_off, frame_rate_series_on,
         frame_rate_series_off, details }

@@ -54,6 +54,12 @@ impl IntervalHistogram {
         self.counts[bin_of(dt_us)] += 1;
     }
 
+    /// Intervals of exactly 0 us: events repeating their pixel's previous one in the same
+    /// microsecond.
+    pub fn zeros(&self) -> u64 {
+        self.counts[0]
+    }
+
     pub fn merge(&mut self, other: &IntervalHistogram) {
         for (a, b) in self.counts.iter_mut().zip(&other.counts) {
             *a += b;

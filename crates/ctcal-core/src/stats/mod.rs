@@ -102,6 +102,13 @@ pub struct IntervalSummary {
     pub p5: Option<f64>,
     pub median: Option<f64>,
     pub count: u64,
+    /// Intervals of 0 us: an event at the same pixel and microsecond as the pixel's
+    /// previous one. A camera's pixel does not fire twice within its refractory period
+    /// (microseconds at the least), so these come from a simulator that gives all events of
+    /// a step one time (ctcal's on-screen sample: 23,799 of 76,918 intervals) or from a
+    /// writer or converter that duplicated events; every count and estimate takes them as
+    /// real. `None` in results written before it was counted.
+    pub zero: Option<u64>,
     /// How the quantiles were computed.
     pub resolution: &'static str,
 }
@@ -454,6 +461,7 @@ impl StatsAccumulator {
                 p5: self.intervals.quantile_us(0.05).map(|us| us * 1e-6),
                 median: self.intervals.quantile_us(0.5).map(|us| us * 1e-6),
                 count: self.intervals.total(),
+                zero: Some(self.intervals.zeros()),
                 resolution: "histogram quantiles: exact below 128 us, above that within 1/128 (0.8 %) of the value",
             },
             frames,
