@@ -207,6 +207,49 @@ fn bad_options_are_usage_errors() {
     );
 }
 
+/// slider_depth's events rewritten in microseconds, its frames left in seconds: no event
+/// lies between its frames. The error named a window the user never chose ("0 s .. -3810.8
+/// s", widen --start/--end); it now gives both clocks and the fix.
+#[test]
+fn frames_and_events_on_different_clocks_are_named_as_such() {
+    let source = real("ijrr_slider_depth_50k");
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["images.txt", "images"] {
+        let from = source.join(name);
+        if from.is_dir() {
+            std::fs::create_dir(dir.path().join(name)).unwrap();
+            for entry in std::fs::read_dir(&from).unwrap() {
+                let entry = entry.unwrap();
+                std::fs::copy(entry.path(), dir.path().join(name).join(entry.file_name())).unwrap();
+            }
+        } else {
+            std::fs::copy(&from, dir.path().join(name)).unwrap();
+        }
+    }
+    let micro: String = std::fs::read_to_string(source.join("events.txt"))
+        .unwrap()
+        .lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split_whitespace().collect();
+            match f.as_slice() {
+                [t, x, y, p] => {
+                    let us = (t.parse::<f64>().unwrap() * 1e6).round() as i64;
+                    format!("{us} {x} {y} {p}\n")
+                }
+                _ => format!("{l}\n"),
+            }
+        })
+        .collect();
+    std::fs::write(dir.path().join("events.txt"), micro).unwrap();
+    let e = bad_input(&["fit", dir.path().to_str().unwrap()]);
+    assert!(
+        e.contains("no event lies between the first and the last frame")
+            && e.contains("not on one clock")
+            && !e.contains("--start"),
+        "{e}"
+    );
+}
+
 #[test]
 fn hdf5_with_integer_microsecond_times_and_signed_polarity() {
     let dir = tempfile::tempdir().unwrap();

@@ -189,8 +189,18 @@ fn space_then_u32(line: &[u8], i: usize) -> Option<(u32, usize)> {
     (j > i + 1).then_some((value, j))
 }
 
-/// A short, printable excerpt of a line for error messages.
+/// The UTF-8 byte-order mark some editors put at the start of a text file.
+const BYTE_ORDER_MARK: &[u8] = b"\xEF\xBB\xBF";
+
+/// A short, printable excerpt of a line for error messages; a byte-order mark at its start
+/// (invisible when printed) is named.
 pub fn excerpt(line: &[u8]) -> String {
+    if let Some(rest) = line.strip_prefix(BYTE_ORDER_MARK) {
+        return format!(
+            "<U+FEFF: a byte-order mark; save without it>{}",
+            excerpt(rest)
+        );
+    }
     let text = String::from_utf8_lossy(&line[..line.len().min(60)]);
     let text = text.trim_end();
     if line.len() > 60 {
@@ -224,6 +234,17 @@ mod tests {
         assert_eq!(seconds_to_us(b"1.2.3"), None);
         assert_eq!(seconds_to_us(b"."), None);
         assert_eq!(seconds_to_us(b""), None);
+    }
+
+    /// A byte-order mark prints as nothing: the excerpt names it.
+    #[test]
+    fn an_excerpt_names_a_byte_order_mark() {
+        assert_eq!(excerpt(b"0.5 1 2 1"), "0.5 1 2 1");
+        let marked = excerpt(b"\xEF\xBB\xBF0.5 1 2 1");
+        assert_eq!(
+            marked,
+            "<U+FEFF: a byte-order mark; save without it>0.5 1 2 1"
+        );
     }
 
     #[test]

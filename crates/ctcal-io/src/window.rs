@@ -358,6 +358,21 @@ fn read_window(
     let unread: Vec<(TimeUs, TimeUs)> =
         chosen.blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
     let events = read_events(recording, source, (from, to), &unread, observer)?;
+    let between_frames = window.events_between_frames && chosen.frames.len() >= 2;
+    if events.is_empty() && between_frames && window.start_s.is_none() && window.end_s.is_none() {
+        // no window was asked for: the frames' span held none of the events
+        return Err(InputError::invalid(
+            &recording.path,
+            format!(
+                "no event lies between the first and the last frame: the frames span {:.6} s .. {:.6} s of the file's clock and the first event is at {:.6} s, so frames and events are not on one clock or in one unit",
+                us_to_s(from),
+                us_to_s(to),
+                us_to_s(first)
+            ),
+            "check that the frames' and the events' times are seconds of the same clock",
+        )
+        .into());
+    }
     if events.is_empty() {
         return Err(InputError::EmptyWindow {
             path: recording.path.clone(),

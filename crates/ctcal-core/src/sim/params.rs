@@ -75,7 +75,8 @@ pub struct PixelParams {
     /// Refractory period, seconds.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub refractory_s: Option<f64>,
-    /// Photoreceptor cutoff at full white (255 DN), Hz; scales as (DN + 20) / 275.
+    /// Photoreceptor cutoff at full white (255 DN), Hz; scales as (DN + 20) / 275. 0: no
+    /// bandwidth limit, as v2e's `cutoff_hz = 0`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cutoff_hz: Option<f64>,
     /// Leak: the reference drifts down by `leak_rate_hz * ct_on` per second.
@@ -123,6 +124,9 @@ pub struct ParamsError {
     pub problem: String,
     pub fix: String,
 }
+
+/// The largest timestamp jitter (standard deviation, seconds) a parameter file may ask for.
+pub const MAX_JITTER_S: f64 = 1.0;
 
 impl PixelParams {
     /// Ideal pixel with these thresholds (every effect off).
@@ -244,6 +248,17 @@ impl PixelParams {
                     "give a rate per pixel per second (real sensors: well below 1e3)",
                 ));
             }
+        }
+        if let Some(j) = self.timestamp_jitter_s
+            && j > MAX_JITTER_S
+        {
+            return Err(fail(
+                "timestamp_jitter_s",
+                format!(
+                    "is {j} s; a jitter's standard deviation beyond {MAX_JITTER_S} s would reorder a recording's seconds, and the simulator keeps events within the frames' span, so it cannot be simulated as given"
+                ),
+                "give the standard deviation in seconds (real sensors: microseconds to a millisecond)",
+            ));
         }
         if let Some(f) = self.hot_pixel_fraction
             && !(0.0..=1.0).contains(&f)
@@ -385,6 +400,25 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().contains("`display.gamma`"), "{e}");
         assert_eq!(first_non_finite("a = [1.0, -inf]"), Some("a[1]".into()));
+    }
+
+    /// A jitter of 1e9 s was accepted and the simulator clamped every event into the
+    /// frames' span: a parameter no sensor has, simulated as something else.
+    #[test]
+    fn a_jitter_beyond_a_second_is_refused() {
+        let e = PixelParams::from_toml(
+            "ct_on = 0.3\nct_off = 0.3\ntimestamp_jitter_s = 1e9\n",
+            "p.toml",
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("`timestamp_jitter_s`"), "{e}");
+        assert!(
+            PixelParams::from_toml(
+                "ct_on = 0.3\nct_off = 0.3\ntimestamp_jitter_s = 0.001\n",
+                "p"
+            )
+            .is_ok()
+        );
     }
 
     #[test]
