@@ -164,9 +164,14 @@ impl PixelParams {
         }
         let params: PixelParams = toml::from_str(text).map_err(|e| ParamsError {
             source_name: source_name.to_string(),
+            // the whole line the error is on, numbered (a span may be an empty value)
             key: e
                 .span()
-                .map(|s| text[s].lines().next().unwrap_or("").trim().to_string())
+                .map(|s| {
+                    let start = text[..s.start].rfind('\n').map_or(0, |i| i + 1);
+                    let line = text[start..].lines().next().unwrap_or("").trim();
+                    format!("line {}: {line}", text[..start].matches('\n').count() + 1)
+                })
                 .unwrap_or_default(),
             problem: format!("cannot be read: {}", e.message()),
             fix: "PARAMS.toml needs ct_on and ct_off; optional keys: ct_sigma, ct_sigma_temporal, refractory_s, cutoff_hz, leak_rate_hz, leak_spread_decades, shot_noise_rate_hz, shot_noise_bright_factor, hot_pixel_fraction, hot_pixel_rate_hz, timestamp_jitter_s, log_response (\"v2e\"|\"eps\"), log_eps, seed, [display]".into(),
@@ -400,6 +405,16 @@ mod tests {
         .unwrap_err();
         assert!(e.to_string().contains("`display.gamma`"), "{e}");
         assert_eq!(first_non_finite("a = [1.0, -inf]"), Some("a[1]".into()));
+    }
+
+    /// A value TOML cannot read names its line (an empty value gave "`` cannot be read").
+    #[test]
+    fn an_unreadable_value_names_its_line() {
+        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = \n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("`line 2: ct_off =`"), "{e}");
+        let e =
+            PixelParams::from_toml("ct_on = 0.3\nct_off = 0.3\nseed = -1\n", "p.toml").unwrap_err();
+        assert!(e.to_string().contains("`line 3: seed = -1`"), "{e}");
     }
 
     /// A jitter of 1e9 s was accepted and the simulator clamped every event into the
