@@ -287,19 +287,25 @@ fn eppps_says_when_the_noise_may_be_every_event_of_a_polarity() {
 /// events are ON; 0.81 ON events per pixel-second where the frames do not change, 0.84
 /// where they change most). Every leak event finds a neighbour's within the support window,
 /// and eppps with frames read ON 0.106 [0.051, 0.219] for 0.79. The pixels whose frames
-/// show a still scene now measure the background: ON is not determinable (it may be every
-/// ON event) and OFF holds the truth (measured: 1.05 [0.39, 2.84]).
+/// show a still scene now measure the background and it sets ON's noise bracket (measured:
+/// ON 0.380 [0.134, 1.080], OFF 1.19 [0.50, 2.88], both holding the truth).
 #[test]
 fn eppps_measures_the_background_where_the_frames_are_still() {
     let work = tempfile::tempdir().unwrap();
     let record = run_peer_draw(Method::Eppps, 11002, work.path());
     assert_eq!(record.case.generator, ctcal::coverage::Generator::Voltmeter);
+    covered_value(&record, "ct_on");
     covered_value(&record, "ct_off");
-    let Reported::NotDeterminable { why } = &record.reported["ct_on"] else {
-        panic!("ON: {:?}", record.reported["ct_on"]);
+    let ctcal::coverage::Outcome::Ok {
+        output: Some(output),
+    } = &record.outcome
+    else {
+        panic!("{:?}", record.outcome);
     };
+    let still = &output["estimators"][0]["details"]["still_pixels"];
+    assert_eq!(still["decides_noise"]["on"], true, "{still}");
     assert!(
-        why.contains("the sensor's background may be every ON event"),
-        "{why}"
+        still["events"]["on"].as_f64().unwrap() > 10_000.0,
+        "{still}"
     );
 }

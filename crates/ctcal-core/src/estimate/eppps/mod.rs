@@ -200,6 +200,16 @@ pub fn estimate(
         None => raw,
     };
     let (on, off) = measure_both(&symmetric, &rates);
+    // with frames, the sensor's background where they are still, the scene's own events
+    // there read at the thresholds just found
+    let still = rates.with_still_background([on.measured.value, off.measured.value]);
+    let (rates, (on, off)) = match still {
+        Some(rates) => {
+            let both = measure_both(&symmetric, &rates);
+            (rates, both)
+        }
+        None => (rates, (on, off)),
+    };
     // the two thresholds interact in every pixel (see `scans::count`): scan again at the
     // OFF/ON ratio the symmetric scans found, and read both polarities there
     let measured_ratio = off.measured.value / on.measured.value;
@@ -726,7 +736,7 @@ fn still_assumption(rates: &RecordingRates) -> String {
             "within the support filter's bound".to_string()
         } else {
             format!(
-                "beyond the support filter's bound for {}, so that many events per pixel-second (95 % interval) come off the counted ones there: between half its lower end (leak delays OFF events while the light falls, instead of adding ON ones) and all its upper end",
+                "beyond the support filter's bound for {}, so that many events per pixel-second (95 % interval, less the most the still pixels' own scene makes: their log range over the threshold read without them) come off the counted ones there: between half its lower end (leak delays OFF events while the light falls, instead of adding ON ones) and all its upper end",
                 decided.join(" and ")
             )
         }

@@ -84,6 +84,39 @@ pub struct RecordingRates {
     /// and per polarity (ON, OFF) whether their rate decided the noise bracket.
     pub still: Option<StillPixels>,
     pub still_decides: [bool; 2],
+    /// ON and OFF events of the units that count, and their counted pixel-seconds.
+    pub counted_events: [f64; 2],
+    pub counted_exposure_s: f64,
+}
+
+impl RecordingRates {
+    /// These rates with the still pixels' background in the noise brackets where it
+    /// exceeds the support filter's bound ([`StillPixels::bracket`]), the scene's own
+    /// events at still pixels read at `thresholds` (ON, OFF: as read without them) taken
+    /// off first; `None` where nothing changes.
+    pub fn with_still_background(&self, thresholds: [f64; 2]) -> Option<RecordingRates> {
+        let still = self.still?;
+        let mut out = self.clone();
+        for (k, &threshold) in thresholds.iter().enumerate() {
+            let support = &self.noise[k];
+            let Some(b) = still.bracket(
+                k,
+                support,
+                (self.counted_events[k], self.counted_exposure_s),
+                threshold,
+            ) else {
+                continue;
+            };
+            let rescale = b.middle / support.middle;
+            if k == 0 {
+                out.on_per_px *= rescale;
+            } else {
+                out.off_per_px *= rescale;
+            }
+            (out.noise[k], out.still_decides[k]) = (b, true);
+        }
+        (out.still_decides != self.still_decides).then_some(out)
+    }
 }
 
 /// Of a recording's consecutive supported events of one polarity at a pixel, how many
@@ -331,15 +364,7 @@ fn finish(
     }
     let groups: Groups = groups.into_iter().filter(|g| g[2] > 0.0).collect();
     let (ln_se_on, ln_se_off) = bootstrap(&groups);
-    let mut brackets = [0, 1].map(|k| noise.bracket(k, f.window));
-    let mut still_decides = [false; 2];
-    if let Some(still) = &f.still {
-        for k in 0..2 {
-            if let Some(b) = still.bracket(k, &brackets[k], noise.all[k], noise.exposure_s) {
-                (brackets[k], still_decides[k]) = (b, true);
-            }
-        }
-    }
+    let brackets = [0, 1].map(|k| noise.bracket(k, f.window));
     let all_total = noise.all[0] + noise.all[1];
     Some(RecordingRates {
         on_per_px: brackets[0].middle * total[0] / total[2],
@@ -365,7 +390,9 @@ fn finish(
         bursts: f.bursts,
         frames_median_dn: f.frames_median_dn,
         still: f.still,
-        still_decides,
+        still_decides: [false; 2],
+        counted_events: noise.all,
+        counted_exposure_s: noise.exposure_s,
     })
 }
 

@@ -12,8 +12,10 @@
 //! adds ON events while the light does not fall and delays OFF events while it falls, so a
 //! moving pixel's ON excess is between half and all of the still pixels' rate (half: light
 //! falling half the time). Noise fires at its rate whatever the scene does. So a still
-//! pixels' rate `r` (Garwood's 95 % interval on their count) takes between half of its
-//! lower end and all of its upper end off the counted events.
+//! pixels' rate `r` (Garwood's 95 % interval on their count, less what their own scene may
+//! make: a camera's pixel starts from any reference, so one whose light moves by a range `d`
+//! fires about `d / C` times for it, `C` the threshold read without the still pixels) takes
+//! between half of its lower end and all of its upper end off the counted events.
 
 use super::recording::NoiseBracket;
 use crate::estimate::frames::PreparedFrames;
@@ -32,6 +34,10 @@ pub struct StillPixels {
     /// Their counted time, pixel-seconds.
     pub exposure_s: f64,
     pub events: [f64; 2],
+    /// The still pixels' log ranges, summed: a still pixel fires for its scene at most
+    /// about range / C times (a camera's pixel starts from any reference, so one within
+    /// its range of a crossing fires once).
+    pub log_range_sum: f64,
 }
 
 /// Spacing of the samples along a pixel's path, pixels of travel (the scans' own step).
@@ -47,14 +53,15 @@ impl StillPixels {
         exposure_s: &[f64],
         excluded: &[bool],
     ) -> Self {
-        let still: Vec<([f64; 2], f64)> = (0..frames.width * frames.height)
-            .filter(|&p| !excluded[p] && exposure_s[p] > 0.0 && is_still(frames, p))
-            .map(|p| (counts[p], exposure_s[p]))
+        let still: Vec<([f64; 2], f64, f64)> = (0..frames.width * frames.height)
+            .filter(|&p| !excluded[p] && exposure_s[p] > 0.0)
+            .filter_map(|p| Some((counts[p], exposure_s[p], still_range(frames, p)? as f64)))
             .collect();
         let mut sum = StillPixels::default();
-        for (count, exposure) in trim_outliers(still) {
+        for (count, exposure, range) in trim_outliers(still) {
             sum.pixels += 1;
             sum.exposure_s += exposure;
+            sum.log_range_sum += range;
             for (total, c) in sum.events.iter_mut().zip(count) {
                 *total += c;
             }
@@ -63,10 +70,13 @@ impl StillPixels {
     }
 
     /// The background rate of polarity `k` (events per pixel-second), Garwood's 95 %
-    /// interval on the still pixels' count; `None` without still time.
-    pub fn rate95(&self, k: usize) -> Option<(f64, f64)> {
+    /// interval on the still pixels' count less the most their scene makes at threshold
+    /// `threshold` (see [`Self::log_range_sum`]); `None` without still time.
+    pub fn rate95(&self, k: usize, threshold: f64) -> Option<(f64, f64)> {
         (self.exposure_s > 0.0).then(|| {
-            let (lo, hi) = crate::stats::binomial::poisson95(self.events[k].round() as usize);
+            let scene = self.log_range_sum / threshold.max(1e-3);
+            let count = (self.events[k] - scene).max(0.0).round() as usize;
+            let (lo, hi) = crate::stats::binomial::poisson95(count);
             (lo / self.exposure_s, hi / self.exposure_s)
         })
     }
@@ -80,10 +90,10 @@ impl StillPixels {
         &self,
         k: usize,
         support: &NoiseBracket,
-        all: f64,
-        exposure_s: f64,
+        (all, exposure_s): (f64, f64),
+        threshold: f64,
     ) -> Option<NoiseBracket> {
-        let (lo, hi) = self.rate95(k)?;
+        let (lo, hi) = self.rate95(k, threshold)?;
         let (least, most) = (0.5 * lo * exposure_s, hi * exposure_s);
         if all <= 0.0 || support.why.is_some() || least <= support.noise_share * all {
             return None;
@@ -115,17 +125,17 @@ const OUTLIER_QUANTILE: f64 = 0.999;
 
 /// The still pixels (ON and OFF counts, counted seconds) whose total count is within
 /// [`OUTLIER_QUANTILE`] of the uniform rate the others make.
-fn trim_outliers(mut still: Vec<([f64; 2], f64)>) -> Vec<([f64; 2], f64)> {
+fn trim_outliers(mut still: Vec<([f64; 2], f64, f64)>) -> Vec<([f64; 2], f64, f64)> {
     use statrs::distribution::{DiscreteCDF, Poisson};
     for _ in 0..2 {
         let (events, exposure) = still
             .iter()
-            .fold((0.0, 0.0), |(n, e), (c, s)| (n + c[0] + c[1], e + s));
+            .fold((0.0, 0.0), |(n, e), (c, s, _)| (n + c[0] + c[1], e + s));
         if events <= 0.0 || exposure <= 0.0 {
             break;
         }
         let rate = events / exposure;
-        still.retain(|(c, s)| {
+        still.retain(|(c, s, _)| {
             let Ok(poisson) = Poisson::new(rate * s) else {
                 return true;
             };
@@ -137,15 +147,14 @@ fn trim_outliers(mut still: Vec<([f64; 2], f64)>) -> Vec<([f64; 2], f64)> {
     still
 }
 
-/// Whether pixel `pixel`'s frames, sampled along its path every [`STEP_PX`] of travel over
-/// every used interval where it is reliable, stay within [`STILL_LN`] in log, at
-/// [`super::DIM_FRAMES_DN`] or more (where the frames' log offset, known only to its
+/// Pixel `pixel`'s log range where its frames, sampled along its path every [`STEP_PX`]
+/// of travel over every used interval where it is reliable, stay within [`STILL_LN`] in log
+/// at [`super::DIM_FRAMES_DN`] or more (where the frames' log offset, known only to its
 /// interval, changes a log range little: a dim pixel still in the frames' log may not be
-/// in the sensor's).
-fn is_still(frames: &PreparedFrames, pixel: usize) -> bool {
+/// in the sensor's); `None` where they do not (or it has no sample).
+fn still_range(frames: &PreparedFrames, pixel: usize) -> Option<f32> {
     let (x, y) = (pixel % frames.width, pixel / frames.width);
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    let mut seen = false;
     for (k, flow) in frames.flows.iter().enumerate() {
         let Some(flow) = flow else { continue };
         if !frames.reliable(k, pixel) {
@@ -158,17 +167,17 @@ fn is_still(frames: &PreparedFrames, pixel: usize) -> bool {
             let t = (t0 + ((t1 - t0) as f64 * j as f64 / steps as f64) as i64).min(t1 - 1);
             if let Some(dn) = frames.dn_at(x as u16, y as u16, t) {
                 if (dn as f64) < super::DIM_FRAMES_DN {
-                    return false;
+                    return None;
                 }
                 let l = frames.log(dn);
-                (lo, hi, seen) = (lo.min(l), hi.max(l), true);
+                (lo, hi) = (lo.min(l), hi.max(l));
                 if hi - lo >= STILL_LN {
-                    return false;
+                    return None;
                 }
             }
         }
     }
-    seen
+    (hi >= lo).then_some(hi - lo)
 }
 
 #[cfg(test)]
@@ -193,11 +202,12 @@ mod tests {
             pixels: 500,
             exposure_s: 1000.0,
             events: [100.0, 0.0],
+            log_range_sum: 0.0,
         };
-        let (lo, hi) = still.rate95(0).unwrap();
+        let (lo, hi) = still.rate95(0, 0.3).unwrap();
         assert!((lo * 1000.0 - 81.36).abs() < 0.01 && (hi * 1000.0 - 121.63).abs() < 0.01);
         let b = still
-            .bracket(0, &support(0.01), 5000.0, 10_000.0)
+            .bracket(0, &support(0.01), (5000.0, 10_000.0), 0.3)
             .expect("decides");
         let (least, most) = (0.5 * lo * 10_000.0, hi * 10_000.0);
         let expected = ((5000.0 - least) * (5000.0 - most)).sqrt() / 5000.0;
@@ -207,11 +217,29 @@ mod tests {
         let half = 0.5 * ((5000.0 - least) / (5000.0 - most)).ln();
         assert!((b.half_range() - half).abs() < 1e-12);
         // within the support filter's bound (up to 20 % noise): the support decides
-        assert!(still.bracket(0, &support(0.2), 5000.0, 10_000.0).is_none());
+        assert!(
+            still
+                .bracket(0, &support(0.2), (5000.0, 10_000.0), 0.3)
+                .is_none()
+        );
         // no OFF event where the frames are still: no background to take off
-        assert!(still.bracket(1, &support(0.0), 5000.0, 10_000.0).is_none());
+        assert!(
+            still
+                .bracket(1, &support(0.0), (5000.0, 10_000.0), 0.3)
+                .is_none()
+        );
+        // the scene's own events at still pixels come off first: 500 pixels over a range
+        // of 0.006 each may make 10 events at a threshold of 0.3, so 90 are background
+        let ranged = StillPixels {
+            log_range_sum: 3.0,
+            ..still
+        };
+        let (lo90, _) = crate::stats::binomial::poisson95(90);
+        assert!((ranged.rate95(0, 0.3).unwrap().0 - lo90 / 1000.0).abs() < 1e-12);
         // a background that may be every event
-        let all = still.bracket(0, &support(0.01), 1000.0, 10_000.0).unwrap();
+        let all = still
+            .bracket(0, &support(0.01), (1000.0, 10_000.0), 0.3)
+            .unwrap();
         let why = all.why.expect("not determinable");
         assert!(why.contains("may be every ON event"), "{why}");
     }
