@@ -179,6 +179,24 @@ fn extend(
     x: usize,
     y: usize,
 ) {
+    let travel = path_samples(frames, k, x, y, |t, dn| {
+        profile.values.push(response.log(dn));
+        profile.times_s.push(t as f64 * 1e-6);
+        true
+    });
+    profile.length += travel;
+}
+
+/// Visits pixel (x, y)'s frame values (DN, without the offset) along its path over
+/// interval `k`, every [`STEP_PX`] of travel at most (interpolated along the flow, where the
+/// pixel is reliable), until `visit(t, dn)` returns `false`; returns the interval's travel.
+pub(super) fn path_samples(
+    frames: &PreparedFrames,
+    k: usize,
+    x: usize,
+    y: usize,
+    mut visit: impl FnMut(crate::events::TimeUs, f32) -> bool,
+) -> f64 {
     let (u, v) = frames.flows[k].as_ref().map_or((0.0, 0.0), |f| f.at(x, y));
     let travel = u.hypot(v) as f64;
     let steps = ((travel / STEP_PX).ceil() as usize).clamp(1, 4000);
@@ -186,12 +204,13 @@ fn extend(
     for j in 0..=steps {
         let t = t0 + ((t1 - t0) as f64 * j as f64 / steps as f64) as crate::events::TimeUs;
         let t = t.min(t1 - 1);
-        if let Some(dn) = frames.dn_at(x as u16, y as u16, t) {
-            profile.values.push(response.log(dn));
-            profile.times_s.push(t as f64 * 1e-6);
+        if let Some(dn) = frames.dn_at(x as u16, y as u16, t)
+            && !visit(t, dn)
+        {
+            break;
         }
     }
-    profile.length += travel;
+    travel
 }
 
 #[cfg(test)]

@@ -40,9 +40,6 @@ pub struct StillPixels {
     pub log_range_sum: f64,
 }
 
-/// Spacing of the samples along a pixel's path, pixels of travel (the scans' own step).
-const STEP_PX: f32 = 0.25;
-
 impl StillPixels {
     /// The still pixels among those counted (`exposure_s[pixel] > 0`, not excluded) and
     /// their events (`counts[pixel]`: ON, OFF, over the pixel's counted intervals), less
@@ -147,34 +144,28 @@ fn trim_outliers(mut still: Vec<([f64; 2], f64, f64)>) -> Vec<([f64; 2], f64, f6
     still
 }
 
-/// Pixel `pixel`'s log range where its frames, sampled along its path every [`STEP_PX`]
-/// of travel over every used interval where it is reliable, stay within [`STILL_LN`] in log
-/// at [`super::DIM_FRAMES_DN`] or more (where the frames' log offset, known only to its
-/// interval, changes a log range little: a dim pixel still in the frames' log may not be
-/// in the sensor's); `None` where they do not (or it has no sample).
+/// Pixel `pixel`'s log range where its frames, sampled along its path as the scans sample
+/// it ([`super::calibration::path_samples`]) over every used interval where it is
+/// reliable, stay within [`STILL_LN`] in log at [`super::DIM_FRAMES_DN`] or more (where the
+/// frames' log offset, known only to its interval, changes a log range little: a dim pixel
+/// still in the frames' log may not be in the sensor's); `None` where they do not (or it
+/// has no sample).
 fn still_range(frames: &PreparedFrames, pixel: usize) -> Option<f32> {
     let (x, y) = (pixel % frames.width, pixel / frames.width);
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    for (k, flow) in frames.flows.iter().enumerate() {
-        let Some(flow) = flow else { continue };
-        if !frames.reliable(k, pixel) {
+    let mut still = true;
+    for k in 0..frames.flows.len() {
+        if frames.flows[k].is_none() || !frames.reliable(k, pixel) {
             continue;
         }
-        let (u, v) = flow.at(x, y);
-        let steps = ((u.hypot(v) / STEP_PX).ceil() as usize).clamp(1, 4000);
-        let (t0, t1) = (frames.times[k], frames.times[k + 1]);
-        for j in 0..=steps {
-            let t = (t0 + ((t1 - t0) as f64 * j as f64 / steps as f64) as i64).min(t1 - 1);
-            if let Some(dn) = frames.dn_at(x as u16, y as u16, t) {
-                if (dn as f64) < super::DIM_FRAMES_DN {
-                    return None;
-                }
-                let l = frames.log(dn);
-                (lo, hi) = (lo.min(l), hi.max(l));
-                if hi - lo >= STILL_LN {
-                    return None;
-                }
-            }
+        super::calibration::path_samples(frames, k, x, y, |_, dn| {
+            let l = frames.log(dn);
+            (lo, hi) = (lo.min(l), hi.max(l));
+            still = (dn as f64) >= super::DIM_FRAMES_DN && hi - lo < STILL_LN;
+            still
+        });
+        if !still {
+            return None;
         }
     }
     (hi >= lo).then_some(hi - lo)
