@@ -786,6 +786,52 @@ fn a_huge_sensor_keeps_state_only_for_the_area_its_events_reach() {
     assert_eq!(left, vec!["far.txt", "huge.raw"]);
 }
 
+/// Events of the real slider recording (no frames) under a first line stating `size`.
+fn slider_events_stating(dir: &Path, name: &str, size: &str) -> String {
+    let events = std::fs::read_to_string(real("ijrr_slider_depth_50k").join("events.txt")).unwrap();
+    let body: String = events
+        .lines()
+        .skip(1)
+        .take(20_000)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let folder = dir.join(name);
+    std::fs::create_dir(&folder).unwrap();
+    write(&folder, "events.txt", format!("{size}\n{body}").as_bytes());
+    folder.to_string_lossy().into_owned()
+}
+
+#[test]
+fn a_stated_sensor_far_beyond_the_events_gives_way_to_their_reach() {
+    // a hostile round's header claimed 4096x4096 over a 1280x720 camera: the estimators'
+    // maps (682 MB for fit) and the hot-pixel share followed the claim
+    let dir = tempfile::tempdir().unwrap();
+    let honest = json(&[
+        "estimate",
+        "eppps",
+        &slider_events_stating(dir.path(), "honest", "240 180"),
+    ]);
+    let claimed = slider_events_stating(dir.path(), "claimed", "4096 4096");
+    let lying = json(&["estimate", "eppps", &claimed]);
+    assert_eq!(lying["ct_on"], honest["ct_on"]);
+    assert_eq!(lying["ct_off_ci95"], honest["ct_off_ci95"]);
+    assert!(
+        strings(&lying["assumptions"])
+            .iter()
+            .any(|a| a.contains("cover those 43200 pixels, not the 16777216 stated")),
+        "{}",
+        lying["assumptions"]
+    );
+    // a size given stands as given
+    let given = json(&["estimate", "eppps", &claimed, "--sensor", "240x180"]);
+    assert_eq!(given["ct_on"], honest["ct_on"]);
+    assert!(
+        !strings(&given["assumptions"])
+            .iter()
+            .any(|a| a.contains("4096x4096 stated"))
+    );
+}
+
 #[test]
 fn noise_and_blur_beyond_the_budget_are_refused_before_anything_is_written() {
     let dir = tempfile::tempdir().unwrap();

@@ -24,6 +24,7 @@ pub mod blosc;
 pub mod dat;
 mod detect;
 pub mod error;
+pub mod events_area;
 pub mod evt2;
 pub mod evt3;
 pub mod fit_region;

@@ -188,7 +188,16 @@ pub fn load(
     }
     let read = read_window(&recording, Source::Decode, window, observer)?;
     let events = read.events;
-    let resolved = recording.resolve_sensor(events.max_coordinates());
+    let mut resolved = recording.resolve_sensor(events.max_coordinates());
+    let mut area_note = None;
+    if let Some((area, note)) = crate::events_area::reach_instead(
+        &resolved,
+        reach_with_region(events.max_coordinates(), selection.roi),
+        !read.chosen.frames.is_empty() || selection.mask.is_some(),
+        &recording.path,
+    ) {
+        (resolved, area_note) = (area, Some(note));
+    }
     if let Some(w) = &resolved.warning {
         observer.warn(w);
     }
@@ -215,7 +224,8 @@ pub fn load(
         });
     }
     let kept = selection.build(sensor, &recording.path, force)?;
-    let notes = notes(&read.chosen, &kept);
+    let mut notes = notes(&read.chosen, &kept);
+    notes.extend(area_note);
     Ok(Loaded {
         excluded: kept.excluded(),
         selection: kept,
@@ -229,6 +239,14 @@ pub fn load(
         unread: read.unread,
         notes,
     })
+}
+
+/// The largest x and y of the events, or of the region where it reaches further (the
+/// region's pixels must lie on the sensor the window works on).
+fn reach_with_region(events: Option<(u16, u16)>, roi: Option<Roi>) -> Option<(u16, u16)> {
+    let Some(roi) = roi else { return events };
+    let (x, y) = events.unwrap_or((0, 0));
+    Some((x.max(roi.x1 - 1), y.max(roi.y1 - 1)))
 }
 
 /// A warning where the sensor's size comes from the grey frames and the events reach under
