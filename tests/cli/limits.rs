@@ -833,6 +833,49 @@ fn a_stated_sensor_far_beyond_the_events_gives_way_to_their_reach() {
 }
 
 #[test]
+fn duplicated_events_are_named_in_the_estimates_assumptions() {
+    // a hostile round doubled every event of the slider recording: eppps moved from 0.378
+    // to 0.248 without a word
+    let dir = tempfile::tempdir().unwrap();
+    let slider = real("ijrr_slider_depth_50k");
+    let doubled: String = std::fs::read_to_string(slider.join("events.txt"))
+        .unwrap()
+        .lines()
+        .flat_map(|l| [l, l])
+        .map(|l| format!("{l}\n"))
+        .collect();
+    write(dir.path(), "events.txt", doubled.as_bytes());
+    for name in ["images.txt", "images"] {
+        let to = dir.path().join(name);
+        if name == "images" {
+            std::fs::create_dir(&to).unwrap();
+            for f in std::fs::read_dir(slider.join(name)).unwrap() {
+                let f = f.unwrap().path();
+                std::fs::copy(&f, to.join(f.file_name().unwrap())).unwrap();
+            }
+        } else {
+            std::fs::copy(slider.join(name), &to).unwrap();
+        }
+    }
+    let repeats = |output: &serde_json::Value| -> Vec<String> {
+        strings(&output["assumptions"])
+            .into_iter()
+            .filter(|a| a.contains("same microsecond"))
+            .map(String::from)
+            .collect()
+    };
+    let out = json(&["estimate", "eppps", dir.path().to_str().unwrap()]);
+    assert_eq!(
+        repeats(&out),
+        vec![
+            "events: 50000 of 100000 (50.0 %) repeat their pixel's previous event in the same microsecond, and every estimate counts them as events; a camera's pixel fires at most once in its refractory period, so they come from a simulator that gives all crossings of a step one time, or from a file whose events were duplicated (then remove the copies: each is counted twice)"
+        ]
+    );
+    let original = json(&["estimate", "eppps", slider.to_str().unwrap()]);
+    assert!(repeats(&original).is_empty());
+}
+
+#[test]
 fn noise_and_blur_beyond_the_budget_are_refused_before_anything_is_written() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("sim");

@@ -228,6 +228,24 @@ impl EventChunk {
         let max_y = self.y.iter().copied().max()?;
         Some((max_x, max_y))
     }
+
+    /// Events at the same pixel and microsecond as their pixel's previous event (time
+    /// order assumed; pixels outside `sensor` are not counted), as `stats` counts them in
+    /// `inter_event_interval_s.zero`.
+    pub fn same_microsecond_repeats(&self, sensor: Sensor) -> usize {
+        let width = sensor.width as usize;
+        let mut last: Vec<TimeUs> = vec![TimeUs::MIN; sensor.pixels()];
+        let mut repeats = 0;
+        for ((&t, &x), &y) in self.t.iter().zip(&self.x).zip(&self.y) {
+            if x >= sensor.width || y >= sensor.height {
+                continue;
+            }
+            let previous = &mut last[y as usize * width + x as usize];
+            repeats += usize::from(*previous == t);
+            *previous = t;
+        }
+        repeats
+    }
 }
 
 impl FromIterator<Event> for EventChunk {
@@ -269,6 +287,27 @@ pub fn s_to_us(t: f64) -> TimeUs {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn same_microsecond_repeats_are_counted_per_pixel() {
+        let mut chunk = EventChunk::default();
+        // pixel (1, 0) twice at 5 us, then again at 5 us (of the other polarity): two
+        // repeats; pixel (2, 0) at 5 us once and pixel (1, 1) at 5 us: none; a pixel outside
+        // the sensor is not counted
+        for (t, x, y, on) in [
+            (5, 1, 0, true),
+            (5, 2, 0, true),
+            (5, 1, 0, true),
+            (5, 1, 1, true),
+            (5, 1, 0, false),
+            (6, 1, 0, true),
+            (6, 9, 0, true),
+            (6, 9, 0, true),
+        ] {
+            chunk.push(t, x, y, on);
+        }
+        assert_eq!(chunk.same_microsecond_repeats(Sensor::new(4, 2)), 2);
+    }
 
     #[test]
     fn merged_keeps_time_order_and_every_event() {

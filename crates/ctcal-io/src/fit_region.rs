@@ -149,6 +149,7 @@ impl Loaded {
             excluded: selection.excluded(),
             selection,
             notes: self.notes.clone(),
+            recording_notes: self.recording_notes.clone(),
         }
     }
 }

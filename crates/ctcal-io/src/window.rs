@@ -37,7 +37,13 @@ pub struct Loaded {
     pub selection: PixelSelection,
     /// One flag per pixel: left out by the region / mask (what the estimators take).
     pub excluded: Vec<bool>,
+    /// What `assumptions` says of the window: its frames and pixels, and
+    /// [`Self::recording_notes`].
     pub notes: Vec<String>,
+    /// What `assumptions` says of the recording's sensor and events whatever frames a
+    /// window takes (a stated sensor given way to the events' reach, same-microsecond
+    /// repeats), carried into its blocks ([`load_blocks`]).
+    pub recording_notes: Vec<String>,
 }
 
 /// What to read.
@@ -224,8 +230,13 @@ pub fn load(
         });
     }
     let kept = selection.build(sensor, &recording.path, force)?;
+    let mut recording_notes: Vec<String> = area_note.into_iter().collect();
+    if let Some(note) = repeats_note(&events, sensor) {
+        observer.warn(&Text::from(format!("{}: {note}", recording.path.display())));
+        recording_notes.push(note);
+    }
     let mut notes = notes(&read.chosen, &kept);
-    notes.extend(area_note);
+    notes.extend(recording_notes.iter().cloned());
     Ok(Loaded {
         excluded: kept.excluded(),
         selection: kept,
@@ -238,6 +249,24 @@ pub fn load(
         frame_limit: read.chosen.limit,
         unread: read.unread,
         notes,
+        recording_notes,
+    })
+}
+
+/// The share of a window's events at which [`repeats_note`] speaks: the shared real
+/// recordings have none or a few in ten thousand (the Gen3 EVT2 sample: 345 of 521,252).
+const REPEATS_SHARE: f64 = 0.01;
+
+/// What `assumptions` says where over [`REPEATS_SHARE`] of the events repeat their pixel's
+/// previous event in the same microsecond.
+fn repeats_note(events: &EventChunk, sensor: Sensor) -> Option<String> {
+    let repeats = events.same_microsecond_repeats(sensor);
+    (repeats as f64 > REPEATS_SHARE * events.len() as f64).then(|| {
+        format!(
+            "events: {repeats} of {} ({:.1} %) repeat their pixel's previous event in the same microsecond, and every estimate counts them as events; a camera's pixel fires at most once in its refractory period, so they come from a simulator that gives all crossings of a step one time, or from a file whose events were duplicated (then remove the copies: each is counted twice)",
+            events.len(),
+            100.0 * repeats as f64 / events.len() as f64
+        )
     })
 }
 
@@ -298,7 +327,8 @@ pub fn load_blocks(
         &window,
         observer,
     )?;
-    let notes = notes(&read.chosen, &whole.selection);
+    let mut notes = notes(&read.chosen, &whole.selection);
+    notes.extend(whole.recording_notes.iter().cloned());
     Ok(Loaded {
         recording: whole.recording.clone(),
         sensor: whole.sensor,
@@ -311,6 +341,7 @@ pub fn load_blocks(
         selection: whole.selection.clone(),
         excluded: whole.excluded.clone(),
         notes,
+        recording_notes: whole.recording_notes.clone(),
     })
 }
 
