@@ -222,6 +222,18 @@ impl PixelParams {
         };
         positive("ct_on", self.ct_on)?;
         positive("ct_off", self.ct_off)?;
+        let floor = super::effects::mismatch::MIN_THRESHOLD;
+        for (key, v) in [("ct_on", self.ct_on), ("ct_off", self.ct_off)] {
+            if (v as f32) < floor {
+                return Err(fail(
+                    key,
+                    format!(
+                        "is {v:e}; the simulator floors every pixel's threshold at {floor} (as ESIM's minimum_contrast_threshold), so it would be simulated as {floor}"
+                    ),
+                    "give a threshold of 0.01 or more (real sensors: about 0.1 to 1)",
+                ));
+            }
+        }
         for (key, v) in [
             ("ct_sigma", self.ct_sigma),
             ("ct_sigma_temporal", self.ct_sigma_temporal),
@@ -486,6 +498,16 @@ blur_px = 0.8
         assert!(e.to_string().contains("cutof_hz"), "{e}");
         let e = PixelParams::from_toml("ct_on = -0.3\nct_off = 0.3\n", "p.toml").unwrap_err();
         assert!(e.to_string().contains("`ct_on`"), "{e}");
+        // a hostile round's 1e-12 was simulated as 0.01 (5.2 M events) without a word
+        let e = PixelParams::from_toml("ct_on = 0.3\nct_off = 1e-12\n", "p.toml").unwrap_err();
+        assert!(
+            e.to_string().contains("`ct_off`")
+                && e.to_string().contains("is 1e-12")
+                && e.to_string()
+                    .contains("floors every pixel's threshold at 0.01"),
+            "{e}"
+        );
+        assert!(PixelParams::from_toml("ct_on = 0.01\nct_off = 0.3\n", "p.toml").is_ok());
         let e = PixelParams::from_toml(
             "ct_on = 0.3\nct_off = 0.3\nhot_pixel_fraction = 2\n",
             "p.toml",
