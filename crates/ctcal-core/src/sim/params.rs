@@ -193,47 +193,21 @@ impl PixelParams {
 
     /// Checks every value's range.
     pub fn validate(&self, source_name: &str) -> Result<(), ParamsError> {
-        let fail = |key: &str, problem: String, fix: &str| ParamsError {
-            source_name: source_name.to_string(),
-            key: key.to_string(),
-            problem,
-            fix: fix.to_string(),
-        };
-        let positive = |key: &str, v: f64| -> Result<(), ParamsError> {
-            if v.is_finite() && v > 0.0 {
-                Ok(())
-            } else {
-                Err(fail(
-                    key,
-                    format!("is {v}; it must be a positive number"),
-                    "give a value > 0",
-                ))
-            }
-        };
-        let non_negative = |key: &str, v: Option<f64>| -> Result<(), ParamsError> {
-            match v {
-                Some(v) if !(v.is_finite() && v >= 0.0) => Err(fail(
-                    key,
-                    format!("is {v}; it must be zero or positive"),
-                    "give a value >= 0, or remove the key to switch the effect off",
-                )),
-                _ => Ok(()),
-            }
-        };
-        positive("ct_on", self.ct_on)?;
-        positive("ct_off", self.ct_off)?;
-        let floor = super::effects::mismatch::MIN_THRESHOLD;
-        for (key, v) in [("ct_on", self.ct_on), ("ct_off", self.ct_off)] {
-            if (v as f32) < floor {
-                return Err(fail(
-                    key,
-                    format!(
-                        "is {v:e}; the simulator floors every pixel's threshold at {floor} (as ESIM's minimum_contrast_threshold), so it would be simulated as {floor}"
-                    ),
-                    "give a threshold of 0.01 or more (real sensors: about 0.1 to 1)",
-                ));
-            }
+        let check = Check { source_name };
+        check.thresholds(self.ct_on, self.ct_off)?;
+        self.check_effects(&check)?;
+        if let Some(eps) = self.log_eps {
+            check.positive("log_eps", eps)?;
         }
+        if let Some(d) = &self.display {
+            check.display(d)?;
+        }
+        Ok(())
+    }
+
+    /// The effects' keys: none negative, no rate beyond one event a microsecond, the
+    /// jitter and the hot-pixel share in their ranges.
+    fn check_effects(&self, check: &Check) -> Result<(), ParamsError> {
         for (key, v) in [
             ("ct_sigma", self.ct_sigma),
             ("ct_sigma_temporal", self.ct_sigma_temporal),
@@ -246,7 +220,7 @@ impl PixelParams {
             ("hot_pixel_rate_hz", self.hot_pixel_rate_hz),
             ("timestamp_jitter_s", self.timestamp_jitter_s),
         ] {
-            non_negative(key, v)?;
+            check.non_negative(key, v)?;
         }
         // events are timed to the microsecond: no pixel fires more often than that
         for (key, v) in [
@@ -257,7 +231,7 @@ impl PixelParams {
             if let Some(v) = v
                 && v > MAX_PIXEL_RATE_HZ
             {
-                return Err(fail(
+                return Err(check.fail(
                     key,
                     format!(
                         "is {v:e} events per pixel per second; events are timed to the microsecond, so no pixel fires more than {MAX_PIXEL_RATE_HZ:e} times a second"
@@ -269,7 +243,7 @@ impl PixelParams {
         if let Some(j) = self.timestamp_jitter_s
             && j > MAX_JITTER_S
         {
-            return Err(fail(
+            return Err(check.fail(
                 "timestamp_jitter_s",
                 format!(
                     "is {j} s; a jitter's standard deviation beyond {MAX_JITTER_S} s would reorder a recording's seconds, and the simulator keeps events within the frames' span, so it cannot be simulated as given"
@@ -280,45 +254,11 @@ impl PixelParams {
         if let Some(f) = self.hot_pixel_fraction
             && !(0.0..=1.0).contains(&f)
         {
-            return Err(fail(
+            return Err(check.fail(
                 "hot_pixel_fraction",
                 format!("is {f}"),
                 "give a fraction between 0 and 1",
             ));
-        }
-        if let Some(eps) = self.log_eps {
-            positive("log_eps", eps)?;
-        }
-        if let Some(d) = &self.display {
-            positive("display.refresh_hz", d.refresh_hz)?;
-            positive("display.gamma", d.gamma)?;
-            positive("display.white_dn", d.white_dn)?;
-            if !(d.black_level.is_finite() && (0.0..1.0).contains(&d.black_level)) {
-                return Err(fail(
-                    "display.black_level",
-                    format!("is {}", d.black_level),
-                    "give the luminance of black as a fraction of white, in [0, 1)",
-                ));
-            }
-            non_negative("display.blur_px", d.blur_px)?;
-            if let Some(blur) = d.blur_px
-                && blur > MAX_BLUR_PX
-            {
-                return Err(fail(
-                    "display.blur_px",
-                    format!(
-                        "is {blur:e} pixels; a blur wider than {MAX_BLUR_PX} pixels (the largest sensor) leaves one uniform grey"
-                    ),
-                    "give the optical blur's sigma in pixels (a few pixels at most for a focused camera)",
-                ));
-            }
-            if d.time_offset_s.is_some_and(|t| !t.is_finite()) {
-                return Err(fail(
-                    "display.time_offset_s",
-                    "is not finite".into(),
-                    "give seconds",
-                ));
-            }
         }
         Ok(())
     }
@@ -400,6 +340,96 @@ pub(crate) fn first_non_finite(text: &str) -> Option<String> {
     }
     let table: toml::Table = toml::from_str(text).ok()?;
     walk(&toml::Value::Table(table), String::new())
+}
+
+/// The range checks of [`PixelParams::validate`], naming the parameters' source in errors.
+struct Check<'a> {
+    source_name: &'a str,
+}
+
+impl Check<'_> {
+    fn fail(&self, key: &str, problem: String, fix: &str) -> ParamsError {
+        ParamsError {
+            source_name: self.source_name.to_string(),
+            key: key.to_string(),
+            problem,
+            fix: fix.to_string(),
+        }
+    }
+
+    fn positive(&self, key: &str, v: f64) -> Result<(), ParamsError> {
+        if v.is_finite() && v > 0.0 {
+            Ok(())
+        } else {
+            Err(self.fail(
+                key,
+                format!("is {v}; it must be a positive number"),
+                "give a value > 0",
+            ))
+        }
+    }
+
+    fn non_negative(&self, key: &str, v: Option<f64>) -> Result<(), ParamsError> {
+        match v {
+            Some(v) if !(v.is_finite() && v >= 0.0) => Err(self.fail(
+                key,
+                format!("is {v}; it must be zero or positive"),
+                "give a value >= 0, or remove the key to switch the effect off",
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// Positive, and at least the floor every pixel's threshold is held to.
+    fn thresholds(&self, ct_on: f64, ct_off: f64) -> Result<(), ParamsError> {
+        let floor = super::effects::mismatch::MIN_THRESHOLD;
+        for (key, v) in [("ct_on", ct_on), ("ct_off", ct_off)] {
+            self.positive(key, v)?;
+            if (v as f32) < floor {
+                return Err(self.fail(
+                    key,
+                    format!(
+                        "is {v:e}; the simulator floors every pixel's threshold at {floor} (as ESIM's minimum_contrast_threshold), so it would be simulated as {floor}"
+                    ),
+                    "give a threshold of 0.01 or more (real sensors: about 0.1 to 1)",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    fn display(&self, d: &DisplayParams) -> Result<(), ParamsError> {
+        self.positive("display.refresh_hz", d.refresh_hz)?;
+        self.positive("display.gamma", d.gamma)?;
+        self.positive("display.white_dn", d.white_dn)?;
+        if !(d.black_level.is_finite() && (0.0..1.0).contains(&d.black_level)) {
+            return Err(self.fail(
+                "display.black_level",
+                format!("is {}", d.black_level),
+                "give the luminance of black as a fraction of white, in [0, 1)",
+            ));
+        }
+        self.non_negative("display.blur_px", d.blur_px)?;
+        if let Some(blur) = d.blur_px
+            && blur > MAX_BLUR_PX
+        {
+            return Err(self.fail(
+                "display.blur_px",
+                format!(
+                    "is {blur:e} pixels; a blur wider than {MAX_BLUR_PX} pixels (the largest sensor) leaves one uniform grey"
+                ),
+                "give the optical blur's sigma in pixels (a few pixels at most for a focused camera)",
+            ));
+        }
+        if d.time_offset_s.is_some_and(|t| !t.is_finite()) {
+            return Err(self.fail(
+                "display.time_offset_s",
+                "is not finite".into(),
+                "give seconds",
+            ));
+        }
+        Ok(())
+    }
 }
 
 #[cfg(test)]
