@@ -145,23 +145,7 @@ pub fn fit(
     progress("the ideal model", 0.2);
     let geometry = Geometry::new(&frames, input.excluded, options.blocks, end);
     let runs = frames.upsample_runs(0.5, options.aps.max_upsampled_bytes);
-    let mut simulation = Simulation {
-        runs: &runs,
-        width: frames.width,
-        height: frames.height,
-        geometry: &geometry,
-        events: input.events,
-        real: super::observe::Observed::new(
-            input.events,
-            &geometry,
-            &vec![false; input.sensor.pixels()],
-        ),
-        grid: timestamp_grid(input.events),
-        seed: options.seed,
-        count: Cell::new(0),
-        hot_events: EventChunk::default(),
-        lag_keys: Default::default(),
-    };
+    let mut simulation = simulation_of(input, &frames, &runs, &geometry, options.seed);
     let ideal = Ideal::measure(
         &simulation,
         &start_params,
@@ -199,14 +183,7 @@ pub fn fit(
     let frame_quality = if ideal.fixed {
         frame_quality::FrameQuality::default()
     } else {
-        let check = frame_quality::Check {
-            frames: &frames,
-            input,
-            options,
-            fit_end: end,
-            masked: &state.masked,
-        };
-        frame_quality::measure(&check, &simulation, &state.model)
+        frame_checks(input, options, (&frames, end), &simulation, &state)
     };
     progress("the final model on the test blocks", 0.97);
     let result = finish::result(
@@ -231,6 +208,53 @@ pub fn fit(
     );
     progress("done", 1.0);
     Ok(result)
+}
+
+/// What every simulation of the fit runs on: the frames' upsampled runs, the blocks, and
+/// the recording's events measured as each simulation's will be (no pixel masked yet).
+fn simulation_of<'a>(
+    input: &FitInput<'a>,
+    frames: &PreparedFrames,
+    runs: &'a [Vec<crate::sim::Sample>],
+    geometry: &'a Geometry,
+    seed: u64,
+) -> Simulation<'a> {
+    Simulation {
+        runs,
+        width: frames.width,
+        height: frames.height,
+        geometry,
+        events: input.events,
+        real: super::observe::Observed::new(
+            input.events,
+            geometry,
+            &vec![false; input.sensor.pixels()],
+        ),
+        grid: timestamp_grid(input.events),
+        seed,
+        count: Cell::new(0),
+        hot_events: EventChunk::default(),
+        lag_keys: Default::default(),
+    }
+}
+
+/// The final model on every 2nd and 3rd frame and a doubled exposure
+/// ([`frame_quality`]): how far the fit depends on the frames it was given.
+fn frame_checks(
+    input: &FitInput,
+    options: &FitOptions,
+    (frames, fit_end): (&PreparedFrames, TimeUs),
+    simulation: &Simulation,
+    state: &State,
+) -> frame_quality::FrameQuality {
+    let check = frame_quality::Check {
+        frames,
+        input,
+        options,
+        fit_end,
+        masked: &state.masked,
+    };
+    frame_quality::measure(&check, simulation, &state.model)
 }
 
 /// The starting thresholds (`estimate aps` on the fit run) and the model they start, the
