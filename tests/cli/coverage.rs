@@ -309,3 +309,31 @@ fn eppps_measures_the_background_where_the_frames_are_still() {
         "{still}"
     );
 }
+
+/// Draw 12035 of the peers' second fresh study: DVS-Voltmeter, a rotation whose leak makes
+/// 97 % of the events ON (thresholds 0.561 both). eppps without frames read OFF 2.40
+/// [0.88, 6.56]: the few OFF events were taken for a high Cn. Without frames an imbalance
+/// may be a leak's or the scene's, so each polarity's interval also holds the threshold
+/// both would share (`estimate::eppps::balance`), and the assumptions say so.
+#[test]
+fn eppps_without_frames_carries_an_imbalance_it_cannot_attribute() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_peer_draw(Method::EpppsEvents, 12035, work.path());
+    assert_eq!(record.case.generator, ctcal::coverage::Generator::Voltmeter);
+    let truth = record.truth.as_ref().unwrap();
+    assert!(truth.on_events as f64 > 0.95 * truth.events as f64);
+    covered_value(&record, "ct_off");
+    let ctcal::coverage::Outcome::Ok {
+        output: Some(output),
+    } = &record.outcome
+    else {
+        panic!("{:?}", record.outcome);
+    };
+    assert!(
+        crate::common::strings(&output["assumptions"])
+            .iter()
+            .any(|a| a.starts_with("ON/OFF balance") && a.contains("OFF [")),
+        "{}",
+        output["assumptions"]
+    );
+}

@@ -21,6 +21,7 @@
 //!    a scene's contrast from the threshold). The interval also holds the recording's sampling error (bootstrap
 //!    over 32 px patches) and the flow's precision.
 
+mod balance;
 pub mod calibration;
 pub mod prior;
 pub mod recording;
@@ -214,7 +215,7 @@ pub fn estimate(
     // OFF/ON ratio the symmetric scans found, and read both polarities there
     let measured_ratio = off.measured.value / on.measured.value;
     let ratio = measured_ratio.clamp(0.2, 5.0);
-    let (on, off) = if ratio.is_finite() && (ratio.ln()).abs() > 0.02 {
+    let (mut on, mut off) = if ratio.is_finite() && (ratio.ln()).abs() > 0.02 {
         progress("calibration scans (OFF/ON ratio measured)", 0.6);
         pixel.ratio = ratio;
         measure_both(&basis.calibrate(&rates, pixel, selections), &rates)
@@ -222,6 +223,12 @@ pub fn estimate(
         (on, off)
     };
     let calibrations = symmetric;
+    // without frames an imbalance may be the scene's or a leak's, not the thresholds'
+    let balance = frames
+        .is_none()
+        .then(|| balance::symmetric(&calibrations, &rates))
+        .flatten()
+        .and_then(|shared| balance::widen(&mut on, &mut off, &shared));
     progress("inverting the calibration curves", 0.9);
     let grid = threshold_grid();
     let mut result = CtEstimate::from_parts(
@@ -235,6 +242,7 @@ pub fn estimate(
         },
     );
     polarity_notes(&mut result, (&on, &off), calibrations.len());
+    result.assumptions.extend(balance);
     if let Some((followed, too_fast)) = outrun.filter(|_| options.use_frames) {
         result.assumptions.push(format!(
             "the frames are not used: the motion between them is too large for the optical flow on {too_fast} intervals and it follows {followed}, so travel and contrast are read from the events, as without frames"
