@@ -228,6 +228,31 @@ fn hdf5_frames_are_checked_before_they_are_read() {
         e.contains("claims shape") && e.contains("stores only"),
         "{e}"
     );
+    // a colour frame among grey ones (a hostile round: the fix said "check that the file
+    // is an event_utils or v2e HDF5 file")
+    let path = dir.path().join("rgb.h5");
+    h5_events(&path, &[0.1, 0.2], &[1i16, 2], &[1i16, 2], &[true, false]);
+    {
+        let file = h5_open_rw(&path);
+        let images = file.create_group("images").unwrap();
+        let ds = images
+            .new_dataset_builder()
+            .with_data(&ndarray::Array3::<u8>::zeros((4, 4, 3)))
+            .create("image000000000")
+            .unwrap();
+        ds.new_attr::<f64>()
+            .create("timestamp")
+            .unwrap()
+            .write_scalar(&0.1)
+            .unwrap();
+    }
+    let e = bad_input(&["stats", path.to_str().unwrap(), "--sensor", "8x8"]);
+    assert!(
+        e.contains("images/image000000000 has shape [4, 4, 3]")
+            && e.contains("colour image (3 channels)")
+            && e.contains("grey"),
+        "{e}"
+    );
     // frames of two sizes, and frames out of order, as for IJRR folders
     for (name, sizes, times) in [
         ("sizes.h5", [(4usize, 4usize), (4, 5)], [0.1, 0.2]),

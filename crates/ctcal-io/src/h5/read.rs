@@ -566,6 +566,17 @@ fn check_dataset(
 ) -> Result<Vec<usize>, InputError> {
     let ds = file.dataset(name).map_err(|e| h5_error(path, name, e))?;
     let shape = ds.shape();
+    let frames = name.starts_with("images/") || name == "frame" || name.ends_with("image_raw");
+    if frames && shape.len() == rank + 1 && matches!(shape[rank], 3 | 4) {
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "{name} has shape {shape:?}: a colour image ({} channels), where ctcal reads grey frames",
+                shape[rank]
+            ),
+            "write the frames as grey images, (H, W) per frame in 8 bits (e.g. in NumPy: 0.299 R + 0.587 G + 0.114 B), as event cameras' APS frames are",
+        ));
+    }
     if shape.len() != rank {
         let what = if shape.is_empty() {
             "a scalar".to_string()
