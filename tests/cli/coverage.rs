@@ -109,6 +109,17 @@ fn covered_value(record: &RunRecord, key: &str) -> (f64, f64) {
     (value, true_value)
 }
 
+/// The JSON a run printed, after asserting that it succeeded with output.
+fn json_output(record: &RunRecord) -> &serde_json::Value {
+    let ctcal::coverage::Outcome::Ok {
+        output: Some(output),
+    } = &record.outcome
+    else {
+        panic!("{}: {:?}", record.case.id, record.outcome);
+    };
+    output
+}
+
 /// A number, or `null` with a reason; a refusal (exit 2) must say why.
 fn assert_answered(record: &RunRecord) {
     let id = &record.case.id;
@@ -231,12 +242,7 @@ fn fit_reads_the_events_alone_where_the_motion_outruns_the_frames() {
     for key in ["ct_on", "ct_off"] {
         covered_value(&record, key);
     }
-    let ctcal::coverage::Outcome::Ok {
-        output: Some(output),
-    } = &record.outcome
-    else {
-        panic!("{:?}", record.outcome);
-    };
+    let output = json_output(&record);
     let said = output["assumptions"].as_array().unwrap().iter().any(|a| {
         a.as_str()
             .unwrap()
@@ -296,12 +302,7 @@ fn eppps_measures_the_background_where_the_frames_are_still() {
     assert_eq!(record.case.generator, ctcal::coverage::Generator::Voltmeter);
     covered_value(&record, "ct_on");
     covered_value(&record, "ct_off");
-    let ctcal::coverage::Outcome::Ok {
-        output: Some(output),
-    } = &record.outcome
-    else {
-        panic!("{:?}", record.outcome);
-    };
+    let output = json_output(&record);
     let still = &output["estimators"][0]["details"]["still_pixels"];
     assert_eq!(still["decides_noise"]["on"], true, "{still}");
     assert!(
@@ -323,12 +324,7 @@ fn eppps_without_frames_carries_an_imbalance_it_cannot_attribute() {
     let truth = record.truth.as_ref().unwrap();
     assert!(truth.on_events as f64 > 0.95 * truth.events as f64);
     covered_value(&record, "ct_off");
-    let ctcal::coverage::Outcome::Ok {
-        output: Some(output),
-    } = &record.outcome
-    else {
-        panic!("{:?}", record.outcome);
-    };
+    let output = json_output(&record);
     assert!(
         crate::common::strings(&output["assumptions"])
             .iter()
