@@ -1,6 +1,7 @@
 //! Bad input: each case gets exit code 2 and a message naming the file, the place and a fix.
 
 use crate::common::*;
+use assert_cmd::Command;
 use std::path::Path;
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
@@ -381,4 +382,103 @@ fn config_refuses_fit_values_no_camera_has_naming_their_json_path() {
             .unwrap()
             .contains("--exposure_time_ms=2")
     );
+}
+
+/// `real/evk4_faery_evt3.raw` cut after its header and `keep` bytes of events (a whole
+/// number of EVT3 words), with its `% geometry 1280x720` rewritten to `geometry`.
+fn evt3_with_geometry(dir: &Path, geometry: &str, keep: usize) -> String {
+    let bytes = std::fs::read(real("evk4_faery_evt3.raw")).unwrap();
+    let at = bytes
+        .windows(8)
+        .position(|w| w == b"1280x720")
+        .expect("the header's geometry");
+    let mut mutated = bytes[..at].to_vec();
+    mutated.extend_from_slice(geometry.as_bytes());
+    let header_end = 225;
+    mutated.extend_from_slice(&bytes[at + 8..header_end + keep]);
+    write(dir, &format!("geometry_{geometry}.raw"), &mutated)
+}
+
+/// A `% geometry` that is no sensor fell back silently to the camera plugin's size (only
+/// sides over 4096 were refused); every stated size now is used, or refused naming its
+/// header line, the line's fix and the plugin's size, and `--sensor` overrides it aloud.
+#[test]
+fn a_prophesee_geometry_that_is_no_sensor_names_its_header_line() {
+    let dir = tempfile::tempdir().unwrap();
+    for (geometry, why) in [
+        ("0x0", "a side of 0 pixels"),
+        ("axb", "`a` is not a whole number of pixels"),
+        ("-5x-5", "`-5` is not a whole number of pixels"),
+        ("65536x65536", "a side of 65536 pixels"),
+        ("100000x1", "a side of 100000 pixels"),
+    ] {
+        let raw = evt3_with_geometry(dir.path(), geometry, 20_000);
+        let e = bad_input(&["stats", &raw]);
+        assert!(
+            e.contains(&format!("geometry_{geometry}.raw: header line 5: `% geometry {geometry}` states no usable sensor size ({why}"))
+                && e.contains("(e.g. `% geometry 1280x720`), or pass --sensor WxH")
+                && e.contains("is 1280x720: pass --sensor 1280x720 if that is the camera"),
+            "{geometry}: {e}"
+        );
+        let output = Command::cargo_bin("ctcal")
+            .unwrap()
+            .args(["info", &raw, "--sensor", "1280x720"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(output.status.success(), "{geometry}: {stderr}");
+        assert!(
+            stderr.contains("warning: header line 5: `% geometry")
+                && stderr.contains("the sensor size given (1280x720) is used"),
+            "{geometry}: {stderr}"
+        );
+    }
+    // a size over 4096 names the line too
+    let raw = evt3_with_geometry(dir.path(), "8192x8192", 20_000);
+    let e = bad_input(&["stats", &raw]);
+    assert!(
+        e.contains("% geometry on header line 5 says the sensor is 8192x8192"),
+        "{e}"
+    );
+}
+
+/// `real/davis346_faery.aedat4` with its streams' `sizeX`/`sizeY` text replaced by `value`
+/// (the XML attribute's type `int` shortened to `type_name` to keep the header's length).
+fn aedat4_with_size(dir: &Path, value: &str, type_name: &str) -> String {
+    let mut bytes = std::fs::read(real("davis346_faery.aedat4")).unwrap();
+    for (key, size) in [("sizeX", "346"), ("sizeY", "260")] {
+        let from = format!(r#"key="{key}" type="int">{size}<"#);
+        let to = format!(r#"key="{key}" type="{type_name}">{value}<"#);
+        assert_eq!(from.len(), to.len());
+        let at = bytes
+            .windows(from.len())
+            .position(|w| w == from.as_bytes())
+            .unwrap();
+        bytes[at..at + to.len()].copy_from_slice(to.as_bytes());
+    }
+    write(dir, &format!("size_{}.aedat4", value.trim()), &bytes)
+}
+
+/// An AEDAT4 event stream whose `sizeX`/`sizeY` give no sensor was said to "not state the
+/// sensor size"; the warning now gives what they state and why it is not used.
+#[test]
+fn an_aedat4_size_that_is_no_sensor_is_named_in_the_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    for (value, type_name, states) in [("99999", "i", "99999x99999"), ("  0", "int", "0x0")] {
+        let file = aedat4_with_size(dir.path(), value, type_name);
+        let output = Command::cargo_bin("ctcal")
+            .unwrap()
+            .args(["info", &file])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(output.status.success(), "{value}: {stderr}");
+        assert!(
+            stderr.contains(&format!(
+                "sizeX/sizeY of the event stream in the AEDAT4 header state {states}, which is no sensor size"
+            )) && stderr.contains("so it is not used; using DAVIS346 (346x260)")
+                && !stderr.contains("does not state"),
+            "{value}: {stderr}"
+        );
+    }
 }

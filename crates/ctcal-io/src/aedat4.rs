@@ -42,7 +42,8 @@ enum StreamKind {
 struct Stream {
     id: i32,
     kind: StreamKind,
-    size: Option<Sensor>,
+    /// `sizeX`/`sizeY`: `None` where not stated, else the sensor or why they give none.
+    size: Option<Result<Sensor, String>>,
 }
 
 /// What the header of an AEDAT4 file says.
@@ -59,10 +60,20 @@ pub struct Aedat4Header {
 impl Aedat4Header {
     /// The event stream's sensor size.
     pub fn event_sensor(&self) -> Option<Sensor> {
+        self.event_size()?.clone().ok()
+    }
+
+    /// What the event stream's `sizeX`/`sizeY` state where they give no sensor size, and
+    /// why.
+    pub fn unusable_event_size(&self) -> Option<String> {
+        self.event_size()?.clone().err()
+    }
+
+    fn event_size(&self) -> Option<&Result<Sensor, String>> {
         self.streams
             .iter()
             .find(|s| s.kind == StreamKind::Events)
-            .and_then(|s| s.size)
+            .and_then(|s| s.size.as_ref())
     }
 
     fn event_stream(&self) -> Option<i32> {
@@ -197,11 +208,7 @@ fn parse_description(xml: &str) -> Result<(Vec<Stream>, Option<String>), String>
         let info = node
             .children()
             .find(|c| c.has_tag_name("node") && c.attribute("name") == Some("info"));
-        let size = info.and_then(|info| {
-            let w = attr(info, "sizeX")?.parse::<u16>().ok()?;
-            let h = attr(info, "sizeY")?.parse::<u16>().ok()?;
-            (w > 0 && h > 0).then(|| Sensor::new(w, h))
-        });
+        let size = info.and_then(|info| stated_size(attr(info, "sizeX")?, attr(info, "sizeY")?));
         if source.is_none() {
             source = info.and_then(|info| attr(info, "source"));
         }
@@ -211,6 +218,17 @@ fn parse_description(xml: &str) -> Result<(Vec<Stream>, Option<String>), String>
         return Err("the description names no event (EVTS) stream".into());
     }
     Ok((streams, source))
+}
+
+/// A stream's `sizeX`/`sizeY` as a sensor, or what they state and why it is none.
+fn stated_size(x: String, y: String) -> Option<Result<Sensor, String>> {
+    let side = super::prophesee::side;
+    Some(match (side(&x), side(&y)) {
+        (Ok(w), Ok(h)) => Ok(Sensor::new(w, h)),
+        (Err(why), _) | (_, Err(why)) => Err(format!(
+            "sizeX/sizeY of the event stream in the AEDAT4 header state {x}x{y}, which is no sensor size ({why})"
+        )),
+    })
 }
 
 /// The most bytes one packet may decompress to (DV writes packets of a few MB at most).

@@ -3,7 +3,8 @@
 //! The sensor comes from `% geometry WxH`, `% Width`/`% Height`, or the camera plugin name.
 
 use super::error::InputError;
-use crate::events::Sensor;
+use crate::events::{MAX_SENSOR_SIDE, Sensor};
+use crate::hint::{Hint, Text};
 use crate::sensors;
 use std::io::Read;
 use std::path::Path;
@@ -80,49 +81,149 @@ impl PropheseeHeader {
         }
     }
 
-    /// The sensor the header states, and how it is known.
-    pub fn sensor(&self) -> Option<(Sensor, String)> {
-        if let Some(g) = self.get("geometry")
-            && let Some(s) = Sensor::parse(g)
-        {
-            return Some((s, "% geometry in the header".into()));
+    /// The sensor the header states, and how it is known; a stated size that is no sensor
+    /// (`% geometry 0x0`, `axb`, a side over 65535) is returned as such, never passed over
+    /// for the next source.
+    pub fn sensor(&self) -> Result<Option<(Sensor, String)>, UnusableSize> {
+        if let Some(line) = self.line_of("geometry") {
+            let s = self.usable(line, parse_wxh(&self.fields[line].1))?;
+            let origin = format!("% geometry on header line {}", line + 1);
+            return Ok(Some((s, origin)));
         }
-        if let Some(format) = self.get("format")
-            && let Some(s) = sensor_from_format_line(format)
+        if let Some(line) = self.line_of("format")
+            && let Some(sides) = sides_of_format_line(&self.fields[line].1)
         {
-            return Some((s, "% format line of the header".into()));
+            let s = self.usable(line, sides)?;
+            let origin = format!("% format on header line {}", line + 1);
+            return Ok(Some((s, origin)));
         }
-        if let (Some(w), Some(h)) = (self.get("Width"), self.get("Height"))
-            && let (Ok(w), Ok(h)) = (w.parse::<u16>(), h.parse::<u16>())
-            && w > 0
-            && h > 0
-        {
-            return Some((Sensor::new(w, h), "% Width/% Height in the header".into()));
+        if let (Some(w), Some(h)) = (self.line_of("Width"), self.line_of("Height")) {
+            let width = side(&self.fields[w].1).map_err(|why| self.unusable(w, why))?;
+            let height = side(&self.fields[h].1).map_err(|why| self.unusable(h, why))?;
+            let origin = format!(
+                "% Width on header line {} and % Height on line {}",
+                w + 1,
+                h + 1
+            );
+            return Ok(Some((Sensor::new(width, height), origin)));
         }
-        if let Some(plugin) = self.get("plugin_name")
-            && let Some(preset) = sensors::from_metadata(plugin)
-        {
-            return Some((
-                preset.sensor(),
-                format!("camera plugin `{plugin}` ({})", preset.name),
-            ));
+        Ok(self.plugin_sensor())
+    }
+
+    /// The sensor of the camera plugin the header names (`plugin_name`), if known.
+    fn plugin_sensor(&self) -> Option<(Sensor, String)> {
+        let plugin = self.get("plugin_name")?;
+        let preset = sensors::from_metadata(plugin)?;
+        Some((
+            preset.sensor(),
+            format!("camera plugin `{plugin}` ({})", preset.name),
+        ))
+    }
+
+    /// The index of the first field named `key` (case-insensitive): its header line - 1.
+    fn line_of(&self, key: &str) -> Option<usize> {
+        self.fields
+            .iter()
+            .position(|(k, _)| k.eq_ignore_ascii_case(key))
+    }
+
+    fn usable(&self, line: usize, size: Result<Sensor, String>) -> Result<Sensor, UnusableSize> {
+        size.map_err(|why| self.unusable(line, why))
+    }
+
+    fn unusable(&self, line: usize, why: String) -> UnusableSize {
+        let (key, value) = &self.fields[line];
+        UnusableSize {
+            line: line + 1,
+            text: format!("% {key} {value}").trim_end().to_string(),
+            why,
+            plugin: self.plugin_sensor(),
         }
-        None
     }
 }
 
-/// `EVT3;height=720;width=1280` (newer Prophesee headers) -> 1280x720.
-fn sensor_from_format_line(format: &str) -> Option<Sensor> {
+/// A size the header states that is no sensor.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnusableSize {
+    /// The header line (1-based: every header line is one field).
+    pub line: usize,
+    /// The line as written.
+    pub text: String,
+    /// Why it gives no sensor.
+    pub why: String,
+    /// The camera plugin's sensor, which ctcal used to take instead.
+    plugin: Option<(Sensor, String)>,
+}
+
+impl UnusableSize {
+    /// What is wrong, for an error or a note.
+    pub fn problem(&self) -> String {
+        format!(
+            "`{}` states no usable sensor size ({})",
+            self.text, self.why
+        )
+    }
+
+    /// The error: the header line and the fixes (the line, or the size given; the plugin's
+    /// size where the header names a camera plugin).
+    pub fn error(&self, path: &Path) -> InputError {
+        let mut fix = Text::from(
+            "write the camera's real size on that line (e.g. `% geometry 1280x720`), or ",
+        )
+        .act(Hint::Sensor(None));
+        if let Some((sensor, origin)) = &self.plugin {
+            fix = fix
+                .words(format!("; the header's {origin} is {sensor}: "))
+                .act(Hint::Sensor(Some(*sensor)))
+                .words(" if that is the camera");
+        }
+        InputError::corrupt(
+            path,
+            format!("header line {}", self.line),
+            self.problem(),
+            fix,
+        )
+    }
+}
+
+/// One side of a stated size: a whole number of 1 to 65535 pixels; else why not.
+pub(crate) fn side(text: &str) -> Result<u16, String> {
+    let text = text.trim();
+    let n: u64 = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a whole number of pixels"))?;
+    match u16::try_from(n) {
+        Ok(0) => Err("a side of 0 pixels".into()),
+        Ok(n) => Ok(n),
+        Err(_) => Err(format!(
+            "a side of {n} pixels; a side is at most 65535 and no sensor sold exceeds {MAX_SENSOR_SIDE}"
+        )),
+    }
+}
+
+/// `WxH` (e.g. `1280x720`).
+fn parse_wxh(text: &str) -> Result<Sensor, String> {
+    let (w, h) = text
+        .trim()
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{text}` is not WxH"))?;
+    Ok(Sensor::new(side(w)?, side(h)?))
+}
+
+/// `EVT3;height=720;width=1280` (newer Prophesee headers) -> 1280x720; `None` where the
+/// line states no size.
+fn sides_of_format_line(format: &str) -> Option<Result<Sensor, String>> {
     let mut width = None;
     let mut height = None;
     for part in format.split(';') {
         match part.split_once('=') {
-            Some(("width", v)) => width = v.trim().parse::<u16>().ok(),
-            Some(("height", v)) => height = v.trim().parse::<u16>().ok(),
+            Some(("width", v)) => width = Some(v),
+            Some(("height", v)) => height = Some(v),
             _ => {}
         }
     }
-    Some(Sensor::new(width?, height?)).filter(|s| s.width > 0 && s.height > 0)
+    let (width, height) = (width?, height?);
+    Some(side(width).and_then(|w| Ok(Sensor::new(w, side(height)?))))
 }
 
 #[cfg(test)]
@@ -136,7 +237,7 @@ mod tests {
         let h = PropheseeHeader::parse(&bytes);
         assert_eq!(h.length, 30);
         assert_eq!(h.evt_version(), Some(3));
-        assert_eq!(h.sensor().unwrap().0, Sensor::new(1280, 720));
+        assert_eq!(h.sensor().unwrap().unwrap().0, Sensor::new(1280, 720));
     }
 
     #[test]
@@ -144,13 +245,23 @@ mod tests {
         let h = PropheseeHeader::parse(b"% format EVT3;height=720;width=1280\n% end\n%\x01\x02");
         assert_eq!(h.length, 42);
         assert_eq!(h.evt_version(), Some(3));
-        assert_eq!(h.sensor().unwrap().0, Sensor::new(1280, 720));
+        assert_eq!(h.sensor().unwrap().unwrap().0, Sensor::new(1280, 720));
+    }
+
+    #[test]
+    fn a_stated_size_that_is_no_sensor_is_not_passed_over_for_the_plugin() {
+        let h = PropheseeHeader::parse(
+            b"% plugin_name hal_plugin_gen3_fx3\n% Width 640\n% Height 0\n\x00",
+        );
+        let unusable = h.sensor().unwrap_err();
+        assert_eq!((unusable.line, unusable.text.as_str()), (3, "% Height 0"));
+        assert!(unusable.problem().contains("a side of 0 pixels"));
     }
 
     #[test]
     fn plugin_name_names_the_sensor() {
         let h = PropheseeHeader::parse(b"% plugin_name hal_plugin_gen3_fx3\n% evt 2.0\n\x00");
-        assert_eq!(h.sensor().unwrap().0, Sensor::new(640, 480));
+        assert_eq!(h.sensor().unwrap().unwrap().0, Sensor::new(640, 480));
         assert_eq!(h.evt_version(), Some(2));
     }
 }

@@ -112,6 +112,28 @@ fn ijrr_source(path: &Path, given: bool) -> Result<(Source, Option<(Sensor, Stri
     Ok((Source::Ijrr(files), sensor))
 }
 
+/// The sensor a Prophesee header states. A stated size that is no sensor is an error
+/// unless the size is `given` (then a note says it is not used).
+fn prophesee_sensor(
+    path: &Path,
+    header: &prophesee::PropheseeHeader,
+    given: Option<Sensor>,
+    notes: &mut Vec<String>,
+) -> Result<Option<(Sensor, String)>, InputError> {
+    match (header.sensor(), given) {
+        (Ok(sensor), _) => Ok(sensor),
+        (Err(unusable), Some(given)) => {
+            notes.push(format!(
+                "header line {}: {}; the sensor size given ({given}) is used",
+                unusable.line,
+                unusable.problem()
+            ));
+            Ok(None)
+        }
+        (Err(unusable), None) => Err(unusable.error(path)),
+    }
+}
+
 impl Recording {
     /// Opens `path`, detecting its format from content unless `options.format` is set.
     pub fn open(path: &Path, options: &OpenOptions) -> Result<Self, InputError> {
@@ -219,6 +241,13 @@ impl Recording {
             }
             Format::Aedat4 => {
                 let header = aedat4::Aedat4Header::read(path)?;
+                if let (Some(unusable), Some(given)) =
+                    (header.unusable_event_size(), options.sensor)
+                {
+                    notes.push(format!(
+                        "{unusable}; the sensor size given ({given}) is used"
+                    ));
+                }
                 let sensor = header.event_sensor().map(|s| {
                     (
                         s,
@@ -229,7 +258,7 @@ impl Recording {
             }
             Format::Evt2 | Format::Evt3 | Format::Dat => {
                 let header = prophesee::PropheseeHeader::read(path)?;
-                let sensor = header.sensor();
+                let sensor = prophesee_sensor(path, &header, options.sensor, notes)?;
                 let data_offset = header.length;
                 let source = match format {
                     Format::Evt2 => Source::Evt2 { data_offset },
@@ -413,13 +442,14 @@ impl Recording {
             };
         }
         let (max_x, max_y) = max_coordinates.unwrap_or((0, 0));
+        let unstated = self.unstated_size();
         match sensors::smallest_containing(max_x, max_y) {
             Some(preset) => ResolvedSensor {
                 sensor: preset.sensor(),
                 source: format!("inferred: {} ({})", preset.name, preset.sensor()),
                 warning: Some(
                     Text::from(format!(
-                        "{}: the file does not state the sensor size; using {} ({}), the smallest known sensor containing every event (x up to {max_x}, y up to {max_y}); ",
+                        "{}: {unstated}; using {} ({}), the smallest known sensor containing every event (x up to {max_x}, y up to {max_y}); ",
                         self.path.display(),
                         preset.name,
                         preset.sensor()
@@ -435,7 +465,7 @@ impl Recording {
                     source: format!("inferred: {sensor} from the coordinates"),
                     warning: Some(
                         Text::from(format!(
-                            "{}: the file does not state the sensor size and no known sensor contains x up to {max_x}, y up to {max_y}; using {sensor}; ",
+                            "{}: {unstated} and no known sensor contains x up to {max_x}, y up to {max_y}; using {sensor}; ",
                             self.path.display()
                         ))
                         .act(Hint::Sensor(None)),
@@ -443,6 +473,17 @@ impl Recording {
                 }
             }
         }
+    }
+
+    /// Why the file gives no sensor size: it states none, or (AEDAT4) one that is no sensor.
+    fn unstated_size(&self) -> String {
+        match &self.source {
+            Source::Aedat4(header) => header
+                .unusable_event_size()
+                .map(|why| format!("{why}, so it is not used")),
+            _ => None,
+        }
+        .unwrap_or_else(|| "the file does not state the sensor size".into())
     }
 
     /// Decodes every frame (APS images) of the recording.

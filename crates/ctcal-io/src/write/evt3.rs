@@ -161,7 +161,7 @@ mod tests {
         writer.write_events(&events).unwrap();
         writer.finish().unwrap();
         let header = PropheseeHeader::read(&path).unwrap();
-        assert_eq!(header.sensor().unwrap().0, Sensor::new(1280, 720));
+        assert_eq!(header.sensor().unwrap().unwrap().0, Sensor::new(1280, 720));
         let mut decoder =
             Evt3Decoder::open(&path, header.length, Some(Sensor::new(1280, 720))).unwrap();
         let mut decoded = EventChunk::default();
