@@ -482,3 +482,79 @@ fn an_aedat4_size_that_is_no_sensor_is_named_in_the_warning() {
         );
     }
 }
+
+/// A copy of `h5/e_ct060_event_utils.h5` in `dir` whose frame 3 (`images/image000000003`)
+/// is replaced by `pixels`, keeping its timestamp.
+fn event_utils_with_frame_3<T: hdf5::H5Type, D: ndarray::Dimension>(
+    dir: &Path,
+    name: &str,
+    pixels: &ndarray::Array<T, D>,
+) -> String {
+    let path = dir.join(name);
+    // written, not copied: the shared file's read-only mode would come along
+    let original = std::fs::read(shared_data().join("h5/e_ct060_event_utils.h5")).unwrap();
+    std::fs::write(&path, original).unwrap();
+    {
+        let file = h5_open_rw(&path);
+        let images = file.group("images").unwrap();
+        let t: f64 = images
+            .dataset("image000000003")
+            .unwrap()
+            .attr("timestamp")
+            .unwrap()
+            .read_scalar()
+            .unwrap();
+        images.unlink("image000000003").unwrap();
+        let ds = images
+            .new_dataset_builder()
+            .with_data(pixels)
+            .create("image000000003")
+            .unwrap();
+        ds.new_attr::<f64>()
+            .create("timestamp")
+            .unwrap()
+            .write_scalar(&t)
+            .unwrap();
+    }
+    path.to_str().unwrap().to_string()
+}
+
+/// A float frame of NaN was read as a black frame (libhdf5 converts NaN to 0) and
+/// `estimate aps` dropped its intervals without a word; a NaN or infinite pixel now names
+/// the frame, how many there are and the first.
+#[test]
+fn a_non_finite_hdf5_frame_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let nan = ndarray::Array2::<f32>::from_elem((180, 240), f32::NAN);
+    let path = event_utils_with_frame_3(dir.path(), "nan.h5", &nan);
+    let e = bad_input(&["estimate", "aps", &path]);
+    assert!(
+        e.contains("nan.h5: images/image000000003 (frame 3): 43200 of the frame's 43200 pixels are NaN or infinite (the first at x = 0, y = 0: NaN)")
+            && e.contains("fix: the frame is damaged"),
+        "{e}"
+    );
+    // one infinite pixel in a v2e frame stack
+    let path = dir.path().join("inf_v2e.h5");
+    {
+        let file = h5_create(&path);
+        file.new_dataset_builder()
+            .with_data(&ndarray::arr2(&[[1000u32, 1, 1, 1], [2000, 2, 2, 0]]))
+            .create("events")
+            .unwrap();
+        let mut frames = ndarray::Array3::<f32>::zeros((2, 4, 4));
+        frames[[1, 2, 3]] = f32::INFINITY;
+        file.new_dataset_builder()
+            .with_data(&frames)
+            .create("frame")
+            .unwrap();
+        file.new_dataset_builder()
+            .with_data(&[0u32, 1500])
+            .create("frame_ts")
+            .unwrap();
+    }
+    let e = bad_input(&["estimate", "aps", path.to_str().unwrap(), "--sensor", "4x4"]);
+    assert!(
+        e.contains("frame[1]: 1 of the frame's 16 pixels is NaN or infinite (the first at x = 3, y = 2: inf)"),
+        "{e}"
+    );
+}
