@@ -558,3 +558,40 @@ fn a_non_finite_hdf5_frame_is_named() {
         "{e}"
     );
 }
+
+/// `real/davis346_faery.aedat4` with `damage` applied to the bytes of its first packet (its
+/// header at 8 bytes before the returned slice start), written to `dir/name`.
+fn aedat4_with_first_packet(dir: &Path, name: &str, damage: impl Fn(&mut [u8])) -> String {
+    let mut bytes = std::fs::read(real("davis346_faery.aedat4")).unwrap();
+    let header = u32::from_le_bytes(bytes[14..18].try_into().unwrap()) as usize;
+    damage(&mut bytes[18 + header..]);
+    write(dir, name, &bytes)
+}
+
+/// A damaged AEDAT4 packet gave the FlatBuffer verifier's own text and trace ("invalid
+/// FlatBuffer: Range [4278190100, 4278190104) is out of bounds." and blank lines); it now
+/// names the packet's index, byte offset and stream, what is wrong in one line, and the fix.
+#[test]
+fn a_damaged_aedat4_packet_is_named_in_one_message() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = aedat4_with_first_packet(dir.path(), "size0.aedat4", |p| {
+        p[4..8].copy_from_slice(&0i32.to_le_bytes())
+    });
+    let garbled = aedat4_with_first_packet(dir.path(), "lz4.aedat4", |p| {
+        p[28..68].iter_mut().for_each(|b| *b ^= 0xff)
+    });
+    for (path, bytes) in [(&empty, "0 bytes"), (&garbled, "6464 bytes")] {
+        let e = bad_input(&["stats", path]);
+        assert!(
+            e.contains("packet 0 at byte offset 3126 (event stream 0): the packet (")
+                && e.contains(&format!(
+                    "{bytes} after decompression) is no valid event packet ("
+                ))
+                && e.contains("fix: the file is damaged at this packet")
+                && !e.contains("invalid FlatBuffer")
+                && !e.contains("\n\n"),
+            "{e}"
+        );
+        assert_eq!(e.lines().count(), 2, "{e}");
+    }
+}

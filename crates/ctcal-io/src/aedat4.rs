@@ -123,7 +123,10 @@ impl Aedat4Header {
             InputError::corrupt(
                 path,
                 "byte offset 18 (IOHeader)",
-                format!("invalid header: {e}"),
+                format!(
+                    "the IOHeader is no valid FlatBuffer table ({})",
+                    first_line(&e)
+                ),
                 FIX_TRUNCATED,
             )
         })?;
@@ -243,6 +246,10 @@ struct PacketReader {
     compression: Compression,
     raw: Vec<u8>,
     decoded: Vec<u8>,
+    /// Packets passed so far (every stream's).
+    count: u64,
+    /// The packet in `decoded`: its index among the file's packets, byte offset and stream.
+    current: (u64, u64, i32),
 }
 
 impl PacketReader {
@@ -259,6 +266,8 @@ impl PacketReader {
             compression: header.compression,
             raw: Vec::new(),
             decoded: Vec::new(),
+            count: 0,
+            current: (0, 0, 0),
         })
     }
 
@@ -299,12 +308,14 @@ impl PacketReader {
                 ));
             }
             self.position = offset + 8 + size as u64;
+            self.count += 1;
             if stream != wanted {
                 self.file
                     .seek_relative(size as i64)
                     .map_err(|e| InputError::io(&self.path, e))?;
                 continue;
             }
+            self.current = (self.count - 1, offset, stream);
             self.raw.resize(size as usize, 0);
             read_exact(
                 &mut self.file,
@@ -333,34 +344,67 @@ impl PacketReader {
             if self.decoded.len() as u64 > MAX_PACKET_BYTES {
                 return Err(InputError::corrupt(
                     &self.path,
-                    format!("byte offset {offset} (packet of stream {stream})"),
+                    self.place(""),
                     format!(
                         "the packet decompresses to more than {} MB",
                         MAX_PACKET_BYTES >> 20
                     ),
-                    FIX_TRUNCATED,
+                    FIX_DAMAGED_PACKET,
                 ));
             }
             result.map_err(|e| {
                 InputError::corrupt(
                     &self.path,
-                    format!("byte offset {offset} (packet of stream {stream})"),
+                    self.place(""),
                     format!("cannot decompress the packet: {e}"),
-                    FIX_TRUNCATED,
+                    FIX_DAMAGED_PACKET,
                 )
             })?;
             return Ok(Some(offset));
         }
     }
 
-    fn invalid(&self, offset: u64, what: &str, error: impl std::fmt::Display) -> InputError {
+    /// The packet in `decoded`, of a `what` (event, frame) stream, whose contents are
+    /// damaged: `problem`.
+    fn damaged(&self, what: &str, problem: impl std::fmt::Display) -> InputError {
         InputError::corrupt(
             &self.path,
-            format!("byte offset {offset} ({what} packet)"),
-            format!("invalid FlatBuffer: {error}"),
-            FIX_TRUNCATED,
+            self.place(&format!("{what} ")),
+            problem.to_string(),
+            FIX_DAMAGED_PACKET,
         )
     }
+
+    /// The packet in `decoded`: its index among the file's packets, offset and stream (of
+    /// `kind`: "event ", "frame ", or "" where not known).
+    fn place(&self, kind: &str) -> String {
+        let (index, offset, stream) = self.current;
+        format!("packet {index} at byte offset {offset} ({kind}stream {stream})")
+    }
+
+    /// The packet in `decoded` is no valid `what` packet, by the FlatBuffer verifier.
+    fn invalid(&self, what: &str, error: &flatbuffers::InvalidFlatbuffer) -> InputError {
+        self.damaged(
+            what,
+            format!(
+                "the packet ({} bytes after decompression) is no valid {what} packet ({})",
+                self.decoded.len(),
+                first_line(error)
+            ),
+        )
+    }
+}
+
+/// The fix for a packet whose contents are damaged.
+const FIX_DAMAGED_PACKET: &str =
+    "the file is damaged at this packet: copy it again from the source recording";
+
+/// The first line of a FlatBuffer verifier error, without its full stop: the lines below it
+/// trace the verifier's path through the buffer (and end in blank lines).
+fn first_line(error: &flatbuffers::InvalidFlatbuffer) -> String {
+    let text = error.to_string();
+    let line = text.lines().next().unwrap_or_default().trim_end();
+    line.strip_suffix('.').unwrap_or(line).to_string()
 }
 
 /// Streaming decoder of the event stream.
@@ -400,7 +444,7 @@ impl Aedat4Decoder {
             return Ok(false);
         };
         let packet = flatbuffers::size_prefixed_root::<EventPacket>(&self.packets.decoded)
-            .map_err(|e| self.packets.invalid(offset, "event", e))?;
+            .map_err(|e| self.packets.invalid("event", &e))?;
         self.pending.clear();
         if let Some(elements) = packet.elements() {
             self.pending.extend_from_slice(elements.bytes());
@@ -508,12 +552,11 @@ fn for_each_frame(
     let mut previous: Option<(TimeUs, u32, u32)> = None;
     while let Some(offset) = packets.next(stream)? {
         let frame = flatbuffers::size_prefixed_root::<FramePacket>(&packets.decoded)
-            .map_err(|e| packets.invalid(offset, "frame", e))?;
+            .map_err(|e| packets.invalid("frame", &e))?;
         let (w, h) = (frame.width(), frame.height());
         let limit = crate::events::MAX_SENSOR_SIDE as i16;
         if w <= 0 || h <= 0 || w > limit || h > limit {
-            return Err(packets.invalid(
-                offset,
+            return Err(packets.damaged(
                 "frame",
                 format!("frame size {w}x{h} (1..={limit} pixels a side expected)"),
             ));
@@ -525,16 +568,11 @@ fn for_each_frame(
             16 => 3,
             24 => 4,
             other => {
-                return Err(packets.invalid(
-                    offset,
-                    "frame",
-                    format!("unknown pixel format {other}"),
-                ));
+                return Err(packets.damaged("frame", format!("unknown pixel format {other}")));
             }
         };
         if data.len() != (w * h) as usize * channels {
-            return Err(packets.invalid(
-                offset,
+            return Err(packets.damaged(
                 "frame",
                 format!(
                     "{} pixel bytes for a {w}x{h} frame with {channels} channels",
@@ -561,8 +599,7 @@ fn for_each_frame(
         }
         if let Some((t0, w0, h0)) = previous {
             if (w, h) != (w0, h0) {
-                return Err(packets.invalid(
-                    offset,
+                return Err(packets.damaged(
                     "frame",
                     format!("the frame is {w}x{h}, the first frame {w0}x{h0}"),
                 ));
