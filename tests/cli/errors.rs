@@ -2,6 +2,7 @@
 
 use crate::common::*;
 use assert_cmd::Command;
+use ctcal::{OpenOptions, Recording};
 use std::path::Path;
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> String {
@@ -594,4 +595,48 @@ fn a_damaged_aedat4_packet_is_named_in_one_message() {
         );
         assert_eq!(e.lines().count(), 2, "{e}");
     }
+}
+
+/// libhdf5's conversion to grey levels turned a frame normalised to [0, 1] into black and
+/// white and saturated a 12-bit readout at 255, both read as scenes without a word; they are
+/// refused naming the frame, while a float frame of whole grey levels reads exactly as the
+/// 8-bit one it came from.
+#[test]
+fn hdf5_frames_that_are_not_grey_levels_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let original = shared_data().join("h5/e_ct060_event_utils.h5");
+    let frames = Recording::open(&original, &OpenOptions::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    let (w, h) = (frames[3].width as usize, frames[3].height as usize);
+    let levels = ndarray::Array2::from_shape_vec((h, w), frames[3].pixels.clone()).unwrap();
+
+    let whole = levels.mapv(|v| v as f32);
+    let path = event_utils_with_frame_3(dir.path(), "whole.h5", &whole);
+    let read = Recording::open(Path::new(&path), &OpenOptions::default())
+        .unwrap()
+        .frames()
+        .unwrap();
+    assert!(read[3].pixels == frames[3].pixels && read.len() == frames.len());
+
+    let normalised = levels.mapv(|v| v as f64 / 255.0);
+    let path = event_utils_with_frame_3(dir.path(), "normalised.h5", &normalised);
+    let e = bad_input(&["estimate", "aps", &path]);
+    assert!(
+        e.contains("normalised.h5: images/image000000003 (frame 3): the frame's values all lie in [0, 1] with fractions")
+            && e.contains("fix: write the frames as 8-bit grey levels: round(255 x value)"),
+        "{e}"
+    );
+
+    let twelve_bit = levels.mapv(|v| v as u16 * 16);
+    let path = event_utils_with_frame_3(dir.path(), "twelve.h5", &twelve_bit);
+    let e = bad_input(&["estimate", "aps", &path]);
+    let over = twelve_bit.iter().filter(|&&v| v > 255).count();
+    assert!(
+        over > 1000
+            && e.contains(&format!("twelve.h5: images/image000000003 (frame 3): {over} of the frame's {} pixels are outside the grey levels 0-255", w * h))
+            && e.contains("scale a 10- or 12-bit readout to 0-255"),
+        "{e}"
+    );
 }

@@ -26,6 +26,8 @@
 #[cfg(feature = "hdf5")]
 mod direct;
 #[cfg(feature = "hdf5")]
+mod frame_pixels;
+#[cfg(feature = "hdf5")]
 mod read;
 #[cfg(feature = "hdf5")]
 pub use read::*;

@@ -3,6 +3,7 @@
 //! ([`super::direct`]).
 
 use super::direct::{DirectColumn, DirectError, ElementKind};
+use super::frame_pixels::frame_pixels;
 use super::{H5Info, Layout, Side};
 use crate::error::InputError;
 use crate::events::{CHUNK_EVENTS, EventChunk, Frame, MAX_SENSOR_SIDE, Sensor, TimeUs};
@@ -19,7 +20,7 @@ impl Side {
     }
 }
 
-fn h5_error(path: &Path, what: &str, e: hdf5::Error) -> InputError {
+pub(super) fn h5_error(path: &Path, what: &str, e: hdf5::Error) -> InputError {
     InputError::hdf5(
         path,
         format!("{what}: {e}"),
@@ -1095,60 +1096,6 @@ pub fn read_frames(path: &Path, info: &H5Info) -> Result<Vec<Frame>, InputError>
         });
     }
     Ok(frames)
-}
-
-/// One frame's grey levels: a whole dataset (`row` `None`) or row `row` of a stack, at
-/// `place`. A float frame must hold finite numbers: libhdf5 converts NaN to a grey level.
-fn frame_pixels(
-    path: &Path,
-    ds: &hdf5::Dataset,
-    row: Option<usize>,
-    place: &str,
-    width: u32,
-) -> Result<Vec<u8>, InputError> {
-    let float = matches!(
-        ds.dtype().and_then(|d| d.to_descriptor()),
-        Ok(TypeDescriptor::Float(_))
-    );
-    if float {
-        let values = frame_values::<f64>(ds, row).map_err(|e| h5_error(path, place, e))?;
-        check_finite(path, place, &values, width)?;
-    }
-    frame_values::<u8>(ds, row).map_err(|e| h5_error(path, place, e))
-}
-
-fn frame_values<T: hdf5::H5Type + Copy>(
-    ds: &hdf5::Dataset,
-    row: Option<usize>,
-) -> hdf5::Result<Vec<T>> {
-    match row {
-        None => ds.read_raw::<T>(),
-        Some(i) => Ok(ds
-            .read_slice_2d::<T, _>(ndarray::s![i, .., ..])?
-            .iter()
-            .copied()
-            .collect()),
-    }
-}
-
-/// Refuses a frame with NaN or infinite pixels, naming how many and the first.
-fn check_finite(path: &Path, place: &str, values: &[f64], width: u32) -> Result<(), InputError> {
-    let Some(first) = values.iter().position(|v| !v.is_finite()) else {
-        return Ok(());
-    };
-    let count = values.iter().filter(|v| !v.is_finite()).count();
-    let verb = if count == 1 { "is" } else { "are" };
-    let (x, y) = (first % width as usize, first / width as usize);
-    Err(InputError::corrupt(
-        path,
-        place,
-        format!(
-            "{count} of the frame's {} pixels {verb} NaN or infinite (the first at x = {x}, y = {y}: {})",
-            values.len(),
-            values[first]
-        ),
-        "the frame is damaged: write it again from its source (grey levels are finite numbers), or leave it out of the file",
-    ))
 }
 
 /// One slice of the event columns, before validation (coordinates may be out of range,
