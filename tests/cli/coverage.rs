@@ -333,3 +333,30 @@ fn eppps_without_frames_carries_an_imbalance_it_cannot_attribute() {
         output["assumptions"]
     );
 }
+
+/// Draw 4078: a natural image at 11 DN mean, 723 events, v2e's lin-log response. The pure
+/// `ln(DN + b)` (b = 37.5 DN) scattered 0.97 times as much and was taken, reading ON 0.067
+/// [0.034, 0.100] for the true 0.442 (OFF 0.132 for 0.818); lin-log gives 0.46 and 1.02.
+/// The pixels leave the score ratio at 0.87 .. 1.08, so the other response's thresholds are
+/// carried into the intervals (`estimate::timing::response`).
+#[test]
+fn aps_carries_a_log_response_the_events_cannot_rule_out() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_draw(Method::Aps, 4078, work.path());
+    let (on, _) = covered_value(&record, "ct_on");
+    covered_value(&record, "ct_off");
+    let output = json_output(&record);
+    let other = &output["log_response_other"];
+    assert_eq!(other["response"], "v2e", "{other}");
+    let ratio = other["ct_on"].as_f64().unwrap() / other["chosen_ct_on"].as_f64().unwrap();
+    assert!(ratio > 3.0 && on < 0.2, "{other}");
+    let [lo, hi] = [0, 1].map(|k| other["score_ratio_ci95"][k].as_f64().unwrap());
+    assert!(lo < 0.98 && hi > 0.98, "{other}");
+    assert!(
+        crate::common::strings(&output["assumptions"])
+            .iter()
+            .any(|a| a.starts_with("log response not determined: v2e's lin-log")),
+        "{}",
+        output["assumptions"]
+    );
+}

@@ -213,6 +213,7 @@ pub fn estimate(
         mut frames,
         alignment,
         offset_report,
+        other_response,
         mut assumptions,
     } = checked_frames(input, options)?;
 
@@ -289,6 +290,7 @@ pub fn estimate(
             alignment: json!(alignment),
             offset: offset_report,
             offset_from_counts: offset_from_counts.map(|c| c.found),
+            other_response,
         },
     );
     progress("done", 1.0);
@@ -310,6 +312,7 @@ struct Checked {
     frames: PreparedFrames,
     alignment: Option<super::align::Alignment>,
     offset_report: Option<super::timing::Offset>,
+    other_response: Option<super::timing::OtherResponse>,
     assumptions: Vec<String>,
 }
 
@@ -325,6 +328,7 @@ fn checked_frames(input: &ApsInput, options: &ApsOptions) -> Result<Checked, Est
         frames,
         alignment,
         offset: offset_report,
+        other_response,
         assumptions: prepared_notes,
     } = prepare(input, &excluded, options)?;
     assumptions.extend(prepared_notes);
@@ -355,6 +359,7 @@ fn checked_frames(input: &ApsInput, options: &ApsOptions) -> Result<Checked, Est
         frames,
         alignment,
         offset_report,
+        other_response,
         assumptions,
     })
 }
@@ -407,8 +412,12 @@ fn frame_assumptions(
     let exposure = super::frames::exposure_of(input.frames, options.exposure_us);
     [
         format!(
-            "log response: {}, of the frame value plus the frames' log offset b (DN + b; b as said below)",
-            options.log_response_name
+            "log response: {}, of the frame value plus the frames' log offset b (DN + b; b as its own line says)",
+            if frames.log_map.response() == options.log_map.response() {
+                options.log_response_name.as_str()
+            } else {
+                "a pure ln(DN + b), chosen from the events' timing (its own line says why)"
+            }
         ),
         format!(
             "frames: {} of {} intervals used; frame times are exposure midpoints (as the file gives them); {}",
@@ -489,6 +498,8 @@ pub struct Prepared {
     pub frames: PreparedFrames,
     pub alignment: Option<super::align::Alignment>,
     pub offset: Option<super::timing::Offset>,
+    /// The log response not chosen, where the events cannot rule it out.
+    pub other_response: Option<super::timing::OtherResponse>,
     pub assumptions: Vec<String>,
 }
 
@@ -538,6 +549,7 @@ pub fn prepare(
             found
         }
     };
+    let mut other_response = None;
     let offset = match options.frame_offset_dn {
         Some(o) => {
             frames.offset = o as f32;
@@ -556,12 +568,13 @@ pub fn prepare(
                 super::timing::thresholds(input.events, &frames, input.sensor, excluded, &fitting);
             if let Some(t) = &found {
                 if t.log_map != frames.log_map {
-                    assumptions.push("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN); used throughout".into());
+                    assumptions.push(format!("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN){}; used throughout", if t.other_response.is_some() { ", though not beyond the pixels' noise (its own line says what that does)" } else { "" }));
                     frames.log_map = t.log_map;
                 }
                 frames.offset = t.offset.offset_dn;
                 frames.offset_range = t.offset.systematic_range;
                 assumptions.push(offset_assumption(&t.offset));
+                other_response = t.other_response.clone();
             }
             found.map(|t| t.offset)
         }
@@ -570,6 +583,7 @@ pub fn prepare(
         frames,
         alignment,
         offset,
+        other_response,
         assumptions,
     })
 }

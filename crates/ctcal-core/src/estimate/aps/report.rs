@@ -186,8 +186,35 @@ fn method_systematic_assumption() -> String {
     )
 }
 
+/// The systematic, relative to each threshold, of a log response the events cannot tell
+/// from the chosen one: the other's thresholds over the chosen ones in the same timing fit,
+/// less one, over 1.96, so that each 95 % interval reaches the other response's value.
+fn response_systematic(other: Option<&crate::estimate::timing::OtherResponse>) -> [f64; 2] {
+    other.map_or([0.0; 2], |o| {
+        o.threshold_ratios().map(|r| (r - 1.0).abs() / 1.96)
+    })
+}
+
+fn response_assumption(other: &crate::estimate::timing::OtherResponse) -> String {
+    let [on, off] = other.threshold_ratios();
+    let name = match other.response {
+        "eps" => format!("a pure ln(DN + b), b = {:.1} DN", other.offset_dn),
+        _ => format!("v2e's lin-log (b = {:.1} DN)", other.offset_dn),
+    };
+    format!(
+        "log response not determined: {name} explains the events' timing within the pixels' noise of the response used (its scatter {:.2} times, 95 % {:.2} .. {:.2}, across the margin {REPLACE:.2} a response must beat); its thresholds, ON {on:.2} and OFF {off:.2} times the ones used, are in the intervals (more events, or frames of brighter scenes, tell the two apart)",
+        other.score_ratio,
+        other.score_ratio_ci95[0],
+        other.score_ratio_ci95[1],
+        REPLACE = crate::estimate::timing::response::REPLACE_MARGIN,
+    )
+}
+
 /// What the estimate reports beside its thresholds.
 pub(super) struct Findings {
+    /// The log response not chosen where the events cannot rule it out: its thresholds
+    /// are carried into the intervals ([`response_systematic`]).
+    pub(super) other_response: Option<crate::estimate::timing::OtherResponse>,
     /// The event timing's per-pixel spread, both polarities combined.
     pub(super) spread: Spread,
     /// The self-calibration's bias of that spread.
@@ -215,16 +242,20 @@ pub(super) fn assemble(
     full: &Pass,
     findings: Findings,
 ) -> CtEstimate {
-    let combined = |pick: fn(&EstimatorReport) -> &Measured| {
+    let response = response_systematic(findings.other_response.as_ref());
+    let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64| {
         let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
         match combine(&refs) {
-            Some((value, error)) => Measured::new(value, error, METHOD_SYSTEMATIC * value),
+            Some((value, error)) => {
+                Measured::new(value, error, METHOD_SYSTEMATIC.hypot(response) * value)
+            }
             None => Measured::new(f64::NAN, f64::NAN, 0.0),
         }
     };
     assumptions.push(method_systematic_assumption());
-    let on = combined(|e| &e.ct_on);
-    let off = combined(|e| &e.ct_off);
+    assumptions.extend(findings.other_response.as_ref().map(response_assumption));
+    let on = combined(|e| &e.ct_on, response[0]);
+    let off = combined(|e| &e.ct_off, response[1]);
     let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames
@@ -263,6 +294,7 @@ pub(super) fn assemble(
             }),
         ),
         ("frame_time_alignment", findings.alignment),
+        ("log_response_other", json!(findings.other_response)),
         (
             "frame_offset_dn",
             json!({"value": frames.offset, "estimate": findings.offset, "from_counts": findings.offset_from_counts}),

@@ -22,18 +22,19 @@
 pub mod model;
 pub mod moments;
 pub mod pixels;
+pub mod response;
 pub mod samples;
 pub mod spread;
 
 use crate::estimate::frames::PreparedFrames;
 use crate::events::{EventChunk, Sensor, TimeUs};
-use crate::sim::LogResponse;
 use crate::sim::log_response::LogMap;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
 use model::{Coefficients, fit_at, offset_interval, offset_root};
 use moments::Resampler;
 use pixels::{PixelSlots, pixel_sums};
 use rayon::prelude::*;
+pub use response::OtherResponse;
 use samples::{Pair, collect};
 use serde::Serialize;
 
@@ -172,6 +173,8 @@ pub struct TimingEstimate {
     /// [`PolarityEstimate::offset_systematic`] is for the thresholds.
     pub sigma_offset_systematic: f64,
     pub offset: Offset,
+    /// The response not chosen, where the events cannot rule it out.
+    pub other_response: Option<OtherResponse>,
     pub drift: Drift,
     pub lag: Lag,
 }
@@ -206,6 +209,8 @@ const OFFSET_SEARCH: (f32, f32) = (-0.9, 255.0);
 pub struct Thresholds {
     pub log_map: LogMap,
     pub offset: Offset,
+    /// The response not chosen, where the events cannot rule it out.
+    pub other_response: Option<OtherResponse>,
     pub ct_on: f64,
     pub ct_off: f64,
 }
@@ -229,6 +234,7 @@ pub fn thresholds(
         ct_off: central.coefficients.c_off,
         log_map: central.log_map,
         offset: central.offset,
+        other_response: central.other_response,
     })
 }
 
@@ -237,6 +243,7 @@ struct Central {
     pairs: Vec<Pair>,
     log_map: LogMap,
     offset: Offset,
+    other_response: Option<OtherResponse>,
     coefficients: Coefficients,
     values: model::Values,
     weights: Vec<f64>,
@@ -262,7 +269,11 @@ impl Central {
             excluded,
             options.support_window_us,
         );
-        let (log_map, offset) = choose_response(&pairs, frames, options);
+        let response::Chosen {
+            log_map,
+            offset,
+            other,
+        } = response::choose(&pairs, frames, options);
         let (offset, (coefficients, values, weights)) = {
             let fit = whole_fit(&pairs, &log_map, sensor.pixels(), options);
             let offset = with_polarity_offsets(offset, &pairs, options, &fit);
@@ -274,6 +285,7 @@ impl Central {
             pairs,
             log_map,
             offset,
+            other_response: other,
             coefficients,
             values,
             weights,
@@ -293,7 +305,7 @@ impl Central {
 
 /// [`fit_at`] of `pairs` through `log_map` with the options' window and leak: the whole
 /// fit at an offset.
-fn whole_fit<'a>(
+pub(super) fn whole_fit<'a>(
     pairs: &'a [Pair],
     log_map: &'a LogMap,
     pixels: usize,
@@ -325,6 +337,7 @@ pub fn estimate(
         pairs,
         log_map,
         offset,
+        other_response,
         coefficients,
         values,
         weights,
@@ -397,6 +410,7 @@ pub fn estimate(
         maps: maps(sensor, &on.1, &off.1),
         sigma_offset_systematic,
         offset,
+        other_response,
         lag: Lag {
             tau_times_dn: coefficients.lag,
             standard_error: boot.lag,
@@ -412,64 +426,13 @@ pub fn estimate(
     })
 }
 
-/// The response and offset: for each candidate response (the frames' own; with
-/// `choose_response` also a pure `ln(DN + b)`), the offset, and the candidate whose
-/// samples scatter least about the model (the weighted mean absolute residual over the mean
-/// threshold; a pure log must do 2 % better to replace the frames' own response).
-fn choose_response(
-    pairs: &[Pair],
-    frames: &PreparedFrames,
-    options: &TimingOptions,
-) -> (LogMap, Offset) {
-    let pixels = frames.width * frames.height;
-    let mut candidates = vec![frames.log_map];
-    if options.fit_offset
-        && options.choose_response
-        && frames.log_map.response() != LogResponse::Eps
-    {
-        candidates.push(LogMap::new(LogResponse::Eps, 0.0));
-    }
-    // each candidate's offset and score on its own thread, then chosen in order
-    let scored: Vec<(LogMap, Offset, f64)> = candidates
-        .into_par_iter()
-        .map(|map| {
-            let fit = whole_fit(pairs, &map, pixels, options);
-            let offset = find_offset(pairs, frames, options, &fit);
-            let score =
-                fit(offset.offset_dn).map_or(f64::INFINITY, |(c, v, w)| scatter(pairs, &c, &v, &w));
-            (map, offset, score)
-        })
-        .collect();
-    let mut best: Option<(LogMap, Offset, f64)> = None;
-    for (k, (map, offset, score)) in scored.into_iter().enumerate() {
-        let margin = if k == 0 { 1.0 } else { 0.98 };
-        if best.as_ref().is_none_or(|b| score < margin * b.2) {
-            best = Some((map, offset, score));
-        }
-    }
-    let (map, offset, _) = best.expect("one candidate at least");
-    (map, offset)
-}
-
 /// The whole fit at one offset ([`fit_at`] with the response and options fixed).
-type Fit<'a> = dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)> + Sync + 'a;
-
-/// Weighted mean absolute residual of the kept pairs over the mean threshold.
-fn scatter(pairs: &[Pair], c: &Coefficients, v: &model::Values, w: &[f64]) -> f64 {
-    let (mut sum, mut total) = (0.0, 0.0);
-    for (i, p) in pairs.iter().enumerate() {
-        if w[i] > 0.0 {
-            let ct = if p.on { c.c_on } else { c.c_off };
-            sum += w[i] * (c.corrected(p, v, i) - ct).abs();
-            total += w[i];
-        }
-    }
-    sum / total.max(1e-12) / (0.5 * (c.c_on + c.c_off)).max(1e-12)
-}
+pub(super) type Fit<'a> =
+    dyn Fn(f32) -> Option<(Coefficients, model::Values, Vec<f64>)> + Sync + 'a;
 
 /// The offset: fitted (root of the level slope, interval from its bootstrap error), given,
 /// or not determined (the frames' own kept; its interval the whole search range).
-fn find_offset(
+pub(super) fn find_offset(
     pairs: &[Pair],
     frames: &PreparedFrames,
     options: &TimingOptions,

@@ -12,6 +12,7 @@ use super::super::{
 use super::State;
 use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
 use crate::estimate::frames::exposure_of;
+use crate::estimate::interval::z95;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
 use crate::stats::robust::mad_sigma;
 use std::collections::BTreeMap;
@@ -142,6 +143,9 @@ pub struct Parts<'a> {
     /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
     /// miss (the intervals reach up by it).
     pub interpolation_share: Option<[f64; 2]>,
+    /// The log response not chosen, where the events cannot rule it out (the intervals
+    /// reach the thresholds it gives).
+    pub other_response: Option<crate::estimate::timing::OtherResponse>,
     /// The thresholds at coarser frame rates and a doubled exposure (their systematics
     /// join the intervals).
     pub frame_quality: super::frame_quality::FrameQuality,
@@ -168,6 +172,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         start,
         known,
         interpolation_share,
+        other_response,
         frame_quality,
         frames_aligned,
         options,
@@ -179,6 +184,7 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
         fixed,
         frame_quality: &frame_quality,
         interpolation_share,
+        other_response: other_response.as_ref(),
         start: start.as_ref(),
     };
     assumptions.extend(threshold_intervals(simulation, &mut state, widening));
@@ -256,6 +262,7 @@ struct Widening<'a> {
     fixed: bool,
     frame_quality: &'a super::frame_quality::FrameQuality,
     interpolation_share: Option<[f64; 2]>,
+    other_response: Option<&'a crate::estimate::timing::OtherResponse>,
     start: Option<&'a super::agreement::Measured>,
 }
 
@@ -288,6 +295,11 @@ fn threshold_intervals(
     {
         assumptions.push(note);
     }
+    if !widening.fixed
+        && let Some(other) = widening.other_response
+    {
+        assumptions.extend(reach_for_other_response(&mut state.uncertainty, other));
+    }
     if !widening.fixed {
         assumptions.extend(super::method_systematic::widen(&mut state.uncertainty));
     }
@@ -295,6 +307,35 @@ fn threshold_intervals(
         &mut state.uncertainty,
     ));
     assumptions
+}
+
+/// Widens each threshold's interval in ln C by the other log response's ratio over 1.96,
+/// in quadrature, so that it reaches the threshold that response gives
+/// ([`crate::estimate::timing::response`]); returns the assumption that says so.
+fn reach_for_other_response(
+    uncertainty: &mut BTreeMap<String, crate::fit::Uncertain>,
+    other: &crate::estimate::timing::OtherResponse,
+) -> Option<String> {
+    let widened: Vec<String> = ["ct_on", "ct_off"]
+        .into_iter()
+        .zip(other.threshold_ratios())
+        .filter(|(_, r)| r.is_finite() && *r > 0.0)
+        .filter_map(|(key, r)| {
+            super::method_systematic::widen_ln(uncertainty, key, r.ln().abs() / z95())
+        })
+        .collect();
+    (!widened.is_empty()).then(|| {
+        let [on, off] = other.threshold_ratios();
+        format!(
+            "log response not determined: {} (b = {:.1} DN) explains the fit run's event timing within the pixels' noise of the response used (its scatter {:.2} times, 95 % {:.2} .. {:.2}); its thresholds, ON {on:.2} and OFF {off:.2} times the ones used, are in the intervals: {}",
+            if other.response == "eps" { "a pure ln(DN + b)" } else { "v2e's lin-log" },
+            other.offset_dn,
+            other.score_ratio,
+            other.score_ratio_ci95[0],
+            other.score_ratio_ci95[1],
+            widened.join("; ")
+        )
+    })
 }
 
 /// The noise parameters' intervals and what they leave undetermined.

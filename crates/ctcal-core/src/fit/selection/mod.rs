@@ -133,6 +133,7 @@ pub fn fit(
         mut frames,
         mut assumptions,
         aligned: frames_aligned,
+        other_response,
     } = match prepare_frames(input, &run, options)? {
         Ok(prepared) => prepared,
         Err(why) => {
@@ -200,6 +201,7 @@ pub fn fit(
             start: start.measured,
             known: loop_run.known,
             interpolation_share: start.interpolation_share,
+            other_response,
             frame_quality,
             frames_aligned,
             options,
@@ -443,6 +445,7 @@ fn prepare_frames(
         frames: prepared.frames,
         assumptions: found.assumptions,
         aligned: options.aps.frame_time_offset_s.is_none() && found.alignment.is_some(),
+        other_response: found.other_response,
     }))
 }
 
@@ -453,6 +456,8 @@ struct FramesToSimulate {
     assumptions: Vec<String>,
     /// Whether their times were aligned to the fit run's events.
     aligned: bool,
+    /// The log response not chosen, where the fit run's events cannot rule it out.
+    other_response: Option<crate::estimate::timing::OtherResponse>,
 }
 
 /// Why the frames cannot be re-simulated. Either the motion outruns the fit run's frames:
