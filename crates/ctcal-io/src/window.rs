@@ -696,9 +696,10 @@ pub fn eppps_of(
         match aps::prepare(&loaded.aps_input(), excluded, options) {
             Ok(p) => {
                 notes.extend(p.assumptions.iter().cloned());
+                // a response the events could not choose is tried both ways
                 let known = !options.choose_response
                     || options.frame_offset_dn.is_some()
-                    || p.offset.is_some();
+                    || (p.offset.is_some() && p.other_response.is_none());
                 Some((p.frames, known))
             }
             Err(e) => {

@@ -568,7 +568,7 @@ pub fn prepare(
                 super::timing::thresholds(input.events, &frames, input.sensor, excluded, &fitting);
             if let Some(t) = &found {
                 if t.log_map != frames.log_map {
-                    assumptions.push(format!("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN){}; used throughout", if t.other_response.is_some() { ", though not beyond the pixels' noise (its own line says what that does)" } else { "" }));
+                    assumptions.push(format!("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN){}; used throughout", if t.other_response.is_some() { ", though not beyond the pixels' noise: the thresholds the other gives are carried into the intervals" } else { "" }));
                     frames.log_map = t.log_map;
                 }
                 frames.offset = t.offset.offset_dn;

@@ -173,8 +173,6 @@ pub struct TimingEstimate {
     /// [`PolarityEstimate::offset_systematic`] is for the thresholds.
     pub sigma_offset_systematic: f64,
     pub offset: Offset,
-    /// The response not chosen, where the events cannot rule it out.
-    pub other_response: Option<OtherResponse>,
     pub drift: Drift,
     pub lag: Lag,
 }
@@ -252,7 +250,7 @@ struct Central {
 
 impl Central {
     /// The pairs of `events` against `frames`, the response and offset
-    /// ([`choose_response`], [`with_polarity_offsets`]) and the fit at that offset; `None`
+    /// ([`response::choose`], [`with_polarity_offsets`]) and the fit at that offset; `None`
     /// where the fit fails.
     fn fit(
         events: &EventChunk,
@@ -333,11 +331,13 @@ pub fn estimate(
     excluded: &[bool],
     options: &TimingOptions,
 ) -> Option<TimingEstimate> {
+    // the response is chosen where the frames are prepared ([`thresholds`], which carries
+    // the other one); callers then fix it
     let Central {
         pairs,
         log_map,
         offset,
-        other_response,
+        other_response: _,
         coefficients,
         values,
         weights,
@@ -410,7 +410,6 @@ pub fn estimate(
         maps: maps(sensor, &on.1, &off.1),
         sigma_offset_systematic,
         offset,
-        other_response,
         lag: Lag {
             tau_times_dn: coefficients.lag,
             standard_error: boot.lag,

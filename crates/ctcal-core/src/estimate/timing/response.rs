@@ -40,7 +40,8 @@ pub struct OtherResponse {
     pub offset_dn: f32,
     pub ct_on: f64,
     pub ct_off: f64,
-    /// The thresholds the chosen response gives in the same fit, for the ratio.
+    /// The thresholds the chosen response gives at its own offset (before the polarities'
+    /// offsets are joined to it), for the ratio.
     pub chosen_ct_on: f64,
     pub chosen_ct_off: f64,
     /// Its score over the chosen response's (below 1: it scatters less).
@@ -121,8 +122,9 @@ pub(super) fn choose(pairs: &[Pair], frames: &PreparedFrames, options: &TimingOp
         ci[0] >= REPLACE_MARGIN
     };
     let (chosen, other) = if replace { (pure, own) } else { (own, pure) };
+    let positive = |c: &Coefficients| [c.c_on, c.c_off].iter().all(|v| v.is_finite() && *v > 0.0);
     let other = match (clear, &chosen.coefficients, &other.coefficients) {
-        (false, Some(c), Some(o)) => Some(OtherResponse {
+        (false, Some(c), Some(o)) if positive(c) && positive(o) => Some(OtherResponse {
             log_map: other.map,
             response: response_name(other.map.response()),
             offset_dn: other.offset.offset_dn,
@@ -212,7 +214,8 @@ fn score(sums: &[[f64; 2]], times: Option<&[u32]>) -> f64 {
 }
 
 /// The 95 % interval (2.5th and 97.5th percentiles) of `score(a) / score(b)` over pixel
-/// draws common to both; `[inf, inf]` where either has no fit.
+/// draws common to both (draws without a score left out); `[inf, inf]` where either has
+/// no fit, or half the draws have no score.
 fn ratio_interval(a: &[[f64; 2]], b: &[[f64; 2]], slots: usize) -> [f64; 2] {
     if a.len() != slots || b.len() != slots || slots == 0 {
         return [f64::INFINITY; 2];
@@ -224,9 +227,14 @@ fn ratio_interval(a: &[[f64; 2]], b: &[[f64; 2]], slots: usize) -> [f64; 2] {
             let times = model::draw_counts(&units, slots, 9000 + k as u64);
             score(a, Some(&times)) / score(b, Some(&times))
         })
+        // a draw of only pixels without kept pairs has no score
+        .filter(|r| r.is_finite())
         .collect();
+    if ratios.len() < RATIO_DRAWS / 2 {
+        return [f64::INFINITY; 2];
+    }
     ratios.sort_by(f64::total_cmp);
-    let at = |q: f64| ratios[((q * (RATIO_DRAWS - 1) as f64).round()) as usize];
+    let at = |q: f64| ratios[(q * (ratios.len() - 1) as f64).round() as usize];
     [at(0.025), at(0.975)]
 }
 
