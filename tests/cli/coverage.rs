@@ -361,3 +361,23 @@ fn aps_carries_a_log_response_the_events_cannot_rule_out() {
         output["assumptions"]
     );
 }
+
+/// Draw 12036 of the peers' second fresh study: ctcal's simulator, Cp 0.116 against Cn 0.656
+/// and a leak of 0.041 Hz. Without frames the isolated events' ON excess read as a leak of
+/// 1.02 [0.87, 1.20] Hz: the scene's own unsupported events fire ON 7.6 times as often as OFF
+/// here, and may be the excess as well as leak. The interval now reaches down to the least
+/// leak the counts allow (`fit::events_only::candidates::SceneShare`).
+#[test]
+fn fit_without_frames_holds_a_leak_the_scene_s_balance_may_explain() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_peer_draw(Method::FitEvents, 12036, work.path());
+    assert_eq!(record.case.generator, ctcal::coverage::Generator::Ctcal);
+    covered_value(&record, "leak_rate_hz");
+    let output = json_output(&record);
+    let why = output["why"]["leak_rate_hz"].as_str().unwrap_or_default();
+    assert!(
+        why.starts_with("the scene fires OFF/ON = "),
+        "{}",
+        output["why"]
+    );
+}

@@ -370,8 +370,12 @@ fn noise_params(
             );
         } else if kept("leak") {
             params.leak_rate_hz = Some(excess);
-            let leak = Uncertain::positive(excess, Some(se));
-            uncertainties.insert("leak_rate_hz".into(), down_to_none(leak, run));
+            let leak = down_to_none(Uncertain::positive(excess, Some(se)), run);
+            let leak = match super::candidates::scene_share(run) {
+                Some(share) => reach_down_to_scene_share(leak, share, se, excess, why),
+                None => leak,
+            };
+            uncertainties.insert("leak_rate_hz".into(), leak);
         } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
             why.insert(
                 "leak_rate_hz".into(),
@@ -381,6 +385,26 @@ fn noise_params(
                 ),
             );
         }
+    }
+}
+
+/// `leak`'s interval reaching down to the least leak the isolated events hold where the
+/// scene's own may be among them ([`super::candidates::SceneShare`]), with 2 standard
+/// errors of the ON excess, and the reason in `why`; as it is where that is no lower.
+fn reach_down_to_scene_share(
+    leak: Uncertain,
+    share: super::candidates::SceneShare,
+    se: f64,
+    excess: f64,
+    why: &mut BTreeMap<String, String>,
+) -> Uncertain {
+    let least = (share.leak_at_least_hz - 2.0 * se).max(0.0);
+    match leak.ci95 {
+        Some([Some(lo), hi]) if least < lo => {
+            why.insert("leak_rate_hz".into(), share.text(excess));
+            Uncertain::with_interval(leak.value, leak.standard_error, [Some(least), hi])
+        }
+        _ => leak,
     }
 }
 
