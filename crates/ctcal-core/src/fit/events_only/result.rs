@@ -68,43 +68,12 @@ pub(super) fn result(parts: Parts) -> FitResult {
         frames_unused,
     } = parts;
     let kept = |name: &str| steps.iter().any(|s| s.effect == name && s.kept);
-    let mut why = BTreeMap::new();
-    let mut uncertainties = BTreeMap::new();
-    let (on, off) = absolute(&thresholds, &mut why, &mut uncertainties);
-    let mut params = PixelParams::ideal(on, off);
-    for (key, reason) in NEEDS_BRIGHTNESS {
-        let reason = match &frames_unused {
-            None => reason.to_string(),
-            Some(_) => format!("{reason}; the recording's frames are not used (see assumptions)"),
-        };
-        why.insert(key.to_string(), reason);
-    }
-    noise_params(&run, &kept, &mut params, &mut why, &mut uncertainties);
-    refractory_param(
-        &run,
-        kept("refractory"),
-        &mut params,
-        &mut why,
-        &mut uncertainties,
-    );
-    let hot = if kept("hot_pixels") {
-        run.hot.clone()
-    } else {
-        Vec::new()
-    };
-    if !hot.is_empty() {
-        let found = &run.hot_found;
-        params.hot_pixel_fraction = Some(found.fraction.value);
-        uncertainties.insert(HOT_FRACTION.into(), found.fraction.clone());
-        // the train a simulator adds on top of the pixel's own events
-        if let Some(rate) = &found.rate {
-            params.hot_pixel_rate_hz = Some(rate.value);
-            uncertainties.insert(HOT_RATE.into(), rate.clone());
-        }
-        if let Some(reason) = hot_rate_unmeasured(&why, &uncertainties) {
-            why.insert(HOT_RATE.into(), reason);
-        }
-    }
+    let Parameters {
+        params,
+        why,
+        uncertainties,
+        hot,
+    } = parameters(&run, &thresholds, &kept, frames_unused.as_deref());
     let TestErrors {
         before,
         after,
@@ -165,6 +134,68 @@ pub(super) fn result(parts: Parts) -> FitResult {
         simulations: 0,
         frame_exposure_us: None,
         events_only: Some(events_only),
+    }
+}
+
+/// The model's parameters with their intervals, what is not identified and why, and the
+/// hot pixels named (where the loop kept them).
+struct Parameters {
+    params: PixelParams,
+    why: BTreeMap<String, String>,
+    uncertainties: BTreeMap<String, Uncertain>,
+    hot: Vec<crate::stats::hot_pixels::HotPixel>,
+}
+
+/// The stages of [`Parameters`]: absolute thresholds, what needs brightness, noise,
+/// refractory period and hot pixels.
+fn parameters(
+    run: &FitRun,
+    thresholds: &Result<CtEstimate, String>,
+    kept: &dyn Fn(&str) -> bool,
+    frames_unused: Option<&str>,
+) -> Parameters {
+    let mut why = BTreeMap::new();
+    let mut uncertainties = BTreeMap::new();
+    let (on, off) = absolute(thresholds, &mut why, &mut uncertainties);
+    let mut params = PixelParams::ideal(on, off);
+    for (key, reason) in NEEDS_BRIGHTNESS {
+        let reason = match frames_unused {
+            None => reason.to_string(),
+            Some(_) => format!("{reason}; the recording's frames are not used (see assumptions)"),
+        };
+        why.insert(key.to_string(), reason);
+    }
+    noise_params(run, kept, &mut params, &mut why, &mut uncertainties);
+    refractory_param(
+        run,
+        kept("refractory"),
+        &mut params,
+        &mut why,
+        &mut uncertainties,
+    );
+    let hot = if kept("hot_pixels") {
+        run.hot.clone()
+    } else {
+        Vec::new()
+    };
+    if !hot.is_empty() {
+        let found = &run.hot_found;
+        params.hot_pixel_fraction = Some(found.fraction.value);
+        uncertainties.insert(HOT_FRACTION.into(), found.fraction.clone());
+        // the train a simulator adds on top of the pixel's own events
+        if let Some(rate) = &found.rate {
+            params.hot_pixel_rate_hz = Some(rate.value);
+            uncertainties.insert(HOT_RATE.into(), rate.clone());
+        }
+        if let Some(reason) = hot_rate_unmeasured(&why, &uncertainties) {
+            why.insert(HOT_RATE.into(), reason);
+        }
+    }
+    Parameters {
+        params,
+        why,
+        uncertainties,
+        hot,
     }
 }
 
@@ -302,8 +333,35 @@ fn noise_params(
     uncertainties: &mut BTreeMap<String, Uncertain>,
 ) {
     let scene = super::candidates::scene_like_isolated(run);
+    shot_noise_param(
+        run,
+        kept("shot_noise"),
+        scene.as_ref(),
+        params,
+        why,
+        uncertainties,
+    );
+    leak_param(
+        run,
+        kept("leak"),
+        scene.as_ref(),
+        params,
+        why,
+        uncertainties,
+    );
+}
+
+/// Shot noise: the isolated events' symmetric rate where kept, else bounded.
+fn shot_noise_param(
+    run: &FitRun,
+    kept: bool,
+    scene: Option<&super::candidates::SceneLike>,
+    params: &mut PixelParams,
+    why: &mut BTreeMap<String, String>,
+    uncertainties: &mut BTreeMap<String, Uncertain>,
+) {
     if let Some((rate, se)) = symmetric_rate(run) {
-        if let (Some(scene), false) = (&scene, kept("shot_noise")) {
+        if let (Some(scene), false) = (scene, kept) {
             // the lower end, from the OFF excess over the scene's balance, may pass the
             // upper (draw 8002: 3 OFF and 1 ON isolated events read 0.0004 to 0.0003 Hz)
             let upper = 2.0 * (rate + 2.0 * se);
@@ -320,7 +378,7 @@ fn noise_params(
                     scene.evidence(),
                 ),
             );
-        } else if kept("shot_noise") {
+        } else if kept {
             params.shot_noise_rate_hz = Some(2.0 * rate);
             let dark = dark_rate(2.0 * rate, 2.0 * se);
             uncertainties.insert("shot_noise_rate_hz".into(), down_to_none(dark, run));
@@ -338,13 +396,25 @@ fn noise_params(
             );
         }
     }
+}
+
+/// Leak: the isolated events' ON excess where kept (a lower bound after an onset, reaching
+/// down to the scene's share where it may hold the excess), else bounded.
+fn leak_param(
+    run: &FitRun,
+    kept: bool,
+    scene: Option<&super::candidates::SceneLike>,
+    params: &mut PixelParams,
+    why: &mut BTreeMap<String, String>,
+    uncertainties: &mut BTreeMap<String, Uncertain>,
+) {
     if let Some((excess, se)) = on_excess(run) {
         // an onset only where the isolated events are not the scene's own: a scene whose
         // unsupported events turn ON-heavy later would rise the same way
-        if let (Some(onset), None) = (&run.leak_onset, &scene) {
+        if let (Some(onset), None) = (&run.leak_onset, scene) {
             // a lower bound, whether or not the loop kept leak: the model simulates the
             // measured excess, the JSON says it is at least that
-            if kept("leak") {
+            if kept {
                 params.leak_rate_hz = Some(excess);
             }
             let lo = (excess - 2.0 * se).max(0.0);
@@ -359,7 +429,7 @@ fn noise_params(
                 "leak_rate_hz".into(),
                 Uncertain::with_interval(excess.max(0.0), Some(se), [Some(lo), None]),
             );
-        } else if let (Some(scene), false) = (&scene, kept("leak")) {
+        } else if let (Some(scene), false) = (scene, kept) {
             why.insert(
                 "leak_rate_hz".into(),
                 format!(
@@ -368,7 +438,7 @@ fn noise_params(
                     excess.max(0.0) + 2.0 * se
                 ),
             );
-        } else if kept("leak") {
+        } else if kept {
             params.leak_rate_hz = Some(excess);
             let leak = down_to_none(Uncertain::positive(excess, Some(se)), run);
             let leak = match super::candidates::scene_share(run) {
