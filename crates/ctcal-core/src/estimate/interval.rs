@@ -56,6 +56,56 @@ impl Measured {
     pub fn total_error(&self) -> f64 {
         self.standard_error.hypot(self.systematic)
     }
+
+    /// The interval reaching `ratio` times the value on the side that lies ([`ln_reach`]);
+    /// `systematic` grows by the reach's linear size over 1.96. As it is where the value or
+    /// the ratio is not positive and finite.
+    pub fn reaching(mut self, ratio: f64) -> Self {
+        if !(self.value > 0.0 && ratio.is_finite() && ratio > 0.0) || ratio == 1.0 {
+            return self;
+        }
+        let [lo, hi] = ln_reach(self.value, [Some(self.ci95[0]), Some(self.ci95[1])], ratio);
+        self.ci95 = [lo.unwrap_or(0.0), hi.unwrap_or(f64::INFINITY)];
+        self.systematic = self.systematic.hypot(self.value * ratio.ln().abs() / z95());
+        self
+    }
+}
+
+/// A 95 % interval `[lo, hi]` about a positive `value` widened by `add` in the logarithm, in
+/// quadrature on each side: `value exp(-+ sqrt(ln(value / lo)^2 + add^2))`. A lower end at
+/// or below 0 becomes 0, and an open side (`None`) stays open.
+pub fn ln_widened(value: f64, [lo, hi]: [Option<f64>; 2], add: f64) -> [Option<f64>; 2] {
+    [
+        lo.map(|lo| widened_side(value, lo, add, Side::Lower)),
+        hi.map(|hi| widened_side(value, hi, add, Side::Upper)),
+    ]
+}
+
+/// A 95 % interval about a positive `value` reaching `ratio` times it on that side only, in
+/// quadrature in the logarithm (an effect known to move the value one way: the side away
+/// from it stays).
+pub fn ln_reach(value: f64, [lo, hi]: [Option<f64>; 2], ratio: f64) -> [Option<f64>; 2] {
+    let add = ratio.ln().abs();
+    if ratio > 1.0 {
+        [lo, hi.map(|hi| widened_side(value, hi, add, Side::Upper))]
+    } else {
+        [lo.map(|lo| widened_side(value, lo, add, Side::Lower)), hi]
+    }
+}
+
+enum Side {
+    Lower,
+    Upper,
+}
+
+/// One end of an interval about `value` widened by `add` in quadrature in the logarithm; a
+/// lower end at or below 0 stays 0.
+fn widened_side(value: f64, end: f64, add: f64, side: Side) -> f64 {
+    match side {
+        Side::Lower if end > 0.0 => value * (-(value / end).ln().hypot(add)).exp(),
+        Side::Lower => 0.0,
+        Side::Upper => value * (end / value).ln().hypot(add).exp(),
+    }
 }
 
 /// One point of a frame-rate series: every `step`-th frame used, and the estimate.
@@ -145,6 +195,33 @@ pub fn combine(estimates: &[&Measured]) -> Option<(f64, f64)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Hand-computed: 0.2 in [0.1, 0.4] (ln 2 each side) widened by ln 2 * sqrt(3) gives
+    /// ln 2 * 2 each side, [0.05, 0.8]; a lower end at 0 stays there, an open side open.
+    #[test]
+    fn intervals_widen_in_the_logarithm() {
+        let add = 2f64.ln() * 3f64.sqrt();
+        let [lo, hi] = ln_widened(0.2, [Some(0.1), Some(0.4)], add);
+        assert!((lo.unwrap() - 0.05).abs() < 1e-12 && (hi.unwrap() - 0.8).abs() < 1e-12);
+        assert_eq!(ln_widened(0.2, [Some(0.0), None], add)[0], Some(0.0));
+        assert_eq!(ln_widened(0.2, [Some(0.1), None], add)[1], None);
+        // reaching 4 times the value: the upper end only, ln 2 and ln 4 -> ln 2 sqrt(5)
+        let [lo, hi] = ln_reach(0.2, [Some(0.1), Some(0.4)], 4.0);
+        assert_eq!(lo, Some(0.1));
+        assert!((hi.unwrap() - 0.2 * (2f64.ln() * 5f64.sqrt()).exp()).abs() < 1e-12);
+        let [lo, hi] = ln_reach(0.2, [Some(0.1), Some(0.4)], 0.25);
+        assert!((lo.unwrap() - 0.2 * (-(2f64.ln() * 5f64.sqrt())).exp()).abs() < 1e-12);
+        assert_eq!(hi, Some(0.4));
+        let m = Measured::new(0.2, 0.0, 0.2 * 0.5 / z95()).reaching(4.0);
+        assert!(
+            (m.ci95[0] - 0.1).abs() < 1e-12 && m.ci95[1] > 0.8 && m.ci95[1] < 0.9,
+            "{m:?}"
+        );
+        assert_eq!(
+            Measured::new(0.2, 0.01, 0.0).reaching(1.0),
+            Measured::new(0.2, 0.01, 0.0)
+        );
+    }
 
     #[test]
     fn intervals_cover_both_kinds_of_error() {

@@ -186,13 +186,11 @@ fn method_systematic_assumption() -> String {
     )
 }
 
-/// The systematic, relative to each threshold, of a log response the events cannot tell
-/// from the chosen one: the other's thresholds over the chosen ones in the same timing fit,
-/// less one, over 1.96, so that each 95 % interval reaches the other response's value.
-fn response_systematic(other: Option<&crate::estimate::timing::OtherResponse>) -> [f64; 2] {
-    other.map_or([0.0; 2], |o| {
-        o.threshold_ratios().map(|r| (r - 1.0).abs() / 1.96)
-    })
+/// How many times each threshold (ON, OFF) a log response the events cannot tell from the
+/// chosen one gives (each at its own offset): the intervals reach it, on its side only
+/// ([`Measured::reaching`]); 1 without one.
+fn response_ratios(other: Option<&crate::estimate::timing::OtherResponse>) -> [f64; 2] {
+    other.map_or([1.0; 2], |o| o.threshold_ratios())
 }
 
 fn response_assumption(other: &crate::estimate::timing::OtherResponse) -> String {
@@ -242,12 +240,12 @@ pub(super) fn assemble(
     full: &Pass,
     findings: Findings,
 ) -> CtEstimate {
-    let response = response_systematic(findings.other_response.as_ref());
+    let response = response_ratios(findings.other_response.as_ref());
     let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64| {
         let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
         match combine(&refs) {
             Some((value, error)) => {
-                Measured::new(value, error, METHOD_SYSTEMATIC.hypot(response) * value)
+                Measured::new(value, error, METHOD_SYSTEMATIC * value).reaching(response)
             }
             None => Measured::new(f64::NAN, f64::NAN, 0.0),
         }

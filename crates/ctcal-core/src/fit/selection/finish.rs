@@ -12,7 +12,6 @@ use super::super::{
 use super::State;
 use super::keep::{PARSIMONY, UNMEASURED_CHANCE};
 use crate::estimate::frames::exposure_of;
-use crate::estimate::interval::z95;
 use crate::stats::jackknife::{t95_scale, weighted_jackknife_se};
 use crate::stats::robust::mad_sigma;
 use std::collections::BTreeMap;
@@ -309,8 +308,8 @@ fn threshold_intervals(
     assumptions
 }
 
-/// Widens each threshold's interval in ln C by the other log response's ratio over 1.96,
-/// in quadrature, so that it reaches the threshold that response gives
+/// Widens each threshold's interval on the other log response's side, in ln C in
+/// quadrature, so that it reaches the threshold that response gives
 /// ([`crate::estimate::timing::response`]); returns the assumption that says so.
 fn reach_for_other_response(
     uncertainty: &mut BTreeMap<String, crate::fit::Uncertain>,
@@ -320,9 +319,7 @@ fn reach_for_other_response(
         .into_iter()
         .zip(other.threshold_ratios())
         .filter(|(_, r)| r.is_finite() && *r > 0.0)
-        .filter_map(|(key, r)| {
-            super::method_systematic::widen_ln(uncertainty, key, r.ln().abs() / z95())
-        })
+        .filter_map(|(key, r)| super::method_systematic::reach_ln(uncertainty, key, r))
         .collect();
     (!widened.is_empty()).then(|| {
         let [on, off] = other.threshold_ratios();

@@ -46,6 +46,41 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>) -> Option<String> {
     })
 }
 
+/// `key`'s 95 % interval reaching `ratio` times its value on that side
+/// ([`crate::estimate::interval::ln_reach`]). Returns `key [lo, hi] -> [lo', hi']`, or
+/// `None` where there is no interval about a positive value.
+pub(super) fn reach_ln(
+    uncertainty: &mut BTreeMap<String, Uncertain>,
+    key: &str,
+    ratio: f64,
+) -> Option<String> {
+    let u = uncertainty.get_mut(key)?;
+    let ([Some(lo), hi], v) = (u.interval()?, u.value) else {
+        return None;
+    };
+    if !(lo >= 0.0 && v > 0.0 && v >= lo && hi.is_none_or(|hi| hi >= v)) {
+        return None;
+    }
+    let [new_lo, new_hi] = crate::estimate::interval::ln_reach(v, [Some(lo), hi], ratio);
+    let new_lo = new_lo.unwrap_or(0.0);
+    u.ci95 = Some([Some(new_lo), new_hi]);
+    Some(interval_change(key, (lo, hi), (new_lo, new_hi)))
+}
+
+/// `key [lo, hi] -> [lo', hi']`, an open end as `open`.
+fn interval_change(
+    key: &str,
+    (lo, hi): (f64, Option<f64>),
+    (new_lo, new_hi): (f64, Option<f64>),
+) -> String {
+    let show = |x: Option<f64>| x.map_or("open".to_string(), |x| format!("{x:.4}"));
+    format!(
+        "{key} [{lo:.4}, {}] -> [{new_lo:.4}, {}]",
+        show(hi),
+        show(new_hi)
+    )
+}
+
 /// `key`'s 95 % interval widened by `ln_sd` (a standard deviation of the parameter's
 /// logarithm) in quadrature on each side in the logarithm: a lower end at 0 stays there and
 /// an open side stays open. Returns `key [lo, hi] -> [lo', hi']`, or `None` where there is
@@ -63,19 +98,10 @@ pub(super) fn widen_ln(
     if !(lo >= 0.0 && v > 0.0 && v >= lo && hi.is_none_or(|hi| hi >= v)) {
         return None;
     }
-    let new_lo = if lo > 0.0 {
-        v * (-(v / lo).ln().hypot(add)).exp()
-    } else {
-        0.0
-    };
-    let new_hi = hi.map(|hi| v * (hi / v).ln().hypot(add).exp());
+    let [new_lo, new_hi] = crate::estimate::interval::ln_widened(v, [Some(lo), hi], add);
+    let new_lo = new_lo.unwrap_or(0.0);
     u.ci95 = Some([Some(new_lo), new_hi]);
-    let show = |x: Option<f64>| x.map_or("open".to_string(), |x| format!("{x:.4}"));
-    Some(format!(
-        "{key} [{lo:.4}, {}] -> [{new_lo:.4}, {}]",
-        show(hi),
-        show(new_hi)
-    ))
+    Some(interval_change(key, (lo, hi), (new_lo, new_hi)))
 }
 
 /// The method systematic of the fitted photoreceptor cutoff, a standard deviation of
