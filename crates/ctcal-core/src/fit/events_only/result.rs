@@ -157,7 +157,6 @@ fn parameters(
     let mut why = BTreeMap::new();
     let mut uncertainties = BTreeMap::new();
     let (on, off) = absolute(thresholds, &mut why, &mut uncertainties);
-    let mut params = PixelParams::ideal(on, off);
     for (key, reason) in NEEDS_BRIGHTNESS {
         let reason = match frames_unused {
             None => reason.to_string(),
@@ -165,37 +164,40 @@ fn parameters(
         };
         why.insert(key.to_string(), reason);
     }
-    noise_params(run, kept, &mut params, &mut why, &mut uncertainties);
+    let mut out = Parameters {
+        params: PixelParams::ideal(on, off),
+        why,
+        uncertainties,
+        hot: Vec::new(),
+    };
+    noise_params(run, kept, &mut out);
     refractory_param(
         run,
         kept("refractory"),
-        &mut params,
-        &mut why,
-        &mut uncertainties,
+        &mut out.params,
+        &mut out.why,
+        &mut out.uncertainties,
     );
-    let hot = if kept("hot_pixels") {
-        run.hot.clone()
-    } else {
-        Vec::new()
-    };
-    if !hot.is_empty() {
-        let found = &run.hot_found;
-        params.hot_pixel_fraction = Some(found.fraction.value);
-        uncertainties.insert(HOT_FRACTION.into(), found.fraction.clone());
-        // the train a simulator adds on top of the pixel's own events
-        if let Some(rate) = &found.rate {
-            params.hot_pixel_rate_hz = Some(rate.value);
-            uncertainties.insert(HOT_RATE.into(), rate.clone());
-        }
-        if let Some(reason) = hot_rate_unmeasured(&why, &uncertainties) {
-            why.insert(HOT_RATE.into(), reason);
-        }
+    if kept("hot_pixels") && !run.hot.is_empty() {
+        out.hot = run.hot.clone();
+        hot_params(run, &mut out);
     }
-    Parameters {
-        params,
-        why,
-        uncertainties,
-        hot,
+    out
+}
+
+/// The named hot pixels' fraction and rate, with their intervals.
+fn hot_params(run: &FitRun, out: &mut Parameters) {
+    let found = &run.hot_found;
+    out.params.hot_pixel_fraction = Some(found.fraction.value);
+    out.uncertainties
+        .insert(HOT_FRACTION.into(), found.fraction.clone());
+    // the train a simulator adds on top of the pixel's own events
+    if let Some(rate) = &found.rate {
+        out.params.hot_pixel_rate_hz = Some(rate.value);
+        out.uncertainties.insert(HOT_RATE.into(), rate.clone());
+    }
+    if let Some(reason) = hot_rate_unmeasured(&out.why, &out.uncertainties) {
+        out.why.insert(HOT_RATE.into(), reason);
     }
 }
 
@@ -325,30 +327,10 @@ fn absolute(
 
 /// Shot noise and leak: their values where kept, else not identified with an upper
 /// bound (absent when even the bound is below the floor at which rates are told apart).
-fn noise_params(
-    run: &FitRun,
-    kept: &dyn Fn(&str) -> bool,
-    params: &mut PixelParams,
-    why: &mut BTreeMap<String, String>,
-    uncertainties: &mut BTreeMap<String, Uncertain>,
-) {
+fn noise_params(run: &FitRun, kept: &dyn Fn(&str) -> bool, out: &mut Parameters) {
     let scene = super::candidates::scene_like_isolated(run);
-    shot_noise_param(
-        run,
-        kept("shot_noise"),
-        scene.as_ref(),
-        params,
-        why,
-        uncertainties,
-    );
-    leak_param(
-        run,
-        kept("leak"),
-        scene.as_ref(),
-        params,
-        why,
-        uncertainties,
-    );
+    shot_noise_param(run, kept("shot_noise"), scene.as_ref(), out);
+    leak_param(run, kept("leak"), scene.as_ref(), out);
 }
 
 /// Shot noise: the isolated events' symmetric rate where kept, else bounded.
@@ -356,10 +338,14 @@ fn shot_noise_param(
     run: &FitRun,
     kept: bool,
     scene: Option<&super::candidates::SceneLike>,
-    params: &mut PixelParams,
-    why: &mut BTreeMap<String, String>,
-    uncertainties: &mut BTreeMap<String, Uncertain>,
+    out: &mut Parameters,
 ) {
+    let Parameters {
+        params,
+        why,
+        uncertainties,
+        ..
+    } = out;
     if let Some((rate, se)) = symmetric_rate(run) {
         if let (Some(scene), false) = (scene, kept) {
             // the lower end, from the OFF excess over the scene's balance, may pass the
@@ -404,10 +390,14 @@ fn leak_param(
     run: &FitRun,
     kept: bool,
     scene: Option<&super::candidates::SceneLike>,
-    params: &mut PixelParams,
-    why: &mut BTreeMap<String, String>,
-    uncertainties: &mut BTreeMap<String, Uncertain>,
+    out: &mut Parameters,
 ) {
+    let Parameters {
+        params,
+        why,
+        uncertainties,
+        ..
+    } = out;
     if let Some((excess, se)) = on_excess(run) {
         // an onset only where the isolated events are not the scene's own: a scene whose
         // unsupported events turn ON-heavy later would rise the same way

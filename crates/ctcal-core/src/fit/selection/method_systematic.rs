@@ -54,31 +54,9 @@ pub(super) fn reach_ln(
     key: &str,
     ratio: f64,
 ) -> Option<String> {
-    let u = uncertainty.get_mut(key)?;
-    let ([Some(lo), hi], v) = (u.interval()?, u.value) else {
-        return None;
-    };
-    if !(lo >= 0.0 && v > 0.0 && v >= lo && hi.is_none_or(|hi| hi >= v)) {
-        return None;
-    }
-    let [new_lo, new_hi] = crate::estimate::interval::ln_reach(v, [Some(lo), hi], ratio);
-    let new_lo = new_lo.unwrap_or(0.0);
-    u.ci95 = Some([Some(new_lo), new_hi]);
-    Some(interval_change(key, (lo, hi), (new_lo, new_hi)))
-}
-
-/// `key [lo, hi] -> [lo', hi']`, an open end as `open`.
-fn interval_change(
-    key: &str,
-    (lo, hi): (f64, Option<f64>),
-    (new_lo, new_hi): (f64, Option<f64>),
-) -> String {
-    let show = |x: Option<f64>| x.map_or("open".to_string(), |x| format!("{x:.4}"));
-    format!(
-        "{key} [{lo:.4}, {}] -> [{new_lo:.4}, {}]",
-        show(hi),
-        show(new_hi)
-    )
+    reshape(uncertainty, key, |v, ends| {
+        crate::estimate::interval::ln_reach(v, ends, ratio)
+    })
 }
 
 /// `key`'s 95 % interval widened by `ln_sd` (a standard deviation of the parameter's
@@ -91,6 +69,19 @@ pub(super) fn widen_ln(
     ln_sd: f64,
 ) -> Option<String> {
     let add = z95() * ln_sd;
+    reshape(uncertainty, key, |v, ends| {
+        crate::estimate::interval::ln_widened(v, ends, add)
+    })
+}
+
+/// `key`'s closed-below 95 % interval about a positive value replaced by `new_ends` of the
+/// value and the ends; returns `key [lo, hi] -> [lo', hi']` (an open end as `open`), or
+/// `None` where there is no such interval.
+fn reshape(
+    uncertainty: &mut BTreeMap<String, Uncertain>,
+    key: &str,
+    new_ends: impl Fn(f64, [Option<f64>; 2]) -> [Option<f64>; 2],
+) -> Option<String> {
     let u = uncertainty.get_mut(key)?;
     let ([Some(lo), hi], v) = (u.interval()?, u.value) else {
         return None;
@@ -98,10 +89,15 @@ pub(super) fn widen_ln(
     if !(lo >= 0.0 && v > 0.0 && v >= lo && hi.is_none_or(|hi| hi >= v)) {
         return None;
     }
-    let [new_lo, new_hi] = crate::estimate::interval::ln_widened(v, [Some(lo), hi], add);
+    let [new_lo, new_hi] = new_ends(v, [Some(lo), hi]);
     let new_lo = new_lo.unwrap_or(0.0);
     u.ci95 = Some([Some(new_lo), new_hi]);
-    Some(interval_change(key, (lo, hi), (new_lo, new_hi)))
+    let show = |x: Option<f64>| x.map_or("open".to_string(), |x| format!("{x:.4}"));
+    Some(format!(
+        "{key} [{lo:.4}, {}] -> [{new_lo:.4}, {}]",
+        show(hi),
+        show(new_hi)
+    ))
 }
 
 /// The method systematic of the fitted photoreceptor cutoff, a standard deviation of
