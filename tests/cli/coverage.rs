@@ -381,3 +381,29 @@ fn fit_without_frames_holds_a_leak_the_scene_s_balance_may_explain() {
         output["why"]
     );
 }
+
+/// Draw 11005 of the peers' first fresh study: ctcal's simulator, a checkerboard at 31 DN
+/// whose photoreceptor cuts off at 6.8 Hz at white, 1.2 Hz at its brightness, with edges
+/// every 80 ms. The pixels average the scene and fire a tenth of what the frames' change
+/// asks for, and the events come frames late: aps read ON 1.95 [0.57, 3.33] for the true
+/// 0.315, its interval missing. The events now show the low-pass
+/// (`estimate::aps::photoreceptor`), the re-simulation with it finds the lower thresholds,
+/// and the intervals reach them.
+#[test]
+fn aps_reaches_the_thresholds_of_a_photoreceptor_slower_than_the_scene() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_peer_draw(Method::Aps, 11005, work.path());
+    assert_eq!(record.case.generator, ctcal::coverage::Generator::Ctcal);
+    covered_value(&record, "ct_on");
+    covered_value(&record, "ct_off");
+    let slow = &json_output(&record)["photoreceptor_slow"];
+    let cutoff = slow["check"]["cutoff_hz"].as_f64().unwrap();
+    // the truth 6.77 Hz at white, on a grid of 1, 2, 3, 5, 7, 10, 20 ... Hz
+    assert!((3.0..=10.0).contains(&cutoff), "{slow}");
+    assert!(
+        slow["check"]["significance"].as_f64().unwrap() > 10.0,
+        "{slow}"
+    );
+    let on = slow["resimulated_thresholds"][0].as_f64().unwrap();
+    assert!(on < 0.6, "{slow}");
+}

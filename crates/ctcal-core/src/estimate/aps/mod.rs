@@ -39,7 +39,10 @@ use report::{Findings, assemble, blocks_assumption, resimulation_report, timing_
 use serde_json::json;
 
 mod count_offset;
+mod photoreceptor;
 mod report;
+
+pub use photoreceptor::SlowPhotoreceptor;
 
 /// Settings of `estimate aps`.
 #[derive(Clone, Debug)]
@@ -239,6 +242,8 @@ pub fn estimate(
     let spread = full.timing.spread();
     let sigma = simulated_sigma(&full.timing);
     let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
+    progress("does the photoreceptor follow the frames", 0.45);
+    let slow = slow_photoreceptor(input, &excluded, &frames, (&runs, &full), sigma, grid);
     drop(runs);
     let alignment_error =
         alignment_systematic(input, &excluded, &mut frames, options, alignment.as_ref());
@@ -291,6 +296,7 @@ pub fn estimate(
             offset: offset_report,
             offset_from_counts: offset_from_counts.map(|c| c.found),
             other_response,
+            slow,
         },
     );
     progress("done", 1.0);
@@ -606,6 +612,50 @@ fn measured_model(timing: &TimingEstimate, sigma: f64) -> PixelParams {
         params.leak_rate_hz = Some(drift.at_median_dn / timing.on.ct);
     }
     params
+}
+
+/// A photoreceptor much slower than the scene ([`photoreceptor::check`]), with the
+/// thresholds the re-simulation finds when it simulates that cutoff (started from its
+/// ideal thresholds times the check's ratios; `None` where it finds none).
+pub(crate) struct Slow {
+    pub(crate) found: SlowPhotoreceptor,
+    pub(crate) thresholds: Option<[f64; 2]>,
+}
+
+fn slow_photoreceptor(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &PreparedFrames,
+    (runs, full): (&[Vec<Sample>], &Pass),
+    sigma: f64,
+    grid: Option<(TimeUs, TimeUs)>,
+) -> Option<Slow> {
+    let found = photoreceptor::check(input.events, frames, excluded)?;
+    let start = full
+        .resim
+        .as_ref()
+        .map_or((full.timing.on.ct, full.timing.off.ct), |r| {
+            (r.ct_on, r.ct_off)
+        });
+    let resim = Resimulation {
+        runs,
+        width: frames.width,
+        height: frames.height,
+        cells: &full.cells,
+        real: &full.real,
+        grid,
+        evaluations: std::cell::Cell::new(0),
+    };
+    let [ron, roff] = found.threshold_ratios;
+    let [qon, qoff] = found.quantiser_thresholds;
+    // from the estimators' thresholds scaled as the check asks, else from the check's own
+    let thresholds = [(start.0 * ron, start.1 * roff), (qon, qoff)]
+        .into_iter()
+        .find_map(|start| {
+            super::resim::fit_with(&resim, start, sigma, Some(found.cutoff_hz), 1).ok()
+        })
+        .map(|r| [r.ct_on, r.ct_off]);
+    Some(Slow { found, thresholds })
 }
 
 /// The photoreceptor cutoff at the median DN (Hz) where the timing's lag is significant

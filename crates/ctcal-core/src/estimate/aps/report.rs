@@ -193,6 +193,26 @@ fn response_ratios(other: Option<&crate::estimate::timing::OtherResponse>) -> [f
     other.map_or([1.0; 2], |o| o.threshold_ratios())
 }
 
+fn slow_assumption(slow: &super::Slow) -> String {
+    let f = &slow.found;
+    let what = match slow.thresholds {
+        Some([on, off]) => format!(
+            "the re-simulation with that cutoff finds ON {on:.4} and OFF {off:.4}, and the intervals reach them on their side"
+        ),
+        None => "the re-simulation with that cutoff finds no thresholds, so the intervals do not carry them (the fit, which models bandwidth, can)".to_string(),
+    };
+    format!(
+        "the photoreceptor is slower than the scene: the events follow the frames low-passed at a cutoff of {} Hz at white ({:.2} Hz at the frames' median DN; {} .. {} Hz within 2 standard errors) better than the frames themselves, by {:.1} standard errors of the block-by-block count distance ({:.3} -> {:.3} per block); such a pixel averages the scene and fires less than the frames' change, so the event timing and the ideal re-simulation read its thresholds high (a refractory period, which also thins the events of fast changes, can look alike: `fit` tells them apart); {what}",
+        f.cutoff_hz,
+        f.cutoff_at_median_dn_hz,
+        f.cutoff_range_hz[0],
+        f.cutoff_range_hz[1],
+        f.significance,
+        f.distance_without,
+        f.distance_at_cutoff,
+    )
+}
+
 fn response_assumption(other: &crate::estimate::timing::OtherResponse) -> String {
     let [on, off] = other.threshold_ratios();
     let name = match other.response {
@@ -228,6 +248,9 @@ pub(super) struct Findings {
     pub(super) offset: Option<crate::estimate::timing::Offset>,
     /// The offset the counts give, where it was searched ([`super::count_offset`]).
     pub(super) offset_from_counts: Option<super::count_offset::CountOffset>,
+    /// A photoreceptor much slower than the scene, where the events show one: the
+    /// thresholds it asks for are carried into the intervals.
+    pub(super) slow: Option<super::Slow>,
 }
 
 /// The estimate: the estimators' thresholds combined, the mismatch, the assumptions (the
@@ -241,19 +264,23 @@ pub(super) fn assemble(
     findings: Findings,
 ) -> CtEstimate {
     let response = response_ratios(findings.other_response.as_ref());
-    let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64| {
+    // the thresholds a photoreceptor much slower than the scene asks for, where the
+    // re-simulation with its cutoff found them
+    let slow = findings.slow.as_ref().and_then(|s| s.thresholds);
+    let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64, slow: Option<f64>| {
         let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
         match combine(&refs) {
-            Some((value, error)) => {
-                Measured::new(value, error, METHOD_SYSTEMATIC * value).reaching(response)
-            }
+            Some((value, error)) => Measured::new(value, error, METHOD_SYSTEMATIC * value)
+                .reaching(response)
+                .reaching(slow.map_or(1.0, |c| c / value)),
             None => Measured::new(f64::NAN, f64::NAN, 0.0),
         }
     };
     assumptions.push(method_systematic_assumption());
     assumptions.extend(findings.other_response.as_ref().map(response_assumption));
-    let on = combined(|e| &e.ct_on, response[0]);
-    let off = combined(|e| &e.ct_off, response[1]);
+    assumptions.extend(findings.slow.as_ref().map(slow_assumption));
+    let on = combined(|e| &e.ct_on, response[0], slow.map(|s| s[0]));
+    let off = combined(|e| &e.ct_off, response[1], slow.map(|s| s[1]));
     let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames
@@ -299,6 +326,13 @@ pub(super) fn assemble(
         ),
         ("ct_sigma_frame_rate_series", json!(findings.sigma_series)),
         ("photoreceptor_lag", lag_report(&full.timing.lag)),
+        (
+            "photoreceptor_slow",
+            json!(findings.slow.as_ref().map(|s| json!({
+                "check": s.found,
+                "resimulated_thresholds": s.thresholds,
+            }))),
+        ),
         ("leak_drift", drift_report(&full.timing.drift)),
         (
             "time_span_s",
