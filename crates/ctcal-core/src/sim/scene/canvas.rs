@@ -227,23 +227,33 @@ impl Canvas {
         {
             // SAFETY: use_avx2() is true, so the CPU has AVX2; the canvas is up to 2^15 px a
             // side and every coordinate is finite and within 4e15 (checked above).
+            // The cells are then within the canvas for blend.
             unsafe {
                 cells(xs, self.size, 1, &mut column);
                 cells(ys, self.size, self.size, &mut row);
+                self.blend(&column, &row, out);
             }
-            self.blend(&column, &row, out);
         }
     }
 
     /// The bilinear blend of [`Self::sample`] at points already split into cells.
+    ///
+    /// # Safety
+    /// The first `out.len()` cells of `column` and `row` are [`cells`] of this canvas (with
+    /// strides 1 and `size`): every offset is then within the canvas (a column below
+    /// `size` plus a row below `size` times `size`), so the reads are not checked.
     #[inline]
-    fn blend(&self, column: &Cells, row: &Cells, out: &mut [f32]) {
+    unsafe fn blend(&self, column: &Cells, row: &Cells, out: &mut [f32]) {
         let p = &self.pixels;
+        debug_assert!(out.len() <= BLOCK);
+        // SAFETY: the offsets are within the canvas (the contract above)
+        let at = |offset: u32| unsafe { *p.get_unchecked(offset as usize) };
         for (k, o) in out.iter_mut().enumerate() {
             let (i0, i1, fx) = (column.c0[k], column.c1[k], column.f[k]);
             let (j0, j1, fy) = (row.c0[k], row.c1[k], row.f[k]);
-            let (p00, p10) = (p[(j0 + i0) as usize], p[(j0 + i1) as usize]);
-            let (p01, p11) = (p[(j1 + i0) as usize], p[(j1 + i1) as usize]);
+            debug_assert!(j1.max(j0) as usize + (i1.max(i0) as usize) < p.len());
+            let (p00, p10) = (at(j0 + i0), at(j0 + i1));
+            let (p01, p11) = (at(j1 + i0), at(j1 + i1));
             let top = p00 + (p10 - p00) * fx;
             let bottom = p01 + (p11 - p01) * fx;
             *o = top + (bottom - top) * fy;
@@ -326,11 +336,35 @@ impl Cells {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn cells(coords: &[f64], size: usize, stride: usize, out: &mut Cells) {
+    // SAFETY: the caller's contract
+    if size.is_power_of_two() {
+        unsafe { cells_with::<true>(coords, size, stride, out) }
+    } else {
+        unsafe { cells_with::<false>(coords, size, stride, out) }
+    }
+}
+
+/// [`cells`]; with `POW2` (`size` a power of two) `x / n` is taken as `x * (1 / n)`: `1 / n`
+/// is exact, so both are the rounding of the same real number, the same bits, without a
+/// division per point.
+///
+/// # Safety
+/// As [`cells`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn cells_with<const POW2: bool>(
+    coords: &[f64],
+    size: usize,
+    stride: usize,
+    out: &mut Cells,
+) {
     let n = size as f64;
+    let inverse = 1.0 / n;
     let (size, stride) = (size as u32, stride as u32);
     let lanes = out.c0.iter_mut().zip(&mut out.c1).zip(&mut out.f);
     for (((c0, c1), f), &x) in lanes.zip(coords) {
-        let x = x - n * ((x / n).floor() + 0.0);
+        let quotient = if POW2 { x * inverse } else { x / n };
+        let x = x - n * (quotient.floor() + 0.0);
         let x = if x < 0.0 { x + n } else { x };
         // SAFETY: x is in [0, n], n <= 2^15 (the caller's contract)
         let i = unsafe { x.to_int_unchecked::<i32>() } as u32;

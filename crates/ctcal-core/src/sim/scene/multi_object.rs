@@ -307,6 +307,19 @@ impl MultiObjectWorld {
     /// over it in depth order. Coordinates are computed a row at a time and the textures
     /// sampled along the row at once ([`Canvas::sample_many`]).
     pub fn render(&self, width: usize, rows: std::ops::Range<usize>, t: f64, out: &mut [f32]) {
+        self.render_with(width, rows, t, out, true);
+    }
+
+    /// [`Self::render`], with [`Bounds`] or (`bounded` false) the exact distance at every
+    /// pixel of each object's bounding square.
+    fn render_with(
+        &self,
+        width: usize,
+        rows: std::ops::Range<usize>,
+        t: f64,
+        out: &mut [f32],
+        bounded: bool,
+    ) {
         let mut row = RowBuffers::new(width);
         // background: the image is the texture seen through the inverse of its motion
         let (centre, angle, scale) = self.background.pose(t);
@@ -320,11 +333,14 @@ impl MultiObjectWorld {
             self.textures[0].sample_many(&row.xs, &row.ys, out);
         }
         for object in &self.objects {
-            self.render_object(object, width, rows.clone(), t, &mut row, out);
+            self.render_object(object, width, rows.clone(), t, &mut row, out, bounded);
         }
     }
 
-    /// Blends one object over rows `rows` of `out`, by its pixel coverage.
+    /// Blends one object over rows `rows` of `out`, by its pixel coverage. `bounded` decides
+    /// the pixels clearly inside or outside the object from [`Bounds`] (the same values as
+    /// without: see there), else every pixel of the bounding square takes the exact distance.
+    #[allow(clippy::too_many_arguments)]
     fn render_object(
         &self,
         object: &Object,
@@ -333,6 +349,7 @@ impl MultiObjectWorld {
         t: f64,
         row: &mut RowBuffers,
         out: &mut [f32],
+        bounded: bool,
     ) {
         let (centre, angle, scale) = object.trajectory.pose(t);
         let reach = object.shape.radius() * scale + 1.0;
@@ -349,16 +366,33 @@ impl MultiObjectWorld {
         }
         let (s, c) = angle.sin_cos();
         let texture = &self.textures[object.texture];
-        let (x_lo, span) = (x_lo as usize, (x_hi - x_lo) as usize + 1);
+        let pose = Pose {
+            centre,
+            sin: s,
+            cos: c,
+            scale,
+        };
+        let square = (x_lo as usize, x_hi as usize);
+        let bounds = if bounded {
+            Bounds::new(&object.shape, &pose, reach)
+        } else {
+            None
+        };
         for y in y_lo as usize..=y_hi as usize {
             let dy = y as f64 - centre[1];
-            let pose = Pose {
-                centre,
-                sin: s,
-                cos: c,
-                scale,
+            let cover = match &bounds {
+                Some(b) => match b.row(dy, square) {
+                    Some(cover) => cover,
+                    None => continue,
+                },
+                None => RowCover {
+                    lo: square.0,
+                    hi: square.1,
+                    inner: 0..0,
+                },
             };
-            cover_row(&object.shape, &pose, dy, x_lo, span, row);
+            let (x_lo, span) = (cover.lo, cover.hi - cover.lo + 1);
+            cover_row(&object.shape, &pose, dy, x_lo, span, cover.inner, row);
             // the pixels the object covers, gathered (written at `m` always, kept where
             // covered: no branch), then sampled at once and blended
             let mut m = 0;
@@ -388,17 +422,243 @@ struct Pose {
     scale: f64,
 }
 
+/// The columns of one row to render: `lo..=hi` (the others have no coverage), of which
+/// `inner` (offsets from `lo`) have coverage 1.
+#[derive(Debug, PartialEq)]
+struct RowCover {
+    lo: usize,
+    hi: usize,
+    inner: std::ops::Range<usize>,
+}
+
+/// Margin of [`Bounds`], both in distance (pixels, the level of `d * scale`) and in columns.
+const MARGIN: f64 = 1.0 / 64.0;
+
+/// An object's outline at one pose, as a row's columns: which pixels of a row its coverage
+/// `(0.5 - d * scale).clamp(0, 1)` ([`cover_row`]) leaves at 0 (skipped) and which at
+/// exactly 1 (no distance computed), so that only the band along the edge takes the exact
+/// distance (an ellipse's `hypot`).
+///
+/// In real numbers, along a row `d * scale` is a convex function of the column for all three
+/// shapes (an ellipse's scaled norm, a maximum of affine functions), so the columns where it
+/// is below a level `L` are an interval: a quadratic's roots for an ellipse, the intersection
+/// of the half-planes' bounds for a rectangle (four edges) and a polygon. [`Bounds::row`]
+/// computes this interval for `L = 0.5 + MARGIN` (outside it `d * scale >= 0.5 + MARGIN`)
+/// and for `L = -0.5 - MARGIN` (inside it `d * scale <= -0.5 - MARGIN`), and widens the
+/// first, narrows the second by another `MARGIN` in columns.
+///
+/// Why a decided pixel gets the same bits as the exact path. Under the guard of
+/// [`Bounds::new`] (finite pose, scale above 2^-20, centre within 2^20 px, reach within 2^12
+/// px, an ellipse's axes within 4x) every quantity is below 2^16 in magnitude (columns and
+/// row offsets within the bounding square, `a * scale`, `k^2 / A` below), and each is a few
+/// roundings (relative error 2^-53 each) from its real value:
+/// - The exact path's `d * scale` is within `2^-53 * 2^16 * 16 = 2^-33` px of its real
+///   value (`dx = x - cx` is the rounded difference, `qx`, `qy` two products, a sum and a
+///   division, then one edge's product-sum, or `hypot` (under 1 ulp), `- 1`, `* min`,
+///   `* scale`). So where the real `d * scale >= 0.5 + MARGIN / 2`, the computed one is
+///   above 0.5, `0.5 - d * scale` rounds to at most 0 (rounding is monotone) and the pixel
+///   is not blended; where it is `<= -0.5 - MARGIN / 2`, `0.5 - d * scale` is above 1 and
+///   the coverage is exactly `1.0`.
+/// - Half-planes: an edge with unit normal `(u, v)` in pixel space and offset `a` keeps
+///   `u dx + v dy < a scale + L`, i.e. `u dx < R`. The column bound `cx + R / u` is computed
+///   with `R` within `2^-33` of its real value, the division within `2^-53 |R|`, the sum
+///   within `2^-53 * 2^14` wherever it bounds a pixel of the square (a bound far outside
+///   the square decides nothing): a column excluded by `MARGIN` past the computed bound has
+///   a real `u dx - R > -2^-30`, so the edge's (and the maximum's) `d * scale` is at least
+///   `L - 2^-30`; likewise a column inside every narrowed bound has `d * scale <= L + 2^-30`
+///   for every edge. `u = 0` keeps a row whole or drops it by the sign of `R` (the same
+///   argument, without the division).
+/// - Ellipse: `h^2 = (qx / rx)^2 + (qy / ry)^2 < k^2` with `k = 1 + L / (scale min(rx, ry))`
+///   is `A (dx - m)^2 < A w^2`, `m = -dy P / A`, `w^2 = k^2 / A - dy^2 D / A^2` (`A`, `P`, `D`
+///   per pose). `m` is within `2^-53 * 2^14` and `w^2` (a difference of terms below 2^28)
+///   within `2^-53 * 2^32 = 2^-21` of their real values, so `w = sqrt(max(w^2, 0))` within
+///   `sqrt(2^-21) < 2^-10` (`|sqrt a - sqrt b| <= sqrt |a - b|`), and the computed interval's
+///   ends within `2^-10 + 2^-30 < MARGIN` columns of the real interval's at level `L`
+///   (a row the real interval misses by less keeps a computed interval of width 0 at `m`).
+///   Widened (narrowed) by `MARGIN`, every column outside (inside) is outside (inside) the
+///   real interval: `d * scale >= 0.5 + MARGIN` (`<= -0.5 - MARGIN`). The inner level is
+///   taken only where `k scale min(rx, ry) = scale min(rx, ry) + L >= 1/16` (else no pixel
+///   is decided 1), which keeps `k^2 / A` and the guard's bounds.
+///
+/// So every pixel decided here gets what the exact path gives (not blended, or coverage
+/// `1.0` with the same object-space point): a margin of 2^-6 against errors below 2^-9.
+/// `bounds_decide_pixels_as_the_exact_distance_does` checks it to the bit.
+#[derive(Debug)]
+struct Bounds {
+    cx: f64,
+    kind: BoundsKind,
+}
+
+#[derive(Debug)]
+enum BoundsKind {
+    /// `h^2 = A dx^2 + 2 dy P dx + dy^2 Q`, `D = A Q - P^2 = (c^2 + s^2)^2 / (ax ay)^2`
+    /// (`ax = scale rx`, `ay = scale ry`); `k^2` at the two levels (the inner one `None`
+    /// where it is not taken).
+    Ellipse {
+        a: f64,
+        p: f64,
+        d: f64,
+        k2_out: f64,
+        k2_in: Option<f64>,
+    },
+    /// Edges `(u, v, a * scale)`: `u dx + v dy - a scale` is the edge's `d * scale`.
+    Edges(Vec<(f64, f64, f64)>),
+}
+
+impl Bounds {
+    /// The bounds of `shape` at `pose`, or `None` outside the guard (every pixel then takes
+    /// the exact distance).
+    fn new(shape: &Shape, pose: &Pose, reach: f64) -> Option<Self> {
+        let Pose {
+            centre,
+            sin: s,
+            cos: c,
+            scale,
+        } = *pose;
+        let finite = [centre[0], centre[1], s, c, scale, reach]
+            .iter()
+            .all(|v| v.is_finite());
+        let guard = finite
+            && scale >= 2f64.powi(-20)
+            && centre[0].abs() <= 2f64.powi(20)
+            && centre[1].abs() <= 2f64.powi(20)
+            && reach <= 2f64.powi(12);
+        if !guard {
+            return None;
+        }
+        let kind = match shape {
+            &Shape::Ellipse { rx, ry } => {
+                let (lo, hi) = (rx.min(ry), rx.max(ry));
+                if !(lo > 0.0 && hi <= 4.0 * lo) {
+                    return None;
+                }
+                let (ax, ay) = (scale * rx, scale * ry);
+                let (ix, iy) = (1.0 / (ax * ax), 1.0 / (ay * ay));
+                let a = c * c * ix + s * s * iy;
+                let p = c * s * (ix - iy);
+                let radius = scale * lo;
+                let k = |level: f64| 1.0 + level / radius;
+                let k_in = k(-0.5 - MARGIN);
+                BoundsKind::Ellipse {
+                    a,
+                    p,
+                    // A Q - P^2, without the cancellation
+                    d: (c * c + s * s).powi(2) * ix * iy,
+                    k2_out: k(0.5 + MARGIN).powi(2),
+                    k2_in: (radius - 0.5 - MARGIN >= 1.0 / 16.0).then_some(k_in * k_in),
+                }
+            }
+            &Shape::Rectangle { hx, hy } => {
+                let edges = [
+                    (1.0, 0.0, hx),
+                    (-1.0, 0.0, hx),
+                    (0.0, 1.0, hy),
+                    (0.0, -1.0, hy),
+                ];
+                BoundsKind::Edges(edges.iter().map(|&e| edge(e, pose)).collect())
+            }
+            Shape::Polygon {
+                apothem, normals, ..
+            } => BoundsKind::Edges(
+                normals
+                    .iter()
+                    .map(|&(ns, nc)| edge((nc, ns, *apothem), pose))
+                    .collect(),
+            ),
+        };
+        Some(Self {
+            cx: centre[0],
+            kind,
+        })
+    }
+
+    /// The columns of the row at `dy` below the centre to render, within `square` (the
+    /// bounding square's columns), or `None` if the object covers none.
+    fn row(&self, dy: f64, square: (usize, usize)) -> Option<RowCover> {
+        let (outer, inner) = match &self.kind {
+            &BoundsKind::Ellipse {
+                a,
+                p,
+                d,
+                k2_out,
+                k2_in,
+            } => {
+                let m = -dy * p / a;
+                let chord = |k2: f64| {
+                    let w = (k2 / a - dy * dy * d / (a * a)).max(0.0).sqrt();
+                    (self.cx + m - w, self.cx + m + w)
+                };
+                let inner = k2_in.map_or((f64::INFINITY, f64::NEG_INFINITY), chord);
+                (chord(k2_out), inner)
+            }
+            BoundsKind::Edges(edges) => {
+                let (mut outer, mut inner) = (
+                    (f64::NEG_INFINITY, f64::INFINITY),
+                    (f64::NEG_INFINITY, f64::INFINITY),
+                );
+                for &(u, v, a) in edges {
+                    let base = a - v * dy;
+                    for (range, level) in [(&mut outer, 0.5 + MARGIN), (&mut inner, -0.5 - MARGIN)]
+                    {
+                        let r = base + level;
+                        if u > 0.0 {
+                            range.1 = range.1.min(self.cx + r / u);
+                        } else if u < 0.0 {
+                            range.0 = range.0.max(self.cx + r / u);
+                        } else if r <= 0.0 {
+                            *range = (f64::INFINITY, f64::NEG_INFINITY);
+                        }
+                    }
+                }
+                (outer, inner)
+            }
+        };
+        let (x_lo, x_hi) = (square.0 as f64, square.1 as f64);
+        let lo = (outer.0 - MARGIN).ceil().max(x_lo);
+        let hi = (outer.1 + MARGIN).floor().min(x_hi);
+        // never NaN: `max` and `min` take the square's end over a NaN
+        if lo > hi {
+            return None;
+        }
+        let in_lo = (inner.0 + MARGIN).ceil().max(lo);
+        let in_hi = (inner.1 - MARGIN).floor().min(hi);
+        let (lo, hi) = (lo as usize, hi as usize);
+        let inner = if in_lo <= in_hi {
+            in_lo as usize - lo..in_hi as usize - lo + 1
+        } else {
+            0..0
+        };
+        Some(RowCover { lo, hi, inner })
+    }
+}
+
+/// An edge of unit normal `(nx, ny)` and offset `a` in object space as [`BoundsKind::Edges`]
+/// holds it at `pose`: `nx qx + ny qy = (u dx + v dy) / scale`.
+fn edge((nx, ny, a): (f64, f64, f64), pose: &Pose) -> (f64, f64, f64) {
+    let (s, c) = (pose.sin, pose.cos);
+    (nx * c - ny * s, nx * s + ny * c, a * pose.scale)
+}
+
 /// The object-space points (`row.qx`, `row.qy`) and pixel coverages (`row.coverage`) of
-/// pixels `x_lo..x_lo + span` of the row at `dy` below the object's centre; with AVX2 when
-/// the CPU has it (the same operations, so the same bits).
-fn cover_row(shape: &Shape, pose: &Pose, dy: f64, x_lo: usize, span: usize, row: &mut RowBuffers) {
+/// pixels `x_lo..x_lo + span` of the row at `dy` below the object's centre, the pixels at
+/// offsets `inner` covered (coverage 1, no distance: [`Bounds`]); with AVX2 when the CPU has
+/// it (the same operations, so the same bits).
+fn cover_row(
+    shape: &Shape,
+    pose: &Pose,
+    dy: f64,
+    x_lo: usize,
+    span: usize,
+    inner: std::ops::Range<usize>,
+    row: &mut RowBuffers,
+) {
     #[cfg(target_arch = "x86_64")]
     if super::canvas::use_avx2() {
         // SAFETY: use_avx2() is true only when the CPU has AVX2.
-        unsafe { cover_row_avx2(shape, pose, dy, x_lo, span, row) };
+        unsafe { cover_row_avx2(shape, pose, dy, x_lo, span, inner, row) };
         return;
     }
-    cover_row_portable(shape, pose, dy, x_lo, span, row);
+    cover_row_portable(shape, pose, dy, x_lo, span, inner, row);
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -409,9 +669,10 @@ fn cover_row_avx2(
     dy: f64,
     x_lo: usize,
     span: usize,
+    inner: std::ops::Range<usize>,
     row: &mut RowBuffers,
 ) {
-    cover_row_portable(shape, pose, dy, x_lo, span, row);
+    cover_row_portable(shape, pose, dy, x_lo, span, inner, row);
 }
 
 #[inline(always)]
@@ -421,6 +682,7 @@ fn cover_row_portable(
     dy: f64,
     x_lo: usize,
     span: usize,
+    inner: std::ops::Range<usize>,
     row: &mut RowBuffers,
 ) {
     let Pose {
@@ -436,11 +698,15 @@ fn cover_row_portable(
         let dx = x as f64 - centre[0];
         (*qx, *qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
     }
-    let distance = &mut row.distance[..span];
-    shape.distances(qx, qy, distance);
-    for (coverage, d) in row.coverage.iter_mut().zip(distance.iter()) {
-        *coverage = (0.5 - d * scale).clamp(0.0, 1.0) as f32;
+    // the band left of the inner columns and the band right of them
+    for band in [0..inner.start, inner.end.max(inner.start)..span] {
+        let distance = &mut row.distance[band.clone()];
+        shape.distances(&qx[band.clone()], &qy[band.clone()], distance);
+        for (coverage, d) in row.coverage[band].iter_mut().zip(distance.iter()) {
+            *coverage = (0.5 - d * scale).clamp(0.0, 1.0) as f32;
+        }
     }
+    row.coverage[inner].fill(1.0);
 }
 
 /// A row's object-space points, distances and coverages, the sample coordinates and columns
@@ -486,6 +752,191 @@ mod tests {
         let square = Shape::polygon(4, 3.0);
         assert!((square.distance(3.0, 0.0)).abs() < 1e-9);
         assert!((square.radius() - 3.0 * 2f64.sqrt()).abs() < 1e-9);
+    }
+
+    /// A random shape of up to 60 px and pose (some at right angles, some with an edge on
+    /// a pixel's half-way point, a coverage level's edge), and its bounding square's reach.
+    fn random_case(rng: &mut impl Rng) -> (Shape, Pose, f64) {
+        let size = if rng.random_bool(0.2) {
+            rng.random_range(0.3..2.0)
+        } else {
+            rng.random_range(0.3..60.0)
+        };
+        let shape = match rng.random_range(0..3u32) {
+            0 => Shape::Ellipse {
+                rx: size,
+                ry: size * rng.random_range(0.25..1.0),
+            },
+            1 => Shape::Rectangle {
+                hx: size,
+                hy: size * rng.random_range(0.2..1.0),
+            },
+            _ => Shape::polygon(rng.random_range(3..=8), size),
+        };
+        let scale = match rng.random_range(0..4u32) {
+            0 => 1.0,
+            1 => rng.random_range(0.01..0.2),
+            _ => rng.random_range(0.2..3.0),
+        };
+        let angle = match rng.random_range(0..3u32) {
+            0 => std::f64::consts::FRAC_PI_4 * rng.random_range(0..8) as f64,
+            _ => rng.random_range(0.0..std::f64::consts::TAU),
+        };
+        let mut centre = [
+            rng.random_range(-30.0..270.0),
+            rng.random_range(-30.0..210.0),
+        ];
+        match rng.random_range(0..4u32) {
+            0 => centre = centre.map(f64::round),
+            1 => {
+                // an edge (or axis end) at a coverage level's boundary, to the last bits
+                let extent = match shape {
+                    Shape::Ellipse { rx, .. } => rx,
+                    Shape::Rectangle { hx, .. } => hx,
+                    Shape::Polygon { apothem, .. } => apothem,
+                };
+                let tiny = [0.0, 1e-13, -1e-13, 1e-9, -1e-9][rng.random_range(0..5)];
+                let level = [0.5, -0.5][rng.random_range(0..2)];
+                centre[0] = centre[0].round() - extent * scale - level + tiny;
+                centre[1] = centre[1].round() + [0.0, 0.5][rng.random_range(0..2)];
+            }
+            _ => {}
+        }
+        let (sin, cos) = angle.sin_cos();
+        let reach = shape.radius() * scale + 1.0;
+        let pose = Pose {
+            centre,
+            sin,
+            cos,
+            scale,
+        };
+        (shape, pose, reach)
+    }
+
+    #[test]
+    fn bounds_decide_pixels_as_the_exact_distance_does() {
+        use rand::SeedableRng;
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(19);
+        let width = 240usize;
+        let (mut exact, mut fast) = (RowBuffers::new(width), RowBuffers::new(width));
+        let (mut pixels, mut decided) = (0usize, 0usize);
+        for case in 0..20_000 {
+            let (shape, pose, reach) = random_case(&mut rng);
+            let [cx, cy] = pose.centre;
+            let x_lo = (cx - reach).floor().max(0.0);
+            let x_hi = (cx + reach).ceil().min(width as f64 - 1.0);
+            let (y_lo, y_hi) = (
+                (cy - reach).floor().max(0.0),
+                (cy + reach).ceil().min(179.0),
+            );
+            if x_lo > x_hi || y_lo > y_hi {
+                continue;
+            }
+            let square = (x_lo as usize, x_hi as usize);
+            let span = square.1 - square.0 + 1;
+            let bounds = Bounds::new(&shape, &pose, reach).expect("within the guard");
+            for y in y_lo as usize..=y_hi as usize {
+                let dy = y as f64 - cy;
+                cover_row(&shape, &pose, dy, square.0, span, 0..0, &mut exact);
+                pixels += span;
+                let Some(cover) = bounds.row(dy, square) else {
+                    decided += span;
+                    for i in 0..span {
+                        assert!(exact.coverage[i] <= 0.0, "case {case} row {y}: {shape:?}");
+                    }
+                    continue;
+                };
+                let fast_span = cover.hi - cover.lo + 1;
+                cover_row(
+                    &shape,
+                    &pose,
+                    dy,
+                    cover.lo,
+                    fast_span,
+                    cover.inner.clone(),
+                    &mut fast,
+                );
+                decided += span - fast_span + cover.inner.len();
+                for (i, x) in (square.0..=square.1).enumerate() {
+                    let e = exact.coverage[i];
+                    if x < cover.lo || x > cover.hi {
+                        assert!(e <= 0.0, "case {case} ({x}, {y}): {e} {shape:?}");
+                        continue;
+                    }
+                    let k = x - cover.lo;
+                    let same = fast.coverage[k].to_bits() == e.to_bits()
+                        && fast.qx[k].to_bits() == exact.qx[i].to_bits()
+                        && fast.qy[k].to_bits() == exact.qy[i].to_bits();
+                    assert!(same, "case {case} ({x}, {y}) {cover:?} {shape:?}");
+                }
+            }
+        }
+        // most pixels are decided by the bounds
+        assert!(decided * 10 > pixels * 7, "{decided} of {pixels}");
+    }
+
+    #[test]
+    fn bounds_give_way_outside_their_guard() {
+        let pose = |scale: f64, centre: [f64; 2]| Pose {
+            centre,
+            sin: 0.0,
+            cos: 1.0,
+            scale,
+        };
+        let ellipse = Shape::Ellipse { rx: 10.0, ry: 5.0 };
+        assert!(Bounds::new(&ellipse, &pose(1.0, [10.0, 10.0]), 11.0).is_some());
+        assert!(Bounds::new(&ellipse, &pose(f64::NAN, [10.0, 10.0]), 11.0).is_none());
+        assert!(Bounds::new(&ellipse, &pose(1.0, [3e6, 10.0]), 11.0).is_none());
+        assert!(Bounds::new(&ellipse, &pose(1.0, [10.0, 10.0]), 1e4).is_none());
+        let thin = Shape::Ellipse { rx: 10.0, ry: 2.0 };
+        assert!(Bounds::new(&thin, &pose(1.0, [10.0, 10.0]), 11.0).is_none());
+        // a small ellipse decides no pixel covered, only uncovered ones
+        let small = Shape::Ellipse { rx: 0.5, ry: 0.5 };
+        let b = Bounds::new(&small, &pose(1.0, [10.2, 10.0]), 1.5).unwrap();
+        let row = b.row(0.0, (8, 12)).unwrap();
+        assert_eq!((row.lo, row.hi, row.inner), (10, 11, 0..0));
+        assert_eq!(b.row(1.2, (8, 12)), None);
+    }
+
+    #[test]
+    fn rendering_with_bounds_is_the_exact_rendering_to_the_bit() {
+        use rand::SeedableRng;
+        let scene = MultiObjectScene {
+            objects: [25, 30],
+            background_velocity_px_s: [0.1, 40.0],
+            background_angular_velocity_deg_s: [0.0, 45.0],
+            background_scale: [1.0, 1.5],
+            object_velocity_px_s: [0.1, 600.0],
+            object_angular_velocity_deg_s: [0.0, 60.0],
+            object_scale: [0.05, 1.5],
+            object_size_px: [0.5, 40.0],
+            textures_dir: None,
+            background_texture: TextureParams {
+                canvas_px: 128,
+                ..Default::default()
+            },
+        };
+        let (width, height) = (240, 180);
+        for seed in 0..4 {
+            let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+            let world = scene.realise(width, height, 1.0, Vec::new(), &mut rng);
+            for k in 0..20 {
+                let t = k as f64 / 19.0;
+                let (mut a, mut b) = (vec![0f32; width * height], vec![0f32; width * height]);
+                world.render(width, 0..height, t, &mut a);
+                world.render_with(width, 0..height, t, &mut b, false);
+                // and in bands, as the parallel renderer does
+                let mut c = vec![0f32; width * height];
+                for (band, out) in c.chunks_mut(width * 7).enumerate() {
+                    let rows = band * 7..(band * 7 + 7).min(height);
+                    world.render(width, rows, t, out);
+                }
+                for (i, ((a, b), c)) in a.iter().zip(&b).zip(&c).enumerate() {
+                    assert_eq!(a.to_bits(), b.to_bits(), "seed {seed} t {t} pixel {i}");
+                    assert_eq!(c.to_bits(), b.to_bits(), "seed {seed} t {t} pixel {i}");
+                }
+            }
+        }
     }
 
     #[test]
