@@ -15,7 +15,7 @@
 //! The check: each pixel's frame samples, linear in time between frames, pass through the
 //! low-pass at each cutoff of [`CUTOFFS_HZ`] and through none; an ideal quantiser fires on
 //! the result, its thresholds set so that the ON and the OFF totals match the recording's
-//! (one threshold per polarity, found by bisection: the count falls with it); its ON and OFF
+//! (one threshold per polarity: the count falls about as its inverse); its ON and OFF
 //! counts per block of 4 x 4 pixels and frame interval are compared with the real ones by
 //! the chi-square distance `(r - s)^2 / (r + s + 1)`. The quantiser carries the memory of a
 //! high threshold (several intervals' change to fire once), which alone would look like a
@@ -40,12 +40,24 @@ pub const CUTOFFS_HZ: [f64; 10] = [1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 20.0, 50.0, 10
 /// distance by to be resolved.
 pub const RESOLVED_SE: f64 = 3.0;
 
+/// The cutoffs tried first (one in three of [`CUTOFFS_HZ`], spanning it), and the gain one
+/// of them must show for the others to be tried: where none lowers the distance by even
+/// one standard error, no neighbour between them lowers it by three (the distance changes
+/// smoothly with the cutoff), and the check stops at a third of its cost.
+const COARSE_CUTOFFS_HZ: [f64; 4] = [2.0, 5.0, 20.0, 100.0];
+const SCREEN_SE: f64 = 1.0;
+
 /// Side of the blocks whose counts are compared, pixels.
 const BLOCK_PX: usize = 4;
 
-/// Bisection steps of a threshold in the logarithm between 1e-3 and 10 (a factor 1e4 in
-/// 2^-24 steps: 1e-4 relative).
-const BISECTION_STEPS: usize = 24;
+/// The thresholds the quantiser's are matched within (log units).
+const MATCH_RANGE: [f64; 2] = [1e-3, 10.0];
+
+/// How close a matched threshold's count comes to the real one (relative).
+const MATCH_TOLERANCE: f64 = 0.005;
+
+/// At most this many counts to match a threshold.
+const MATCH_COUNTS: usize = 40;
 
 /// What the check found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -108,14 +120,31 @@ pub fn check(
 /// resolved against no low-pass.
 fn resolve(samples: &Samples) -> Option<SlowPhotoreceptor> {
     let without = samples.distances(None)?;
-    let tried: Vec<(f64, Vec<f64>, [f64; 2])> = CUTOFFS_HZ
-        .par_iter()
-        .filter_map(|&f| {
-            let (d, c) = samples.distances(Some(f))?;
-            Some((f, d, c))
-        })
-        .collect();
     let gain = |d: &[f64]| paired_gain(&without.0, d);
+    let tried_at = |cutoffs: &[f64]| -> Vec<(f64, Vec<f64>, [f64; 2])> {
+        cutoffs
+            .par_iter()
+            .filter_map(|&f| {
+                let (d, c) = samples.distances(Some(f))?;
+                Some((f, d, c))
+            })
+            .collect()
+    };
+    // every third cutoff first; the rest only where one of those gains at all
+    let mut tried = tried_at(&COARSE_CUTOFFS_HZ);
+    let screened = tried.iter().any(|t| {
+        let (g, se) = gain(&t.1);
+        g > SCREEN_SE * se
+    });
+    if !screened {
+        return None;
+    }
+    let rest: Vec<f64> = CUTOFFS_HZ
+        .iter()
+        .copied()
+        .filter(|f| !COARSE_CUTOFFS_HZ.contains(f))
+        .collect();
+    tried.extend(tried_at(&rest));
     let (best, best_gain) = tried
         .iter()
         .map(|t| (t, gain(&t.1)))
@@ -277,17 +306,20 @@ impl Samples {
     #[inline]
     fn quantise(&self, y: &[f32], c: f32, on: bool, mut fire: impl FnMut(usize, u32)) {
         let mut memory = y[0];
+        let inverse = 1.0 / c;
         for k in 0..y.len() - 1 {
             if self.restart[k] {
                 memory = y[k + 1];
                 continue;
             }
             let change = y[k + 1] - memory;
-            let steps = (change.abs() / c).floor();
-            if steps >= 1.0 {
-                memory += steps * c * change.signum();
+            // whole thresholds crossed: the truncation of a non-negative ratio is its floor
+            // (without libm's `floorf` call)
+            let steps = (change.abs() * inverse) as u32;
+            if steps >= 1 {
+                memory += steps as f32 * c * change.signum();
                 if (change > 0.0) == on && self.compared[k] {
-                    fire(k, steps as u32);
+                    fire(k, steps);
                 }
             }
         }
@@ -317,19 +349,35 @@ impl Samples {
     }
 
     /// The threshold at which the quantiser's total of one polarity on `signal` matches
-    /// the real one (bisection in the logarithm; the count falls as the threshold rises).
+    /// the real one. The count falls about as `1 / c`, so `c n(c) / target` is nearly the
+    /// root, and a step to it usually lands within [`MATCH_TOLERANCE`] in a few counts; the
+    /// count is a step function, so each step is kept inside the bracket the counts so
+    /// far allow and falls back to bisecting it (in the logarithm) where it would leave it.
     fn matched_threshold(&self, signal: &[f32], on: bool) -> f32 {
-        let target = if on { self.total_on } else { self.total_off };
-        let (mut lo, mut hi) = (1e-3f32.ln(), 10f32.ln());
-        for _ in 0..BISECTION_STEPS {
-            let mid = 0.5 * (lo + hi);
-            if self.quantised_total(signal, mid.exp(), on) > target {
-                lo = mid;
-            } else {
-                hi = mid;
+        let target = (if on { self.total_on } else { self.total_off }) as f64;
+        let (mut lo, mut hi) = (MATCH_RANGE[0], MATCH_RANGE[1]);
+        let mut c = 0.3f64;
+        for _ in 0..MATCH_COUNTS {
+            let n = self.quantised_total(signal, c as f32, on) as f64;
+            if (n - target).abs() <= MATCH_TOLERANCE * target {
+                return c as f32;
             }
+            if n > target {
+                lo = c;
+            } else {
+                hi = c;
+            }
+            if hi / lo < 1.0 + 1e-4 {
+                break;
+            }
+            let step = c * n / target;
+            c = if n > 0.0 && step > lo && step < hi {
+                step
+            } else {
+                (lo * hi).sqrt()
+            };
         }
-        (0.5 * (lo + hi)).exp()
+        c as f32
     }
 
     /// Per-block distance (summed over compared intervals, ON and OFF) of the quantiser on
