@@ -20,8 +20,12 @@
 //! the chi-square distance `(r - s)^2 / (r + s + 1)`. The quantiser carries the memory of a
 //! high threshold (several intervals' change to fire once), which alone would look like a
 //! lag, and frame noise hits both sides alike. A cutoff is resolved where it lowers the
-//! distance, block by block against no low-pass, by more than [`RESOLVED_SE`] standard
-//! errors of that paired difference. No flow and no simulator: the frames' samples only,
+//! distance, tile by tile (16 x 16 pixels: neighbouring blocks share edges) against no
+//! low-pass, by more than [`RESOLVED_SE`] standard errors of that paired difference, asks
+//! for lower thresholds on both polarities, and is not the grid's fastest (a pixel that
+//! fast follows the frames within an interval). Pixels near black or clipped are not
+//! compared in an interval (as the rest of aps leaves them out), the filter starts settled
+//! at the first frame and after a span not read. No flow and no simulator: the frames' samples only,
 //! which is enough to tell a pixel that averages over several frames from one that follows
 //! them, not to measure a threshold (aps re-simulates with the cutoff found for that).
 
@@ -31,45 +35,66 @@ use crate::sim::effects::bandwidth;
 use rayon::prelude::*;
 use serde::Serialize;
 
-/// The cutoffs at white (255 DN) tried, Hz. Above 200 Hz a pixel follows frames at the
-/// rates APS frames come (at most a few hundred per second) within an interval; the event
-/// timing's lag term covers the rest.
+/// The cutoffs at white (255 DN) tried, Hz. At the top of the grid a pixel follows frames
+/// at the rates APS frames come (at most a few hundred per second) within an interval, and
+/// the event timing's lag term covers it: a best cutoff there is not resolved.
 pub const CUTOFFS_HZ: [f64; 10] = [1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 20.0, 50.0, 100.0, 200.0];
 
-/// Standard errors of the paired block-by-block difference a cutoff must lower the
+/// The cutoffs tried first (every other one, with both ends' neighbours), and the gain
+/// one of them must show for the rest to be tried: the distance changes smoothly with the
+/// cutoff, so where none lowers it by one standard error no cutoff between them lowers it
+/// by [`RESOLVED_SE`], and the check stops at half its cost.
+const COARSE_CUTOFFS_HZ: [f64; 5] = [1.0, 3.0, 7.0, 20.0, 100.0];
+const SCREEN_SE: f64 = 1.0;
+
+/// Standard errors of the paired tile-by-tile difference a cutoff must lower the
 /// distance by to be resolved.
 pub const RESOLVED_SE: f64 = 3.0;
-
-/// The cutoffs tried first (one in three of [`CUTOFFS_HZ`], spanning it), and the gain one
-/// of them must show for the others to be tried: where none lowers the distance by even
-/// one standard error, no neighbour between them lowers it by three (the distance changes
-/// smoothly with the cutoff), and the check stops at a third of its cost.
-const COARSE_CUTOFFS_HZ: [f64; 4] = [2.0, 5.0, 20.0, 100.0];
-const SCREEN_SE: f64 = 1.0;
 
 /// Side of the blocks whose counts are compared, pixels.
 const BLOCK_PX: usize = 4;
 
-/// The thresholds the quantiser's are matched within (log units).
-const MATCH_RANGE: [f64; 2] = [1e-3, 10.0];
+/// Side of the tiles whose gains are taken as independent, blocks (16 x 16 pixels, the
+/// re-simulation's tiles: an edge crosses neighbouring blocks together).
+const TILE_BLOCKS: usize = 4;
 
-/// How close a matched threshold's count comes to the real one (relative).
+/// The thresholds the quantiser's are matched within (log units), and how close a count
+/// must come to the real total: within [`MATCH_TOLERANCE`] the search stops. A coarse
+/// staircase of counts (a checkerboard's pixels all cross the same contrast) can leave no
+/// threshold that matches: the nearest count's cells are then scaled to the real total,
+/// so that both sides of a comparison hold the recording's events; beyond [`MATCH_MISS`]
+/// the cutoff is not compared.
+const MATCH_RANGE: [f64; 2] = [1e-3, 10.0];
 const MATCH_TOLERANCE: f64 = 0.005;
+const MATCH_MISS: f64 = 0.5;
 
 /// At most this many counts to match a threshold.
 const MATCH_COUNTS: usize = 40;
 
+/// The first threshold tried (log units: a DAVIS's typical 0.2-0.5, Stoffregen et al.
+/// 2020); the steps from it are what matter.
+const MATCH_START: f64 = 0.3;
+
+/// At most this many pixel samples (pixels x frames) are held (two f32 copies, 128 MB);
+/// beyond, every n-th row of blocks is compared.
+const MAX_SAMPLES: usize = 16_000_000;
+
+/// Fewest real events of each polarity, and kept pixels, for a comparison.
+const MIN_EVENTS: u64 = 50;
+const MIN_PIXELS: usize = 16;
+
 /// What the check found.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SlowPhotoreceptor {
-    /// The cutoff at white whose low-pass explains the events best (Hz, simulator terms).
+    /// The cutoff at white whose low-pass explains the events best (Hz, the simulator's
+    /// terms: [`bandwidth::cutoff_at_dn`]).
     pub cutoff_hz: f64,
-    /// The cutoffs of the grid whose distance lies within two standard errors of the
-    /// best's (Hz at white).
+    /// The grid's cutoffs whose distance lies within two standard errors of the best's
+    /// (Hz at white).
     pub cutoff_range_hz: [f64; 2],
-    /// The cutoff at the frames' median DN, Hz.
+    /// The cutoff at the middle frame's median DN, Hz.
     pub cutoff_at_median_dn_hz: f64,
-    /// Mean distance per block without a low-pass and at the cutoff.
+    /// Mean distance per tile without a low-pass and at the cutoff.
     pub distance_without: f64,
     pub distance_at_cutoff: f64,
     /// How many standard errors of the paired difference the cutoff lowers the distance.
@@ -80,30 +105,16 @@ pub struct SlowPhotoreceptor {
     /// The quantiser's thresholds with the cutoff (frame samples only: a start for the
     /// re-simulation, not a measurement).
     pub quantiser_thresholds: [f64; 2],
+    /// Every how many rows of blocks were compared (1: all; more where the recording holds
+    /// more than [`MAX_SAMPLES`] pixel samples).
+    pub block_row_step: usize,
 }
 
-/// The pixels' frame samples, the real counts and the blocks they are compared in.
-struct Samples {
-    /// Log intensity per frame, pixel-major (`pixel * frames + k`), kept pixels only.
-    log: Vec<f32>,
-    /// Frame DN per frame, same layout (the cutoff's intensity).
-    dn: Vec<f32>,
-    /// Frame times, microseconds.
-    times: Vec<TimeUs>,
-    /// Intervals whose counts are compared (used by aps).
-    compared: Vec<bool>,
-    /// Intervals after which the filter and quantiser restart (a span whose events were
-    /// not read).
-    restart: Vec<bool>,
-    /// Block of each kept pixel.
-    block_of: Vec<usize>,
-    blocks: usize,
-    /// Real ON and OFF counts per (block, interval): `block * intervals + k`.
-    real_on: Vec<u32>,
-    real_off: Vec<u32>,
-    /// Real totals over the compared intervals.
-    total_on: u64,
-    total_off: u64,
+/// The quantiser at one cutoff: per-tile distances and its matched thresholds.
+struct Tried {
+    cutoff_hz: f64,
+    distances: Vec<f64>,
+    thresholds: [f64; 2],
 }
 
 /// The check on `events` and `frames`; `None` where there are too few frames, events or
@@ -117,24 +128,49 @@ pub fn check(
 }
 
 /// The cutoff of [`CUTOFFS_HZ`] that explains `samples`' real counts best, where it is
-/// resolved against no low-pass.
+/// resolved against no low-pass and consistent with a slow photoreceptor.
 fn resolve(samples: &Samples) -> Option<SlowPhotoreceptor> {
-    let without = samples.distances(None)?;
-    let gain = |d: &[f64]| paired_gain(&without.0, d);
-    let tried_at = |cutoffs: &[f64]| -> Vec<(f64, Vec<f64>, [f64; 2])> {
+    let without = samples.tried(None)?;
+    let tried = screened_grid(samples, &without)?;
+    let best = tried.iter().max_by(|a, b| {
+        let gain = |t: &Tried| paired_gain(&without.distances, &t.distances).0;
+        gain(a).total_cmp(&gain(b))
+    })?;
+    let (gain, se) = paired_gain(&without.distances, &best.distances);
+    let significance = if se > 0.0 { gain / se } else { 0.0 };
+    let ratios = [0, 1].map(|i| best.thresholds[i] / without.thresholds[i]);
+    let slower = ratios.iter().all(|&r| r < 1.0);
+    let fastest = CUTOFFS_HZ[CUTOFFS_HZ.len() - 1];
+    if !(significance > RESOLVED_SE && slower && best.cutoff_hz < fastest) {
+        return None;
+    }
+    let tiles = without.distances.len().max(1) as f64;
+    Some(SlowPhotoreceptor {
+        cutoff_hz: best.cutoff_hz,
+        cutoff_range_hz: cutoff_range(&tried, best),
+        cutoff_at_median_dn_hz: bandwidth::cutoff_at_dn(samples.median_dn, best.cutoff_hz),
+        distance_without: without.distances.iter().sum::<f64>() / tiles,
+        distance_at_cutoff: best.distances.iter().sum::<f64>() / tiles,
+        significance,
+        threshold_ratios: ratios,
+        quantiser_thresholds: best.thresholds,
+        block_row_step: samples.block_row_step,
+    })
+}
+
+/// The quantiser at the coarse cutoffs, and at the rest where one of those gains at
+/// least [`SCREEN_SE`] standard errors; `None` where none does.
+fn screened_grid(samples: &Samples, without: &Tried) -> Option<Vec<Tried>> {
+    let tried_at = |cutoffs: &[f64]| -> Vec<Tried> {
         cutoffs
             .par_iter()
-            .filter_map(|&f| {
-                let (d, c) = samples.distances(Some(f))?;
-                Some((f, d, c))
-            })
+            .filter_map(|&f| samples.tried(Some(f)))
             .collect()
     };
-    // every third cutoff first; the rest only where one of those gains at all
     let mut tried = tried_at(&COARSE_CUTOFFS_HZ);
     let screened = tried.iter().any(|t| {
-        let (g, se) = gain(&t.1);
-        g > SCREEN_SE * se
+        let (gain, se) = paired_gain(&without.distances, &t.distances);
+        gain > SCREEN_SE * se
     });
     if !screened {
         return None;
@@ -145,44 +181,24 @@ fn resolve(samples: &Samples) -> Option<SlowPhotoreceptor> {
         .filter(|f| !COARSE_CUTOFFS_HZ.contains(f))
         .collect();
     tried.extend(tried_at(&rest));
-    let (best, best_gain) = tried
-        .iter()
-        .map(|t| (t, gain(&t.1)))
-        .max_by(|a, b| a.1.0.total_cmp(&b.1.0))?;
-    let (gain_sum, se) = best_gain;
-    let significance = if se > 0.0 { gain_sum / se } else { 0.0 };
-    if significance.is_nan() || significance <= RESOLVED_SE {
-        return None;
-    }
-    let best_total: f64 = best.1.iter().sum();
-    // a worse cutoff raises the distance against the best's: within 2 standard errors
-    let within: Vec<f64> = tried
-        .iter()
-        .filter(|t| {
-            let (g, se) = paired_gain(&best.1, &t.1);
-            -g <= 2.0 * se
-        })
-        .map(|t| t.0)
-        .collect();
-    let blocks = without.0.len().max(1) as f64;
-    let median_dn = samples.median_dn();
-    Some(SlowPhotoreceptor {
-        cutoff_hz: best.0,
-        cutoff_range_hz: [
-            within.iter().copied().fold(f64::INFINITY, f64::min),
-            within.iter().copied().fold(0.0, f64::max),
-        ],
-        cutoff_at_median_dn_hz: best.0 * (median_dn + 20.0) / 275.0,
-        distance_without: without.0.iter().sum::<f64>() / blocks,
-        distance_at_cutoff: best_total / blocks,
-        significance,
-        threshold_ratios: [best.2[0] / without.1[0], best.2[1] / without.1[1]],
-        quantiser_thresholds: best.2,
+    Some(tried)
+}
+
+/// The lowest and highest cutoffs whose distance rises over the best's by no more than
+/// two standard errors of the paired difference.
+fn cutoff_range(tried: &[Tried], best: &Tried) -> [f64; 2] {
+    let within = tried.iter().filter(|t| {
+        let (gain, se) = paired_gain(&best.distances, &t.distances);
+        -gain <= 2.0 * se
+    });
+    within.fold([f64::INFINITY, 0.0], |[lo, hi], t| {
+        [lo.min(t.cutoff_hz), hi.max(t.cutoff_hz)]
     })
 }
 
-/// How much `other` lowers the per-block distances `base`: the sum of the differences and
-/// its standard error (the differences' spread times the square root of their number).
+/// How much `other` lowers the per-tile distances `base`: the sum of the differences and
+/// its standard error (the differences' spread times the square root of their number; 0
+/// for a single tile, which then resolves nothing).
 fn paired_gain(base: &[f64], other: &[f64]) -> (f64, f64) {
     let n = base.len() as f64;
     let d: Vec<f64> = base.iter().zip(other).map(|(a, b)| a - b).collect();
@@ -192,32 +208,69 @@ fn paired_gain(base: &[f64], other: &[f64]) -> (f64, f64) {
     (sum, (var * n).sqrt())
 }
 
+/// The pixels' frame samples, the real counts and the blocks they are compared in.
+struct Samples {
+    /// Log intensity per frame, pixel-major (`pixel * frames + k`), kept pixels only.
+    log: Vec<f32>,
+    /// Frame DN per frame, same layout (the cutoff's intensity, and which intervals are
+    /// reliable).
+    dn: Vec<f32>,
+    /// Frame times, microseconds.
+    times: Vec<TimeUs>,
+    /// Intervals whose counts are compared (used by aps).
+    compared: Vec<bool>,
+    /// Intervals after which the filter and quantiser restart (a span whose events were
+    /// not read).
+    restart: Vec<bool>,
+    /// Block of each kept pixel, and tile of each block.
+    block_of: Vec<usize>,
+    tile_of: Vec<usize>,
+    tiles: usize,
+    /// Real ON and OFF counts per (block, interval): `block * intervals + k`.
+    real_on: Vec<u32>,
+    real_off: Vec<u32>,
+    /// Real totals over the compared intervals.
+    total_on: u64,
+    total_off: u64,
+    median_dn: f64,
+    block_row_step: usize,
+}
+
+/// Kept pixels: their index into the samples by sensor index (`usize::MAX`: not kept),
+/// block, log and DN samples.
+struct Kept {
+    slot: Vec<usize>,
+    block_of: Vec<usize>,
+    log: Vec<f32>,
+    dn: Vec<f32>,
+}
+
+/// Whether a frame value is a reliable intensity (neither near black nor clipped), as
+/// [`PreparedFrames::reliable`] takes it.
+#[inline]
+fn reliable(dn0: f32, dn1: f32) -> bool {
+    let ok = |v: f32| v > 3.0 && v < 254.0;
+    ok(dn0) && ok(dn1)
+}
+
 impl Samples {
     fn new(events: &EventChunk, frames: &PreparedFrames, excluded: &[bool]) -> Option<Self> {
-        let (width, height) = (frames.width, frames.height);
-        let k_frames = frames.times.len();
-        if k_frames < 4 {
+        let n_frames = frames.times.len();
+        if n_frames < 4 || frames.width == 0 || frames.height == 0 {
             return None;
         }
-        let intervals = k_frames - 1;
-        let blocks_x = width.div_ceil(BLOCK_PX);
-        let blocks = blocks_x * height.div_ceil(BLOCK_PX);
-        let mut kept = vec![usize::MAX; width * height];
-        let mut block_of = Vec::new();
-        let mut log = Vec::new();
-        let mut dn = Vec::new();
-        for (index, slot) in kept.iter_mut().enumerate() {
-            if excluded.get(index).copied().unwrap_or(false) {
-                continue;
-            }
-            *slot = block_of.len();
-            block_of.push((index / width / BLOCK_PX) * blocks_x + (index % width) / BLOCK_PX);
-            for frame in &frames.dn {
-                let v = frame.data[index];
-                dn.push(v);
-                log.push(frames.log(v));
-            }
-        }
+        let intervals = n_frames - 1;
+        let (blocks_x, blocks_y) = (
+            frames.width.div_ceil(BLOCK_PX),
+            frames.height.div_ceil(BLOCK_PX),
+        );
+        let block_row_step = (frames.width * frames.height * n_frames).div_ceil(MAX_SAMPLES);
+        let kept = Self::kept(frames, excluded, block_row_step.max(1));
+        let tiles_x = blocks_x.div_ceil(TILE_BLOCKS);
+        let tile_of: Vec<usize> = (0..blocks_x * blocks_y)
+            .map(|b| (b / blocks_x / TILE_BLOCKS) * tiles_x + (b % blocks_x) / TILE_BLOCKS)
+            .collect();
+        let tiles = tiles_x * blocks_y.div_ceil(TILE_BLOCKS);
         let compared: Vec<bool> = frames.intervals.iter().map(|i| i.used).collect();
         let restart: Vec<bool> = (0..intervals)
             .map(|k| {
@@ -225,62 +278,110 @@ impl Samples {
                 frames.unread.iter().any(|&(s, e)| s < b && e > a)
             })
             .collect();
-        let mut real_on = vec![0u32; blocks * intervals];
-        let mut real_off = vec![0u32; blocks * intervals];
-        let (mut total_on, mut total_off) = (0u64, 0u64);
-        for i in 0..events.len() {
-            let t = events.t[i];
-            let k = frames.times.partition_point(|&ft| ft <= t);
-            if k == 0 || k > intervals || !compared[k - 1] {
-                continue;
-            }
-            let index = events.y[i] as usize * width + events.x[i] as usize;
-            let Some(&p) = kept.get(index).filter(|&&p| p != usize::MAX) else {
-                continue;
-            };
-            let cell = block_of[p] * intervals + (k - 1);
-            if events.on[i] {
-                real_on[cell] += 1;
-                total_on += 1;
-            } else {
-                real_off[cell] += 1;
-                total_off += 1;
-            }
-        }
-        (total_on >= 50 && total_off >= 50 && block_of.len() >= 16).then_some(Self {
-            log,
-            dn,
+        let mut samples = Self {
             times: frames.times.clone(),
             compared,
             restart,
-            block_of,
-            blocks,
-            real_on,
-            real_off,
-            total_on,
-            total_off,
-        })
+            tile_of,
+            tiles,
+            real_on: vec![0; blocks_x * blocks_y * intervals],
+            real_off: vec![0; blocks_x * blocks_y * intervals],
+            total_on: 0,
+            total_off: 0,
+            median_dn: median_dn(frames),
+            block_row_step: block_row_step.max(1),
+            log: Vec::new(),
+            dn: Vec::new(),
+            block_of: Vec::new(),
+        };
+        samples.count_real(events, frames, &kept.slot, &kept.block_of);
+        (samples.total_on >= MIN_EVENTS
+            && samples.total_off >= MIN_EVENTS
+            && kept.block_of.len() >= MIN_PIXELS)
+            .then(|| {
+                samples.log = kept.log;
+                samples.dn = kept.dn;
+                samples.block_of = kept.block_of;
+                samples
+            })
+    }
+
+    /// The pixels compared: not `excluded`, in every `step`-th row of blocks, with finite
+    /// log values in every frame.
+    fn kept(frames: &PreparedFrames, excluded: &[bool], step: usize) -> Kept {
+        let (width, height) = (frames.width, frames.height);
+        let blocks_x = width.div_ceil(BLOCK_PX);
+        let mut kept = Kept {
+            slot: vec![usize::MAX; width * height],
+            block_of: Vec::new(),
+            log: Vec::new(),
+            dn: Vec::new(),
+        };
+        for (index, slot) in kept.slot.iter_mut().enumerate() {
+            let (x, y) = (index % width, index / width);
+            let out = excluded.get(index).copied().unwrap_or(false)
+                || !(y / BLOCK_PX).is_multiple_of(step)
+                || frames
+                    .dn
+                    .iter()
+                    .any(|f| !frames.log(f.data[index]).is_finite());
+            if out {
+                continue;
+            }
+            *slot = kept.block_of.len();
+            kept.block_of.push((y / BLOCK_PX) * blocks_x + x / BLOCK_PX);
+            for frame in &frames.dn {
+                let v = frame.data[index];
+                kept.dn.push(v);
+                kept.log.push(frames.log(v));
+            }
+        }
+        kept
+    }
+
+    /// The real ON and OFF counts per (block, interval) of the compared intervals, where
+    /// the pixel is kept and reliable in both frames.
+    fn count_real(
+        &mut self,
+        events: &EventChunk,
+        frames: &PreparedFrames,
+        slot: &[usize],
+        block_of: &[usize],
+    ) {
+        let intervals = self.times.len() - 1;
+        let (width, height) = (frames.width, frames.height);
+        for i in 0..events.len() {
+            let (x, y) = (events.x[i] as usize, events.y[i] as usize);
+            let k = self.times.partition_point(|&ft| ft <= events.t[i]);
+            if x >= width || y >= height || k == 0 || k > intervals || !self.compared[k - 1] {
+                continue;
+            }
+            let index = y * width + x;
+            let p = slot[index];
+            if p == usize::MAX || !frames.reliable(k - 1, index) {
+                continue;
+            }
+            let cell = block_of[p] * intervals + (k - 1);
+            if events.on[i] {
+                self.real_on[cell] += 1;
+                self.total_on += 1;
+            } else {
+                self.real_off[cell] += 1;
+                self.total_off += 1;
+            }
+        }
     }
 
     fn frames(&self) -> usize {
         self.times.len()
     }
 
-    fn median_dn(&self) -> f64 {
-        let mut v: Vec<f32> = self.dn.iter().copied().step_by(7).collect();
-        if v.is_empty() {
-            return 128.0;
-        }
-        let mid = v.len() / 2;
-        *v.select_nth_unstable_by(mid, f32::total_cmp).1 as f64
-    }
-
     /// Every kept pixel's log signal at the frame times through the low-pass at `cutoff`
     /// (at white; `None`: no filter), pixel-major as `log`.
-    fn filtered(&self, cutoff: Option<f64>) -> Vec<f32> {
+    fn filtered(&self, cutoff: Option<f64>) -> std::borrow::Cow<'_, [f32]> {
         let n = self.frames();
         let Some(cutoff) = cutoff else {
-            return self.log.clone();
+            return std::borrow::Cow::Borrowed(&self.log);
         };
         let mut out = vec![0f32; self.log.len()];
         out.par_chunks_mut(n)
@@ -297,14 +398,21 @@ impl Samples {
                     y[k + 1] = bandwidth::advance(y[k], u[k], u[k + 1], h, tau);
                 }
             });
-        out
+        std::borrow::Cow::Owned(out)
     }
 
     /// The ideal quantiser's ON (`on`) or OFF events on pixel signal `y` (its frame
-    /// samples) with one threshold `c` for both polarities: `fire(k, count)` for each
-    /// interval `k` in which it fires.
+    /// samples, `dn` its frame values) with one threshold `c` for both polarities:
+    /// `fire(k, count)` for each compared interval `k` in which it fires where the pixel is
+    /// reliable.
     #[inline]
-    fn quantise(&self, y: &[f32], c: f32, on: bool, mut fire: impl FnMut(usize, u32)) {
+    fn quantise(
+        &self,
+        (y, dn): (&[f32], &[f32]),
+        c: f32,
+        on: bool,
+        mut fire: impl FnMut(usize, u32),
+    ) {
         let mut memory = y[0];
         let inverse = 1.0 / c;
         for k in 0..y.len() - 1 {
@@ -318,20 +426,28 @@ impl Samples {
             let steps = (change.abs() * inverse) as u32;
             if steps >= 1 {
                 memory += steps as f32 * c * change.signum();
-                if (change > 0.0) == on && self.compared[k] {
+                if (change > 0.0) == on && self.compared[k] && reliable(dn[k], dn[k + 1]) {
                     fire(k, steps);
                 }
             }
         }
     }
 
+    fn pixels<'a>(&'a self, signal: &'a [f32]) -> impl Iterator<Item = (&'a [f32], &'a [f32])> {
+        signal
+            .chunks(self.frames())
+            .zip(self.dn.chunks(self.frames()))
+    }
+
     /// The quantiser's total of one polarity over the compared intervals.
     fn quantised_total(&self, signal: &[f32], c: f32, on: bool) -> u64 {
+        let n = self.frames();
         signal
-            .par_chunks(self.frames())
-            .map(|y| {
+            .par_chunks(n)
+            .zip(self.dn.par_chunks(n))
+            .map(|pixel| {
                 let mut total = 0u64;
-                self.quantise(y, c, on, |_, n| total += n as u64);
+                self.quantise(pixel, c, on, |_, fired| total += fired as u64);
                 total
             })
             .sum()
@@ -340,10 +456,12 @@ impl Samples {
     /// The quantiser's counts of one polarity per (block, interval).
     fn quantised_cells(&self, signal: &[f32], c: f32, on: bool) -> Vec<u32> {
         let intervals = self.frames() - 1;
-        let mut cells = vec![0u32; self.blocks * intervals];
-        for (p, y) in signal.chunks(self.frames()).enumerate() {
+        let mut cells = vec![0u32; self.real_on.len()];
+        for (p, pixel) in self.pixels(signal).enumerate() {
             let base = self.block_of[p] * intervals;
-            self.quantise(y, c, on, |k, n| cells[base + k] += n);
+            self.quantise(pixel, c, on, |k, fired| {
+                cells[base + k] = cells[base + k].saturating_add(fired)
+            });
         }
         cells
     }
@@ -353,22 +471,25 @@ impl Samples {
     /// root, and a step to it usually lands within [`MATCH_TOLERANCE`] in a few counts; the
     /// count is a step function, so each step is kept inside the bracket the counts so
     /// far allow and falls back to bisecting it (in the logarithm) where it would leave it.
-    fn matched_threshold(&self, signal: &[f32], on: bool) -> f32 {
+    /// The threshold whose count came nearest, with the real total over that count;
+    /// `None` where it misses by more than [`MATCH_MISS`].
+    fn matched_threshold(&self, signal: &[f32], on: bool) -> Option<(f32, f64)> {
         let target = (if on { self.total_on } else { self.total_off }) as f64;
         let (mut lo, mut hi) = (MATCH_RANGE[0], MATCH_RANGE[1]);
-        let mut c = 0.3f64;
+        let (mut c, mut nearest) = (MATCH_START, (f64::INFINITY, MATCH_START, 0.0));
         for _ in 0..MATCH_COUNTS {
             let n = self.quantised_total(signal, c as f32, on) as f64;
-            if (n - target).abs() <= MATCH_TOLERANCE * target {
-                return c as f32;
+            let miss = (n - target).abs() / target;
+            if miss < nearest.0 {
+                nearest = (miss, c, n);
+            }
+            if miss <= MATCH_TOLERANCE || hi / lo < 1.0 + 1e-4 {
+                break;
             }
             if n > target {
                 lo = c;
             } else {
                 hi = c;
-            }
-            if hi / lo < 1.0 + 1e-4 {
-                break;
             }
             let step = c * n / target;
             c = if n > 0.0 && step > lo && step < hi {
@@ -377,31 +498,40 @@ impl Samples {
                 (lo * hi).sqrt()
             };
         }
-        c as f32
+        (nearest.0 <= MATCH_MISS && nearest.2 > 0.0).then(|| (nearest.1 as f32, target / nearest.2))
     }
 
-    /// Per-block distance (summed over compared intervals, ON and OFF) of the quantiser on
-    /// the signal low-passed at `cutoff`, with the matched thresholds.
-    fn distances(&self, cutoff: Option<f64>) -> Option<(Vec<f64>, [f64; 2])> {
+    /// The quantiser on the signal low-passed at `cutoff` with the matched thresholds: its
+    /// per-tile distance (summed over compared intervals, ON and OFF); `None` where a
+    /// threshold does not match.
+    fn tried(&self, cutoff: Option<f64>) -> Option<Tried> {
         let signal = self.filtered(cutoff);
         let intervals = self.frames() - 1;
-        let mut distance = vec![0f64; self.blocks];
+        let mut distances = vec![0f64; self.tiles];
         let mut thresholds = [0f64; 2];
         for (slot, on) in [(0, true), (1, false)] {
-            let c = self.matched_threshold(&signal, on);
+            let (c, scale) = self.matched_threshold(&signal, on)?;
             thresholds[slot] = c as f64;
             let simulated = self.quantised_cells(&signal, c, on);
             let real = if on { &self.real_on } else { &self.real_off };
             for (cell, (&r, &s)) in real.iter().zip(&simulated).enumerate() {
-                let (r, s) = (r as f64, s as f64);
-                distance[cell / intervals] += (r - s).powi(2) / (r + s + 1.0);
+                let (r, s) = (r as f64, s as f64 * scale);
+                distances[self.tile_of[cell / intervals]] += (r - s).powi(2) / (r + s + 1.0);
             }
         }
-        thresholds
-            .iter()
-            .all(|c| c.is_finite())
-            .then_some((distance, thresholds))
+        Some(Tried {
+            cutoff_hz: cutoff.unwrap_or(f64::INFINITY),
+            distances,
+            thresholds,
+        })
     }
+}
+
+/// The median DN of the middle frame (where the cutoff at white is read as a cutoff).
+fn median_dn(frames: &PreparedFrames) -> f64 {
+    let mut v: Vec<f32> = frames.dn[frames.dn.len() / 2].data.clone();
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f32::total_cmp).1 as f64
 }
 
 #[cfg(test)]
@@ -421,25 +551,29 @@ mod tests {
                 });
             }
         }
+        let intervals = frames - 1;
         Samples {
             dn: vec![200.0; log.len()],
             log,
             times: (0..frames as TimeUs).map(|k| k * 10_000).collect(),
-            compared: vec![true; frames - 1],
-            restart: vec![false; frames - 1],
+            compared: vec![true; intervals],
+            restart: vec![false; intervals],
             block_of: (0..pixels).collect(),
-            blocks: pixels,
-            real_on: Vec::new(),
-            real_off: Vec::new(),
+            tile_of: (0..pixels).collect(),
+            tiles: pixels,
+            real_on: vec![0; pixels * intervals],
+            real_off: vec![0; pixels * intervals],
             total_on: 0,
             total_off: 0,
+            median_dn: 200.0,
+            block_row_step: 1,
         }
     }
 
     /// `samples` with the real counts an ideal quantiser with threshold `c` makes from its
     /// signal low-passed at `cutoff`.
     fn with_counts(mut samples: Samples, cutoff: Option<f64>, c: f32) -> Samples {
-        let signal = samples.filtered(cutoff);
+        let signal = samples.filtered(cutoff).into_owned();
         samples.real_on = samples.quantised_cells(&signal, c, true);
         samples.real_off = samples.quantised_cells(&signal, c, false);
         samples.total_on = samples.real_on.iter().map(|&n| n as u64).sum();
@@ -452,8 +586,18 @@ mod tests {
         let mut samples = square_waves(1, 5, 2);
         samples.log = vec![0.0, 0.25, 0.5, 0.1, -0.3];
         let (mut on, mut off) = (vec![0; 4], vec![0; 4]);
-        samples.quantise(&samples.log, 0.2, true, |k, n| on[k] += n);
-        samples.quantise(&samples.log, 0.2, false, |k, n| off[k] += n);
+        samples.dn = vec![200.0; 5];
+        let pixel = (&samples.log[..], &samples.dn[..]);
+        samples.quantise(pixel, 0.2, true, |k, n| on[k] += n);
+        samples.quantise(pixel, 0.2, false, |k, n| off[k] += n);
+        // a clipped frame leaves its intervals uncompared, the memory still moves
+        let mut clipped = samples.dn.clone();
+        clipped[2] = 255.0;
+        let mut on_clipped = vec![0; 4];
+        samples.quantise((&samples.log, &clipped), 0.2, true, |k, n| {
+            on_clipped[k] += n
+        });
+        assert_eq!(on_clipped, [1, 0, 0, 0]);
         // memory 0 -> 0.2 -> 0.4 -> 0.2 -> -0.2
         assert_eq!(on, [1, 1, 0, 0]);
         assert_eq!(off, [0, 0, 1, 2]);
@@ -476,6 +620,30 @@ mod tests {
         assert!((found.cutoff_at_median_dn_hz - 5.0 * 220.0 / 275.0).abs() < 1e-9);
         // the unfiltered wave asks for thresholds several times higher on these counts
         assert!(found.threshold_ratios.iter().all(|&r| r < 0.7), "{found:?}");
+    }
+
+    #[test]
+    fn a_count_between_the_steps_is_matched_by_the_nearest_scaled() {
+        // a wave of amplitude 1: each rise fires 1 ON for c in (0.5, 1], 2 in (1/3, 0.5]
+        let mut samples = square_waves(8, 40, 8);
+        let rises = samples.quantised_total(&samples.log, 0.9, true);
+        // more events than the lowest threshold tried (1e-3: 1000 a rise) makes
+        samples.total_on = rises * 5000;
+        assert_eq!(samples.matched_threshold(&samples.log, true), None);
+        // between the steps: the nearest count, scaled to the total
+        samples.total_on = rises + rises * 3 / 10;
+        let (c, scale) = samples.matched_threshold(&samples.log, true).expect("near");
+        let n = samples.quantised_total(&samples.log, c, true) as f64;
+        assert!(c > 1.0 / 3.0 && c <= 1.0, "{c}");
+        assert!(
+            (n * scale - samples.total_on as f64).abs() < 1e-6,
+            "{n} {scale}"
+        );
+        samples.total_on = rises;
+        let (c, scale) = samples
+            .matched_threshold(&samples.log, true)
+            .expect("matched");
+        assert!(c > 0.5 && c <= 1.0 && scale == 1.0, "{c} {scale}");
     }
 
     #[test]

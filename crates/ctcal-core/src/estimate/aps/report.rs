@@ -197,12 +197,12 @@ fn slow_assumption(slow: &super::Slow) -> String {
     let f = &slow.found;
     let what = match slow.thresholds {
         Some([on, off]) => format!(
-            "the re-simulation with that cutoff finds ON {on:.4} and OFF {off:.4}, and the intervals reach them on their side"
+            "the re-simulation with that cutoff (started from the estimators' thresholds times those ratios, else from the quantiser's own) finds ON {on:.4} and OFF {off:.4}, and the intervals reach down to them where they are lower"
         ),
         None => "the re-simulation with that cutoff finds no thresholds, so the intervals do not carry them (the fit, which models bandwidth, can)".to_string(),
     };
     format!(
-        "the photoreceptor is slower than the scene: the events follow the frames low-passed at a cutoff of {} Hz at white ({:.2} Hz at the frames' median DN; {} .. {} Hz within 2 standard errors) better than the frames themselves, by {:.1} standard errors of the block-by-block count distance ({:.3} -> {:.3} per block); such a pixel averages the scene and fires less than the frames' change, so the event timing and the ideal re-simulation read its thresholds high (a refractory period, which also thins the events of fast changes, can look alike: `fit` tells them apart); {what}",
+        "the photoreceptor may be slower than the scene: the events follow the frames low-passed at a cutoff of {} Hz at white ({:.2} Hz at the middle frame's median DN; {} .. {} Hz within 2 standard errors) better than the frames themselves, by {:.1} standard errors of the tile-by-tile count distance of an ideal quantiser on the frames' samples ({:.3} -> {:.3} per 16 x 16 px tile{}), and asks for thresholds {:.2} (ON) and {:.2} (OFF) times as high; the check also fires on simulated recordings without a cutoff (refractory periods, leak and noise spread counts over frames too), where the reach is small (`benches/coverage/aps-slow-photoreceptor-2026-12-05`); such a pixel averages the scene and fires less than the frames' change, so the event timing and the ideal re-simulation read its thresholds high (a refractory period, which also thins the events of fast changes, can look alike: `fit` tells them apart); {what}",
         f.cutoff_hz,
         f.cutoff_at_median_dn_hz,
         f.cutoff_range_hz[0],
@@ -210,6 +210,16 @@ fn slow_assumption(slow: &super::Slow) -> String {
         f.significance,
         f.distance_without,
         f.distance_at_cutoff,
+        if f.block_row_step > 1 {
+            format!(
+                "; every {}th row of 4 x 4 px blocks compared",
+                f.block_row_step
+            )
+        } else {
+            String::new()
+        },
+        f.threshold_ratios[0],
+        f.threshold_ratios[1],
     )
 }
 
@@ -272,7 +282,8 @@ pub(super) fn assemble(
         match combine(&refs) {
             Some((value, error)) => Measured::new(value, error, METHOD_SYSTEMATIC * value)
                 .reaching(response)
-                .reaching(slow.map_or(1.0, |c| c / value)),
+                // a slow photoreceptor reads thresholds high only: the reach goes down
+                .reaching(slow.map_or(1.0, |c| (c / value).min(1.0))),
             None => Measured::new(f64::NAN, f64::NAN, 0.0),
         }
     };

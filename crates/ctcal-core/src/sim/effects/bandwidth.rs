@@ -13,6 +13,12 @@ pub fn tau_us(dn: f32, cutoff_hz: f32) -> f32 {
     1.0 / rate_per_us(dn, cutoff_hz)
 }
 
+/// The cutoff (Hz) at intensity `dn` of a photoreceptor whose cutoff at white is
+/// `cutoff_hz`: `cutoff_hz (DN + 20) / 275`.
+pub fn cutoff_at_dn(dn: f64, cutoff_hz: f64) -> f64 {
+    cutoff_hz * (dn.max(0.0) + 20.0) / 275.0
+}
+
 /// `1 / tau` in 1/us: `2 pi cutoff_hz (DN + 20) / 275 * 1e-6` (no division).
 #[inline(always)]
 pub fn rate_per_us(dn: f32, cutoff_hz: f32) -> f32 {
