@@ -40,7 +40,8 @@ def status(iv, t):
 
 before_dir, after_dir = sys.argv[1], sys.argv[2]
 all_dir = sys.argv[3] if len(sys.argv) > 3 else after_dir
-names = sorted(os.path.basename(f)[:-5] for f in glob.glob(f'{after_dir}/*.json'))
+names = sorted(os.path.basename(f)[:-5] for f in glob.glob(f'{after_dir}/*.json')
+               if os.path.exists(f'{before_dir}/' + os.path.basename(f)))
 count = collections.Counter()
 widen = []
 rows = []
