@@ -194,6 +194,14 @@ fn no_usable_interval(intervals: &[IntervalInfo]) -> EstimateError {
     )
 }
 
+/// Whether a pixel's values in an interval's two frames, `dn0` and `dn1`, are both reliable
+/// intensities: neither near black (at most 3 DN) nor clipped (at least 254 DN).
+#[inline]
+pub fn reliable_pair(dn0: f32, dn1: f32) -> bool {
+    let ok = |v: f32| v > 3.0 && v < 254.0;
+    ok(dn0) && ok(dn1)
+}
+
 impl PreparedFrames {
     /// Prepares `frames` (time-sorted, one size); `event_times` (sorted) decide which
     /// intervals hold events; an interval across one of the `unread` spans is not used.
@@ -423,8 +431,7 @@ impl PreparedFrames {
     /// both frames of interval `k`.
     #[inline]
     pub fn reliable(&self, k: usize, index: usize) -> bool {
-        let ok = |v: f32| v > 3.0 && v < 254.0;
-        ok(self.dn[k].data[index]) && ok(self.dn[k + 1].data[index])
+        reliable_pair(self.dn[k].data[index], self.dn[k + 1].data[index])
     }
 
     /// The log response of a frame value (with the offset).

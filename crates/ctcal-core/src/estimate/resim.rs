@@ -408,7 +408,27 @@ pub struct Resimulation<'a> {
     pub evaluations: std::cell::Cell<usize>,
 }
 
-impl Resimulation<'_> {
+impl<'a> Resimulation<'a> {
+    /// The re-simulation of `runs` (frames of `width` x `height` upsampled along the flow)
+    /// against the recording's `real` counts in `cells`, on the timestamp `grid`.
+    pub fn new(
+        runs: &'a [Vec<Sample>],
+        (width, height): (usize, usize),
+        cells: &'a Cells,
+        real: &'a Counts,
+        grid: Option<(TimeUs, TimeUs)>,
+    ) -> Self {
+        Self {
+            runs,
+            width,
+            height,
+            cells,
+            real,
+            grid,
+            evaluations: std::cell::Cell::new(0),
+        }
+    }
+
     /// The cells' counts of the runs simulated with `params` (on the recording's grid).
     pub fn counts(&self, params: &PixelParams) -> Result<Counts, EstimateError> {
         self.evaluations.set(self.evaluations.get() + 1);

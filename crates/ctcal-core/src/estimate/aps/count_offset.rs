@@ -157,15 +157,13 @@ pub fn search(
     let mut at = |b: f32| -> Option<DarkBright> {
         shift_runs(runs, b - own - shifted);
         shifted = b - own;
-        let resim = Resimulation {
+        let resim = Resimulation::new(
             runs,
-            width: setup.width,
-            height: setup.height,
-            cells: setup.cells,
-            real: setup.real,
-            grid: setup.grid,
-            evaluations: std::cell::Cell::new(0),
-        };
+            (setup.width, setup.height),
+            setup.cells,
+            setup.real,
+            setup.grid,
+        );
         let r = fit_with(&resim, thresholds, sigma, None, 1).ok()?;
         thresholds = (r.ct_on, r.ct_off);
         Some(brightness.compare(setup.real, &r.counts))

@@ -174,15 +174,13 @@ fn run_pass(
         input.events,
     );
     let real = cells.count(input.events);
-    let resim = Resimulation {
+    let resim = Resimulation::new(
         runs,
-        width: frames.width,
-        height: frames.height,
-        cells: &cells,
-        real: &real,
-        grid: timestamp_grid(input.events),
-        evaluations: std::cell::Cell::new(0),
-    };
+        (frames.width, frames.height),
+        &cells,
+        &real,
+        timestamp_grid(input.events),
+    );
     let resim = super::resim::fit(&resim, (cp, cn), sigma).ok();
     let used: Vec<f64> = frames
         .intervals
@@ -637,15 +635,13 @@ fn slow_photoreceptor(
         .map_or((full.timing.on.ct, full.timing.off.ct), |r| {
             (r.ct_on, r.ct_off)
         });
-    let resim = Resimulation {
+    let resim = Resimulation::new(
         runs,
-        width: frames.width,
-        height: frames.height,
-        cells: &full.cells,
-        real: &full.real,
+        (frames.width, frames.height),
+        &full.cells,
+        &full.real,
         grid,
-        evaluations: std::cell::Cell::new(0),
-    };
+    );
     let [ron, roff] = found.threshold_ratios;
     let [qon, qoff] = found.quantiser_thresholds;
     // from the estimators' thresholds scaled as the check asks, else from the check's own

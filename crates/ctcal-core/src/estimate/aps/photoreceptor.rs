@@ -29,7 +29,7 @@
 //! which is enough to tell a pixel that averages over several frames from one that follows
 //! them, not to measure a threshold (aps re-simulates with the cutoff found for that).
 
-use super::super::frames::PreparedFrames;
+use super::super::frames::{PreparedFrames, reliable_pair};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::effects::bandwidth;
 use rayon::prelude::*;
@@ -245,12 +245,54 @@ struct Kept {
     dn: Vec<f32>,
 }
 
-/// Whether a frame value is a reliable intensity (neither near black nor clipped), as
-/// [`PreparedFrames::reliable`] takes it.
-#[inline]
-fn reliable(dn0: f32, dn1: f32) -> bool {
-    let ok = |v: f32| v > 3.0 && v < 254.0;
-    ok(dn0) && ok(dn1)
+/// The recording's ON and OFF counts per (block, interval), and their totals.
+struct RealCounts {
+    on: Vec<u32>,
+    off: Vec<u32>,
+    total_on: u64,
+    total_off: u64,
+}
+
+impl Kept {
+    /// The real counts of the `compared` intervals in `cells` (block x interval) cells,
+    /// where the pixel is kept and reliable in both frames.
+    fn count_real(
+        &self,
+        events: &EventChunk,
+        frames: &PreparedFrames,
+        compared: &[bool],
+        cells: usize,
+    ) -> RealCounts {
+        let intervals = compared.len();
+        let (width, height) = (frames.width, frames.height);
+        let mut real = RealCounts {
+            on: vec![0; cells],
+            off: vec![0; cells],
+            total_on: 0,
+            total_off: 0,
+        };
+        for i in 0..events.len() {
+            let (x, y) = (events.x[i] as usize, events.y[i] as usize);
+            let k = frames.times.partition_point(|&ft| ft <= events.t[i]);
+            if x >= width || y >= height || k == 0 || k > intervals || !compared[k - 1] {
+                continue;
+            }
+            let index = y * width + x;
+            let p = self.slot[index];
+            if p == usize::MAX || !frames.reliable(k - 1, index) {
+                continue;
+            }
+            let cell = self.block_of[p] * intervals + (k - 1);
+            if events.on[i] {
+                real.on[cell] += 1;
+                real.total_on += 1;
+            } else {
+                real.off[cell] += 1;
+                real.total_off += 1;
+            }
+        }
+        real
+    }
 }
 
 impl Samples {
@@ -278,32 +320,27 @@ impl Samples {
                 frames.unread.iter().any(|&(s, e)| s < b && e > a)
             })
             .collect();
-        let mut samples = Self {
+        let cells = blocks_x * blocks_y * intervals;
+        let real = kept.count_real(events, frames, &compared, cells);
+        let enough = real.total_on >= MIN_EVENTS
+            && real.total_off >= MIN_EVENTS
+            && kept.block_of.len() >= MIN_PIXELS;
+        enough.then(|| Self {
             times: frames.times.clone(),
             compared,
             restart,
             tile_of,
             tiles,
-            real_on: vec![0; blocks_x * blocks_y * intervals],
-            real_off: vec![0; blocks_x * blocks_y * intervals],
-            total_on: 0,
-            total_off: 0,
+            real_on: real.on,
+            real_off: real.off,
+            total_on: real.total_on,
+            total_off: real.total_off,
             median_dn: median_dn(frames),
             block_row_step: block_row_step.max(1),
-            log: Vec::new(),
-            dn: Vec::new(),
-            block_of: Vec::new(),
-        };
-        samples.count_real(events, frames, &kept.slot, &kept.block_of);
-        (samples.total_on >= MIN_EVENTS
-            && samples.total_off >= MIN_EVENTS
-            && kept.block_of.len() >= MIN_PIXELS)
-            .then(|| {
-                samples.log = kept.log;
-                samples.dn = kept.dn;
-                samples.block_of = kept.block_of;
-                samples
-            })
+            log: kept.log,
+            dn: kept.dn,
+            block_of: kept.block_of,
+        })
     }
 
     /// The pixels compared: not `excluded`, in every `step`-th row of blocks, with finite
@@ -337,39 +374,6 @@ impl Samples {
             }
         }
         kept
-    }
-
-    /// The real ON and OFF counts per (block, interval) of the compared intervals, where
-    /// the pixel is kept and reliable in both frames.
-    fn count_real(
-        &mut self,
-        events: &EventChunk,
-        frames: &PreparedFrames,
-        slot: &[usize],
-        block_of: &[usize],
-    ) {
-        let intervals = self.times.len() - 1;
-        let (width, height) = (frames.width, frames.height);
-        for i in 0..events.len() {
-            let (x, y) = (events.x[i] as usize, events.y[i] as usize);
-            let k = self.times.partition_point(|&ft| ft <= events.t[i]);
-            if x >= width || y >= height || k == 0 || k > intervals || !self.compared[k - 1] {
-                continue;
-            }
-            let index = y * width + x;
-            let p = slot[index];
-            if p == usize::MAX || !frames.reliable(k - 1, index) {
-                continue;
-            }
-            let cell = block_of[p] * intervals + (k - 1);
-            if events.on[i] {
-                self.real_on[cell] += 1;
-                self.total_on += 1;
-            } else {
-                self.real_off[cell] += 1;
-                self.total_off += 1;
-            }
-        }
     }
 
     fn frames(&self) -> usize {
@@ -426,7 +430,7 @@ impl Samples {
             let steps = (change.abs() * inverse) as u32;
             if steps >= 1 {
                 memory += steps as f32 * c * change.signum();
-                if (change > 0.0) == on && self.compared[k] && reliable(dn[k], dn[k + 1]) {
+                if (change > 0.0) == on && self.compared[k] && reliable_pair(dn[k], dn[k + 1]) {
                     fire(k, steps);
                 }
             }
