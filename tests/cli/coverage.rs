@@ -387,7 +387,7 @@ fn fit_without_frames_holds_a_leak_the_scene_s_balance_may_explain() {
 /// every 80 ms. The pixels average the scene and fire a tenth of what the frames' change
 /// asks for, and the events come frames late: aps read ON 1.95 [0.57, 3.33] for the true
 /// 0.315, its interval missing. The events now show the low-pass
-/// (`estimate::aps::photoreceptor`), the re-simulation with it finds the lower thresholds,
+/// (`estimate::photoreceptor`), the re-simulation with it finds the lower thresholds,
 /// and the intervals reach them.
 #[test]
 fn aps_reaches_the_thresholds_of_a_photoreceptor_slower_than_the_scene() {
@@ -406,4 +406,24 @@ fn aps_reaches_the_thresholds_of_a_photoreceptor_slower_than_the_scene() {
     );
     let on = slow["resimulated_thresholds"][0].as_f64().unwrap();
     assert!(on < 0.6, "{slow}");
+}
+
+/// The same draw through `estimate eppps`: its ideal scans along the frames read ON = OFF
+/// 1.53 for the true 0.315 / 0.220 (the pixels fire a tenth of the frames' change), and
+/// both intervals, [0.738, 3.18], missed. The scans through the low-pass the events show
+/// (7 Hz at white) read 0.386 [0.186, 0.798] and 0.186 [0.090, 0.386], and the intervals
+/// now reach down to those lower ends: [0.186, 3.18] and [0.090, 3.18].
+#[test]
+fn eppps_reaches_the_thresholds_of_a_photoreceptor_slower_than_the_scene() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_peer_draw(Method::Eppps, 11005, work.path());
+    let (value, truth) = covered_value(&record, "ct_on");
+    assert!(value > 3.0 * truth, "the ideal scans' value stays: {value}");
+    covered_value(&record, "ct_off");
+    let slow = &json_output(&record)["photoreceptor_slow"];
+    let cutoff = slow["check"]["cutoff_hz"].as_f64().unwrap();
+    assert!((3.0..=10.0).contains(&cutoff), "{slow}");
+    let scanned = |side: &str| slow["scanned"][side]["value"].as_f64().unwrap();
+    assert!((0.2..0.6).contains(&scanned("on")), "{slow}");
+    assert!((0.1..0.4).contains(&scanned("off")), "{slow}");
 }

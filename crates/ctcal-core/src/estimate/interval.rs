@@ -71,6 +71,25 @@ impl Measured {
     }
 }
 
+impl Measured {
+    /// The interval extended down to `lo` where that is lower: the lower end of another
+    /// reading of the same quantity under a model the data cannot rule out, so that the
+    /// interval holds both readings' intervals. The systematic grows, in quadrature in the
+    /// logarithm, by what the extension adds to the lower side.
+    pub fn extended_down_to(mut self, lo: f64) -> Self {
+        let [below, _] = self.ci95;
+        if !(self.value > 0.0 && lo > 0.0 && below > 0.0 && lo < below) {
+            return self;
+        }
+        let z = z95();
+        let (wide, narrow) = ((self.value / lo).ln() / z, (self.value / below).ln() / z);
+        let added = (wide * wide - narrow * narrow).max(0.0).sqrt();
+        self.systematic = self.systematic.hypot(self.value * added);
+        self.ci95[0] = lo;
+        self
+    }
+}
+
 /// A 95 % interval `[lo, hi]` about a positive `value` widened by `add` in the logarithm, in
 /// quadrature on each side: `value exp(-+ sqrt(ln(value / lo)^2 + add^2))`. A lower end at
 /// or below 0 becomes 0, and an open side (`None`) stays open.

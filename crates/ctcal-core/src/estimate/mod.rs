@@ -18,6 +18,7 @@ pub mod frames;
 pub mod image;
 pub mod interval;
 pub mod lsq;
+pub mod photoreceptor;
 pub mod resim;
 pub mod root;
 pub mod screen;

@@ -39,10 +39,10 @@ use report::{Findings, assemble, blocks_assumption, resimulation_report, timing_
 use serde_json::json;
 
 mod count_offset;
-mod photoreceptor;
 mod report;
 
-pub use photoreceptor::SlowPhotoreceptor;
+use super::photoreceptor;
+pub use super::photoreceptor::SlowPhotoreceptor;
 
 /// Settings of `estimate aps`.
 #[derive(Clone, Debug)]

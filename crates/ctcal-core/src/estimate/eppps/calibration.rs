@@ -8,6 +8,7 @@
 use super::recording::RecordingRates;
 use super::scans::{BURN_IN_PX, Block, LogImage, Profile, STEP_PX, Scan, TILE_PX};
 use crate::estimate::frames::PreparedFrames;
+use crate::sim::effects::bandwidth;
 use crate::sim::log_response::LogMap;
 use crate::sim::params::LogResponse;
 use rand::{RngExt, SeedableRng};
@@ -107,11 +108,13 @@ impl Response {
 /// Every second pixel (in x and y) of the frames, each along its path through every run of
 /// consecutive used intervals where it is reliable: log intensity interpolated along the
 /// flow, sampled every quarter pixel of travel; burn-in along the first interval's flow
-/// backwards from the run's first frame.
+/// backwards from the run's first frame. With `photoreceptor_hz` (a cutoff at white), each
+/// profile is what a photoreceptor that slow passes of it ([`low_pass`]).
 pub fn frame_profiles(
     frames: &PreparedFrames,
     excluded: &[bool],
     response: &Response,
+    photoreceptor_hz: Option<f64>,
 ) -> Vec<Profile> {
     let (w, h) = (frames.width, frames.height);
     let mut out = Vec::new();
@@ -121,25 +124,89 @@ pub fn frame_profiles(
             if excluded[pixel] {
                 continue;
             }
-            let mut run: Option<Profile> = None;
+            let mut run: Option<Building> = None;
             for k in 0..frames.flows.len() {
                 let usable = frames.flows[k].is_some() && frames.reliable(k, pixel);
                 if !usable {
-                    out.extend(run.take());
+                    out.extend(run.take().map(|b| b.finish(photoreceptor_hz)));
                     continue;
                 }
-                let profile = run.get_or_insert_with(|| burn_in(frames, response, k, x, y));
-                extend(profile, frames, response, k, x, y);
+                let building = run.get_or_insert_with(|| burn_in(frames, response, k, x, y));
+                building.extend(frames, response, k, x, y);
             }
-            out.extend(run);
+            out.extend(run.map(|b| b.finish(photoreceptor_hz)));
         }
     }
     out.retain(|p| p.length > 0.0);
     out
 }
 
+/// A pixel's profile while it is built, with each sample's frame DN (the intensity that
+/// sets a photoreceptor's cutoff).
+struct Building {
+    profile: Profile,
+    dn: Vec<f32>,
+}
+
+impl Building {
+    /// Appends the pixel's samples over interval `k` (at most a quarter pixel apart).
+    fn extend(
+        &mut self,
+        frames: &PreparedFrames,
+        response: &Response,
+        k: usize,
+        x: usize,
+        y: usize,
+    ) {
+        let (profile, dn) = (&mut self.profile, &mut self.dn);
+        let travel = path_samples(frames, k, x, y, |t, v| {
+            profile.values.push(response.log(v));
+            profile.times_s.push(t as f64 * 1e-6);
+            dn.push(v);
+            true
+        });
+        profile.length += travel;
+    }
+
+    /// The profile, low-passed where a photoreceptor cutoff is given.
+    fn finish(mut self, photoreceptor_hz: Option<f64>) -> Profile {
+        if let Some(cutoff_hz) = photoreceptor_hz {
+            low_pass(&mut self.profile, &self.dn, cutoff_hz);
+        }
+        self.profile
+    }
+}
+
+/// `profile`'s log intensity as a photoreceptor whose cutoff at white is `cutoff_hz`
+/// passes it: the simulator's first-order low-pass ([`bandwidth`], v2e's law), its cutoff
+/// at each step's mean frame DN (`dn`), exact for an input linear between samples. It
+/// starts settled at the mean of the burn-in (a slow pixel holds an average of what passed
+/// it, and the burn-in is all the scan knows of that); at the first sample without one.
+pub fn low_pass(profile: &mut Profile, dn: &[f32], cutoff_hz: f64) {
+    let (values, times_s) = (&mut profile.values, &profile.times_s);
+    let Some(&first) = values.first() else {
+        return;
+    };
+    let burn = profile.burn.min(values.len());
+    let settled = if burn > 0 {
+        values[..burn].iter().sum::<f32>() / burn as f32
+    } else {
+        first
+    };
+    values[0] = settled;
+    let (mut filtered, mut input_before) = (settled, first);
+    for i in 1..values.len() {
+        let input = values[i];
+        let h_us = ((times_s[i] - times_s[i - 1]) * 1e6) as f32;
+        let tau_us = bandwidth::tau_us(0.5 * (dn[i - 1] + dn[i]), cutoff_hz as f32);
+        filtered = bandwidth::advance(filtered, input_before, input, h_us, tau_us);
+        input_before = input;
+        values[i] = filtered;
+    }
+}
+
 /// A profile holding only the burn-in before frame `k` at (x, y).
-fn burn_in(frames: &PreparedFrames, response: &Response, k: usize, x: usize, y: usize) -> Profile {
+fn burn_in(frames: &PreparedFrames, response: &Response, k: usize, x: usize, y: usize) -> Building {
     let (u, v) = frames.flows[k].as_ref().map_or((0.0, 0.0), |f| f.at(x, y));
     let norm = u.hypot(v).max(1e-6) as f64;
     let (dx, dy) = (u as f64 / norm, v as f64 / norm);
@@ -155,36 +222,23 @@ fn burn_in(frames: &PreparedFrames, response: &Response, k: usize, x: usize, y: 
     let times_s = (0..burn).map(|i| t0 - (burn - i) as f64 * dt).collect();
     // the content that passed the pixel before the frame: at fraction a < 0 of the
     // interval it saw the frame at (x, y) - a (u, v), downstream along the flow
-    let values = (0..burn)
+    let dn: Vec<f32> = (0..burn)
         .map(|i| {
             let s = (burn - i) as f64 * STEP_PX;
             let dn = frame.sample_cubic((x as f64 + s * dx) as f32, (y as f64 + s * dy) as f32);
-            response.log(dn.max(0.0))
+            dn.max(0.0)
         })
         .collect();
-    Profile {
-        values,
-        times_s,
-        burn,
-        length: 0.0,
+    let values = dn.iter().map(|&v| response.log(v)).collect();
+    Building {
+        profile: Profile {
+            values,
+            times_s,
+            burn,
+            length: 0.0,
+        },
+        dn,
     }
-}
-
-/// Appends the pixel's samples over interval `k` (at most a quarter pixel apart).
-fn extend(
-    profile: &mut Profile,
-    frames: &PreparedFrames,
-    response: &Response,
-    k: usize,
-    x: usize,
-    y: usize,
-) {
-    let travel = path_samples(frames, k, x, y, |t, dn| {
-        profile.values.push(response.log(dn));
-        profile.times_s.push(t as f64 * 1e-6);
-        true
-    });
-    profile.length += travel;
 }
 
 /// Visits pixel (x, y)'s frame values (DN, without the offset) along its path over
@@ -216,6 +270,35 @@ pub(super) fn path_samples(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A step of 1 in log intensity through a photoreceptor of 10 Hz at white: at 255 DN
+    /// its time constant is 1 / (2 pi 10 Hz) = 15.915 ms, so 16 ms after the step it has
+    /// risen 1 - exp(-16 / 15.915) = 0.6340; at 35 DN the cutoff is 10 (35 + 20) / 275 =
+    /// 2 Hz, 79.58 ms, and it has risen 1 - exp(-16 / 79.58) = 0.1822. Before the step it
+    /// holds the first sample.
+    #[test]
+    fn a_slow_photoreceptor_lags_a_step_by_its_time_constant_at_the_pixel_s_brightness() {
+        let risen = |dn: f32| {
+            let mut times_s = vec![0.0, 0.001];
+            times_s.extend((0..=16).map(|k| 0.001 + 1e-6 + k as f64 * 1e-3));
+            let mut values = vec![0.0f32; 2];
+            values.extend(std::iter::repeat_n(1.0f32, 17));
+            let dn = vec![dn; values.len()];
+            let mut profile = Profile {
+                values,
+                times_s,
+                burn: 0,
+                length: 1.0,
+            };
+            low_pass(&mut profile, &dn, 10.0);
+            (profile.values[1], profile.values[18] as f64)
+        };
+        let (before, bright) = risen(255.0);
+        assert_eq!(before, 0.0);
+        assert!((bright - 0.6340).abs() < 1e-3, "{bright}");
+        let (_, dim) = risen(35.0);
+        assert!((dim - 0.1822).abs() < 1e-3, "{dim}");
+    }
 
     /// The two ends of the response prior agree on a bright scene and part in a dim one: a
     /// factor 2 in light is ln 2 = 0.693 through both at 100 -> 200 DN, but 15 -> 30 DN

@@ -32,6 +32,7 @@ pub mod still;
 use super::interval::{Measured, z95};
 use super::{CtEstimate, Determinable, EstimateError, EstimatorReport, Progress};
 use crate::estimate::frames::PreparedFrames;
+use crate::estimate::photoreceptor::{self, SlowPhotoreceptor};
 use crate::events::{EventChunk, Sensor};
 use rayon::prelude::*;
 use recording::RecordingRates;
@@ -176,23 +177,84 @@ pub fn estimate(
     let frames = input
         .frames
         .filter(|_| options.use_frames && outrun.is_none());
-    let rates = match frames {
-        Some(f) => recording::from_frames(input.events, f, input.sensor, &excluded),
-        None => recording::from_events(input.events, input.sensor, &excluded),
+    let rates = recording_rates(input, frames, &excluded)?;
+    let refractory = refractory_edge(input.events, input.sensor);
+    let pixel = ScanPixel {
+        ratio: 1.0,
+        refractory_s: refractory.as_ref().map_or(0.0, |e| e.edge_us * 1e-6),
+    };
+    let basis = Basis::new(frames, input.response_known, &excluded, options);
+    let mut scanned = scan_thresholds(&basis, rates, pixel, progress);
+    let slow = frames.and_then(|f| {
+        progress("photoreceptor bandwidth", 0.8);
+        slow_photoreceptor(input.events, f, &basis, &scanned)
+    });
+    if let Some(slow) = &slow {
+        slow.reach(&mut scanned.on, &mut scanned.off);
+    }
+    progress("inverting the calibration curves", 0.9);
+    let mut result = assemble(&scanned, &basis, refractory.as_ref(), hot);
+    if let Some((followed, too_fast)) = outrun.filter(|_| options.use_frames) {
+        result.assumptions.push(format!(
+            "the frames are not used: the motion between them is too large for the optical flow on {too_fast} intervals and it follows {followed}, so travel and contrast are read from the events, as without frames"
+        ));
+    }
+    if let Some(slow) = &slow {
+        result.assumptions.push(slow.assumption());
+    }
+    result.extra.insert(
+        "photoreceptor_slow".into(),
+        json!(slow.as_ref().map(SlowReach::report)),
+    );
+    progress("done", 1.0);
+    Ok(result)
+}
+
+/// The recording's events per pixel of travel, through its frames where they are used.
+fn recording_rates(
+    input: &EpppsInput,
+    frames: Option<&PreparedFrames>,
+    excluded: &[bool],
+) -> Result<RecordingRates, EstimateError> {
+    match frames {
+        Some(f) => recording::from_frames(input.events, f, input.sensor, excluded),
+        None => recording::from_events(input.events, input.sensor, excluded),
     }
     .ok_or_else(|| {
         EstimateError::new(
             "no motion to measure: no part of the view has a flow that sharpens its events (a static scene, flicker or noise)",
             "use a part of the recording where the scene or the camera moves",
         )
-    })?;
-    let refractory = refractory_edge(input.events, input.sensor);
-    let mut pixel = ScanPixel {
-        ratio: 1.0,
-        refractory_s: refractory.as_ref().map_or(0.0, |e| e.edge_us * 1e-6),
-    };
+    })
+}
+
+/// What the scans read: the calibrations (ON = OFF, the ones shown), the recording's rates
+/// (with the still pixels' background where the frames show them), both polarities'
+/// thresholds, the OFF/ON ratio they gave (measured, held) and the pixel scanned last.
+struct Scanned {
+    calibrations: Vec<Calibration>,
+    reading: Option<Reading>,
+    rates: RecordingRates,
+    on: Polarity,
+    off: Polarity,
+    measured_ratio: f64,
+    ratio: f64,
+    pixel: ScanPixel,
+    /// An ON/OFF imbalance the events cannot attribute (without frames), in words.
+    balance: Option<String>,
+}
+
+/// The thresholds at which the calibration scans make the recording's rates: ON = OFF
+/// first (read at the recording's sharpness without frames), then again at the OFF/ON
+/// ratio that gave, since the two thresholds interact in every pixel (see
+/// [`scans::count`]).
+fn scan_thresholds(
+    basis: &Basis,
+    rates: RecordingRates,
+    pixel: ScanPixel,
+    progress: Progress,
+) -> Scanned {
     progress("calibration scans (ON = OFF)", 0.3);
-    let basis = Basis::new(frames, input.response_known, &excluded, options);
     let raw = basis.calibrate(&rates, pixel, None);
     let reading = basis.select(&raw, &rates);
     let selections = reading.as_ref().map(|r| &r.kept[..]);
@@ -211,25 +273,68 @@ pub fn estimate(
         }
         None => (rates, (on, off)),
     };
-    // the two thresholds interact in every pixel (see `scans::count`): scan again at the
-    // OFF/ON ratio the symmetric scans found, and read both polarities there
-    let measured_ratio = off.measured.value / on.measured.value;
-    let ratio = measured_ratio.clamp(0.2, 5.0);
-    let (mut on, mut off) = if ratio.is_finite() && (ratio.ln()).abs() > 0.02 {
-        progress("calibration scans (OFF/ON ratio measured)", 0.6);
-        pixel.ratio = ratio;
+    progress("calibration scans (OFF/ON ratio measured)", 0.6);
+    let (measured_ratio, ratio) = ratio_of(&on, &off);
+    let ((mut on, mut off), pixel) = at_ratio((on, off), ratio, pixel, |pixel| {
         measure_both(&basis.calibrate(&rates, pixel, selections), &rates)
-    } else {
-        (on, off)
-    };
-    let calibrations = symmetric;
+    });
     // without frames an imbalance may be the scene's or a leak's, not the thresholds'
-    let balance = frames
+    let balance = basis
+        .frames
         .is_none()
-        .then(|| balance::symmetric(&calibrations, &rates))
+        .then(|| balance::symmetric(&symmetric, &rates))
         .flatten()
         .and_then(|shared| balance::widen(&mut on, &mut off, &shared));
-    progress("inverting the calibration curves", 0.9);
+    Scanned {
+        calibrations: symmetric,
+        reading,
+        rates,
+        on,
+        off,
+        measured_ratio,
+        ratio,
+        pixel,
+        balance,
+    }
+}
+
+/// The OFF/ON ratio of two thresholds, and as it is scanned (held to 0.2-5).
+fn ratio_of(on: &Polarity, off: &Polarity) -> (f64, f64) {
+    let measured = off.measured.value / on.measured.value;
+    (measured, measured.clamp(0.2, 5.0))
+}
+
+/// Both thresholds read again by `measure` with `pixel`'s OFF threshold `ratio` times its
+/// ON one, where that ratio is known and not 1 (`read`, the ON = OFF reading, otherwise):
+/// the two thresholds interact in every pixel ([`scans::count`]).
+fn at_ratio(
+    read: (Polarity, Polarity),
+    ratio: f64,
+    mut pixel: ScanPixel,
+    measure: impl FnOnce(ScanPixel) -> (Polarity, Polarity),
+) -> ((Polarity, Polarity), ScanPixel) {
+    if !(ratio.is_finite() && ratio.ln().abs() > 0.02) {
+        return (read, pixel);
+    }
+    pixel.ratio = ratio;
+    (measure(pixel), pixel)
+}
+
+/// The estimate from what the scans read, with its notes and assumptions.
+fn assemble(
+    scanned: &Scanned,
+    basis: &Basis,
+    refractory: Option<&crate::fit::events_only::refractory::Edge>,
+    hot: usize,
+) -> CtEstimate {
+    let Scanned {
+        calibrations,
+        rates,
+        on,
+        off,
+        pixel,
+        ..
+    } = scanned;
     let grid = threshold_grid();
     let mut result = CtEstimate::from_parts(
         "eppps",
@@ -241,31 +346,106 @@ pub fn estimate(
             what: "the calibration curve",
         },
     );
-    polarity_notes(&mut result, (&on, &off), calibrations.len());
-    result.assumptions.extend(balance);
-    if let Some((followed, too_fast)) = outrun.filter(|_| options.use_frames) {
-        result.assumptions.push(format!(
-            "the frames are not used: the motion between them is too large for the optical flow on {too_fast} intervals and it follows {followed}, so travel and contrast are read from the events, as without frames"
-        ));
-    }
+    polarity_notes(&mut result, (on, off), calibrations.len());
+    result.assumptions.extend(scanned.balance.clone());
     result
         .assumptions
-        .extend(assumptions(&rates, &calibrations, basis.images(), hot));
+        .extend(assumptions(rates, calibrations, basis.images(), hot));
     result.assumptions.extend(scan_assumptions(
-        frames.is_none().then_some(&reading),
-        &rates,
-        (measured_ratio, ratio, pixel.ratio),
-        refractory.as_ref(),
+        basis.frames.is_none().then_some(&scanned.reading),
+        rates,
+        (scanned.measured_ratio, scanned.ratio, pixel.ratio),
+        refractory,
     ));
     report(
         &mut result,
-        &rates,
-        &calibrations,
-        (&on, &off),
-        frames.is_some(),
+        rates,
+        calibrations,
+        (on, off),
+        basis.frames.is_some(),
     );
-    progress("done", 1.0);
-    Ok(result)
+    result
+}
+
+/// A photoreceptor much slower than the scene ([`photoreceptor::check`] on the frames),
+/// and what the frames' scans, passed through that low-pass, read at the recording's rates
+/// (a polarity's `why` says where they read nothing).
+struct SlowReach {
+    found: SlowPhotoreceptor,
+    on: Polarity,
+    off: Polarity,
+}
+
+/// The check on `frames`, and where it finds a cutoff, the scans again through it, at the
+/// rates and refractory period `scanned` read the thresholds with: ON = OFF, then at the
+/// OFF/ON ratio that gives.
+fn slow_photoreceptor(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    basis: &Basis,
+    scanned: &Scanned,
+) -> Option<SlowReach> {
+    let found = photoreceptor::check(events, frames, basis.excluded)?;
+    let rates = &scanned.rates;
+    let read = |pixel| {
+        let calibrations = basis.calibrate_frames(pixel, Some(found.cutoff_hz));
+        measure_both(&calibrations, rates)
+    };
+    let symmetric = read(ScanPixel {
+        ratio: 1.0,
+        ..scanned.pixel
+    });
+    let (_, ratio) = ratio_of(&symmetric.0, &symmetric.1);
+    let ((on, off), _) = at_ratio(symmetric, ratio, scanned.pixel, read);
+    Some(SlowReach { found, on, off })
+}
+
+impl SlowReach {
+    /// Each polarity's interval extended down to the lower end of the low-passed scans'
+    /// interval, where that is lower ([`Measured::extended_down_to`]): the data cannot
+    /// tell a slow photoreceptor from spread counts (refractory periods, leak and noise
+    /// fire the check too), so the interval holds both readings; a slow photoreceptor
+    /// thins the events, so ideal scans can only read high, and the upper end stays, as do
+    /// the values.
+    fn reach(&self, on: &mut Polarity, off: &mut Polarity) {
+        for (polarity, slow) in [(on, &self.on), (off, &self.off)] {
+            if polarity.why.is_none() && slow.why.is_none() {
+                let lower = slow.measured.ci95[0];
+                polarity.measured = polarity.measured.clone().extended_down_to(lower);
+            }
+        }
+    }
+
+    /// The low-passed scans' threshold of each polarity (`None` where they read none).
+    fn thresholds(&self) -> [Option<f64>; 2] {
+        [&self.on, &self.off].map(|p| p.why.is_none().then_some(p.measured.value))
+    }
+
+    fn assumption(&self) -> String {
+        let f = &self.found;
+        let side = |v: Option<f64>| v.map_or("none".to_string(), |v| format!("{v:.4}"));
+        format!(
+            "the photoreceptor may be slower than the scene: the events follow the frames low-passed at a cutoff of {} Hz at white ({:.2} Hz at the middle frame's median DN; {} .. {} Hz within 2 standard errors) better than the frames themselves, by {:.1} standard errors of the tile-by-tile count distance of an ideal quantiser on the frames' samples; such a pixel averages the scene and fires less than the frames' change, so ideal scans read its thresholds high; the scans through that low-pass give ON {} and OFF {}, and each interval reaches down to the lower end of theirs where that is lower (the upper ends and the values stay: the check also fires on simulated recordings without a cutoff, where refractory periods, leak and noise spread counts over frames: `benches/coverage/aps-slow-photoreceptor-2026-12-05`)",
+            f.cutoff_hz,
+            f.cutoff_at_median_dn_hz,
+            f.cutoff_range_hz[0],
+            f.cutoff_range_hz[1],
+            f.significance,
+            side(self.thresholds()[0]),
+            side(self.thresholds()[1]),
+        )
+    }
+
+    fn report(&self) -> serde_json::Value {
+        let polarity = |p: &Polarity| match &p.why {
+            None => json!({"value": p.measured.value, "ci95": p.measured.ci95}),
+            Some(why) => json!({"value": null, "why": why}),
+        };
+        json!({
+            "check": self.found,
+            "scanned": {"on": polarity(&self.on), "off": polarity(&self.off)},
+        })
+    }
 }
 
 /// A polarity without a value gets its reason under `why`; one whose recording makes more
@@ -424,23 +604,10 @@ impl<'a> Basis<'a> {
         pixel: ScanPixel,
         selections: Option<&[Selection]>,
     ) -> Vec<Calibration> {
-        let grid = threshold_grid();
-        if let Some(f) = self.frames {
-            return self
-                .responses
-                .iter()
-                .map(|(response, name)| Calibration {
-                    name: name.clone(),
-                    image: None,
-                    curve: curve(
-                        &calibration::frame_profiles(f, self.excluded, response),
-                        &grid,
-                        false,
-                        pixel,
-                    ),
-                })
-                .collect();
+        if self.frames.is_some() {
+            return self.calibrate_frames(pixel, None);
         }
+        let grid = threshold_grid();
         let scan = |images: &[&prior::PriorImage]| -> Vec<Calibration> {
             images
                 .par_iter()
@@ -472,6 +639,33 @@ impl<'a> Basis<'a> {
                 sharpness::mix(&scan(&images), &tags, &renumbered)
             }
         }
+    }
+
+    /// The calibration curves through the frames (one per log response; none without
+    /// frames), for a photoreceptor whose cutoff at white is `photoreceptor_hz` where one
+    /// is given ([`calibration::low_pass`]).
+    fn calibrate_frames(
+        &self,
+        pixel: ScanPixel,
+        photoreceptor_hz: Option<f64>,
+    ) -> Vec<Calibration> {
+        let Some(f) = self.frames else {
+            return Vec::new();
+        };
+        let grid = threshold_grid();
+        self.responses
+            .iter()
+            .map(|(response, name)| Calibration {
+                name: name.clone(),
+                image: None,
+                curve: curve(
+                    &calibration::frame_profiles(f, self.excluded, response, photoreceptor_hz),
+                    &grid,
+                    false,
+                    pixel,
+                ),
+            })
+            .collect()
     }
 
     /// How many prior images the calibrations scan (0 with frames).
@@ -960,6 +1154,63 @@ mod tests {
             top: 9.49,
             bottom: 0.03,
         }
+    }
+
+    /// A slow photoreceptor's scans extend an interval down, never up: 1.0 [0.7, 1.4]
+    /// beside scans through the low-pass reading 0.5 [0.35, 0.7] becomes [0.35, 1.4], its
+    /// systematic grown by sqrt(ln(1 / 0.35)^2 - ln(1 / 0.7)^2) / 1.96 = 0.5038; beside
+    /// scans reading [0.8, 1.6] (higher) it stays, and a polarity they read nothing for
+    /// keeps its interval.
+    #[test]
+    fn a_slow_photoreceptor_extends_the_interval_down_to_its_scans_only() {
+        let polarity = |value: f64, ci95: [f64; 2], why: Option<&str>| {
+            let mut measured = Measured::log_normal(value, 0.1, 0.0);
+            measured.ci95 = ci95;
+            measured.systematic = 0.0;
+            Polarity {
+                per_calibration: vec![Some(value)],
+                measured,
+                prior_ln_sd: 0.0,
+                beyond_grid: Beyond::default(),
+                why: why.map(String::from),
+            }
+        };
+        let found = SlowPhotoreceptor {
+            cutoff_hz: 5.0,
+            cutoff_range_hz: [3.0, 7.0],
+            cutoff_at_median_dn_hz: 1.0,
+            distance_without: 2.0,
+            distance_at_cutoff: 1.0,
+            significance: 5.0,
+            threshold_ratios: [0.5, 0.5],
+            quantiser_thresholds: [0.1, 0.1],
+            block_row_step: 1,
+        };
+        let slow = SlowReach {
+            found,
+            on: polarity(0.5, [0.35, 0.7], None),
+            off: polarity(1.2, [0.8, 1.6], None),
+        };
+        let (mut on, mut off) = (
+            polarity(1.0, [0.7, 1.4], None),
+            polarity(1.0, [0.7, 1.4], None),
+        );
+        slow.reach(&mut on, &mut off);
+        assert_eq!(on.measured.ci95, [0.35, 1.4]);
+        assert!(
+            (on.measured.systematic - 0.5038).abs() < 1e-3,
+            "{:?}",
+            on.measured
+        );
+        assert_eq!(off.measured.ci95, [0.7, 1.4]);
+        let slow = SlowReach {
+            off: polarity(f64::NAN, [f64::NAN; 2], Some("no events")),
+            ..slow
+        };
+        let mut off = polarity(1.0, [0.7, 1.4], None);
+        slow.reach(&mut polarity(1.0, [0.7, 1.4], None), &mut off);
+        assert_eq!(off.measured.ci95, [0.7, 1.4]);
+        assert_eq!(slow.thresholds(), [Some(0.5), None]);
     }
 
     #[test]

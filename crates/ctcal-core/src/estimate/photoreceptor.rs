@@ -27,9 +27,10 @@
 //! compared in an interval (as the rest of aps leaves them out), the filter starts settled
 //! at the first frame and after a span not read. No flow and no simulator: the frames' samples only,
 //! which is enough to tell a pixel that averages over several frames from one that follows
-//! them, not to measure a threshold (aps re-simulates with the cutoff found for that).
+//! them, not to measure a threshold: aps re-simulates the frames with the cutoff found,
+//! and eppps scans them through it ([`super::eppps::calibration::low_pass`]).
 
-use super::super::frames::{PreparedFrames, reliable_pair};
+use super::frames::{PreparedFrames, reliable_pair};
 use crate::events::{EventChunk, TimeUs};
 use crate::sim::effects::bandwidth;
 use rayon::prelude::*;
