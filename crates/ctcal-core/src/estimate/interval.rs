@@ -69,23 +69,37 @@ impl Measured {
         self.systematic = self.systematic.hypot(self.value * ratio.ln().abs() / z95());
         self
     }
-}
 
-impl Measured {
-    /// The interval extended down to `lo` where that is lower: the lower end of another
-    /// reading of the same quantity under a model the data cannot rule out, so that the
-    /// interval holds both readings' intervals. The systematic grows, in quadrature in the
-    /// logarithm, by what the extension adds to the lower side.
-    pub fn extended_down_to(mut self, lo: f64) -> Self {
-        let [below, _] = self.ci95;
-        if !(self.value > 0.0 && lo > 0.0 && below > 0.0 && lo < below) {
+    /// The interval extended to hold `[lo, hi]` (another reading's interval, under a model
+    /// the data cannot rule out), on each side where that is wider. The systematic grows,
+    /// in quadrature in the logarithm, by the larger of what the extension adds to either
+    /// side (a side that becomes open adds nothing it can size).
+    pub fn spanning(mut self, [lo, hi]: [f64; 2]) -> Self {
+        let value = self.value;
+        if value.is_nan() || value <= 0.0 {
             return self;
         }
         let z = z95();
-        let (wide, narrow) = ((self.value / lo).ln() / z, (self.value / below).ln() / z);
-        let added = (wide * wide - narrow * narrow).max(0.0).sqrt();
-        self.systematic = self.systematic.hypot(self.value * added);
-        self.ci95[0] = lo;
+        // what reaching `to` from `end` adds, in ln units of one standard deviation
+        let added = |end: f64, to: f64| {
+            let (wide, narrow) = ((to / value).ln().abs() / z, (end / value).ln().abs() / z);
+            if wide.is_finite() && narrow.is_finite() {
+                (wide * wide - narrow * narrow).max(0.0).sqrt()
+            } else {
+                0.0
+            }
+        };
+        let [below, above] = self.ci95;
+        let mut grown = 0f64;
+        if lo < below {
+            grown = grown.max(added(below, lo));
+            self.ci95[0] = lo.max(0.0);
+        }
+        if hi > above {
+            grown = grown.max(added(above, hi));
+            self.ci95[1] = hi;
+        }
+        self.systematic = self.systematic.hypot(value * grown);
         self
     }
 }
