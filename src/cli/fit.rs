@@ -246,13 +246,37 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
 /// What a fit of an on-screen recording without the screen method's thresholds says.
 const ON_SCREEN: &str = "an on-screen recording (its stimulus.txt is given): the thresholds are fitted to the camera's own frames of the display, whose refresh, response and gamma that re-simulation does not model, so they and their intervals may be off; measure them through the stimulus with `ctcal estimate screen --json SCREEN.json` and fit with --thresholds-from SCREEN.json (as `ctcal report` does)";
 
+/// Prints a fit as a table: its thresholds, the events-only fit's numbers, the other
+/// parameters, the effects chosen and the held-out error.
 fn print_human(r: &FitResult) -> std::io::Result<()> {
+    let mut rows = threshold_rows(r);
+    if let Some(e) = &r.events_only {
+        push_events_only_rows(e, &mut rows);
+    }
+    push_parameter_rows(r, &mut rows);
+    push_selection_rows(r, &mut rows);
+    if !r.hot_pixels_masked.is_empty() {
+        rows.push((
+            "hot pixels masked".into(),
+            r.hot_pixels_masked
+                .iter()
+                .map(|h| format!("({}, {})", h.x, h.y))
+                .collect::<Vec<_>>()
+                .join(" "),
+        ));
+    }
+    rows.push(("simulations".into(), r.simulations.to_string()));
+    output::print_table(&rows)
+}
+
+/// The table's first rows: the ON and OFF thresholds (or why not) and the biases.
+fn threshold_rows(r: &FitResult) -> Vec<(String, String)> {
     let threshold = |key: &str, v: f64| {
         r.why
             .get(key)
             .map_or(format!("{v:.4}"), |why| format!("not determinable ({why})"))
     };
-    let mut rows = vec![
+    vec![
         (
             "thresholds".to_string(),
             format!(
@@ -262,45 +286,56 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
             ),
         ),
         output::biases_row(r.biases.as_ref()),
-    ];
-    if let Some(e) = &r.events_only {
-        rows.push(("thresholds from".into(), e.thresholds_source.clone()));
-        if let Some(ratio) = &e.ct_ratio {
-            rows.push((
-                "Cp/Cn (ON/OFF balance)".into(),
-                format!(
-                    "{:.3} (+- {:.3})",
-                    ratio.value,
-                    ratio.standard_error.unwrap_or(f64::NAN)
-                ),
-            ));
-        }
-        let rate = |u: &Option<ctcal::fit::Uncertain>| {
-            u.as_ref()
-                .map_or("-".to_string(), |u| format!("{:.4}", u.value))
-        };
+    ]
+}
+
+/// The rows of a fit from the events alone: where its thresholds came from, their balance,
+/// the isolated-event rates and how the test blocks were judged.
+fn push_events_only_rows(
+    e: &ctcal::fit::events_only::EventsOnly,
+    rows: &mut Vec<(String, String)>,
+) {
+    rows.push(("thresholds from".into(), e.thresholds_source.clone()));
+    if let Some(ratio) = &e.ct_ratio {
         rows.push((
-            "isolated events (Hz/px)".into(),
+            "Cp/Cn (ON/OFF balance)".into(),
             format!(
-                "ON {}, OFF {} (fit blocks); test blocks ON {}, OFF {}",
-                rate(&e.noise_on_hz),
-                rate(&e.noise_off_hz),
-                e.noise_on_test_hz.map_or("-".into(), |v| format!("{v:.4}")),
-                e.noise_off_test_hz
-                    .map_or("-".into(), |v| format!("{v:.4}"))
+                "{:.3} (+- {:.3})",
+                ratio.value,
+                ratio.standard_error.unwrap_or(f64::NAN)
             ),
         ));
-        rows.push((
-            "test blocks".into(),
-            match &e.simulated_back_why {
-                None => format!(
-                    "model simulated back over the recorded scene (from parameters alone: {:.4} -> {:.4})",
-                    e.predicted_error_before, e.predicted_error_after
-                ),
-                Some(why) => format!("errors from the model's parameters: {why}"),
-            },
-        ));
     }
+    let rate = |u: &Option<ctcal::fit::Uncertain>| {
+        u.as_ref()
+            .map_or("-".to_string(), |u| format!("{:.4}", u.value))
+    };
+    rows.push((
+        "isolated events (Hz/px)".into(),
+        format!(
+            "ON {}, OFF {} (fit blocks); test blocks ON {}, OFF {}",
+            rate(&e.noise_on_hz),
+            rate(&e.noise_off_hz),
+            e.noise_on_test_hz.map_or("-".into(), |v| format!("{v:.4}")),
+            e.noise_off_test_hz
+                .map_or("-".into(), |v| format!("{v:.4}"))
+        ),
+    ));
+    rows.push((
+        "test blocks".into(),
+        match &e.simulated_back_why {
+            None => format!(
+                "model simulated back over the recorded scene (from parameters alone: {:.4} -> {:.4})",
+                e.predicted_error_before, e.predicted_error_after
+            ),
+            Some(why) => format!("errors from the model's parameters: {why}"),
+        },
+    ));
+}
+
+/// The rows of the parameters other than the thresholds: why each not identified was not,
+/// then each identified one with its 95 % interval.
+fn push_parameter_rows(r: &FitResult, rows: &mut Vec<(String, String)>) {
     for (key, why) in r.why.iter().filter(|(k, _)| !k.starts_with("ct_o")) {
         rows.push((key.clone(), format!("not identified: {why}")));
     }
@@ -321,6 +356,11 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
             },
         ));
     }
+}
+
+/// The rows of the effect selection: the effects added, the pairs not separated, the
+/// held-out error before and after, and each step's decision.
+fn push_selection_rows(r: &FitResult, rows: &mut Vec<(String, String)>) {
     rows.push((
         "effects added".into(),
         if r.effects_added.is_empty() {
@@ -361,16 +401,4 @@ fn print_human(r: &FitResult) -> std::io::Result<()> {
             ),
         ));
     }
-    if !r.hot_pixels_masked.is_empty() {
-        rows.push((
-            "hot pixels masked".into(),
-            r.hot_pixels_masked
-                .iter()
-                .map(|h| format!("({}, {})", h.x, h.y))
-                .collect::<Vec<_>>()
-                .join(" "),
-        ));
-    }
-    rows.push(("simulations".into(), r.simulations.to_string()));
-    output::print_table(&rows)
 }
