@@ -229,16 +229,28 @@ fn over_budget_message(recording: &Recording, over: ctcal::stats::OverBudget) ->
     )
 }
 
+/// Prints a recording's statistics as a table: what was recorded, the rates, the hot
+/// pixels, the rate timeline and the frames.
 fn print_human(s: &SequenceStats) -> std::io::Result<()> {
-    // a value, or why it is not determined
-    let shown = |value: Option<String>, key: &str| {
-        value.unwrap_or_else(|| {
-            let why = s.why.get(key).map_or("", String::as_str);
-            format!("not determined: {why}")
-        })
-    };
-    let rate = |r: Option<f64>| shown(r.map(|r| format!("{r:.6}")), "events_per_pixel_per_second");
-    let mut rows = vec![
+    let mut rows = recording_rows(s);
+    rows.extend(rate_rows(s));
+    push_hot_pixel_rows(s, &mut rows);
+    push_timeline_rows(s, &mut rows);
+    output::print_table(&rows)
+}
+
+/// A value, or why it is not determined (the statistics' `why` under `key`).
+fn shown_or_why(s: &SequenceStats, value: Option<String>, key: &str) -> String {
+    value.unwrap_or_else(|| {
+        let why = s.why.get(key).map_or("", String::as_str);
+        format!("not determined: {why}")
+    })
+}
+
+/// The rows of what was recorded: the sensor, the events, their time span and the pixels
+/// kept.
+fn recording_rows(s: &SequenceStats) -> Vec<(String, String)> {
+    vec![
         (
             "sensor".to_string(),
             format!("{}x{} ({})", s.width, s.height, s.sensor_source),
@@ -263,6 +275,21 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
             "pixels".into(),
             format!("{} ({})", s.pixels_kept, s.selection),
         ),
+    ]
+}
+
+/// The rows of the event rates: per pixel, ON and OFF, the active pixels, the background
+/// activity, the median pixel rate, the same-pixel interval, the hot-pixel count and the
+/// biases.
+fn rate_rows(s: &SequenceStats) -> Vec<(String, String)> {
+    let rate = |r: Option<f64>| {
+        shown_or_why(
+            s,
+            r.map(|r| format!("{r:.6}")),
+            "events_per_pixel_per_second",
+        )
+    };
+    vec![
         ("events/pixel/s".into(), rate(s.events_per_pixel_per_second)),
         (
             "  ON / OFF".into(),
@@ -277,7 +304,8 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
         ),
         (
             "background activity".into(),
-            shown(
+            shown_or_why(
+                s,
                 s.background_rate_hz.map(|r| {
                     format!(
                         "{r:.4} Hz per pixel (events with no neighbour event in the {} before; hot pixels excluded)",
@@ -289,7 +317,8 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
         ),
         (
             "median pixel rate".into(),
-            shown(
+            shown_or_why(
+                s,
                 s.median_pixel_rate_hz.map(|r| format!("{r:.4} Hz")),
                 "median_pixel_rate_hz",
             ),
@@ -305,7 +334,12 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
         ),
         ("hot pixels".into(), s.hot_pixels.len().to_string()),
         output::biases_row(s.biases.as_ref()),
-    ];
+    ]
+}
+
+/// The rows of events repeated within a microsecond (if any) and of the first ten hot
+/// pixels.
+fn push_hot_pixel_rows(s: &SequenceStats, rows: &mut Vec<(String, String)>) {
     if let Some(repeated) = s.inter_event_interval_s.zero.filter(|&n| n > 0) {
         rows.push((
             "same-microsecond events".into(),
@@ -327,6 +361,10 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
             format!("{} more (see --json)", s.hot_pixels.len() - 10),
         ));
     }
+}
+
+/// The rows of the rate timeline (its windows and peak) and of the frames.
+fn push_timeline_rows(s: &SequenceStats, rows: &mut Vec<(String, String)>) {
     let peak = s
         .rate_timeline
         .iter()
@@ -351,5 +389,4 @@ fn print_human(s: &SequenceStats) -> std::io::Result<()> {
             None => "none".into(),
         },
     ));
-    output::print_table(&rows)
 }
