@@ -338,33 +338,12 @@ pub(super) fn stage_spinner(global: &Global) -> indicatif::ProgressBar {
     bar
 }
 
+/// `estimate aps`: the arguments checked, the recording's frames loaded, the thresholds
+/// estimated and the maps written (`--maps`), then the result presented.
 fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     let common = &args.common;
     let (log_map, log_name) = common.log_map()?;
-    if let Some(e) = args.exposure_s
-        && !(e.is_finite() && (0.0..=10.0).contains(&e))
-    {
-        return Err(BadInput(format!("--exposure-s {e} must be between 0 and 10 seconds")).into());
-    }
-    if let Some(o) = args.frame_offset_dn
-        && !(o.is_finite() && (-250.0..=1000.0).contains(&o))
-    {
-        return Err(BadInput(format!(
-            "--frame-offset-dn {o} must be between -250 and 1000"
-        ))
-        .into());
-    }
-    if let Some(s) = args.frame_time_offset_s
-        && !(s.is_finite() && s.abs() <= 10.0)
-    {
-        return Err(BadInput(format!(
-            "--frame-time-offset-s {s} must be within 10 seconds"
-        ))
-        .into());
-    }
-    if args.max_frames < 2 {
-        return Err(BadInput("--max-frames must be at least 2".into()).into());
-    }
+    check_aps_args(args)?;
     let policy = global.outputs([common.input.input.as_path()]);
     check_json(common.json.as_deref(), &policy)?;
     if let Some(dir) = &args.maps {
@@ -374,33 +353,7 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
     let loaded = common.load(Some(args.max_frames), true, global)?;
     let path = loaded.recording.path.clone();
     if loaded.frames.len() < 2 {
-        let windowed = common.start.is_some() || common.end.is_some();
-        let on_screen = matches!(loaded.recording.stimulus(), Ok(Some(_)));
-        return Err(BadInput(format!(
-            "{}: `estimate aps` needs grey frames (two or more); {} holds {}\n  fix: {}use {}",
-            path.display(),
-            if windowed {
-                "the window --start/--end selects"
-            } else {
-                "the recording"
-            },
-            if loaded.frames.len() == 1 {
-                "only one"
-            } else {
-                "none"
-            },
-            if windowed {
-                "widen the window to hold two frames, or "
-            } else {
-                ""
-            },
-            if on_screen {
-                "`ctcal estimate screen`, which measures through the stimulus played"
-            } else {
-                "`ctcal estimate eppps`, which needs no frames"
-            }
-        ))
-        .into());
+        return Err(too_few_frames(&loaded, common).into());
     }
     let options = ApsOptions {
         log_map,
@@ -427,6 +380,67 @@ fn run_aps(args: &ApsArgs, global: &Global) -> anyhow::Result<()> {
         write_maps(dir, &result.maps, &policy)?;
     }
     present(&result.estimate, &loaded, common, &policy)
+}
+
+/// Refuses `estimate aps` arguments out of range: the exposure, the frames' offsets in
+/// level and time, and a `--max-frames` under 2.
+fn check_aps_args(args: &ApsArgs) -> Result<(), BadInput> {
+    if let Some(e) = args.exposure_s
+        && !(e.is_finite() && (0.0..=10.0).contains(&e))
+    {
+        return Err(BadInput(format!(
+            "--exposure-s {e} must be between 0 and 10 seconds"
+        )));
+    }
+    if let Some(o) = args.frame_offset_dn
+        && !(o.is_finite() && (-250.0..=1000.0).contains(&o))
+    {
+        return Err(BadInput(format!(
+            "--frame-offset-dn {o} must be between -250 and 1000"
+        )));
+    }
+    if let Some(s) = args.frame_time_offset_s
+        && !(s.is_finite() && s.abs() <= 10.0)
+    {
+        return Err(BadInput(format!(
+            "--frame-time-offset-s {s} must be within 10 seconds"
+        )));
+    }
+    if args.max_frames < 2 {
+        return Err(BadInput("--max-frames must be at least 2".into()));
+    }
+    Ok(())
+}
+
+/// The refusal of a recording (or window of it) with fewer than two grey frames, naming
+/// the method to use instead.
+fn too_few_frames(loaded: &Loaded, common: &CommonArgs) -> BadInput {
+    let windowed = common.start.is_some() || common.end.is_some();
+    let on_screen = matches!(loaded.recording.stimulus(), Ok(Some(_)));
+    BadInput(format!(
+        "{}: `estimate aps` needs grey frames (two or more); {} holds {}\n  fix: {}use {}",
+        loaded.recording.path.display(),
+        if windowed {
+            "the window --start/--end selects"
+        } else {
+            "the recording"
+        },
+        if loaded.frames.len() == 1 {
+            "only one"
+        } else {
+            "none"
+        },
+        if windowed {
+            "widen the window to hold two frames, or "
+        } else {
+            ""
+        },
+        if on_screen {
+            "`ctcal estimate screen`, which measures through the stimulus played"
+        } else {
+            "`ctcal estimate eppps`, which needs no frames"
+        }
+    ))
 }
 
 /// The files `--maps` writes into its folder.
