@@ -519,25 +519,48 @@ fn present(
     common: &CommonArgs,
     policy: &ctcal::io::write::OutputPolicy,
 ) -> anyhow::Result<()> {
-    let with_biases;
     let biases = loaded.recording.biases();
-    let estimate = match &biases {
-        Some(b) => {
-            let mut e = estimate.clone();
-            e.extra.insert("biases".into(), serde_json::to_value(b)?);
-            with_biases = e;
-            &with_biases
-        }
-        None => estimate,
-    };
+    let estimate = with_biases(estimate, biases.as_ref())?;
     let target = common.json.as_deref().map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(estimate, target, policy)?;
+        emit_json(&*estimate, target, policy)?;
     }
     if matches!(target, Some(JsonTarget::Stdout)) {
         return Ok(());
     }
-    let value = |key: &str, v: Option<f64>, ci: Option<ctcal::estimate::Interval>| match v {
+    let mut rows = headline_rows(&estimate, loaded, biases.as_ref());
+    push_detail_rows(&estimate, &mut rows);
+    for a in &estimate.assumptions {
+        rows.push(("assumes".into(), a.clone()));
+    }
+    output::print_table(&rows)?;
+    Ok(())
+}
+
+/// The estimate with the recording's biases (if it has them) among its extra fields.
+fn with_biases<'a>(
+    estimate: &'a CtEstimate,
+    biases: Option<&ctcal::io::Biases>,
+) -> anyhow::Result<std::borrow::Cow<'a, CtEstimate>> {
+    Ok(match biases {
+        Some(b) => {
+            let mut e = estimate.clone();
+            e.extra.insert("biases".into(), serde_json::to_value(b)?);
+            std::borrow::Cow::Owned(e)
+        }
+        None => std::borrow::Cow::Borrowed(estimate),
+    })
+}
+
+/// A threshold with its 95 % interval (an open side shown as such), or why it is not
+/// determinable (the estimate's `why` under `key`).
+fn threshold_value(
+    estimate: &CtEstimate,
+    key: &str,
+    v: Option<f64>,
+    ci: Option<ctcal::estimate::Interval>,
+) -> String {
+    match v {
         Some(v) => {
             let [lo, hi] = ci.unwrap_or([None, None]);
             let side = |b: Option<f64>| b.map_or("open".to_string(), |b| format!("{b:.4}"));
@@ -550,6 +573,18 @@ fn present(
                 .get(key)
                 .map_or("no reason given", |w| w.as_str())
         ),
+    }
+}
+
+/// The summary's first rows: the method, the recording, the three thresholds, the biases
+/// and the mismatch (where estimated).
+fn headline_rows(
+    estimate: &CtEstimate,
+    loaded: &Loaded,
+    biases: Option<&ctcal::io::Biases>,
+) -> Vec<(String, String)> {
+    let value = |key: &str, v: Option<f64>, ci: Option<ctcal::estimate::Interval>| {
+        threshold_value(estimate, key, v, ci)
     };
     let mut rows = vec![
         ("method".to_string(), estimate.method.to_string()),
@@ -572,7 +607,7 @@ fn present(
             value("ct_off", estimate.ct_off, estimate.ct_off_ci95),
         ),
         ("ct".into(), value("ct", estimate.ct, estimate.ct_ci95)),
-        output::biases_row(biases.as_ref()),
+        output::biases_row(biases),
     ];
     if let (Some(s), Some(ci)) = (estimate.ct_sigma, estimate.ct_sigma_ci95) {
         rows.push((
@@ -580,6 +615,13 @@ fn present(
             value("ct_sigma", Some(s), Some(ci.map(Some))),
         ));
     }
+    rows
+}
+
+/// The summary's rows of how the thresholds were reached: each estimator, the frame
+/// intervals used, and the screen method's display model and its placing among the
+/// paper's presets.
+fn push_detail_rows(estimate: &CtEstimate, rows: &mut Vec<(String, String)>) {
     for e in &estimate.estimators {
         rows.push((
             format!("  {}", e.name),
@@ -631,9 +673,4 @@ fn present(
     {
         rows.push(("vs the paper's presets".into(), position.to_string()));
     }
-    for a in &estimate.assumptions {
-        rows.push(("assumes".into(), a.clone()));
-    }
-    output::print_table(&rows)?;
-    Ok(())
 }
