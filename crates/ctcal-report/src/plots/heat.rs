@@ -4,6 +4,7 @@
 use super::style::*;
 use super::{DrawResult, FONT, Figure, err};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 
@@ -57,31 +58,61 @@ impl Heat {
         if hi > lo { (lo, hi) } else { (lo, lo + 1.0) }
     }
 
+    /// Draws the map on `area`: the heat map at its left with square pixels, `marks`
+    /// circled on it, and its colour bar at the right.
     pub(super) fn draw_on<DB: DrawingBackend>(
         &self,
         area: &DrawingArea<DB, Shift>,
         marks: &[(u16, u16)],
     ) -> DrawResult {
-        let (block, bw, bh, values) = self.blocks();
         let (lo, hi) = self.range();
         let (plot, bar) = area.split_horizontally(area.dim_in_pixel().0 as i32 - px(100) as i32);
-        // square pixels: the spare room becomes margin
+        let layout = self.layout(plot.dim_in_pixel());
+        self.draw_map(&plot, &layout, (lo, hi), marks)?;
+        self.draw_colour_bar(&bar, &layout, (lo, hi))
+    }
+
+    /// The heat map's margins and label areas on a plot of `(pw, ph)` pixels, its pixels
+    /// square: the spare room becomes margin.
+    fn layout(&self, (pw, ph): (u32, u32)) -> Layout {
         let (margin, caption, x_labels, y_labels) = (px(8), px(30), px(30), px(45));
-        let (pw, ph) = plot.dim_in_pixel();
         let room_w = pw.saturating_sub(2 * margin + y_labels).max(1) as f64;
         let room_h = ph.saturating_sub(2 * margin + caption + x_labels).max(1) as f64;
         let scale = (room_w / self.width as f64).min(room_h / self.height as f64);
-        let spare_w = ((room_w - scale * self.width as f64) / 2.0).max(0.0) as u32;
-        let spare_h = ((room_h - scale * self.height as f64) / 2.0).max(0.0) as u32;
-        let mut chart = ChartBuilder::on(&plot)
+        Layout {
+            margin,
+            caption,
+            x_labels,
+            y_labels,
+            spare_w: ((room_w - scale * self.width as f64) / 2.0).max(0.0) as u32,
+            spare_h: ((room_h - scale * self.height as f64) / 2.0).max(0.0) as u32,
+        }
+    }
+
+    /// The heat map: its axes, its blocks coloured from `lo` to `hi` (grey without a
+    /// value), and `marks` circled.
+    fn draw_map<DB: DrawingBackend>(
+        &self,
+        plot: &DrawingArea<DB, Shift>,
+        layout: &Layout,
+        (lo, hi): (f64, f64),
+        marks: &[(u16, u16)],
+    ) -> DrawResult {
+        let Layout {
+            margin,
+            spare_w,
+            spare_h,
+            ..
+        } = *layout;
+        let mut chart = ChartBuilder::on(plot)
             .caption(&self.label, (FONT, px(17)))
             .margin(margin)
             .margin_left(margin + spare_w)
             .margin_right(margin + spare_w)
             .margin_top(margin + spare_h)
             .margin_bottom(margin + spare_h)
-            .x_label_area_size(x_labels)
-            .y_label_area_size(y_labels)
+            .x_label_area_size(layout.x_labels)
+            .y_label_area_size(layout.y_labels)
             .build_cartesian_2d(0f64..self.width as f64, self.height as f64..0f64)
             .map_err(err)?;
         chart
@@ -92,6 +123,27 @@ impl Heat {
             .label_style((FONT, px(12)))
             .draw()
             .map_err(err)?;
+        self.draw_blocks(&mut chart, (lo, hi))?;
+        chart
+            .draw_series(marks.iter().map(|&(x, y)| {
+                Circle::new(
+                    (x as f64 + 0.5, y as f64 + 0.5),
+                    px(8),
+                    RGBColor(230, 30, 30).stroke_width(px(2)),
+                )
+            }))
+            .map_err(err)?;
+        Ok(())
+    }
+
+    /// The map's blocks (of [`Self::blocks`]) coloured from `lo` to `hi`, grey without a
+    /// value.
+    fn draw_blocks<DB: DrawingBackend>(
+        &self,
+        chart: &mut ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+        (lo, hi): (f64, f64),
+    ) -> DrawResult {
+        let (block, bw, bh, values) = self.blocks();
         chart
             .draw_series((0..bh).flat_map(|by| {
                 let values = &values;
@@ -110,19 +162,22 @@ impl Heat {
                 })
             }))
             .map_err(err)?;
-        chart
-            .draw_series(marks.iter().map(|&(x, y)| {
-                Circle::new(
-                    (x as f64 + 0.5, y as f64 + 0.5),
-                    px(8),
-                    RGBColor(230, 30, 30).stroke_width(px(2)),
-                )
-            }))
-            .map_err(err)?;
-        // the colour bar
-        let mut scale = ChartBuilder::on(&bar)
-            .margin_top(margin + spare_h + caption)
-            .margin_bottom(margin + spare_h + x_labels)
+        Ok(())
+    }
+
+    /// The colour bar from `lo` to `hi` beside the map, as tall as its plot area.
+    fn draw_colour_bar<DB: DrawingBackend>(
+        &self,
+        bar: &DrawingArea<DB, Shift>,
+        layout: &Layout,
+        (lo, hi): (f64, f64),
+    ) -> DrawResult {
+        let Layout {
+            margin, spare_h, ..
+        } = *layout;
+        let mut scale = ChartBuilder::on(bar)
+            .margin_top(margin + spare_h + layout.caption)
+            .margin_bottom(margin + spare_h + layout.x_labels)
             .margin_left(px(6))
             .margin_right(px(4))
             .right_y_label_area_size(px(64))
@@ -153,6 +208,18 @@ impl Heat {
             .map_err(err)?;
         Ok(())
     }
+}
+
+/// Where a heat map sits on its plot (pixels): the margin, the caption's and the label
+/// areas' sizes, and the spare room on each side that keeps its pixels square.
+#[derive(Clone, Copy)]
+struct Layout {
+    margin: u32,
+    caption: u32,
+    x_labels: u32,
+    y_labels: u32,
+    spare_w: u32,
+    spare_h: u32,
 }
 
 /// Per-pixel threshold maps, ON and OFF.
