@@ -131,7 +131,9 @@ pub fn frame_profiles(
                     out.extend(run.take().map(|b| b.finish(photoreceptor_hz)));
                     continue;
                 }
-                let building = run.get_or_insert_with(|| burn_in(frames, response, k, x, y));
+                let building = run.get_or_insert_with(|| {
+                    burn_in(frames, response, k, x, y, photoreceptor_hz.is_some())
+                });
                 building.extend(frames, response, k, x, y);
             }
             out.extend(run.map(|b| b.finish(photoreceptor_hz)));
@@ -142,10 +144,10 @@ pub fn frame_profiles(
 }
 
 /// A pixel's profile while it is built, with each sample's frame DN (the intensity that
-/// sets a photoreceptor's cutoff).
+/// sets a photoreceptor's cutoff) where it is to be low-passed.
 struct Building {
     profile: Profile,
-    dn: Vec<f32>,
+    dn: Option<Vec<f32>>,
 }
 
 impl Building {
@@ -162,7 +164,9 @@ impl Building {
         let travel = path_samples(frames, k, x, y, |t, v| {
             profile.values.push(response.log(v));
             profile.times_s.push(t as f64 * 1e-6);
-            dn.push(v);
+            if let Some(dn) = dn {
+                dn.push(v);
+            }
             true
         });
         profile.length += travel;
@@ -170,8 +174,8 @@ impl Building {
 
     /// The profile, low-passed where a photoreceptor cutoff is given.
     fn finish(mut self, photoreceptor_hz: Option<f64>) -> Profile {
-        if let Some(cutoff_hz) = photoreceptor_hz {
-            low_pass(&mut self.profile, &self.dn, cutoff_hz);
+        if let (Some(cutoff_hz), Some(dn)) = (photoreceptor_hz, &self.dn) {
+            low_pass(&mut self.profile, dn, cutoff_hz);
         }
         self.profile
     }
@@ -205,8 +209,16 @@ pub fn low_pass(profile: &mut Profile, dn: &[f32], cutoff_hz: f64) {
     }
 }
 
-/// A profile holding only the burn-in before frame `k` at (x, y).
-fn burn_in(frames: &PreparedFrames, response: &Response, k: usize, x: usize, y: usize) -> Building {
+/// A profile holding only the burn-in before frame `k` at (x, y), and its DN where
+/// `keep_dn` (a low-pass to come).
+fn burn_in(
+    frames: &PreparedFrames,
+    response: &Response,
+    k: usize,
+    x: usize,
+    y: usize,
+    keep_dn: bool,
+) -> Building {
     let (u, v) = frames.flows[k].as_ref().map_or((0.0, 0.0), |f| f.at(x, y));
     let norm = u.hypot(v).max(1e-6) as f64;
     let (dx, dy) = (u as f64 / norm, v as f64 / norm);
@@ -237,7 +249,7 @@ fn burn_in(frames: &PreparedFrames, response: &Response, k: usize, x: usize, y: 
             burn,
             length: 0.0,
         },
-        dn,
+        dn: keep_dn.then_some(dn),
     }
 }
 
