@@ -319,6 +319,36 @@ fn eppps_measures_the_background_where_the_frames_are_still() {
     );
 }
 
+/// Draw 13010 of the peers' third fresh study: DVS-Voltmeter, thresholds 0.469, a
+/// multi-object scene at 10 px/s whose background grows with the light (2.7 ON events per
+/// pixel-second at 40-80 DN, 11.1 at 200-255 DN, still pixels and moving ones alike; 127,291
+/// of its 127,304 events are ON). Its still pixels, pooled to one rate (5.5), left a fifth of
+/// the ON events to the scene, and eppps read ON 0.102 [0.038, 0.274]. Read at each counted
+/// pixel's brightness, the background may be every ON event: ON is not determinable.
+#[test]
+fn eppps_reads_the_background_at_each_pixels_brightness() {
+    let work = tempfile::tempdir().unwrap();
+    let record = run_peer_draw(Method::Eppps, 13010, work.path());
+    assert_eq!(record.case.generator, ctcal::coverage::Generator::Voltmeter);
+    let Reported::NotDeterminable { why } = &record.reported["ct_on"] else {
+        panic!("ON: {:?}", record.reported["ct_on"]);
+    };
+    assert!(why.contains("background may be every ON event"), "{why}");
+    let output = json_output(&record);
+    let ranges = output["estimators"][0]["details"]["still_pixels"]["by_brightness"]
+        .as_array()
+        .expect("still pixels per brightness")
+        .clone();
+    let rate = |r: &serde_json::Value| {
+        r["events"][0].as_f64().unwrap() / r["exposure_s"].as_f64().unwrap()
+    };
+    let (dimmest, brightest) = (rate(&ranges[0]), rate(&ranges[ranges.len() - 1]));
+    assert!(
+        brightest > 2.0 * dimmest,
+        "{dimmest} {brightest}: {ranges:?}"
+    );
+}
+
 /// Draw 12035 of the peers' second fresh study: DVS-Voltmeter, a rotation whose leak makes
 /// 97 % of the events ON (thresholds 0.561 both). eppps without frames read OFF 2.40
 /// [0.88, 6.56]: the few OFF events were taken for a high Cn. Without frames an imbalance

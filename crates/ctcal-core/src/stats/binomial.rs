@@ -4,7 +4,8 @@
 //! Binomial(n, 1/2); Conover, *Practical Nonparametric Statistics*, 3rd ed., sec. 3.2),
 //! and the exact interval of a Poisson mean from one count (Garwood, Biometrika 1936), and
 //! the exact conditional test of two Poisson counts over equal exposures (Przyborowski &
-//! Wilenski, Biometrika 1940).
+//! Wilenski, Biometrika 1940), and the gamma interval of a weighted sum of Poisson counts
+//! (Fay & Feuer, Statistics in Medicine 1997: a directly standardised rate).
 
 use crate::estimate::interval::z95;
 
@@ -47,6 +48,31 @@ pub fn poisson95(n: usize) -> (f64, f64) {
         quantile(2.0 * n as f64, 0.025)
     };
     (lo, quantile(2.0 * n as f64 + 2.0, 0.975))
+}
+
+/// The 95 % interval of `sum w_i lambda_i` from independent Poisson counts `n_i` with
+/// weights `w_i` (`(n_i, w_i)` pairs): Fay & Feuer's gamma interval (Statistics in Medicine
+/// 16, 1997, 791-801), the interval of a directly standardised rate. With `y = sum w_i n_i`
+/// and `v = sum w_i^2 n_i`, the lower end is the 2.5 % quantile of a gamma of mean `y` and
+/// variance `v`, the upper end the 97.5 % quantile of one of mean `y + w_max` and variance
+/// `v + w_max^2`. One count gives Garwood's interval times its weight ([`poisson95`]); the
+/// interval is conservative where the weights differ. Pairs with weight 0 count for
+/// nothing; `None` where no pair has a positive weight.
+pub fn weighted_poisson95(counts: &[(f64, f64)]) -> Option<(f64, f64)> {
+    use statrs::distribution::{ContinuousCDF, Gamma};
+    let counts: Vec<(f64, f64)> = counts.iter().copied().filter(|&(_, w)| w > 0.0).collect();
+    let w_max = counts.iter().map(|&(_, w)| w).fold(0.0, f64::max);
+    if w_max <= 0.0 {
+        return None;
+    }
+    let y: f64 = counts.iter().map(|&(n, w)| w * n).sum();
+    let v: f64 = counts.iter().map(|&(n, w)| w * w * n).sum();
+    // a gamma of this mean and variance (shape mean^2 / variance, rate mean / variance)
+    let quantile = |mean: f64, variance: f64, p: f64| {
+        Gamma::new(mean * mean / variance, mean / variance).map_or(f64::NAN, |g| g.inverse_cdf(p))
+    };
+    let lo = if y > 0.0 { quantile(y, v, 0.025) } else { 0.0 };
+    Some((lo, quantile(y + w_max, v + w_max * w_max, 0.975)))
 }
 
 /// Whether a Poisson count `n` exceeds a count `m` over an equal exposure beyond chance: the
@@ -133,6 +159,29 @@ mod tests {
             (lo - 4.7954).abs() < 1e-3 && (hi - 18.3904).abs() < 1e-3,
             "{lo} {hi}"
         );
+    }
+
+    /// One count is Garwood's interval times its weight; three counts against scipy's
+    /// gamma quantiles (y = 59, v = 135.5, w_max = 4: `gamma.ppf(0.025, y*y/v, scale=v/y)`
+    /// and `gamma.ppf(0.975, (y+4)**2/(v+16), scale=(v+16)/(y+4))`).
+    #[test]
+    fn a_weighted_sum_of_counts_takes_fay_and_feuers_gamma_interval() {
+        let (lo, hi) = weighted_poisson95(&[(10.0, 3.0)]).unwrap();
+        let (glo, ghi) = poisson95(10);
+        assert!(
+            (lo - 3.0 * glo).abs() < 1e-6 && (hi - 3.0 * ghi).abs() < 1e-6,
+            "{lo} {hi}"
+        );
+        let (lo, hi) =
+            weighted_poisson95(&[(12.0, 2.0), (30.0, 0.5), (5.0, 4.0), (7.0, 0.0)]).unwrap();
+        assert!(
+            (lo - 38.4315).abs() < 1e-3 && (hi - 89.3155).abs() < 1e-3,
+            "{lo} {hi}"
+        );
+        // no count: 0 to the weight times Garwood's upper end of 0
+        let (lo, hi) = weighted_poisson95(&[(0.0, 2.0)]).unwrap();
+        assert!(lo == 0.0 && (hi - 2.0 * 3.6889).abs() < 1e-3, "{hi}");
+        assert!(weighted_poisson95(&[(5.0, 0.0)]).is_none());
     }
 
     #[test]

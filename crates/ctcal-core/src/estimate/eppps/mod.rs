@@ -938,7 +938,7 @@ fn noise_assumption(rates: &RecordingRates, frames: bool) -> String {
 /// What the frames' still pixels showed of the sensor's background (with frames), and
 /// where it decided the noise bracket.
 fn still_assumption(rates: &RecordingRates) -> String {
-    let Some(still) = rates.still.filter(|s| s.pixels > 0) else {
+    let Some(still) = rates.still.as_ref().filter(|s| s.pixels > 0) else {
         return String::new();
     };
     let decided: Vec<&str> = (0..2)
@@ -958,10 +958,35 @@ fn still_assumption(rates: &RecordingRates) -> String {
             "within the support filter's bound".to_string()
         } else {
             format!(
-                "beyond the support filter's bound for {}, so that many events per pixel-second (95 % interval, less the most the still pixels' own scene makes: their log range over the threshold read without them) come off the counted ones there: between half its lower end (leak delays OFF events while the light falls, instead of adding ON ones) and all its upper end",
-                decided.join(" and ")
+                "beyond the support filter's bound for {}, so that many events per pixel-second (95 % interval, less the most the still pixels' own scene makes: their log range over the threshold read without them) come off the counted ones there: between half its lower end (leak delays OFF events while the light falls, instead of adding ON ones) and all its upper end; {}",
+                decided.join(" and "),
+                by_brightness(still)
             )
         }
+    )
+}
+
+/// The still pixels' background per brightness range, in words.
+fn by_brightness(still: &still::StillPixels) -> String {
+    let ranges: Vec<String> = still
+        .ranges
+        .iter()
+        .filter(|r| r.exposure_s > 0.0)
+        .map(|r| {
+            format!(
+                "{:.0}-{:.0} DN {:.3} ON and {:.3} OFF ({} pixels)",
+                r.dn[0],
+                r.dn[1],
+                r.events[0] / r.exposure_s,
+                r.events[1] / r.exposure_s,
+                r.pixels
+            )
+        })
+        .collect();
+    format!(
+        "the background is read per brightness (ranges a factor 1.41 in DN apart; one with under {} still pixels, and the pixels under {DIM_FRAMES_DN:.0} DN, take the nearest range's), each counted pixel taking its own brightness's rate, since leak grows with the light and shot noise in the dark: {}",
+        still::MIN_RANGE_PIXELS,
+        ranges.join(", ")
     )
 }
 
@@ -1125,10 +1150,11 @@ fn report(
             "prior_ln_sd_off": off.prior_ln_sd,
             "prior_prediction_scale": prediction_scale(calibrations),
             "frames_median_dn": rates.frames_median_dn,
-            "still_pixels": rates.still.map(|s| json!({
+            "still_pixels": rates.still.as_ref().map(|s| json!({
                 "pixels": s.pixels,
                 "pixel_seconds": s.exposure_s,
                 "events": {"on": s.events[0], "off": s.events[1]},
+                "by_brightness": s.ranges,
                 "decides_noise": {"on": rates.still_decides[0], "off": rates.still_decides[1]},
             })),
             "z95": z95(),

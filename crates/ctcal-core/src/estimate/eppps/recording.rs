@@ -95,7 +95,7 @@ impl RecordingRates {
     /// events at still pixels read at `thresholds` (ON, OFF: as read without them) taken
     /// off first; `None` where nothing changes.
     pub fn with_still_background(&self, thresholds: [f64; 2]) -> Option<RecordingRates> {
-        let still = self.still?;
+        let still = self.still.as_ref()?;
         let mut out = self.clone();
         for (k, &threshold) in thresholds.iter().enumerate() {
             let support = &self.noise[k];

@@ -19,6 +19,7 @@
 
 use super::recording::NoiseBracket;
 use crate::estimate::frames::PreparedFrames;
+use serde::Serialize;
 
 /// A pixel whose frames' log intensity, along its path over every counted interval, stays
 /// within this range shows a still scene: 2 % of light, under the smallest thresholds
@@ -27,8 +28,44 @@ use crate::estimate::frames::PreparedFrames;
 /// its reference lies within 0.02 of a crossing (a share of about 0.02 / C of such pixels).
 pub const STILL_LN: f32 = 0.02;
 
-/// The still pixels' events and time, per polarity (ON, OFF).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// The background is read per brightness range, each a factor sqrt(2) in DN above
+/// [`super::DIM_FRAMES_DN`] (the still pixels' least; the counted pixels below it form a
+/// range of their own, which takes the nearest range's rate). Leak and noise depend on the
+/// light: leak grows with it (parasitic photocurrent at the reset switch, Nozaki &
+/// Delbruck, IEEE TED 2017; DVS-Voltmeter's drift, Lin et al. ECCV 2022), shot noise grows
+/// in the dark (Graca & Delbruck, IISW 2021). Coverage draw 13010 (DVS-Voltmeter, 99.99 %
+/// of 127,304 events ON) fired 2.7 ON events per pixel-second at 40-80 DN and 11.1 at
+/// 200-255 DN, still pixels and moving ones alike at each brightness; its still pixels,
+/// pooled and trimmed to one rate, gave 5.5 and left a fifth of the ON events to the scene.
+const RANGE_FACTOR: f64 = std::f64::consts::SQRT_2;
+/// Brightness ranges, the one under [`super::DIM_FRAMES_DN`] included (255 DN falls in the
+/// last).
+const RANGES: usize = 9;
+/// A brightness range reads its own background from at least this many still pixels; the
+/// still pixels and counted time of one with fewer join the nearest range that has them
+/// (all of them pooled where none has).
+pub const MIN_RANGE_PIXELS: usize = 10;
+
+/// The still pixels of one brightness range (after ranges with too few were joined to it)
+/// and the counted pixels' time there.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct BrightnessRange {
+    /// The DN range of the pixels it holds, `[lo, hi)` (joined ranges included).
+    pub dn: [f64; 2],
+    pub pixels: usize,
+    /// Still pixel-seconds.
+    pub exposure_s: f64,
+    /// ON and OFF events at its still pixels.
+    pub events: [f64; 2],
+    /// Its still pixels' log ranges, summed ([`StillPixels::log_range_sum`]).
+    pub log_range_sum: f64,
+    /// The counted pixels' time at this brightness, pixel-seconds.
+    pub counted_s: f64,
+}
+
+/// The still pixels' events and time, per polarity (ON, OFF), in total and per brightness
+/// range ([`RANGE_FACTOR`]).
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct StillPixels {
     pub pixels: usize,
     /// Their counted time, pixel-seconds.
@@ -38,44 +75,114 @@ pub struct StillPixels {
     /// about range / C times (a camera's pixel starts from any reference, so one within
     /// its range of a crossing fires once).
     pub log_range_sum: f64,
+    /// The same per brightness range, with the counted pixels' time in each; the
+    /// background of the counted pixels is each range's rate over its counted time.
+    pub ranges: Vec<BrightnessRange>,
+}
+
+/// One pixel of the count: its ON and OFF events, counted seconds, brightness (DN) and,
+/// where its frames are still, its log range.
+#[derive(Clone, Copy, Debug)]
+struct PixelTally {
+    events: [f64; 2],
+    exposure_s: f64,
+    dn: f64,
+    still_range: Option<f64>,
 }
 
 impl StillPixels {
     /// The still pixels among those counted (`exposure_s[pixel] > 0`, not excluded) and
-    /// their events (`counts[pixel]`: ON, OFF, over the pixel's counted intervals), less
-    /// those whose count no uniform background explains (see [`trim_outliers`]).
+    /// their events (`counts[pixel]`: ON, OFF, over the pixel's counted intervals), per
+    /// brightness range with every counted pixel's time, less those whose count no uniform
+    /// background of their range explains (see [`trim_outliers`]).
     pub fn measure(
         frames: &PreparedFrames,
         counts: &[[f64; 2]],
         exposure_s: &[f64],
         excluded: &[bool],
     ) -> Self {
-        let still: Vec<([f64; 2], f64, f64)> = (0..frames.width * frames.height)
+        let counted: Vec<PixelTally> = (0..frames.width * frames.height)
             .filter(|&p| !excluded[p] && exposure_s[p] > 0.0)
-            .filter_map(|p| Some((counts[p], exposure_s[p], still_range(frames, p)? as f64)))
+            .filter_map(|p| {
+                Some(PixelTally {
+                    events: counts[p],
+                    exposure_s: exposure_s[p],
+                    dn: pixel_dn(frames, p)?,
+                    still_range: still_range(frames, p).map(f64::from),
+                })
+            })
             .collect();
-        let mut sum = StillPixels::default();
-        for (count, exposure, range) in trim_outliers(still) {
-            sum.pixels += 1;
-            sum.exposure_s += exposure;
-            sum.log_range_sum += range;
-            for (total, c) in sum.events.iter_mut().zip(count) {
-                *total += c;
-            }
-        }
-        sum
+        Self::from_pixels(&counted)
     }
 
-    /// The background rate of polarity `k` (events per pixel-second), Garwood's 95 %
-    /// interval on the still pixels' count less the most their scene makes at threshold
-    /// `threshold` (see [`Self::log_range_sum`]); `None` without still time.
+    /// Sums `counted` by brightness range, joined as [`MIN_RANGE_PIXELS`] says, each
+    /// range's still pixels trimmed to one rate.
+    fn from_pixels(counted: &[PixelTally]) -> Self {
+        let home = joined_ranges(counted);
+        let mut out = StillPixels::default();
+        for (r, &h) in home.iter().enumerate() {
+            if h != r {
+                continue;
+            }
+            let members: Vec<&PixelTally> = counted
+                .iter()
+                .filter(|p| home[range_of(p.dn)] == r)
+                .collect();
+            if members.is_empty() {
+                continue;
+            }
+            let still = trim_outliers(
+                members
+                    .iter()
+                    .filter_map(|p| Some((p.events, p.exposure_s, p.still_range?)))
+                    .collect(),
+            );
+            let mut range = BrightnessRange {
+                dn: members.iter().fold([f64::INFINITY, 0.0], |[lo, hi], p| {
+                    let (a, b) = range_bounds(range_of(p.dn));
+                    [lo.min(a), hi.max(b)]
+                }),
+                counted_s: members.iter().map(|p| p.exposure_s).sum(),
+                ..BrightnessRange::default()
+            };
+            for (events, exposure, log_range) in still {
+                range.pixels += 1;
+                range.exposure_s += exposure;
+                range.log_range_sum += log_range;
+                range.events = [range.events[0] + events[0], range.events[1] + events[1]];
+            }
+            out.pixels += range.pixels;
+            out.exposure_s += range.exposure_s;
+            out.log_range_sum += range.log_range_sum;
+            out.events = [
+                out.events[0] + range.events[0],
+                out.events[1] + range.events[1],
+            ];
+            out.ranges.push(range);
+        }
+        out
+    }
+
+    /// The background rate of polarity `k` at the counted pixels (events per counted
+    /// pixel-second): each brightness range's still count, less the most its scene makes
+    /// at threshold `threshold` (see [`Self::log_range_sum`]), over its still time, weighted
+    /// by the counted time at that brightness; the 95 % interval of that standardised rate
+    /// (Fay & Feuer's, [`crate::stats::binomial::weighted_poisson95`]; Garwood's for one
+    /// range). `None` without still time.
     pub fn rate95(&self, k: usize, threshold: f64) -> Option<(f64, f64)> {
-        (self.exposure_s > 0.0).then(|| {
-            let scene = self.log_range_sum / threshold.max(1e-3);
-            let count = (self.events[k] - scene).max(0.0).round() as usize;
-            let (lo, hi) = crate::stats::binomial::poisson95(count);
-            (lo / self.exposure_s, hi / self.exposure_s)
-        })
+        let counted_s: f64 = self.ranges.iter().map(|r| r.counted_s).sum();
+        let weighted: Vec<(f64, f64)> = self
+            .ranges
+            .iter()
+            .filter(|r| r.exposure_s > 0.0 && r.counted_s > 0.0)
+            .map(|r| {
+                let scene = r.log_range_sum / threshold.max(1e-3);
+                let count = (r.events[k] - scene).max(0.0).round();
+                (count, r.counted_s / r.exposure_s)
+            })
+            .collect();
+        let (lo, hi) = crate::stats::binomial::weighted_poisson95(&weighted)?;
+        Some((lo / counted_s, hi / counted_s))
     }
 
     /// Polarity `k`'s noise bracket over `all` counted events in `exposure_s` counted
@@ -99,10 +206,12 @@ impl StillPixels {
         let floor = all - most;
         if floor <= 0.0 {
             return Some(NoiseBracket::undetermined(format!(
-                "the sensor's background may be every {polarity} event: pixels whose frames do not change fire {:.3} {polarity} events per pixel-second ({:.0} in {:.0} pixel-s; an ideal pixel there fires none), up to {most:.0} of the {all:.0} counted (leak or noise that the support filter does not see)",
+                "the sensor's background may be every {polarity} event: pixels whose frames do not change fire {:.3} {polarity} events per pixel-second ({:.0} in {:.0} pixel-s; an ideal pixel there fires none), {:.3} to {:.3} at the counted pixels' brightness, up to {most:.0} of the {all:.0} counted (leak or noise that the support filter does not see)",
                 self.events[k] / self.exposure_s,
                 self.events[k],
-                self.exposure_s
+                self.exposure_s,
+                lo,
+                hi
             )));
         }
         let half_range = 0.5 * ((all - least) / floor).ln();
@@ -142,6 +251,59 @@ fn trim_outliers(mut still: Vec<([f64; 2], f64, f64)>) -> Vec<([f64; 2], f64, f6
         });
     }
     still
+}
+
+/// The brightness range of a pixel of `dn`: 0 under [`super::DIM_FRAMES_DN`], then one
+/// per [`RANGE_FACTOR`].
+fn range_of(dn: f64) -> usize {
+    if dn < super::DIM_FRAMES_DN {
+        return 0;
+    }
+    let steps = ((dn / super::DIM_FRAMES_DN).ln() / RANGE_FACTOR.ln()).floor() as usize;
+    (1 + steps).min(RANGES - 1)
+}
+
+/// The DN bounds of range `r` (the last reaches 256).
+fn range_bounds(r: usize) -> (f64, f64) {
+    let at = |i: usize| super::DIM_FRAMES_DN * RANGE_FACTOR.powi(i as i32);
+    match r {
+        0 => (0.0, super::DIM_FRAMES_DN),
+        r if r == RANGES - 1 => (at(r - 1), 256.0),
+        r => (at(r - 1), at(r)),
+    }
+}
+
+/// For each brightness range, the range it joins: itself where it holds at least
+/// [`MIN_RANGE_PIXELS`] still pixels, else the nearest such (the brighter of two as near,
+/// since leak, which the still pixels mostly show, grows with the light), or range 0 for
+/// all where none does (one pooled rate).
+fn joined_ranges(counted: &[PixelTally]) -> [usize; RANGES] {
+    let mut still = [0usize; RANGES];
+    for p in counted.iter().filter(|p| p.still_range.is_some()) {
+        still[range_of(p.dn)] += 1;
+    }
+    let own: Vec<usize> = (0..RANGES)
+        .filter(|&r| still[r] >= MIN_RANGE_PIXELS)
+        .collect();
+    std::array::from_fn(|r| {
+        own.iter()
+            .copied()
+            .min_by_key(|&o| (o.abs_diff(r), std::cmp::Reverse(o)))
+            .unwrap_or(0)
+    })
+}
+
+/// Pixel `pixel`'s mean DN over the frames of the used intervals where it is reliable
+/// (`None` where there are none).
+fn pixel_dn(frames: &PreparedFrames, pixel: usize) -> Option<f64> {
+    let (mut sum, mut n) = (0.0, 0usize);
+    for k in (0..frames.flows.len()).filter(|&k| frames.flows[k].is_some()) {
+        if frames.reliable(k, pixel) {
+            sum += (frames.dn[k].data[pixel] + frames.dn[k + 1].data[pixel]) as f64;
+            n += 2;
+        }
+    }
+    (n > 0).then(|| sum / n as f64)
 }
 
 /// Pixel `pixel`'s log range where its frames, sampled along its path as the scans sample
@@ -184,17 +346,105 @@ mod tests {
         }
     }
 
+    /// Still pixels of one brightness range, with 10,000 counted pixel-seconds.
+    fn one_range(pixels: usize, exposure_s: f64, events: [f64; 2], log_range: f64) -> StillPixels {
+        let range = BrightnessRange {
+            dn: [20.0, 256.0],
+            pixels,
+            exposure_s,
+            events,
+            log_range_sum: log_range,
+            counted_s: 10_000.0,
+        };
+        StillPixels {
+            pixels,
+            exposure_s,
+            events,
+            log_range_sum: log_range,
+            ranges: vec![range],
+        }
+    }
+
+    /// `n` pixels at `dn`, each with `on` ON events in one second, still or not.
+    fn pixels(n: usize, dn: f64, on: f64, still: bool) -> Vec<PixelTally> {
+        vec![
+            PixelTally {
+                events: [on, 0.0],
+                exposure_s: 1.0,
+                dn,
+                still_range: still.then_some(0.0),
+            };
+            n
+        ]
+    }
+
+    /// Ranges with too few still pixels join the nearest that has enough: 12 still pixels
+    /// at 25 DN (range 20-28.3) and 12 at 150 DN (113-160); 2 at 60 DN (56.6-80) are two
+    /// ranges from 150 DN and three from 25 DN, so they join 150 DN, with the moving
+    /// pixels at 60 DN; the moving ones at 10 DN join 25 DN.
+    #[test]
+    fn ranges_with_too_few_still_pixels_join_the_nearest() {
+        let counted = [
+            pixels(12, 25.0, 1.0, true),
+            pixels(12, 150.0, 4.0, true),
+            pixels(2, 60.0, 2.0, true),
+            pixels(30, 60.0, 9.0, false),
+            pixels(40, 10.0, 9.0, false),
+        ]
+        .concat();
+        let still = StillPixels::from_pixels(&counted);
+        assert_eq!(still.ranges.len(), 2, "{:?}", still.ranges);
+        let (dim, bright) = (still.ranges[0], still.ranges[1]);
+        assert_eq!((dim.pixels, dim.counted_s, dim.events[0]), (12, 52.0, 12.0));
+        assert_eq!(dim.dn[0], 0.0);
+        assert!((dim.dn[1] - 20.0 * std::f64::consts::SQRT_2).abs() < 1e-9);
+        assert_eq!(
+            (bright.pixels, bright.counted_s, bright.events[0]),
+            (14, 44.0, 52.0)
+        );
+        assert!((bright.dn[0] - 40.0 * std::f64::consts::SQRT_2).abs() < 1e-9);
+        assert!((bright.dn[1] - 160.0).abs() < 1e-9);
+        assert_eq!((still.pixels, still.events[0]), (26, 64.0));
+    }
+
+    /// A background that grows with the light is read at the counted pixels' brightness:
+    /// 50 ON events in 100 still pixel-seconds at one brightness and 200 in 100 at another,
+    /// with 1,000 and 3,000 counted pixel-seconds there, is (1000 x 0.5 + 3000 x 2) / 4000
+    /// = 1.625 per counted pixel-second (pooled: 1.25); Fay & Feuer's interval
+    /// 1.4211-1.8504 (scipy's gamma quantiles of mean 6500, variance 185,000, w_max 30).
+    #[test]
+    fn the_background_is_read_at_the_counted_pixels_brightness() {
+        let range = |dn: [f64; 2], events: f64, counted_s: f64| BrightnessRange {
+            dn,
+            pixels: 100,
+            exposure_s: 100.0,
+            events: [events, 0.0],
+            log_range_sum: 0.0,
+            counted_s,
+        };
+        let still = StillPixels {
+            pixels: 200,
+            exposure_s: 200.0,
+            events: [250.0, 0.0],
+            log_range_sum: 0.0,
+            ranges: vec![
+                range([20.0, 40.0], 50.0, 1000.0),
+                range([80.0, 160.0], 200.0, 3000.0),
+            ],
+        };
+        let (lo, hi) = still.rate95(0, 0.3).unwrap();
+        assert!(
+            (lo - 1.42107).abs() < 1e-4 && (hi - 1.85042).abs() < 1e-4,
+            "{lo} {hi}"
+        );
+    }
+
     /// 100 ON events in 1,000 still pixel-seconds: Garwood's 95 % interval 81.36-121.63,
     /// so over 10,000 counted pixel-seconds 406.8 (half the lower end) to 1216.3 of 5,000
     /// counted events are background.
     #[test]
     fn a_still_background_beyond_the_support_bound_takes_its_share_off() {
-        let still = StillPixels {
-            pixels: 500,
-            exposure_s: 1000.0,
-            events: [100.0, 0.0],
-            log_range_sum: 0.0,
-        };
+        let still = one_range(500, 1000.0, [100.0, 0.0], 0.0);
         let (lo, hi) = still.rate95(0, 0.3).unwrap();
         assert!((lo * 1000.0 - 81.36).abs() < 0.01 && (hi * 1000.0 - 121.63).abs() < 0.01);
         let b = still
@@ -221,10 +471,7 @@ mod tests {
         );
         // the scene's own events at still pixels come off first: 500 pixels over a range
         // of 0.006 each may make 10 events at a threshold of 0.3, so 90 are background
-        let ranged = StillPixels {
-            log_range_sum: 3.0,
-            ..still
-        };
+        let ranged = one_range(500, 1000.0, [100.0, 0.0], 3.0);
         let (lo90, _) = crate::stats::binomial::poisson95(90);
         assert!((ranged.rate95(0, 0.3).unwrap().0 - lo90 / 1000.0).abs() < 1e-12);
         // a background that may be every event
