@@ -164,101 +164,20 @@ impl Geometry {
     /// change of role.
     pub fn new(frames: &PreparedFrames, excluded: &[bool], blocks: usize, fit_end: TimeUs) -> Self {
         let sensor = Sensor::new(frames.width as u16, frames.height as u16);
-        let (w, h) = (frames.width, frames.height);
-        let pixels = w * h;
-        let used: Vec<usize> = (0..frames.flows.len())
-            .filter(|&k| frames.flows[k].is_some())
-            .collect();
-        let blocks = blocks.clamp(1, used.len().max(1));
-        // blocks of about equal duration over the used intervals
-        let durations: Vec<f64> = used
-            .iter()
-            .map(|&k| (frames.times[k + 1] - frames.times[k]) as f64)
-            .collect();
-        let total: f64 = durations.iter().sum();
-        let frame_interval_s = {
-            let mut sorted = durations.clone();
-            sorted.sort_by(f64::total_cmp);
-            sorted.get(sorted.len() / 2).map_or(0.0, |d| d * 1e-6)
-        };
-        let mut interval_block = vec![None; frames.flows.len()];
-        let mut elapsed = 0.0;
-        for (i, &k) in used.iter().enumerate() {
-            let middle = elapsed + durations[i] / 2.0;
-            interval_block[k] = Some(((middle / total * blocks as f64) as usize).min(blocks - 1));
-            elapsed += durations[i];
-        }
-        let mut block_end = vec![TimeUs::MIN; blocks];
-        for &k in &used {
-            let b = interval_block[k].expect("assigned");
-            block_end[b] = block_end[b].max(frames.times[k + 1]);
-        }
-        let fitting = block_end.iter().filter(|&&end| end <= fit_end).count();
-        let role = roles(fitting, blocks);
-        let guard_seconds = guard_intervals(&mut interval_block, &role, &durations, &used);
-        let region: Vec<u8> = (0..pixels)
-            .map(|p| {
-                let (x, y) = (p % w, p / w);
-                ((y * REGIONS_Y / h) * REGIONS_X + x * REGIONS_X / w) as u8
-            })
-            .collect();
-        let mut intensity = vec![Vec::new(); frames.flows.len()];
-        let mut change = vec![Vec::new(); frames.flows.len()];
-        for (first, end) in frames.runs() {
-            let bins = change::run_change_bins(frames, first, end);
-            for (k, bins) in (first..end).zip(bins) {
-                // guard intervals have no block
-                if interval_block[k].is_some() {
-                    change[k] = bins;
-                }
-            }
-        }
-        let mut exposure = vec![[0.0; INTENSITY_BINS]; blocks];
-        let mut still_exposure = vec![0.0; blocks];
-        for &k in &used {
-            // guard intervals have no block
-            let Some(block) = interval_block[k] else {
-                continue;
-            };
-            let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
-            let (a, b) = (&frames.dn[k].data, &frames.dn[k + 1].data);
-            let mut bins = vec![u8::MAX; pixels];
-            for p in 0..pixels {
-                if frames.reliable(k, p) {
-                    let bin = bin_of(&INTENSITY_EDGES, 0.5 * (a[p] + b[p]));
-                    bins[p] = bin;
-                    if !excluded[p] {
-                        exposure[block][bin as usize] += dt;
-                        if change[k].get(p) == Some(&0) {
-                            still_exposure[block] += dt;
-                        }
-                    }
-                }
-            }
-            intensity[k] = bins;
-        }
-        let span = match (used.first(), used.last()) {
-            (Some(&a), Some(&b)) => (frames.times[a], frames.times[b + 1]),
-            _ => (0, 0),
-        };
-        let mut centres = [0.0; INTENSITY_BINS];
-        let mut lower = 3.0f64;
-        for (i, centre) in centres.iter_mut().enumerate() {
-            let upper = INTENSITY_EDGES.get(i).map_or(255.0, |&e| e as f64);
-            *centre = (lower * upper).sqrt();
-            lower = upper;
-        }
-        let mut change_centres = [0.0; CHANGE_BINS];
-        let mut lower = 0.1f64;
-        for (i, centre) in change_centres.iter_mut().enumerate() {
-            let upper = CHANGE_EDGES
-                .get(i)
-                .map_or(2.0 * lower.max(8.0), |&e| e as f64);
-            *centre = (lower * upper).sqrt();
-            lower = upper;
-        }
+        let assigned = Blocks::assign(frames, blocks, fit_end);
+        let change = interval_change_bins(frames, &assigned.interval_block);
+        let measured = Exposure::measure(frames, &assigned, &change, excluded);
+        let span = assigned.span(frames);
+        let Blocks {
+            interval_block,
+            blocks,
+            role,
+            guard_seconds,
+            frame_interval_s,
+            ..
+        } = assigned;
         Self {
-            change_centres,
+            change_centres: change_centres(),
             sensor,
             times: frames.times.clone(),
             unread: frames.unread.clone(),
@@ -266,15 +185,15 @@ impl Geometry {
             blocks,
             role,
             guard_seconds,
-            region,
+            region: pixel_regions(frames.width, frames.height),
             excluded: excluded.to_vec(),
-            intensity,
+            intensity: measured.intensity,
             change,
-            exposure,
-            still_exposure,
+            exposure: measured.per_bin,
+            still_exposure: measured.still,
             span,
             frame_interval_s,
-            intensity_centres: centres,
+            intensity_centres: intensity_centres(),
         }
     }
 
@@ -384,6 +303,204 @@ fn guard_intervals(
         }
     }
     guarded
+}
+
+/// The used frame intervals grouped into blocks: each interval's block, each block's role,
+/// and the guard intervals left out between roles.
+struct Blocks {
+    /// The frame intervals with a flow, in time order.
+    used: Vec<usize>,
+    /// Block of each frame interval (`None`: not used, or a guard).
+    interval_block: Vec<Option<usize>>,
+    blocks: usize,
+    role: Vec<Role>,
+    guard_seconds: f64,
+    /// Median duration of the used intervals, seconds.
+    frame_interval_s: f64,
+}
+
+impl Blocks {
+    /// Groups the used intervals of `frames` into about `blocks` blocks of equal duration,
+    /// gives the blocks their roles by `fit_end` ([`roles`]) and leaves out the guards.
+    fn assign(frames: &PreparedFrames, blocks: usize, fit_end: TimeUs) -> Self {
+        let used: Vec<usize> = (0..frames.flows.len())
+            .filter(|&k| frames.flows[k].is_some())
+            .collect();
+        let blocks = blocks.clamp(1, used.len().max(1));
+        // blocks of about equal duration over the used intervals
+        let durations: Vec<f64> = used
+            .iter()
+            .map(|&k| (frames.times[k + 1] - frames.times[k]) as f64)
+            .collect();
+        let frame_interval_s = {
+            let mut sorted = durations.clone();
+            sorted.sort_by(f64::total_cmp);
+            sorted.get(sorted.len() / 2).map_or(0.0, |d| d * 1e-6)
+        };
+        let mut interval_block =
+            equal_duration_blocks(frames.flows.len(), &used, &durations, blocks);
+        let fitting = fitting_blocks(frames, &used, &interval_block, blocks, fit_end);
+        let role = roles(fitting, blocks);
+        let guard_seconds = guard_intervals(&mut interval_block, &role, &durations, &used);
+        Self {
+            used,
+            interval_block,
+            blocks,
+            role,
+            guard_seconds,
+            frame_interval_s,
+        }
+    }
+
+    /// The first and last time of the used intervals (`(0, 0)` where there are none).
+    fn span(&self, frames: &PreparedFrames) -> (TimeUs, TimeUs) {
+        match (self.used.first(), self.used.last()) {
+            (Some(&a), Some(&b)) => (frames.times[a], frames.times[b + 1]),
+            _ => (0, 0),
+        }
+    }
+}
+
+/// The block of each of `intervals` frame intervals: the `used` ones by where their middle
+/// falls in `blocks` equal shares of their total duration, the others `None`.
+fn equal_duration_blocks(
+    intervals: usize,
+    used: &[usize],
+    durations: &[f64],
+    blocks: usize,
+) -> Vec<Option<usize>> {
+    let total: f64 = durations.iter().sum();
+    let mut interval_block = vec![None; intervals];
+    let mut elapsed = 0.0;
+    for (i, &k) in used.iter().enumerate() {
+        let middle = elapsed + durations[i] / 2.0;
+        interval_block[k] = Some(((middle / total * blocks as f64) as usize).min(blocks - 1));
+        elapsed += durations[i];
+    }
+    interval_block
+}
+
+/// How many of the `blocks` blocks end by `fit_end` (the blocks that fit).
+fn fitting_blocks(
+    frames: &PreparedFrames,
+    used: &[usize],
+    interval_block: &[Option<usize>],
+    blocks: usize,
+    fit_end: TimeUs,
+) -> usize {
+    let mut block_end = vec![TimeUs::MIN; blocks];
+    for &k in used {
+        let b = interval_block[k].expect("assigned");
+        block_end[b] = block_end[b].max(frames.times[k + 1]);
+    }
+    block_end.iter().filter(|&&end| end <= fit_end).count()
+}
+
+/// The region of each pixel of a `w` x `h` sensor ([`REGIONS_X`] x [`REGIONS_Y`] grid).
+fn pixel_regions(w: usize, h: usize) -> Vec<u8> {
+    (0..w * h)
+        .map(|p| {
+            let (x, y) = (p % w, p / w);
+            ((y * REGIONS_Y / h) * REGIONS_X + x * REGIONS_X / w) as u8
+        })
+        .collect()
+}
+
+/// Each frame interval's change bins per pixel (empty for intervals without a block).
+fn interval_change_bins(frames: &PreparedFrames, interval_block: &[Option<usize>]) -> Vec<Vec<u8>> {
+    let mut change = vec![Vec::new(); frames.flows.len()];
+    for (first, end) in frames.runs() {
+        let bins = change::run_change_bins(frames, first, end);
+        for (k, bins) in (first..end).zip(bins) {
+            // guard intervals have no block
+            if interval_block[k].is_some() {
+                change[k] = bins;
+            }
+        }
+    }
+    change
+}
+
+/// Each blocked interval's intensity bins per pixel, and the pixel-seconds per block of
+/// each intensity bin and of still pixels (reliable, kept pixels).
+struct Exposure {
+    /// Per frame interval, each pixel's intensity bin (empty for unused intervals).
+    intensity: Vec<Vec<u8>>,
+    /// Pixel-seconds per block and intensity bin.
+    per_bin: Vec<[f64; INTENSITY_BINS]>,
+    /// Pixel-seconds per block of still pixels.
+    still: Vec<f64>,
+}
+
+impl Exposure {
+    /// Bins each pixel's intensity in every blocked interval of `frames` and sums the
+    /// pixel-seconds of the pixels not `excluded`.
+    fn measure(
+        frames: &PreparedFrames,
+        assigned: &Blocks,
+        change: &[Vec<u8>],
+        excluded: &[bool],
+    ) -> Self {
+        let pixels = frames.width * frames.height;
+        let mut intensity = vec![Vec::new(); frames.flows.len()];
+        let mut per_bin = vec![[0.0; INTENSITY_BINS]; assigned.blocks];
+        let mut still = vec![0.0; assigned.blocks];
+        for &k in &assigned.used {
+            // guard intervals have no block
+            let Some(block) = assigned.interval_block[k] else {
+                continue;
+            };
+            let dt = (frames.times[k + 1] - frames.times[k]) as f64 * 1e-6;
+            let (a, b) = (&frames.dn[k].data, &frames.dn[k + 1].data);
+            let mut bins = vec![u8::MAX; pixels];
+            for p in 0..pixels {
+                if frames.reliable(k, p) {
+                    let bin = bin_of(&INTENSITY_EDGES, 0.5 * (a[p] + b[p]));
+                    bins[p] = bin;
+                    if !excluded[p] {
+                        per_bin[block][bin as usize] += dt;
+                        if change[k].get(p) == Some(&0) {
+                            still[block] += dt;
+                        }
+                    }
+                }
+            }
+            intensity[k] = bins;
+        }
+        Self {
+            intensity,
+            per_bin,
+            still,
+        }
+    }
+}
+
+/// The representative DN of each intensity bin: the geometric middle of its edges (from
+/// 3 DN, the last bin to 255).
+fn intensity_centres() -> [f64; INTENSITY_BINS] {
+    let mut centres = [0.0; INTENSITY_BINS];
+    let mut lower = 3.0f64;
+    for (i, centre) in centres.iter_mut().enumerate() {
+        let upper = INTENSITY_EDGES.get(i).map_or(255.0, |&e| e as f64);
+        *centre = (lower * upper).sqrt();
+        lower = upper;
+    }
+    centres
+}
+
+/// The representative rate of each change bin (log units per second): the geometric
+/// middle of its edges (from 0.1, the last bin to twice its lower edge).
+fn change_centres() -> [f64; CHANGE_BINS] {
+    let mut centres = [0.0; CHANGE_BINS];
+    let mut lower = 0.1f64;
+    for (i, centre) in centres.iter_mut().enumerate() {
+        let upper = CHANGE_EDGES
+            .get(i)
+            .map_or(2.0 * lower.max(8.0), |&e| e as f64);
+        *centre = (lower * upper).sqrt();
+        lower = upper;
+    }
+    centres
 }
 
 /// The statistics of one event set on a [`Geometry`].
