@@ -47,85 +47,129 @@ pub fn try_effect(
     hot_found: Option<(Vec<HotPixel>, Vec<HotTrain>)>,
     run: &LoopRun,
 ) -> Result<Step, FitError> {
-    let (fixed, noise) = (run.fixed, run.noise);
     let effect = evidence.effect;
     let count_before = simulation.count.get();
     let mut step = Step::untried(effect.name().into(), evidence.text.clone(), evidence.score);
     step.residuals_before = Some(fit_residuals(simulation, &state.model));
-    let (candidate, uncertain) = match effect {
+    let searched = match effect {
         Effect::Display => {
             step.reason = "a display's parameters come from the stimulus that was played (the screen method); not added".into();
             return Ok(step);
         }
         Effect::HotPixels => {
-            let (hot, trains) = hot_found.unwrap_or_default();
-            let previous = std::mem::take(&mut simulation.hot_events);
-            simulation.hot_events =
-                effects::hot_pixels::events(&trains, simulation.geometry.span, simulation.seed);
-            let observed = simulation.observe(&state.model.params, &state.masked)?;
-            step.parameters
-                .insert("hot_pixels".into(), trains.len() as f64);
-            step.parameters.insert(
-                "hot_events_per_second".into(),
-                trains.iter().map(|t| t.rate_hz).sum(),
-            );
-            let mut verdict = judge(simulation, &state.model.observed, &observed, &state.kept);
-            // measured directly (a robust z-score on the fit blocks): kept whatever the
-            // distance says, which a few pixels barely move; the selection error is reported
-            verdict.kept = !trains.is_empty();
-            verdict.reason = format!(
-                "{} pixels hot on the fit blocks, simulated where they are at their own rates; {}",
-                trains.len(),
-                verdict.reason
-            );
-            if !verdict.kept {
-                simulation.hot_events = previous;
-            } else {
-                state.hot = hot;
-            }
-            let model = Simulated {
-                params: state.model.params.clone(),
-                observed,
-            };
-            return Ok(finish_step(
-                simulation,
-                state,
-                step,
-                verdict,
-                model,
-                None,
-                count_before,
-            ));
+            let found = hot_found.unwrap_or_default();
+            return try_hot_pixels(simulation, state, step, found, count_before);
         }
-        _ => {
-            let key = effect
-                .parameter()
-                .expect("every other effect has a parameter");
-            let start = evidence.start.unwrap_or(1.0);
-            let (range, counted) = search_range(
-                effect,
-                effect.range(start),
-                run.known,
-                simulation.geometry,
-                &state.model.params,
-            );
-            let searched = within_count(
-                search_profiled(
-                    simulation,
-                    &state.model.params,
-                    effect,
-                    range,
-                    (&state.masked, &state.kept),
-                    (fixed, effect.searched_with_mismatch()),
-                    noise,
-                )?,
-                counted,
-            );
-            step.parameters.insert(key.into(), searched.value);
-            let uncertain = uncertain_of(key, &searched);
-            (searched.model, Some(uncertain))
-        }
+        _ => search_effect(simulation, state, evidence, run, &mut step)?,
     };
+    judge_searched(
+        simulation,
+        state,
+        (step, count_before),
+        effect,
+        searched,
+        run,
+    )
+}
+
+/// Hot pixels tried: the pixels found hot on the fit blocks simulated as their own event
+/// trains, kept where there are any (the selection error is reported).
+fn try_hot_pixels(
+    simulation: &mut Simulation,
+    state: &mut State,
+    mut step: Step,
+    (hot, trains): (Vec<HotPixel>, Vec<HotTrain>),
+    count_before: usize,
+) -> Result<Step, FitError> {
+    let previous = std::mem::take(&mut simulation.hot_events);
+    simulation.hot_events =
+        effects::hot_pixels::events(&trains, simulation.geometry.span, simulation.seed);
+    let observed = simulation.observe(&state.model.params, &state.masked)?;
+    step.parameters
+        .insert("hot_pixels".into(), trains.len() as f64);
+    step.parameters.insert(
+        "hot_events_per_second".into(),
+        trains.iter().map(|t| t.rate_hz).sum(),
+    );
+    let mut verdict = judge(simulation, &state.model.observed, &observed, &state.kept);
+    // measured directly (a robust z-score on the fit blocks): kept whatever the
+    // distance says, which a few pixels barely move; the selection error is reported
+    verdict.kept = !trains.is_empty();
+    verdict.reason = format!(
+        "{} pixels hot on the fit blocks, simulated where they are at their own rates; {}",
+        trains.len(),
+        verdict.reason
+    );
+    if !verdict.kept {
+        simulation.hot_events = previous;
+    } else {
+        state.hot = hot;
+    }
+    let model = Simulated {
+        params: state.model.params.clone(),
+        observed,
+    };
+    Ok(finish_step(
+        simulation,
+        state,
+        step,
+        verdict,
+        model,
+        None,
+        count_before,
+    ))
+}
+
+/// The effect's parameter searched with the thresholds (and, where the effect needs it,
+/// the mismatch) on the fit blocks: the candidate model and the parameter's uncertainty,
+/// the value recorded in `step`.
+fn search_effect(
+    simulation: &Simulation,
+    state: &State,
+    evidence: &effects::Evidence,
+    run: &LoopRun,
+    step: &mut Step,
+) -> Result<(Simulated, Option<NamedUncertain>), FitError> {
+    let effect = evidence.effect;
+    let key = effect
+        .parameter()
+        .expect("every other effect has a parameter");
+    let start = evidence.start.unwrap_or(1.0);
+    let (range, counted) = search_range(
+        effect,
+        effect.range(start),
+        run.known,
+        simulation.geometry,
+        &state.model.params,
+    );
+    let searched = within_count(
+        search_profiled(
+            simulation,
+            &state.model.params,
+            effect,
+            range,
+            (&state.masked, &state.kept),
+            (run.fixed, effect.searched_with_mismatch()),
+            run.noise,
+        )?,
+        counted,
+    );
+    step.parameters.insert(key.into(), searched.value);
+    let uncertain = uncertain_of(key, &searched);
+    Ok((searched.model, Some(uncertain)))
+}
+
+/// A searched effect judged on the selection blocks and recorded (kept into `state` where
+/// the verdict says so); a kept effect searched with the mismatch has the mismatch
+/// searched once more ([`mismatch_searched_again`]).
+fn judge_searched(
+    simulation: &Simulation,
+    state: &mut State,
+    (step, count_before): (Step, usize),
+    effect: Effect,
+    (candidate, uncertain): (Simulated, Option<NamedUncertain>),
+    run: &LoopRun,
+) -> Result<Step, FitError> {
     let verdict = judge_effect(
         simulation,
         state,
@@ -226,7 +270,10 @@ pub(super) fn judge_effect(
 }
 
 /// The searched value with its standard error, or the bound it sits at.
-fn uncertain_of(key: &str, searched: &Searched) -> (String, Uncertain, Option<f64>) {
+/// A searched parameter's name, value with its uncertainty, and the bound it stopped at.
+type NamedUncertain = (String, Uncertain, Option<f64>);
+
+fn uncertain_of(key: &str, searched: &Searched) -> NamedUncertain {
     (key.to_string(), searched.uncertain(), searched.at_bound)
 }
 
