@@ -209,104 +209,193 @@ pub fn estimate(
     progress: Progress,
 ) -> Result<ApsResult, EstimateError> {
     progress("frames: selection and optical flow", 0.0);
-    let Checked {
-        excluded,
-        mut frames,
-        alignment,
-        offset_report,
-        other_response,
-        mut assumptions,
-    } = checked_frames(input, options)?;
+    let mut checked = checked_frames(input, options)?;
 
     progress("event timing and re-simulation", 0.2);
-    // the full frames upsampled once: for their pass and the self-calibration's simulation
-    let mut runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
-    let mut full = run_pass(input, &excluded, &frames, &runs, options, None)?;
-    let grid = timestamp_grid(input.events);
-    let offset_from_counts = count_offset::offset_from_counts(
-        input,
-        &excluded,
-        &mut frames,
-        options,
-        (&mut runs, &mut full),
-        offset_report.as_ref(),
-        grid,
-    )?;
-    assumptions.extend(
-        offset_from_counts
-            .as_ref()
-            .map(|c| count_offset::assumption(c, &frames)),
-    );
-    let spread = full.timing.spread();
-    let sigma = simulated_sigma(&full.timing);
-    let calibration_events = calibration_events(&runs, &frames, options, &full.timing, sigma, grid);
-    progress("does the photoreceptor follow the frames", 0.45);
-    let slow = slow_photoreceptor(input, &excluded, &frames, (&runs, &full), sigma, grid);
-    drop(runs);
-    let alignment_error =
-        alignment_systematic(input, &excluded, &mut frames, options, alignment.as_ref());
+    let mut first = FullPass::run(input, &mut checked, options, progress)?;
+    let calibration_events = first.calibration_events.take();
 
     progress("frame-rate check (every 2nd and 3rd frame)", 0.5);
-    let subsampled = subsampled_passes(input, &excluded, &frames, options, &full);
-    let mut passes = vec![(1usize, &full)];
+    let subsampled = subsampled_passes(
+        input,
+        &checked.excluded,
+        &checked.frames,
+        options,
+        &first.full,
+    );
+    let mut passes = vec![(1usize, &first.full)];
     passes.extend(subsampled.iter().map(|(s, p)| (*s, p)));
 
     // self-calibration of the timing estimator on a simulation of the same frames
     progress("self-calibration on a simulation of the frames", 0.8);
+    let (estimators, sigma_bias) = estimator_reports(
+        input,
+        &mut checked,
+        options,
+        &first,
+        calibration_events,
+        &passes,
+    );
+    let sigma_series = report::series(&passes, |p| {
+        Some(p.timing.spread().sigma).filter(|s| s.is_finite())
+    });
+    let result = first.finish(input, checked, estimators, (sigma_bias, sigma_series));
+    progress("done", 1.0);
+    Ok(result)
+}
+
+/// The full frames' pass, and what is found along with it: the frames' offset from the
+/// counts, the self-calibration's simulated events, the photoreceptor check and the
+/// frame-time alignment's systematic.
+struct FullPass {
+    full: Pass,
+    grid: Option<(TimeUs, TimeUs)>,
+    offset_from_counts: Option<count_offset::FromCounts>,
+    spread: super::timing::spread::Spread,
+    sigma: f64,
+    calibration_events: Option<EventChunk>,
+    slow: Option<Slow>,
+    alignment_error: (f64, f64),
+}
+
+impl FullPass {
+    /// Runs the full frames' pass (event timing and re-simulation, the frames upsampled
+    /// once for it and the self-calibration's simulation), checks its offset against the
+    /// counts, then the photoreceptor and the frame-time alignment.
+    fn run(
+        input: &ApsInput,
+        checked: &mut Checked,
+        options: &ApsOptions,
+        progress: Progress,
+    ) -> Result<Self, EstimateError> {
+        let (excluded, frames) = (&checked.excluded, &mut checked.frames);
+        let mut runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+        let mut full = run_pass(input, excluded, frames, &runs, options, None)?;
+        let grid = timestamp_grid(input.events);
+        let offset_from_counts = count_offset::offset_from_counts(
+            input,
+            excluded,
+            frames,
+            options,
+            (&mut runs, &mut full),
+            checked.offset_report.as_ref(),
+            grid,
+        )?;
+        checked.assumptions.extend(
+            offset_from_counts
+                .as_ref()
+                .map(|c| count_offset::assumption(c, frames)),
+        );
+        let spread = full.timing.spread();
+        let sigma = simulated_sigma(&full.timing);
+        let calibration_events =
+            calibration_events(&runs, frames, options, &full.timing, sigma, grid);
+        progress("does the photoreceptor follow the frames", 0.45);
+        let slow = slow_photoreceptor(input, excluded, frames, (&runs, &full), sigma, grid);
+        drop(runs);
+        let alignment_error =
+            alignment_systematic(input, excluded, frames, options, checked.alignment.as_ref());
+        Ok(Self {
+            full,
+            grid,
+            offset_from_counts,
+            spread,
+            sigma,
+            calibration_events,
+            slow,
+            alignment_error,
+        })
+    }
+
+    /// The result: the least-squares cross-check, the estimators combined with the
+    /// findings ([`assemble`]), and the full pass's maps.
+    fn finish(
+        self,
+        input: &ApsInput,
+        checked: Checked,
+        estimators: Vec<super::EstimatorReport>,
+        (sigma_bias, sigma_series): (f64, Vec<super::interval::FrameRatePoint>),
+    ) -> ApsResult {
+        let Self {
+            full,
+            spread,
+            offset_from_counts,
+            slow,
+            ..
+        } = self;
+        let frames = &checked.frames;
+        // the least-squares cross-check
+        let lsq = super::lsq::fit(
+            input.events,
+            frames,
+            input.sensor,
+            &checked.excluded,
+            Some((&full.timing.maps.ct_on, &full.timing.maps.ct_off)),
+        );
+        let estimate = assemble(
+            estimators,
+            checked.assumptions,
+            frames,
+            &full,
+            Findings {
+                spread,
+                sigma_bias,
+                sigma_series,
+                sigma_offset_systematic: full.timing.sigma_offset_systematic,
+                lsq,
+                alignment: json!(checked.alignment),
+                offset: checked.offset_report,
+                offset_from_counts: offset_from_counts.map(|c| c.found),
+                other_response: checked.other_response,
+                slow,
+            },
+        );
+        ApsResult {
+            estimate,
+            interpolation_share: [
+                full.timing.on.interpolation_share,
+                full.timing.off.interpolation_share,
+            ],
+            maps: full.timing.maps,
+            frame_offset_dn: (frames.offset, frames.offset_range),
+        }
+    }
+}
+
+/// The estimators' reports: event timing's, corrected by the self-calibration's bias
+/// (whose spread bias is returned too), and the re-simulation's where it ran, with the
+/// assumptions they add.
+fn estimator_reports(
+    input: &ApsInput,
+    checked: &mut Checked,
+    options: &ApsOptions,
+    first: &FullPass,
+    calibration_events: Option<EventChunk>,
+    passes: &[(usize, &Pass)],
+) -> (Vec<super::EstimatorReport>, f64) {
     let calibrating = Calibrating {
         input,
-        excluded: &excluded,
+        excluded: &checked.excluded,
         options,
-        sigma,
-        alignment: alignment.as_ref(),
-        grid,
+        sigma: first.sigma,
+        alignment: checked.alignment.as_ref(),
+        grid: first.grid,
     };
-    let bias = calibrating.bias(&mut frames, &full, calibration_events, &mut assumptions);
-    assumptions.extend(blocks_assumption(&full.timing));
-    let mut estimators = vec![timing_report(&passes, bias, alignment_error)];
-    if let Some(r) = &full.resim {
-        let (report, note) = resimulation_report(&passes, r);
+    let assumptions = &mut checked.assumptions;
+    let bias = calibrating.bias(
+        &mut checked.frames,
+        &first.full,
+        calibration_events,
+        assumptions,
+    );
+    assumptions.extend(blocks_assumption(&first.full.timing));
+    let mut estimators = vec![timing_report(passes, bias, first.alignment_error)];
+    if let Some(r) = &first.full.resim {
+        let (report, note) = resimulation_report(passes, r);
         assumptions.extend(note);
         estimators.push(report);
     }
-    // the least-squares cross-check
-    let lsq = super::lsq::fit(
-        input.events,
-        &frames,
-        input.sensor,
-        &excluded,
-        Some((&full.timing.maps.ct_on, &full.timing.maps.ct_off)),
-    );
-    let estimate = assemble(
-        estimators,
-        assumptions,
-        &frames,
-        &full,
-        Findings {
-            spread,
-            sigma_bias: bias.2,
-            sigma_series: report::series(&passes, |p| {
-                Some(p.timing.spread().sigma).filter(|s| s.is_finite())
-            }),
-            sigma_offset_systematic: full.timing.sigma_offset_systematic,
-            lsq,
-            alignment: json!(alignment),
-            offset: offset_report,
-            offset_from_counts: offset_from_counts.map(|c| c.found),
-            other_response,
-            slow,
-        },
-    );
-    progress("done", 1.0);
-    Ok(ApsResult {
-        estimate,
-        interpolation_share: [
-            full.timing.on.interpolation_share,
-            full.timing.off.interpolation_share,
-        ],
-        maps: full.timing.maps,
-        frame_offset_dn: (frames.offset, frames.offset_range),
-    })
+    (estimators, bias.2)
 }
 
 /// The frames prepared for estimation and checked to measure thresholds, with the pixels
