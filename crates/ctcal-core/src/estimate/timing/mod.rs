@@ -299,6 +299,42 @@ impl Central {
             weights: &self.weights,
         }
     }
+
+    /// The estimate: the polarities `[on, off]` with their errors, the `maps`, the spread's
+    /// offset systematic, and the offset, the lag and the drift the fit found (their
+    /// standard errors from `boot`).
+    fn into_estimate(
+        self,
+        [on, off]: [PolarityEstimate; 2],
+        maps: ThresholdMaps,
+        sigma_offset_systematic: f64,
+        boot: &Bootstrap,
+    ) -> TimingEstimate {
+        let coefficients = &self.coefficients;
+        let median_dn = median_level(&self.pairs);
+        let cutoff = coefficients.cutoff_hz(median_dn, self.offset.offset_dn as f64);
+        let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
+        TimingEstimate {
+            log_map: self.log_map,
+            on,
+            off,
+            maps,
+            sigma_offset_systematic,
+            offset: self.offset,
+            lag: Lag {
+                tau_times_dn: coefficients.lag,
+                standard_error: boot.lag,
+                cutoff_hz_at_median_dn: cutoff,
+                median_dn,
+            },
+            drift: Drift {
+                at_zero_dn: coefficients.drift,
+                per_dn: coefficients.drift_per_dn,
+                at_median_dn: drift_at_median(coefficients),
+                standard_error: boot.drift,
+            },
+        }
+    }
 }
 
 /// [`fit_at`] of `pairs` through `log_map` with the options' window and leak: the whole
@@ -333,28 +369,51 @@ pub fn estimate(
 ) -> Option<TimingEstimate> {
     // the response is chosen where the frames are prepared ([`thresholds`], which carries
     // the other one); callers then fix it
-    let Central {
-        pairs,
-        log_map,
-        offset,
-        other_response: _,
-        coefficients,
-        values,
-        weights,
-        slots,
-    } = Central::fit(events, frames, sensor, excluded, options)?;
-    let pixels = sensor.pixels();
-    let fit = whole_fit(&pairs, &log_map, pixels, options);
+    let central = Central::fit(events, frames, sensor, excluded, options)?;
     // the thresholds, and each polarity's per-pixel spread, across the offset's interval
-    let (lo, hi) = offset.systematic_range;
-    let ends: Vec<(Coefficients, Option<[PolarityEstimate; 2]>)> = [lo, hi]
+    let ends = offset_ends(&central, sensor, options);
+    let fitted = central.fitted();
+    let boot = bootstrap(&fitted, sensor.pixels(), options);
+    let blocks = between_blocks(&fitted, options.fit_leak);
+    let (on, on_map) = polarity(&fitted, &central.coefficients, true, sensor)?;
+    let (off, off_map) = polarity(&fitted, &central.coefficients, false, sensor)?;
+    let sigma_offset_systematic = spread::offset_systematic(
+        ends.iter().filter_map(|e| e.1.as_ref()),
+        [&on, &off],
+        [boot.excess_on, boot.excess_off],
+    );
+    let errors = Errors {
+        boot: &boot,
+        blocks,
+        ends: &ends,
+        central: &central.coefficients,
+    };
+    let polarities = [errors.polarity(on, true), errors.polarity(off, false)];
+    Some(central.into_estimate(
+        polarities,
+        maps(sensor, &on_map, &off_map),
+        sigma_offset_systematic,
+        &boot,
+    ))
+}
+
+/// The fit at each end of the offset's systematic range (but the offset itself): the
+/// coefficients there, and each polarity's per-pixel spread (`None` where a polarity fails).
+type OffsetEnd = (Coefficients, Option<[PolarityEstimate; 2]>);
+
+/// The whole fit of `central`'s pairs at each end of its offset's systematic range
+/// ([`OffsetEnd`]), in parallel; an end that fails is left out.
+fn offset_ends(central: &Central, sensor: Sensor, options: &TimingOptions) -> Vec<OffsetEnd> {
+    let fit = whole_fit(&central.pairs, &central.log_map, sensor.pixels(), options);
+    let (lo, hi) = central.offset.systematic_range;
+    [lo, hi]
         .par_iter()
-        .filter(|&&b| b != offset.offset_dn)
+        .filter(|&&b| b != central.offset.offset_dn)
         .filter_map(|&b| {
             let (c, values, weights) = fit(b)?;
             let fitted = Fitted {
-                pairs: &pairs,
-                slots: &slots,
+                pairs: &central.pairs,
+                slots: &central.slots,
                 values: &values,
                 weights: &weights,
             };
@@ -363,66 +422,46 @@ pub fn estimate(
                 .map(|(on, off)| [on.0, off.0]);
             Some((c, spread))
         })
-        .collect();
-    let shift = |pick: fn(&Coefficients) -> f64| {
-        ends.iter()
-            .map(|e| (pick(&e.0) - pick(&coefficients)).abs())
+        .collect()
+}
+
+/// What a polarity's errors are made of: the bootstrap over pixels, the spread between
+/// blocks of frames, and the thresholds' change across the offset's range.
+struct Errors<'a> {
+    boot: &'a Bootstrap,
+    blocks: Option<[f64; 2]>,
+    ends: &'a [OffsetEnd],
+    /// The coefficients at the offset.
+    central: &'a Coefficients,
+}
+
+impl Errors<'_> {
+    /// The polarity `estimate` (ON where `on`) with its standard errors and its offset
+    /// systematic (the largest change at the range's ends, as a standard error).
+    fn polarity(&self, estimate: PolarityEstimate, on: bool) -> PolarityEstimate {
+        let boot = self.boot;
+        let (se, sigma_se, excess_se) = if on {
+            (boot.on, boot.sigma_on, boot.excess_on)
+        } else {
+            (boot.off, boot.sigma_off, boot.excess_off)
+        };
+        let block = self.blocks.map(|b| b[if on { 0 } else { 1 }]);
+        let pick = |c: &Coefficients| if on { c.c_on } else { c.c_off };
+        let shift = self
+            .ends
+            .iter()
+            .map(|e| (pick(&e.0) - pick(self.central)).abs())
             .fold(0.0, f64::max)
-            / 1.96
-    };
-    let fitted = Fitted {
-        pairs: &pairs,
-        slots: &slots,
-        values: &values,
-        weights: &weights,
-    };
-    let boot = bootstrap(&fitted, pixels, options);
-    let blocks = between_blocks(&fitted, options.fit_leak);
-    let combined = |boot: f64, block: Option<f64>| block.map_or(boot, |b| b.hypot(boot));
-    let on = polarity(&fitted, &coefficients, true, sensor)?;
-    let off = polarity(&fitted, &coefficients, false, sensor)?;
-    let sigma_offset_systematic = spread::offset_systematic(
-        ends.iter().filter_map(|e| e.1.as_ref()),
-        [&on.0, &off.0],
-        [boot.excess_on, boot.excess_off],
-    );
-    let median_dn = median_level(&pairs);
-    let cutoff = coefficients.cutoff_hz(median_dn, offset.offset_dn as f64);
-    let drift_at_median = |c: &Coefficients| c.drift + c.drift_per_dn * median_dn;
-    Some(TimingEstimate {
-        log_map,
-        on: PolarityEstimate {
-            standard_error: combined(boot.on, blocks.map(|b| b[0])),
-            between_blocks_standard_error: blocks.map(|b| b[0]),
-            offset_systematic: shift(|c| c.c_on),
-            sigma_standard_error: boot.sigma_on,
-            excess_variance_standard_error: boot.excess_on,
-            ..on.0
-        },
-        off: PolarityEstimate {
-            standard_error: combined(boot.off, blocks.map(|b| b[1])),
-            between_blocks_standard_error: blocks.map(|b| b[1]),
-            offset_systematic: shift(|c| c.c_off),
-            sigma_standard_error: boot.sigma_off,
-            excess_variance_standard_error: boot.excess_off,
-            ..off.0
-        },
-        maps: maps(sensor, &on.1, &off.1),
-        sigma_offset_systematic,
-        offset,
-        lag: Lag {
-            tau_times_dn: coefficients.lag,
-            standard_error: boot.lag,
-            cutoff_hz_at_median_dn: cutoff,
-            median_dn,
-        },
-        drift: Drift {
-            at_zero_dn: coefficients.drift,
-            per_dn: coefficients.drift_per_dn,
-            at_median_dn: drift_at_median(&coefficients),
-            standard_error: boot.drift,
-        },
-    })
+            / 1.96;
+        PolarityEstimate {
+            standard_error: block.map_or(se, |b| b.hypot(se)),
+            between_blocks_standard_error: block,
+            offset_systematic: shift,
+            sigma_standard_error: sigma_se,
+            excess_variance_standard_error: excess_se,
+            ..estimate
+        }
+    }
 }
 
 /// The whole fit at one offset ([`fit_at`] with the response and options fixed).
