@@ -59,47 +59,95 @@ pub struct FitArgs {
 
 /// Reads the thresholds of an `estimate --json` result.
 fn thresholds_from(path: &std::path::Path) -> Result<ctcal::estimate::CtEstimate, BadInput> {
-    let bad = |what: String| {
-        BadInput(format!(
-            "{}: {what}\n  fix: give the JSON that `ctcal estimate METHOD INPUT --json FILE` wrote",
-            path.display()
-        ))
-    };
-    let text = std::fs::read_to_string(path).map_err(|e| bad(format!("cannot be read: {e}")))?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| bad(format!("is not JSON: {e}")))?;
-    let method = match value.get("method").and_then(|m| m.as_str()) {
-        Some("screen") => "screen",
-        Some("aps") => "aps",
-        Some("eppps") => "eppps",
-        Some("combined") => "combined",
-        other => {
-            return Err(bad(format!(
+    let json = EstimateJson::read(path)?;
+    let method = json.method()?;
+    let (ct_on, ct_off) = (json.threshold("ct_on")?, json.threshold("ct_off")?);
+    if ct_on.is_none() && ct_off.is_none() {
+        return Err(json.bad("holds no thresholds (`ct_on` and `ct_off` are null)".into()));
+    }
+    Ok(ctcal::estimate::CtEstimate {
+        method,
+        ct_on,
+        ct_off,
+        ct: ct_on.zip(ct_off).map(|(a, b)| 0.5 * (a + b)),
+        ct_on_ci95: json.interval("ct_on_ci95"),
+        ct_off_ci95: json.interval("ct_off_ci95"),
+        ct_ci95: json.interval("ct_ci95"),
+        why: json.why(),
+        intervals_used: Vec::new(),
+        assumptions: json.strings("assumptions"),
+        ct_sigma: None,
+        ct_sigma_ci95: None,
+        estimators: Vec::new(),
+        intervals_dropped: Vec::new(),
+        extra: serde_json::Map::new(),
+    })
+}
+
+/// The error for what is wrong with the `--thresholds-from` file at `path`, with its fix.
+fn bad_estimate_json(path: &std::path::Path, what: String) -> BadInput {
+    BadInput(format!(
+        "{}: {what}\n  fix: give the JSON that `ctcal estimate METHOD INPUT --json FILE` wrote",
+        path.display()
+    ))
+}
+
+/// An `estimate --json` result as read from its file, for `--thresholds-from`.
+struct EstimateJson<'a> {
+    path: &'a std::path::Path,
+    value: serde_json::Value,
+}
+
+impl<'a> EstimateJson<'a> {
+    /// Reads and parses the file at `path`.
+    fn read(path: &'a std::path::Path) -> Result<Self, BadInput> {
+        let bad = |what: String| bad_estimate_json(path, what);
+        let text =
+            std::fs::read_to_string(path).map_err(|e| bad(format!("cannot be read: {e}")))?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(format!("is not JSON: {e}")))?;
+        Ok(Self { path, value })
+    }
+
+    /// The error for what is wrong with the file ([`bad_estimate_json`]).
+    fn bad(&self, what: String) -> BadInput {
+        bad_estimate_json(self.path, what)
+    }
+
+    /// The estimate's `method`: screen, aps, eppps or combined.
+    fn method(&self) -> Result<&'static str, BadInput> {
+        match self.value.get("method").and_then(|m| m.as_str()) {
+            Some("screen") => Ok("screen"),
+            Some("aps") => Ok("aps"),
+            Some("eppps") => Ok("eppps"),
+            Some("combined") => Ok("combined"),
+            other => Err(self.bad(format!(
                 "`method` is {other:?}, not one of screen, aps, eppps"
-            )));
+            ))),
         }
-    };
-    let number = |key: &str| -> Result<Option<f64>, BadInput> {
-        match value.get(key) {
+    }
+
+    /// The threshold `key`: `None` where absent or null, an error where not a positive
+    /// threshold.
+    fn threshold(&self, key: &str) -> Result<Option<f64>, BadInput> {
+        match self.value.get(key) {
             None | Some(serde_json::Value::Null) => Ok(None),
             Some(v) => match v.as_f64() {
                 Some(x) if x.is_finite() && x > 0.0 && x < 100.0 => Ok(Some(x)),
-                _ => Err(bad(format!("`{key}` is {v}, not a positive threshold"))),
+                _ => Err(self.bad(format!("`{key}` is {v}, not a positive threshold"))),
             },
         }
-    };
-    let interval = |key: &str| -> Option<ctcal::estimate::Interval> {
-        let v = value.get(key)?.as_array()?;
-        (v.len() == 2).then(|| [v[0].as_f64(), v[1].as_f64()])
-    };
-    let (ct_on, ct_off) = (number("ct_on")?, number("ct_off")?);
-    if ct_on.is_none() && ct_off.is_none() {
-        return Err(bad(
-            "holds no thresholds (`ct_on` and `ct_off` are null)".into()
-        ));
     }
-    let strings = |key: &str| -> Vec<String> {
-        value
+
+    /// The interval `key`, where it is an array of two.
+    fn interval(&self, key: &str) -> Option<ctcal::estimate::Interval> {
+        let v = self.value.get(key)?.as_array()?;
+        (v.len() == 2).then(|| [v[0].as_f64(), v[1].as_f64()])
+    }
+
+    /// The strings of the array `key` (none where it is not one).
+    fn strings(&self, key: &str) -> Vec<String> {
+        self.value
             .get(key)
             .and_then(|v| v.as_array())
             .map(|a| {
@@ -108,33 +156,20 @@ fn thresholds_from(path: &std::path::Path) -> Result<ctcal::estimate::CtEstimate
                     .collect()
             })
             .unwrap_or_default()
-    };
-    let why = value
-        .get("why")
-        .and_then(|w| w.as_object())
-        .map(|w| {
-            w.iter()
-                .filter_map(|(k, v)| Some((k.clone(), v.as_str()?.to_string())))
-                .collect()
-        })
-        .unwrap_or_default();
-    Ok(ctcal::estimate::CtEstimate {
-        method,
-        ct_on,
-        ct_off,
-        ct: ct_on.zip(ct_off).map(|(a, b)| 0.5 * (a + b)),
-        ct_on_ci95: interval("ct_on_ci95"),
-        ct_off_ci95: interval("ct_off_ci95"),
-        ct_ci95: interval("ct_ci95"),
-        why,
-        intervals_used: Vec::new(),
-        assumptions: strings("assumptions"),
-        ct_sigma: None,
-        ct_sigma_ci95: None,
-        estimators: Vec::new(),
-        intervals_dropped: Vec::new(),
-        extra: serde_json::Map::new(),
-    })
+    }
+
+    /// The `why` object's string values, by key.
+    fn why(&self) -> std::collections::BTreeMap<String, String> {
+        self.value
+            .get("why")
+            .and_then(|w| w.as_object())
+            .map(|w| {
+                w.iter()
+                    .filter_map(|(k, v)| Some((k.clone(), v.as_str()?.to_string())))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
 }
 
 /// Parses `--effects`.
