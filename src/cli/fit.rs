@@ -197,27 +197,8 @@ fn effect_choice(text: &str) -> Result<EffectChoice, BadInput> {
 
 pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     let common = &args.common;
-    let effects = effect_choice(&args.effects)?;
-    let split = FitOptions {
-        holdout: args.holdout,
-        ..FitOptions::default()
-    };
-    if let Err(e) = split.check() {
-        return Err(BadInput(format!(
-            "--holdout {}: {}\n  fix: {}",
-            args.holdout, e.problem, e.fix
-        ))
-        .into());
-    }
-    if args.max_frames < 2 {
-        return Err(BadInput("--max-frames must be at least 2".into()).into());
-    }
-    if let Some(e) = args.exposure_s
-        && !(e.is_finite() && (0.0..=10.0).contains(&e))
-    {
-        return Err(BadInput(format!("--exposure-s {e} must be between 0 and 10 seconds")).into());
-    }
-    let (log_map, log_name) = common.log_map()?;
+    let effects = checked_options(args)?;
+    let log_response = common.log_map()?;
     let policy = global.outputs([common.input.input.as_path()]);
     check_json(common.json.as_deref(), &policy)?;
     let thresholds = args
@@ -240,20 +221,7 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     }
     let spinner = stage_spinner(global);
     let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
-    let options = FitOptions {
-        effects,
-        holdout: args.holdout,
-        aps: ApsOptions {
-            log_map,
-            log_response_name: log_name,
-            choose_response: args.common.choose_response(),
-            exposure_us: args.exposure_s.map(|s| (s * 1e6).round() as i64),
-            ..ApsOptions::default()
-        },
-        thresholds,
-        seed: args.seed,
-        ..FitOptions::default()
-    };
+    let options = fit_options(args, effects, log_response, thresholds);
     let result = ctcal::fit_region::fit(
         &loaded,
         &options,
@@ -268,12 +236,72 @@ pub fn run(args: &FitArgs, global: &Global) -> anyhow::Result<()> {
     if on_screen {
         result.assumptions.push(ON_SCREEN.into());
     }
-    let target = common.json.as_deref().map(JsonTarget::parse);
+    present(&result, common.json.as_deref(), &policy)
+}
+
+/// Checks `--effects`, `--holdout`, `--max-frames` and `--exposure-s`; returns the effects.
+fn checked_options(args: &FitArgs) -> Result<EffectChoice, BadInput> {
+    let effects = effect_choice(&args.effects)?;
+    let split = FitOptions {
+        holdout: args.holdout,
+        ..FitOptions::default()
+    };
+    if let Err(e) = split.check() {
+        return Err(BadInput(format!(
+            "--holdout {}: {}\n  fix: {}",
+            args.holdout, e.problem, e.fix
+        )));
+    }
+    if args.max_frames < 2 {
+        return Err(BadInput("--max-frames must be at least 2".into()));
+    }
+    if let Some(e) = args.exposure_s
+        && !(e.is_finite() && (0.0..=10.0).contains(&e))
+    {
+        return Err(BadInput(format!(
+            "--exposure-s {e} must be between 0 and 10 seconds"
+        )));
+    }
+    Ok(effects)
+}
+
+/// The fit's options from the command line: the effects, the held-out share, the log
+/// response (`(map, name)`), the frames' exposure, the given thresholds and the seed.
+fn fit_options(
+    args: &FitArgs,
+    effects: EffectChoice,
+    (log_map, log_name): (ctcal::sim::log_response::LogMap, String),
+    thresholds: Option<ctcal::estimate::CtEstimate>,
+) -> FitOptions {
+    FitOptions {
+        effects,
+        holdout: args.holdout,
+        aps: ApsOptions {
+            log_map,
+            log_response_name: log_name,
+            choose_response: args.common.choose_response(),
+            exposure_us: args.exposure_s.map(|s| (s * 1e6).round() as i64),
+            ..ApsOptions::default()
+        },
+        thresholds,
+        seed: args.seed,
+        ..FitOptions::default()
+    }
+}
+
+/// Writes the fit as JSON where `--json` asks, and as a table unless the JSON went to
+/// stdout.
+fn present(
+    result: &FitResult,
+    json: Option<&std::path::Path>,
+    policy: &ctcal::io::write::OutputPolicy,
+) -> anyhow::Result<()> {
+    let target = json.map(JsonTarget::parse);
     if let Some(target) = &target {
-        emit_json(&result, target, &policy)?;
+        emit_json(result, target, policy)?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) {
-        print_human(&result)?;
+        print_human(result)?;
     }
     Ok(())
 }
