@@ -266,28 +266,51 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
     inputs.extend(args.screen.as_deref());
     let policy = global.outputs(inputs);
     check_json(common.json.as_deref(), &policy)?;
-    let screen = match &args.screen {
-        Some(path) => {
-            let text = ctcal::files::read_small_text(path, 1 << 20)
-                .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
-            Some(DisplayParams::from_toml(
-                &text,
-                &path.display().to_string(),
-            )?)
-        }
-        None => None,
-    };
+    let screen = args.screen.as_deref().map(screen_model).transpose()?;
     // --log-eps is checked whether or not a response is named
     let (log, _) = common.log_map()?;
     let response = (!common.choose_response()).then_some(log);
     let loaded = common.load(None, false, global)?;
     let path = loaded.recording.path.clone();
-    let stimulus = match &args.stimulus {
+    let frames = stimulus_frames(args.stimulus.as_deref(), &loaded)?;
+    let spinner = stage_spinner(global);
+    let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
+    let result = screen_of(
+        &loaded,
+        &frames,
+        (screen, response),
+        args.refresh_hz,
+        &progress,
+    );
+    spinner.finish_and_clear();
+    let estimate = result.map_err(|e| estimate_failed(&path, &e))?;
+    present(&estimate, &loaded, common, &policy)
+}
+
+/// The screen model of `--screen` (a SCREEN.toml).
+fn screen_model(path: &Path) -> anyhow::Result<DisplayParams> {
+    let text = ctcal::files::read_small_text(path, 1 << 20)
+        .map_err(|e| ctcal::InputError::not_a_file(path, e))?;
+    Ok(DisplayParams::from_toml(
+        &text,
+        &path.display().to_string(),
+    )?)
+}
+
+/// The frames of the stimulus that was played: `--stimulus` (a folder with its
+/// `stimulus.txt`, or that file), else the recording's own; refused where there is none,
+/// or where it has fewer than 2 or more than 100000 frames.
+fn stimulus_frames(
+    stimulus: Option<&Path>,
+    loaded: &Loaded,
+) -> anyhow::Result<Vec<ctcal::events::Frame>> {
+    let path = &loaded.recording.path;
+    let stimulus = match stimulus {
         Some(dir) => {
             let index = if dir.is_dir() {
                 dir.join("stimulus.txt")
             } else {
-                dir.clone()
+                dir.to_path_buf()
             };
             Some(ctcal::io::FrameList::read(&index)?)
         }
@@ -308,19 +331,7 @@ fn run_screen(args: &ScreenArgs, global: &Global) -> anyhow::Result<()> {
         ))
         .into());
     }
-    let frames = stimulus.load_all()?;
-    let spinner = stage_spinner(global);
-    let progress = |stage: &str, _: f64| spinner.set_message(stage.to_string());
-    let result = screen_of(
-        &loaded,
-        &frames,
-        (screen, response),
-        args.refresh_hz,
-        &progress,
-    );
-    spinner.finish_and_clear();
-    let estimate = result.map_err(|e| estimate_failed(&path, &e))?;
-    present(&estimate, &loaded, common, &policy)
+    Ok(stimulus.load_all()?)
 }
 
 /// A spinner on stderr showing the stage (hidden when quiet).
