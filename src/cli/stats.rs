@@ -166,30 +166,55 @@ fn pass(
         accumulator.add(&all);
         all.max_coordinates()
     } else {
-        let mut stream = match origin {
-            Some(origin) => {
-                let at = |s: Option<f64>, default| {
-                    s.map_or(default, |s| origin.saturating_add((s * 1e6).round() as i64))
-                };
-                recording.events_between(at(args.start, i64::MIN), at(args.end, i64::MAX))?
-            }
-            None => recording.events()?,
-        };
-        for note in &stream.notes {
-            warn(global, note);
-        }
-        let bar = progress_bar(global, stream.progress().total, "reading");
-        let read_ahead = rayon::current_num_threads() > 1;
-        ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, progress| {
-            accumulator.add(chunk);
-            bar.set_position(progress.done);
-        })?;
-        bar.finish_and_clear();
-        stream.max_coordinates()
+        stream_into(&mut accumulator, recording, origin, args, global)?
     };
     if let Some(over) = accumulator.over_budget() {
         return Err(BadInput(over_budget_message(recording, over)).into());
     }
+    finish(accumulator, recording, max_coordinates, args, global)
+}
+
+/// Streams the recording's events (those between `--start` and `--end` where `origin`,
+/// the first event's time, is given) into `accumulator`, with a progress bar; returns the
+/// largest coordinates read.
+fn stream_into(
+    accumulator: &mut StatsAccumulator,
+    recording: &Recording,
+    origin: Option<ctcal::events::TimeUs>,
+    args: &StatsArgs,
+    global: &Global,
+) -> anyhow::Result<Option<(u16, u16)>> {
+    let mut stream = match origin {
+        Some(origin) => {
+            let at = |s: Option<f64>, default| {
+                s.map_or(default, |s| origin.saturating_add((s * 1e6).round() as i64))
+            };
+            recording.events_between(at(args.start, i64::MIN), at(args.end, i64::MAX))?
+        }
+        None => recording.events()?,
+    };
+    for note in &stream.notes {
+        warn(global, note);
+    }
+    let bar = progress_bar(global, stream.progress().total, "reading");
+    let read_ahead = rayon::current_num_threads() > 1;
+    ctcal::io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, progress| {
+        accumulator.add(chunk);
+        bar.set_position(progress.done);
+    })?;
+    bar.finish_and_clear();
+    Ok(stream.max_coordinates())
+}
+
+/// The statistics of what `accumulator` read, on the sensor resolved from the recording
+/// and `max_coordinates` (with its frame times); an error where the window held no events.
+fn finish(
+    accumulator: StatsAccumulator,
+    recording: &Recording,
+    max_coordinates: Option<(u16, u16)>,
+    args: &StatsArgs,
+    global: &Global,
+) -> anyhow::Result<SequenceStats> {
     let resolved = recording.resolve_sensor(max_coordinates);
     if let Some(w) = &resolved.warning {
         warn(global, &super::flags::render(w));
