@@ -258,61 +258,21 @@ fn estimate(
     stimulus: Option<PathBuf>,
 ) -> PyResult<String> {
     let open = open_options(format, sensor)?;
-    let quiet = |_: &str, _: f64| {};
     let method = method.to_string();
     let estimate = py
         .detach(|| -> Result<_, String> {
             let aps_method = method == "aps";
             let loaded = load(&path, &open, start, end, max_frames, aps_method, roi, mask)?;
-            let named = |e: ctcal_core::estimate::EstimateError| format!("{}: {e}", path.display());
             let mut estimate = match method.as_str() {
                 "aps" => {
-                    if loaded.frames.len() < 2 {
-                        return Err(format!(
-                            "{}: `estimate aps` needs grey frames; the recording has {}\n  fix: use the eppps method, which needs no frames",
-                            path.display(),
-                            if loaded.frames.len() == 1 { "only one" } else { "none" }
-                        ));
-                    }
                     let budget = ctcal_io::fit_region::FitBudget {
                         max_pixels,
                         max_events,
                     };
-                    ctcal_io::aps_region::aps(&loaded, &ApsOptions::default(), budget, &quiet)
-                        .map_err(named)?
-                        .estimate
+                    aps_estimate(&path, &loaded, budget)?
                 }
-                "eppps" => ctcal_io::window::eppps_of(
-                    &loaded,
-                    &ApsOptions::default(),
-                    ctcal_core::estimate::eppps::EpppsOptions {
-                        seed,
-                        ..Default::default()
-                    },
-                    &quiet,
-                )
-                .map_err(named)?,
-                "screen" => {
-                    let list = match &stimulus {
-                        Some(dir) => Some(ctcal_io::FrameList::read(dir).map_err(|e| e.to_string())?),
-                        None => loaded.recording.stimulus().map_err(|e| e.to_string())?,
-                    };
-                    let Some(list) = list else {
-                        return Err(format!(
-                            "{}: no stimulus.txt beside the recording\n  fix: give the stimulus folder (stimulus=...)",
-                            path.display()
-                        ));
-                    };
-                    let frames = list.load_all().map_err(|e| e.to_string())?;
-                    ctcal_io::window::screen_of(
-                        &loaded,
-                        &frames,
-                        (None, None),
-                        None,
-                        &quiet,
-                    )
-                    .map_err(named)?
-                }
+                "eppps" => eppps_estimate(&path, &loaded, seed)?,
+                "screen" => screen_estimate(&path, &loaded, stimulus.as_deref())?,
                 other => {
                     return Err(format!(
                         "unknown method `{other}`\n  fix: aps, eppps or screen"
@@ -320,14 +280,84 @@ fn estimate(
                 }
             };
             if let Some(b) = loaded.recording.biases() {
-                estimate
-                    .extra
-                    .insert("biases".into(), serde_json::to_value(b).map_err(|e| e.to_string())?);
+                estimate.extra.insert(
+                    "biases".into(),
+                    serde_json::to_value(b).map_err(|e| e.to_string())?,
+                );
             }
             Ok(estimate)
         })
         .map_err(err)?;
     json(&estimate)
+}
+
+/// An estimate's error as its message, after the recording's `path`.
+fn named(path: &Path) -> impl Fn(ctcal_core::estimate::EstimateError) -> String + '_ {
+    move |e| format!("{}: {e}", path.display())
+}
+
+/// `estimate aps` of the recording at `path` within `budget`; refused without two frames.
+fn aps_estimate(
+    path: &Path,
+    loaded: &Loaded,
+    budget: ctcal_io::fit_region::FitBudget,
+) -> Result<ctcal_core::estimate::CtEstimate, String> {
+    if loaded.frames.len() < 2 {
+        return Err(format!(
+            "{}: `estimate aps` needs grey frames; the recording has {}\n  fix: use the eppps method, which needs no frames",
+            path.display(),
+            if loaded.frames.len() == 1 {
+                "only one"
+            } else {
+                "none"
+            }
+        ));
+    }
+    Ok(
+        ctcal_io::aps_region::aps(loaded, &ApsOptions::default(), budget, &|_, _| {})
+            .map_err(named(path))?
+            .estimate,
+    )
+}
+
+/// `estimate eppps` of the recording at `path`, its scenes simulated with `seed`.
+fn eppps_estimate(
+    path: &Path,
+    loaded: &Loaded,
+    seed: u64,
+) -> Result<ctcal_core::estimate::CtEstimate, String> {
+    ctcal_io::window::eppps_of(
+        loaded,
+        &ApsOptions::default(),
+        ctcal_core::estimate::eppps::EpppsOptions {
+            seed,
+            ..Default::default()
+        },
+        &|_, _| {},
+    )
+    .map_err(named(path))
+}
+
+/// `estimate screen` of the recording at `path` against the `stimulus` folder's frames,
+/// else the recording's own stimulus; refused where there is none.
+fn screen_estimate(
+    path: &Path,
+    loaded: &Loaded,
+    stimulus: Option<&Path>,
+) -> Result<ctcal_core::estimate::CtEstimate, String> {
+    let list = match stimulus {
+        Some(dir) => Some(ctcal_io::FrameList::read(dir).map_err(|e| e.to_string())?),
+        None => loaded.recording.stimulus().map_err(|e| e.to_string())?,
+    };
+    let Some(list) = list else {
+        return Err(format!(
+            "{}: no stimulus.txt beside the recording\n  fix: give the stimulus folder (stimulus=...)",
+            path.display()
+        ));
+    };
+    let frames = list.load_all().map_err(|e| e.to_string())?;
+    ctcal_io::window::screen_of(loaded, &frames, (None, None), None, &|_, _| {})
+        .map_err(named(path))
 }
 
 /// `ctcal fit` of `path` with the default options, as JSON.
