@@ -669,41 +669,69 @@ fn stats(
                 },
                 recording.sensor,
             );
-            let mut stream = match origin {
-                Some(origin) => {
-                    let at = |s: Option<f64>, default| {
-                        s.map_or(default, |s| origin.saturating_add((s * 1e6).round() as i64))
-                    };
-                    recording.events_between(at(start, i64::MIN), at(end, i64::MAX))
-                }
-                None => recording.events(),
-            }
-            .map_err(|e| e.to_string())?;
-            let read_ahead = rayon_threads() > 1;
-            ctcal_io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, _| {
-                accumulator.add(chunk)
-            })
-            .map_err(|e| e.to_string())?;
-            if let Some(over) = accumulator.over_budget() {
-                return Err(format!(
-                    "{}: the events reach x = {}, y = {}: statistics of that area keep {} pixels of state, more than the budget of {} pixels\n  fix: give the camera's real sensor size (sensor=\"WxH\")",
-                    recording.path.display(),
-                    over.max_x,
-                    over.max_y,
-                    over.pixels,
-                    ctcal_core::stats::PIXEL_BUDGET
-                ));
-            }
-            let resolved = recording.resolve_sensor(stream.max_coordinates());
-            let frame_times = recording.frame_times().map_err(|e| e.to_string())?;
-            let mut stats = accumulator
-                .finish(resolved.sensor, &resolved.source, &frame_times)
-                .ok_or_else(|| format!("{}: no events in the selected time window", recording.path.display()))?;
-            stats.biases = recording.biases();
-            Ok(stats)
+            let window = origin.map(|origin| (origin, start, end));
+            let max_coordinates = accumulate(&recording, &mut accumulator, window)?;
+            finished_stats(&recording, accumulator, max_coordinates)
         })
         .map_err(err)?;
     json(&stats)
+}
+
+/// Reads the recording's events into `accumulator` (only those from `start` to `end`
+/// seconds after `origin`, the first event's time, where `window` gives them); refused
+/// where the events reach beyond the per-pixel budget. Returns the largest coordinates.
+fn accumulate(
+    recording: &Recording,
+    accumulator: &mut StatsAccumulator,
+    window: Option<(ctcal_core::TimeUs, Option<f64>, Option<f64>)>,
+) -> Result<Option<(u16, u16)>, String> {
+    let mut stream = match window {
+        Some((origin, start, end)) => {
+            let at = |s: Option<f64>, default| {
+                s.map_or(default, |s| origin.saturating_add((s * 1e6).round() as i64))
+            };
+            recording.events_between(at(start, i64::MIN), at(end, i64::MAX))
+        }
+        None => recording.events(),
+    }
+    .map_err(|e| e.to_string())?;
+    let read_ahead = rayon_threads() > 1;
+    ctcal_io::read_ahead::for_each_chunk(&mut stream, read_ahead, |chunk, _| {
+        accumulator.add(chunk)
+    })
+    .map_err(|e| e.to_string())?;
+    if let Some(over) = accumulator.over_budget() {
+        return Err(format!(
+            "{}: the events reach x = {}, y = {}: statistics of that area keep {} pixels of state, more than the budget of {} pixels\n  fix: give the camera's real sensor size (sensor=\"WxH\")",
+            recording.path.display(),
+            over.max_x,
+            over.max_y,
+            over.pixels,
+            ctcal_core::stats::PIXEL_BUDGET
+        ));
+    }
+    Ok(stream.max_coordinates())
+}
+
+/// The statistics `accumulator` gathered, on the sensor resolved from the recording and
+/// `max_coordinates`, with the frame times and the biases; an error where it holds none.
+fn finished_stats(
+    recording: &Recording,
+    accumulator: StatsAccumulator,
+    max_coordinates: Option<(u16, u16)>,
+) -> Result<ctcal_core::stats::SequenceStats, String> {
+    let resolved = recording.resolve_sensor(max_coordinates);
+    let frame_times = recording.frame_times().map_err(|e| e.to_string())?;
+    let mut stats = accumulator
+        .finish(resolved.sensor, &resolved.source, &frame_times)
+        .ok_or_else(|| {
+            format!(
+                "{}: no events in the selected time window",
+                recording.path.display()
+            )
+        })?;
+    stats.biases = recording.biases();
+    Ok(stats)
 }
 
 fn rayon_threads() -> usize {
