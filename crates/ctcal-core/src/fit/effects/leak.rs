@@ -6,9 +6,7 @@
 //! (isolated events), beyond any excess of OFF events (which shot noise would make
 //! alike), growing with the time since a pixel's last event. Evidence: the ON excess
 //! minus the OFF excess, in Poisson standard errors; it matters above 0.005 events per
-//! pixel-second. Start: that excess rate (one leak event per period, most of them isolated),
-//! or the still pixels' ON excess beyond OFF where it is larger ([`still_excess_hz`]: a leak
-//! that fires every pixel at once leaves few events isolated).
+//! pixel-second. Start: that excess rate (one leak event per period, most of them isolated).
 //!
 //! The isolated events of all pixels are also the misses of every other effect the model
 //! lacks or gets wrong, and a leak's drift moves the scene's own ON and OFF crossings, so
