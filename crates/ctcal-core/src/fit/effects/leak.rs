@@ -35,40 +35,17 @@ pub fn evidence(c: &Context) -> Evidence {
     let excess_on = r_on - s_on;
     let excess_off = (r_off - s_off).max(0.0);
     let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
-    let still = still_excess_hz(c);
     Evidence {
         effect: Effect::Leak,
         score,
         relevant: rate > RELEVANT_HZ,
         text: format!(
-            "isolated ON events exceed the model's by {:.4} Hz per pixel beyond the OFF excess ({:.4} Hz): {score:.1} standard errors{}",
+            "isolated ON events exceed the model's by {:.4} Hz per pixel beyond the OFF excess ({:.4} Hz): {score:.1} standard errors",
             excess_on / exposure,
             excess_off / exposure,
-            still.map_or(String::new(), |hz| format!(
-                "; at still pixels ON exceeds OFF by {hz:.4} Hz per pixel beyond the model"
-            )),
         ),
-        start: Some((rate.max(still.unwrap_or(0.0)) / 0.9).max(1e-3)),
+        start: Some((rate / 0.9).max(1e-3)),
     }
-}
-
-/// The recording's ON less OFF events at still pixels beyond the model's, per still
-/// pixel-second, on the context's blocks (`None` without still time). Only leak fires ON
-/// where the light does not change, and there it fires whether or not its events find a
-/// neighbour's: a leak that fires every pixel at once (DVS-Voltmeter's drift, which grows
-/// with the light) leaves few isolated events, and the isolated excess alone started the
-/// search below it (coverage draw 13010: isolated excess 0.33 Hz, still pixels 5.5 Hz; the
-/// search, a factor 5 either way of its start, ended at 0.37 Hz). A still pixel fires its
-/// first leak event one period after its last reset, so on a recording shorter than a few
-/// periods this reads below the rate: a start, not a measurement.
-fn still_excess_hz(c: &Context) -> Option<f64> {
-    let pixel_seconds: f64 = (0..c.geometry.blocks)
-        .filter(|&b| c.geometry.in_subset(b, c.subset))
-        .map(|b| c.geometry.still_exposure[b])
-        .sum();
-    let seen =
-        net(c.real.still_of(c.geometry, c.subset)) - net(c.sim.still_of(c.geometry, c.subset));
-    (pixel_seconds > 0.0).then(|| seen.max(0.0) / pixel_seconds)
 }
 
 /// The ON excess rate (beyond any OFF excess) below which leak does not matter, events per
@@ -288,32 +265,6 @@ mod tests {
         assert!(e.score > EVIDENCE_THRESHOLD, "{e:?}");
         let start = e.start.unwrap();
         assert!(start > 0.2 / 2.0 && start < 0.2 * 2.0, "{start}");
-    }
-
-    /// A leak of 2 Hz that fires every pixel at once (DVS-Voltmeter's drift from a common
-    /// reset): its events all find neighbours', so few are isolated, but at still pixels
-    /// ON exceeds OFF by the rate: the search starts there (within a factor 2), not at the
-    /// isolated excess.
-    #[test]
-    fn a_leak_that_fires_every_pixel_at_once_starts_from_the_still_pixels() {
-        let mut synchronized = Vec::new();
-        for y in 0..12u16 {
-            for x in 0..16u16 {
-                let mut t = 0.1;
-                while t < 10.0 {
-                    synchronized.push(((t * 1e6) as TimeUs, x, y, true));
-                    t += 0.5;
-                }
-            }
-        }
-        let model = chunk(noise_floor());
-        let recording = chunk(with(noise_floor(), synchronized));
-        let f = Fixture::new(&static_frames(16, 12, 10.0, 100.0), &recording, &model);
-        let ([r_off, r_on, s_off, s_on], exposure) = background_totals(&f.context());
-        let (_, isolated) = score([r_off, r_on, s_off, s_on], exposure);
-        assert!(isolated < 0.2, "isolated excess {isolated} Hz");
-        let start = evidence(&f.context()).start.unwrap();
-        assert!(start > 1.0 && start < 4.0, "{start}");
     }
 
     #[test]
