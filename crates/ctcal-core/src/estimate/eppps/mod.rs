@@ -938,9 +938,10 @@ fn noise_assumption(rates: &RecordingRates, frames: bool) -> String {
 /// What the frames' still pixels showed of the sensor's background (with frames), and
 /// where it decided the noise bracket.
 fn still_assumption(rates: &RecordingRates) -> String {
-    let Some(still) = rates.still.as_ref().filter(|s| s.pixels > 0) else {
+    let Some(still) = rates.still.as_ref().filter(|s| s.total().pixels > 0) else {
         return String::new();
     };
+    let total = still.total();
     let decided: Vec<&str> = (0..2)
         .filter(|&k| rates.still_decides[k])
         .map(|k| ["ON", "OFF"][k])
@@ -948,12 +949,12 @@ fn still_assumption(rates: &RecordingRates) -> String {
     format!(
         "; the sensor's background where the frames show a still scene (log range under {:.2} along the pixel's path): {} pixels, {:.0} pixel-s, {:.0} ON and {:.0} OFF events ({:.4} and {:.4} per pixel-second; an ideal pixel there fires none); {}",
         still::STILL_LN,
-        still.pixels,
-        still.exposure_s,
-        still.events[0],
-        still.events[1],
-        still.events[0] / still.exposure_s,
-        still.events[1] / still.exposure_s,
+        total.pixels,
+        total.exposure_s,
+        total.events[0],
+        total.events[1],
+        total.events[0] / total.exposure_s,
+        total.events[1] / total.exposure_s,
         if decided.is_empty() {
             "within the support filter's bound".to_string()
         } else {
@@ -1150,10 +1151,10 @@ fn report(
             "prior_ln_sd_off": off.prior_ln_sd,
             "prior_prediction_scale": prediction_scale(calibrations),
             "frames_median_dn": rates.frames_median_dn,
-            "still_pixels": rates.still.as_ref().map(|s| json!({
-                "pixels": s.pixels,
-                "pixel_seconds": s.exposure_s,
-                "events": {"on": s.events[0], "off": s.events[1]},
+            "still_pixels": rates.still.as_ref().map(|s| (s, s.total())).map(|(s, t)| json!({
+                "pixels": t.pixels,
+                "pixel_seconds": t.exposure_s,
+                "events": {"on": t.events[0], "off": t.events[1]},
                 "by_brightness": s.ranges,
                 "decides_noise": {"on": rates.still_decides[0], "off": rates.still_decides[1]},
             })),

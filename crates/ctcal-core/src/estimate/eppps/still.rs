@@ -63,20 +63,13 @@ pub struct BrightnessRange {
     pub counted_s: f64,
 }
 
-/// The still pixels' events and time, per polarity (ON, OFF), in total and per brightness
-/// range ([`RANGE_FACTOR`]).
+/// The still pixels' events and time, per polarity (ON, OFF), per brightness range
+/// ([`RANGE_FACTOR`]), with the counted pixels' time in each; the background of the
+/// counted pixels is each range's rate over its counted time. A still pixel fires for its
+/// scene at most about its log range / C times (a camera's pixel starts from any
+/// reference, so one within its range of a crossing fires once).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct StillPixels {
-    pub pixels: usize,
-    /// Their counted time, pixel-seconds.
-    pub exposure_s: f64,
-    pub events: [f64; 2],
-    /// The still pixels' log ranges, summed: a still pixel fires for its scene at most
-    /// about range / C times (a camera's pixel starts from any reference, so one within
-    /// its range of a crossing fires once).
-    pub log_range_sum: f64,
-    /// The same per brightness range, with the counted pixels' time in each; the
-    /// background of the counted pixels is each range's rate over its counted time.
     pub ranges: Vec<BrightnessRange>,
 }
 
@@ -91,6 +84,24 @@ struct PixelTally {
 }
 
 impl StillPixels {
+    /// Every range together (its `dn` spanning them all).
+    pub fn total(&self) -> BrightnessRange {
+        self.ranges.iter().fold(
+            BrightnessRange {
+                dn: [f64::INFINITY, 0.0],
+                ..BrightnessRange::default()
+            },
+            |t, r| BrightnessRange {
+                dn: [t.dn[0].min(r.dn[0]), t.dn[1].max(r.dn[1])],
+                pixels: t.pixels + r.pixels,
+                exposure_s: t.exposure_s + r.exposure_s,
+                events: [t.events[0] + r.events[0], t.events[1] + r.events[1]],
+                log_range_sum: t.log_range_sum + r.log_range_sum,
+                counted_s: t.counted_s + r.counted_s,
+            },
+        )
+    }
+
     /// The still pixels among those counted (`exposure_s[pixel] > 0`, not excluded) and
     /// their events (`counts[pixel]`: ON, OFF, over the pixel's counted intervals), per
     /// brightness range with every counted pixel's time, less those whose count no uniform
@@ -151,13 +162,6 @@ impl StillPixels {
                 range.log_range_sum += log_range;
                 range.events = [range.events[0] + events[0], range.events[1] + events[1]];
             }
-            out.pixels += range.pixels;
-            out.exposure_s += range.exposure_s;
-            out.log_range_sum += range.log_range_sum;
-            out.events = [
-                out.events[0] + range.events[0],
-                out.events[1] + range.events[1],
-            ];
             out.ranges.push(range);
         }
         out
@@ -205,11 +209,12 @@ impl StillPixels {
         let polarity = ["ON", "OFF"][k];
         let floor = all - most;
         if floor <= 0.0 {
+            let total = self.total();
             return Some(NoiseBracket::undetermined(format!(
                 "the sensor's background may be every {polarity} event: pixels whose frames do not change fire {:.3} {polarity} events per pixel-second ({:.0} in {:.0} pixel-s; an ideal pixel there fires none), {:.3} to {:.3} at the counted pixels' brightness, up to {most:.0} of the {all:.0} counted (leak or noise that the support filter does not see)",
-                self.events[k] / self.exposure_s,
-                self.events[k],
-                self.exposure_s,
+                total.events[k] / total.exposure_s,
+                total.events[k],
+                total.exposure_s,
                 lo,
                 hi
             )));
@@ -357,10 +362,6 @@ mod tests {
             counted_s: 10_000.0,
         };
         StillPixels {
-            pixels,
-            exposure_s,
-            events,
-            log_range_sum: log_range,
             ranges: vec![range],
         }
     }
@@ -404,7 +405,8 @@ mod tests {
         );
         assert!((bright.dn[0] - 40.0 * std::f64::consts::SQRT_2).abs() < 1e-9);
         assert!((bright.dn[1] - 160.0).abs() < 1e-9);
-        assert_eq!((still.pixels, still.events[0]), (26, 64.0));
+        let total = still.total();
+        assert_eq!((total.pixels, total.events[0]), (26, 64.0));
     }
 
     /// A background that grows with the light is read at the counted pixels' brightness:
@@ -423,10 +425,6 @@ mod tests {
             counted_s,
         };
         let still = StillPixels {
-            pixels: 200,
-            exposure_s: 200.0,
-            events: [250.0, 0.0],
-            log_range_sum: 0.0,
             ranges: vec![
                 range([20.0, 40.0], 50.0, 1000.0),
                 range([80.0, 160.0], 200.0, 3000.0),
