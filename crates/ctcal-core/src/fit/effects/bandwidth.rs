@@ -210,6 +210,7 @@ fn lag_evidence(c: &Context, floor: &NoiseFloor) -> Option<Evidence> {
         score: best.z,
         relevant: best.excess_s > relevant_s,
         text,
+        other_start: None,
         start: (best.excess_s > 0.0).then(|| {
             let (lo, hi) = Effect::Bandwidth.range(100.0);
             best.cutoff_hz.clamp(lo, hi)
@@ -232,6 +233,7 @@ fn count_evidence(c: &Context, floor: &NoiseFloor) -> Evidence {
             "log(simulated/real) counts rise by {slope:.3} (+- {se:.3}) per unit of ln(change rate / intensity): the model makes {:.0} % more events for fast changes in the dark than for slow changes in the bright, relative to the recording",
             100.0 * (change.exp() - 1.0)
         ),
+        other_start: None,
         start: Some(100.0),
     }
 }

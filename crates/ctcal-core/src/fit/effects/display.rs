@@ -46,6 +46,7 @@ pub fn evidence(c: &Context) -> Evidence {
             text: format!(
                 "the event rate has a spectral line at {frequency:.1} Hz ({power:.0} times the median power; the model: {simulated:.1})"
             ),
+            other_start: None,
             start: Some(frequency),
         },
         None => Evidence::none(Effect::Display, "too short a recording for a spectrum"),

@@ -39,6 +39,7 @@ pub fn evidence(c: &Context) -> Evidence {
             100.0 * r,
             100.0 * s
         ),
+        other_start: None,
         start: Some(100e-6),
     }
 }

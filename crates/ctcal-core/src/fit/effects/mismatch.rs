@@ -29,6 +29,7 @@ pub fn evidence(c: &Context) -> Evidence {
             text: format!(
                 "event timing measures a frozen per-pixel threshold spread of {sigma:.4} (95 % interval {lo:.4} to {hi:.4})"
             ),
+            other_start: None,
             start: Some(sigma.max(0.005)),
         };
     }
@@ -52,6 +53,7 @@ pub fn evidence(c: &Context) -> Evidence {
                     "per-pixel counts are {:.0} % more dispersed within tiles than the model's",
                     100.0 * (excess.exp() - 1.0)
                 ),
+                other_start: None,
                 start: Some(0.03),
             }
         }

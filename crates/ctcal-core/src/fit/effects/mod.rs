@@ -203,6 +203,11 @@ pub struct Evidence {
     /// Where the parameter search starts.
     #[serde(skip)]
     pub start: Option<f64>,
+    /// A second reading of the start that disagrees with `start` (leak's still pixels,
+    /// [`leak::evidence`]): the search runs from both and keeps the value with the lower
+    /// error on the fit blocks.
+    #[serde(skip)]
+    pub other_start: Option<f64>,
 }
 
 /// The evidence (in standard errors) an effect needs to be tried.
@@ -216,6 +221,7 @@ impl Evidence {
             relevant: false,
             text: text.into(),
             start: None,
+            other_start: None,
         }
     }
 

@@ -251,6 +251,7 @@ pub(crate) fn signature(c: &Context, relevant_hz: f64) -> Evidence {
             score: found.z,
             relevant: true,
             text: found.text,
+            other_start: None,
             start: Some(found.start_hz),
         };
     }

@@ -72,6 +72,7 @@ pub fn evidence(c: &Context) -> Evidence {
         score: (found.sim_share - found.real_share) / se,
         relevant: found.sim_share - found.real_share > 0.02,
         text,
+        other_start: None,
         start: Some(c.shortest_interval_s.unwrap_or(edge)),
     }
 }

@@ -47,6 +47,7 @@ pub fn evidence(c: &Context) -> Evidence {
             excess_on / exposure,
             excess_off / exposure,
         ),
+        other_start: None,
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
     };
     // ruled out by the quiet pixels: not called for, its start kept for a listed try

@@ -276,6 +276,7 @@ mod tests {
             relevant: score > 0.0,
             text: "0.0 % of the recording's same-pixel intervals are shorter than 4.217 ms against 33.4 % in the model".into(),
             start: None,
+            other_start: None,
         }
     }
 

@@ -135,6 +135,31 @@ fn search_effect(
         .parameter()
         .expect("every other effect has a parameter");
     let start = evidence.start.unwrap_or(1.0);
+    let mut searched = search_from(simulation, state, effect, start, run)?;
+    if let Some(other) = evidence.other_start {
+        let from_other = search_from(simulation, state, effect, other, run)?;
+        step.evidence.push_str(&format!(
+            "; searched from {start:.4} (ended at {:.4}, fit error {:.4}) and from {other:.4} (ended at {:.4}, fit error {:.4}), the lower error kept",
+            searched.value, searched.fit_error, from_other.value, from_other.fit_error
+        ));
+        if from_other.fit_error < searched.fit_error {
+            searched = from_other;
+        }
+    }
+    step.parameters.insert(key.into(), searched.value);
+    let uncertain = uncertain_of(key, &searched);
+    Ok((searched.model, Some(uncertain)))
+}
+
+/// `effect`'s parameter searched over its range around `start` ([`search_range`]), with
+/// the thresholds (and the mismatch where the effect needs it) on the fit blocks.
+fn search_from(
+    simulation: &Simulation,
+    state: &State,
+    effect: Effect,
+    start: f64,
+    run: &LoopRun,
+) -> Result<crate::fit::search::Searched, FitError> {
     let (range, counted) = search_range(
         effect,
         effect.range(start),
@@ -142,21 +167,16 @@ fn search_effect(
         simulation.geometry,
         &state.model.params,
     );
-    let searched = within_count(
-        search_profiled(
-            simulation,
-            &state.model.params,
-            effect,
-            range,
-            (&state.masked, &state.kept),
-            (run.fixed, effect.searched_with_mismatch()),
-            run.noise,
-        )?,
-        counted,
-    );
-    step.parameters.insert(key.into(), searched.value);
-    let uncertain = uncertain_of(key, &searched);
-    Ok((searched.model, Some(uncertain)))
+    let searched = search_profiled(
+        simulation,
+        &state.model.params,
+        effect,
+        range,
+        (&state.masked, &state.kept),
+        (run.fixed, effect.searched_with_mismatch()),
+        run.noise,
+    )?;
+    Ok(within_count(searched, counted))
 }
 
 /// A searched effect judged on the selection blocks and recorded (kept into `state` where

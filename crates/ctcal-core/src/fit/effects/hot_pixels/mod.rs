@@ -62,6 +62,7 @@ pub fn evidence(c: &Context) -> Evidence {
                 .collect::<Vec<_>>()
                 .join(", ")
         ),
+        other_start: None,
         start: None,
     }
 }
