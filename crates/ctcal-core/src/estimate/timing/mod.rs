@@ -142,6 +142,11 @@ pub struct Offset {
     pub source: &'static str,
 }
 
+/// [`Offset::source`] of an offset whose root the level slope's chance error leaves
+/// unbounded on both sides.
+pub const NOT_BOUNDED: &str =
+    "not determined: the thresholds' change with brightness bounds the offset on neither side";
+
 /// The range of offsets taken where the data do not bound it, DN: from none to the largest
 /// met in practice with margin. DVS-Voltmeter's fits to real sensors put it at 20 (DAVIS346)
 /// and 23 (DVS240) in 8-bit DN (Lin et al., ECCV 2022, `config.py`); DAVIS APS frames are
@@ -521,6 +526,16 @@ pub(super) fn find_offset(
     });
     let bound = 1.96 * std_dev(&slopes);
     let ci95 = offset_interval(&slope, root, bound, range);
+    if ci95 == [None, None] {
+        // the level slope's chance error reaches zero at both ends of the search: the root
+        // is a start, not a measurement (coverage draw 13037, frames at 11 DN: a root of
+        // 35 DN, open both ways, read through by eppps as the response shrank its
+        // contrasts 5x)
+        return Offset {
+            source: NOT_BOUNDED,
+            ..not_determined
+        };
+    }
     if !(OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(&root) {
         // a black level beyond any met in practice: more likely an effect the timing model
         // lacks (refractory delays, a nonlinear response) than the frames' offset
