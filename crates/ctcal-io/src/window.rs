@@ -700,7 +700,9 @@ pub fn eppps_of(
                 let known = !options.choose_response
                     || options.frame_offset_dn.is_some()
                     || (p.offset.is_some() && p.other_response.is_none());
-                Some((p.frames, known))
+                let fitted = options.frame_offset_dn.is_none()
+                    && p.offset.as_ref().is_some_and(|o| o.source == "fitted");
+                Some((p.frames, known, fitted))
             }
             Err(e) => {
                 notes.push(format!("frames not used for the dynamics: {}", e.problem));
@@ -714,8 +716,9 @@ pub fn eppps_of(
         &eppps::EpppsInput {
             sensor: loaded.sensor,
             events: &loaded.events,
-            frames: prepared.as_ref().map(|(f, _)| f),
-            response_known: prepared.as_ref().is_some_and(|(_, known)| *known),
+            frames: prepared.as_ref().map(|(f, _, _)| f),
+            response_known: prepared.as_ref().is_some_and(|(_, known, _)| *known),
+            offset_fitted: prepared.as_ref().is_some_and(|(_, _, fitted)| *fitted),
             excluded,
         },
         &eppps_options,

@@ -135,6 +135,10 @@ pub struct EpppsInput<'a> {
     /// Whether the frames' log response is known (given, or measured from the events'
     /// timing): otherwise the frames are scanned through both ends of what sensors use.
     pub response_known: bool,
+    /// Whether the frames' offset (`PreparedFrames::offset`) was fitted to the events'
+    /// timing, its 95 % range `PreparedFrames::offset_range`: where that range moves the
+    /// frames' contrast, they are scanned at its ends too ([`offset_bracket`]).
+    pub offset_fitted: bool,
     pub excluded: &'a [bool],
 }
 
@@ -183,7 +187,17 @@ pub fn estimate(
         ratio: 1.0,
         refractory_s: refractory.as_ref().map_or(0.0, |e| e.edge_us * 1e-6),
     };
-    let basis = Basis::new(frames, input.response_known, &excluded, options);
+    let response = match frames {
+        Some(f) if input.response_known => {
+            let bracket = input
+                .offset_fitted
+                .then(|| offset_bracket(f, rates.frames_median_dn))
+                .flatten();
+            FramesResponse::Known(bracket)
+        }
+        _ => FramesResponse::Unknown,
+    };
+    let basis = Basis::new(frames, response, &excluded, options);
     let mut scanned = scan_thresholds(&basis, rates, pixel, progress);
     let mut slow = frames.and_then(|f| {
         progress("photoreceptor bandwidth", 0.8);
@@ -350,7 +364,7 @@ fn assemble(
     result.assumptions.extend(scanned.balance.clone());
     result
         .assumptions
-        .extend(assumptions(rates, calibrations, basis.images(), hot));
+        .extend(assumptions(rates, calibrations, basis, hot));
     result.assumptions.extend(scan_assumptions(
         basis.frames.is_none().then_some(&scanned.reading),
         rates,
@@ -565,10 +579,63 @@ fn refractory_edge(
     refractory::edge(&mut intervals, refractory::timestamp_step(events)).filter(|e| e.found)
 }
 
+/// How the frames' log response is known.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum FramesResponse {
+    /// Neither measured nor given: both ends of what sensors use are scanned.
+    Unknown,
+    /// Measured or given; with the fitted offset's range where it moves the contrast.
+    Known(Option<OffsetBracket>),
+}
+
+/// A fitted offset's 95 % range where it moves the frames' contrast by more than
+/// [`OFFSET_BRACKET_RATIO`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct OffsetBracket {
+    lo: f32,
+    hi: f32,
+    /// `(median DN + hi) / (median DN + lo)`: how far the range moves the contrast.
+    ratio: f64,
+}
+
+/// How far (a factor) a fitted offset's range must move the frames' contrast at their
+/// median DN for the scans to run at its ends too. The offset b in ln(DN + b) scales a
+/// log change by DN / (DN + b); in dim frames a range of tens of DN is a factor of
+/// several. Read through the point alone, eppps missed on coverage draws 13037 (11 DN, b =
+/// 35 DN, range 0-60: ON 0.105 [0.042, 0.261] for 0.524), 11012 and 1028, and read 0.45-0.55x
+/// the truth on 77 and 1046 (9-10 DN): the fitted offsets of dim frames run high
+/// (a photoreceptor's lag looks like a larger offset, [`crate::estimate::timing`]).
+const OFFSET_BRACKET_RATIO: f64 = 1.25;
+
+/// The fitted offset's range as a bracket of the frames' response, where it moves their
+/// contrast at `median_dn` by more than [`OFFSET_BRACKET_RATIO`].
+fn offset_bracket(frames: &PreparedFrames, median_dn: Option<f64>) -> Option<OffsetBracket> {
+    let dn = median_dn?;
+    let (lo, hi) = frames.offset_range;
+    // DN + b stays positive at every pixel: no negative offset is scanned
+    let lo = lo.min(frames.offset).max(0.0);
+    let hi = hi.max(frames.offset);
+    let ratio = (dn + hi as f64) / (dn + lo as f64).max(0.5);
+    (ratio > OFFSET_BRACKET_RATIO).then_some(OffsetBracket { lo, hi, ratio })
+}
+
+/// What the scans at a fitted offset's ends assume.
+fn offset_bracket_assumption(bracket: &OffsetBracket, median_dn: Option<f64>) -> String {
+    format!(
+        "the frames' fitted log offset b leaves a range {:.1} .. {:.1} DN (its 95 % interval and the ON and OFF samples' own, no negative offset scanned) that moves their contrast at the median {:.0} DN by a factor {:.2}: they are scanned at both ends and at the fitted offset, the threshold is the three's geometric mean and their spread is in the interval",
+        bracket.lo,
+        bracket.hi,
+        median_dn.unwrap_or(f64::NAN),
+        bracket.ratio
+    )
+}
+
 /// What a recording is compared with: its frames, or the prior's images under every blur
 /// and floor (and what each of them is).
 struct Basis<'a> {
     frames: Option<&'a PreparedFrames>,
+    /// How the frames' log response is known.
+    response: FramesResponse,
     /// The log responses the frames are read through, and their names.
     responses: Vec<(calibration::Response, String)>,
     excluded: &'a [bool],
@@ -584,20 +651,30 @@ const MIN_BURST_PAIRS: usize = 200;
 impl<'a> Basis<'a> {
     fn new(
         frames: Option<&'a PreparedFrames>,
-        response_known: bool,
+        response: FramesResponse,
         excluded: &'a [bool],
         options: &'a EpppsOptions,
     ) -> Self {
-        let responses = match frames {
-            Some(f) if response_known => vec![(
+        let responses = match (frames, response) {
+            (Some(f), FramesResponse::Known(None)) => vec![(
                 calibration::Response::of(f),
                 "the recording's frames".to_string(),
             )],
-            Some(_) => calibration::Response::ends()
+            (Some(f), FramesResponse::Known(Some(bracket))) => {
+                let at = |offset_dn: f32| calibration::Response {
+                    offset_dn,
+                    ..calibration::Response::of(f)
+                };
+                [bracket.lo, f.offset, bracket.hi]
+                    .into_iter()
+                    .map(|b| (at(b), format!("the recording's frames at b = {b:.1} DN")))
+                    .collect()
+            }
+            (Some(_), FramesResponse::Unknown) => calibration::Response::ends()
                 .into_iter()
                 .map(|(r, name)| (r, format!("the recording's frames through {name}")))
                 .collect(),
-            None => Vec::new(),
+            (None, _) => Vec::new(),
         };
         let priors = match frames {
             Some(_) => Vec::new(),
@@ -606,6 +683,7 @@ impl<'a> Basis<'a> {
         let tags = priors.iter().map(prior::PriorImage::tag).collect();
         Basis {
             frames,
+            response,
             responses,
             excluded,
             options,
@@ -994,9 +1072,10 @@ fn by_brightness(still: &still::StillPixels) -> String {
 fn assumptions(
     rates: &RecordingRates,
     calibrations: &[Calibration],
-    images: usize,
+    basis: &Basis,
     hot: usize,
 ) -> Vec<String> {
+    let images = basis.images();
     let frames = images == 0;
     let mut out = Vec::new();
     if hot > 0 {
@@ -1019,7 +1098,9 @@ fn assumptions(
     if frames {
         out.push("calibration: ideal pixels along each pixel's own path through the frames (the scene's contrast measured); ON = OFF threshold in the scans".into());
     }
-    if frames && calibrations.len() > 1 {
+    if let (true, FramesResponse::Known(Some(bracket))) = (frames, basis.response) {
+        out.push(offset_bracket_assumption(&bracket, rates.frames_median_dn));
+    } else if frames && calibrations.len() > 1 {
         out.push(format!(
             "{RESPONSE_NOT_MEASURED}: they are scanned through both ends of what sensors and simulators use, v2e's lin-log (linear below 20 DN, as an offset of about 20 DN; DVS-Voltmeter fits ln(DN + 20-23 DN)) and a pure log (ESIM's ln(I + 0.001)); the threshold is their geometric mean and their spread ({} calibrations) is in the interval; they differ where the scene is dim (a response given where the sensor's is known replaces them)",
             calibrations.len()
@@ -1193,6 +1274,43 @@ fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Frames at 11 DN whose fitted offset 35.1 DN has the range -2.3 .. 60 DN (coverage
+    /// draw 13037): the range moves their contrast by (11 + 60) / (11 + 0) = 6.45 (no
+    /// negative offset scanned), so they are scanned at 0, 35.1 and 60 DN; at 200 DN the
+    /// same range moves it by 260 / 200 = 1.3, still bracketed; a range of 30 .. 40 DN at
+    /// 100 DN moves it by 1.077 and the fitted offset is read alone.
+    #[test]
+    fn a_fitted_offset_is_bracketed_where_its_range_moves_the_contrast() {
+        let mut frames = crate::fit::effects::fixture::static_frames(4, 4, 0.3, 11.0);
+        frames.offset = 35.1;
+        frames.offset_range = (-2.3, 60.0);
+        let bracket = offset_bracket(&frames, Some(11.0)).unwrap();
+        assert_eq!((bracket.lo, bracket.hi), (0.0, 60.0));
+        assert!((bracket.ratio - 71.0 / 11.0).abs() < 1e-9, "{bracket:?}");
+        assert!((offset_bracket(&frames, Some(200.0)).unwrap().ratio - 1.3).abs() < 1e-9);
+        assert_eq!(offset_bracket(&frames, None), None);
+        frames.offset = 34.0;
+        frames.offset_range = (30.0, 40.0);
+        assert_eq!(offset_bracket(&frames, Some(100.0)), None);
+
+        frames.offset = 35.1;
+        frames.offset_range = (-2.3, 60.0);
+        let options = EpppsOptions::default();
+        let excluded = vec![false; 16];
+        let response = FramesResponse::Known(offset_bracket(&frames, Some(11.0)));
+        let basis = Basis::new(Some(&frames), response, &excluded, &options);
+        let offsets: Vec<f32> = basis.responses.iter().map(|(r, _)| r.offset_dn).collect();
+        assert_eq!(offsets, vec![0.0, 35.1, 60.0]);
+        let single = Basis::new(
+            Some(&frames),
+            FramesResponse::Known(None),
+            &excluded,
+            &options,
+        );
+        assert_eq!(single.responses.len(), 1);
+        assert_eq!(single.responses[0].0.offset_dn, 35.1);
+    }
 
     fn beyond(above: usize, below: usize) -> Beyond {
         Beyond {

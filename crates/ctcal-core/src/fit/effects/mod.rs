@@ -17,7 +17,7 @@
 pub mod bandwidth;
 pub mod display;
 #[cfg(test)]
-pub(in crate::fit) mod fixture;
+pub(crate) mod fixture;
 pub mod hot_pixels;
 pub mod jitter;
 pub mod leak;

@@ -447,6 +447,7 @@ fn thresholds(
             events: &fit_events,
             frames: None,
             response_known: false,
+            offset_fitted: false,
             excluded: input.excluded,
         },
         &EpppsOptions {
