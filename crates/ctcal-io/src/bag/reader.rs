@@ -2,7 +2,7 @@
 //! decompressed one after another (memory: one chunk), and the connection and message
 //! records inside them handed out in file order.
 
-use super::records::{self, BagDamage, InnerRecords, RecordFile, op};
+use super::records::{self, BagDamage, FileRecord, InnerRecords, RecordFile, op};
 use crate::error::{FIX_TRUNCATED, InputError};
 use std::path::Path;
 
@@ -94,68 +94,13 @@ impl MessageReader {
         loop {
             if self.inner < self.chunk.len() {
                 let start = self.inner;
-                // what the record is, with the data as a range (the borrow of the chunk
-                // ends before the chunk may be refilled)
-                let parsed = {
-                    let mut records = InnerRecords::new(&self.chunk[start..]);
-                    let record = records.next().expect("bytes remain");
-                    self.inner += records.consumed();
-                    let place = || {
-                        format!(
-                            "chunk at byte offset {}, record at byte {start} of the chunk",
-                            self.chunk_offset
-                        )
-                    };
-                    let record = record.map_err(|problem| {
-                        InputError::corrupt(&path, place(), problem, FIX_TRUNCATED)
-                    })?;
-                    let damaged = |problem: String| {
-                        InputError::corrupt(&path, place(), problem, FIX_TRUNCATED)
-                    };
-                    match records::op_of(&record.fields) {
-                        Some(op::CONNECTION) => Parsed::Connection(
-                            connection(&record.fields, record.data).map_err(damaged)?,
-                        ),
-                        Some(op::MESSAGE) => {
-                            let connection = records::int_field::<4>(&record.fields, "conn")
-                                .ok_or_else(|| damaged("the message has no `conn` id".into()))?;
-                            let data = start + record.data_offset;
-                            Parsed::Message(connection as u32, data..data + record.data.len())
-                        }
-                        _ => Parsed::Other,
-                    }
-                };
-                match parsed {
+                match self.parse_inner(&path, start)? {
                     Parsed::Connection(c) => {
-                        if !self.known.iter().any(|(id, _)| *id == c.id) {
-                            self.known.push((c.id, c.topic.clone()));
-                        }
+                        self.remember(&c);
                         return Ok(Some(Item::Connection(c)));
                     }
-                    Parsed::Message(connection, _)
-                        if !self.known.iter().any(|(id, _)| *id == connection) =>
-                    {
-                        // its topic cannot be told: events or frames would go missing
-                        let defined = if self.known.is_empty() {
-                            "none".to_string()
-                        } else {
-                            self.known
-                                .iter()
-                                .map(|(id, topic)| format!("{id} ({topic})"))
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        };
-                        return Err(InputError::corrupt(
-                            &path,
-                            format!(
-                                "chunk at byte offset {}, record at byte {start} of the chunk",
-                                self.chunk_offset
-                            ),
-                            format!(
-                                "a message of connection id {connection}, which no connection record before it defines (defined: {defined}), so its topic is unknown"
-                            ),
-                            FIX_TRUNCATED,
-                        ));
+                    Parsed::Message(connection, _) if !self.is_known(connection) => {
+                        return Err(self.unknown_connection(&path, start, connection));
                     }
                     Parsed::Message(connection, range) => {
                         self.messages += 1;
@@ -167,49 +112,141 @@ impl MessageReader {
                     Parsed::Other => continue,
                 }
             }
-            // the next chunk
+            if !self.load_next_chunk(&path)? {
+                return Ok(None);
+            }
+        }
+    }
+
+    /// Where the inner record at byte `start` of the current chunk lies, for messages.
+    fn record_place(&self, start: usize) -> String {
+        format!(
+            "chunk at byte offset {}, record at byte {start} of the chunk",
+            self.chunk_offset
+        )
+    }
+
+    /// Reads the inner record at byte `start` of the current chunk and moves past it.
+    /// rosbag v2.0: a chunk's records are connections (op 0x07: `conn` id and `topic` in
+    /// the header, the message `type` in the data) and messages (op 0x02: `conn` id in the
+    /// header, the serialized message as data); any other op is passed over. A message's
+    /// data is returned as a range of the chunk, so that the borrow of the chunk ends here
+    /// (before the chunk may be refilled).
+    fn parse_inner(&mut self, path: &Path, start: usize) -> Result<Parsed, InputError> {
+        let mut records = InnerRecords::new(&self.chunk[start..]);
+        let record = records.next().expect("bytes remain");
+        self.inner += records.consumed();
+        let record = record.map_err(|problem| {
+            InputError::corrupt(path, self.record_place(start), problem, FIX_TRUNCATED)
+        })?;
+        let damaged = |problem: String| {
+            InputError::corrupt(path, self.record_place(start), problem, FIX_TRUNCATED)
+        };
+        Ok(match records::op_of(&record.fields) {
+            Some(op::CONNECTION) => {
+                Parsed::Connection(connection(&record.fields, record.data).map_err(damaged)?)
+            }
+            Some(op::MESSAGE) => {
+                let connection = records::int_field::<4>(&record.fields, "conn")
+                    .ok_or_else(|| damaged("the message has no `conn` id".into()))?;
+                let data = start + record.data_offset;
+                Parsed::Message(connection as u32, data..data + record.data.len())
+            }
+            _ => Parsed::Other,
+        })
+    }
+
+    /// Whether a connection record read so far defines connection `id`.
+    fn is_known(&self, id: u32) -> bool {
+        self.known.iter().any(|(known, _)| *known == id)
+    }
+
+    /// Records the id and topic of connection `c` (once per id), so that the messages after
+    /// it can be told apart by topic.
+    fn remember(&mut self, c: &Connection) {
+        if !self.is_known(c.id) {
+            self.known.push((c.id, c.topic.clone()));
+        }
+    }
+
+    /// The error for a message (at byte `start` of the chunk) of a connection id that no
+    /// connection record before it defines: its topic cannot be told, so events or frames
+    /// would go missing.
+    fn unknown_connection(&self, path: &Path, start: usize, connection: u32) -> InputError {
+        let defined = if self.known.is_empty() {
+            "none".to_string()
+        } else {
+            self.known
+                .iter()
+                .map(|(id, topic)| format!("{id} ({topic})"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        InputError::corrupt(
+            path,
+            self.record_place(start),
+            format!(
+                "a message of connection id {connection}, which no connection record before it defines (defined: {defined}), so its topic is unknown"
+            ),
+            FIX_TRUNCATED,
+        )
+    }
+
+    /// Reads record headers up to the next chunk record and loads that chunk
+    /// ([`Self::load_chunk`]); the data of any other record (rosbag v2.0: the index data
+    /// records, op 0x04, that follow each chunk) is skipped. `false` at the end of the chunk
+    /// section.
+    fn load_next_chunk(&mut self, path: &Path) -> Result<bool, InputError> {
+        loop {
             let header = match self
                 .file
                 .next_header(self.end)
-                .map_err(|e| InputError::io(&path, e))?
+                .map_err(|e| InputError::io(path, e))?
             {
                 Ok(Some(h)) => h,
-                Ok(None) => return Ok(None),
-                Err(damage) => return Err(damage_error(&path, damage)),
+                Ok(None) => return Ok(false),
+                Err(damage) => return Err(damage_error(path, damage)),
             };
             let place = format!("record at byte offset {}", header.offset);
             let fields = records::fields(&header.header)
-                .map_err(|problem| InputError::corrupt(&path, &place, problem, FIX_TRUNCATED))?;
+                .map_err(|problem| InputError::corrupt(path, &place, problem, FIX_TRUNCATED))?;
             if records::op_of(&fields) != Some(op::CHUNK) {
                 self.file
                     .skip_data(&header)
-                    .map_err(|e| InputError::io(&path, e))?;
+                    .map_err(|e| InputError::io(path, e))?;
                 continue;
             }
-            let (compression, size) = records::chunk_header(&fields).map_err(|problem| {
-                InputError::corrupt(
-                    &path,
-                    format!("chunk at byte offset {}", header.offset),
-                    problem,
-                    FIX_TRUNCATED,
-                )
-            })?;
-            self.file
-                .read_data(&header, &mut self.compressed)
-                .map_err(|e| InputError::io(&path, e))?;
-            self.chunk_offset = header.offset;
-            records::decompress(compression, &self.compressed, size, &mut self.chunk).map_err(
-                |problem| {
-                    InputError::corrupt(
-                        &path,
-                        format!("chunk at byte offset {}", header.offset),
-                        problem,
-                        FIX_TRUNCATED,
-                    )
-                },
-            )?;
-            self.inner = 0;
+            self.load_chunk(path, &header, &fields)?;
+            return Ok(true);
         }
+    }
+
+    /// Reads the data of chunk record `header` and decompresses it into `self.chunk`,
+    /// positioned at its first inner record. rosbag v2.0: a chunk (op 0x05) states its
+    /// `compression` (`none`, `bz2` or `lz4`) and uncompressed `size` in its header.
+    fn load_chunk(
+        &mut self,
+        path: &Path,
+        header: &FileRecord,
+        fields: &[(&str, &[u8])],
+    ) -> Result<(), InputError> {
+        let chunk_damaged = |problem: String| {
+            InputError::corrupt(
+                path,
+                format!("chunk at byte offset {}", header.offset),
+                problem,
+                FIX_TRUNCATED,
+            )
+        };
+        let (compression, size) = records::chunk_header(fields).map_err(chunk_damaged)?;
+        self.file
+            .read_data(header, &mut self.compressed)
+            .map_err(|e| InputError::io(path, e))?;
+        self.chunk_offset = header.offset;
+        records::decompress(compression, &self.compressed, size, &mut self.chunk)
+            .map_err(chunk_damaged)?;
+        self.inner = 0;
+        Ok(())
     }
 }
 
