@@ -39,8 +39,27 @@ fn le32(bytes: &[u8], at: usize) -> Result<usize, String> {
     usize::try_from(v).map_err(|_| format!("holds a negative length ({v}) at byte {at}"))
 }
 
-/// Decompresses a Blosc buffer into exactly `expected` bytes.
-pub fn decompress(data: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+/// What decoding needs of a Blosc 1 header.
+struct Header {
+    flags: u8,
+    typesize: usize,
+    nbytes: usize,
+    blocksize: usize,
+}
+
+impl Header {
+    /// The codec, in the top three flag bits (0 BloscLZ, 1 LZ4, 2 Snappy, 3 zlib, 4
+    /// Zstandard).
+    fn codec(&self) -> u8 {
+        self.flags >> 5
+    }
+}
+
+/// Reads and checks the 16-byte header (blosc1 format: byte 0 `version`, 1 `versionlz`, 2
+/// `flags`, 3 `typesize`, then little-endian i32 `nbytes` (uncompressed), `blocksize` and
+/// `cbytes` (compressed, header included)): `nbytes` must be the chunk's `expected` size,
+/// `cbytes` within `data`, the version 1 or 2 and the reserved flag bit `0x8` clear.
+fn read_header(data: &[u8], expected: usize) -> Result<Header, String> {
     if data.len() < HEADER {
         return Err("is shorter than a Blosc header".into());
     }
@@ -61,99 +80,168 @@ pub fn decompress(data: &[u8], expected: usize) -> Result<Vec<u8>, String> {
             "has an unknown Blosc header (version {version}, flags {flags:#x})"
         ));
     }
-    if flags & FLAG_MEMCPYED != 0 {
+    Ok(Header {
+        flags,
+        typesize,
+        nbytes,
+        blocksize,
+    })
+}
+
+/// Decompresses a Blosc buffer into exactly `expected` bytes.
+pub fn decompress(data: &[u8], expected: usize) -> Result<Vec<u8>, String> {
+    let header = read_header(data, expected)?;
+    if header.flags & FLAG_MEMCPYED != 0 {
         return data
-            .get(HEADER..HEADER + nbytes)
+            .get(HEADER..HEADER + header.nbytes)
             .map(<[u8]>::to_vec)
             .ok_or_else(|| "is cut short".to_string());
     }
-    let codec = flags >> 5;
-    if flags & FLAG_BITSHUFFLE != 0 || !matches!(codec, 1 | 3 | 4) {
+    if header.flags & FLAG_BITSHUFFLE != 0 || !matches!(header.codec(), 1 | 3 | 4) {
         return with_c_blosc(data, expected);
     }
-    if blocksize == 0 {
+    if header.blocksize == 0 {
         return Err("has a block size of 0".into());
     }
+    let mut out = vec![0u8; header.nbytes];
+    decode_blocks(data, &header, &mut out)?;
+    Ok(out)
+}
+
+/// Decodes every block of `data` into its place in `out` (`nbytes` long). blosc1 format:
+/// the header is followed by one i32 offset per block (from the start of the buffer);
+/// block `j` holds bytes `j * blocksize..` of the result, `blocksize` of them except the
+/// last, which holds what is left over.
+fn decode_blocks(data: &[u8], header: &Header, out: &mut [u8]) -> Result<(), String> {
+    let (nbytes, blocksize) = (header.nbytes, header.blocksize);
     let blocks = nbytes.div_ceil(blocksize);
     let leftover = nbytes % blocksize;
-    let mut out = vec![0u8; nbytes];
+    // reused by every zlib split of the buffer
     let mut split = Vec::new();
     for j in 0..blocks {
         let last = j + 1 == blocks && leftover > 0;
         let size = if last { leftover } else { blocksize };
-        let splits = if flags & FLAG_DONT_SPLIT == 0
-            && typesize <= MAX_SPLITS
-            && size / typesize >= MIN_BUFFERSIZE
-            && !last
-        {
-            typesize
-        } else {
-            1
-        };
-        let per_split = size / splits;
-        let shuffled = flags & FLAG_SHUFFLE != 0 && typesize > 1;
-        let mut at = le32(data, HEADER + 4 * j)?;
         let block = &mut out[j * blocksize..j * blocksize + size];
-        // unshuffled blocks decompress straight into place; shuffled ones via a buffer
-        let mut buffer = if shuffled {
-            vec![0u8; size]
+        decode_block(data, header, j, last, block, &mut split)?;
+    }
+    Ok(())
+}
+
+/// How many streams ("splits") a block of `size` bytes is stored in, as c-blosc's
+/// `blosc_d` decides: one per byte of the type, unless the header's flag `0x10` says not
+/// to split, the type is wider than [`MAX_SPLITS`] bytes, the block holds fewer than
+/// [`MIN_BUFFERSIZE`] elements, or it is the leftover block (then one).
+fn split_count(header: &Header, size: usize, last: bool) -> usize {
+    let typesize = header.typesize;
+    if header.flags & FLAG_DONT_SPLIT == 0
+        && typesize <= MAX_SPLITS
+        && size / typesize >= MIN_BUFFERSIZE
+        && !last
+    {
+        typesize
+    } else {
+        1
+    }
+}
+
+/// Decodes block `j` into `block` (its bytes of the result). blosc1 format: the block is
+/// its splits one after another, each an i32 compressed length and that many bytes (a
+/// length equal to the split's raw size means stored as it is); with flag `0x1` (and a
+/// type wider than a byte) the decoded block is byte-shuffled. `split` is a buffer reused
+/// for zlib.
+fn decode_block(
+    data: &[u8],
+    header: &Header,
+    j: usize,
+    last: bool,
+    block: &mut [u8],
+    split: &mut Vec<u8>,
+) -> Result<(), String> {
+    let size = block.len();
+    let splits = split_count(header, size, last);
+    let per_split = size / splits;
+    let shuffled = header.flags & FLAG_SHUFFLE != 0 && header.typesize > 1;
+    let mut at = le32(data, HEADER + 4 * j)?;
+    // unshuffled blocks decompress straight into place; shuffled ones via a buffer
+    let mut buffer = if shuffled {
+        vec![0u8; size]
+    } else {
+        Vec::new()
+    };
+    for s in 0..splits {
+        let length = le32(data, at)?;
+        at += 4;
+        let source = data
+            .get(at..at + length)
+            .ok_or_else(|| format!("block {j} runs past the end of the buffer"))?;
+        at += length;
+        let target = if shuffled {
+            &mut buffer[s * per_split..(s + 1) * per_split]
         } else {
-            Vec::new()
+            &mut block[s * per_split..(s + 1) * per_split]
         };
-        for s in 0..splits {
-            let length = le32(data, at)?;
-            at += 4;
-            let source = data
-                .get(at..at + length)
-                .ok_or_else(|| format!("block {j} runs past the end of the buffer"))?;
-            at += length;
-            let target = if shuffled {
-                &mut buffer[s * per_split..(s + 1) * per_split]
-            } else {
-                &mut block[s * per_split..(s + 1) * per_split]
-            };
-            if length == per_split {
-                target.copy_from_slice(source);
-                continue;
-            }
-            split.clear();
-            let got = match codec {
-                1 => lz4_flex::block::decompress_into(source, target)
-                    .map_err(|e| format!("block {j}: LZ4 data do not decompress ({e})"))?,
-                3 => {
-                    flate2::read::ZlibDecoder::new(source)
-                        .take(per_split as u64 + 1)
-                        .read_to_end(&mut split)
-                        .map_err(|e| format!("block {j}: zlib data do not decompress ({e})"))?;
-                    let n = split.len().min(per_split);
-                    target[..n].copy_from_slice(&split[..n]);
-                    split.len()
-                }
-                _ => ZSTD.with(|cell| {
-                    let mut cell = cell.borrow_mut();
-                    if cell.is_none() {
-                        *cell = Some(
-                            zstd::bulk::Decompressor::new()
-                                .map_err(|e| format!("cannot start Zstandard ({e})"))?,
-                        );
-                    }
-                    cell.as_mut()
-                        .expect("set above")
-                        .decompress_to_buffer(source, target)
-                        .map_err(|e| format!("block {j}: Zstandard data do not decompress ({e})"))
-                })?,
-            };
-            if got != per_split {
-                return Err(format!(
-                    "block {j} decompresses to {got} bytes instead of {per_split}"
-                ));
-            }
+        if length == per_split {
+            target.copy_from_slice(source);
+            continue;
         }
-        if shuffled {
-            unshuffle(&buffer, typesize, block);
+        let got = decode_split(header.codec(), j, source, target, split)?;
+        if got != per_split {
+            return Err(format!(
+                "block {j} decompresses to {got} bytes instead of {per_split}"
+            ));
         }
     }
-    Ok(out)
+    if shuffled {
+        unshuffle(&buffer, header.typesize, block);
+    }
+    Ok(())
+}
+
+/// Decompresses one compressed split of block `j`, `source`, into `target` (its raw size)
+/// with `codec` (1 LZ4 block, 3 zlib, else Zstandard); the number of bytes it decompresses
+/// to (zlib: up to one more than `target` holds, so that an overlong split is told).
+/// `split` is a buffer reused for zlib.
+fn decode_split(
+    codec: u8,
+    j: usize,
+    source: &[u8],
+    target: &mut [u8],
+    split: &mut Vec<u8>,
+) -> Result<usize, String> {
+    let per_split = target.len();
+    split.clear();
+    Ok(match codec {
+        1 => lz4_flex::block::decompress_into(source, target)
+            .map_err(|e| format!("block {j}: LZ4 data do not decompress ({e})"))?,
+        3 => {
+            flate2::read::ZlibDecoder::new(source)
+                .take(per_split as u64 + 1)
+                .read_to_end(split)
+                .map_err(|e| format!("block {j}: zlib data do not decompress ({e})"))?;
+            let n = split.len().min(per_split);
+            target[..n].copy_from_slice(&split[..n]);
+            split.len()
+        }
+        _ => zstd_into(j, source, target)?,
+    })
+}
+
+/// Zstandard-decompresses a split of block `j`, `source`, into `target` with this thread's
+/// context (made on first use; see the module docs); the number of bytes written.
+fn zstd_into(j: usize, source: &[u8], target: &mut [u8]) -> Result<usize, String> {
+    ZSTD.with(|cell| {
+        let mut cell = cell.borrow_mut();
+        if cell.is_none() {
+            *cell = Some(
+                zstd::bulk::Decompressor::new()
+                    .map_err(|e| format!("cannot start Zstandard ({e})"))?,
+            );
+        }
+        cell.as_mut()
+            .expect("set above")
+            .decompress_to_buffer(source, target)
+            .map_err(|e| format!("block {j}: Zstandard data do not decompress ({e})"))
+    })
 }
 
 /// Undoes Blosc's byte shuffle of one block: byte `b` of element `i` was stored at
