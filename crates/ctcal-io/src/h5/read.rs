@@ -633,49 +633,7 @@ fn check_dataset(
 pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
     let file = open_file(path)?;
     let layout = layout_of(path, &file, side)?;
-    let events = match layout {
-        Layout::EventUtils => {
-            let n = check_dataset(path, &file, "events/ts", 1)?[0];
-            for name in ["events/xs", "events/ys", "events/ps"] {
-                let len = check_dataset(path, &file, name, 1)?[0];
-                if len != n {
-                    return Err(InputError::hdf5(
-                        path,
-                        format!("{name} has {len} entries but events/ts has {n}"),
-                        "the file is damaged or was written incompletely; rewrite it",
-                    ));
-                }
-            }
-            n
-        }
-        Layout::V2e => check_dataset(path, &file, "events", 2)?[0],
-        Layout::Mvsec(side) => {
-            let name = format!("{}/events", side.group());
-            let shape = check_dataset(path, &file, &name, 2)?;
-            if shape[1] != 4 {
-                return Err(InputError::hdf5(
-                    path,
-                    format!("{name} has shape {shape:?}, expected N x 4"),
-                    "MVSEC files store events as N rows of [x, y, t, p]",
-                ));
-            }
-            shape[0]
-        }
-        Layout::Dsec => {
-            let n = check_dataset(path, &file, "events/t", 1)?[0];
-            for name in ["events/x", "events/y", "events/p"] {
-                let len = check_dataset(path, &file, name, 1)?[0];
-                if len != n {
-                    return Err(InputError::hdf5(
-                        path,
-                        format!("{name} has {len} entries but events/t has {n}"),
-                        "the file is damaged or was written incompletely; rewrite it",
-                    ));
-                }
-            }
-            n
-        }
-    };
+    let events = event_count(path, &file, layout)?;
     let notes = time_precision(path, &file, layout, events)?
         .into_iter()
         .collect::<Vec<_>>();
@@ -697,38 +655,7 @@ pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
     };
     let (sensor, sensor_note) = match claimed {
         None => (None, None),
-        Some((h, w)) => {
-            let (max_x, max_y) = coordinate_extent(path, &file, layout, events)?;
-            let fits = |w: u16, h: u16| max_x < w as i64 && max_y < h as i64;
-            if fits(w, h) {
-                (
-                    Some(Sensor::new(w, h)),
-                    Some(format!("sensor_resolution ({h}, {w}) read as (H, W)")),
-                )
-            } else if fits(h, w) {
-                (
-                    Some(Sensor::new(h, w)),
-                    Some(format!(
-                        "sensor_resolution is stored as ({h}, {w}); the coordinates (x up to {max_x}, y up to {max_y}) only fit {h}x{w}, so it was read as (W, H)"
-                    )),
-                )
-            } else {
-                return Err(InputError::OutsideSensor {
-                    path: path.to_path_buf(),
-                    place: "root attribute sensor_resolution".into(),
-                    x: max_x,
-                    y: max_y,
-                    width: w,
-                    height: h,
-                    claimed: format!(
-                        " the file claims (sensor_resolution = ({h}, {w}), in either order)"
-                    ),
-                    fix: Text::default()
-                        .act(Hint::Sensor(None))
-                        .words(" with the real sensor size"),
-                });
-            }
-        }
+        Some((h, w)) => checked_resolution(path, &file, layout, events, h, w)?,
     };
     Ok(H5Info {
         layout,
@@ -738,6 +665,102 @@ pub fn probe(path: &Path, side: Side) -> Result<H5Info, InputError> {
         frame_count: frames.times.len(),
         notes,
     })
+}
+
+/// The number of events of `layout`, after [`check_dataset`] on every event dataset (HDF5:
+/// rank, filters, chunk and stored sizes): the four 1-D columns of event_utils
+/// (`events/ts`, `xs`, `ys`, `ps`) and DSEC (`events/t`, `x`, `y`, `p`) must have one
+/// length; the v2e table `events` is 2-D (its 4 columns checked by [`layout_of`]) and
+/// MVSEC's `davis/{side}/events` N x 4.
+fn event_count(path: &Path, file: &hdf5::File, layout: Layout) -> Result<usize, InputError> {
+    Ok(match layout {
+        Layout::EventUtils => column_length(
+            path,
+            file,
+            "events/ts",
+            ["events/xs", "events/ys", "events/ps"],
+        )?,
+        Layout::V2e => check_dataset(path, file, "events", 2)?[0],
+        Layout::Mvsec(side) => {
+            let name = format!("{}/events", side.group());
+            let shape = check_dataset(path, file, &name, 2)?;
+            if shape[1] != 4 {
+                return Err(InputError::hdf5(
+                    path,
+                    format!("{name} has shape {shape:?}, expected N x 4"),
+                    "MVSEC files store events as N rows of [x, y, t, p]",
+                ));
+            }
+            shape[0]
+        }
+        Layout::Dsec => {
+            column_length(path, file, "events/t", ["events/x", "events/y", "events/p"])?
+        }
+    })
+}
+
+/// The length of the 1-D column `first`, after checking each column (`first` and the
+/// `others`, [`check_dataset`]) and that the `others` have the same length.
+fn column_length(
+    path: &Path,
+    file: &hdf5::File,
+    first: &str,
+    others: [&str; 3],
+) -> Result<usize, InputError> {
+    let n = check_dataset(path, file, first, 1)?[0];
+    for name in others {
+        let len = check_dataset(path, file, name, 1)?[0];
+        if len != n {
+            return Err(InputError::hdf5(
+                path,
+                format!("{name} has {len} entries but {first} has {n}"),
+                "the file is damaged or was written incompletely; rewrite it",
+            ));
+        }
+    }
+    Ok(n)
+}
+
+/// The sensor and how it is known, from the `sensor_resolution` the file claims, (`h`, `w`)
+/// as event_utils writes it, checked against the largest coordinates over the whole file:
+/// read as (H, W) where the events fit, else as (W, H) where they fit that, else the events
+/// lie outside the sensor and the file is refused.
+fn checked_resolution(
+    path: &Path,
+    file: &hdf5::File,
+    layout: Layout,
+    events: usize,
+    h: u16,
+    w: u16,
+) -> Result<(Option<Sensor>, Option<String>), InputError> {
+    let (max_x, max_y) = coordinate_extent(path, file, layout, events)?;
+    let fits = |w: u16, h: u16| max_x < w as i64 && max_y < h as i64;
+    if fits(w, h) {
+        Ok((
+            Some(Sensor::new(w, h)),
+            Some(format!("sensor_resolution ({h}, {w}) read as (H, W)")),
+        ))
+    } else if fits(h, w) {
+        Ok((
+            Some(Sensor::new(h, w)),
+            Some(format!(
+                "sensor_resolution is stored as ({h}, {w}); the coordinates (x up to {max_x}, y up to {max_y}) only fit {h}x{w}, so it was read as (W, H)"
+            )),
+        ))
+    } else {
+        Err(InputError::OutsideSensor {
+            path: path.to_path_buf(),
+            place: "root attribute sensor_resolution".into(),
+            x: max_x,
+            y: max_y,
+            width: w,
+            height: h,
+            claimed: format!(" the file claims (sensor_resolution = ({h}, {w}), in either order)"),
+            fix: Text::default()
+                .act(Hint::Sensor(None))
+                .words(" with the real sensor size"),
+        })
+    }
 }
 
 /// The coarsest spacing of stored times ctcal accepts, seconds: events less than this
