@@ -366,105 +366,152 @@ impl EventTable {
         columns.t.clear();
         columns.p.clear();
         match self {
-            EventTable::EventUtils(c) => {
-                let Columns { t, x, y, p } = columns;
-                x.clear();
-                y.clear();
-                let seconds = &mut buffers.seconds;
-                seconds.clear();
-                // the four columns at once (see the DSEC case)
-                let ((rt, rx), (ry, rp)) = rayon::join(
-                    || {
-                        rayon::join(
-                            || {
-                                if c.integer_times {
-                                    // integer timestamps are microseconds (seconds as
-                                    // integers make no sense)
-                                    c.ts.ints(range.clone(), t)
-                                } else {
-                                    c.ts.floats(range.clone(), seconds)
-                                }
-                            },
-                            || c.xs.ints(range.clone(), x),
-                        )
-                    },
-                    || {
-                        rayon::join(
-                            || c.ys.ints(range.clone(), y),
-                            || c.ps.ints(range.clone(), p),
-                        )
-                    },
-                );
-                rt.and(rx).and(ry).and(rp)?;
-                if !c.integer_times {
-                    // a non-finite time becomes i64::MIN and is reported by read_chunk
-                    t.extend(seconds.iter().map(|&s| {
-                        if s.is_finite() {
-                            crate::events::s_to_us(s)
-                        } else {
-                            TimeUs::MIN
-                        }
-                    }));
-                }
-                Ok(())
-            }
-            EventTable::V2e(ds) => {
-                let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, ..])?;
-                columns.t.extend(rows.column(0).iter());
-                columns.x.clear();
-                columns.y.clear();
-                columns.x.extend(rows.column(1).iter());
-                columns.y.extend(rows.column(2).iter());
-                columns.p.extend(rows.column(3).iter());
-                Ok(())
-            }
-            EventTable::Mvsec(ds, _) => {
-                let rows = ds.read_slice_2d::<f64, _>(ndarray::s![range, ..])?;
-                columns.x.clear();
-                columns.y.clear();
-                columns
-                    .x
-                    .extend(rows.column(0).iter().map(|&v| float_to_int(v)));
-                columns
-                    .y
-                    .extend(rows.column(1).iter().map(|&v| float_to_int(v)));
-                // seconds since the epoch, to the nearest microsecond (float64 resolves
-                // 0.24 us there)
-                columns.t.extend(rows.column(2).iter().map(|&s| {
-                    if s.is_finite() && s.abs() < 1e12 {
-                        crate::events::s_to_us(s)
-                    } else {
-                        TimeUs::MIN
-                    }
-                }));
-                columns
-                    .p
-                    .extend(rows.column(3).iter().map(|&v| float_to_int(v)));
-                Ok(())
-            }
-            EventTable::Dsec(c) => {
-                let Columns { t, x, y, p } = columns;
-                x.clear();
-                y.clear();
-                // the four columns at once: each column's chunks are read under libhdf5's
-                // lock one after another, but decompress while the next column is read
-                let ((rt, rx), (ry, rp)) = rayon::join(
-                    || rayon::join(|| c.t.ints(range.clone(), t), || c.x.ints(range.clone(), x)),
-                    || rayon::join(|| c.y.ints(range.clone(), y), || c.p.ints(range.clone(), p)),
-                );
-                rt.and(rx).and(ry).and(rp)?;
-                let offset = c.t_offset;
-                for t in t.iter_mut() {
-                    // an offset that overflows is damage: reported like a non-finite time
-                    *t = if *t == NOT_AN_INTEGER {
-                        TimeUs::MIN
-                    } else {
-                        t.checked_add(offset).unwrap_or(TimeUs::MIN)
-                    };
-                }
-                Ok(())
-            }
+            EventTable::EventUtils(c) => c.read(range, &mut buffers.seconds, columns),
+            EventTable::V2e(ds) => read_v2e_rows(ds, range, columns),
+            EventTable::Mvsec(ds, _) => read_mvsec_rows(ds, range, columns),
+            EventTable::Dsec(c) => c.read(range, columns),
         }
+    }
+}
+
+impl EventColumns {
+    /// Replaces `columns.x`, `y` and `p` with the events of `range` and appends their times
+    /// to the emptied `columns.t`. event_utils: `events/ts` in seconds (floats, read via
+    /// `seconds`, a reused buffer) or, as integers, in microseconds; `xs`, `ys`, `ps` as
+    /// integers.
+    fn read(
+        &self,
+        range: std::ops::Range<usize>,
+        seconds: &mut Vec<f64>,
+        columns: &mut Columns,
+    ) -> hdf5::Result<()> {
+        let Columns { t, x, y, p } = columns;
+        x.clear();
+        y.clear();
+        seconds.clear();
+        // the four columns at once (see DsecColumns::read)
+        let ((rt, rx), (ry, rp)) = rayon::join(
+            || {
+                rayon::join(
+                    || {
+                        if self.integer_times {
+                            // integer timestamps are microseconds (seconds as
+                            // integers make no sense)
+                            self.ts.ints(range.clone(), t)
+                        } else {
+                            self.ts.floats(range.clone(), seconds)
+                        }
+                    },
+                    || self.xs.ints(range.clone(), x),
+                )
+            },
+            || {
+                rayon::join(
+                    || self.ys.ints(range.clone(), y),
+                    || self.ps.ints(range.clone(), p),
+                )
+            },
+        );
+        rt.and(rx).and(ry).and(rp)?;
+        if !self.integer_times {
+            // a non-finite time becomes i64::MIN and is reported by read_chunk
+            t.extend(seconds.iter().map(|&s| {
+                if s.is_finite() {
+                    crate::events::s_to_us(s)
+                } else {
+                    TimeUs::MIN
+                }
+            }));
+        }
+        Ok(())
+    }
+}
+
+/// Appends the events of rows `range` of v2e's N x 4 table `events` (`[t_us, x, y, p]`,
+/// read as integers) to the emptied `columns.t` and `p`, replacing `columns.x` and `y`.
+fn read_v2e_rows(
+    ds: &hdf5::Dataset,
+    range: std::ops::Range<usize>,
+    columns: &mut Columns,
+) -> hdf5::Result<()> {
+    let rows = ds.read_slice_2d::<i64, _>(ndarray::s![range, ..])?;
+    columns.t.extend(rows.column(0).iter());
+    columns.x.clear();
+    columns.y.clear();
+    columns.x.extend(rows.column(1).iter());
+    columns.y.extend(rows.column(2).iter());
+    columns.p.extend(rows.column(3).iter());
+    Ok(())
+}
+
+/// Appends the events of rows `range` of MVSEC's N x 4 float64 table
+/// `davis/{side}/events` (`[x, y, t, p]`, t in seconds since the epoch) to the emptied
+/// `columns.t` and `p`, replacing `columns.x` and `y`; a value that is no integer (or no
+/// finite time) is marked for read_chunk to report.
+fn read_mvsec_rows(
+    ds: &hdf5::Dataset,
+    range: std::ops::Range<usize>,
+    columns: &mut Columns,
+) -> hdf5::Result<()> {
+    let rows = ds.read_slice_2d::<f64, _>(ndarray::s![range, ..])?;
+    columns.x.clear();
+    columns.y.clear();
+    columns
+        .x
+        .extend(rows.column(0).iter().map(|&v| float_to_int(v)));
+    columns
+        .y
+        .extend(rows.column(1).iter().map(|&v| float_to_int(v)));
+    // seconds since the epoch, to the nearest microsecond (float64 resolves
+    // 0.24 us there)
+    columns.t.extend(rows.column(2).iter().map(|&s| {
+        if s.is_finite() && s.abs() < 1e12 {
+            crate::events::s_to_us(s)
+        } else {
+            TimeUs::MIN
+        }
+    }));
+    columns
+        .p
+        .extend(rows.column(3).iter().map(|&v| float_to_int(v)));
+    Ok(())
+}
+
+impl DsecColumns {
+    /// Replaces `columns.x`, `y` and `p` with the events of `range` and appends their times
+    /// to the emptied `columns.t`. DSEC: `events/t` (microseconds, to which the file's
+    /// `t_offset` is added), `x`, `y`, `p` as integers.
+    fn read(&self, range: std::ops::Range<usize>, columns: &mut Columns) -> hdf5::Result<()> {
+        let Columns { t, x, y, p } = columns;
+        x.clear();
+        y.clear();
+        // the four columns at once: each column's chunks are read under libhdf5's
+        // lock one after another, but decompress while the next column is read
+        let ((rt, rx), (ry, rp)) = rayon::join(
+            || {
+                rayon::join(
+                    || self.t.ints(range.clone(), t),
+                    || self.x.ints(range.clone(), x),
+                )
+            },
+            || {
+                rayon::join(
+                    || self.y.ints(range.clone(), y),
+                    || self.p.ints(range.clone(), p),
+                )
+            },
+        );
+        rt.and(rx).and(ry).and(rp)?;
+        let offset = self.t_offset;
+        for t in t.iter_mut() {
+            // an offset that overflows is damage: reported like a non-finite time
+            *t = if *t == NOT_AN_INTEGER {
+                TimeUs::MIN
+            } else {
+                t.checked_add(offset).unwrap_or(TimeUs::MIN)
+            };
+        }
+        Ok(())
     }
 }
 
