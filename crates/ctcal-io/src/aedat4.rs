@@ -539,6 +539,9 @@ pub fn read_frame_times(path: &Path, header: &Aedat4Header) -> Result<Vec<TimeUs
     Ok(times)
 }
 
+/// Calls `f` with every frame of the first frame stream, in file order, each checked
+/// ([`frame_layout`], [`frame_time`], [`check_frame_sequence`]); with `keep_pixels` false
+/// the frames carry no pixels.
 fn for_each_frame(
     path: &Path,
     header: &Aedat4Header,
@@ -553,78 +556,15 @@ fn for_each_frame(
     while let Some(offset) = packets.next(stream)? {
         let frame = flatbuffers::size_prefixed_root::<FramePacket>(&packets.decoded)
             .map_err(|e| packets.invalid("frame", &e))?;
-        let (w, h) = (frame.width(), frame.height());
-        let limit = crate::events::MAX_SENSOR_SIDE as i16;
-        if w <= 0 || h <= 0 || w > limit || h > limit {
-            return Err(packets.damaged(
-                "frame",
-                format!("frame size {w}x{h} (1..={limit} pixels a side expected)"),
-            ));
-        }
-        let (w, h) = (w as u32, h as u32);
-        let data = frame.pixels().map(|p| p.bytes()).unwrap_or_default();
-        let channels = match frame.format() {
-            0 => 1,
-            16 => 3,
-            24 => 4,
-            other => {
-                return Err(packets.damaged("frame", format!("unknown pixel format {other}")));
-            }
-        };
-        if data.len() != (w * h) as usize * channels {
-            return Err(packets.damaged(
-                "frame",
-                format!(
-                    "{} pixel bytes for a {w}x{h} frame with {channels} channels",
-                    data.len()
-                ),
-            ));
-        }
-        let (start, end) = (frame.exposure_start_t(), frame.exposure_end_t());
-        let (t, exposure_us) = if end > start && start > 0 {
-            (start + (end - start) / 2, Some(end - start))
-        } else {
-            (frame.t(), None)
-        };
-        if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
-            return Err(InputError::corrupt(
-                &packets.path,
-                format!("byte offset {offset} (frame packet)"),
-                format!(
-                    "frame time {t} us lies beyond +-{} us (about 73,000 years) of zero",
-                    crate::events::TIME_LIMIT_US
-                ),
-                "the file is damaged at this place; cut the recording before it or copy it again from the source",
-            ));
-        }
-        if let Some((t0, w0, h0)) = previous {
-            if (w, h) != (w0, h0) {
-                return Err(packets.damaged(
-                    "frame",
-                    format!("the frame is {w}x{h}, the first frame {w0}x{h0}"),
-                ));
-            }
-            if t < t0 {
-                return Err(InputError::corrupt(
-                    &packets.path,
-                    format!("byte offset {offset} (frame packet)"),
-                    format!("frame time {t} us is earlier than the frame before ({t0} us)"),
-                    "the file is damaged; frames must come in time order",
-                ));
-            }
-        }
+        let layout = frame_layout(&packets, &frame)?;
+        let (w, h) = (layout.width, layout.height);
+        let (t, exposure_us) = frame_time(&packets, offset, &frame)?;
+        check_frame_sequence(&packets, offset, previous, (t, w, h))?;
         previous = Some((t, w, h));
-        let pixels = if !keep_pixels {
-            Vec::new()
-        } else if channels == 1 {
-            data.to_vec()
+        let pixels = if keep_pixels {
+            grey_pixels(layout.data, layout.channels)
         } else {
-            data.chunks_exact(channels)
-                .map(|p| {
-                    let (b, g, r) = (p[0] as f32, p[1] as f32, p[2] as f32);
-                    (0.299 * r + 0.587 * g + 0.114 * b).round() as u8
-                })
-                .collect()
+            Vec::new()
         };
         f(Frame {
             t,
@@ -635,6 +575,131 @@ fn for_each_frame(
         });
     }
     Ok(())
+}
+
+/// A frame packet's size and pixel bytes, checked by [`frame_layout`].
+struct FrameLayout<'a> {
+    width: u32,
+    height: u32,
+    /// Bytes per pixel: 1 (grey), 3 (BGR) or 4 (BGRA).
+    channels: usize,
+    /// The pixels, row by row, `channels` bytes each.
+    data: &'a [u8],
+}
+
+/// The size and pixel bytes of the frame in packet `frame`, checked. AEDAT4 (dv-processing
+/// `frame.fbs`): `sizeX`/`sizeY` must lie in 1..=`MAX_SENSOR_SIDE`, `format` is an OpenCV
+/// pixel type (0 grey `CV_8UC1`, 16 BGR `CV_8UC3`, 24 BGRA `CV_8UC4`), and `pixels` must
+/// hold exactly width x height x channels bytes.
+fn frame_layout<'a>(
+    packets: &PacketReader,
+    frame: &FramePacket<'a>,
+) -> Result<FrameLayout<'a>, InputError> {
+    let (w, h) = (frame.width(), frame.height());
+    let limit = crate::events::MAX_SENSOR_SIDE as i16;
+    if w <= 0 || h <= 0 || w > limit || h > limit {
+        return Err(packets.damaged(
+            "frame",
+            format!("frame size {w}x{h} (1..={limit} pixels a side expected)"),
+        ));
+    }
+    let (w, h) = (w as u32, h as u32);
+    let data = frame.pixels().map(|p| p.bytes()).unwrap_or_default();
+    let channels = match frame.format() {
+        0 => 1,
+        16 => 3,
+        24 => 4,
+        other => {
+            return Err(packets.damaged("frame", format!("unknown pixel format {other}")));
+        }
+    };
+    if data.len() != (w * h) as usize * channels {
+        return Err(packets.damaged(
+            "frame",
+            format!(
+                "{} pixel bytes for a {w}x{h} frame with {channels} channels",
+                data.len()
+            ),
+        ));
+    }
+    Ok(FrameLayout {
+        width: w,
+        height: h,
+        channels,
+        data,
+    })
+}
+
+/// The time of the frame in packet `frame` (at byte `offset`) and its exposure, us. AEDAT4
+/// (dv-processing `frame.fbs`): the midpoint of `timestampStartOfExposure` ..
+/// `timestampEndOfExposure` where the packet gives a positive exposure, else the frame's
+/// `timestamp`; a time beyond `TIME_LIMIT_US` of zero is damage.
+fn frame_time(
+    packets: &PacketReader,
+    offset: u64,
+    frame: &FramePacket,
+) -> Result<(TimeUs, Option<i64>), InputError> {
+    let (start, end) = (frame.exposure_start_t(), frame.exposure_end_t());
+    let (t, exposure_us) = if end > start && start > 0 {
+        (start + (end - start) / 2, Some(end - start))
+    } else {
+        (frame.t(), None)
+    };
+    if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
+        return Err(InputError::corrupt(
+            &packets.path,
+            format!("byte offset {offset} (frame packet)"),
+            format!(
+                "frame time {t} us lies beyond +-{} us (about 73,000 years) of zero",
+                crate::events::TIME_LIMIT_US
+            ),
+            "the file is damaged at this place; cut the recording before it or copy it again from the source",
+        ));
+    }
+    Ok((t, exposure_us))
+}
+
+/// Checks frame `(t, w, h)` (in the packet at byte `offset`) against the frame before it,
+/// `previous`: frames must share one size and come in time order.
+fn check_frame_sequence(
+    packets: &PacketReader,
+    offset: u64,
+    previous: Option<(TimeUs, u32, u32)>,
+    (t, w, h): (TimeUs, u32, u32),
+) -> Result<(), InputError> {
+    if let Some((t0, w0, h0)) = previous {
+        if (w, h) != (w0, h0) {
+            return Err(packets.damaged(
+                "frame",
+                format!("the frame is {w}x{h}, the first frame {w0}x{h0}"),
+            ));
+        }
+        if t < t0 {
+            return Err(InputError::corrupt(
+                &packets.path,
+                format!("byte offset {offset} (frame packet)"),
+                format!("frame time {t} us is earlier than the frame before ({t0} us)"),
+                "the file is damaged; frames must come in time order",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The grey levels of a frame's pixel bytes `data` of `channels` bytes a pixel: grey
+/// frames as they are, BGR(A) ones by ITU-R BT.601 weights (0.299 R + 0.587 G + 0.114 B,
+/// rounded).
+fn grey_pixels(data: &[u8], channels: usize) -> Vec<u8> {
+    if channels == 1 {
+        data.to_vec()
+    } else {
+        data.chunks_exact(channels)
+            .map(|p| {
+                let (b, g, r) = (p[0] as f32, p[1] as f32, p[2] as f32);
+                (0.299 * r + 0.587 * g + 0.114 * b).round() as u8
+            })
+            .collect()
+    }
 }
 
 // --- FlatBuffer accessors (field slots from the dv-processing schemas) ---
