@@ -9,7 +9,7 @@
 //! pixel-second. Start: that excess rate (one leak event per period, most of them isolated),
 //! and a second start at the still pixels' ON-beyond-OFF excess where that is over twice
 //! it (a leak that fires every pixel at once); the search runs from both and keeps the
-//! lower fit error ([`still_excess_hz`]).
+//! lower fit error ([`still_excess`]).
 //!
 //! The isolated events of all pixels are also the misses of every other effect the model
 //! lacks or gets wrong, and a leak's drift moves the scene's own ON and OFF crossings, so
@@ -39,10 +39,12 @@ pub fn evidence(c: &Context) -> Evidence {
     let excess_off = (r_off - s_off).max(0.0);
     let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
     let start = (rate / 0.9).max(1e-3);
-    let still = still_excess_hz(c);
+    let still = still_excess(c);
     let other_start = still
-        .map(|hz| hz / 0.9)
+        .filter(|e| e.z >= STILL_Z)
+        .map(|e| e.hz / 0.9)
         .filter(|&s| s > start * OTHER_START_RATIO);
+    let still = still.map(|e| e.hz);
     Evidence {
         effect: Effect::Leak,
         score,
@@ -61,9 +63,18 @@ pub fn evidence(c: &Context) -> Evidence {
 }
 
 /// How far above the isolated excess the still pixels' excess must read for the search to
-/// run from it too: the search spans a factor 5 either way of its start, and a start a
-/// factor 2 away already ends in another optimum on some recordings (coverage draw 13029).
+/// run from it too: the search spans a factor 5 either way of its start, so a start within
+/// a factor 2 is inside the first search's range (where a start a factor 3.2 away ended in
+/// another optimum, on coverage draw 13029, the lower fit error chose the first).
 const OTHER_START_RATIO: f64 = 2.0;
+
+/// The still pixels' ON-beyond-OFF excess over the model: per still pixel-second, and in
+/// Poisson standard errors of the counts.
+#[derive(Clone, Copy, Debug)]
+struct StillExcess {
+    hz: f64,
+    z: f64,
+}
 
 /// The recording's ON less OFF events at still pixels beyond the model's, per still
 /// pixel-second, on the context's blocks (`None` without still time). Only leak fires ON
@@ -73,18 +84,24 @@ const OTHER_START_RATIO: f64 = 2.0;
 /// search below it (coverage draw 13010: isolated excess 0.33 Hz, still pixels 5.5 Hz; the
 /// search, a factor 5 either way of its start, ended at 0.37 Hz). A still pixel fires its
 /// first leak event one period after its last reset, so on a recording shorter than a few
-/// periods this reads below the rate: a second start, not a measurement. Started from it
-/// alone the search ended in a worse optimum on other draws (13029: selection error 0.35
-/// -> 0.80; study `benches/coverage/fit-leak-start-2026-12-06`), so it is searched from
-/// both ([`Evidence::other_start`]).
-fn still_excess_hz(c: &Context) -> Option<f64> {
+/// periods this reads below the rate: a second start, not a measurement, and one only
+/// where it stands [`STILL_Z`] standard errors above chance. Started from it alone the
+/// search ended in a worse optimum on other draws (13029: fit error 0.354 -> 0.635; study
+/// `benches/coverage/fit-leak-start-2026-12-06`), so it is searched from both
+/// ([`Evidence::other_start`]).
+fn still_excess(c: &Context) -> Option<StillExcess> {
     let pixel_seconds: f64 = (0..c.geometry.blocks)
         .filter(|&b| c.geometry.in_subset(b, c.subset))
         .map(|b| c.geometry.still_exposure[b])
         .sum();
-    let seen =
-        net(c.real.still_of(c.geometry, c.subset)) - net(c.sim.still_of(c.geometry, c.subset));
-    (pixel_seconds > 0.0).then(|| seen.max(0.0) / pixel_seconds)
+    let real = c.real.still_of(c.geometry, c.subset);
+    let model = c.sim.still_of(c.geometry, c.subset);
+    let seen = net(real) - net(model);
+    let sigma = (total(real) + total(model) + 1.0).sqrt();
+    (pixel_seconds > 0.0).then(|| StillExcess {
+        hz: seen.max(0.0) / pixel_seconds,
+        z: seen / sigma,
+    })
 }
 
 /// The ON excess rate (beyond any OFF excess) below which leak does not matter, events per

@@ -204,8 +204,9 @@ pub struct Evidence {
     #[serde(skip)]
     pub start: Option<f64>,
     /// A second reading of the start that disagrees with `start` (leak's still pixels,
-    /// [`leak::evidence`]): the search runs from both and keeps the value with the lower
-    /// error on the fit blocks.
+    /// [`leak::evidence`]): the effect's own step searches from both and keeps the value
+    /// with the lower error on the fit blocks (the comparisons of look-alikes,
+    /// `selection::alternatives`, search from `start` alone).
     #[serde(skip)]
     pub other_start: Option<f64>,
 }

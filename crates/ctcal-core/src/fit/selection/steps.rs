@@ -137,18 +137,46 @@ fn search_effect(
     let start = evidence.start.unwrap_or(1.0);
     let mut searched = search_from(simulation, state, effect, start, run)?;
     if let Some(other) = evidence.other_start {
-        let from_other = search_from(simulation, state, effect, other, run)?;
-        step.evidence.push_str(&format!(
-            "; searched from {start:.4} (ended at {:.4}, fit error {:.4}) and from {other:.4} (ended at {:.4}, fit error {:.4}), the lower error kept",
-            searched.value, searched.fit_error, from_other.value, from_other.fit_error
-        ));
-        if from_other.fit_error < searched.fit_error {
-            searched = from_other;
+        match search_from(simulation, state, effect, other, run) {
+            Ok(from_other) => {
+                step.evidence.push_str(&format!(
+                    "; searched from {start:.4} (ended at {:.4}, fit error {:.4}) and from {other:.4} (ended at {:.4}, fit error {:.4}), the lower error kept",
+                    searched.value, searched.fit_error, from_other.value, from_other.fit_error
+                ));
+                searched = better_of(searched, from_other);
+            }
+            Err(e) => step.evidence.push_str(&format!(
+                "; the search from {other:.4} failed ({e}): the one from {start:.4} kept"
+            )),
         }
     }
     step.parameters.insert(key.into(), searched.value);
     let uncertain = uncertain_of(key, &searched);
     Ok((searched.model, Some(uncertain)))
+}
+
+/// The better of two searches of one parameter from different starts: the one with the
+/// lower fit error, the other's evaluated points joined to it. Where the two ends' errors
+/// lie within the rise chance gives (`1.96^2 noise`, [`profile_interval`]) the
+/// curvature's standard error, one optimum's, is dropped, so that the interval is read
+/// off the points of both and holds both ends.
+///
+/// [`profile_interval`]: crate::fit::search::profile_interval
+fn better_of(
+    first: crate::fit::search::Searched,
+    second: crate::fit::search::Searched,
+) -> crate::fit::search::Searched {
+    let (mut kept, other) = if second.fit_error < first.fit_error {
+        (second, first)
+    } else {
+        (first, second)
+    };
+    let rise = crate::estimate::interval::z95().powi(2) * kept.noise.max(0.0);
+    if other.fit_error - kept.fit_error <= rise {
+        kept.standard_error = None;
+    }
+    kept.evaluations.extend(other.evaluations);
+    kept
 }
 
 /// `effect`'s parameter searched over its range around `start` ([`search_range`]), with
@@ -486,4 +514,65 @@ pub fn untried(evidence: &effects::Evidence) -> Step {
         "not called for by the residuals".into()
     };
     step
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::effects::fixture::{Fixture, chunk, static_frames};
+    use crate::fit::search::{Evaluation, Searched};
+    use crate::sim::params::PixelParams;
+
+    /// A search that ended at `value` with `fit_error` (a curvature error of 0.1), its
+    /// evaluated points `(value, fit error)`, the chance noise 0.01 (a rise of 0.0384).
+    fn searched(value: f64, fit_error: f64, points: &[(f64, f64)]) -> Searched {
+        let f = Fixture::new(
+            &static_frames(4, 4, 1.0, 100.0),
+            &chunk(Vec::new()),
+            &chunk(Vec::new()),
+        );
+        Searched {
+            value,
+            model: Simulated {
+                params: PixelParams::ideal(0.3, 0.3),
+                observed: f.sim,
+            },
+            fit_error,
+            standard_error: Some(0.1),
+            at_bound: None,
+            evaluations: points
+                .iter()
+                .map(|&(value, fit_error)| Evaluation {
+                    value,
+                    fit_error,
+                    ct_on: 0.3,
+                    ct_off: 0.3,
+                })
+                .collect(),
+            noise: 0.01,
+        }
+    }
+
+    /// The lower fit error wins, with both searches' points; where the two ends differ by
+    /// less than the rise chance gives (1.96^2 x 0.01 = 0.0384), its curvature error is
+    /// dropped and the interval read off the points holds both ends (0.5 .. 6.0, the
+    /// nearest points beyond the rise on either side); where they differ by more, it is
+    /// kept.
+    #[test]
+    fn the_better_search_keeps_both_searches_points_and_spans_both_ends_within_chance() {
+        let first = searched(3.40, 0.354, &[(0.5, 0.9), (3.40, 0.354)]);
+        let second = searched(4.01, 0.380, &[(4.01, 0.380), (6.0, 0.9)]);
+        let kept = better_of(second, first);
+        assert_eq!(kept.value, 3.40);
+        assert_eq!(kept.standard_error, None);
+        assert_eq!(kept.evaluations.len(), 4);
+        let interval =
+            crate::fit::search::profile_interval(&kept.evaluations, kept.value, kept.noise);
+        assert_eq!(interval, [Some(0.5), Some(6.0)]);
+
+        let first = searched(3.40, 0.354, &[(3.40, 0.354)]);
+        let second = searched(4.01, 0.635, &[(4.01, 0.635)]);
+        let kept = better_of(first, second);
+        assert_eq!((kept.value, kept.standard_error), (3.40, Some(0.1)));
+    }
 }
