@@ -702,6 +702,9 @@ pub fn eppps_of(
                     || (p.offset.is_some() && p.other_response.is_none());
                 let fitted = options.frame_offset_dn.is_none()
                     && p.offset.as_ref().is_some_and(|o| o.source == "fitted");
+                if known && !fitted && options.frame_offset_dn.is_none() && p.offset.is_some() {
+                    notes.push(eppps::OFFSET_NOT_BRACKETED.to_string());
+                }
                 Some((p.frames, known, fitted))
             }
             Err(e) => {

@@ -778,7 +778,7 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
             o.systematic_range.1
         ),
         super::timing::NOT_BOUNDED => format!(
-            "the frames' log offset b in ln(DN + b) is not determined: the offset at which the thresholds stop depending on brightness has a 95 % interval open on both sides (the frames' brightness range or the events are too few to bound it); b = {:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",
+            "the frames' log offset b in ln(DN + b) is not determined: the 95 % interval of the offset at which the thresholds stop depending on brightness spans the prior range on both sides (the frames' brightness range or the events are too few to bound it; below 20 DN the lin-log response's linear part hides what an offset does); b = {:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",
             o.offset_dn, o.systematic_range.0, o.systematic_range.1
         ),
         _ => format!(

@@ -136,8 +136,11 @@ pub struct EpppsInput<'a> {
     /// timing): otherwise the frames are scanned through both ends of what sensors use.
     pub response_known: bool,
     /// Whether the frames' offset (`PreparedFrames::offset`) was fitted to the events'
-    /// timing, its 95 % range `PreparedFrames::offset_range`: where that range moves the
-    /// frames' contrast, they are scanned at its ends too ([`offset_bracket`]).
+    /// timing, its range `PreparedFrames::offset_range` (the 95 % interval and both
+    /// polarities' offsets, the prior's end where a side is open): where that range moves
+    /// the frames' contrast, they are scanned at its ends too ([`offset_bracket`]). An
+    /// offset the timing did not determine is read at the frames' own (see
+    /// [`OFFSET_NOT_BRACKETED`]).
     pub offset_fitted: bool,
     pub excluded: &'a [bool],
 }
@@ -598,6 +601,26 @@ struct OffsetBracket {
     ratio: f64,
 }
 
+impl OffsetBracket {
+    /// The offsets scanned: both ends and `offset` (the fitted one, or the frames' own
+    /// where none was determined), each once.
+    fn offsets(&self, offset: f32) -> Vec<f32> {
+        let mut offsets = vec![self.lo, offset.clamp(self.lo, self.hi), self.hi];
+        offsets.dedup();
+        offsets
+    }
+}
+
+/// Why an offset the events' timing did not determine is read at the frames' own, not
+/// bracketed over the prior range (0-60 DN) as `aps` brackets it: on 109 kept coverage
+/// draws (80 of the 221 whose offset was not determined, at random, and the 29 with the
+/// widest fitted ranges), bracketing those widened the intervals 2.4x (median hi/lo 4.8
+/// -> 11.5), opened 44 lower ends and moved 118 of 148 readings away from the truth, for
+/// 3 misses of 203 fewer (study `benches/coverage/eppps-offset-bracket-2026-12-06`). The
+/// simulators' responses have no offset; a sensor whose frames carry a black level does,
+/// and reads thresholds high by (DN + b) / DN, which this assumption states.
+pub const OFFSET_NOT_BRACKETED: &str = "the frames' log offset b was not determined by the events' timing: eppps reads the frames at the frames' own offset, and its interval does not hold the prior range 0-60 DN that aps carries (bracketing it widened intervals 2.4x on simulated recordings, whose responses have no offset, and moved most readings away from the truth); frames that carry a black level of b DN read thresholds high by (DN + b) / DN at their median DN";
+
 /// How far (a factor) a fitted offset's range must move the frames' contrast at their
 /// median DN for the scans to run at its ends too. The offset b in ln(DN + b) scales a
 /// log change by DN / (DN + b); in dim frames a range of tens of DN is a factor of
@@ -612,8 +635,13 @@ const OFFSET_BRACKET_RATIO: f64 = 1.25;
 fn offset_bracket(frames: &PreparedFrames, median_dn: Option<f64>) -> Option<OffsetBracket> {
     let dn = median_dn?;
     let (lo, hi) = frames.offset_range;
-    // DN + b stays positive at every pixel: no negative offset is scanned
-    let lo = lo.min(frames.offset).max(0.0);
+    // no negative offset is scanned, and none under 1 DN through a pure log, whose
+    // ln(DN + b) has no value at a black pixel (the lin-log is linear there)
+    let floor = match frames.log_map.response() {
+        crate::sim::params::LogResponse::V2e => 0.0,
+        _ => 1.0,
+    };
+    let lo = lo.min(frames.offset).max(floor);
     let hi = hi.max(frames.offset);
     let ratio = (dn + hi as f64) / (dn + lo as f64).max(0.5);
     (ratio > OFFSET_BRACKET_RATIO).then_some(OffsetBracket { lo, hi, ratio })
@@ -622,7 +650,7 @@ fn offset_bracket(frames: &PreparedFrames, median_dn: Option<f64>) -> Option<Off
 /// What the scans at a fitted offset's ends assume.
 fn offset_bracket_assumption(bracket: &OffsetBracket, median_dn: Option<f64>) -> String {
     format!(
-        "the frames' fitted log offset b leaves a range {:.1} .. {:.1} DN (its 95 % interval and the ON and OFF samples' own, no negative offset scanned) that moves their contrast at the median {:.0} DN by a factor {:.2}: they are scanned at both ends and at the fitted offset, the threshold is the three's geometric mean and their spread is in the interval",
+        "the frames' log offset b fitted to the events' timing leaves a range {:.1} .. {:.1} DN (its 95 % interval and the ON and OFF samples' own, the prior's end 0 or 60 DN where the data leave a side open; no negative offset scanned, none under 1 DN through a pure log) that moves their contrast at the median {:.0} DN by a factor {:.2}: they are scanned at both ends and at the fitted offset, the threshold is the readings' geometric mean and their spread is in the interval",
         bracket.lo,
         bracket.hi,
         median_dn.unwrap_or(f64::NAN),
@@ -665,7 +693,8 @@ impl<'a> Basis<'a> {
                     offset_dn,
                     ..calibration::Response::of(f)
                 };
-                [bracket.lo, f.offset, bracket.hi]
+                bracket
+                    .offsets(f.offset)
                     .into_iter()
                     .map(|b| (at(b), format!("the recording's frames at b = {b:.1} DN")))
                     .collect()

@@ -137,13 +137,15 @@ pub struct Offset {
     /// difference is what other brightness-dependent errors do to the fit.
     pub by_polarity: [Option<f32>; 2],
     /// `fitted`, `given` (by the caller), or `not determined...` (the thresholds do not
-    /// become independent of brightness at any offset, or the photoreceptor's lag hides
-    /// what the offset does: the frames' own kept, the prior range spanned).
+    /// become independent of brightness at any offset, the photoreceptor's lag hides what
+    /// the offset does, the root lies outside [`OFFSET_PRIOR`], or its interval spans the
+    /// prior, [`NOT_BOUNDED`]: the frames' own kept, the prior range spanned).
     pub source: &'static str,
 }
 
 /// [`Offset::source`] of an offset whose root the level slope's chance error leaves
-/// unbounded on both sides.
+/// unbounded within [`OFFSET_PRIOR`] on both sides (each end of its 95 % interval open or
+/// beyond the prior's).
 pub const NOT_BOUNDED: &str =
     "not determined: the thresholds' change with brightness bounds the offset on neither side";
 
@@ -526,10 +528,12 @@ pub(super) fn find_offset(
     });
     let bound = 1.96 * std_dev(&slopes);
     let ci95 = offset_interval(&slope, root, bound, range);
-    if ci95 == [None, None] {
-        // the level slope's chance error reaches zero at both ends of the search: the root
-        // is a start, not a measurement (coverage draw 13037, frames at 11 DN: a root of
-        // 35 DN, open both ways, read through by eppps as the response shrank its
+    let open_below = ci95[0].is_none_or(|lo| lo <= OFFSET_PRIOR.0);
+    let open_above = ci95[1].is_none_or(|hi| hi >= OFFSET_PRIOR.1);
+    if open_below && open_above {
+        // the level slope's chance error spans the whole prior range: the root is a start,
+        // not a measurement (coverage draw 13037, frames at 11 DN: a root of 35 DN, open
+        // above and at -2.3 DN below, read through by eppps as the response shrank its
         // contrasts 5x)
         return Offset {
             source: NOT_BOUNDED,
