@@ -377,96 +377,153 @@ impl StatsAccumulator {
             return None;
         }
         let first = self.first?;
+        self.close_last_window();
+        let selection = self.options.selection.take();
+        // a selection fixes the sensor
+        let sensor = selection.as_ref().map_or(sensor, |s| s.sensor());
+        let area = KeptArea::new(sensor, &self.pixels, selection.as_ref());
+        let kept_pixels = area.kept_pixels;
+        let pixels = kept_pixels.max(1) as f64;
+        let duration_s = us_to_s(self.last - first);
+        let per_pixel = self.per_pixel(&area, duration_s);
+        let timeline = self.rate_timeline(first, pixels);
+        let frames =
+            timeline::frame_summary(&self.frames_selected(frame_times), !frame_times.is_empty());
+        let why = undetermined(
+            duration_s,
+            &per_pixel.background_rate_hz,
+            &timeline,
+            frames.as_ref(),
+        );
+        let measured = Measured {
+            sensor,
+            first,
+            duration_s,
+            kept_pixels,
+            pixels,
+            per_pixel,
+            timeline,
+            frames,
+            why,
+            selection: selection.map_or_else(|| "the whole sensor".into(), |s| s.description()),
+        };
+        Some(self.assemble(sensor_source, measured))
+    }
+
+    /// Counts the window the last events fell in: the kernel stores a window only when an
+    /// event passes its end.
+    fn close_last_window(&mut self) {
         if self.windows.count > 0 {
             self.windows
                 .timeline
                 .add(self.windows.index, self.windows.count);
         }
-        let selection = self.options.selection.take();
-        // a selection fixes the sensor
-        let sensor = selection.as_ref().map_or(sensor, |s| s.sensor());
-        let (width, height) = (sensor.width as usize, sensor.height as usize);
-        // the per-pixel maps cover the area the grid holds (where events are; the rest of
-        // the sensor has none): the whole sensor unless it was too large to allocate
-        let (area_w, area_h) = (width.min(self.pixels.width), height.min(self.pixels.height));
-        // whether the pixel at index `i` of the area is kept
-        let keep = |i: usize| {
-            selection
-                .as_ref()
-                .is_none_or(|s| s.kept_mask()[(i / area_w) * width + i % area_w])
-        };
-        let kept_pixels = selection.as_ref().map_or(width * height, |s| s.kept());
-        let pixels = kept_pixels.max(1) as f64;
-        let duration_s = us_to_s(self.last - first);
-        let per_pixel_per_second =
-            |n: u64| (duration_s > 0.0).then(|| n as f64 / (pixels * duration_s));
-        let all_counts = self.pixels.counts(area_w, area_h);
-        let unsupported = self.pixels.map(area_w, area_h, |c| c.unsupported);
+    }
+
+    /// The per-pixel results over the kept pixels of `area`: the active pixels (at least
+    /// one event), the hot pixels (see [`hot_pixels`]; each judged against its real
+    /// neighbours, kept or not), the background rate (Delbruck 2008's unsupported events,
+    /// see [`background_rate`]) and the median pixel rate (the kept pixels outside the
+    /// area, without events, counted as zeros).
+    fn per_pixel(&self, area: &KeptArea, duration_s: f64) -> PixelResults {
+        let all_counts = self.pixels.counts(area.width, area.height);
+        let unsupported = self.pixels.map(area.width, area.height, |c| c.unsupported);
         let counts: Vec<u32> = (0..all_counts.len())
-            .filter(|&i| keep(i))
+            .filter(|&i| area.keeps(i))
             .map(|i| all_counts[i])
             .collect();
         // kept pixels outside the area: no events
-        let silent = kept_pixels - counts.len();
+        let silent = area.kept_pixels - counts.len();
         let active = counts.iter().filter(|&&c| c > 0).count();
         // hot pixels are judged against their real neighbours, kept or not
         let hot: Vec<HotPixel> =
-            hot_pixels::find_hot_pixels(&all_counts, area_w, area_h, duration_s)
+            hot_pixels::find_hot_pixels(&all_counts, area.width, area.height, duration_s)
                 .into_iter()
-                .filter(|h| keep(h.y as usize * area_w + h.x as usize))
+                .filter(|h| area.keeps(h.y as usize * area.width + h.x as usize))
                 .collect();
-        let background_rate_hz =
-            background_rate(&unsupported, area_w, &hot, duration_s, &keep, kept_pixels);
+        let keep = |i: usize| area.keeps(i);
+        let background_rate_hz = background_rate(
+            &unsupported,
+            area.width,
+            &hot,
+            duration_s,
+            &keep,
+            area.kept_pixels,
+        );
         let median_pixel_rate_hz = median_rate(&counts, silent, duration_s);
-        let timeline = timeline::rate_timeline(
+        PixelResults {
+            active,
+            hot,
+            background_rate_hz,
+            median_pixel_rate_hz,
+        }
+    }
+
+    /// The rate timeline: events per kept pixel (`pixels`) per second in windows of
+    /// `window_us` from the first selected event (`first`), each window's `t_s` offset by
+    /// the time from the stream's first event to it (a `--start` window).
+    fn rate_timeline(&self, first: TimeUs, pixels: f64) -> timeline::Timeline {
+        timeline::rate_timeline(
             &self.windows.timeline,
             self.window_us,
             self.last - first,
             us_to_s(first - self.stream_first.unwrap_or(first)),
             pixels,
-        );
-        let frames =
-            timeline::frame_summary(&self.frames_selected(frame_times), !frame_times.is_empty());
-        let why = undetermined(duration_s, &background_rate_hz, &timeline, frames.as_ref());
+        )
+    }
+
+    /// Quantiles of the same-pixel inter-event intervals, read from their histogram.
+    fn interval_summary(&self) -> IntervalSummary {
+        IntervalSummary {
+            p5: self.intervals.quantile_us(0.05).map(|us| us * 1e-6),
+            median: self.intervals.quantile_us(0.5).map(|us| us * 1e-6),
+            count: self.intervals.total(),
+            zero: Some(self.intervals.zeros()),
+            resolution: "histogram quantiles: exact below 128 us, above that within 1/128 (0.8 %) of the value",
+        }
+    }
+
+    /// The `ctcal stats` JSON of what [`Self::finish`] measured: the event totals, each
+    /// also per kept pixel per second (`events / (pixels * duration_s)`, the rate
+    /// Stoffregen et al. 2020 match between real and simulated data; null over no time),
+    /// the per-pixel results, the timeline and the interval quantiles.
+    fn assemble(self, sensor_source: &str, m: Measured) -> SequenceStats {
+        let (pixels, duration_s) = (m.pixels, m.duration_s);
+        let per_pixel_per_second =
+            |n: u64| (duration_s > 0.0).then(|| n as f64 / (pixels * duration_s));
         let off = self.events - self.on;
-        Some(SequenceStats {
+        SequenceStats {
             biases: None,
-            width: sensor.width,
-            height: sensor.height,
+            width: m.sensor.width,
+            height: m.sensor.height,
             sensor_source: sensor_source.to_string(),
             events: self.events,
             on_events: self.on,
             off_events: off,
             on_fraction: self.on as f64 / self.events as f64,
-            t_first_us: first,
+            t_first_us: m.first,
             t_last_us: self.last,
             duration_s,
             events_per_pixel_per_second: per_pixel_per_second(self.events),
             on_per_pixel_per_second: per_pixel_per_second(self.on),
             off_per_pixel_per_second: per_pixel_per_second(off),
-            active_pixel_fraction: active as f64 / pixels,
-            rate_window_s: us_to_s(timeline.window_us),
-            rate_window_note: timeline.note(self.window_us),
-            rate_timeline: timeline.windows,
-            hot_pixels: hot,
+            active_pixel_fraction: m.per_pixel.active as f64 / pixels,
+            rate_window_s: us_to_s(m.timeline.window_us),
+            rate_window_note: m.timeline.note(self.window_us),
+            rate_timeline: m.timeline.windows,
+            hot_pixels: m.per_pixel.hot,
             hot_pixel_method: hot_pixels::METHOD,
-            background_rate_hz: background_rate_hz.ok(),
+            background_rate_hz: m.per_pixel.background_rate_hz.ok(),
             background_rate_method: BACKGROUND_RATE_METHOD,
             support_window_s: us_to_s(self.support_us),
-            median_pixel_rate_hz,
-            pixels_kept: kept_pixels as u64,
-            selection: selection.map_or_else(|| "the whole sensor".into(), |s| s.description()),
+            median_pixel_rate_hz: m.per_pixel.median_pixel_rate_hz,
+            pixels_kept: m.kept_pixels as u64,
+            selection: m.selection,
             excluded_hot_pixels: Vec::new(),
-            inter_event_interval_s: IntervalSummary {
-                p5: self.intervals.quantile_us(0.05).map(|us| us * 1e-6),
-                median: self.intervals.quantile_us(0.5).map(|us| us * 1e-6),
-                count: self.intervals.total(),
-                zero: Some(self.intervals.zeros()),
-                resolution: "histogram quantiles: exact below 128 us, above that within 1/128 (0.8 %) of the value",
-            },
-            frames,
-            why,
-        })
+            inter_event_interval_s: self.interval_summary(),
+            frames: m.frames,
+            why: m.why,
+        }
     }
 
     /// The frame times within the selected time window (all of them without one).
@@ -477,6 +534,68 @@ impl StatsAccumulator {
             .filter(|t| (self.select_from..=self.select_to).contains(t))
             .collect()
     }
+}
+
+/// The pixels [`StatsAccumulator::finish`] measures: the kept ones (the whole sensor's, or
+/// a selection's), over the area of the grid that holds per-pixel state.
+struct KeptArea<'a> {
+    selection: Option<&'a PixelSelection>,
+    /// The sensor's width (a row of the selection's mask).
+    sensor_width: usize,
+    /// The area the per-pixel maps cover (where events are; the rest of the sensor has
+    /// none): the whole sensor unless it was too large to allocate.
+    width: usize,
+    height: usize,
+    /// Pixels kept: every per-pixel quantity divides by them.
+    kept_pixels: usize,
+}
+
+impl<'a> KeptArea<'a> {
+    fn new(sensor: Sensor, grid: &PixelGrid, selection: Option<&'a PixelSelection>) -> Self {
+        let (width, height) = (sensor.width as usize, sensor.height as usize);
+        Self {
+            selection,
+            sensor_width: width,
+            width: width.min(grid.width),
+            height: height.min(grid.height),
+            kept_pixels: selection.map_or(width * height, |s| s.kept()),
+        }
+    }
+
+    /// Whether the pixel at index `i` of the area is kept.
+    fn keeps(&self, i: usize) -> bool {
+        self.selection
+            .is_none_or(|s| s.kept_mask()[(i / self.width) * self.sensor_width + i % self.width])
+    }
+}
+
+/// The per-pixel results of [`StatsAccumulator::finish`], over the kept pixels.
+struct PixelResults {
+    /// Kept pixels with at least one event.
+    active: usize,
+    hot: Vec<HotPixel>,
+    /// Unsupported events per pixel per second, or why it is not determined.
+    background_rate_hz: Result<f64, String>,
+    median_pixel_rate_hz: Option<f64>,
+}
+
+/// What [`StatsAccumulator::finish`] measured, before [`StatsAccumulator::assemble`] lays
+/// it out with the accumulator's totals.
+struct Measured {
+    /// The sensor (a selection's, when there is one).
+    sensor: Sensor,
+    /// The first selected event's time.
+    first: TimeUs,
+    duration_s: f64,
+    kept_pixels: usize,
+    /// The kept pixels as every per-pixel rate's divisor (at least 1).
+    pixels: f64,
+    per_pixel: PixelResults,
+    timeline: timeline::Timeline,
+    frames: Option<FrameSummary>,
+    why: BTreeMap<String, String>,
+    /// The selection's description.
+    selection: String,
 }
 
 /// Why a rate of events that span no time is not determined.
