@@ -214,74 +214,118 @@ fn estimates(
     framed: Result<&Loaded, String>,
     options: &Options,
 ) -> Result<(Vec<MethodResult>, Option<PixelMaps>), SequenceError> {
-    let quiet = |_: &str, _: f64| {};
     let aps_options = ApsOptions::default();
     let mut methods = Vec::new();
-    let mut maps = None;
-    if let Err(why) = &framed {
-        methods.push(MethodResult {
-            method: "aps",
-            estimate: None,
-            not_applied: Some(why.clone()),
-        });
-    } else if let Ok(framed) = framed
-        && framed.frames.len() >= 2
-    {
-        match ctcal_io::aps_region::aps(framed, &aps_options, options.fit_budget, &quiet) {
-            Ok(result) => {
-                maps = Some(PixelMaps {
-                    width: result.maps.width,
-                    height: result.maps.height,
-                    ct_on: result.maps.ct_on,
-                    ct_off: result.maps.ct_off,
-                });
-                methods.push(MethodResult {
-                    method: "aps",
-                    estimate: Some(result.estimate),
-                    not_applied: None,
-                });
-            }
-            Err(e) => methods.push(MethodResult {
-                method: "aps",
-                estimate: None,
-                not_applied: Some(e.to_string()),
-            }),
-        }
-    } else {
-        methods.push(MethodResult {
-            method: "aps",
-            estimate: None,
-            not_applied: Some("the recording has no grey frames".into()),
-        });
-    }
+    let (aps, maps) = aps_method(framed, &aps_options, options);
+    methods.push(aps);
     let stimulus = loaded.recording.stimulus()?;
-    if stimulus.is_some() && loaded.frames.len() < 2 {
+    methods.push(eppps_method(
+        loaded,
+        stimulus.is_some(),
+        &aps_options,
+        options,
+    ));
+    methods.push(screen_method(loaded, stimulus, options)?);
+    Ok((methods, maps))
+}
+
+/// A method that could not be applied, and why.
+fn not_applied(method: &'static str, why: String) -> MethodResult {
+    MethodResult {
+        method,
+        estimate: None,
+        not_applied: Some(why),
+    }
+}
+
+/// A method's estimate, or its error's message as why it could not be applied.
+fn outcome(
+    method: &'static str,
+    found: Result<crate::estimate::CtEstimate, impl std::fmt::Display>,
+) -> MethodResult {
+    MethodResult {
+        method,
+        not_applied: found.as_ref().err().map(|e| e.to_string()),
+        estimate: found.ok(),
+    }
+}
+
+/// The `aps` method (thresholds from the grey frames, Stoffregen et al. 2020 Sec. 3.1: event
+/// timing and re-simulation combined) on `framed`, with its per-pixel threshold maps; not
+/// applied without two frames or where the blocks of frames could not be read.
+fn aps_method(
+    framed: Result<&Loaded, String>,
+    aps_options: &ApsOptions,
+    options: &Options,
+) -> (MethodResult, Option<PixelMaps>) {
+    let quiet = |_: &str, _: f64| {};
+    let framed = match framed {
+        Err(why) => return (not_applied("aps", why), None),
+        Ok(framed) if framed.frames.len() >= 2 => framed,
+        Ok(_) => {
+            let why = "the recording has no grey frames".into();
+            return (not_applied("aps", why), None);
+        }
+    };
+    match ctcal_io::aps_region::aps(framed, aps_options, options.fit_budget, &quiet) {
+        Ok(result) => {
+            let maps = PixelMaps {
+                width: result.maps.width,
+                height: result.maps.height,
+                ct_on: result.maps.ct_on,
+                ct_off: result.maps.ct_off,
+            };
+            let aps = MethodResult {
+                method: "aps",
+                estimate: Some(result.estimate),
+                not_applied: None,
+            };
+            (aps, Some(maps))
+        }
+        Err(e) => (not_applied("aps", e.to_string()), None),
+    }
+}
+
+/// The `eppps` method (events per pixel per second against simulated scenes, Stoffregen
+/// et al. 2020 Sec. 3.1 and Fig. 2); not applied to an on-screen recording (`on_screen`:
+/// it has a stimulus) without grey frames, whose scene is no natural one.
+fn eppps_method(
+    loaded: &Loaded,
+    on_screen: bool,
+    aps_options: &ApsOptions,
+    options: &Options,
+) -> MethodResult {
+    let quiet = |_: &str, _: f64| {};
+    if on_screen && loaded.frames.len() < 2 {
         // without frames eppps compares the events with natural images (its prior); an
         // on-screen recording's scene is the stimulus, whose contrast the display sets
-        methods.push(MethodResult {
-            method: "eppps",
-            estimate: None,
-            not_applied: Some(
-                "an on-screen recording without grey frames: its scene is the stimulus on a display, not a natural scene, so the events-only prior (natural images) does not describe it; the screen method measures the thresholds through the stimulus".into(),
-            ),
-        });
-    } else {
-        let eppps = crate::window::eppps_of(
-            loaded,
-            &aps_options,
-            crate::estimate::eppps::EpppsOptions {
-                seed: options.seed,
-                ..Default::default()
-            },
-            &quiet,
+        return not_applied(
+            "eppps",
+            "an on-screen recording without grey frames: its scene is the stimulus on a display, not a natural scene, so the events-only prior (natural images) does not describe it; the screen method measures the thresholds through the stimulus".into(),
         );
-        methods.push(MethodResult {
-            method: "eppps",
-            not_applied: eppps.as_ref().err().map(|e| e.to_string()),
-            estimate: eppps.ok(),
-        });
     }
-    match stimulus {
+    let eppps = crate::window::eppps_of(
+        loaded,
+        aps_options,
+        crate::estimate::eppps::EpppsOptions {
+            seed: options.seed,
+            ..Default::default()
+        },
+        &quiet,
+    );
+    outcome("eppps", eppps)
+}
+
+/// The `screen` method (an on-screen stimulus's frames simulated through a fitted display
+/// model, Stoffregen et al. 2020 Sec. 3.1's on-screen checkerboard) where the recording
+/// has a stimulus of at least two frames.
+fn screen_method(
+    loaded: &Loaded,
+    stimulus: Option<ctcal_io::FrameList>,
+    options: &Options,
+) -> Result<MethodResult, SequenceError> {
+    let quiet = |_: &str, _: f64| {};
+    Ok(match stimulus {
         Some(list) if list.len() >= 2 => {
             let frames = list.load_all()?;
             let found = crate::window::screen_of(
@@ -291,21 +335,13 @@ fn estimates(
                 None,
                 &quiet,
             );
-            methods.push(MethodResult {
-                method: "screen",
-                not_applied: found.as_ref().err().map(|e| e.to_string()),
-                estimate: found.ok(),
-            });
+            outcome("screen", found)
         }
-        _ => methods.push(MethodResult {
-            method: "screen",
-            estimate: None,
-            not_applied: Some(
-                "the recording has no stimulus.txt (not an on-screen recording)".into(),
-            ),
-        }),
-    }
-    Ok((methods, maps))
+        _ => not_applied(
+            "screen",
+            "the recording has no stimulus.txt (not an on-screen recording)".into(),
+        ),
+    })
 }
 
 /// The fit of a recording, or why there is none.
