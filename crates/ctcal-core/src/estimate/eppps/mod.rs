@@ -602,8 +602,7 @@ struct OffsetBracket {
 }
 
 impl OffsetBracket {
-    /// The offsets scanned: both ends and `offset` (the fitted one, or the frames' own
-    /// where none was determined), each once.
+    /// The offsets scanned: both ends and the fitted `offset`, each once.
     fn offsets(&self, offset: f32) -> Vec<f32> {
         let mut offsets = vec![self.lo, offset.clamp(self.lo, self.hi), self.hi];
         offsets.dedup();
