@@ -8,7 +8,7 @@ use ctcal::sim::budget::{EffectWork, MAX_SIDE, Work};
 use ctcal::sim::display::DisplayModel;
 use ctcal::sim::scene::{SceneSource, SceneSpec};
 use ctcal::sim::source::{DisplaySource, LoadedFrames};
-use ctcal::sim::{FrameSource, PixelMaps, PixelParams, SimError};
+use ctcal::sim::{FrameSource, PixelMaps, PixelParams, SimError, SimSummary};
 use ctcal::{EventChunk, Frame, Sensor};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -244,25 +244,14 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
     let (width, height) = source.size();
     let sensor = Sensor::new(width as u16, height as u16);
     let maps = load_maps(args, sensor)?;
-    let mut writer = match to {
-        SimOutput::Ijrr => Writer::Ijrr(IjrrWriter::create(&args.out, sensor, &policy)?),
-        SimOutput::H5 => Writer::H5(H5Writer::create(&args.out, sensor, &policy)?),
-    };
-    let bar = progress_bar(global, source.len_hint().unwrap_or(0), "simulating");
-    let summary = ctcal::sim::run::<anyhow::Error>(
-        source.as_mut(),
-        &params,
-        maps,
-        |events| writer.events(events),
-        |n| bar.set_position(n),
-    )?;
-    bar.finish_and_clear();
+    let mut writer = create_writer(to, &args.out, sensor, &policy)?;
+    let summary = simulate_into(source.as_mut(), &params, maps, &mut writer, global)?;
     for frame in &aps_frames {
         writer.frame(frame)?;
     }
     write_stimulus(args, &mut writer)?;
     let wall_s = started.elapsed().as_secs_f64();
-    let duration_s = (summary.t_last_sample_us - summary.t_first_sample_us) as f64 * 1e-6;
+    let (duration_s, rate) = duration_and_rate(&summary, (width, height));
     let result = Provenance {
         width,
         height,
@@ -272,30 +261,79 @@ pub fn run(args: &SimulateArgs, global: &Global) -> anyhow::Result<()> {
         t_first_sample_us: summary.t_first_sample_us,
         t_last_sample_us: summary.t_last_sample_us,
         duration_s,
-        events_per_pixel_per_second: if duration_s > 0.0 {
-            summary.events as f64 / ((width * height) as f64 * duration_s)
-        } else {
-            0.0
-        },
+        events_per_pixel_per_second: rate,
         aps_frames: aps_frames.len(),
         render_hz,
         params,
         scene: scene_spec,
         frames: args.frames.clone(),
     };
-    match writer {
-        Writer::Ijrr(mut w) => {
-            w.add_file("simulation.json", output::json_text(&result)?.as_bytes())?;
-            w.finish()?
-        }
-        Writer::H5(w) => w.finish()?,
-    }
+    finish_output(writer, &result)?;
     let summary = Summary {
         provenance: &result,
         wall_s,
         samples_per_second: summary.samples as f64 / wall_s,
     };
     present(args, global, &policy, &summary)
+}
+
+/// Creates the output: an IJRR folder or an event_utils HDF5 file at `out`.
+fn create_writer(
+    to: SimOutput,
+    out: &Path,
+    sensor: Sensor,
+    policy: &super::OutputPolicy,
+) -> anyhow::Result<Writer> {
+    Ok(match to {
+        SimOutput::Ijrr => Writer::Ijrr(IjrrWriter::create(out, sensor, policy)?),
+        SimOutput::H5 => Writer::H5(H5Writer::create(out, sensor, policy)?),
+    })
+}
+
+/// Runs the pixel model `params` (with the per-pixel `maps`) over every sample of
+/// `source`, each batch of events written as it comes, with a progress bar of the samples.
+fn simulate_into(
+    source: &mut dyn FrameSource,
+    params: &PixelParams,
+    maps: PixelMaps,
+    writer: &mut Writer,
+    global: &Global,
+) -> anyhow::Result<SimSummary> {
+    let bar = progress_bar(global, source.len_hint().unwrap_or(0), "simulating");
+    let summary = ctcal::sim::run::<anyhow::Error>(
+        source,
+        params,
+        maps,
+        |events| writer.events(events),
+        |n| bar.set_position(n),
+    )?;
+    bar.finish_and_clear();
+    Ok(summary)
+}
+
+/// The simulated span, seconds (first to last input sample), and the events per pixel per
+/// second over it, `events / (width * height * duration_s)` (the rate Stoffregen et al.
+/// 2020 match between real and simulated data; 0 over no time).
+fn duration_and_rate(summary: &SimSummary, (width, height): (usize, usize)) -> (f64, f64) {
+    let duration_s = (summary.t_last_sample_us - summary.t_first_sample_us) as f64 * 1e-6;
+    let rate = if duration_s > 0.0 {
+        summary.events as f64 / ((width * height) as f64 * duration_s)
+    } else {
+        0.0
+    };
+    (duration_s, rate)
+}
+
+/// Finishes the output: an IJRR folder also gets `simulation.json` (the provenance).
+fn finish_output(writer: Writer, result: &Provenance) -> anyhow::Result<()> {
+    match writer {
+        Writer::Ijrr(mut w) => {
+            w.add_file("simulation.json", output::json_text(result)?.as_bytes())?;
+            w.finish()?
+        }
+        Writer::H5(w) => w.finish()?,
+    }
+    Ok(())
 }
 
 /// The files the simulation reads (never written over).
