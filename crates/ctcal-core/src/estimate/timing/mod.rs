@@ -514,10 +514,23 @@ pub(super) fn find_offset(
     let Some(root) = offset_root(&slope, range) else {
         return not_determined;
     };
-    // the slope's bootstrap error at the root
-    let Some((_, values, weights)) = fit(root) else {
+    let Some(bound) = slope_bound(pairs, frames, options, fit, root) else {
         return not_determined;
     };
+    let ci95 = offset_interval(&slope, root, bound, range);
+    classified(root, ci95, not_determined)
+}
+
+/// The level slope's 95 % chance bound at `root`: 1.96 standard deviations of the slope
+/// over 40 bootstrap draws of the pixels' samples (`None` where the fit at the root fails).
+fn slope_bound(
+    pairs: &[Pair],
+    frames: &PreparedFrames,
+    options: &TimingOptions,
+    fit: &Fit<'_>,
+    root: f32,
+) -> Option<f64> {
+    let (_, values, weights) = fit(root)?;
     let pixels = frames.width * frames.height;
     let slots = PixelSlots::new(pairs);
     let resampler = Resampler::new(pairs, &slots, &values, &weights, pixels);
@@ -526,8 +539,13 @@ pub(super) fn find_offset(
             .fit(&resampler.draw(500 + k as u64), options.fit_leak)
             .map(|c| c.level_slope)
     });
-    let bound = 1.96 * std_dev(&slopes);
-    let ci95 = offset_interval(&slope, root, bound, range);
+    Some(1.96 * std_dev(&slopes))
+}
+
+/// The offset a `root` with its 95 % interval `ci95` stands for: fitted, or not determined
+/// (`not_determined` with its source) where the interval spans the prior on both sides or
+/// the root lies beyond the prior.
+fn classified(root: f32, ci95: [Option<f32>; 2], not_determined: Offset) -> Offset {
     let open_below = ci95[0].is_none_or(|lo| lo <= OFFSET_PRIOR.0);
     let open_above = ci95[1].is_none_or(|hi| hi >= OFFSET_PRIOR.1);
     if open_below && open_above {
