@@ -1134,44 +1134,69 @@ fn assumptions(
             calibrations.len()
         ));
     } else if !frames {
-        out.push(format!(
-            "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread is in the interval as a 95 % prediction interval for one more scene ({} images read: Student t with one degree of freedom fewer, and the spread of their mean, x {:.2} the spread); the interval holds for scenes of the photographs' contrast (log-luminance standard deviation {:.2}-{:.2} over the floors scanned): a scene k times less contrasty (a smooth texture, fog, a low-contrast pattern) reads a threshold k times too high, a more contrasty one (a printed pattern, a high-contrast lab scene) k times too low",
-            images_read(calibrations),
-            prediction_scale(calibrations),
-            prior::log_std_range().0,
-            prior::log_std_range().1,
-        ));
-        let (lo, hi) = prior::FLOOR_RANGE_OF_MEAN;
-        out.push(format!(
-            "prior: the pixel's log response ln(light + floor), the floor (dark current and lens glare) {:.0}-{:.0} % of the scene's mean light (log-uniform; scanned at {}); not measured without frames, its spread is in the interval: sRGB photographs decoded to linear luminance, each under every floor ({} calibrations)",
-            100.0 * lo,
-            100.0 * hi,
-            prior::FLOORS_OF_MEAN
-                .iter()
-                .map(|f| format!("{:.1} %", 100.0 * f))
-                .collect::<Vec<_>>()
-                .join(", "),
-            calibrations.len()
-        ));
-        out.push(format!(
-            "flow precision: half a pixel of displacement per window, or the split-half spread where larger: {:.1} % of the travel, a systematic error",
-            100.0 * rates.travel_relative_error
-        ));
+        out.extend(prior_assumptions(rates, calibrations, images));
     }
     out.push(format!(
         "scans start from the state {} px of the same motion left (the recording is part of a longer one); ideal pixels: bandwidth, refractory period and noise of the real sensor are not in the scans",
         scans::BURN_IN_PX
     ));
-    out.push(
-        if let Some(dn) = dim_frames_dn(rates.frames_median_dn).filter(|_| frames) {
-            format!("method systematic: {:.0} % (in ln C) in every interval, for frames under {DIM_FRAMES_DN:.0} DN (median {dn:.0} DN): a dim scene, where a photoreceptor whose cutoff falls with the light thins the events the ideal scans count and leak and noise weigh more; the smallest term that covers 95 % of such polarity-cases of simulated recordings with random scenes and sensor effects read through their frames (coverage study, benches/coverage/eppps-dim-frames-2026-12-05; the {:.0} % of brighter frames covered 79 % of them); a frame's DN depends on exposure and gain, so short exposures of a bright scene are held to this wider term too", 100.0 * METHOD_LN_SYSTEMATIC_DIM, 100.0 * METHOD_LN_SYSTEMATIC)
-        } else if frames {
-            format!("method systematic: {:.0} % (in ln C) in every interval, the scans' error beyond their own intervals on simulated recordings with known thresholds, random scenes and random sensor effects read through their frames (coverage study, 262 polarity-cases: the smallest term that covers 95 % of them; 90 % of 80 draws it was not measured on); a sensor whose bandwidth, refractory period, leak or noise lies far outside that study's range moves the count further", 100.0 * METHOD_LN_SYSTEMATIC)
-        } else {
-            format!("method systematic: {:.0} % (in ln C) in every interval beside the prior's spread, the scans' error on simulated recordings with known thresholds and no other effect (six polarity-cases); bandwidth or a refractory period, which thin the events further, is not in it. Scope, from 55 coverage draws read without frames: the intervals held 27 of 27 ON and 26 of 27 OFF thresholds of scenes as contrasty as the prior's photographs and at 20 DN or more of their frames, and 15 of 18 and 12 of 18 of the rest: a texture 1.8-2.4 times less contrasty than the least contrasty photograph read 3-5 times high, and under 20 DN a photoreceptor slowed by the dark thinned the events (read 3-5 times high) or leak added to few (read 4-5 times low) (benches/coverage/eppps-scope-2026-12-04)", 100.0 * METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES)
-        },
-    );
+    out.push(method_systematic_assumption(rates, frames));
     out
+}
+
+/// Without frames: what the natural-image prior stands for (the scenes' contrast, the
+/// response's floor) and the flow's precision.
+fn prior_assumptions(
+    rates: &RecordingRates,
+    calibrations: &[Calibration],
+    images: usize,
+) -> Vec<String> {
+    let mut out = Vec::new();
+    out.push(format!(
+        "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread is in the interval as a 95 % prediction interval for one more scene ({} images read: Student t with one degree of freedom fewer, and the spread of their mean, x {:.2} the spread); the interval holds for scenes of the photographs' contrast (log-luminance standard deviation {:.2}-{:.2} over the floors scanned): a scene k times less contrasty (a smooth texture, fog, a low-contrast pattern) reads a threshold k times too high, a more contrasty one (a printed pattern, a high-contrast lab scene) k times too low",
+        images_read(calibrations),
+        prediction_scale(calibrations),
+        prior::log_std_range().0,
+        prior::log_std_range().1,
+    ));
+    let (lo, hi) = prior::FLOOR_RANGE_OF_MEAN;
+    out.push(format!(
+        "prior: the pixel's log response ln(light + floor), the floor (dark current and lens glare) {:.0}-{:.0} % of the scene's mean light (log-uniform; scanned at {}); not measured without frames, its spread is in the interval: sRGB photographs decoded to linear luminance, each under every floor ({} calibrations)",
+        100.0 * lo,
+        100.0 * hi,
+        prior::FLOORS_OF_MEAN
+            .iter()
+            .map(|f| format!("{:.1} %", 100.0 * f))
+            .collect::<Vec<_>>()
+            .join(", "),
+        calibrations.len()
+    ));
+    out.push(format!(
+        "flow precision: half a pixel of displacement per window, or the split-half spread where larger: {:.1} % of the travel, a systematic error",
+        100.0 * rates.travel_relative_error
+    ));
+    out
+}
+
+/// The method systematic term in every interval, and what it was measured on.
+fn method_systematic_assumption(rates: &RecordingRates, frames: bool) -> String {
+    if let Some(dn) = dim_frames_dn(rates.frames_median_dn).filter(|_| frames) {
+        format!(
+            "method systematic: {:.0} % (in ln C) in every interval, for frames under {DIM_FRAMES_DN:.0} DN (median {dn:.0} DN): a dim scene, where a photoreceptor whose cutoff falls with the light thins the events the ideal scans count and leak and noise weigh more; the smallest term that covers 95 % of such polarity-cases of simulated recordings with random scenes and sensor effects read through their frames (coverage study, benches/coverage/eppps-dim-frames-2026-12-05; the {:.0} % of brighter frames covered 79 % of them); a frame's DN depends on exposure and gain, so short exposures of a bright scene are held to this wider term too",
+            100.0 * METHOD_LN_SYSTEMATIC_DIM,
+            100.0 * METHOD_LN_SYSTEMATIC
+        )
+    } else if frames {
+        format!(
+            "method systematic: {:.0} % (in ln C) in every interval, the scans' error beyond their own intervals on simulated recordings with known thresholds, random scenes and random sensor effects read through their frames (coverage study, 262 polarity-cases: the smallest term that covers 95 % of them; 90 % of 80 draws it was not measured on); a sensor whose bandwidth, refractory period, leak or noise lies far outside that study's range moves the count further",
+            100.0 * METHOD_LN_SYSTEMATIC
+        )
+    } else {
+        format!(
+            "method systematic: {:.0} % (in ln C) in every interval beside the prior's spread, the scans' error on simulated recordings with known thresholds and no other effect (six polarity-cases); bandwidth or a refractory period, which thin the events further, is not in it. Scope, from 55 coverage draws read without frames: the intervals held 27 of 27 ON and 26 of 27 OFF thresholds of scenes as contrasty as the prior's photographs and at 20 DN or more of their frames, and 15 of 18 and 12 of 18 of the rest: a texture 1.8-2.4 times less contrasty than the least contrasty photograph read 3-5 times high, and under 20 DN a photoreceptor slowed by the dark thinned the events (read 3-5 times high) or leak added to few (read 4-5 times low) (benches/coverage/eppps-scope-2026-12-04)",
+            100.0 * METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES
+        )
+    }
 }
 
 /// The curve in the recording's terms: events per kept pixel per second it would make.
