@@ -90,10 +90,7 @@ struct StillExcess {
 /// `benches/coverage/fit-leak-start-2026-12-06`), so it is searched from both
 /// ([`Evidence::other_start`]).
 fn still_excess(c: &Context) -> Option<StillExcess> {
-    let pixel_seconds: f64 = (0..c.geometry.blocks)
-        .filter(|&b| c.geometry.in_subset(b, c.subset))
-        .map(|b| c.geometry.still_exposure[b])
-        .sum();
+    let pixel_seconds = still_pixel_seconds(c.geometry, c.subset);
     let real = c.real.still_of(c.geometry, c.subset);
     let model = c.sim.still_of(c.geometry, c.subset);
     let seen = net(real) - net(model);
@@ -134,6 +131,14 @@ pub struct StillBalance {
     pub pixel_seconds: f64,
 }
 
+/// Still pixel-seconds ([`Geometry::still_exposure`]) on `subset`'s blocks.
+fn still_pixel_seconds(geometry: &Geometry, subset: Subset) -> f64 {
+    (0..geometry.blocks)
+        .filter(|&b| geometry.in_subset(b, subset))
+        .map(|b| geometry.still_exposure[b])
+        .sum()
+}
+
 fn net([off, on]: [u64; 2]) -> f64 {
     on as f64 - off as f64
 }
@@ -159,10 +164,7 @@ impl StillBalance {
             recording: real.still_of(geometry, subset),
             without: without.still_of(geometry, subset),
             with: with.still_of(geometry, subset),
-            pixel_seconds: (0..geometry.blocks)
-                .filter(|&b| geometry.in_subset(b, subset))
-                .map(|b| geometry.still_exposure[b])
-                .sum(),
+            pixel_seconds: still_pixel_seconds(geometry, subset),
         }
     }
 
