@@ -438,12 +438,13 @@ impl Setup<'_> {
         }
     }
 
-    /// The roots of the ON and OFF median log ratios ([`super::root`]), the display fixed.
+    /// The roots of the ON and OFF median log ratios ([`super::root`]), the display fixed;
+    /// [`Unmatched::Beyond`] where no threshold in [`THRESHOLD_LIMITS`] matches the counts.
     fn thresholds(
         &self,
         start: (f64, f64),
         display: Option<&DisplayParams>,
-    ) -> Result<(f64, f64), EstimateError> {
+    ) -> Result<(f64, f64), Unmatched> {
         let mut ct = [start.0, start.1];
         for slot in 0..2 {
             let problem = Root {
@@ -466,19 +467,35 @@ impl Setup<'_> {
             ct[slot] = match threshold_root(cost, ct[slot], &search)? {
                 Crossing::Root(c) => c,
                 Crossing::Beyond { reached, too_many } => {
-                    return Err(EstimateError::new(
-                        format!(
-                            "the simulated stimulus makes {} {} events than the recording even at a threshold of {reached} (the {} tried)",
-                            if too_many { "more" } else { "fewer" },
-                            if slot == 0 { "ON" } else { "OFF" },
-                            if too_many { "largest" } else { "smallest" },
-                        ),
-                        "check that the stimulus is the one the recording shows",
-                    ));
+                    return Err(Unmatched::Beyond(format!(
+                        "the simulated stimulus makes {} {} events than the recording even at a threshold of {reached} (the {} tried){}",
+                        if too_many { "more" } else { "fewer" },
+                        if slot == 0 { "ON" } else { "OFF" },
+                        if too_many { "largest" } else { "smallest" },
+                        if too_many {
+                            ": the recording has fewer events than any threshold ctcal tries would make (check that the stimulus is the one the recording shows)"
+                        } else {
+                            ": the recording has more events than the stimulus can make (background events such as leak or noise, or another stimulus than the one given)"
+                        },
+                    )));
                 }
             };
         }
         Ok((ct[0], ct[1]))
+    }
+}
+
+/// Why thresholds were not matched: no threshold within [`THRESHOLD_LIMITS`] makes the
+/// recording's counts (the estimate is then not determinable, with this reason), or an
+/// error.
+enum Unmatched {
+    Beyond(String),
+    Failed(EstimateError),
+}
+
+impl From<EstimateError> for Unmatched {
+    fn from(e: EstimateError) -> Self {
+        Unmatched::Failed(e)
     }
 }
 
@@ -601,7 +618,11 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         Err(reason) => return Ok(unregistered(&reason)),
     };
     let (setup, excluded) = counting_setup(input, &hot_mask, &located, offset_us, refresh_hz);
-    let matched = matched_thresholds(setup, &excluded, &inputs, &mut located, progress)?;
+    let matched = match matched_thresholds(setup, &excluded, &inputs, &mut located, progress) {
+        Ok(matched) => matched,
+        Err(Unmatched::Beyond(why)) => return Ok(CtEstimate::not_determinable("screen", &why)),
+        Err(Unmatched::Failed(e)) => return Err(e),
+    };
     let (on, off) = measured(&matched, input.gamma_prior)?;
     let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
     describe(&mut estimate, &matched, &located, hot, (on, off));
@@ -704,7 +725,7 @@ fn matched_thresholds<'a>(
     inputs: &register::Inputs,
     located: &mut Located,
     progress: Progress,
-) -> Result<Matched<'a>, EstimateError> {
+) -> Result<Matched<'a>, Unmatched> {
     let input = setup.input;
     progress("naive estimate (no display model)", 0.1);
     // through the setup's first response: `naive_response`

@@ -379,3 +379,30 @@ fn a_dark_offset_large_against_a_dim_screen_is_not_read_as_high_thresholds() {
         );
     }
 }
+
+/// A recording without ON events (a sensor whose ON side is off) matches no ON threshold:
+/// its ON threshold is not determinable, with the reason, and never the root's plateau.
+#[test]
+fn a_recording_without_on_events_has_no_on_threshold() {
+    let one_to_one = geometry([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 0.0);
+    let stimulus = stimulus();
+    let all = record(&one_to_one, &stimulus);
+    let mut events = EventChunk::default();
+    for i in (0..all.len()).filter(|&i| !all.on[i]) {
+        events.push(all.t[i], all.x[i], all.y[i], false);
+    }
+    let excluded = vec![false; SENSOR.0 * SENSOR.1];
+    let input = ScreenInput {
+        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
+        events: &events,
+        stimulus: &stimulus,
+        screen: display(),
+        gamma_prior: super::GammaPrior::Measured(display().gamma),
+        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
+        refresh_hz: None,
+        excluded: &excluded,
+    };
+    let e = estimate(&input, &|_, _| {}).unwrap();
+    assert_eq!(e.ct_on, None, "{e:?}");
+    assert!(e.why["ct_on"].contains("not determinable"), "{:?}", e.why);
+}
