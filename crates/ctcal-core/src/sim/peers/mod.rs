@@ -10,11 +10,14 @@
 //! | DVS-Voltmeter | `k1 ln(DN + k2)` in volts, threshold 1 | none (diffusion) | none | `k4 + k5 DN` | none | diffusion `k3 sqrt(DN)/(DN+k2) + k6` |
 //! | IEBCS | `ln(DN/255 * 1e4 + 1)` | redrawn after every event | drops changes, reference reset at its end | none | low-pass `tau (1 klux / E)`, latency + jitter | fixed-rate or measured ON/OFF |
 //!
+//! A display's refreshes reach every peer as steps ([`held`]).
+//!
 //! [`write_case_with`] renders a scene through one of them into an IJRR folder with the truth
 //! in ctcal's terms (`params.json`, [`CaseTruth`]), through a [`CaseWriter`] the caller
 //! creates (the IO crate's `peers::write_case` gives it its IJRR writer).
 
 pub mod esim;
+mod held;
 pub mod iebcs;
 pub mod voltmeter;
 
@@ -51,12 +54,15 @@ impl Peer {
         }
     }
 
-    /// Runs the peer over `source`: the time-sorted events (deterministic for a seed).
+    /// Runs the peer over `source`: the time-sorted events (deterministic for a seed). A
+    /// held sample (a display's refresh) reaches the peer as a step at its time
+    /// ([`held::HeldAsSteps`]).
     pub fn simulate(
         &self,
         source: &mut dyn FrameSource,
         seed: u64,
     ) -> Result<EventChunk, SimError> {
+        let source = &mut held::HeldAsSteps::new(source);
         match self {
             Peer::Esim(p) => esim::simulate(source, p, seed),
             Peer::Voltmeter(p) => voltmeter::simulate(source, p, seed),
