@@ -245,34 +245,8 @@ fn choose(
 pub fn probe(path: &Path, choice: &TopicChoice) -> Result<BagInfo, InputError> {
     let (data_start, index_pos, len) = bag_header(path)?;
     let mut notes = Vec::new();
-    if index_pos > len {
-        return Err(InputError::corrupt(
-            path,
-            "the bag header record (byte offset 13)",
-            format!(
-                "the index lies at byte {index_pos}, beyond the end of the file ({len} bytes): the bag is cut short"
-            ),
-            "copy the whole bag again from its source (or run `rosbag reindex` on a complete copy)",
-        ));
-    }
-    let indexed = index_pos >= data_start;
-    let chunks_end = if indexed { index_pos } else { len };
-    let index = if indexed {
-        read_index(path, index_pos)?
-    } else {
-        None
-    };
-    let (connections, counts) = match index {
-        Some(found) => found,
-        None => {
-            notes.push(if indexed {
-                "the bag's index does not read; topics found by scanning the whole bag".to_string()
-            } else {
-                "the bag has no index (it was not closed when recorded); topics found by scanning it (`rosbag reindex` adds one)".to_string()
-            });
-            scan_connections(path, data_start, chunks_end)?
-        }
-    };
+    let (chunks_end, (connections, counts)) =
+        bag_connections(path, data_start, index_pos, len, &mut notes)?;
     let topics = topics_of(&connections, &counts);
     let events_topic = choose(
         &topics,
@@ -280,42 +254,7 @@ pub fn probe(path: &Path, choice: &TopicChoice) -> Result<BagInfo, InputError> {
         choice.events.as_deref(),
         Hint::Topic,
     );
-    let image_topic = match choose(
-        &topics,
-        messages::IMAGE,
-        choice.images.as_deref(),
-        Hint::ImageTopic,
-    ) {
-        Ok(t) => Some(t),
-        Err((problem, fix)) if choice.images.is_some() => {
-            return Err(InputError::invalid(path, problem, fix));
-        }
-        Err(_) => {
-            // several image topics: the one beside the events topic (/davis/left/...)
-            let images: Vec<&Topic> = topics
-                .iter()
-                .filter(|t| t.message_type == messages::IMAGE)
-                .collect();
-            let namespace = |name: &str| {
-                name.rsplit_once('/')
-                    .map(|(ns, _)| ns.to_string())
-                    .unwrap_or_default()
-            };
-            let beside = events_topic.as_ref().ok().and_then(|e| {
-                images
-                    .iter()
-                    .find(|t| namespace(&t.name) == namespace(e))
-                    .map(|t| t.name.clone())
-            });
-            if beside.is_none() && images.len() > 1 {
-                notes.push(format!(
-                    "{} image topics and none beside the events topic: frames not read (name the image topic to read them)",
-                    images.len()
-                ));
-            }
-            beside
-        }
-    };
+    let image_topic = chosen_image_topic(path, &topics, &events_topic, choice, &mut notes)?;
     if choice.events.is_some()
         && let Err((problem, fix)) = &events_topic
     {
@@ -334,6 +273,97 @@ pub fn probe(path: &Path, choice: &TopicChoice) -> Result<BagInfo, InputError> {
         data_start,
         chunks_end,
     })
+}
+
+/// The chunks' end and every connection's message count: from the index, else by a scan (noted).
+fn bag_connections(
+    path: &Path,
+    data_start: u64,
+    index_pos: u64,
+    len: u64,
+    notes: &mut Vec<String>,
+) -> Result<(u64, Connections), InputError> {
+    if index_pos > len {
+        return Err(InputError::corrupt(
+            path,
+            "the bag header record (byte offset 13)",
+            format!(
+                "the index lies at byte {index_pos}, beyond the end of the file ({len} bytes): the bag is cut short"
+            ),
+            "copy the whole bag again from its source (or run `rosbag reindex` on a complete copy)",
+        ));
+    }
+    let indexed = index_pos >= data_start;
+    let chunks_end = if indexed { index_pos } else { len };
+    let index = if indexed {
+        read_index(path, index_pos)?
+    } else {
+        None
+    };
+    let connections = match index {
+        Some(found) => found,
+        None => {
+            notes.push(if indexed {
+                "the bag's index does not read; topics found by scanning the whole bag".to_string()
+            } else {
+                "the bag has no index (it was not closed when recorded); topics found by scanning it (`rosbag reindex` adds one)".to_string()
+            });
+            scan_connections(path, data_start, chunks_end)?
+        }
+    };
+    Ok((chunks_end, connections))
+}
+
+/// The image topic: the one asked for, else the only one, else the one beside the events topic.
+fn chosen_image_topic(
+    path: &Path,
+    topics: &[Topic],
+    events_topic: &Result<String, (String, Text)>,
+    choice: &TopicChoice,
+    notes: &mut Vec<String>,
+) -> Result<Option<String>, InputError> {
+    match choose(
+        topics,
+        messages::IMAGE,
+        choice.images.as_deref(),
+        Hint::ImageTopic,
+    ) {
+        Ok(t) => Ok(Some(t)),
+        Err((problem, fix)) if choice.images.is_some() => {
+            Err(InputError::invalid(path, problem, fix))
+        }
+        Err(_) => Ok(image_topic_beside_events(topics, events_topic, notes)),
+    }
+}
+
+/// The image topic beside the events topic (/davis/left/...), noting several with none beside it.
+fn image_topic_beside_events(
+    topics: &[Topic],
+    events_topic: &Result<String, (String, Text)>,
+    notes: &mut Vec<String>,
+) -> Option<String> {
+    let images: Vec<&Topic> = topics
+        .iter()
+        .filter(|t| t.message_type == messages::IMAGE)
+        .collect();
+    let namespace = |name: &str| {
+        name.rsplit_once('/')
+            .map(|(ns, _)| ns.to_string())
+            .unwrap_or_default()
+    };
+    let beside = events_topic.as_ref().ok().and_then(|e| {
+        images
+            .iter()
+            .find(|t| namespace(&t.name) == namespace(e))
+            .map(|t| t.name.clone())
+    });
+    if beside.is_none() && images.len() > 1 {
+        notes.push(format!(
+            "{} image topics and none beside the events topic: frames not read (name the image topic to read them)",
+            images.len()
+        ));
+    }
+    beside
 }
 
 /// Every connection and its message count, by reading every chunk.
