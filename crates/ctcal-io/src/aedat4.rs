@@ -92,33 +92,8 @@ impl Aedat4Header {
 
     /// Reads and checks the header of `path`.
     pub fn read(path: &Path) -> Result<Self, InputError> {
-        let mut file = std::fs::File::open(path).map_err(|e| InputError::io(path, e))?;
-        let mut magic = [0u8; 14];
-        read_exact(&mut file, &mut magic, path, 0, "the AEDAT4 magic line")?;
-        if magic != MAGIC {
-            return Err(InputError::corrupt(
-                path,
-                "byte offset 0",
-                "the file does not start with #!AER-DAT4.0",
-                "this is not an AEDAT 4.0 file; AEDAT 2/3 files must be converted with DV first",
-            ));
-        }
-        let mut length = [0u8; 4];
-        read_exact(&mut file, &mut length, path, 14, "the header length")?;
-        let length = u32::from_le_bytes(length) as usize;
-        let file_size = file.metadata().map_err(|e| InputError::io(path, e))?.len();
-        if 18 + length as u64 > file_size {
-            return Err(InputError::corrupt(
-                path,
-                "byte offset 14",
-                format!(
-                    "the header claims {length} bytes, more than the {file_size}-byte file holds"
-                ),
-                FIX_TRUNCATED,
-            ));
-        }
-        let mut buffer = vec![0u8; length];
-        read_exact(&mut file, &mut buffer, path, 18, "the IOHeader")?;
+        let buffer = read_io_header_bytes(path)?;
+        let length = buffer.len();
         let header = flatbuffers::root::<IoHeader>(&buffer).map_err(|e| {
             InputError::corrupt(
                 path,
@@ -130,19 +105,7 @@ impl Aedat4Header {
                 FIX_TRUNCATED,
             )
         })?;
-        let compression = match header.compression() {
-            0 => Compression::None,
-            1 | 2 => Compression::Lz4,
-            3 | 4 => Compression::Zstd,
-            other => {
-                return Err(InputError::corrupt(
-                    path,
-                    "byte offset 18 (IOHeader)",
-                    format!("unknown compression code {other}"),
-                    "re-export the recording from DV with LZ4, Zstd or no compression",
-                ));
-            }
-        };
+        let compression = compression_of(path, header.compression())?;
         let description = header.description().unwrap_or_default();
         let (streams, source) = parse_description(description).map_err(|problem| {
             InputError::corrupt(
@@ -160,6 +123,51 @@ impl Aedat4Header {
             streams,
             source,
         })
+    }
+}
+
+/// The IOHeader's bytes, after checking the magic line and that the file holds them.
+fn read_io_header_bytes(path: &Path) -> Result<Vec<u8>, InputError> {
+    let mut file = std::fs::File::open(path).map_err(|e| InputError::io(path, e))?;
+    let mut magic = [0u8; 14];
+    read_exact(&mut file, &mut magic, path, 0, "the AEDAT4 magic line")?;
+    if magic != MAGIC {
+        return Err(InputError::corrupt(
+            path,
+            "byte offset 0",
+            "the file does not start with #!AER-DAT4.0",
+            "this is not an AEDAT 4.0 file; AEDAT 2/3 files must be converted with DV first",
+        ));
+    }
+    let mut length = [0u8; 4];
+    read_exact(&mut file, &mut length, path, 14, "the header length")?;
+    let length = u32::from_le_bytes(length) as usize;
+    let file_size = file.metadata().map_err(|e| InputError::io(path, e))?.len();
+    if 18 + length as u64 > file_size {
+        return Err(InputError::corrupt(
+            path,
+            "byte offset 14",
+            format!("the header claims {length} bytes, more than the {file_size}-byte file holds"),
+            FIX_TRUNCATED,
+        ));
+    }
+    let mut buffer = vec![0u8; length];
+    read_exact(&mut file, &mut buffer, path, 18, "the IOHeader")?;
+    Ok(buffer)
+}
+
+/// The packets' compression from the IOHeader's code (an error for an unknown code).
+fn compression_of(path: &Path, code: i32) -> Result<Compression, InputError> {
+    match code {
+        0 => Ok(Compression::None),
+        1 | 2 => Ok(Compression::Lz4),
+        3 | 4 => Ok(Compression::Zstd),
+        other => Err(InputError::corrupt(
+            path,
+            "byte offset 18 (IOHeader)",
+            format!("unknown compression code {other}"),
+            "re-export the recording from DV with LZ4, Zstd or no compression",
+        )),
     }
 }
 
@@ -237,6 +245,24 @@ fn stated_size(x: String, y: String) -> Option<Result<Sensor, String>> {
 /// The most bytes one packet may decompress to (DV writes packets of a few MB at most).
 const MAX_PACKET_BYTES: u64 = 256 << 20;
 
+/// Decompresses `raw` onto `decoded`, stopping one byte beyond [`MAX_PACKET_BYTES`].
+fn decompress(compression: Compression, raw: &[u8], decoded: &mut Vec<u8>) -> std::io::Result<()> {
+    let limit = MAX_PACKET_BYTES + 1;
+    match compression {
+        Compression::None => {
+            decoded.extend_from_slice(raw);
+            Ok(())
+        }
+        Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(raw)
+            .take(limit)
+            .read_to_end(decoded)
+            .map(|_| ()),
+        Compression::Zstd => zstd::stream::read::Decoder::new(raw)
+            .and_then(|d| d.take(limit).read_to_end(decoded))
+            .map(|_| ()),
+    }
+}
+
 /// Reads packets one at a time, decompressing those of one stream.
 struct PacketReader {
     path: PathBuf,
@@ -275,40 +301,9 @@ impl PacketReader {
     /// are then in `self.decoded`. `None` at the end of the packets.
     fn next(&mut self, wanted: i32) -> Result<Option<u64>, InputError> {
         loop {
-            if self.position + 8 > self.end {
-                if self.position < self.end {
-                    return Err(InputError::corrupt(
-                        &self.path,
-                        format!("byte offset {}", self.position),
-                        "the file ends inside a packet header",
-                        FIX_TRUNCATED,
-                    ));
-                }
+            let Some((offset, stream, size)) = self.next_packet_header()? else {
                 return Ok(None);
-            }
-            let offset = self.position;
-            let mut head = [0u8; 8];
-            read_exact(
-                &mut self.file,
-                &mut head,
-                &self.path,
-                offset,
-                "a packet header",
-            )?;
-            let stream = i32::from_le_bytes([head[0], head[1], head[2], head[3]]);
-            let size = i32::from_le_bytes([head[4], head[5], head[6], head[7]]);
-            if size < 0 || offset + 8 + size as u64 > self.end {
-                return Err(InputError::corrupt(
-                    &self.path,
-                    format!("byte offset {offset}"),
-                    format!(
-                        "packet of stream {stream} claims {size} bytes, more than the file holds"
-                    ),
-                    FIX_TRUNCATED,
-                ));
-            }
-            self.position = offset + 8 + size as u64;
-            self.count += 1;
+            };
             if stream != wanted {
                 self.file
                     .seek_relative(size as i64)
@@ -316,52 +311,81 @@ impl PacketReader {
                 continue;
             }
             self.current = (self.count - 1, offset, stream);
-            self.raw.resize(size as usize, 0);
-            read_exact(
-                &mut self.file,
-                &mut self.raw,
-                &self.path,
-                offset + 8,
-                "a packet",
-            )?;
-            self.decoded.clear();
-            // a packet decompresses to at most MAX_PACKET_BYTES: more is a decompression
-            // bomb or damage, never an event packet
-            let limit = MAX_PACKET_BYTES + 1;
-            let result = match self.compression {
-                Compression::None => {
-                    self.decoded.extend_from_slice(&self.raw);
-                    Ok(())
-                }
-                Compression::Lz4 => lz4_flex::frame::FrameDecoder::new(&self.raw[..])
-                    .take(limit)
-                    .read_to_end(&mut self.decoded)
-                    .map(|_| ()),
-                Compression::Zstd => zstd::stream::read::Decoder::new(&self.raw[..])
-                    .and_then(|d| d.take(limit).read_to_end(&mut self.decoded))
-                    .map(|_| ()),
-            };
-            if self.decoded.len() as u64 > MAX_PACKET_BYTES {
-                return Err(InputError::corrupt(
-                    &self.path,
-                    self.place(""),
-                    format!(
-                        "the packet decompresses to more than {} MB",
-                        MAX_PACKET_BYTES >> 20
-                    ),
-                    FIX_DAMAGED_PACKET,
-                ));
-            }
-            result.map_err(|e| {
-                InputError::corrupt(
-                    &self.path,
-                    self.place(""),
-                    format!("cannot decompress the packet: {e}"),
-                    FIX_DAMAGED_PACKET,
-                )
-            })?;
+            self.read_packet_data(offset, size)?;
             return Ok(Some(offset));
         }
+    }
+
+    /// Reads the next packet header and passes it: (offset, stream, byte size); `None` at the end.
+    fn next_packet_header(&mut self) -> Result<Option<(u64, i32, i32)>, InputError> {
+        if self.position + 8 > self.end {
+            if self.position < self.end {
+                return Err(InputError::corrupt(
+                    &self.path,
+                    format!("byte offset {}", self.position),
+                    "the file ends inside a packet header",
+                    FIX_TRUNCATED,
+                ));
+            }
+            return Ok(None);
+        }
+        let offset = self.position;
+        let mut head = [0u8; 8];
+        read_exact(
+            &mut self.file,
+            &mut head,
+            &self.path,
+            offset,
+            "a packet header",
+        )?;
+        let stream = i32::from_le_bytes([head[0], head[1], head[2], head[3]]);
+        let size = i32::from_le_bytes([head[4], head[5], head[6], head[7]]);
+        if size < 0 || offset + 8 + size as u64 > self.end {
+            return Err(InputError::corrupt(
+                &self.path,
+                format!("byte offset {offset}"),
+                format!("packet of stream {stream} claims {size} bytes, more than the file holds"),
+                FIX_TRUNCATED,
+            ));
+        }
+        self.position = offset + 8 + size as u64;
+        self.count += 1;
+        Ok(Some((offset, stream, size)))
+    }
+
+    /// Reads the `size` bytes of the packet at `offset` and decompresses them into `decoded`.
+    fn read_packet_data(&mut self, offset: u64, size: i32) -> Result<(), InputError> {
+        self.raw.resize(size as usize, 0);
+        read_exact(
+            &mut self.file,
+            &mut self.raw,
+            &self.path,
+            offset + 8,
+            "a packet",
+        )?;
+        self.decoded.clear();
+        // a packet decompresses to at most MAX_PACKET_BYTES: more is a decompression
+        // bomb or damage, never an event packet
+        let result = decompress(self.compression, &self.raw, &mut self.decoded);
+        if self.decoded.len() as u64 > MAX_PACKET_BYTES {
+            return Err(InputError::corrupt(
+                &self.path,
+                self.place(""),
+                format!(
+                    "the packet decompresses to more than {} MB",
+                    MAX_PACKET_BYTES >> 20
+                ),
+                FIX_DAMAGED_PACKET,
+            ));
+        }
+        result.map_err(|e| {
+            InputError::corrupt(
+                &self.path,
+                self.place(""),
+                format!("cannot decompress the packet: {e}"),
+                FIX_DAMAGED_PACKET,
+            )
+        })
     }
 
     /// The packet in `decoded`, of a `what` (event, frame) stream, whose contents are
