@@ -134,6 +134,75 @@ fn prophesee_sensor(
     }
 }
 
+/// A bag's topics (its notes to `notes`) and the sensor its first event message states.
+fn bag_source(
+    path: &Path,
+    options: &OpenOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Source, Option<(Sensor, String)>), InputError> {
+    let info = bag::probe(
+        path,
+        &bag::TopicChoice {
+            events: options.topic.clone(),
+            images: options.image_topic.clone(),
+        },
+    )?;
+    notes.extend(info.notes.iter().cloned());
+    let sensor = info.sensor.map(|s| {
+        (
+            s,
+            "width/height of the first dvs_msgs/EventArray message".to_string(),
+        )
+    });
+    Ok((Source::Bag(info), sensor))
+}
+
+/// An HDF5 file's layout (its notes to `notes`) and the sensor size it states.
+#[cfg(feature = "hdf5")]
+fn h5_source(
+    path: &Path,
+    options: &OpenOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Source, Option<(Sensor, String)>), InputError> {
+    let info = h5::probe(path, options.side.unwrap_or_default())?;
+    let sensor = info.sensor.map(|s| {
+        (
+            s,
+            info.sensor_note
+                .clone()
+                .unwrap_or_else(|| "sensor_resolution".into()),
+        )
+    });
+    if let Some(note) = &info.sensor_note
+        && note.contains("(W, H)")
+    {
+        notes.push(note.clone());
+    }
+    notes.extend(info.notes.iter().cloned());
+    Ok((Source::H5(info), sensor))
+}
+
+/// An AEDAT4 header and the event stream's sensor size (an unusable one noted if given).
+fn aedat4_source(
+    path: &Path,
+    options: &OpenOptions,
+    notes: &mut Vec<String>,
+) -> Result<(Source, Option<(Sensor, String)>), InputError> {
+    let header = aedat4::Aedat4Header::read(path)?;
+    if let (Some(unusable), Some(given)) = (header.unusable_event_size(), options.sensor) {
+        notes.push(format!(
+            "{unusable}; the sensor size given ({given}) is used"
+        ));
+    }
+    let sensor = header.event_sensor().map(|s| {
+        (
+            s,
+            "sizeX/sizeY of the event stream in the AEDAT4 header".to_string(),
+        )
+    });
+    Ok((Source::Aedat4(header), sensor))
+}
+
 impl Recording {
     /// Opens `path`, detecting its format from content unless `options.format` is set.
     pub fn open(path: &Path, options: &OpenOptions) -> Result<Self, InputError> {
@@ -195,23 +264,7 @@ impl Recording {
     ) -> Result<(Source, Option<(Sensor, String)>), InputError> {
         Ok(match format {
             Format::Ijrr => ijrr_source(path, options.sensor.is_some())?,
-            Format::Bag => {
-                let info = bag::probe(
-                    path,
-                    &bag::TopicChoice {
-                        events: options.topic.clone(),
-                        images: options.image_topic.clone(),
-                    },
-                )?;
-                notes.extend(info.notes.iter().cloned());
-                let sensor = info.sensor.map(|s| {
-                    (
-                        s,
-                        "width/height of the first dvs_msgs/EventArray message".to_string(),
-                    )
-                });
-                (Source::Bag(info), sensor)
-            }
+            Format::Bag => bag_source(path, options, notes)?,
             #[cfg(not(feature = "hdf5"))]
             Format::H5 => {
                 return Err(InputError::hdf5(
@@ -221,41 +274,8 @@ impl Recording {
                 ));
             }
             #[cfg(feature = "hdf5")]
-            Format::H5 => {
-                let info = h5::probe(path, options.side.unwrap_or_default())?;
-                let sensor = info.sensor.map(|s| {
-                    (
-                        s,
-                        info.sensor_note
-                            .clone()
-                            .unwrap_or_else(|| "sensor_resolution".into()),
-                    )
-                });
-                if let Some(note) = &info.sensor_note
-                    && note.contains("(W, H)")
-                {
-                    notes.push(note.clone());
-                }
-                notes.extend(info.notes.iter().cloned());
-                (Source::H5(info), sensor)
-            }
-            Format::Aedat4 => {
-                let header = aedat4::Aedat4Header::read(path)?;
-                if let (Some(unusable), Some(given)) =
-                    (header.unusable_event_size(), options.sensor)
-                {
-                    notes.push(format!(
-                        "{unusable}; the sensor size given ({given}) is used"
-                    ));
-                }
-                let sensor = header.event_sensor().map(|s| {
-                    (
-                        s,
-                        "sizeX/sizeY of the event stream in the AEDAT4 header".to_string(),
-                    )
-                });
-                (Source::Aedat4(header), sensor)
-            }
+            Format::H5 => h5_source(path, options, notes)?,
+            Format::Aedat4 => aedat4_source(path, options, notes)?,
             Format::Evt2 | Format::Evt3 | Format::Dat => {
                 let header = prophesee::PropheseeHeader::read(path)?;
                 let sensor = prophesee_sensor(path, &header, options.sensor, notes)?;
