@@ -306,7 +306,21 @@ impl BagWriter {
             .out
             .stream_position()
             .map_err(|e| InputError::write(&self.staged.shown, e))?;
-        let data = match self.compression {
+        let data = self.compressed_chunk()?;
+        let mut out = self.chunk_record(&data);
+        let (start, end, counts) = self.append_index_data(&mut out);
+        self.out
+            .write_all(&out)
+            .map_err(|e| InputError::write(&self.staged.shown, e))?;
+        self.chunks.push((position, start, end, counts));
+        self.chunk.clear();
+        self.index.clear();
+        Ok(())
+    }
+
+    /// The open chunk's records, compressed as set (uncompressed: taken from the chunk).
+    fn compressed_chunk(&mut self) -> Result<Vec<u8>, InputError> {
+        Ok(match self.compression {
             BagCompression::None => std::mem::take(&mut self.chunk),
             BagCompression::Bz2 => {
                 let mut encoder =
@@ -325,7 +339,11 @@ impl BagWriter {
                     .finish()
                     .map_err(|e| InputError::write(&self.staged.shown, std::io::Error::other(e)))?
             }
-        };
+        })
+    }
+
+    /// The chunk record (op 5) holding `data`, the open chunk's records as compressed.
+    fn chunk_record(&self, data: &[u8]) -> Vec<u8> {
         let uncompressed = if self.compression == BagCompression::None {
             data.len()
         } else {
@@ -344,7 +362,12 @@ impl BagWriter {
         );
         field(&mut header, "size", &(uncompressed as u32).to_le_bytes());
         let mut out = Vec::with_capacity(data.len() + 1024);
-        record(&mut out, &header, &data);
+        record(&mut out, &header, data);
+        out
+    }
+
+    /// Appends an index data record (op 4) per connection; the chunk's time span and counts.
+    fn append_index_data(&self, out: &mut Vec<u8>) -> (TimeUs, TimeUs, BTreeMap<u32, u32>) {
         let (mut start, mut end) = (TimeUs::MAX, TimeUs::MIN);
         let mut counts = BTreeMap::new();
         for (&id, entries) in &self.index {
@@ -360,16 +383,10 @@ impl BagWriter {
                 start = start.min(e.time);
                 end = end.max(e.time);
             }
-            record(&mut out, &header, &body);
+            record(out, &header, &body);
             counts.insert(id, entries.len() as u32);
         }
-        self.out
-            .write_all(&out)
-            .map_err(|e| InputError::write(&self.staged.shown, e))?;
-        self.chunks.push((position, start, end, counts));
-        self.chunk.clear();
-        self.index.clear();
-        Ok(())
+        (start, end, counts)
     }
 
     /// Writes the rest, the index section and the final bag header, and moves the bag into
