@@ -37,57 +37,9 @@ impl FrameList {
             if trimmed.is_empty() || trimmed[0] == b'#' {
                 continue;
             }
-            let mut fields = [&b""[..]; 2];
-            let n = text::split_fields(trimmed, &mut fields);
-            let t = (n == 2).then(|| text::seconds_to_us(fields[0])).flatten();
-            let Some(t) = t else {
-                return Err(InputError::corrupt(
-                    index_path,
-                    format!("line {line}"),
-                    format!(
-                        "expected `t path` (t in seconds), found `{}`",
-                        text::excerpt(raw)
-                    ),
-                    "each line names a frame: its time in seconds, a space, and the image path relative to this folder",
-                ));
-            };
-            // a time as events have them (not beyond 2^61 us)
-            if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
-                return Err(InputError::corrupt(
-                    index_path,
-                    format!("line {line}"),
-                    format!(
-                        "frame time {} s lies beyond +-{} s (about 73,000 years) of zero",
-                        text::excerpt(fields[0]),
-                        crate::events::TIME_LIMIT_US / 1_000_000
-                    ),
-                    "the line is damaged: give the frame's time in seconds",
-                ));
-            }
-            if let Some(previous) = entries.last()
-                && t < previous.t
-            {
-                return Err(InputError::corrupt(
-                    index_path,
-                    format!("line {line}"),
-                    format!(
-                        "frame time {} s is earlier than the line before ({} s)",
-                        t as f64 * 1e-6,
-                        previous.t as f64 * 1e-6
-                    ),
-                    "list frames in time order",
-                ));
-            }
-            let path = folder.join(String::from_utf8_lossy(fields[1]).as_ref());
-            if !path.is_file() {
-                return Err(InputError::corrupt(
-                    index_path,
-                    format!("line {line}"),
-                    format!("the image {} does not exist", path.display()),
-                    "restore the image or remove its line",
-                ));
-            }
-            entries.push(FrameEntry { t, path, line });
+            let (t, path) = time_and_path_field(index_path, line, raw, trimmed)?;
+            let entry = frame_entry(index_path, folder, line, t, path, entries.last())?;
+            entries.push(entry);
         }
         Ok(Self {
             index_path: index_path.to_path_buf(),
@@ -162,4 +114,76 @@ impl FrameList {
             "replace the image with an intact 8-bit PNG of the sensor's size",
         )
     }
+}
+
+/// A `t path` line's time (checked against the limit of event times) and its path field.
+fn time_and_path_field<'a>(
+    index_path: &Path,
+    line: usize,
+    raw: &[u8],
+    trimmed: &'a [u8],
+) -> Result<(TimeUs, &'a [u8]), InputError> {
+    let mut fields = [&b""[..]; 2];
+    let n = text::split_fields(trimmed, &mut fields);
+    let t = (n == 2).then(|| text::seconds_to_us(fields[0])).flatten();
+    let Some(t) = t else {
+        return Err(InputError::corrupt(
+            index_path,
+            format!("line {line}"),
+            format!(
+                "expected `t path` (t in seconds), found `{}`",
+                text::excerpt(raw)
+            ),
+            "each line names a frame: its time in seconds, a space, and the image path relative to this folder",
+        ));
+    };
+    // a time as events have them (not beyond 2^61 us)
+    if t.unsigned_abs() > crate::events::TIME_LIMIT_US as u64 {
+        return Err(InputError::corrupt(
+            index_path,
+            format!("line {line}"),
+            format!(
+                "frame time {} s lies beyond +-{} s (about 73,000 years) of zero",
+                text::excerpt(fields[0]),
+                crate::events::TIME_LIMIT_US / 1_000_000
+            ),
+            "the line is damaged: give the frame's time in seconds",
+        ));
+    }
+    Ok((t, fields[1]))
+}
+
+/// The entry of a line at `t` naming `path`, which must not precede `previous` and must exist.
+fn frame_entry(
+    index_path: &Path,
+    folder: &Path,
+    line: usize,
+    t: TimeUs,
+    path: &[u8],
+    previous: Option<&FrameEntry>,
+) -> Result<FrameEntry, InputError> {
+    if let Some(previous) = previous
+        && t < previous.t
+    {
+        return Err(InputError::corrupt(
+            index_path,
+            format!("line {line}"),
+            format!(
+                "frame time {} s is earlier than the line before ({} s)",
+                t as f64 * 1e-6,
+                previous.t as f64 * 1e-6
+            ),
+            "list frames in time order",
+        ));
+    }
+    let path = folder.join(String::from_utf8_lossy(path).as_ref());
+    if !path.is_file() {
+        return Err(InputError::corrupt(
+            index_path,
+            format!("line {line}"),
+            format!("the image {} does not exist", path.display()),
+            "restore the image or remove its line",
+        ));
+    }
+    Ok(FrameEntry { t, path, line })
 }
