@@ -193,45 +193,12 @@ pub fn load(
         observer.warn(&note.as_str().into());
     }
     let read = read_window(&recording, Source::Decode, window, observer)?;
-    let events = read.events;
-    let mut resolved = recording.resolve_sensor(events.max_coordinates());
-    let mut area_note = None;
-    if let Some((area, note)) = crate::events_area::reach_instead(
-        &resolved,
-        reach_with_region(events.max_coordinates(), selection.roi),
-        !read.chosen.frames.is_empty() || selection.mask.is_some(),
-        &recording.path,
-    ) {
-        (resolved, area_note) = (area, Some(note));
-    }
-    if let Some(w) = &resolved.warning {
-        observer.warn(w);
-    }
-    if let Some(w) = frames_larger_than_events(&resolved, events.max_coordinates(), &recording.path)
-    {
-        observer.warn(&w);
-    }
-    if let Some(f) = read.chosen.frames.first()
-        && (f.width as u16, f.height as u16) != (resolved.sensor.width, resolved.sensor.height)
-    {
-        return Err(LoadError::FrameSize {
-            path: recording.path.clone(),
-            frames: (f.width as usize, f.height as usize),
-            sensor: resolved.sensor,
-        });
-    }
-    // the estimators keep several maps of one value per pixel
+    let (resolved, area_note) = window_sensor(&recording, &read, selection, observer);
     let sensor = resolved.sensor;
-    if sensor.pixels() > crate::stats::PIXEL_BUDGET && !force {
-        return Err(LoadError::OverBudget {
-            path: recording.path.clone(),
-            sensor,
-            reach: events.max_coordinates().unwrap_or((0, 0)),
-        });
-    }
+    check_sensor_fits(&recording, &read, sensor, force)?;
     let kept = selection.build(sensor, &recording.path, force)?;
     let mut recording_notes: Vec<String> = area_note.into_iter().collect();
-    if let Some(note) = repeats_note(&events, sensor) {
+    if let Some(note) = repeats_note(&read.events, sensor) {
         observer.warn(&Text::from(format!("{}: {note}", recording.path.display())));
         recording_notes.push(note);
     }
@@ -243,7 +210,7 @@ pub fn load(
         sensor: resolved.sensor,
         sensor_source: resolved.source,
         recording,
-        events,
+        events: read.events,
         frames: read.chosen.frames,
         frames_available: read.chosen.available,
         frame_limit: read.chosen.limit,
@@ -251,6 +218,63 @@ pub fn load(
         notes,
         recording_notes,
     })
+}
+
+/// The sensor of a window's recording, resolved from the reach of its events (and the
+/// region's), with the warnings that come of it, and the note where the events' area
+/// replaces the recording's sensor.
+fn window_sensor(
+    recording: &Recording,
+    read: &WindowRead,
+    selection: &SelectionSpec,
+    observer: &dyn LoadObserver,
+) -> (crate::recording::ResolvedSensor, Option<String>) {
+    let reach = read.events.max_coordinates();
+    let mut resolved = recording.resolve_sensor(reach);
+    let mut area_note = None;
+    if let Some((area, note)) = crate::events_area::reach_instead(
+        &resolved,
+        reach_with_region(reach, selection.roi),
+        !read.chosen.frames.is_empty() || selection.mask.is_some(),
+        &recording.path,
+    ) {
+        (resolved, area_note) = (area, Some(note));
+    }
+    if let Some(w) = &resolved.warning {
+        observer.warn(w);
+    }
+    if let Some(w) = frames_larger_than_events(&resolved, reach, &recording.path) {
+        observer.warn(&w);
+    }
+    (resolved, area_note)
+}
+
+/// Refuses a window whose frames are not the size of `sensor`, or whose `sensor` is over
+/// the pixel budget (unless `force`).
+fn check_sensor_fits(
+    recording: &Recording,
+    read: &WindowRead,
+    sensor: Sensor,
+    force: bool,
+) -> Result<(), LoadError> {
+    if let Some(f) = read.chosen.frames.first()
+        && (f.width as u16, f.height as u16) != (sensor.width, sensor.height)
+    {
+        return Err(LoadError::FrameSize {
+            path: recording.path.clone(),
+            frames: (f.width as usize, f.height as usize),
+            sensor,
+        });
+    }
+    // the estimators keep several maps of one value per pixel
+    if sensor.pixels() > crate::stats::PIXEL_BUDGET && !force {
+        return Err(LoadError::OverBudget {
+            path: recording.path.clone(),
+            sensor,
+            reach: read.events.max_coordinates().unwrap_or((0, 0)),
+        });
+    }
+    Ok(())
 }
 
 /// The share of a window's events at which [`repeats_note`] speaks: the shared real
