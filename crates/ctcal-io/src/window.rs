@@ -424,17 +424,42 @@ fn read_window(
         )?,
         None => ChosenFrames::default(),
     };
-    if window.events_between_frames && chosen.frames.len() >= 2 {
+    let between_frames = window.events_between_frames && chosen.frames.len() >= 2;
+    if between_frames {
         from = from.max(chosen.frames[0].t);
         to = to.min(chosen.frames[chosen.frames.len() - 1].t);
     }
     let unread: Vec<(TimeUs, TimeUs)> =
         chosen.blocks.windows(2).map(|w| (w[0].1, w[1].0)).collect();
     let events = read_events(recording, source, (from, to), &unread, observer)?;
-    let between_frames = window.events_between_frames && chosen.frames.len() >= 2;
-    if events.is_empty() && between_frames && window.start_s.is_none() && window.end_s.is_none() {
+    if events.is_empty() {
+        return Err(no_events_error(
+            recording,
+            window,
+            between_frames,
+            (from, to),
+            first,
+        ));
+    }
+    Ok(WindowRead {
+        chosen,
+        unread,
+        events,
+    })
+}
+
+/// Why a window read no event in `[from, to]`: frames and events on different clocks, where
+/// no window was asked for and only the frames' span was read; otherwise an empty window.
+fn no_events_error(
+    recording: &Recording,
+    window: &Window,
+    between_frames: bool,
+    (from, to): (TimeUs, TimeUs),
+    first: TimeUs,
+) -> LoadError {
+    if between_frames && window.start_s.is_none() && window.end_s.is_none() {
         // no window was asked for: the frames' span held none of the events
-        return Err(InputError::invalid(
+        return InputError::invalid(
             &recording.path,
             format!(
                 "no event lies between the first and the last frame: the frames span {:.6} s .. {:.6} s of the file's clock and the first event is at {:.6} s, so frames and events are not on one clock or in one unit",
@@ -444,28 +469,21 @@ fn read_window(
             ),
             "check that the frames' and the events' times are seconds of the same clock",
         )
-        .into());
+        .into();
     }
-    if events.is_empty() {
-        return Err(InputError::EmptyWindow {
-            path: recording.path.clone(),
-            detail: format!(
-                "{:.6} s .. {:.6} s",
-                us_to_s(from.max(first) - first),
-                if to == TimeUs::MAX {
-                    f64::INFINITY
-                } else {
-                    us_to_s(to - first)
-                }
-            ),
-        }
-        .into());
+    InputError::EmptyWindow {
+        path: recording.path.clone(),
+        detail: format!(
+            "{:.6} s .. {:.6} s",
+            us_to_s(from.max(first) - first),
+            if to == TimeUs::MAX {
+                f64::INFINITY
+            } else {
+                us_to_s(to - first)
+            }
+        ),
     }
-    Ok(WindowRead {
-        chosen,
-        unread,
-        events,
-    })
+    .into()
 }
 
 /// Calls `each` on the chunks of events from `source` that reach into `[from, to]`, in time
