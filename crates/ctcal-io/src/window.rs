@@ -13,6 +13,7 @@ use crate::selection::{PixelSelection, Roi};
 use crate::sim::DisplayParams;
 use crate::sim::log_response::LogMap;
 use crate::{InputError, OpenOptions, Recording};
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
 /// The most events a window holds in memory (about 1.3 GB).
@@ -552,42 +553,73 @@ fn choose_frames(
         available: inside.len(),
         ..Default::default()
     };
-    let given = max_frames;
+    let (max_frames, scaled_note) = scaled_frame_limit(recording, &inside, max_frames)?;
+    chosen.limit = max_frames;
+    let keep = kept_frames(
+        recording,
+        source,
+        window,
+        (&inside, &inside_times),
+        first,
+        observer,
+        &mut chosen,
+    )?;
+    chosen.frames = frames_kept(recording, source, (&inside, &inside_times), &keep)?;
+    if let (Some(scaled), Some(note)) = (scaled_note, chosen.note.as_mut()) {
+        *note = format!("{scaled}: {note}");
+    }
+    Ok(chosen)
+}
+
+/// The frame limit `given`, scaled to the size of the window's frames (`inside`: their
+/// indices in the recording) by [`frame_blocks::scaled_limit`], and what `assumptions`
+/// says where the scaled limit is lower.
+fn scaled_frame_limit(
+    recording: &Recording,
+    inside: &[usize],
+    given: usize,
+) -> Result<(usize, Option<String>), LoadError> {
     // a larger sensor's frames count for more (only where the limit could bind)
     let max_frames = match inside.first() {
-        Some(&i) if inside.len() > frame_blocks::MIN_SCALED_FRAMES.min(max_frames) => {
+        Some(&i) if inside.len() > frame_blocks::MIN_SCALED_FRAMES.min(given) => {
             let pixels = recording.frame_pixels(i)?.unwrap_or(0);
-            frame_blocks::scaled_limit(max_frames, pixels)
+            frame_blocks::scaled_limit(given, pixels)
         }
-        _ => max_frames,
+        _ => given,
     };
-    chosen.limit = max_frames;
     let scaled_note = (max_frames < given).then(|| {
         format!(
             "the frame limit of {given} is for sensors up to 346x260 pixels; these frames are larger, so at most {max_frames} of them (the same frame pixels, at least {} frames)",
             frame_blocks::MIN_SCALED_FRAMES.min(given)
         )
     });
-    let keep: std::collections::BTreeSet<usize> = match frame_blocks::plan(
-        &inside_times,
-        max_frames,
-    ) {
-        frame_blocks::Plan::Blocks { step } if window.events_between_frames => {
-            let counts = interval_counts(recording, source, &inside_times, observer)?;
-            let thinned: Vec<usize> = (0..inside.len()).step_by(step).collect();
-            let blocks =
-                frame_blocks::choose(&frame_blocks::thinned_counts(&counts, step), max_frames);
-            let times_of: Vec<TimeUs> = thinned.iter().map(|&k| inside_times[k]).collect();
-            chosen.note = Some(blocks_note(&blocks, &times_of, (step, inside.len()), first));
-            chosen.blocks = blocks
-                .iter()
-                .map(|&(a, b)| (times_of[a], times_of[b]))
-                .collect();
-            blocks
-                .iter()
-                .flat_map(|&(a, b)| thinned[a..=b].iter().map(|&k| inside[k]))
-                .collect()
-        }
+    Ok((max_frames, scaled_note))
+}
+
+/// The recording's indices of the frames kept of the window's frames (`inside`, at
+/// `inside_times`) under the limit `chosen.limit`: all, every k-th, or blocks of
+/// consecutive frames (the latter only where the window keeps just the events between its
+/// frames); the choice's note (and blocks) go into `chosen`.
+fn kept_frames(
+    recording: &Recording,
+    source: Source,
+    window: &Window,
+    (inside, inside_times): (&[usize], &[TimeUs]),
+    first: TimeUs,
+    observer: &dyn LoadObserver,
+    chosen: &mut ChosenFrames,
+) -> Result<BTreeSet<usize>, LoadError> {
+    let max_frames = chosen.limit;
+    Ok(match frame_blocks::plan(inside_times, max_frames) {
+        frame_blocks::Plan::Blocks { step } if window.events_between_frames => kept_in_blocks(
+            recording,
+            source,
+            (inside, inside_times),
+            step,
+            first,
+            observer,
+            chosen,
+        )?,
         frame_blocks::Plan::All => inside.iter().copied().collect(),
         frame_blocks::Plan::Stride(_) | frame_blocks::Plan::Blocks { .. } => {
             let stride = inside.len().div_ceil(max_frames.max(2)).max(1);
@@ -598,14 +630,50 @@ fn choose_frames(
             ));
             inside.iter().step_by(stride).copied().collect()
         }
-    };
-    chosen.frames = match source {
-        // the frames already read are the window's, in the order of `inside` (checked by
-        // their times)
+    })
+}
+
+/// The recording's indices of the frames kept in blocks of consecutive frames, thinned to
+/// every `step`-th and chosen on the events between them ([`frame_blocks::choose`], under
+/// the limit `chosen.limit`); the blocks' spans and note go into `chosen`.
+fn kept_in_blocks(
+    recording: &Recording,
+    source: Source,
+    (inside, inside_times): (&[usize], &[TimeUs]),
+    step: usize,
+    first: TimeUs,
+    observer: &dyn LoadObserver,
+    chosen: &mut ChosenFrames,
+) -> Result<BTreeSet<usize>, LoadError> {
+    let counts = interval_counts(recording, source, inside_times, observer)?;
+    let thinned: Vec<usize> = (0..inside.len()).step_by(step).collect();
+    let blocks = frame_blocks::choose(&frame_blocks::thinned_counts(&counts, step), chosen.limit);
+    let times_of: Vec<TimeUs> = thinned.iter().map(|&k| inside_times[k]).collect();
+    chosen.note = Some(blocks_note(&blocks, &times_of, (step, inside.len()), first));
+    chosen.blocks = blocks
+        .iter()
+        .map(|&(a, b)| (times_of[a], times_of[b]))
+        .collect();
+    Ok(blocks
+        .iter()
+        .flat_map(|&(a, b)| thinned[a..=b].iter().map(|&k| inside[k]))
+        .collect())
+}
+
+/// The frames `keep` of the window's frames (`inside`, at `inside_times`): those `source`
+/// already read where they are the window's, in the order of `inside` (checked by their
+/// times); read from the recording otherwise.
+fn frames_kept(
+    recording: &Recording,
+    source: Source,
+    (inside, inside_times): (&[usize], &[TimeUs]),
+    keep: &BTreeSet<usize>,
+) -> Result<Vec<Frame>, LoadError> {
+    Ok(match source {
         Source::Read {
             frames: Some(read), ..
         } if read.len() == inside.len()
-            && read.iter().zip(&inside_times).all(|(f, &t)| f.t == t) =>
+            && read.iter().zip(inside_times).all(|(f, &t)| f.t == t) =>
         {
             inside
                 .iter()
@@ -615,11 +683,7 @@ fn choose_frames(
                 .collect()
         }
         _ => recording.frames_where(|i, _| keep.contains(&i))?,
-    };
-    if let (Some(scaled), Some(note)) = (scaled_note, chosen.note.as_mut()) {
-        *note = format!("{scaled}: {note}");
-    }
-    Ok(chosen)
+    })
 }
 
 /// The events in `[from, to]` outside the `unread` spans, at most [`MAX_EVENTS`].
