@@ -47,52 +47,10 @@ fn missing(path: &Path, what: &str) -> InputError {
 
 fn layout_of(path: &Path, file: &hdf5::File, side: Side) -> Result<Layout, InputError> {
     if let Ok(group) = file.group("events") {
-        // event_utils names its columns ts/xs/ys/ps, DSEC t/x/y/p
-        for (names, layout) in [
-            (["ts", "xs", "ys", "ps"], Layout::EventUtils),
-            (["t", "x", "y", "p"], Layout::Dsec),
-        ] {
-            if group.link_exists(names[0]) {
-                for name in names {
-                    if !group.link_exists(name) {
-                        return Err(missing(path, &format!("dataset events/{name}")));
-                    }
-                }
-                return Ok(layout);
-            }
-        }
-        return Err(missing(
-            path,
-            "events/ts (event_utils) or events/t (DSEC) in group `events`",
-        ));
+        return columns_layout(path, &group);
     }
     if let Ok(davis) = file.group("davis") {
-        let wanted = side.group();
-        if file.link_exists(&format!("{wanted}/events")) {
-            return Ok(Layout::Mvsec(side));
-        }
-        let others: Vec<String> = davis
-            .member_names()
-            .unwrap_or_default()
-            .into_iter()
-            .filter(|n| file.link_exists(&format!("davis/{n}/events")))
-            .collect();
-        return Err(InputError::hdf5(
-            path,
-            format!(
-                "an MVSEC file without {wanted}/events (cameras with events: {})",
-                if others.is_empty() {
-                    "none".to_string()
-                } else {
-                    others.join(", ")
-                }
-            ),
-            match others.first() {
-                Some(other) => Text::default().act(Hint::Side(other.clone())),
-                None => "the file holds no MVSEC events (davis/left/events or davis/right/events)"
-                    .into(),
-            },
-        ));
+        return mvsec_layout(path, file, &davis, side);
     }
     if let Ok(ds) = file.dataset("events") {
         let shape = ds.shape();
@@ -108,6 +66,66 @@ fn layout_of(path: &Path, file: &hdf5::File, side: Side) -> Result<Layout, Input
     Err(missing(
         path,
         "group `events` (event_utils, DSEC), dataset `events` (v2e) or group `davis` (MVSEC)",
+    ))
+}
+
+/// The layout of a file whose group `events` holds one column per field: event_utils
+/// (`ts`, `xs`, `ys`, `ps`) or DSEC (`t`, `x`, `y`, `p`), every column present.
+fn columns_layout(path: &Path, group: &hdf5::Group) -> Result<Layout, InputError> {
+    // event_utils names its columns ts/xs/ys/ps, DSEC t/x/y/p
+    for (names, layout) in [
+        (["ts", "xs", "ys", "ps"], Layout::EventUtils),
+        (["t", "x", "y", "p"], Layout::Dsec),
+    ] {
+        if group.link_exists(names[0]) {
+            for name in names {
+                if !group.link_exists(name) {
+                    return Err(missing(path, &format!("dataset events/{name}")));
+                }
+            }
+            return Ok(layout);
+        }
+    }
+    Err(missing(
+        path,
+        "events/ts (event_utils) or events/t (DSEC) in group `events`",
+    ))
+}
+
+/// The MVSEC layout of the camera `side`, where the file's group `davis` holds its events;
+/// otherwise an error naming the cameras that have events.
+fn mvsec_layout(
+    path: &Path,
+    file: &hdf5::File,
+    davis: &hdf5::Group,
+    side: Side,
+) -> Result<Layout, InputError> {
+    let wanted = side.group();
+    if file.link_exists(&format!("{wanted}/events")) {
+        return Ok(Layout::Mvsec(side));
+    }
+    let others: Vec<String> = davis
+        .member_names()
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|n| file.link_exists(&format!("davis/{n}/events")))
+        .collect();
+    Err(InputError::hdf5(
+        path,
+        format!(
+            "an MVSEC file without {wanted}/events (cameras with events: {})",
+            if others.is_empty() {
+                "none".to_string()
+            } else {
+                others.join(", ")
+            }
+        ),
+        match others.first() {
+            Some(other) => Text::default().act(Hint::Side(other.clone())),
+            None => {
+                "the file holds no MVSEC events (davis/left/events or davis/right/events)".into()
+            }
+        },
     ))
 }
 
