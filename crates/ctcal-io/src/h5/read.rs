@@ -632,6 +632,27 @@ fn check_dataset(
 ) -> Result<Vec<usize>, InputError> {
     let ds = file.dataset(name).map_err(|e| h5_error(path, name, e))?;
     let shape = ds.shape();
+    check_shape(path, name, &shape, rank)?;
+    check_filters(path, name, &ds)?;
+    let element = ds.dtype().map(|d| d.size()).unwrap_or(1) as f64;
+    check_chunk_size(path, name, &ds, element)?;
+    let logical = shape.iter().map(|&n| n as f64).product::<f64>() * element;
+    let stored = ds.storage_size() as f64;
+    if logical > 1100.0 * stored.max(4096.0) {
+        return Err(InputError::hdf5(
+            path,
+            format!(
+                "{name} claims shape {shape:?} ({logical:.3e} bytes) but stores only {stored:.0} bytes"
+            ),
+            "the file is damaged or was written incompletely; rewrite it from the source",
+        ));
+    }
+    Ok(shape)
+}
+
+/// Checks the shape of dataset `name`: `rank` dimensions, and grey frames, not colour
+/// images, where it holds frames.
+fn check_shape(path: &Path, name: &str, shape: &[usize], rank: usize) -> Result<(), InputError> {
     let frames = name.starts_with("images/") || name == "frame" || name.ends_with("image_raw");
     if frames && shape.len() == rank + 1 && matches!(shape[rank], 3 | 4) {
         return Err(InputError::hdf5(
@@ -655,6 +676,11 @@ fn check_dataset(
             "check that the file is an event_utils or v2e HDF5 file (h5ls -r shows its layout)",
         ));
     }
+    Ok(())
+}
+
+/// Checks that libhdf5 can undo every filter of dataset `name`.
+fn check_filters(path: &Path, name: &str, ds: &hdf5::Dataset) -> Result<(), InputError> {
     for filter in ds.filters() {
         if !filter.decode_enabled() {
             return Err(InputError::hdf5(
@@ -667,7 +693,17 @@ fn check_dataset(
             ));
         }
     }
-    let element = ds.dtype().map(|d| d.size()).unwrap_or(1) as f64;
+    Ok(())
+}
+
+/// Checks that a chunk of dataset `name` (of `element` bytes per value) is at most
+/// [`MAX_CHUNK_BYTES`].
+fn check_chunk_size(
+    path: &Path,
+    name: &str,
+    ds: &hdf5::Dataset,
+    element: f64,
+) -> Result<(), InputError> {
     if let Some(chunk) = ds.chunk() {
         let chunk_bytes = chunk.iter().map(|&n| n as f64).product::<f64>() * element;
         if chunk_bytes > MAX_CHUNK_BYTES {
@@ -680,18 +716,7 @@ fn check_dataset(
             ));
         }
     }
-    let logical = shape.iter().map(|&n| n as f64).product::<f64>() * element;
-    let stored = ds.storage_size() as f64;
-    if logical > 1100.0 * stored.max(4096.0) {
-        return Err(InputError::hdf5(
-            path,
-            format!(
-                "{name} claims shape {shape:?} ({logical:.3e} bytes) but stores only {stored:.0} bytes"
-            ),
-            "the file is damaged or was written incompletely; rewrite it from the source",
-        ));
-    }
-    Ok(shape)
+    Ok(())
 }
 
 /// Inspects an HDF5 event file and checks its sensor claim against the coordinates.
