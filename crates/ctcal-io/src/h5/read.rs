@@ -1400,56 +1400,90 @@ fn dsec_window(
     if ms == 0 || n == 0 {
         return Ok(None);
     }
-    let at = |k: usize| -> Result<usize, InputError> {
-        let v: u64 = element(file, "ms_to_idx", k).map_err(|e| h5_error(path, "ms_to_idx", e))?;
-        Ok((v as usize).min(n))
-    };
-    let time_at = |row: usize| -> Result<TimeUs, InputError> {
-        if row >= n {
-            return Ok(TimeUs::MAX);
-        }
-        let t = element::<u64>(file, "events/t", row)
-            .map(|t| t as i64)
-            .or_else(|_| element::<i64>(file, "events/t", row))
-            .map_err(|e| h5_error(path, "events/t", e))?;
-        Ok(t.saturating_add(offset))
+    let index = DsecIndex {
+        path,
+        file,
+        n,
+        offset,
     };
     let millisecond = |t: TimeUs| (t.saturating_sub(offset)).div_euclid(1000);
     let mut notes = Vec::new();
-    // the row ms_to_idx gives for millisecond `k`, checked against the times: the
-    // first row at or after the millisecond's start
-    let checked = |k: usize, notes: &mut Vec<String>| -> Result<usize, InputError> {
-        let row = at(k)?;
-        let begins = offset.saturating_add(k as i64 * 1000);
-        let before_ok = row == 0 || time_at(row - 1)? < begins;
-        let at_ok = row >= n || time_at(row)? >= begins;
+    let first = millisecond(from).clamp(0, ms as i64 - 1) as usize;
+    let last = millisecond(to).saturating_add(1);
+    let near_start = if from <= offset {
+        0
+    } else {
+        index.checked(first, &mut notes)?
+    };
+    let near_end = if last < 0 {
+        0
+    } else if (last as u64) < ms as u64 {
+        index.checked(last as usize, &mut notes)?
+    } else {
+        n
+    };
+    // the exact ends, on the times (the index's rows are where the search starts)
+    let rows = rows_on_times((near_start, near_end), n, (from, to), &|row| {
+        index.time_at(row)
+    })?;
+    Ok(Some((rows, notes.into_iter().next())))
+}
+
+/// A DSEC file's `ms_to_idx` and event times (`n` events, `t_offset` `offset`), read a row
+/// at a time.
+struct DsecIndex<'a> {
+    path: &'a Path,
+    file: &'a hdf5::File,
+    n: usize,
+    offset: TimeUs,
+}
+
+impl DsecIndex<'_> {
+    /// The time of event `row` in the file's clock (`t_offset` added); `TimeUs::MAX` past
+    /// the last event.
+    fn time_at(&self, row: usize) -> Result<TimeUs, InputError> {
+        if row >= self.n {
+            return Ok(TimeUs::MAX);
+        }
+        let t = element::<u64>(self.file, "events/t", row)
+            .map(|t| t as i64)
+            .or_else(|_| element::<i64>(self.file, "events/t", row))
+            .map_err(|e| h5_error(self.path, "events/t", e))?;
+        Ok(t.saturating_add(self.offset))
+    }
+
+    /// The row `ms_to_idx` gives for millisecond `k`, checked against the times: the first
+    /// row at or after the millisecond's start (a contradiction is noted in `notes`).
+    fn checked(&self, k: usize, notes: &mut Vec<String>) -> Result<usize, InputError> {
+        let (path, n) = (self.path, self.n);
+        let v: u64 =
+            element(self.file, "ms_to_idx", k).map_err(|e| h5_error(path, "ms_to_idx", e))?;
+        let row = (v as usize).min(n);
+        let begins = self.offset.saturating_add(k as i64 * 1000);
+        let before_ok = row == 0 || self.time_at(row - 1)? < begins;
+        let at_ok = row >= n || self.time_at(row)? >= begins;
         if !(before_ok && at_ok) {
-            let actual = first_row_at_or_after(row, n, begins, &time_at)?;
+            let actual = first_row_at_or_after(row, n, begins, &|row| self.time_at(row))?;
             notes.push(format!(
                 "{}: ms_to_idx[{k}] = {row} contradicts events/t: the first event of millisecond {k} is row {actual}; the window was found on the event times instead (the index is damaged: rewrite it)",
                 path.display()
             ));
         }
         Ok(row)
-    };
-    let first = millisecond(from).clamp(0, ms as i64 - 1) as usize;
-    let last = millisecond(to).saturating_add(1);
-    let near_start = if from <= offset {
-        0
-    } else {
-        checked(first, &mut notes)?
-    };
-    let near_end = if last < 0 {
-        0
-    } else if (last as u64) < ms as u64 {
-        checked(last as usize, &mut notes)?
-    } else {
-        n
-    };
-    // the exact ends, on the times (the index's rows are where the search starts)
-    let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
-    let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
-    Ok(Some((start..end.max(start), notes.into_iter().next())))
+    }
+}
+
+/// The rows of the events of times `from..=to` of `n` rows sorted by time (`time_at`),
+/// found on the times from rows an index gives near the window's start and end.
+fn rows_on_times(
+    (near_start, near_end): (usize, usize),
+    n: usize,
+    (from, to): (TimeUs, TimeUs),
+    time_at: &impl Fn(usize) -> Result<TimeUs, InputError>,
+) -> Result<std::ops::Range<usize>, InputError> {
+    let start = first_row_at_or_after(near_start.min(n), n, from, time_at)?;
+    let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), time_at)?;
+    Ok(start..end.max(start))
 }
 
 /// [`index_window`] through MVSEC's `image_raw_event_inds` (the event nearest each frame),
