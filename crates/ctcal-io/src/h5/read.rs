@@ -1496,6 +1496,44 @@ fn mvsec_window(
     from: TimeUs,
     to: TimeUs,
 ) -> Result<Option<IndexedRows>, InputError> {
+    let Some((us, indices)) = mvsec_frame_index(path, file, side, n)? else {
+        return Ok(None);
+    };
+    // the frames around the window give rows near its ends (the event nearest each
+    // frame); the exact ends are then found on the event times themselves
+    let events = file
+        .dataset(&format!("{}/events", side.group()))
+        .map_err(|e| h5_error(path, "events", e))?;
+    let before = us.partition_point(|&t| t <= from);
+    let near_start = if before >= 1 {
+        indices[before - 1] as usize
+    } else {
+        0
+    };
+    let after = us.partition_point(|&t| t < to);
+    let near_end = if after < indices.len() {
+        indices[after] as usize
+    } else {
+        n
+    };
+    let rows = rows_on_times((near_start, near_end), n, (from, to), &|row| {
+        mvsec_event_time(path, &events, row)
+    })?;
+    Ok(Some((rows, None)))
+}
+
+/// Each frame's time (microseconds) and the row of the event nearest it.
+type FrameRows = (Vec<TimeUs>, Vec<i64>);
+
+/// MVSEC's frame index where it is usable: each frame's time (microseconds) and the row of
+/// the event nearest it, the rows non-decreasing within the `n` events; `None` where the
+/// file has no index or it is not usable.
+fn mvsec_frame_index(
+    path: &Path,
+    file: &hdf5::File,
+    side: Side,
+    n: usize,
+) -> Result<Option<FrameRows>, InputError> {
     let inds = format!("{}/image_raw_event_inds", side.group());
     let stamps = format!("{}/image_raw_ts", side.group());
     if !file.link_exists(&inds) || !file.link_exists(&stamps) {
@@ -1518,38 +1556,22 @@ fn mvsec_window(
         return Ok(None);
     }
     let us: Vec<TimeUs> = times.iter().map(|&t| crate::events::s_to_us(t)).collect();
-    // the frames around the window give rows near its ends (the event nearest each
-    // frame); the exact ends are then found on the event times themselves
-    let events = file
-        .dataset(&format!("{}/events", side.group()))
+    Ok(Some((us, indices)))
+}
+
+/// The time of event `row` of an MVSEC `events` table (its third column, in seconds);
+/// `TimeUs::MAX` where it is not a plausible time or past the last event.
+fn mvsec_event_time(path: &Path, events: &hdf5::Dataset, row: usize) -> Result<TimeUs, InputError> {
+    let v = events
+        .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, 2..3])
         .map_err(|e| h5_error(path, "events", e))?;
-    let time_at = |row: usize| -> Result<TimeUs, InputError> {
-        let v = events
-            .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, 2..3])
-            .map_err(|e| h5_error(path, "events", e))?;
-        Ok(v.iter().next().map_or(TimeUs::MAX, |&s| {
-            if s.is_finite() && s.abs() < 1e12 {
-                crate::events::s_to_us(s)
-            } else {
-                TimeUs::MAX
-            }
-        }))
-    };
-    let before = us.partition_point(|&t| t <= from);
-    let near_start = if before >= 1 {
-        indices[before - 1] as usize
-    } else {
-        0
-    };
-    let after = us.partition_point(|&t| t < to);
-    let near_end = if after < indices.len() {
-        indices[after] as usize
-    } else {
-        n
-    };
-    let start = first_row_at_or_after(near_start.min(n), n, from, &time_at)?;
-    let end = first_row_at_or_after(near_end.min(n), n, to.saturating_add(1), &time_at)?;
-    Ok(Some((start..end.max(start), None)))
+    Ok(v.iter().next().map_or(TimeUs::MAX, |&s| {
+        if s.is_finite() && s.abs() < 1e12 {
+            crate::events::s_to_us(s)
+        } else {
+            TimeUs::MAX
+        }
+    }))
 }
 
 /// The columns appended to `out` (one fused pass split over the cores, converting while
