@@ -1637,31 +1637,7 @@ impl H5Decoder {
         for i in 0..t.len() {
             let (x, y) = (xs[i], ys[i]);
             let index = self.position + i;
-            if x == NOT_AN_INTEGER || y == NOT_AN_INTEGER {
-                let (name, value) = if x == NOT_AN_INTEGER {
-                    (names.x, x)
-                } else {
-                    (names.y, y)
-                };
-                return Err(InputError::corrupt(
-                    &self.path,
-                    format!("{name}[{index}]"),
-                    format!("the coordinate is {}", shown(value)),
-                    "coordinates must be whole pixel numbers; the file is damaged or was written from floating-point data: rewrite it with integer x and y",
-                ));
-            }
-            if !(x >= 0 && y >= 0 && crate::within(self.sensor, x as u32, y as u32))
-                || x > u32::MAX as i64
-                || y > u32::MAX as i64
-            {
-                return Err(crate::outside_sensor(
-                    &self.path,
-                    format!("event index {index} ({}, {})", names.x, names.y),
-                    x,
-                    y,
-                    self.sensor,
-                ));
-            }
+            check_coordinates(&self.path, &names, index, (x, y), self.sensor)?;
             if t[i] == TimeUs::MIN {
                 return Err(InputError::corrupt(
                     &self.path,
@@ -1670,22 +1646,63 @@ impl H5Decoder {
                     "the file is damaged; rewrite it from the source recording",
                 ));
             }
-            let on = match ps[i] {
-                1 => true,
-                0 | -1 => false,
-                other => {
-                    return Err(InputError::corrupt(
-                        &self.path,
-                        format!("{}[{index}]", names.p),
-                        format!("the polarity is {}", shown(other)),
-                        "polarities are 1 (ON) and 0 or -1 (OFF); the file is damaged or uses another convention",
-                    ));
-                }
-            };
+            let on = checked_polarity(&self.path, names.p, index, ps[i])?;
             self.order.check(t[i], || format!("{}[{index}]", names.t));
             out.push(t[i], x as u16, y as u16, on);
         }
         Ok(())
+    }
+}
+
+/// Checks the coordinates of event `index`: whole numbers (stored in the datasets `names`
+/// gives), on `sensor` (within [`MAX_SENSOR_SIDE`] where it is not known).
+fn check_coordinates(
+    path: &Path,
+    names: &FieldNames,
+    index: usize,
+    (x, y): (i64, i64),
+    sensor: Option<Sensor>,
+) -> Result<(), InputError> {
+    if x == NOT_AN_INTEGER || y == NOT_AN_INTEGER {
+        let (name, value) = if x == NOT_AN_INTEGER {
+            (names.x, x)
+        } else {
+            (names.y, y)
+        };
+        return Err(InputError::corrupt(
+            path,
+            format!("{name}[{index}]"),
+            format!("the coordinate is {}", shown(value)),
+            "coordinates must be whole pixel numbers; the file is damaged or was written from floating-point data: rewrite it with integer x and y",
+        ));
+    }
+    if !(x >= 0 && y >= 0 && crate::within(sensor, x as u32, y as u32))
+        || x > u32::MAX as i64
+        || y > u32::MAX as i64
+    {
+        return Err(crate::outside_sensor(
+            path,
+            format!("event index {index} ({}, {})", names.x, names.y),
+            x,
+            y,
+            sensor,
+        ));
+    }
+    Ok(())
+}
+
+/// Whether the polarity `p` of event `index` (in dataset `name`) is ON: 1 is ON, 0 and -1
+/// are OFF, anything else an error.
+fn checked_polarity(path: &Path, name: &str, index: usize, p: i64) -> Result<bool, InputError> {
+    match p {
+        1 => Ok(true),
+        0 | -1 => Ok(false),
+        other => Err(InputError::corrupt(
+            path,
+            format!("{name}[{index}]"),
+            format!("the polarity is {}", shown(other)),
+            "polarities are 1 (ON) and 0 or -1 (OFF); the file is damaged or uses another convention",
+        )),
     }
 }
 
