@@ -242,6 +242,19 @@ impl CtEstimate {
         self.ct_sigma_ci95 = None;
     }
 
+    /// Withdraws one threshold (ON when `on`, else OFF) for `reason`; the mean goes with it.
+    pub fn withhold_polarity(&mut self, on: bool, reason: &str) {
+        let part = |value: Option<f64>, ci: Option<Interval>| Some((value?, ci?));
+        let mut parts = [
+            part(self.ct_on, self.ct_on_ci95),
+            part(self.ct_off, self.ct_off_ci95),
+        ];
+        parts[usize::from(!on)] = None;
+        let key = if on { "ct_on" } else { "ct_off" };
+        self.why.insert(key.into(), reason.to_string());
+        self.set_parts(parts[0], parts[1]);
+    }
+
     /// An estimate that determined nothing, for `reason`.
     pub fn not_determinable(method: &'static str, reason: &str) -> Self {
         let mut estimate = Self::empty(method);

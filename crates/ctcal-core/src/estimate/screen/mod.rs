@@ -35,6 +35,7 @@
 //!    after the refreshes and the changes ([`lag`]), and the thresholds are matched again
 //!    through the fitted display with that photoreceptor.
 
+mod bursts;
 mod coarse;
 mod display_fit;
 pub mod dlt;
@@ -322,6 +323,17 @@ struct Setup<'a> {
 }
 
 impl Setup<'_> {
+    /// The stimulus's refreshes on the recording's clock.
+    fn refresh_clock(&self) -> lag::RefreshClock {
+        let period = 1e6 / self.refresh_hz;
+        let start_us = self.offset_us + self.input.stimulus[0].t;
+        lag::RefreshClock {
+            start_us,
+            period_us: period,
+            end_us: start_us + (self.input.stimulus.len() as f64 * period).round() as TimeUs,
+        }
+    }
+
     /// Counts simulated with thresholds and a display (`None`: the naive simulation, the
     /// stimulus values as the camera's), with the setup's photoreceptor.
     fn counts(
@@ -626,6 +638,7 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
     let (on, off) = measured(&matched, input.gamma_prior)?;
     let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
     describe(&mut estimate, &matched, &located, hot, (on, off));
+    withhold_cut_bursts(&mut estimate, &matched, &excluded)?;
     progress("done", 1.0);
     Ok(estimate)
 }
@@ -766,14 +779,7 @@ fn matched_thresholds<'a>(
         "measuring the photoreceptor's lag from the events' timing",
         0.85,
     );
-    let period = 1e6 / setup.refresh_hz;
-    let clock = lag::RefreshClock {
-        start_us: setup.offset_us + input.stimulus[0].t,
-        period_us: period,
-        end_us: setup.offset_us
-            + input.stimulus[0].t
-            + (input.stimulus.len() as f64 * period).round() as TimeUs,
-    };
+    let clock = setup.refresh_clock();
     let included = excluded.iter().map(|&e| !e).collect();
     let recorded = lag::Recorded::new(input.events, clock, included, input.sensor);
     let lag_profile = lag::profile(&setup, &recorded, ideal, Some(&display))?;
@@ -953,6 +959,49 @@ fn extras(m: &Matched, located: &Located, ct: f64) -> [(&'static str, serde_json
             )),
         ),
     ]
+}
+
+/// A threshold whose bursts the recording cuts short ([`bursts`]) is withdrawn: its counts
+/// bound it from above only. The recording's and the fitted model's repeats are reported
+/// under `bursts` either way.
+fn withhold_cut_bursts(
+    estimate: &mut CtEstimate,
+    m: &Matched,
+    excluded: &[bool],
+) -> Result<(), EstimateError> {
+    let included: Vec<bool> = excluded.iter().map(|&e| !e).collect();
+    let width = m.setup.input.sensor.width as usize;
+    let clock = m.setup.refresh_clock();
+    let recorded = bursts::repeats(m.setup.input.events, clock, &included, width);
+    let model_events = m
+        .setup
+        .events_at(m.fitted, Some(&m.display), m.setup.cutoff_hz)?;
+    let model = bursts::repeats(&model_events, clock, &included, width);
+    let mut cut = [false; 2];
+    for (slot, name) in ["ON", "OFF"].into_iter().enumerate() {
+        cut[slot] = bursts::cut_short(recorded[slot], model[slot]);
+        let read = if slot == 0 { m.fitted.0 } else { m.fitted.1 };
+        if cut[slot] {
+            estimate.withhold_polarity(
+                slot == 0,
+                &format!(
+                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half), so something drops the events of a step after its first (a refractory period that drops what comes within it, with a photoreceptor fast against it); the counts then bound the threshold from above only ({read:.3})",
+                    100.0 * recorded[slot].share(),
+                    100.0 * model[slot].share()
+                ),
+            );
+        }
+    }
+    let side = |r: bursts::Repeats, c: bool| json!({"events": r.events, "repeats": r.repeats, "share": r.share(), "cut_short": c});
+    estimate.extra.insert(
+        "bursts".into(),
+        json!({
+            "recorded": {"on": side(recorded[0], cut[0]), "off": side(recorded[1], cut[1])},
+            "model": {"on": side(model[0], false), "off": side(model[1], false)},
+            "truncated_below": bursts::TRUNCATED_BELOW,
+        }),
+    );
+    Ok(())
 }
 
 /// The result when the screen is not found: nothing determinable, and why.

@@ -406,3 +406,46 @@ fn a_recording_without_on_events_has_no_on_threshold() {
     assert_eq!(e.ct_on, None, "{e:?}");
     assert!(e.why["ct_on"].contains("not determinable"), "{:?}", e.why);
 }
+
+/// The same recording with each pixel's burst cut to its first event per refresh (as a
+/// refractory period that drops what comes within it leaves a step): both thresholds are
+/// withdrawn as upper bounds, where they would read too high.
+#[test]
+fn bursts_cut_to_their_first_event_withdraw_the_thresholds() {
+    let one_to_one = geometry([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 0.0);
+    let stimulus = stimulus();
+    let all = record(&one_to_one, &stimulus);
+    let period_us = 1e6 / display().refresh_hz;
+    let mut last = std::collections::HashMap::new();
+    let mut events = EventChunk::default();
+    for i in 0..all.len() {
+        let window = (all.t[i] as f64 / period_us).round() as i64;
+        let key = (all.x[i], all.y[i], all.on[i]);
+        if last.insert(key, window) != Some(window) {
+            events.push(all.t[i], all.x[i], all.y[i], all.on[i]);
+        }
+    }
+    let excluded = vec![false; SENSOR.0 * SENSOR.1];
+    let input = ScreenInput {
+        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
+        events: &events,
+        stimulus: &stimulus,
+        screen: display(),
+        gamma_prior: super::GammaPrior::Measured(display().gamma),
+        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
+        refresh_hz: None,
+        excluded: &excluded,
+    };
+    let e = estimate(&input, &|_, _| {}).unwrap();
+    for key in ["ct_on", "ct_off"] {
+        assert!(
+            e.why
+                .get(key)
+                .is_some_and(|w| w.contains("bursts are cut short")),
+            "{key}: {:?} {:?}",
+            e.why,
+            e.extra.get("bursts")
+        );
+    }
+    assert_eq!((e.ct_on, e.ct_off, e.ct), (None, None, None));
+}
