@@ -459,13 +459,29 @@ fn compare_one(
     };
     let evidence = effects::evidence(other, &context);
     let start = evidence.start.unwrap_or_else(|| typical_start(other));
-    let searched = super::search_counted(
-        simulation,
-        (&without.params, other, other.range(start)),
-        state,
-        known,
-        (fixed, noise),
-    )?;
+    let search = |from: f64| {
+        super::search_counted(
+            simulation,
+            (&without.params, other, other.range(from)),
+            state,
+            known,
+            (fixed, noise),
+        )
+    };
+    // searched from both starts where the evidence has two, as the step that added it was
+    // (a leak's isolated and still-pixel excess: [`effects::Evidence::other_start`])
+    let mut searched = search(start)?;
+    let mut starts = String::new();
+    if let Some((other_start, from_other)) = evidence
+        .other_start
+        .and_then(|s| search(s).ok().map(|found| (s, found)))
+    {
+        starts = format!(
+            "; from {start:.4} and from {other_start:.4}, the lower fit error ({:.4}, {:.4}) kept",
+            searched.fit_error, from_other.fit_error
+        );
+        searched = super::steps::better_of(searched, from_other);
+    }
     let key = other.parameter().expect("a searched effect");
     let wins = judge(
         simulation,
@@ -496,7 +512,7 @@ fn compare_one(
     let mut step = Step::untried(
         format!("{} in place of {}?", other.name(), kept.name()),
         format!(
-            "the model without {} and with {key} searched ({}) against the fitted one",
+            "the model without {} and with {key} searched ({}{starts}) against the fitted one",
             kept.name(),
             evidence.text
         ),

@@ -162,7 +162,7 @@ fn search_effect(
 /// off the points of both and holds both ends.
 ///
 /// [`profile_interval`]: crate::fit::search::profile_interval
-fn better_of(
+pub(super) fn better_of(
     first: crate::fit::search::Searched,
     second: crate::fit::search::Searched,
 ) -> crate::fit::search::Searched {
