@@ -4,9 +4,12 @@
 //! stores the level it is reset at) leaves one event of a step when the photoreceptor
 //! follows the step faster than the refractory period ends (Lichtsteiner et al., JSSC
 //! 2008, Sec. II; the screen's white is the brightest light the pixels see, where they are
-//! fastest). The counts then say less about the thresholds than about the steps: matched
+//! fastest). A response that compresses large steps does the same (DVS-Voltmeter's
+//! per-frame drift, `2x` for `2 atanh(x)`: its steps fire fewer events than their log
+//! crossings). The counts then say less about the thresholds than about the steps: matched
 //! with pixels that fire every crossing, they read too high (coverage draw 14018, ESIM
-//! with a 0.5 ms refractory period at 139 Hz: ON 0.73 for 0.18).
+//! with a 0.5 ms refractory period at 139 Hz: ON 0.73 for 0.18; 11020, DVS-Voltmeter:
+//! 1.39 for 0.65 when the screen reached it as a cross-fade).
 //!
 //! The signature is in the recording: the share of events that repeat a pixel's polarity
 //! within one refresh window. The fitted model predicts it; a recording with under half of

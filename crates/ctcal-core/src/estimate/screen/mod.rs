@@ -985,7 +985,7 @@ fn withhold_cut_bursts(
             estimate.withhold_polarity(
                 slot == 0,
                 &format!(
-                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half), so something drops the events of a step after its first (a refractory period that drops what comes within it, with a photoreceptor fast against it); the counts then bound the threshold from above only ({read:.3})",
+                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half), so the pixels answer a step with fewer events than its crossings (a refractory period that drops what comes within it, with a photoreceptor fast against it, or a response that compresses large steps); the counts then bound the threshold from above only ({read:.3})",
                     100.0 * recorded[slot].share(),
                     100.0 * model[slot].share()
                 ),
