@@ -23,9 +23,9 @@
 
 use super::super::effects::leak::StillBalance;
 use super::super::effects::{self, Context, Effect};
-use super::super::search::{Simulated, Simulation};
+use super::super::search::{Searched, Simulated, Simulation};
 use super::super::{AddedEffect, FitError, Step};
-use super::keep::judge;
+use super::keep::{Verdict, judge};
 use super::{Known, State, context_of};
 use crate::fit::Uncertain;
 use serde::Serialize;
@@ -449,6 +449,48 @@ fn compare_one(
     other: Effect,
     (fixed, noise): (bool, f64),
 ) -> Result<Comparison, FitError> {
+    let (searched, evidence, starts) =
+        searched_in_place(simulation, state, known, (kept, other), (fixed, noise))?;
+    let key = other.parameter().expect("a searched effect");
+    let outcome = PlaceOutcome::of(simulation, state, other, &searched);
+    let mut step = Step::untried(
+        format!("{} in place of {}?", other.name(), kept.name()),
+        format!(
+            "the model without {} and with {key} searched ({}{starts}) against the fitted one",
+            kept.name(),
+            evidence.text
+        ),
+        evidence.score,
+    );
+    step.parameters.insert(key.into(), searched.value);
+    step.error_before = Some(outcome.wins.before.total);
+    step.error_after = Some(outcome.wins.after.total);
+    step.components_after = Some(outcome.wins.after.clone());
+    step.chance = outcome.wins.chance;
+    step.kept = outcome.replaces;
+    step.reason = outcome.reason(kept);
+    Ok(Comparison {
+        value: searched.value,
+        uncertain: searched.uncertain(),
+        at_bound: searched.at_bound,
+        alternative: searched.model,
+        step,
+        replaces: outcome.replaces,
+        ambiguous: outcome.ambiguous,
+    })
+}
+
+/// `other` searched in a model without `kept` (its thresholds profiled), from both of its
+/// evidence's starts where it has two, as the step that added it was (a leak's isolated
+/// and still-pixel excess: [`effects::Evidence::other_start`]): the better search, the
+/// evidence and what the second start did (empty without one).
+fn searched_in_place(
+    simulation: &Simulation,
+    state: &State,
+    known: Known,
+    (kept, other): (Effect, Effect),
+    (fixed, noise): (bool, f64),
+) -> Result<(Searched, effects::Evidence, String), FitError> {
     let mut reduced = state.model.params.clone();
     kept.clear(&mut reduced);
     let without = simulation.profile(&reduced, &state.masked, fixed)?;
@@ -468,8 +510,6 @@ fn compare_one(
             (fixed, noise),
         )
     };
-    // searched from both starts where the evidence has two, as the step that added it was
-    // (a leak's isolated and still-pixel excess: [`effects::Evidence::other_start`])
     let mut searched = search(start)?;
     let mut starts = String::new();
     if let Some((other_start, from_other)) = evidence
@@ -482,78 +522,83 @@ fn compare_one(
         );
         searched = super::steps::better_of(searched, from_other);
     }
-    let key = other.parameter().expect("a searched effect");
-    let wins = judge(
-        simulation,
-        &state.model.observed,
-        &searched.model.observed,
-        &state.kept,
-    );
-    // a leak takes no place its still pixels contradict, whatever the distance
-    let contradicted = (other == Effect::Leak)
-        .then(|| {
-            StillBalance::judged(
-                &simulation.real,
-                (&state.model.observed, &searched.model.observed),
-                simulation.geometry,
+    Ok((searched, evidence, starts))
+}
+
+/// How the model with the look-alike fared against the fitted one: judged both ways, and
+/// (for a leak) against the still pixels' balance.
+struct PlaceOutcome {
+    /// The look-alike's model judged as the candidate.
+    wins: Verdict,
+    /// The fitted model judged as the candidate against the look-alike's.
+    loses: Verdict,
+    /// The still pixels that contradict a leak, whatever the distance.
+    contradicted: Option<StillBalance>,
+    replaces: bool,
+    ambiguous: bool,
+}
+
+impl PlaceOutcome {
+    fn of(simulation: &Simulation, state: &State, other: Effect, searched: &Searched) -> Self {
+        let wins = judge(
+            simulation,
+            &state.model.observed,
+            &searched.model.observed,
+            &state.kept,
+        );
+        // a leak takes no place its still pixels contradict, whatever the distance
+        let contradicted = (other == Effect::Leak)
+            .then(|| {
+                StillBalance::judged(
+                    &simulation.real,
+                    (&state.model.observed, &searched.model.observed),
+                    simulation.geometry,
+                )
+            })
+            .filter(StillBalance::contradicted);
+        let loses = judge(
+            simulation,
+            &searched.model.observed,
+            &state.model.observed,
+            &state.kept,
+        );
+        let (replaces, ambiguous) = match contradicted {
+            Some(_) => (false, false),
+            None => (wins.kept, !wins.kept && !loses.kept),
+        };
+        Self {
+            wins,
+            loses,
+            contradicted,
+            replaces,
+            ambiguous,
+        }
+    }
+
+    /// The comparison's reason, naming `kept`.
+    fn reason(&self, kept: Effect) -> String {
+        if let Some(still) = &self.contradicted {
+            format!(
+                "{} stays: the recording lacks the look-alike's signature ({}); {}",
+                kept.name(),
+                still.text(),
+                self.wins.reason
             )
-        })
-        .filter(StillBalance::contradicted);
-    let loses = judge(
-        simulation,
-        &searched.model.observed,
-        &state.model.observed,
-        &state.kept,
-    );
-    let (replaces, ambiguous) = match contradicted {
-        Some(_) => (false, false),
-        None => (wins.kept, !wins.kept && !loses.kept),
-    };
-    let mut step = Step::untried(
-        format!("{} in place of {}?", other.name(), kept.name()),
-        format!(
-            "the model without {} and with {key} searched ({}{starts}) against the fitted one",
-            kept.name(),
-            evidence.text
-        ),
-        evidence.score,
-    );
-    step.parameters.insert(key.into(), searched.value);
-    step.error_before = Some(wins.before.total);
-    step.error_after = Some(wins.after.total);
-    step.components_after = Some(wins.after);
-    step.chance = wins.chance;
-    step.kept = replaces;
-    step.reason = if let Some(still) = contradicted {
-        format!(
-            "{} stays: the recording lacks the look-alike's signature ({}); {}",
-            kept.name(),
-            still.text(),
-            wins.reason
-        )
-    } else if replaces {
-        format!("replaces {}: {}", kept.name(), wins.reason)
-    } else if ambiguous {
-        format!(
-            "not separated: either explains the recording within chance ({})",
-            wins.reason
-        )
-    } else {
-        format!(
-            "{} explains the recording better: {}",
-            kept.name(),
-            loses.reason
-        )
-    };
-    Ok(Comparison {
-        value: searched.value,
-        uncertain: searched.uncertain(),
-        at_bound: searched.at_bound,
-        alternative: searched.model,
-        step,
-        replaces,
-        ambiguous,
-    })
+        } else if self.replaces {
+            format!("replaces {}: {}", kept.name(), self.wins.reason)
+        } else if self.ambiguous {
+            format!(
+                "not separated: either explains the recording within chance ({})",
+                self.wins.reason
+            )
+        } else {
+            format!(
+                "{} explains the recording better: {}",
+                kept.name(),
+                self.loses.reason
+            )
+        }
+    }
 }
 
 #[cfg(test)]
