@@ -980,24 +980,39 @@ fn withhold_cut_bursts(
     let mut cut = [false; 2];
     for (slot, name) in ["ON", "OFF"].into_iter().enumerate() {
         cut[slot] = bursts::cut_short(recorded[slot], model[slot]);
-        let read = if slot == 0 { m.fitted.0 } else { m.fitted.1 };
+        let (value, ci) = if slot == 0 {
+            (estimate.ct_on, estimate.ct_on_ci95)
+        } else {
+            (estimate.ct_off, estimate.ct_off_ci95)
+        };
+        let bound = match (value, ci.and_then(|ci| ci[1])) {
+            (Some(v), Some(hi)) => format!("{v:.3}, at most {hi:.3} with its interval"),
+            (Some(v), None) => format!("{v:.3}"),
+            _ => "not read".into(),
+        };
         if cut[slot] {
             estimate.withhold_polarity(
                 slot == 0,
                 &format!(
-                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half), so the pixels answer a step with fewer events than its crossings (a refractory period that drops what comes within it, with a photoreceptor fast against it, or a response that compresses large steps); the counts then bound the threshold from above only ({read:.3})",
+                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half), so the pixels answer a step with fewer events than its crossings (a refractory period that drops what comes within it, with a photoreceptor fast against it, or a response that compresses large steps); the counts then bound the threshold from above only (read {bound})",
                     100.0 * recorded[slot].share(),
                     100.0 * model[slot].share()
                 ),
             );
         }
     }
-    let side = |r: bursts::Repeats, c: bool| json!({"events": r.events, "repeats": r.repeats, "share": r.share(), "cut_short": c});
+    let repeats =
+        |r: bursts::Repeats| json!({"events": r.events, "repeats": r.repeats, "share": r.share()});
+    let side = |r: bursts::Repeats, c: bool| {
+        let mut v = repeats(r);
+        v["cut_short"] = json!(c);
+        v
+    };
     estimate.extra.insert(
         "bursts".into(),
         json!({
             "recorded": {"on": side(recorded[0], cut[0]), "off": side(recorded[1], cut[1])},
-            "model": {"on": side(model[0], false), "off": side(model[1], false)},
+            "model": {"on": repeats(model[0]), "off": repeats(model[1])},
             "truncated_below": bursts::TRUNCATED_BELOW,
         }),
     );
