@@ -635,10 +635,16 @@ pub fn estimate(input: &ScreenInput, progress: Progress) -> Result<CtEstimate, E
         Err(Unmatched::Beyond(why)) => return Ok(CtEstimate::not_determinable("screen", &why)),
         Err(Unmatched::Failed(e)) => return Err(e),
     };
-    let (on, off) = measured(&matched, input.gamma_prior)?;
+    // the final model's events, for the cells' spread and the bursts alike
+    let final_events = matched.setup.events_at(
+        matched.fitted,
+        Some(&matched.display),
+        matched.setup.cutoff_hz,
+    )?;
+    let (on, off) = measured(&matched, &final_events, input.gamma_prior)?;
     let mut estimate = CtEstimate::from_parts("screen", &on, &off, Determinable::POSITIVE);
     describe(&mut estimate, &matched, &located, hot, (on, off));
-    withhold_cut_bursts(&mut estimate, &matched, &excluded)?;
+    withhold_cut_bursts(&mut estimate, &matched, &final_events, &excluded);
     progress("done", 1.0);
     Ok(estimate)
 }
@@ -813,7 +819,11 @@ fn matched_thresholds<'a>(
 /// [`GammaPrior::ends_in_sigmas`]; where the other log response is among them, its change
 /// is scaled alike: a two-way choice's standard deviation is half the change, close to
 /// its sqrt(3)rd) with a share of the photoreceptor's correction.
-fn measured(m: &Matched, prior: GammaPrior) -> Result<(Measured, Measured), EstimateError> {
+fn measured(
+    m: &Matched,
+    final_events: &EventChunk,
+    prior: GammaPrior,
+) -> Result<(Measured, Measured), EstimateError> {
     let variants = m.fits.compatible();
     // the fits were made with ideal pixels: their spread is taken about the ideal pixels'
     // thresholds and scaled to the final ones
@@ -824,7 +834,7 @@ fn measured(m: &Matched, prior: GammaPrior) -> Result<(Measured, Measured), Esti
             .fold(0.0, f64::max)
             / prior.ends_in_sigmas()
     };
-    let simulated = m.setup.counts(m.fitted, Some(&m.display))?;
+    let simulated = m.setup.cells.count(final_events);
     let standard_error = |r: &[u32], s: &[u32], c: f64| {
         cell_spread(r, s).map_or(f64::NAN, |spread| c * spread.relative_standard_error)
     };
@@ -962,21 +972,19 @@ fn extras(m: &Matched, located: &Located, ct: f64) -> [(&'static str, serde_json
 }
 
 /// A threshold whose bursts the recording cuts short ([`bursts`]) is withdrawn: its counts
-/// bound it from above only. The recording's and the fitted model's repeats are reported
-/// under `bursts` either way.
+/// bound it from above only. The recording's and the fitted model's (`model_events`)
+/// repeats are reported under `bursts` either way.
 fn withhold_cut_bursts(
     estimate: &mut CtEstimate,
     m: &Matched,
+    model_events: &EventChunk,
     excluded: &[bool],
-) -> Result<(), EstimateError> {
+) {
     let included: Vec<bool> = excluded.iter().map(|&e| !e).collect();
     let width = m.setup.input.sensor.width as usize;
     let clock = m.setup.refresh_clock();
     let recorded = bursts::repeats(m.setup.input.events, clock, &included, width);
-    let model_events = m
-        .setup
-        .events_at(m.fitted, Some(&m.display), m.setup.cutoff_hz)?;
-    let model = bursts::repeats(&model_events, clock, &included, width);
+    let model = bursts::repeats(model_events, clock, &included, width);
     let mut cut = [false; 2];
     for (slot, name) in ["ON", "OFF"].into_iter().enumerate() {
         cut[slot] = bursts::cut_short(recorded[slot], model[slot]);
@@ -1016,7 +1024,6 @@ fn withhold_cut_bursts(
             "truncated_below": bursts::TRUNCATED_BELOW,
         }),
     );
-    Ok(())
 }
 
 /// The result when the screen is not found: nothing determinable, and why.

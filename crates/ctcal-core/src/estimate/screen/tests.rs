@@ -96,6 +96,23 @@ fn record_through(
     events
 }
 
+/// `estimate screen` on `events` of `stimulus`, the display given as measured and the
+/// pixels' response declared as recorded (the registration and the counts are under test).
+fn estimated_as_recorded(events: &EventChunk, stimulus: &[Frame]) -> CtEstimate {
+    let excluded = vec![false; SENSOR.0 * SENSOR.1];
+    let input = ScreenInput {
+        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
+        events,
+        stimulus,
+        screen: display(),
+        gamma_prior: super::GammaPrior::Measured(display().gamma),
+        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
+        refresh_hz: None,
+        excluded: &excluded,
+    };
+    estimate(&input, &|_, _| {}).unwrap()
+}
+
 fn geometry(h: [[f64; 3]; 3], k1: f64) -> ScreenGeometry {
     ScreenGeometry {
         homography: Homography(h),
@@ -115,20 +132,8 @@ fn recovered(e: &CtEstimate) -> ScreenGeometry {
 fn run(truth: &ScreenGeometry) -> (CtEstimate, f64) {
     let stimulus = stimulus();
     let events = record(truth, &stimulus);
-    let excluded = vec![false; SENSOR.0 * SENSOR.1];
-    let input = ScreenInput {
-        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
-        events: &events,
-        stimulus: &stimulus,
-        screen: display(),
-        gamma_prior: super::GammaPrior::Measured(display().gamma),
-        // the pixels' response, as recorded (the registration is under test)
-        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
-        refresh_hz: None,
-        excluded: &excluded,
-    };
     let started = std::time::Instant::now();
-    let e = estimate(&input, &|_, _| {}).unwrap();
+    let e = estimated_as_recorded(&events, &stimulus);
     (e, started.elapsed().as_secs_f64())
 }
 
@@ -222,19 +227,7 @@ fn events_without_the_stimulus_are_not_registered() {
         }
     }
     events.sort_by_time();
-    let excluded = vec![false; SENSOR.0 * SENSOR.1];
-    let input = ScreenInput {
-        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
-        events: &events,
-        stimulus: &stimulus,
-        screen: display(),
-        gamma_prior: super::GammaPrior::Measured(display().gamma),
-        // the pixels' response, as recorded (the registration is under test)
-        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
-        refresh_hz: None,
-        excluded: &excluded,
-    };
-    let e = estimate(&input, &|_, _| {}).unwrap();
+    let e = estimated_as_recorded(&events, &stimulus);
     assert!(e.ct.is_none());
     let why = &e.why["ct"];
     assert!(why.contains("could not be found"), "{why}");
@@ -391,18 +384,7 @@ fn a_recording_without_on_events_has_no_on_threshold() {
     for i in (0..all.len()).filter(|&i| !all.on[i]) {
         events.push(all.t[i], all.x[i], all.y[i], false);
     }
-    let excluded = vec![false; SENSOR.0 * SENSOR.1];
-    let input = ScreenInput {
-        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
-        events: &events,
-        stimulus: &stimulus,
-        screen: display(),
-        gamma_prior: super::GammaPrior::Measured(display().gamma),
-        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
-        refresh_hz: None,
-        excluded: &excluded,
-    };
-    let e = estimate(&input, &|_, _| {}).unwrap();
+    let e = estimated_as_recorded(&events, &stimulus);
     assert_eq!(e.ct_on, None, "{e:?}");
     assert!(e.why["ct_on"].contains("not determinable"), "{:?}", e.why);
 }
@@ -425,18 +407,7 @@ fn bursts_cut_to_their_first_event_withdraw_the_thresholds() {
             events.push(all.t[i], all.x[i], all.y[i], all.on[i]);
         }
     }
-    let excluded = vec![false; SENSOR.0 * SENSOR.1];
-    let input = ScreenInput {
-        sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
-        events: &events,
-        stimulus: &stimulus,
-        screen: display(),
-        gamma_prior: super::GammaPrior::Measured(display().gamma),
-        response: super::ResponsePrior::Declared(LogMap::new(LogResponse::V2e, 0.001)),
-        refresh_hz: None,
-        excluded: &excluded,
-    };
-    let e = estimate(&input, &|_, _| {}).unwrap();
+    let e = estimated_as_recorded(&events, &stimulus);
     for key in ["ct_on", "ct_off"] {
         assert!(
             e.why
