@@ -273,25 +273,7 @@ pub(super) fn assemble(
     full: &Pass,
     findings: Findings,
 ) -> CtEstimate {
-    let response = response_ratios(findings.other_response.as_ref());
-    // the thresholds a photoreceptor much slower than the scene asks for, where the
-    // re-simulation with its cutoff found them
-    let slow = findings.slow.as_ref().and_then(|s| s.thresholds);
-    let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64, slow: Option<f64>| {
-        let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
-        match combine(&refs) {
-            Some((value, error)) => Measured::new(value, error, METHOD_SYSTEMATIC * value)
-                .reaching(response)
-                // a slow photoreceptor reads thresholds high only: the reach goes down
-                .reaching(slow.map_or(1.0, |c| (c / value).min(1.0))),
-            None => Measured::new(f64::NAN, f64::NAN, 0.0),
-        }
-    };
-    assumptions.push(method_systematic_assumption());
-    assumptions.extend(findings.other_response.as_ref().map(response_assumption));
-    assumptions.extend(findings.slow.as_ref().map(slow_assumption));
-    let on = combined(|e| &e.ct_on, response[0], slow.map(|s| s[0]));
-    let off = combined(|e| &e.ct_off, response[1], slow.map(|s| s[1]));
+    let [on, off] = combined_thresholds(&estimators, &findings, &mut assumptions);
     let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames
@@ -319,8 +301,53 @@ pub(super) fn assemble(
         ));
     }
     estimate.estimators = estimators;
+    for (key, value) in extra_reports(frames, full, findings) {
+        estimate.extra.insert(key.into(), value);
+    }
+    estimate
+}
+
+/// ON and OFF thresholds combined over the `estimators`, each with the method's systematic
+/// error and reaching to what the other log response and a slow photoreceptor ask for;
+/// their assumptions added.
+fn combined_thresholds(
+    estimators: &[EstimatorReport],
+    findings: &Findings,
+    assumptions: &mut Vec<String>,
+) -> [Measured; 2] {
+    let response = response_ratios(findings.other_response.as_ref());
+    // the thresholds a photoreceptor much slower than the scene asks for, where the
+    // re-simulation with its cutoff found them
+    let slow = findings.slow.as_ref().and_then(|s| s.thresholds);
+    let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64, slow: Option<f64>| {
+        let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
+        match combine(&refs) {
+            Some((value, error)) => Measured::new(value, error, METHOD_SYSTEMATIC * value)
+                .reaching(response)
+                // a slow photoreceptor reads thresholds high only: the reach goes down
+                .reaching(slow.map_or(1.0, |c| (c / value).min(1.0))),
+            None => Measured::new(f64::NAN, f64::NAN, 0.0),
+        }
+    };
+    assumptions.push(method_systematic_assumption());
+    assumptions.extend(findings.other_response.as_ref().map(response_assumption));
+    assumptions.extend(findings.slow.as_ref().map(slow_assumption));
+    [
+        combined(|e| &e.ct_on, response[0], slow.map(|s| s[0])),
+        combined(|e| &e.ct_off, response[1], slow.map(|s| s[1])),
+    ]
+}
+
+/// The estimate's `extra` beside the thresholds: the per-pixel maps' reach, the frame
+/// alignment, the log response and offset, the spread's frame-rate series, the
+/// photoreceptor's lag and slowness, leak drift and the time span.
+fn extra_reports(
+    frames: &PreparedFrames,
+    full: &Pass,
+    findings: Findings,
+) -> [(&'static str, serde_json::Value); 9] {
     let maps = &full.timing.maps;
-    let extra = [
+    [
         (
             "maps",
             json!({
@@ -352,11 +379,7 @@ pub(super) fn assemble(
                 us_to_s(*frames.times.last().expect("two frames"))
             ]),
         ),
-    ];
-    for (key, value) in extra {
-        estimate.extra.insert(key.into(), value);
-    }
-    estimate
+    ]
 }
 
 /// The method's own systematic error of the spread `ct_sigma`, absolute (ln units): what
