@@ -915,19 +915,7 @@ fn measure(
         .iter()
         .map(|c| invert(&c.curve, side, target))
         .collect();
-    let ends = calibrations.first().map(|c| &c.curve[..]).unwrap_or(&[]);
-    let beyond = Beyond {
-        above: inverted
-            .iter()
-            .filter(|i| matches!(i, Inverted::Above(_)))
-            .count(),
-        below: inverted
-            .iter()
-            .filter(|i| matches!(i, Inverted::Below(_)))
-            .count(),
-        top: ends.last().map_or(f64::NAN, |p| side.threshold(p)),
-        bottom: ends.first().map_or(f64::NAN, |p| side.threshold(p)),
-    };
+    let beyond = Beyond::of(calibrations, &inverted, side);
     let per_calibration = inverted
         .iter()
         .map(|i| match i {
@@ -939,18 +927,51 @@ fn measure(
         Some(why) => Err(why.clone()),
         None => classify(&inverted, beyond, target, side),
     };
-    let values = match classified {
-        Ok(values) => values,
-        Err(why) => {
-            return Polarity {
-                per_calibration,
-                measured: Measured::new(f64::NAN, f64::NAN, 0.0),
-                prior_ln_sd: f64::NAN,
-                beyond_grid: beyond,
-                why: Some(why),
-            };
+    let (measured, prior_ln_sd, why) = match classified {
+        Ok(values) => {
+            let (measured, prior_ln_sd) =
+                combined_in_log(&values, calibrations, rates, side, ln_se, beyond);
+            (measured, prior_ln_sd, None)
         }
+        Err(why) => (Measured::new(f64::NAN, f64::NAN, 0.0), f64::NAN, Some(why)),
     };
+    Polarity {
+        per_calibration,
+        measured,
+        prior_ln_sd,
+        beyond_grid: beyond,
+        why,
+    }
+}
+
+impl Beyond {
+    /// How many of the `inverted` calibrations the recording lies beyond, and the grid's
+    /// ends (the first calibration's).
+    fn of(calibrations: &[Calibration], inverted: &[Inverted], side: Side) -> Beyond {
+        let ends = calibrations.first().map(|c| &c.curve[..]).unwrap_or(&[]);
+        let count = |wanted: fn(&Inverted) -> bool| inverted.iter().filter(|i| wanted(i)).count();
+        Beyond {
+            above: count(|i| matches!(i, Inverted::Above(_))),
+            below: count(|i| matches!(i, Inverted::Below(_))),
+            top: ends.last().map_or(f64::NAN, |p| side.threshold(p)),
+            bottom: ends.first().map_or(f64::NAN, |p| side.threshold(p)),
+        }
+    }
+}
+
+/// The calibrations' threshold `values` combined in the logarithm, and the spread between
+/// them widened to a prediction for the recording's scene (`prior_ln_sd`): the
+/// statistical error is the recording's (`ln_se`, bootstrap) through the curves' mean
+/// slope; the systematic holds that spread, the travel's and noise's precision and the
+/// method's own. Open on the side where the recording lies beyond a calibration.
+fn combined_in_log(
+    values: &[f64],
+    calibrations: &[Calibration],
+    rates: &RecordingRates,
+    side: Side,
+    ln_se: f64,
+    beyond: Beyond,
+) -> (Measured, f64) {
     let logs: Vec<f64> = values.iter().map(|v| v.ln()).collect();
     let n = logs.len() as f64;
     let mean = logs.iter().sum::<f64>() / n;
@@ -985,13 +1006,7 @@ fn measure(
     if beyond.below > 0 {
         measured.ci95[0] = 0.0;
     }
-    Polarity {
-        per_calibration,
-        measured,
-        prior_ln_sd,
-        beyond_grid: beyond,
-        why: None,
-    }
+    (measured, prior_ln_sd)
 }
 
 /// What the estimate assumed; `images`: the prior's images (0: the recording's frames).
@@ -1238,6 +1253,8 @@ fn curve_at(curve: &[ReportedPoint], ct: f64) -> Option<f64> {
         })
 }
 
+/// The estimate's report: the estimator with its calibrations, the calibration curve and
+/// where the recording's rate lies among the simulator presets, and the recording's rates.
 fn report(
     result: &mut CtEstimate,
     rates: &RecordingRates,
@@ -1248,12 +1265,30 @@ fn report(
     let curve = reported_curve(rates, calibrations);
     let compared = (rates.on_per_px + rates.off_per_px) * rates.counted_travel_px
         / (rates.kept_pixels.max(1) as f64 * rates.duration_s.max(1e-9));
+    let (presets, position) = preset_position(&curve, compared);
+    result.estimators = vec![estimator_report(rates, calibrations, (on, off))];
+    result
+        .extra
+        .insert("calibration_curve".into(), json!(curve));
+    result.extra.insert("presets".into(), json!(presets));
+    result
+        .extra
+        .insert("preset_position".into(), json!(position));
+    result.extra.insert(
+        "recording".into(),
+        recording_report(rates, compared, frames_used),
+    );
+}
+
+/// The calibration `curve`'s rate at each simulator preset, and where the recording's
+/// `compared` rate lies among them.
+fn preset_position(curve: &[ReportedPoint], compared: f64) -> (Vec<PresetPoint>, String) {
     let presets: Vec<PresetPoint> = PRESETS
         .iter()
         .filter_map(|&ct| {
             Some(PresetPoint {
                 ct,
-                events_per_pixel_per_second: curve_at(&curve, ct)?,
+                events_per_pixel_per_second: curve_at(curve, ct)?,
             })
         })
         .collect();
@@ -1270,7 +1305,17 @@ fn report(
             }
             _ => format!("below the CT {} preset", PRESETS[PRESETS.len() - 1]),
         });
-    result.estimators = vec![EstimatorReport {
+    (presets, position)
+}
+
+/// The one estimator: its thresholds, the calibrations' own and their spread, and the
+/// still pixels' background.
+fn estimator_report(
+    rates: &RecordingRates,
+    calibrations: &[Calibration],
+    (on, off): (&Polarity, &Polarity),
+) -> EstimatorReport {
+    EstimatorReport {
         name: "events_per_pixel_of_travel",
         description: "the threshold at which ideal pixels along line scans with the recording's travel make its ON (OFF) events per pixel of travel, noise taken out; one per calibration, combined in the logarithm",
         ct_on: on.measured.clone(),
@@ -1294,17 +1339,12 @@ fn report(
             })),
             "z95": z95(),
         }),
-    }];
-    result
-        .extra
-        .insert("calibration_curve".into(), json!(curve));
-    result.extra.insert("presets".into(), json!(presets));
-    result
-        .extra
-        .insert("preset_position".into(), json!(position));
-    result.extra.insert(
-        "recording".into(),
-        json!({
+    }
+}
+
+/// The recording's rates as compared, with how they were counted.
+fn recording_report(rates: &RecordingRates, compared: f64, frames_used: bool) -> serde_json::Value {
+    json!({
             "events_per_pixel_per_second": compared,
             "supported_events_per_pixel_per_second": rates.events_per_pixel_per_second,
             "on_per_pixel_of_travel": rates.on_per_px,
@@ -1320,8 +1360,7 @@ fn report(
             "chance_support": rates.chance_support,
             "noise_share_at_most": {"on": rates.noise[0].noise_share, "off": rates.noise[1].noise_share},
             "counted": "the events of the units that count (every reliable pixel with frames, 8 x 8 px tiles with a supported event without), in the windows with a flow, with the noise taken out: the middle of all of them and all but the most noise they can hold (unsupported events over the time no neighbour's window covers, 97.5 % upper end; chance_support is how often a noise event finds a neighbour by chance); supported_events_per_pixel_per_second is the supported events per kept pixel per second, events_per_pixel_per_second the compared rate per kept pixel per second",
-        }),
-    );
+    })
 }
 
 #[cfg(test)]
