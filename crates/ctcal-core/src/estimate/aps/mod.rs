@@ -612,66 +612,9 @@ pub fn prepare(
         options.log_map,
         &options.frames,
     )?;
-    let alignment = match options.frame_time_offset_s {
-        Some(shift) => {
-            frames.shift_times((shift * 1e6).round() as TimeUs);
-            assumptions.push(format!(
-                "frame times shifted by {:.3} ms (the frame time offset given)",
-                shift * 1e3
-            ));
-            None
-        }
-        None => {
-            let found = super::align::align(
-                input.events,
-                &mut frames,
-                input.sensor,
-                excluded,
-                &options.timing,
-            );
-            if let Some(a) = &found {
-                frames.shift_times((a.shift_s * 1e6).round() as TimeUs);
-                assumptions.push(format!(
-                    "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); a frame time offset given overrides it",
-                    a.shift_s * 1e3,
-                    a.precision_s * 1e3,
-                    a.spread_unshifted,
-                    a.spread_aligned
-                ));
-            }
-            found
-        }
-    };
-    let mut other_response = None;
-    let offset = match options.frame_offset_dn {
-        Some(o) => {
-            frames.offset = o as f32;
-            frames.offset_range = (o as f32, o as f32);
-            assumptions.push(format!("frames offset by {o} DN before the log (as given)"));
-            None
-        }
-        None => {
-            let fitting = TimingOptions {
-                fit_offset: true,
-                choose_response: options.choose_response,
-                ..options.timing.clone()
-            };
-            // the response and the offset alone: the thresholds' errors are not needed here
-            let found =
-                super::timing::thresholds(input.events, &frames, input.sensor, excluded, &fitting);
-            if let Some(t) = &found {
-                if t.log_map != frames.log_map {
-                    assumptions.push(format!("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN){}; used throughout", if t.other_response.is_some() { ", though not beyond the pixels' noise: the thresholds the other gives are carried into the intervals" } else { "" }));
-                    frames.log_map = t.log_map;
-                }
-                frames.offset = t.offset.offset_dn;
-                frames.offset_range = t.offset.systematic_range;
-                assumptions.push(offset_assumption(&t.offset));
-                other_response = t.other_response.clone();
-            }
-            found.map(|t| t.offset)
-        }
-    };
+    let alignment = aligned(input, excluded, options, &mut frames, &mut assumptions);
+    let (offset, other_response) =
+        offset_found(input, excluded, options, &mut frames, &mut assumptions);
     Ok(Prepared {
         frames,
         alignment,
@@ -679,6 +622,83 @@ pub fn prepare(
         other_response,
         assumptions,
     })
+}
+
+/// The frames shifted to the events' clock: by the offset `options` gives, or where the
+/// events agree best with them ([`super::align`]); the alignment found, and its assumption.
+fn aligned(
+    input: &ApsInput,
+    excluded: &[bool],
+    options: &ApsOptions,
+    frames: &mut PreparedFrames,
+    assumptions: &mut Vec<String>,
+) -> Option<super::align::Alignment> {
+    if let Some(shift) = options.frame_time_offset_s {
+        frames.shift_times((shift * 1e6).round() as TimeUs);
+        assumptions.push(format!(
+            "frame times shifted by {:.3} ms (the frame time offset given)",
+            shift * 1e3
+        ));
+        return None;
+    }
+    let found = super::align::align(
+        input.events,
+        frames,
+        input.sensor,
+        excluded,
+        &options.timing,
+    );
+    if let Some(a) = &found {
+        frames.shift_times((a.shift_s * 1e6).round() as TimeUs);
+        assumptions.push(format!(
+            "frame times shifted by {:+.2} ms (+- {:.2} ms), where the events agree best with the frames (sample spread {:.3} -> {:.3}); a frame time offset given overrides it",
+            a.shift_s * 1e3,
+            a.precision_s * 1e3,
+            a.spread_unshifted,
+            a.spread_aligned
+        ));
+    }
+    found
+}
+
+/// The frames' log offset `b` of `ln(DN + b)` and their response: as `options` gives, or
+/// fitted to the events' timing ([`super::timing`]); the offset found, the response not
+/// chosen where the events cannot rule it out, and their assumptions.
+fn offset_found(
+    input: &ApsInput,
+    excluded: &[bool],
+    options: &ApsOptions,
+    frames: &mut PreparedFrames,
+    assumptions: &mut Vec<String>,
+) -> (
+    Option<super::timing::Offset>,
+    Option<super::timing::OtherResponse>,
+) {
+    if let Some(o) = options.frame_offset_dn {
+        frames.offset = o as f32;
+        frames.offset_range = (o as f32, o as f32);
+        assumptions.push(format!("frames offset by {o} DN before the log (as given)"));
+        return (None, None);
+    }
+    let fitting = TimingOptions {
+        fit_offset: true,
+        choose_response: options.choose_response,
+        ..options.timing.clone()
+    };
+    // the response and the offset alone: the thresholds' errors are not needed here
+    let found = super::timing::thresholds(input.events, frames, input.sensor, excluded, &fitting);
+    let mut other_response = None;
+    if let Some(t) = &found {
+        if t.log_map != frames.log_map {
+            assumptions.push(format!("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN){}; used throughout", if t.other_response.is_some() { ", though not beyond the pixels' noise: the thresholds the other gives are carried into the intervals" } else { "" }));
+            frames.log_map = t.log_map;
+        }
+        frames.offset = t.offset.offset_dn;
+        frames.offset_range = t.offset.systematic_range;
+        assumptions.push(offset_assumption(&t.offset));
+        other_response = t.other_response.clone();
+    }
+    (found.map(|t| t.offset), other_response)
 }
 
 /// The model event timing measured: its thresholds and mismatch, and the photoreceptor's
