@@ -533,47 +533,17 @@ pub fn from_events(
     let support = supported(events, sensor, window);
     // the patch side the flow settled on (larger than asked for a sparse recording)
     let p = flows.first().map_or(options.patch_px, |f| f.size);
-    let (w, tiles_x) = (sensor.width as usize, (sensor.width as usize).div_ceil(p));
-    let tiles = tiles_x * (sensor.height as usize).div_ceil(p);
-    let mut by_patch: Vec<Vec<&PatchFlow>> = vec![Vec::new(); tiles];
-    for f in &flows {
-        by_patch[(f.y0 / p) * tiles_x + f.x0 / p].push(f);
-    }
-    for windows in &mut by_patch {
-        windows.sort_by_key(|f| f.t_start);
-    }
-    let patch_of = |pixel: usize| (pixel / w / p) * tiles_x + (pixel % w) / p;
+    let by_patch = PatchWindows::new(&flows, sensor, p);
     let tally = Tally::new(events, sensor, excluded, &support, |i, pixel| {
-        let t = events.t[i];
-        by_patch[patch_of(pixel)]
-            .iter()
-            .any(|f| f.t_start <= t && t <= f.t_end)
+        by_patch.at(pixel, events.t[i]).is_some()
     });
     let bursts = BurstShare::measure(events, sensor, excluded, &support, |i, pixel| {
-        let t = events.t[i];
-        by_patch[patch_of(pixel)]
-            .iter()
-            .find(|f| f.t_start <= t && t <= f.t_end)
+        by_patch
+            .at(pixel, events.t[i])
             .map(|f| if f.trusted() { f.speed() } else { median })
     });
-    let (patches, travel_error) = patch_paths(&by_patch, median);
-    // the time a patch's events count: its windows with a flow
-    let patch_exposure_s: Vec<f64> = by_patch
-        .iter()
-        .map(|windows| {
-            windows
-                .iter()
-                .map(|f| (f.t_end - f.t_start) as f64 * 1e-6)
-                .sum()
-        })
-        .collect();
-    let pixels = sensor.pixels();
-    let paths = Paths {
-        travel: (0..pixels).map(|q| patches[patch_of(q)].0).collect(),
-        direction: (0..pixels).map(|q| patches[patch_of(q)].1).collect(),
-        exposure_s: (0..pixels).map(|q| patch_exposure_s[patch_of(q)]).collect(),
-        tile_px: Some(super::scans::TILE_PX),
-    };
+    let (paths, travel_error) = by_patch.paths(median, sensor.pixels());
+    let w = sensor.width as usize;
     let finish_with = Finish {
         kept: excluded.iter().filter(|&&e| !e).count(),
         duration: duration_s(events),
@@ -587,7 +557,7 @@ pub fn from_events(
         still: None,
         // a patch's windows are time-sorted and disjoint: only those reaching past `from`
         covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
-            let windows = &by_patch[patch_of(q)];
+            let windows = &by_patch.windows[by_patch.of(q)];
             windows[windows.partition_point(|f| f.t_end <= from)..]
                 .iter()
                 .take_while(|f| f.t_start < to)
@@ -596,6 +566,75 @@ pub fn from_events(
         })),
     };
     finish(&tally, &paths, excluded, w, finish_with)
+}
+
+/// The events' flow windows grouped by patch (`side` px square, row-major), each patch's
+/// time-sorted.
+struct PatchWindows<'a> {
+    side: usize,
+    width: usize,
+    tiles_x: usize,
+    windows: Vec<Vec<&'a PatchFlow>>,
+}
+
+impl<'a> PatchWindows<'a> {
+    fn new(flows: &'a [PatchFlow], sensor: Sensor, side: usize) -> Self {
+        let (width, tiles_x) = (
+            sensor.width as usize,
+            (sensor.width as usize).div_ceil(side),
+        );
+        let tiles = tiles_x * (sensor.height as usize).div_ceil(side);
+        let mut windows: Vec<Vec<&PatchFlow>> = vec![Vec::new(); tiles];
+        for f in flows {
+            windows[(f.y0 / side) * tiles_x + f.x0 / side].push(f);
+        }
+        for patch in &mut windows {
+            patch.sort_by_key(|f| f.t_start);
+        }
+        PatchWindows {
+            side,
+            width,
+            tiles_x,
+            windows,
+        }
+    }
+
+    /// The patch of `pixel`.
+    fn of(&self, pixel: usize) -> usize {
+        (pixel / self.width / self.side) * self.tiles_x + (pixel % self.width) / self.side
+    }
+
+    /// The window of `pixel`'s patch that holds time `t`.
+    fn at(&self, pixel: usize, t: TimeUs) -> Option<&'a PatchFlow> {
+        self.windows[self.of(pixel)]
+            .iter()
+            .find(|f| f.t_start <= t && t <= f.t_end)
+            .copied()
+    }
+
+    /// Every pixel's path, its patch's (travel, direction, and the time its events count:
+    /// the patch's windows with a flow), and the travel's relative precision
+    /// ([`patch_paths`]).
+    fn paths(&self, median: f64, pixels: usize) -> (Paths, f64) {
+        let (patches, travel_error) = patch_paths(&self.windows, median);
+        let patch_exposure_s: Vec<f64> = self
+            .windows
+            .iter()
+            .map(|windows| {
+                windows
+                    .iter()
+                    .map(|f| (f.t_end - f.t_start) as f64 * 1e-6)
+                    .sum()
+            })
+            .collect();
+        let paths = Paths {
+            travel: (0..pixels).map(|q| patches[self.of(q)].0).collect(),
+            direction: (0..pixels).map(|q| patches[self.of(q)].1).collect(),
+            exposure_s: (0..pixels).map(|q| patch_exposure_s[self.of(q)]).collect(),
+            tile_px: Some(super::scans::TILE_PX),
+        };
+        (paths, travel_error)
+    }
 }
 
 /// Each patch's travel (px) and the direction of its longest trusted window, and the
