@@ -1002,26 +1002,29 @@ fn withhold_cut_bursts(
             estimate.withhold_polarity(
                 slot == 0,
                 &format!(
-                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half), so the pixels answer a step with fewer events than its crossings (a refractory period that drops what comes within it, with a photoreceptor fast against it, or a response that compresses large steps); the counts then bound the threshold from above only (read {bound})",
+                    "the recording's bursts are cut short: {:.1} % of its {name} events repeat a pixel's {name} event within one refresh where the fitted model's repeat {:.1} % (under half by {:.1} standard errors), so the pixels answer a step with fewer events than its crossings (a refractory period that drops what comes within it, with a photoreceptor fast against it, or a response that compresses large steps); the counts then bound the threshold from above only (read {bound})",
                     100.0 * recorded[slot].share(),
-                    100.0 * model[slot].share()
+                    100.0 * model[slot].share(),
+                    bursts::shortfall_z(recorded[slot], model[slot])
                 ),
             );
         }
     }
-    let repeats =
-        |r: bursts::Repeats| json!({"events": r.events, "repeats": r.repeats, "share": r.share()});
-    let side = |r: bursts::Repeats, c: bool| {
-        let mut v = repeats(r);
-        v["cut_short"] = json!(c);
+    let repeats = |r: bursts::Repeats| json!({"events": r.events, "repeats": r.repeats, "share": r.share(), "share_se": r.share_se});
+    let side = |slot: usize| {
+        let mut v = repeats(recorded[slot]);
+        v["shortfall_z"] = json!(bursts::shortfall_z(recorded[slot], model[slot]));
+        v["cut_short"] = json!(cut[slot]);
         v
     };
     estimate.extra.insert(
         "bursts".into(),
         json!({
-            "recorded": {"on": side(recorded[0], cut[0]), "off": side(recorded[1], cut[1])},
+            "recorded": {"on": side(0), "off": side(1)},
             "model": {"on": repeats(model[0]), "off": repeats(model[1])},
             "truncated_below": bursts::TRUNCATED_BELOW,
+            "z_cut": bursts::Z_CUT,
+            "noise_blocks": bursts::NOISE_BLOCKS,
         }),
     );
 }
