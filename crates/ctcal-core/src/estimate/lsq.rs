@@ -83,9 +83,38 @@ pub fn fit(
     excluded: &[bool],
     maps: Option<(&[f32], &[f32])>,
 ) -> Option<LeastSquares> {
-    let pixels = sensor.pixels();
+    let span = intervals_per_span(events, frames, sensor)?;
+    let normals = span_normals(events, frames, sensor, excluded, span);
+    let mut total = Normal::default();
+    normals.iter().for_each(|n| total.merge(n));
+    let (ct_on, ct_off) = total.solve()?;
+    let fitted: Vec<Option<(f64, f64)>> = normals.iter().map(Normal::solve).collect();
+    let correlation = |pick: fn((f64, f64)) -> f64, map: &[f32]| {
+        let pairs: Vec<(f64, f64)> = fitted
+            .iter()
+            .zip(map)
+            .filter_map(|(f, &m)| Some((pick((*f)?), m as f64)).filter(|_| m.is_finite()))
+            .collect();
+        correlation(&pairs)
+    };
+    Some(LeastSquares {
+        ct_on,
+        ct_off,
+        intervals_per_span: span,
+        pixels: fitted.iter().filter(|f| f.is_some()).count(),
+        map_correlation_on: maps.and_then(|(m, _)| correlation(|f| f.0, m)),
+        map_correlation_off: maps.and_then(|(_, m)| correlation(|f| f.1, m)),
+    })
+}
+
+/// Intervals per span: enough that an active pixel holds [`EVENTS_PER_SPAN`] events, from
+/// the events per active pixel and used interval (`None` without a used interval).
+fn intervals_per_span(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+) -> Option<usize> {
     let width = sensor.width as usize;
-    // intervals per span, from the events per active pixel and used interval
     let used: Vec<usize> = (0..frames.flows.len())
         .filter(|&k| frames.flows[k].is_some())
         .collect();
@@ -95,13 +124,27 @@ pub fn fit(
     );
     let lo = events.t.partition_point(|&t| t < first);
     let hi = events.t.partition_point(|&t| t < last);
-    let mut active = vec![false; pixels];
+    let mut active = vec![false; sensor.pixels()];
     for i in lo..hi {
         active[events.y[i] as usize * width + events.x[i] as usize] = true;
     }
     let active = active.iter().filter(|&&a| a).count().max(1);
     let per_interval = (hi - lo) as f64 / (active * used.len()) as f64;
-    let span = ((EVENTS_PER_SPAN / per_interval.max(1e-9)).round() as usize).max(1);
+    Some(((EVENTS_PER_SPAN / per_interval.max(1e-9)).round() as usize).max(1))
+}
+
+/// Each pixel's normal equations over spans of `span` intervals of the frames' runs: its ON
+/// and OFF counts against the log change between the span's ends, where the pixel fired
+/// and its frames are reliable throughout.
+fn span_normals(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    excluded: &[bool],
+    span: usize,
+) -> Vec<Normal> {
+    let pixels = sensor.pixels();
+    let width = sensor.width as usize;
     let mut normals = vec![Normal::default(); pixels];
     let mut on = vec![0u32; pixels];
     let mut off = vec![0u32; pixels];
@@ -136,26 +179,7 @@ pub fn fit(
             start = end;
         }
     }
-    let mut total = Normal::default();
-    normals.iter().for_each(|n| total.merge(n));
-    let (ct_on, ct_off) = total.solve()?;
-    let fitted: Vec<Option<(f64, f64)>> = normals.iter().map(Normal::solve).collect();
-    let correlation = |pick: fn((f64, f64)) -> f64, map: &[f32]| {
-        let pairs: Vec<(f64, f64)> = fitted
-            .iter()
-            .zip(map)
-            .filter_map(|(f, &m)| Some((pick((*f)?), m as f64)).filter(|_| m.is_finite()))
-            .collect();
-        correlation(&pairs)
-    };
-    Some(LeastSquares {
-        ct_on,
-        ct_off,
-        intervals_per_span: span,
-        pixels: fitted.iter().filter(|f| f.is_some()).count(),
-        map_correlation_on: maps.and_then(|(m, _)| correlation(|f| f.0, m)),
-        map_correlation_off: maps.and_then(|(_, m)| correlation(|f| f.1, m)),
-    })
+    normals
 }
 
 /// Pearson correlation of pairs (`None` for fewer than 10).
