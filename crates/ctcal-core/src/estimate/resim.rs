@@ -516,38 +516,8 @@ pub fn fit_with(
         for (slot, on) in [(0, true), (1, false)] {
             base.ct_on = estimate[0];
             base.ct_off = estimate[1];
-            let problem = Mismatch {
-                resim,
-                base: base.clone(),
-                on,
-            };
-            let current = estimate[slot];
-            let search = Search {
-                first_log_step: if round == 0 { 0.08 } else { 0.03 },
-                limits: [current * (1.0 - MAX_CHANGE), current * (1.0 + MAX_CHANGE)],
-                relative_tolerance: 0.002,
-                max_iterations: 20,
-            };
-            let cost = |c: f64| {
-                problem
-                    .cost(&c)
-                    .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
-            };
-            estimate[slot] = match threshold_root(cost, current, &search)? {
-                Crossing::Root(c) => c,
-                Crossing::Beyond { .. } => {
-                    return Err(EstimateError::new(
-                        format!(
-                            "the re-simulated {} counts do not cross the real ones for thresholds within {:.0} % of {current:.3}",
-                            if on { "ON" } else { "OFF" },
-                            100.0 * MAX_CHANGE
-                        ),
-                        Text::from("the frames do not explain the events (check the frame times and exposure, or use ")
-                            .name(Hint::Analysis(Analysis::Eppps))
-                            .words(")"),
-                    ));
-                }
-            };
+            let first_log_step = if round == 0 { 0.08 } else { 0.03 };
+            estimate[slot] = polarity_root(resim, &base, on, estimate[slot], first_log_step)?;
         }
     }
     base.ct_on = estimate[0];
@@ -571,6 +541,49 @@ pub fn fit_with(
         simulations: resim.evaluations.get(),
         counts: simulated,
     })
+}
+
+/// One polarity's threshold (`on`) where the re-simulated counts of `base` cross the real
+/// ones, searched from `current` within [`MAX_CHANGE`] of it; an error where they do not
+/// cross there.
+fn polarity_root(
+    resim: &Resimulation,
+    base: &PixelParams,
+    on: bool,
+    current: f64,
+    first_log_step: f64,
+) -> Result<f64, EstimateError> {
+    let problem = Mismatch {
+        resim,
+        base: base.clone(),
+        on,
+    };
+    let search = Search {
+        first_log_step,
+        limits: [current * (1.0 - MAX_CHANGE), current * (1.0 + MAX_CHANGE)],
+        relative_tolerance: 0.002,
+        max_iterations: 20,
+    };
+    let cost = |c: f64| {
+        problem
+            .cost(&c)
+            .map_err(|e| EstimateError::new(e.to_string(), "report this as a bug"))
+    };
+    match threshold_root(cost, current, &search)? {
+        Crossing::Root(c) => Ok(c),
+        Crossing::Beyond { .. } => Err(EstimateError::new(
+            format!(
+                "the re-simulated {} counts do not cross the real ones for thresholds within {:.0} % of {current:.3}",
+                if on { "ON" } else { "OFF" },
+                100.0 * MAX_CHANGE
+            ),
+            Text::from(
+                "the frames do not explain the events (check the frame times and exposure, or use ",
+            )
+            .name(Hint::Analysis(Analysis::Eppps))
+            .words(")"),
+        )),
+    }
 }
 
 #[cfg(test)]
