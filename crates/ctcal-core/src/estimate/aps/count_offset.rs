@@ -152,21 +152,14 @@ pub fn search(
     start: (f64, f64),
     sigma: f64,
 ) -> Option<CountOffset> {
-    let mut shifted = 0.0f32;
-    let mut thresholds = start;
-    let mut at = |b: f32| -> Option<DarkBright> {
-        shift_runs(runs, b - own - shifted);
-        shifted = b - own;
-        let resim = Resimulation::new(
-            runs,
-            (setup.width, setup.height),
-            setup.cells,
-            setup.real,
-            setup.grid,
-        );
-        let r = fit_with(&resim, thresholds, sigma, None, 1).ok()?;
-        thresholds = (r.ct_on, r.ct_off);
-        Some(brightness.compare(setup.real, &r.counts))
+    let mut probe = OffsetProbe {
+        setup,
+        brightness,
+        runs,
+        own,
+        shifted: 0.0,
+        thresholds: start,
+        sigma,
     };
     // the difference falls as the offset grows: step away from `own` towards the root,
     // doubling the step, until the sign changes or the prior's end is reached; each fit
@@ -179,47 +172,19 @@ pub fn search(
     if (bound - own) * direction <= 0.0 {
         return None;
     }
-    let first_step = (0.5 * own.abs()).max(FIRST_STEP_DN);
-    let (mut near, mut d_near) = (own, at_own.difference);
-    let mut step = first_step;
-    let (far, d_far) = loop {
-        let b = if direction > 0.0 {
-            (own + step).min(bound)
-        } else {
-            (own - step).max(bound)
-        };
-        let d = at(b)?.difference;
-        if d.signum() != at_own.difference.signum() {
-            break (b, d);
-        }
-        if b == bound {
-            return Some(CountOffset {
-                offset_dn: bound,
-                ci95: [bound.min(own), bound.max(own)],
-                at_timing_offset: at_own,
-                at_bound: true,
-            });
-        }
-        (near, d_near) = (b, d);
-        step *= 2.0;
+    let Some(((near, d_near), (far, d_far))) =
+        probe.bracket(at_own.difference, direction, bound)?
+    else {
+        return Some(CountOffset {
+            offset_dn: bound,
+            ci95: [bound.min(own), bound.max(own)],
+            at_timing_offset: at_own,
+            at_bound: true,
+        });
     };
     // the slope over the bracket, for the root's standard error
     let slope = (d_far - d_near) / (far - near) as f64;
-    let (mut lo, mut d_lo, mut hi, mut d_hi) = if near < far {
-        (near, d_near, far, d_far)
-    } else {
-        (far, d_far, near, d_near)
-    };
-    for _ in 0..ROOT_STEPS {
-        let mid = 0.5 * (lo + hi);
-        let d = at(mid)?.difference;
-        if d > 0.0 {
-            (lo, d_lo) = (mid, d);
-        } else {
-            (hi, d_hi) = (mid, d);
-        }
-    }
-    let root = lo + (hi - lo) * (d_lo / (d_lo - d_hi)) as f32;
+    let root = probe.root((near, d_near), (far, d_far))?;
     let half = (1.96 * at_own.standard_error / slope.abs().max(1e-12)) as f32;
     Some(CountOffset {
         offset_dn: root,
@@ -227,6 +192,88 @@ pub fn search(
         at_timing_offset: at_own,
         at_bound: false,
     })
+}
+
+/// A trial offset (DN) and the counts' dark-bright difference there.
+type Trial = (f32, f64);
+
+/// The counts' dark-bright difference at a trial offset: the upsampled runs shifted
+/// there in place and re-simulated, the thresholds fitted from the last trial's.
+struct OffsetProbe<'s, 'r> {
+    setup: &'s Setup<'s>,
+    brightness: &'s Brightness,
+    runs: &'r mut [Vec<Sample>],
+    /// The offset the runs were upsampled at.
+    own: f32,
+    /// How far they are shifted from it now.
+    shifted: f32,
+    thresholds: (f64, f64),
+    sigma: f64,
+}
+
+impl OffsetProbe<'_, '_> {
+    /// The difference at offset `b` (`None` where the fit fails).
+    fn at(&mut self, b: f32) -> Option<DarkBright> {
+        shift_runs(self.runs, b - self.own - self.shifted);
+        self.shifted = b - self.own;
+        let setup = self.setup;
+        let resim = Resimulation::new(
+            self.runs,
+            (setup.width, setup.height),
+            setup.cells,
+            setup.real,
+            setup.grid,
+        );
+        let r = fit_with(&resim, self.thresholds, self.sigma, None, 1).ok()?;
+        self.thresholds = (r.ct_on, r.ct_off);
+        Some(self.brightness.compare(setup.real, &r.counts))
+    }
+
+    /// Offsets stepped from `own` (its difference `d_own`) in `direction`, the step
+    /// doubling, until the difference changes sign: the last two (offset, difference)
+    /// pairs, nearer first; `Some(None)` where the prior's end `bound` is reached first.
+    fn bracket(
+        &mut self,
+        d_own: f64,
+        direction: f32,
+        bound: f32,
+    ) -> Option<Option<(Trial, Trial)>> {
+        let own = self.own;
+        let mut step = (0.5 * own.abs()).max(FIRST_STEP_DN);
+        let mut near = (own, d_own);
+        loop {
+            let b = if direction > 0.0 {
+                (own + step).min(bound)
+            } else {
+                (own - step).max(bound)
+            };
+            let d = self.at(b)?.difference;
+            if d.signum() != d_own.signum() {
+                return Some(Some((near, (b, d))));
+            }
+            if b == bound {
+                return Some(None);
+            }
+            near = (b, d);
+            step *= 2.0;
+        }
+    }
+
+    /// The root within the bracket `a`, `b` ((offset, difference) pairs of opposite
+    /// signs): [`ROOT_STEPS`] bisections, then the secant.
+    fn root(&mut self, a: Trial, b: Trial) -> Option<f32> {
+        let ((mut lo, mut d_lo), (mut hi, mut d_hi)) = if a.0 < b.0 { (a, b) } else { (b, a) };
+        for _ in 0..ROOT_STEPS {
+            let mid = 0.5 * (lo + hi);
+            let d = self.at(mid)?.difference;
+            if d > 0.0 {
+                (lo, d_lo) = (mid, d);
+            } else {
+                (hi, d_hi) = (mid, d);
+            }
+        }
+        Some(lo + (hi - lo) * (d_lo / (d_lo - d_hi)) as f32)
+    }
 }
 
 /// The counts' offset and whether it moved the frames' offset or its range.
