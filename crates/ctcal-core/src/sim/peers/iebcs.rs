@@ -64,7 +64,7 @@
 
 use super::super::rng::{Stream, generator};
 use super::super::{FrameSource, SimError};
-use crate::events::EventChunk;
+use crate::events::{EventChunk, TimeUs};
 use rand::{Rng, RngExt};
 use rand_distr::{Distribution, Normal, StandardNormal};
 use serde::{Deserialize, Serialize};
@@ -462,26 +462,7 @@ pub fn simulate(
         off_threshold: normal(-params.th_neg),
         noise,
     };
-    let mut pixels: Vec<Pixel> = first
-        .dn
-        .iter()
-        .map(|&dn| {
-            let lux = params.lux(dn);
-            let v = (lux + 1.0).ln();
-            Pixel {
-                last_v: v,
-                cur_v: v,
-                th_pos: 0.0,
-                th_neg: 0.0,
-                cur_ref: NOT_REFRACTORY,
-                time_px: 0,
-                tau_p: params.tau_us * 1e3 / (lux + 1.0),
-                bgn_pos_next: u64::MAX,
-                bgn_neg_next: u64::MAX,
-                noise_rows: [0, 0],
-            }
-        })
-        .collect();
+    let mut pixels = initial_pixels(&first.dn, params);
     first_noise(&mut pixels, source.size(), &sensor.noise, seed);
     for p in &mut pixels {
         p.th_pos = sensor.draw_on();
@@ -512,6 +493,35 @@ pub fn simulate(
         time += dt;
         last_t = sample.t;
     }
+    Ok(time_ordered(events, origin, width))
+}
+
+/// The pixels of IEBCS's `init_image` at the first sample's `dn`: the low-passed and
+/// reference log at the sample's, the time constant at its light, no threshold drawn yet.
+fn initial_pixels(dn: &[f32], params: &Params) -> Vec<Pixel> {
+    dn.iter()
+        .map(|&dn| {
+            let lux = params.lux(dn);
+            let v = (lux + 1.0).ln();
+            Pixel {
+                last_v: v,
+                cur_v: v,
+                th_pos: 0.0,
+                th_neg: 0.0,
+                cur_ref: NOT_REFRACTORY,
+                time_px: 0,
+                tau_p: params.tau_us * 1e3 / (lux + 1.0),
+                bgn_pos_next: u64::MAX,
+                bgn_neg_next: u64::MAX,
+                noise_rows: [0, 0],
+            }
+        })
+        .collect()
+}
+
+/// `events` (time since `origin`, pixel, polarity) sorted by time, then pixel, as a chunk
+/// on the recording's clock.
+fn time_ordered(mut events: Vec<(u64, usize, bool)>, origin: TimeUs, width: usize) -> EventChunk {
     events.sort_by_key(|&(t, i, _)| (t, i));
     let mut out = EventChunk::with_capacity(events.len());
     for (t, i, on) in events {
@@ -522,7 +532,7 @@ pub fn simulate(
             on,
         );
     }
-    Ok(out)
+    out
 }
 
 #[cfg(test)]
