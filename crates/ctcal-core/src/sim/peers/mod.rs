@@ -74,79 +74,94 @@ impl Peer {
     /// distributions, if it is given them, for their mean rates).
     pub fn truth(&self) -> Result<Truth, SimError> {
         Ok(match self {
-            Peer::Esim(p) => Truth {
-                ct_on: p.contrast_threshold_pos,
-                ct_off: p.contrast_threshold_neg,
-                ct_sigma: p.contrast_threshold_sigma_pos,
-                ct_sigma_off: p.contrast_threshold_sigma_neg,
-                ct_sigma_kind: "per_interval",
-                log_offset_dn: p.use_log_image.then_some(255.0 * p.log_eps),
-                refractory: Refractory {
-                    period_s: p.refractory_period_ns as f64 * 1e-9,
-                    semantics: "drop",
-                },
-                ..Truth::ideal()
-            },
-            Peer::Voltmeter(p) => {
-                let [k1, k2, k3, k4, k5, k6] = p.k;
-                Truth {
-                    ct_on: 1.0 / k1,
-                    ct_off: 1.0 / k1,
-                    log_offset_dn: Some(k2),
-                    leak: Leak {
-                        on_rate_hz: k4 * 1e6,
-                        on_rate_hz_per_dn: k5 * 1e6,
-                    },
-                    noise: Noise {
-                        model: format!(
-                            "Brownian diffusion sigma(DN) = {k3} sqrt(DN) / (DN + {k2}) + {k6} \
-                             per sqrt(us), thresholds at +-1"
-                        ),
-                        ..Noise::none()
-                    },
-                    ..Truth::ideal()
-                }
-            }
-            Peer::Iebcs(p) => {
-                let offset = 255.0 / p.lux_at_255;
-                let [on_rate_hz, off_rate_hz] = p.noise_rates()?;
-                let model = match &p.noise_distributions {
-                    None => "fixed period per pixel, random phase; resets the pixel".into(),
-                    Some([on, off]) => format!(
-                        "measured distributions {} and {}, a random row per pixel; resets the pixel",
-                        on.display(),
-                        off.display()
-                    ),
-                };
-                Truth {
-                    ct_on: p.th_pos,
-                    ct_off: p.th_neg,
-                    ct_sigma: p.th_noise,
-                    ct_sigma_off: p.th_noise,
-                    ct_sigma_kind: "per_event",
-                    log_offset_dn: Some(offset),
-                    refractory: Refractory {
-                        period_s: p.ref_us as f64 * 1e-6,
-                        semantics: "drop",
-                    },
-                    noise: Noise {
-                        on_rate_hz,
-                        off_rate_hz,
-                        model,
-                    },
-                    cutoff: Some(Cutoff {
-                        hz_at_255: (p.lux_at_255 + 1.0) * 1e3 / (std::f64::consts::TAU * p.tau_us),
-                        dn_offset: offset,
-                    }),
-                    latency: Latency {
-                        mean_s: p.lat_us * 1e-6,
-                        jitter_s: p.jit_us * 1e-6,
-                    },
-                    ..Truth::ideal()
-                }
-            }
+            Peer::Esim(p) => esim_truth(p),
+            Peer::Voltmeter(p) => voltmeter_truth(p),
+            Peer::Iebcs(p) => iebcs_truth(p)?,
         })
     }
+}
+
+/// ESIM's parameters in ctcal's terms: its threshold spread redrawn per interval, its
+/// `ln(I + eps)` as an offset, its refractory period dropping changes.
+fn esim_truth(p: &esim::Params) -> Truth {
+    Truth {
+        ct_on: p.contrast_threshold_pos,
+        ct_off: p.contrast_threshold_neg,
+        ct_sigma: p.contrast_threshold_sigma_pos,
+        ct_sigma_off: p.contrast_threshold_sigma_neg,
+        ct_sigma_kind: "per_interval",
+        log_offset_dn: p.use_log_image.then_some(255.0 * p.log_eps),
+        refractory: Refractory {
+            period_s: p.refractory_period_ns as f64 * 1e-9,
+            semantics: "drop",
+        },
+        ..Truth::ideal()
+    }
+}
+
+/// DVS-Voltmeter's parameters in ctcal's terms: thresholds `1/k1`, the log offset `k2`,
+/// its leak (`k4`, and `k5` per DN) and Brownian noise.
+fn voltmeter_truth(p: &voltmeter::Params) -> Truth {
+    let [k1, k2, k3, k4, k5, k6] = p.k;
+    Truth {
+        ct_on: 1.0 / k1,
+        ct_off: 1.0 / k1,
+        log_offset_dn: Some(k2),
+        leak: Leak {
+            on_rate_hz: k4 * 1e6,
+            on_rate_hz_per_dn: k5 * 1e6,
+        },
+        noise: Noise {
+            model: format!(
+                "Brownian diffusion sigma(DN) = {k3} sqrt(DN) / (DN + {k2}) + {k6} \
+                 per sqrt(us), thresholds at +-1"
+            ),
+            ..Noise::none()
+        },
+        ..Truth::ideal()
+    }
+}
+
+/// IEBCS's parameters in ctcal's terms: thresholds redrawn per event, the log offset of
+/// `ln(lux + 1)`, refractory period, noise rates (its measured distributions read for
+/// their means), the photoreceptor's cutoff and latency.
+fn iebcs_truth(p: &iebcs::Params) -> Result<Truth, SimError> {
+    let offset = 255.0 / p.lux_at_255;
+    let [on_rate_hz, off_rate_hz] = p.noise_rates()?;
+    let model = match &p.noise_distributions {
+        None => "fixed period per pixel, random phase; resets the pixel".into(),
+        Some([on, off]) => format!(
+            "measured distributions {} and {}, a random row per pixel; resets the pixel",
+            on.display(),
+            off.display()
+        ),
+    };
+    Ok(Truth {
+        ct_on: p.th_pos,
+        ct_off: p.th_neg,
+        ct_sigma: p.th_noise,
+        ct_sigma_off: p.th_noise,
+        ct_sigma_kind: "per_event",
+        log_offset_dn: Some(offset),
+        refractory: Refractory {
+            period_s: p.ref_us as f64 * 1e-6,
+            semantics: "drop",
+        },
+        noise: Noise {
+            on_rate_hz,
+            off_rate_hz,
+            model,
+        },
+        cutoff: Some(Cutoff {
+            hz_at_255: (p.lux_at_255 + 1.0) * 1e3 / (std::f64::consts::TAU * p.tau_us),
+            dn_offset: offset,
+        }),
+        latency: Latency {
+            mean_s: p.lat_us * 1e-6,
+            jitter_s: p.jit_us * 1e-6,
+        },
+        ..Truth::ideal()
+    })
 }
 
 /// A peer's parameters in ctcal's terms. Thresholds are in natural-log units of what the
