@@ -1010,7 +1010,24 @@ fn withhold_cut_bursts(
             );
         }
     }
-    let repeats = |r: bursts::Repeats| json!({"events": r.events, "repeats": r.repeats, "share": r.share(), "share_se": r.share_se});
+    estimate.assumptions.push(format!(
+        "bursts: {:.1} % of the ON and {:.1} % of the OFF events repeat a pixel's polarity within one refresh, against the fitted model's {:.1} % and {:.1} %; a polarity whose share falls under {} of the model's by more than {} standard errors (the shares' noise over {} blocks of refreshes) is withdrawn as an upper bound (its bursts cut short)",
+        100.0 * recorded[0].share(),
+        100.0 * recorded[1].share(),
+        100.0 * model[0].share(),
+        100.0 * model[1].share(),
+        bursts::TRUNCATED_BELOW,
+        bursts::Z_CUT,
+        bursts::NOISE_BLOCKS
+    ));
+    let repeats = |r: bursts::Repeats| {
+        json!({
+            "events": r.events,
+            "repeats": r.repeats,
+            "share": r.share(),
+            "share_se": r.share_se,
+        })
+    };
     let side = |slot: usize| {
         let mut v = repeats(recorded[slot]);
         v["shortfall_z"] = json!(bursts::shortfall_z(recorded[slot], model[slot]));
