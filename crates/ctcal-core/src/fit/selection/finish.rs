@@ -158,43 +158,87 @@ pub struct Parts<'a> {
 /// The result of the fit, in stages: the final model's error on the test blocks, the
 /// thresholds' intervals, the noise intervals, hot pixels and the detections, then what the
 /// data leave undetermined. Each stage appends its assumptions in this order.
-pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitResult {
-    let g = simulation.geometry;
-    let Parts {
-        before,
-        residuals_before,
-        added,
-        steps,
-        mut ambiguities,
-        mut assumptions,
-        fixed,
-        start,
-        known,
-        interpolation_share,
-        other_response,
-        frame_quality,
-        frames_aligned,
-        options,
-        input,
-    } = parts;
-    let after = simulation.distance(&state.model.observed, g.testing(), &state.kept);
-    let residuals_after = residuals(&simulation.real, &state.model.observed, g, Subset::Fit);
+pub fn result(simulation: &Simulation, mut state: State, mut parts: Parts) -> FitResult {
+    let tested = Tested::of(simulation, &state);
+    let written = intervals(simulation, &mut state, &mut parts);
+    let judged = judged(simulation, &mut state, &mut parts, written.noise);
+    let params = written.params;
+    let identified = super::super::identified(&params, &judged.not_identified);
+    FitResult {
+        biases: None,
+        why: judged.not_identified.clone(),
+        identified,
+        params: FittedParams {
+            model: params,
+            not_identified: judged.not_identified,
+        },
+        uncertainties: state.uncertainty,
+        effects_added: parts.added,
+        error_metric: ERROR_METRIC,
+        error_before: parts.before.total,
+        error_after: tested.after.total,
+        components_before: parts.before,
+        components_after: tested.after,
+        steps: parts.steps,
+        ambiguities: parts.ambiguities,
+        hot_pixels_masked: state.hot,
+        hot_pixel_detection: state.hot_detection,
+        noise_detection: judged.noise_detection,
+        bandwidth_detection: judged.bandwidth_detection,
+        residuals_before: Some(parts.residuals_before),
+        residuals_after: Some(tested.residuals_after),
+        events_only: None,
+        assumptions: parts.assumptions,
+        holdout: holdout(simulation, parts.options),
+        simulations: simulation.count.get(),
+        frame_exposure_us: exposure_of(parts.input.frames, parts.options.aps.exposure_us),
+    }
+}
+
+/// The final model as the loop left it, measured before any interval is taken: its error
+/// on the test blocks and its residuals on the fit blocks.
+struct Tested {
+    after: super::super::metric::Components,
+    residuals_after: Residuals,
+}
+
+impl Tested {
+    fn of(simulation: &Simulation, state: &State) -> Self {
+        let g = simulation.geometry;
+        Tested {
+            after: simulation.distance(&state.model.observed, g.testing(), &state.kept),
+            residuals_after: residuals(&simulation.real, &state.model.observed, g, Subset::Fit),
+        }
+    }
+}
+
+/// The parameters as written and the noise intervals, from [`intervals`].
+struct Written {
+    params: crate::sim::params::PixelParams,
+    noise: NoiseIntervals,
+}
+
+/// The intervals, in order: the thresholds' (widened), the noise parameters', the hot
+/// pixels' (which may change the parameters as written), then the method's spread
+/// systematic; each appends its assumptions to the parts'.
+fn intervals(simulation: &Simulation, state: &mut State, parts: &mut Parts) -> Written {
     let widening = Widening {
-        fixed,
-        frame_quality: &frame_quality,
-        interpolation_share,
-        other_response: other_response.as_ref(),
-        start: start.as_ref(),
+        fixed: parts.fixed,
+        frame_quality: &parts.frame_quality,
+        interpolation_share: parts.interpolation_share,
+        other_response: parts.other_response.as_ref(),
+        start: parts.start.as_ref(),
     };
-    assumptions.extend(threshold_intervals(simulation, &mut state, widening));
-    let noise = noise_intervals(simulation, &mut state, fixed, known, &mut assumptions);
-    let mut params = params_to_write(&state);
+    let assumptions = &mut parts.assumptions;
+    assumptions.extend(threshold_intervals(simulation, state, widening));
+    let noise = noise_intervals(simulation, state, parts.fixed, parts.known, assumptions);
+    let mut params = params_to_write(state);
     if !state.hot.is_empty() {
         assumptions.push(super::hot_report::hot_pixels(
             simulation,
-            &mut state,
-            input,
-            known.mismatch,
+            state,
+            parts.input,
+            parts.known.mismatch,
             &mut params,
         ));
     }
@@ -202,56 +246,52 @@ pub fn result(simulation: &Simulation, mut state: State, parts: Parts) -> FitRes
     assumptions.extend(super::method_systematic::widen_spread(
         &mut state.uncertainty,
     ));
+    Written { params, noise }
+}
+
+/// What the final model is checked for and what the data leave undetermined, from
+/// [`judged`].
+struct Judged {
+    noise_detection: Option<crate::fit::NoiseDetection>,
+    bandwidth_detection: Option<crate::fit::BandwidthDetection>,
+    not_identified: BTreeMap<String, String>,
+}
+
+/// The detections, the parameters the data do not identify, then the assumptions of the
+/// blocks' split; each appends its assumptions to the parts'.
+fn judged(
+    simulation: &Simulation,
+    state: &mut State,
+    parts: &mut Parts,
+    noise: NoiseIntervals,
+) -> Judged {
     let (noise_detection, bandwidth_detection) = detections(
         simulation,
-        &state,
-        &steps,
-        known,
-        frames_aligned,
-        &mut assumptions,
+        state,
+        &parts.steps,
+        parts.known,
+        parts.frames_aligned,
+        &mut parts.assumptions,
     );
     let not_identified = undetermined(
         simulation,
-        &mut state,
+        state,
         Undetermined {
-            fixed,
-            steps: &steps,
-            measured_spread: known.mismatch,
+            fixed: parts.fixed,
+            steps: &parts.steps,
+            measured_spread: parts.known.mismatch,
             noise,
         },
-        &mut ambiguities,
-        &mut assumptions,
+        &mut parts.ambiguities,
+        &mut parts.assumptions,
     );
-    assumptions.extend(split_assumptions(simulation, options));
-    let identified = super::super::identified(&params, &not_identified);
-    FitResult {
-        biases: None,
-        why: not_identified.clone(),
-        identified,
-        params: FittedParams {
-            model: params,
-            not_identified,
-        },
-        uncertainties: state.uncertainty,
-        effects_added: added,
-        error_metric: ERROR_METRIC,
-        error_before: before.total,
-        error_after: after.total,
-        components_before: before,
-        components_after: after,
-        steps,
-        ambiguities,
-        hot_pixels_masked: state.hot,
-        hot_pixel_detection: state.hot_detection,
+    parts
+        .assumptions
+        .extend(split_assumptions(simulation, parts.options));
+    Judged {
         noise_detection,
         bandwidth_detection,
-        residuals_before: Some(residuals_before),
-        residuals_after: Some(residuals_after),
-        events_only: None,
-        assumptions,
-        holdout: holdout(simulation, options),
-        simulations: simulation.count.get(),
-        frame_exposure_us: exposure_of(input.frames, options.aps.exposure_us),
+        not_identified,
     }
 }
 
