@@ -87,47 +87,88 @@ fn dn_label(i: usize) -> String {
 
 /// The residuals of `sim` against `real` over `subset`.
 pub fn residuals(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> Residuals {
-    let (rc, sc) = (real.cells_of(g, subset), sim.cells_of(g, subset));
-    let sum = |c: &[u32], pick: &dyn Fn(usize, usize, usize) -> bool| -> u64 {
-        (0..CELLS)
-            .filter(|&i| {
-                let (intensity, change, pol) = cell_of(i);
-                pick(intensity, change, pol)
-            })
-            .map(|i| c[i] as u64)
-            .sum()
+    let cells = CellCounts {
+        real: real.cells_of(g, subset),
+        sim: sim.cells_of(g, subset),
     };
-    let by_intensity_pol = |pol: Option<usize>| -> Vec<Bin> {
+    Residuals {
+        by_intensity: cells.by_intensity(g, None),
+        by_intensity_on: cells.by_intensity(g, Some(1)),
+        by_intensity_off: cells.by_intensity(g, Some(0)),
+        by_rate_of_change: cells.by_rate_of_change(g),
+        by_polarity: by_polarity(real, sim, g, subset),
+        by_region: by_region(real, sim, g, subset),
+        over_time: over_time(real, sim, g, subset),
+        background: background(real, sim, g, subset),
+        intervals: IntervalDistributions {
+            bin_start_s: (0..INTERVAL_BINS).map(interval_bin_start).collect(),
+            real: normalised(&real.intervals_of(g, subset)),
+            simulated: normalised(&sim.intervals_of(g, subset)),
+        },
+        spectrum: spectrum(real, sim),
+    }
+}
+
+/// The count cells (intensity x rate of change x polarity) of the recording and of the
+/// simulation over one subset.
+struct CellCounts {
+    real: Vec<u32>,
+    sim: Vec<u32>,
+}
+
+impl CellCounts {
+    /// The bin of the cells `pick` keeps (by intensity bin, change bin, polarity).
+    fn bin(&self, label: String, x: f64, pick: impl Fn(usize, usize, usize) -> bool) -> Bin {
+        let sum = |c: &[u32]| -> u64 {
+            (0..CELLS)
+                .filter(|&i| {
+                    let (intensity, change, pol) = cell_of(i);
+                    pick(intensity, change, pol)
+                })
+                .map(|i| c[i] as u64)
+                .sum()
+        };
+        bin(label, x, sum(&self.real), sum(&self.sim))
+    }
+
+    /// By scene intensity, of one polarity or (`None`) both.
+    fn by_intensity(&self, g: &Geometry, pol: Option<usize>) -> Vec<Bin> {
         (0..INTENSITY_BINS)
             .map(|i| {
                 let pick = |k: usize, _: usize, p: usize| k == i && pol.is_none_or(|q| q == p);
-                bin(
-                    dn_label(i),
-                    g.intensity_centres[i],
-                    sum(&rc, &pick),
-                    sum(&sc, &pick),
-                )
+                self.bin(dn_label(i), g.intensity_centres[i], pick)
             })
             .collect()
-    };
-    let by_rate_of_change = (0..CHANGE_BINS)
-        .map(|i| {
-            let lower = if i == 0 { 0.0 } else { CHANGE_EDGES[i - 1] };
-            let label = match CHANGE_EDGES.get(i) {
-                Some(upper) => format!("{lower}-{upper} /s"),
-                None => format!("{lower}+ /s"),
-            };
-            let pick = |_: usize, k: usize, _: usize| k == i;
-            bin(label, g.change_centres[i], sum(&rc, &pick), sum(&sc, &pick))
-        })
-        .collect();
+    }
+
+    /// By local rate of log-intensity change.
+    fn by_rate_of_change(&self, g: &Geometry) -> Vec<Bin> {
+        (0..CHANGE_BINS)
+            .map(|i| {
+                let lower = if i == 0 { 0.0 } else { CHANGE_EDGES[i - 1] };
+                let label = match CHANGE_EDGES.get(i) {
+                    Some(upper) => format!("{lower}-{upper} /s"),
+                    None => format!("{lower}+ /s"),
+                };
+                self.bin(label, g.change_centres[i], |_, k, _| k == i)
+            })
+            .collect()
+    }
+}
+
+/// OFF and ON events.
+fn by_polarity(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> Vec<Bin> {
     let ([r_off, r_on], [s_off, s_on]) = (real.polarity_of(g, subset), sim.polarity_of(g, subset));
-    let by_polarity = vec![
+    vec![
         bin("OFF".into(), 0.0, r_off, s_off),
         bin("ON".into(), 1.0, r_on, s_on),
-    ];
+    ]
+}
+
+/// Events of both polarities by region of the sensor.
+fn by_region(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> Vec<Bin> {
     let (rr, sr) = (real.regions_of(g, subset), sim.regions_of(g, subset));
-    let by_region = (0..REGIONS)
+    (0..REGIONS)
         .map(|region| {
             let both = |c: &[u32]| (c[2 * region] + c[2 * region + 1]) as u64;
             bin(
@@ -137,19 +178,27 @@ pub fn residuals(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) 
                 both(&sr),
             )
         })
-        .collect();
-    let over_time = (0..g.blocks)
+        .collect()
+}
+
+/// Events of both polarities by block of the subset.
+fn over_time(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> Vec<Bin> {
+    (0..g.blocks)
         .filter(|&b| g.in_subset(b, subset))
         .map(|b| {
             let one = |o: &Observed| o.polarity[b][0] + o.polarity[b][1];
             bin(format!("block {b}"), b as f64, one(real), one(sim))
         })
-        .collect();
+        .collect()
+}
+
+/// Unsupported-event rates by intensity bin, ON and OFF.
+fn background(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> Vec<BackgroundBin> {
     let (rb, sb) = (
         background_rates(real, g, subset),
         background_rates(sim, g, subset),
     );
-    let background = (0..INTENSITY_BINS)
+    (0..INTENSITY_BINS)
         .map(|i| BackgroundBin {
             intensity_dn: g.intensity_centres[i],
             real_on_hz: rb[2 * i + 1],
@@ -157,29 +206,17 @@ pub fn residuals(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) 
             real_off_hz: rb[2 * i],
             simulated_off_hz: sb[2 * i],
         })
-        .collect();
-    let intervals = IntervalDistributions {
-        bin_start_s: (0..INTERVAL_BINS).map(interval_bin_start).collect(),
-        real: normalised(&real.intervals_of(g, subset)),
-        simulated: normalised(&sim.intervals_of(g, subset)),
-    };
+        .collect()
+}
+
+/// The power spectra of both event-rate timelines ([`power_spectrum`]).
+fn spectrum(real: &Observed, sim: &Observed) -> Spectrum {
     let (frequency_hz, real_power) = power_spectrum(&real.timeline);
     let (_, simulated_power) = power_spectrum(&sim.timeline);
-    Residuals {
-        by_intensity: by_intensity_pol(None),
-        by_intensity_on: by_intensity_pol(Some(1)),
-        by_intensity_off: by_intensity_pol(Some(0)),
-        by_rate_of_change,
-        by_polarity,
-        by_region,
-        over_time,
-        background,
-        intervals,
-        spectrum: Spectrum {
-            frequency_hz,
-            real: real_power,
-            simulated: simulated_power,
-        },
+    Spectrum {
+        frequency_hz,
+        real: real_power,
+        simulated: simulated_power,
     }
 }
 
