@@ -163,16 +163,7 @@ pub fn compare(
 ) -> Result<Vec<Ambiguity>, FitError> {
     let mut found = Vec::new();
     for (kept, other, separated_by) in LOOK_ALIKES {
-        let in_model = |e: Effect| added.iter().any(|a| a.effect == e);
-        if !in_model(kept) || in_model(other) {
-            continue;
-        }
-        let named = |a: &Ambiguity| {
-            let pair = [a.kept.as_str(), a.alternative.as_str()];
-            pair == [kept.name(), other.name()] || pair == [other.name(), kept.name()]
-        };
-        if found.iter().any(named) {
-            // the reverse of a comparison that did not separate them: already named
+        if !applies((kept, other), added, &found) {
             continue;
         }
         if let Some(why) = effects::ruled_out(other, &context_of(state, simulation, known)) {
@@ -180,19 +171,13 @@ pub fn compare(
             continue;
         }
         let count_before = simulation.count.get();
-        let c = compare_one(simulation, state, known, kept, other, (fixed, noise))?;
-        let mut step = c.step;
-        step.simulations = simulation.count.get() - count_before;
+        let mut c = compare_one(simulation, state, known, kept, other, (fixed, noise))?;
+        c.step.simulations = simulation.count.get() - count_before;
         if c.replaces
             && let Some(held) =
                 held_by_signature((simulation, &*state, known), kept, other, &c.alternative)
         {
-            step.kept = false;
-            step.reason = format!(
-                "{}; but not in its place: {held}",
-                step.reason.replacen("replaces", "would replace", 1)
-            );
-            steps.push(step);
+            steps.push(not_in_place(c.step, &held));
             steps.push(beside(
                 (simulation, state, known),
                 (kept, other),
@@ -206,30 +191,70 @@ pub fn compare(
                 (simulation, &*state, known),
                 (kept, other, separated_by),
                 (&c.alternative, c.value),
-                &mut step,
+                &mut c.step,
                 &mut found,
             );
-        if c.replaces || lower {
-            let key = kept.parameter().expect("a searched effect");
-            state.uncertainty.remove(key);
-            state.at_bound.remove(key);
-            state.model = c.alternative;
-            state.set_uncertain(
-                other.parameter().expect("a searched effect").into(),
-                c.uncertain,
-                c.at_bound,
-            );
-            if let Some(a) = added.iter_mut().find(|a| a.effect == kept) {
-                *a = AddedEffect {
-                    effect: other,
-                    evidence: step.evidence.clone(),
-                    error_after: step.error_after.unwrap_or(a.error_after),
-                };
-            }
-        }
-        steps.push(step);
+        steps.push(if c.replaces || lower {
+            put_in_place(state, (kept, other), added, c)
+        } else {
+            c.step
+        });
     }
     Ok(found)
+}
+
+/// Whether the pair (`kept`, `other`) is compared: the kept effect is in the model, the
+/// look-alike is not, and the pair was not already named the other way round.
+fn applies((kept, other): (Effect, Effect), added: &[AddedEffect], found: &[Ambiguity]) -> bool {
+    let in_model = |e: Effect| added.iter().any(|a| a.effect == e);
+    if !in_model(kept) || in_model(other) {
+        return false;
+    }
+    let named = |a: &Ambiguity| {
+        let pair = [a.kept.as_str(), a.alternative.as_str()];
+        pair == [kept.name(), other.name()] || pair == [other.name(), kept.name()]
+    };
+    // the reverse of a comparison that did not separate them: already named
+    !found.iter().any(named)
+}
+
+/// The step of a look-alike that would replace the kept effect, which its own signature
+/// still calls for (`held`, [`held_by_signature`]): not kept in its place.
+fn not_in_place(mut step: Step, held: &str) -> Step {
+    step.kept = false;
+    step.reason = format!(
+        "{}; but not in its place: {held}",
+        step.reason.replacen("replaces", "would replace", 1)
+    );
+    step
+}
+
+/// The look-alike `other` in the place of `kept`: the model with it becomes the fitted
+/// one, its parameter's interval replaces the kept one's, and it takes the kept effect's
+/// entry among the added effects. Returns the comparison's step.
+fn put_in_place(
+    state: &mut State,
+    (kept, other): (Effect, Effect),
+    added: &mut [AddedEffect],
+    c: Comparison,
+) -> Step {
+    let key = kept.parameter().expect("a searched effect");
+    state.uncertainty.remove(key);
+    state.at_bound.remove(key);
+    state.model = c.alternative;
+    state.set_uncertain(
+        other.parameter().expect("a searched effect").into(),
+        c.uncertain,
+        c.at_bound,
+    );
+    if let Some(a) = added.iter_mut().find(|a| a.effect == kept) {
+        *a = AddedEffect {
+            effect: other,
+            evidence: c.step.evidence.clone(),
+            error_after: c.step.error_after.unwrap_or(a.error_after),
+        };
+    }
+    c.step
 }
 
 /// Why the kept effect stays whatever its look-alike does in its place: it is judged by its
