@@ -231,34 +231,70 @@ pub fn widen(uncertainty: &mut BTreeMap<String, Uncertain>, quality: &FrameQuali
         ),
     ];
     for (key, name, points, doubled) in polarities {
+        let systematics = Systematics::of(name, points, doubled);
+        if let Some(u) = uncertainty.get_mut(key) {
+            systematics.widen(u);
+        }
+        rate_parts.extend(systematics.rate_part);
+        exposure_parts.extend(systematics.exposure_part);
+    }
+    notes(quality, &rate_parts, &exposure_parts)
+}
+
+/// One threshold's frame-rate and exposure systematics, with what each check measured for
+/// the notes (`None` where the check has nothing for it).
+struct Systematics {
+    rate: f64,
+    exposure: f64,
+    rate_part: Option<String>,
+    exposure_part: Option<String>,
+}
+
+impl Systematics {
+    /// From the threshold's points at frame steps 1, 2, 3 (`name`: OFF or ON) and its
+    /// value with the exposure's motion blur doubled, where profiled.
+    fn of(name: &str, points: &[FrameRatePoint], doubled: Option<f64>) -> Self {
         let (limit, rate) = frame_rate_systematic(points);
-        if points.len() >= 2 {
+        let rate_part = (points.len() >= 2).then(|| {
             let values: Vec<String> = points.iter().map(|p| format!("{:.4}", p.value)).collect();
-            rate_parts.push(format!(
+            format!(
                 "{name} {} (limit {}, systematic {rate:.4})",
                 values.join(" / "),
                 limit.map_or("-".into(), |l| format!("{l:.4}"))
-            ));
-        }
+            )
+        });
         let full = points[0].value;
         // a straight line through exposures e and 2e reaches e = 0 as far below the
         // full value as the doubled one lies above it
         let exposure = doubled.map_or(0.0, |d| (d - full).abs());
-        if let Some(d) = doubled {
-            exposure_parts.push(format!(
+        let exposure_part = doubled.map(|d| {
+            format!(
                 "{name} {full:.4} / {d:.4} (limit {:.4}, systematic {exposure:.4})",
                 2.0 * full - d
-            ));
+            )
+        });
+        Systematics {
+            rate,
+            exposure,
+            rate_part,
+            exposure_part,
         }
-        let Some(u) = uncertainty.get_mut(key) else {
-            continue;
-        };
-        let Some(se) = u.standard_error else { continue };
-        let systematic = rate.hypot(exposure);
+    }
+
+    /// Adds both systematics to the threshold's standard error in quadrature, where it has
+    /// one.
+    fn widen(&self, u: &mut Uncertain) {
+        let Some(se) = u.standard_error else { return };
+        let systematic = self.rate.hypot(self.exposure);
         if systematic > 0.0 && u.value > 0.0 {
             *u = Uncertain::positive(u.value, Some(se.hypot(systematic)));
         }
     }
+}
+
+/// The assumptions the two checks add: what each measured (`rate_parts`, `exposure_parts`:
+/// one entry a threshold), or why it was not run.
+fn notes(quality: &FrameQuality, rate_parts: &[String], exposure_parts: &[String]) -> Vec<String> {
     let mut notes = Vec::new();
     if rate_parts.is_empty() {
         notes.push("frame-rate check not run: every 2nd and 3rd frame left no interval the optical flow follows (or their thresholds could not be profiled), so the gap between frames is not in the thresholds' intervals".into());
