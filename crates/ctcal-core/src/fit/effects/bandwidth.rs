@@ -37,7 +37,7 @@
 use super::{Context, Effect, Evidence};
 use crate::fit::metric::cell_ratios;
 use crate::fit::observe::lag::BinDelay;
-use crate::fit::observe::{INTENSITY_BINS, cell_of};
+use crate::fit::observe::{Geometry, INTENSITY_BINS, cell_of};
 
 /// The evidence of the counts or of the lag, whichever is stronger.
 pub fn evidence(c: &Context) -> Evidence {
@@ -129,9 +129,26 @@ struct LagReading {
 /// The lag part (see the module docs); `None` without two intensity bins of paired events.
 fn lag_evidence(c: &Context, floor: &NoiseFloor) -> Option<Evidence> {
     let g = c.geometry;
-    let bins: Vec<(usize, BinDelay)> = c
-        .sim
-        .delay_of(g, c.subset)
+    let relevant_s = LAG_RELEVANT * g.frame_interval_s;
+    let best = strongest_lag(&floored_delays(c, floor), g, relevant_s)?;
+    Some(Evidence {
+        effect: Effect::Bandwidth,
+        score: best.z,
+        relevant: best.excess_s > relevant_s,
+        text: best.text(g),
+        other_start: None,
+        start: (best.excess_s > 0.0).then(|| {
+            let (lo, hi) = Effect::Bandwidth.range(100.0);
+            best.cutoff_hz.clamp(lo, hi)
+        }),
+    })
+}
+
+/// The intensity bins with paired events, darkest first, each with the delay both
+/// polarities show; its standard error held at least at `floor`'s.
+fn floored_delays(c: &Context, floor: &NoiseFloor) -> Vec<(usize, BinDelay)> {
+    c.sim
+        .delay_of(c.geometry, c.subset)
         .iter()
         .enumerate()
         .filter_map(|(bin, lag)| {
@@ -141,11 +158,16 @@ fn lag_evidence(c: &Context, floor: &NoiseFloor) -> Option<Evidence> {
                 (bin, l)
             })
         })
-        .collect();
+        .collect()
+}
+
+/// Of every darker bin's readings, on its own and over the brightest bin, the one whose
+/// lag is relevant (above `relevant_s`) and largest in standard errors; `None` without two
+/// bins.
+fn strongest_lag(bins: &[(usize, BinDelay)], g: &Geometry, relevant_s: f64) -> Option<LagReading> {
     let &(bright, reference) = bins.last()?;
     let tau = |bin: usize| tau_of_1_hz(g.intensity_centres[bin]);
-    let relevant_s = LAG_RELEVANT * g.frame_interval_s;
-    let best = bins[..bins.len() - 1]
+    bins[..bins.len() - 1]
         .iter()
         .flat_map(|&(dark, d)| {
             let (l, reference) = (d.common, reference.common);
@@ -175,47 +197,43 @@ fn lag_evidence(c: &Context, floor: &NoiseFloor) -> Option<Evidence> {
             (a.excess_s > relevant_s)
                 .cmp(&(b.excess_s > relevant_s))
                 .then(a.z.total_cmp(&b.z))
-        })?;
-    let centre = |bin: usize| g.intensity_centres[bin];
-    let text = match best.against {
-        _ if best.excess_s <= 0.0 => format!(
-            "no lag that the recording's ON and OFF events both show (at {:.0} DN OFF {:+.2} ms, ON {:+.2} ms: a delay moves both, a threshold the model puts off one)",
-            centre(best.dark),
-            best.polarities_s.0 * 1e3,
-            best.polarities_s.1 * 1e3,
-        ),
-        Some(bright) => format!(
-            "the recording's ON and OFF events both lag the model by {:.2} ms more at {:.0} DN than at {:.0} DN ({:.1} standard errors; OFF {:+.2} ms, ON {:+.2} ms at {:.0} DN), as a cutoff of {:.0} Hz at white would",
-            best.excess_s * 1e3,
-            centre(best.dark),
-            centre(bright),
-            best.z,
-            best.polarities_s.0 * 1e3,
-            best.polarities_s.1 * 1e3,
-            centre(best.dark),
-            best.cutoff_hz
-        ),
-        None => format!(
-            "the recording's ON and OFF events both lag the model by {:.2} ms at {:.0} DN ({:.1} standard errors; OFF {:+.2} ms, ON {:+.2} ms), as a cutoff of {:.0} Hz at white would",
-            best.excess_s * 1e3,
-            centre(best.dark),
-            best.z,
-            best.polarities_s.0 * 1e3,
-            best.polarities_s.1 * 1e3,
-            best.cutoff_hz
-        ),
-    };
-    Some(Evidence {
-        effect: Effect::Bandwidth,
-        score: best.z,
-        relevant: best.excess_s > relevant_s,
-        text,
-        other_start: None,
-        start: (best.excess_s > 0.0).then(|| {
-            let (lo, hi) = Effect::Bandwidth.range(100.0);
-            best.cutoff_hz.clamp(lo, hi)
-        }),
-    })
+        })
+}
+
+impl LagReading {
+    /// What the reading says: no lag both polarities show, or the lag and the cutoff that
+    /// explains it.
+    fn text(&self, g: &Geometry) -> String {
+        let centre = |bin: usize| g.intensity_centres[bin];
+        match self.against {
+            _ if self.excess_s <= 0.0 => format!(
+                "no lag that the recording's ON and OFF events both show (at {:.0} DN OFF {:+.2} ms, ON {:+.2} ms: a delay moves both, a threshold the model puts off one)",
+                centre(self.dark),
+                self.polarities_s.0 * 1e3,
+                self.polarities_s.1 * 1e3,
+            ),
+            Some(bright) => format!(
+                "the recording's ON and OFF events both lag the model by {:.2} ms more at {:.0} DN than at {:.0} DN ({:.1} standard errors; OFF {:+.2} ms, ON {:+.2} ms at {:.0} DN), as a cutoff of {:.0} Hz at white would",
+                self.excess_s * 1e3,
+                centre(self.dark),
+                centre(bright),
+                self.z,
+                self.polarities_s.0 * 1e3,
+                self.polarities_s.1 * 1e3,
+                centre(self.dark),
+                self.cutoff_hz
+            ),
+            None => format!(
+                "the recording's ON and OFF events both lag the model by {:.2} ms at {:.0} DN ({:.1} standard errors; OFF {:+.2} ms, ON {:+.2} ms), as a cutoff of {:.0} Hz at white would",
+                self.excess_s * 1e3,
+                centre(self.dark),
+                self.z,
+                self.polarities_s.0 * 1e3,
+                self.polarities_s.1 * 1e3,
+                self.cutoff_hz
+            ),
+        }
+    }
 }
 
 /// The count part (see the module docs).
