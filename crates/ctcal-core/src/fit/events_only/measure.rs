@@ -285,12 +285,47 @@ impl Measuring<'_> {
 
 /// Measures every block (`spans`, in time order).
 pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
+    let w = m.sensor.width as usize;
+    let kept = m.kept_pixels();
+    let (clean, hot_events) = without_hot_pixels(m, spans, &kept);
+    let kept_pixels = kept.iter().filter(|&&k| k).count().max(1);
+    let ranges: Vec<std::ops::Range<usize>> = spans
+        .iter()
+        .map(|span| {
+            clean.t.partition_point(|&t| t < span.0)..clean.t.partition_point(|&t| t < span.1)
+        })
+        .collect();
+    let mut blocks = sized_blocks(spans, hot_events, &ranges, kept_pixels);
+    let mut last = vec![TimeUs::MIN; w * m.sensor.height as usize];
+    for (b, range) in blocks.iter_mut().zip(&ranges) {
+        b.intervals = super::refractory::intervals(&clean, range.clone(), w, &mut last, None);
+    }
+    let measured = isolated_under_every_support(m, &clean, spans, &kept);
+    for (k, per_block) in measured.into_iter().enumerate() {
+        for (b, (isolated, signal)) in blocks.iter_mut().zip(per_block) {
+            b.isolated.push(isolated);
+            if k == 0 {
+                (b.signal_on, b.signal_off) = signal;
+                b.signal_rate_hz =
+                    (signal.0 + signal.1) as f64 / (kept_pixels as f64 * b.seconds.max(1e-9));
+            }
+        }
+    }
+    blocks
+}
+
+/// The events of the kept pixels in the blocks (the clean events, masked and named hot
+/// pixels out), and each block's events of each named hot pixel.
+fn without_hot_pixels(
+    m: &Measuring,
+    spans: &[(TimeUs, TimeUs)],
+    kept: &[bool],
+) -> (EventChunk, Vec<Vec<u64>>) {
     let (w, h) = (m.sensor.width as usize, m.sensor.height as usize);
     let mut hot_index = vec![u32::MAX; w * h];
     for (k, &(x, y)) in m.hot.iter().enumerate() {
         hot_index[y as usize * w + x as usize] = k as u32;
     }
-    let kept = m.kept_pixels();
     let mut clean = EventChunk::with_capacity(m.events.len());
     let mut hot_events = vec![Vec::new(); spans.len()];
     for (b, span) in spans.iter().enumerate() {
@@ -307,17 +342,21 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
         }
         hot_events[b] = counts;
     }
-    let kept_pixels = kept.iter().filter(|&&k| k).count().max(1);
-    let ranges: Vec<std::ops::Range<usize>> = spans
-        .iter()
-        .map(|span| {
-            clean.t.partition_point(|&t| t < span.0)..clean.t.partition_point(|&t| t < span.1)
-        })
-        .collect();
-    let mut blocks: Vec<BlockMeasure> = spans
+    (clean, hot_events)
+}
+
+/// Each block's length, kept pixel-seconds, hot pixels' events and event rate (its clean
+/// events are `ranges`), the rest to measure.
+fn sized_blocks(
+    spans: &[(TimeUs, TimeUs)],
+    hot_events: Vec<Vec<u64>>,
+    ranges: &[std::ops::Range<usize>],
+    kept_pixels: usize,
+) -> Vec<BlockMeasure> {
+    spans
         .iter()
         .zip(hot_events)
-        .zip(&ranges)
+        .zip(ranges)
         .map(|((&span, hot_events), range)| {
             let seconds = (span.1 - span.0) as f64 * 1e-6;
             BlockMeasure {
@@ -328,12 +367,18 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
                 ..BlockMeasure::default()
             }
         })
-        .collect();
-    let mut last = vec![TimeUs::MIN; w * h];
-    for (b, range) in blocks.iter_mut().zip(&ranges) {
-        b.intervals = super::refractory::intervals(&clean, range.clone(), w, &mut last, None);
-    }
-    // every support window and radius on the pool (window-major, as `Isolation::index`)
+        .collect()
+}
+
+/// The isolated events and supported (ON, OFF) counts of each block ([`isolated`]) under
+/// every support window and radius, window-major as [`Isolation::index`], the supports
+/// measured in parallel.
+fn isolated_under_every_support(
+    m: &Measuring,
+    clean: &EventChunk,
+    spans: &[(TimeUs, TimeUs)],
+    kept: &[bool],
+) -> Vec<Vec<(Isolated, (u64, u64))>> {
     let nears: Vec<Near> = SUPPORT_WINDOWS_US
         .into_iter()
         .flat_map(|window| {
@@ -344,32 +389,21 @@ pub fn measure(m: &Measuring, spans: &[(TimeUs, TimeUs)]) -> Vec<BlockMeasure> {
             })
         })
         .collect();
-    let measured: Vec<Vec<(Isolated, (u64, u64))>> = nears
+    nears
         .par_iter()
         .map(|&near| {
             let support = crate::stats::support::supported_two_sided_within(
-                &clean,
+                clean,
                 m.sensor,
                 near.window,
                 near.radius,
             );
             spans
                 .iter()
-                .map(|&span| isolated(&clean, &support, span, near, &kept))
+                .map(|&span| isolated(clean, &support, span, near, kept))
                 .collect()
         })
-        .collect();
-    for (k, per_block) in measured.into_iter().enumerate() {
-        for (b, (isolated, signal)) in blocks.iter_mut().zip(per_block) {
-            b.isolated.push(isolated);
-            if k == 0 {
-                (b.signal_on, b.signal_off) = signal;
-                b.signal_rate_hz =
-                    (signal.0 + signal.1) as f64 / (kept_pixels as f64 * b.seconds.max(1e-9));
-            }
-        }
-    }
-    blocks
+        .collect()
 }
 
 /// The neighbourhood an event's support is looked for in.
