@@ -179,7 +179,18 @@ fn esim_flag(name: &str, value: impl std::fmt::Display) -> String {
 
 /// An ESIM flagfile.
 pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
-    let (exposure_ms, seed) = (setup.exposure_ms, setup.seed);
+    let mut lines = esim_header(setup);
+    lines.extend(esim_threshold_flags(p));
+    lines.extend(esim_response_flags(p, setup));
+    if let Some(missing) = esim_inexpressible(p) {
+        lines.push(missing);
+    }
+    lines.join("\n") + "\n"
+}
+
+/// The flagfile's opening comments: where it comes from, the sensor's size, the parameters
+/// the fits do not identify.
+fn esim_header(setup: &Setup) -> Vec<String> {
     let mut lines = vec![
         "# ESIM flagfile written by ctcal from a fit of the simulator to a recording".to_string(),
     ];
@@ -193,6 +204,13 @@ pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
             .lines()
             .map(str::to_string),
     );
+    lines
+}
+
+/// The thresholds, their mismatch (frozen per pixel in the fit, redrawn per event by ESIM)
+/// and the refractory period.
+fn esim_threshold_flags(p: &PixelParams) -> Vec<String> {
+    let mut lines = Vec::new();
     let sigma = p.ct_sigma.unwrap_or(0.0);
     lines.push(esim_flag(
         "contrast_threshold_pos",
@@ -219,6 +237,13 @@ pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
         "refractory_period_ns",
         (p.refractory_s.unwrap_or(0.0) * 1e9).round() as i64,
     ));
+    lines
+}
+
+/// The log response (ESIM's log(I + eps), the nearest to a lin-log fit), the frame
+/// exposure and the seed.
+fn esim_response_flags(p: &PixelParams, setup: &Setup) -> Vec<String> {
+    let mut lines = Vec::new();
     let eps = p.log_eps();
     match p.log_response() {
         crate::sim::LogResponse::Eps => {}
@@ -228,14 +253,20 @@ pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
     }
     lines.push(esim_flag("log_eps", eps));
     lines.push(esim_flag("use_log_image", true));
-    match exposure_ms {
+    match setup.exposure_ms {
         Some(e) => lines.push(esim_flag("exposure_time_ms", format!("{e:.3}"))),
         None => {
             lines.push("# the recording does not state its frame exposure".to_string());
             lines.push(esim_flag("exposure_time_ms", "0.0"));
         }
     }
-    lines.push(esim_flag("random_seed", seed));
+    lines.push(esim_flag("random_seed", setup.seed));
+    lines
+}
+
+/// The comment naming the fitted effects ESIM has no flag for (bandwidth, leak, shot
+/// noise, hot pixels, timestamp jitter) with their values, if any.
+fn esim_inexpressible(p: &PixelParams) -> Option<String> {
     let missing: Vec<String> = [
         (
             "photoreceptor bandwidth",
@@ -264,13 +295,12 @@ pub fn esim_flagfile(p: &PixelParams, setup: &Setup) -> String {
     .into_iter()
     .filter_map(|(what, value)| value.map(|v| format!("{what} ({v})")))
     .collect();
-    if !missing.is_empty() {
-        lines.push(format!(
+    (!missing.is_empty()).then(|| {
+        format!(
             "# ESIM cannot express: {} (use v2e or ctcal simulate for them)",
             missing.join(", ")
-        ));
-    }
-    lines.join("\n") + "\n"
+        )
+    })
 }
 
 /// ctcal's PARAMS.toml (read back by `ctcal simulate --params`).
