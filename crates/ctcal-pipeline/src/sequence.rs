@@ -109,6 +109,107 @@ impl crate::window::LoadObserver for Warnings<'_> {
     }
 }
 
+/// The seconds each stage of a sequence took, by stage name.
+struct Laps {
+    seconds: BTreeMap<String, f64>,
+    clock: Instant,
+}
+
+impl Laps {
+    fn start() -> Self {
+        Laps {
+            seconds: BTreeMap::new(),
+            clock: Instant::now(),
+        }
+    }
+
+    /// Records the time since the last lap (or the start) as stage `name`'s.
+    fn lap(&mut self, name: &str) {
+        self.seconds
+            .insert(name.to_string(), self.clock.elapsed().as_secs_f64());
+        self.clock = Instant::now();
+    }
+}
+
+/// The part of a recording a report reads: the options' start and end, at most
+/// `max_frames` frames.
+fn report_window(options: &Options) -> Window {
+    Window {
+        start_s: options.start_s,
+        end_s: options.end_s,
+        frames: Some(options.max_frames),
+        events_between_frames: false,
+    }
+}
+
+/// The recording read in `window`, its warnings passed on to `progress`.
+fn read(
+    input: &Input,
+    window: &Window,
+    options: &Options,
+    progress: &Observer,
+) -> Result<Loaded, SequenceError> {
+    Ok(load(
+        &input.path,
+        &Default::default(),
+        window,
+        &options.selection,
+        options.force,
+        &Warnings {
+            name: &input.name,
+            progress,
+        },
+    )?)
+}
+
+/// The window in blocks of consecutive frames, where it has two frames or more (or why
+/// they could not be read).
+///
+/// The frame-based methods (aps, fit) read the events between the first and last frame,
+/// in blocks of consecutive frames where the frames pass the limit (see
+/// `ctcal_io::frame_blocks`: their optical flow still holds), as `ctcal estimate aps`
+/// and `ctcal fit` read them, so that the report's numbers are theirs (from the events
+/// already read: the recording is decoded once).
+fn frame_blocks(loaded: &Loaded, window: &Window) -> Option<Result<Loaded, String>> {
+    (loaded.frames.len() >= 2)
+        .then(|| crate::window::load_blocks(loaded, window, &crate::window::Silent))
+        .map(|read| {
+            read.map_err(|e| format!("the blocks of consecutive frames could not be read: {e}"))
+        })
+}
+
+/// What the frame-based methods read: the blocks of frames where there are any, else the
+/// window as loaded; or why the blocks could not be read.
+fn framed_window<'a>(
+    loaded: &'a Loaded,
+    blocks: &'a Option<Result<Loaded, String>>,
+) -> Result<&'a Loaded, String> {
+    match blocks {
+        None => Ok(loaded),
+        Some(Ok(read)) => Ok(read),
+        Some(Err(why)) => Err(why.clone()),
+    }
+}
+
+/// The thresholds of the screen method, where it measured either: an on-screen
+/// recording's thresholds come from the screen method (measured through the display
+/// model), not from eppps's prior, where a fit has no frames to measure them.
+fn screen_thresholds(methods: &[MethodResult]) -> Option<&crate::estimate::CtEstimate> {
+    methods
+        .iter()
+        .find(|m| m.method == "screen")
+        .and_then(|m| m.estimate.as_ref())
+        .filter(|e| e.ct_on.is_some() || e.ct_off.is_some())
+}
+
+/// The recording's format as the report names it, with its layout where it has one.
+fn format_name(loaded: &Loaded) -> String {
+    match loaded.recording.layout() {
+        Some(layout) => format!("{} ({layout})", loaded.recording.format),
+        None => loaded.recording.format.to_string(),
+    }
+}
+
 /// Everything reported of one recording, and its per-pixel data; `progress` hears of each
 /// stage done and of what reading the recording warned of.
 pub fn sequence(
@@ -116,79 +217,36 @@ pub fn sequence(
     options: &Options,
     progress: &Observer,
 ) -> Result<(SequenceReport, PixelData), SequenceError> {
-    let mut seconds = BTreeMap::new();
-    let mut clock = Instant::now();
-    let mut lap = |name: &str, seconds: &mut BTreeMap<String, f64>| {
-        seconds.insert(name.to_string(), clock.elapsed().as_secs_f64());
-        clock = Instant::now();
-    };
-    let window = Window {
-        start_s: options.start_s,
-        end_s: options.end_s,
-        frames: Some(options.max_frames),
-        events_between_frames: false,
-    };
-    let loaded = load(
-        &input.path,
-        &Default::default(),
-        &window,
-        &options.selection,
-        options.force,
-        &Warnings {
-            name: &input.name,
-            progress,
-        },
-    )?;
-    // the frame-based methods (aps, fit) read the events between the first and last frame,
-    // in blocks of consecutive frames where the frames pass the limit (see
-    // `ctcal_io::frame_blocks`: their optical flow still holds), as `ctcal estimate aps`
-    // and `ctcal fit` read them, so that the report's numbers are theirs (from the events
-    // already read: the recording is decoded once)
-    let blocks = (loaded.frames.len() >= 2)
-        .then(|| crate::window::load_blocks(&loaded, &window, &crate::window::Silent))
-        .map(|read| {
-            read.map_err(|e| format!("the blocks of consecutive frames could not be read: {e}"))
-        });
-    let framed = match &blocks {
-        None => Ok(&loaded),
-        Some(Ok(read)) => Ok(read),
-        Some(Err(why)) => Err(why.clone()),
-    };
+    let mut laps = Laps::start();
+    let window = report_window(options);
+    let loaded = read(input, &window, options, progress)?;
+    let blocks = frame_blocks(&loaded, &window);
+    let framed = framed_window(&loaded, &blocks);
     let inputs = input_files(&loaded);
-    lap("reading", &mut seconds);
+    laps.lap("reading");
     progress(&input.name, Event::Done(Stage::Reading));
 
     let (mut stats, pixel_counts) = statistics(&loaded, &input.path)?;
     // the sensor biases saved in or beside the recording (as `ctcal stats` shows them)
     stats.biases = loaded.recording.biases();
-    lap("statistics", &mut seconds);
+    laps.lap("statistics");
     progress(&input.name, Event::Done(Stage::Statistics));
 
     let (methods, maps) = estimates(&loaded, framed.clone(), options)?;
-    lap("estimates", &mut seconds);
+    laps.lap("estimates");
     progress(&input.name, Event::Done(Stage::Estimates));
 
-    // an on-screen recording's thresholds come from the screen method (measured through
-    // the display model), not from eppps's prior, where a fit has no frames to measure them
-    let screen = methods
-        .iter()
-        .find(|m| m.method == "screen")
-        .and_then(|m| m.estimate.as_ref())
-        .filter(|e| e.ct_on.is_some() || e.ct_off.is_some());
     let (fit, fit_not_applied) = match framed {
-        Ok(framed) => fit_of(framed, options, screen),
-        Err(why) => (None, Some(why.clone())),
+        Ok(framed) => fit_of(framed, options, screen_thresholds(&methods)),
+        Err(why) => (None, Some(why)),
     };
-    lap("fit", &mut seconds);
+    laps.lap("fit");
     progress(&input.name, Event::Done(Stage::Fit));
     let report = SequenceReport {
         name: input.name.clone(),
         // named once every sequence's sensor is known (see `grouping`)
         dataset: String::new(),
-        format: match loaded.recording.layout() {
-            Some(layout) => format!("{} ({layout})", loaded.recording.format),
-            None => loaded.recording.format.to_string(),
-        },
+        format: format_name(&loaded),
         inputs,
         stats,
         methods,
@@ -197,7 +255,7 @@ pub fn sequence(
         truth: truth(&loaded.recording.path),
         warnings: loaded.notes.clone(),
         outputs: Default::default(),
-        seconds,
+        seconds: laps.seconds,
     };
     let pixels = PixelData {
         counts: pixel_counts,
