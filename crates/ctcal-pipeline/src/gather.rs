@@ -98,22 +98,24 @@ fn sequence_files(dir: &Path, s: &SequenceReport) -> Result<Vec<OutputFile>, Gat
         .collect()
 }
 
-/// The reports in `dirs` (report folders, or their `results.json`), in order.
-pub fn gather(dirs: &[PathBuf]) -> Result<Gathered, GatherError> {
-    let mut seed: Option<(u64, PathBuf)> = None;
-    let mut presets = Vec::new();
-    let mut outcomes = Vec::new();
-    let mut files = Vec::new();
-    let mut seen: BTreeMap<String, PathBuf> = BTreeMap::new();
-    for given in dirs {
+/// A report given to gather: its folder, its `results.json` and what that says.
+struct GivenReport {
+    dir: PathBuf,
+    results: PathBuf,
+    read: decode::Results,
+}
+
+impl GivenReport {
+    /// The report `given` (a report folder, or its `results.json`), read and decoded.
+    fn read(given: &Path) -> Result<Self, GatherError> {
         let (dir, results) = if given.is_dir() {
-            (given.clone(), given.join("results.json"))
+            (given.to_path_buf(), given.join("results.json"))
         } else {
             let parent = given.parent().unwrap_or(Path::new(".")).to_path_buf();
-            (parent, given.clone())
+            (parent, given.to_path_buf())
         };
         if !results.is_file() {
-            return Err(GatherError::NotAReport(given.clone()));
+            return Err(GatherError::NotAReport(given.to_path_buf()));
         }
         let bytes = read(&results)?;
         let json: serde_json::Value =
@@ -125,65 +127,121 @@ pub fn gather(dirs: &[PathBuf]) -> Result<Gathered, GatherError> {
             path: results.clone(),
             source,
         })?;
-        match &seed {
-            Some((ours, first)) if *ours != read.seed => {
-                return Err(GatherError::Seeds {
-                    path: results,
-                    theirs: read.seed,
-                    first: first.clone(),
-                    ours: *ours,
-                });
-            }
-            Some(_) => {}
-            None => {
-                seed = Some((read.seed, results.clone()));
-                presets = read.presets;
-            }
-        }
-        let mut claim = |name: &str| match seen.get(name) {
-            Some(first) => Err(GatherError::Twice {
-                name: name.to_string(),
-                first: first.clone(),
-                path: results.clone(),
-            }),
-            None => {
-                seen.insert(name.to_string(), results.clone());
-                Ok(())
-            }
-        };
-        for mut s in read.sequences {
-            claim(&s.name)?;
-            let own = sequence_files(&dir, &s)?;
-            if let Some(path) = decode::params_toml_path(&s).map(str::to_string)
-                && let Some(f) = own.iter().find(|f| f.path == path)
-            {
-                let text = String::from_utf8_lossy(&f.bytes).into_owned();
-                decode::restore_fit_model(&mut s, &text).map_err(|source| GatherError::Decode {
-                    path: dir.join(&path),
-                    source,
-                })?;
-            }
-            files.extend(own);
-            let input = Input {
-                path: s
-                    .inputs
-                    .first()
-                    .map_or_else(|| dir.clone(), |f| PathBuf::from(&f.path)),
-                name: s.name.clone(),
-                origin: Origin::Named(s.dataset.clone()),
-            };
-            outcomes.push((input, Ok(s)));
+        Ok(GivenReport { dir, results, read })
+    }
+}
+
+/// The reports gathered so far: the first one's seed (and where it is from) and presets,
+/// the sequences, their files, and which report each sequence's name came from.
+#[derive(Default)]
+struct Gathering {
+    seed: Option<(u64, PathBuf)>,
+    presets: Vec<PresetLevel>,
+    outcomes: Vec<(Input, Result<SequenceReport, String>)>,
+    files: Vec<OutputFile>,
+    seen: BTreeMap<String, PathBuf>,
+}
+
+impl Gathering {
+    /// Adds one report's sequences (with their files) and failed recordings.
+    fn add(&mut self, report: GivenReport) -> Result<(), GatherError> {
+        let GivenReport { dir, results, read } = report;
+        self.agree_on_seed(&results, read.seed, read.presets)?;
+        for s in read.sequences {
+            self.claim(&s.name, &results)?;
+            self.add_sequence(&dir, s)?;
         }
         for (name, path, error) in read.failed {
-            claim(&name)?;
+            self.claim(&name, &results)?;
             let input = Input {
                 path: PathBuf::from(path),
                 name,
                 origin: Origin::Named(String::new()),
             };
-            outcomes.push((input, Err(error)));
+            self.outcomes.push((input, Err(error)));
+        }
+        Ok(())
+    }
+
+    /// Refuses a report (its `results`) made with another seed than the first; the first
+    /// sets the seed and the presets.
+    fn agree_on_seed(
+        &mut self,
+        results: &Path,
+        seed: u64,
+        presets: Vec<PresetLevel>,
+    ) -> Result<(), GatherError> {
+        match &self.seed {
+            Some((ours, first)) if *ours != seed => Err(GatherError::Seeds {
+                path: results.to_path_buf(),
+                theirs: seed,
+                first: first.clone(),
+                ours: *ours,
+            }),
+            Some(_) => Ok(()),
+            None => {
+                self.seed = Some((seed, results.to_path_buf()));
+                self.presets = presets;
+                Ok(())
+            }
         }
     }
+
+    /// Refuses a sequence `name` an earlier report (or this one, `results`) already has.
+    fn claim(&mut self, name: &str, results: &Path) -> Result<(), GatherError> {
+        match self.seen.get(name) {
+            Some(first) => Err(GatherError::Twice {
+                name: name.to_string(),
+                first: first.clone(),
+                path: results.to_path_buf(),
+            }),
+            None => {
+                self.seen.insert(name.to_string(), results.to_path_buf());
+                Ok(())
+            }
+        }
+    }
+
+    /// Adds a sequence of the report folder `dir` with its files, its fit's model restored
+    /// from its params.toml.
+    fn add_sequence(&mut self, dir: &Path, mut s: SequenceReport) -> Result<(), GatherError> {
+        let own = sequence_files(dir, &s)?;
+        if let Some(path) = decode::params_toml_path(&s).map(str::to_string)
+            && let Some(f) = own.iter().find(|f| f.path == path)
+        {
+            let text = String::from_utf8_lossy(&f.bytes).into_owned();
+            decode::restore_fit_model(&mut s, &text).map_err(|source| GatherError::Decode {
+                path: dir.join(&path),
+                source,
+            })?;
+        }
+        self.files.extend(own);
+        let input = Input {
+            path: s
+                .inputs
+                .first()
+                .map_or_else(|| dir.to_path_buf(), |f| PathBuf::from(&f.path)),
+            name: s.name.clone(),
+            origin: Origin::Named(s.dataset.clone()),
+        };
+        self.outcomes.push((input, Ok(s)));
+        Ok(())
+    }
+}
+
+/// The reports in `dirs` (report folders, or their `results.json`), in order.
+pub fn gather(dirs: &[PathBuf]) -> Result<Gathered, GatherError> {
+    let mut gathering = Gathering::default();
+    for given in dirs {
+        gathering.add(GivenReport::read(given)?)?;
+    }
+    let Gathering {
+        seed,
+        presets,
+        outcomes,
+        files,
+        ..
+    } = gathering;
     let (seed, _) = seed.ok_or(GatherError::Nothing)?;
     Ok(Gathered {
         seed,
