@@ -330,91 +330,121 @@ fn pixel_counts(s: &SequenceReport, pixels: &PixelData) -> Plots {
 /// distributions of the recording and the models.
 fn fit_residuals(s: &SequenceReport) -> Plots {
     let mut plots = Vec::new();
-    let name = |what: &str| format!("{}/{what}", s.name);
     if let Some((f, residuals_before, residuals_after)) = s
         .fit
         .as_ref()
         .and_then(|f| Some((f, f.residuals_before.as_ref()?, f.residuals_after.as_ref()?)))
     {
-        // bins with too few events to say anything are left out
-        let points = |bins: &[crate::fit::residuals::Bin]| -> Vec<(f64, f64)> {
-            bins.iter()
-                .filter(|b| b.real + b.simulated >= MIN_RESIDUAL_EVENTS)
-                .map(|b| (b.x, b.log_ratio))
-                .collect()
-        };
-        let mut intensity = vec![(
-            "ideal model".to_string(),
-            points(&residuals_before.by_intensity),
-        )];
-        let mut change = vec![(
-            "ideal model".to_string(),
-            points(&residuals_before.by_rate_of_change),
-        )];
-        for step in f.steps.iter().filter(|st| st.kept) {
-            if let Some(after) = &step.residuals_after {
-                intensity.push((format!("+ {}", step.effect), points(&after.by_intensity)));
-                change.push((
-                    format!("+ {}", step.effect),
-                    points(&after.by_rate_of_change),
-                ));
-            }
-        }
-        plots.push(render(
-            name("fit_residuals"),
-            &format!("{}: the fit's residuals, ln(simulated / real) supported events, as each effect was added", s.name),
-            &Pair(
-                Lines {
-                    title: "by scene intensity".into(),
-                    x_label: "intensity (DN)".into(),
-                    y_label: "ln(simulated / real)".into(),
-                    log_x: true,
-                    series: intensity,
-                    zero: true,
-                },
-                Lines {
-                    title: "by rate of change".into(),
-                    x_label: "log-intensity change (1/s)".into(),
-                    y_label: "ln(simulated / real)".into(),
-                    log_x: true,
-                    series: change,
-                    zero: true,
-                },
-            ),
-        ));
-        let distribution = |label: &str, values: &[f64], starts: &[f64]| {
-            (
-                label.to_string(),
-                starts
-                    .iter()
-                    .zip(values)
-                    .skip(1)
-                    .map(|(&x, &y)| (x, y))
-                    .collect::<Vec<_>>(),
-            )
-        };
-        let (before, after) = (&residuals_before.intervals, &residuals_after.intervals);
-        plots.push(render(
-            name("intervals"),
-            &format!(
-                "{}: same-pixel inter-event intervals, recording against simulations",
-                s.name
-            ),
-            &Lines {
-                title: "Same-pixel inter-event intervals".into(),
-                x_label: "interval (s)".into(),
-                y_label: "share of intervals per bin".into(),
-                log_x: true,
-                series: over_the_data(vec![
-                    distribution("recording", &after.real, &after.bin_start_s),
-                    distribution("ideal model", &before.simulated, &before.bin_start_s),
-                    distribution("fitted model", &after.simulated, &after.bin_start_s),
-                ]),
-                zero: false,
-            },
-        ));
+        plots.push(residuals_by_effect(s, f, residuals_before));
+        plots.push(intervals(s, residuals_before, residuals_after));
     }
     plots
+}
+
+/// A series of residual bins, (x, ln(simulated / real)): bins with too few events to say
+/// anything are left out.
+fn supported_points(bins: &[crate::fit::residuals::Bin]) -> Vec<(f64, f64)> {
+    bins.iter()
+        .filter(|b| b.real + b.simulated >= MIN_RESIDUAL_EVENTS)
+        .map(|b| (b.x, b.log_ratio))
+        .collect()
+}
+
+/// The residuals by scene intensity and by rate of change: the ideal model's
+/// (`residuals_before`), then after each effect the fit kept.
+fn residuals_by_effect(
+    s: &SequenceReport,
+    f: &crate::fit::FitResult,
+    residuals_before: &crate::fit::residuals::Residuals,
+) -> Result<Plot, String> {
+    let mut intensity = vec![(
+        "ideal model".to_string(),
+        supported_points(&residuals_before.by_intensity),
+    )];
+    let mut change = vec![(
+        "ideal model".to_string(),
+        supported_points(&residuals_before.by_rate_of_change),
+    )];
+    for step in f.steps.iter().filter(|st| st.kept) {
+        if let Some(after) = &step.residuals_after {
+            intensity.push((
+                format!("+ {}", step.effect),
+                supported_points(&after.by_intensity),
+            ));
+            change.push((
+                format!("+ {}", step.effect),
+                supported_points(&after.by_rate_of_change),
+            ));
+        }
+    }
+    render(
+        format!("{}/fit_residuals", s.name),
+        &format!(
+            "{}: the fit's residuals, ln(simulated / real) supported events, as each effect was added",
+            s.name
+        ),
+        &Pair(
+            Lines {
+                title: "by scene intensity".into(),
+                x_label: "intensity (DN)".into(),
+                y_label: "ln(simulated / real)".into(),
+                log_x: true,
+                series: intensity,
+                zero: true,
+            },
+            Lines {
+                title: "by rate of change".into(),
+                x_label: "log-intensity change (1/s)".into(),
+                y_label: "ln(simulated / real)".into(),
+                log_x: true,
+                series: change,
+                zero: true,
+            },
+        ),
+    )
+}
+
+/// A share-per-bin distribution as a series: each bin's share at its lower edge (the
+/// first bin left out).
+fn distribution(label: &str, values: &[f64], starts: &[f64]) -> (String, Vec<(f64, f64)>) {
+    (
+        label.to_string(),
+        starts
+            .iter()
+            .zip(values)
+            .skip(1)
+            .map(|(&x, &y)| (x, y))
+            .collect::<Vec<_>>(),
+    )
+}
+
+/// The same-pixel interval distributions of the recording, the ideal model (`before`)
+/// and the fitted one (`after`).
+fn intervals(
+    s: &SequenceReport,
+    before: &crate::fit::residuals::Residuals,
+    after: &crate::fit::residuals::Residuals,
+) -> Result<Plot, String> {
+    let (before, after) = (&before.intervals, &after.intervals);
+    render(
+        format!("{}/intervals", s.name),
+        &format!(
+            "{}: same-pixel inter-event intervals, recording against simulations",
+            s.name
+        ),
+        &Lines {
+            title: "Same-pixel inter-event intervals".into(),
+            x_label: "interval (s)".into(),
+            y_label: "share of intervals per bin".into(),
+            log_x: true,
+            series: over_the_data(vec![
+                distribution("recording", &after.real, &after.bin_start_s),
+                distribution("ideal model", &before.simulated, &before.bin_start_s),
+                distribution("fitted model", &after.simulated, &after.bin_start_s),
+            ]),
+            zero: false,
+        },
+    )
 }
 
 #[cfg(test)]
