@@ -175,10 +175,7 @@ const MAX_EXPOSURE_US: i64 = 10_000_000;
 /// microseconds. Errors name `file` and the JSON path of the bad value (`prefix` is where
 /// the fit lies in the file, e.g. `sequences[0].fit.`).
 fn validate_fit_json(fit: &serde_json::Value, file: &str, prefix: &str) -> Result<()> {
-    let bad = |path: &str, problem: String, fix: &str| {
-        FitSetError(format!("{file}: `{prefix}{path}` {problem}\n  fix: {fix}"))
-    };
-    const UNEDITED: &str = "give an unedited `ctcal fit` result (or correct this value)";
+    let place = Place { file, prefix };
     let Some(params) = fit.get("params") else {
         return Err(FitSetError(format!(
             "{file}: {}has no `params` (not a `ctcal fit` result)\n  fix: give a `ctcal fit` result (its JSON) or a report folder",
@@ -189,14 +186,49 @@ fn validate_fit_json(fit: &serde_json::Value, file: &str, prefix: &str) -> Resul
             }
         )));
     };
-    let describe = |v: &serde_json::Value| match v {
+    for (key, value) in param_values(params, &place)? {
+        plausible_param(fit, &key, value, &place)?;
+    }
+    plausible_exposure(fit, &place)
+}
+
+/// Where a fit lies: its `file` and the JSON path (`prefix`) inside it.
+struct Place<'a> {
+    file: &'a str,
+    prefix: &'a str,
+}
+
+/// What to do about a value that is not what a fit writes.
+const UNEDITED: &str = "give an unedited `ctcal fit` result (or correct this value)";
+
+impl Place<'_> {
+    /// The value at `path` (below the fit) refused: its `problem` and the `fix`.
+    fn bad(&self, path: &str, problem: String, fix: &str) -> FitSetError {
+        FitSetError(format!(
+            "{}: `{}{path}` {problem}\n  fix: {fix}",
+            self.file, self.prefix
+        ))
+    }
+}
+
+/// A JSON value as an error message names it.
+fn describe(v: &serde_json::Value) -> String {
+    match v {
         serde_json::Value::Array(_) => "a list".to_string(),
         serde_json::Value::Object(_) => "an object".to_string(),
         serde_json::Value::String(s) => format!("the string {s:?}"),
         other => other.to_string(),
-    };
+    }
+}
+
+/// Every value of a fit's `params`, by key (the `display` table's as `display.KEY`);
+/// refused where `params` or its display is no object.
+fn param_values<'a>(
+    params: &'a serde_json::Value,
+    place: &Place,
+) -> Result<Vec<(String, &'a serde_json::Value)>> {
     let Some(object) = params.as_object() else {
-        return Err(bad(
+        return Err(place.bad(
             "params",
             format!(
                 "is {}; a fit's parameters are an object of PARAMS.toml keys",
@@ -209,7 +241,7 @@ fn validate_fit_json(fit: &serde_json::Value, file: &str, prefix: &str) -> Resul
     for (key, value) in object {
         if key == "display" {
             let Some(display) = value.as_object() else {
-                return Err(bad(
+                return Err(place.bad(
                     "params.display",
                     format!("is {}; the display is an object", describe(value)),
                     UNEDITED,
@@ -220,47 +252,59 @@ fn validate_fit_json(fit: &serde_json::Value, file: &str, prefix: &str) -> Resul
             values.push((key.clone(), value));
         }
     }
-    for (key, value) in values {
-        let Some(&(_, max)) = PLAUSIBLE.iter().find(|(k, _)| *k == key) else {
-            continue;
-        };
-        let path = format!("params.{key}");
-        // a parameter the fit says it does not identify is null, with its reason
-        if value.is_null() && fit["why"][key.as_str()].is_string() {
-            continue;
-        }
-        let Some(v) = value.as_f64() else {
-            return Err(bad(
-                &path,
-                format!("is {}, not a number", describe(value)),
-                UNEDITED,
-            ));
-        };
-        if !(v.is_finite() && v.abs() <= max) {
-            return Err(bad(
-                &path,
-                format!("is {v:e}, beyond any camera (at most {max:e} in magnitude)"),
-                UNEDITED,
-            ));
-        }
+    Ok(values)
+}
+
+/// Refuses a numeric parameter `key` of the fit that is no number or beyond
+/// [`PLAUSIBLE`]; keys it does not list pass, as does a null the fit gives its reason for.
+fn plausible_param(
+    fit: &serde_json::Value,
+    key: &str,
+    value: &serde_json::Value,
+    place: &Place,
+) -> Result<()> {
+    let Some(&(_, max)) = PLAUSIBLE.iter().find(|(k, _)| *k == key) else {
+        return Ok(());
+    };
+    let path = format!("params.{key}");
+    // a parameter the fit says it does not identify is null, with its reason
+    if value.is_null() && fit["why"][key].is_string() {
+        return Ok(());
     }
-    match fit.get("frame_exposure_us") {
-        None | Some(serde_json::Value::Null) => {}
-        Some(value) => match value.as_i64() {
-            Some(us) if us > 0 && us <= MAX_EXPOSURE_US => {}
-            _ => {
-                return Err(bad(
-                    "frame_exposure_us",
-                    format!(
-                        "is {}; an exposure is a whole number of microseconds, 1..={MAX_EXPOSURE_US}",
-                        describe(value)
-                    ),
-                    UNEDITED,
-                ));
-            }
-        },
+    let Some(v) = value.as_f64() else {
+        return Err(place.bad(
+            &path,
+            format!("is {}, not a number", describe(value)),
+            UNEDITED,
+        ));
+    };
+    if !(v.is_finite() && v.abs() <= max) {
+        return Err(place.bad(
+            &path,
+            format!("is {v:e}, beyond any camera (at most {max:e} in magnitude)"),
+            UNEDITED,
+        ));
     }
     Ok(())
+}
+
+/// Refuses a `frame_exposure_us` that is not a whole number of microseconds in
+/// 1..=[`MAX_EXPOSURE_US`] (none, or null, passes).
+fn plausible_exposure(fit: &serde_json::Value, place: &Place) -> Result<()> {
+    match fit.get("frame_exposure_us") {
+        None | Some(serde_json::Value::Null) => Ok(()),
+        Some(value) => match value.as_i64() {
+            Some(us) if us > 0 && us <= MAX_EXPOSURE_US => Ok(()),
+            _ => Err(place.bad(
+                "frame_exposure_us",
+                format!(
+                    "is {}; an exposure is a whole number of microseconds, 1..={MAX_EXPOSURE_US}",
+                    describe(value)
+                ),
+                UNEDITED,
+            )),
+        },
+    }
 }
 
 /// The parameters of one fit result in `file`, at JSON path `prefix` (`place` names it in
