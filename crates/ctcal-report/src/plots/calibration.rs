@@ -4,6 +4,7 @@
 use super::style::*;
 use super::{DrawResult, FONT, Figure, err};
 use plotters::coord::Shift;
+use plotters::coord::combinators::WithKeyPoints;
 use plotters::prelude::*;
 use std::fmt::Write as _;
 
@@ -23,8 +24,57 @@ pub(super) struct Calibration {
     pub(super) estimate: f64,
 }
 
+/// The chart of the calibration curve: threshold across, events per pixel per second up,
+/// both log.
+type CalibrationChart<'a, DB> =
+    ChartContext<'a, DB, Cartesian2d<WithKeyPoints<LogCoord<f64>>, WithKeyPoints<LogCoord<f64>>>>;
+
+/// The thresholds across, the calibration's range.
+const CT_RANGE: std::ops::Range<f64> = 0.07..2.2;
+
 impl Figure for Calibration {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
+        let mut chart = self.axes(root)?;
+        self.draw_simulated(&mut chart)?;
+        self.draw_recording(&mut chart)?;
+        let curve: Vec<(f64, f64)> = self
+            .curve
+            .iter()
+            .map(|p| (p.ct, p.events_per_pixel_per_second))
+            .collect();
+        let data = [
+            curve,
+            vec![
+                (CT_RANGE.start, self.recording),
+                (CT_RANGE.end, self.recording),
+            ],
+            vec![(self.estimate, self.recording)],
+        ];
+        draw_legend(&mut chart, 14, &data)?;
+        Ok(())
+    }
+
+    fn csv(&self) -> String {
+        let mut out = String::from("ct,events_per_pixel_per_second,lo,hi\n");
+        for p in &self.curve {
+            let _ = writeln!(
+                out,
+                "{},{},{},{}",
+                p.ct, p.events_per_pixel_per_second, p.lo, p.hi
+            );
+        }
+        let _ = writeln!(out, "{},{},,", self.estimate, self.recording);
+        out
+    }
+}
+
+impl Calibration {
+    /// The chart with its caption and axes drawn: the thresholds across, a log axis up
+    /// spanning the curve's range and the recording's rate.
+    fn axes<'a, DB: DrawingBackend>(
+        &self,
+        root: &'a DrawingArea<DB, Shift>,
+    ) -> Result<CalibrationChart<'a, DB>, String> {
         let values = self
             .curve
             .iter()
@@ -38,7 +88,7 @@ impl Figure for Calibration {
             .margin(px(12))
             .x_label_area_size(px(45))
             .y_label_area_size(px(70))
-            .build_cartesian_2d(log_axis(0.07f64..2.2), log_axis(log_range(values)))
+            .build_cartesian_2d(log_axis(CT_RANGE), log_axis(log_range(values)))
             .map_err(err)?;
         chart
             .configure_mesh()
@@ -50,6 +100,14 @@ impl Figure for Calibration {
             .label_style((FONT, px(14)))
             .draw()
             .map_err(err)?;
+        Ok(chart)
+    }
+
+    /// The simulated curve: its range over the scenes as a band, its mean as a line.
+    fn draw_simulated<DB: DrawingBackend>(
+        &self,
+        chart: &mut CalibrationChart<'_, DB>,
+    ) -> DrawResult {
         let band: Vec<(f64, f64)> = self
             .curve
             .iter()
@@ -75,9 +133,21 @@ impl Figure for Calibration {
                     SIMULATED.stroke_width(px(2)),
                 )
             });
+        Ok(())
+    }
+
+    /// The recording's rate as a line across, the estimate as a dot where it meets the
+    /// curve.
+    fn draw_recording<DB: DrawingBackend>(
+        &self,
+        chart: &mut CalibrationChart<'_, DB>,
+    ) -> DrawResult {
         chart
             .draw_series(LineSeries::new(
-                [(0.07, self.recording), (2.2, self.recording)],
+                [
+                    (CT_RANGE.start, self.recording),
+                    (CT_RANGE.end, self.recording),
+                ],
                 RECORDING.stroke_width(px(2)),
             ))
             .map_err(err)?
@@ -97,30 +167,6 @@ impl Figure for Calibration {
             .map_err(err)?
             .label(format!("estimate CT {:.3}", self.estimate))
             .legend(|(x, y)| Circle::new((x + px(10) as i32, y), px(5), RECORDING.filled()));
-        let curve: Vec<(f64, f64)> = self
-            .curve
-            .iter()
-            .map(|p| (p.ct, p.events_per_pixel_per_second))
-            .collect();
-        let data = [
-            curve,
-            vec![(0.07, self.recording), (2.2, self.recording)],
-            vec![(self.estimate, self.recording)],
-        ];
-        draw_legend(&mut chart, 14, &data)?;
         Ok(())
-    }
-
-    fn csv(&self) -> String {
-        let mut out = String::from("ct,events_per_pixel_per_second,lo,hi\n");
-        for p in &self.curve {
-            let _ = writeln!(
-                out,
-                "{},{},{},{}",
-                p.ct, p.events_per_pixel_per_second, p.lo, p.hi
-            );
-        }
-        let _ = writeln!(out, "{},{},,", self.estimate, self.recording);
-        out
     }
 }
