@@ -44,72 +44,97 @@ pub(crate) fn table(name: &'static str, caption: &'static str, columns: Vec<Colu
 
 /// One row per sequence: its statistics.
 pub fn statistics(sequences: &[&SequenceReport]) -> Table {
-    let s = |f: &dyn Fn(&SequenceReport) -> Option<f64>| -> Vec<Option<f64>> {
-        sequences.iter().map(|q| f(q)).collect()
-    };
-    table(
-        "statistics",
-        "Event statistics of each sequence",
-        vec![
-            strings(
-                "sequence",
-                sequences.iter().map(|q| q.name.clone()).collect(),
-            ),
-            strings(
-                "dataset",
-                sequences.iter().map(|q| q.dataset.clone()).collect(),
-            ),
-            strings(
-                "sensor",
-                sequences
-                    .iter()
-                    .map(|q| format!("{}x{}", q.stats.width, q.stats.height))
-                    .collect(),
-            ),
-            counts(
-                "events",
-                sequences.iter().map(|q| Some(q.stats.events)).collect(),
-            ),
-            floats("duration_s", s(&|q| Some(q.stats.duration_s))),
-            floats(
-                "events_per_pixel_per_second",
-                s(&|q| q.stats.events_per_pixel_per_second),
-            ),
-            floats(
-                "on_per_pixel_per_second",
-                s(&|q| q.stats.on_per_pixel_per_second),
-            ),
-            floats(
-                "off_per_pixel_per_second",
-                s(&|q| q.stats.off_per_pixel_per_second),
-            ),
-            floats("on_fraction", s(&|q| Some(q.stats.on_fraction))),
-            floats(
-                "active_pixel_fraction",
-                s(&|q| Some(q.stats.active_pixel_fraction)),
-            ),
-            floats("background_rate_hz", s(&|q| q.stats.background_rate_hz)),
-            counts(
-                "hot_pixels",
-                sequences
-                    .iter()
-                    .map(|q| Some(q.stats.hot_pixels.len() as u64))
-                    .collect(),
-            ),
-            floats("interval_p5_s", s(&|q| q.stats.inter_event_interval_s.p5)),
-            floats(
-                "interval_median_s",
-                s(&|q| q.stats.inter_event_interval_s.median),
-            ),
-            counts(
-                "frames",
-                sequences
-                    .iter()
-                    .map(|q| q.stats.frames.as_ref().map(|f| f.count as u64))
-                    .collect(),
-            ),
-        ],
-    )
+    let mut columns = naming_columns(sequences);
+    columns.extend(rate_columns(sequences));
+    columns.extend(pixel_interval_frame_columns(sequences));
+    table("statistics", "Event statistics of each sequence", columns)
+}
+
+/// A float of each sequence.
+fn per_sequence(
+    sequences: &[&SequenceReport],
+    f: &dyn Fn(&SequenceReport) -> Option<f64>,
+) -> Vec<Option<f64>> {
+    sequences.iter().map(|q| f(q)).collect()
+}
+
+/// The statistics' columns that name each sequence: its name, dataset and sensor.
+fn naming_columns(sequences: &[&SequenceReport]) -> Vec<Column> {
+    vec![
+        strings(
+            "sequence",
+            sequences.iter().map(|q| q.name.clone()).collect(),
+        ),
+        strings(
+            "dataset",
+            sequences.iter().map(|q| q.dataset.clone()).collect(),
+        ),
+        strings(
+            "sensor",
+            sequences
+                .iter()
+                .map(|q| format!("{}x{}", q.stats.width, q.stats.height))
+                .collect(),
+        ),
+    ]
+}
+
+/// The statistics' columns of events and their rates: count, duration, rates per pixel
+/// (both polarities, ON, OFF), ON fraction, active pixels, background rate.
+fn rate_columns(sequences: &[&SequenceReport]) -> Vec<Column> {
+    let s = |f: &dyn Fn(&SequenceReport) -> Option<f64>| per_sequence(sequences, f);
+    vec![
+        counts(
+            "events",
+            sequences.iter().map(|q| Some(q.stats.events)).collect(),
+        ),
+        floats("duration_s", s(&|q| Some(q.stats.duration_s))),
+        floats(
+            "events_per_pixel_per_second",
+            s(&|q| q.stats.events_per_pixel_per_second),
+        ),
+        floats(
+            "on_per_pixel_per_second",
+            s(&|q| q.stats.on_per_pixel_per_second),
+        ),
+        floats(
+            "off_per_pixel_per_second",
+            s(&|q| q.stats.off_per_pixel_per_second),
+        ),
+        floats("on_fraction", s(&|q| Some(q.stats.on_fraction))),
+        floats(
+            "active_pixel_fraction",
+            s(&|q| Some(q.stats.active_pixel_fraction)),
+        ),
+        floats("background_rate_hz", s(&|q| q.stats.background_rate_hz)),
+    ]
+}
+
+/// The statistics' last columns: hot pixels, the same-pixel intervals' 5th percentile and
+/// median, frames.
+fn pixel_interval_frame_columns(sequences: &[&SequenceReport]) -> Vec<Column> {
+    let s = |f: &dyn Fn(&SequenceReport) -> Option<f64>| per_sequence(sequences, f);
+    vec![
+        counts(
+            "hot_pixels",
+            sequences
+                .iter()
+                .map(|q| Some(q.stats.hot_pixels.len() as u64))
+                .collect(),
+        ),
+        floats("interval_p5_s", s(&|q| q.stats.inter_event_interval_s.p5)),
+        floats(
+            "interval_median_s",
+            s(&|q| q.stats.inter_event_interval_s.median),
+        ),
+        counts(
+            "frames",
+            sequences
+                .iter()
+                .map(|q| q.stats.frames.as_ref().map(|f| f.count as u64))
+                .collect(),
+        ),
+    ]
 }
 
 /// One row per sequence and method: thresholds with their 95 % intervals, and the truth.
