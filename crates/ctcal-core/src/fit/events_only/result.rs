@@ -55,73 +55,100 @@ pub(super) struct Parts<'a> {
     pub frames_unused: Option<String>,
 }
 
+/// The result in stages: the parameters, the test errors, the details, then the
+/// assumptions (the test errors' and the hot pixels' last).
 pub(super) fn result(parts: Parts) -> FitResult {
-    let Parts {
-        input,
-        options,
-        blocks,
-        judging,
-        run,
-        thresholds,
-        steps,
-        model,
-        frames_unused,
-    } = parts;
-    let kept = |name: &str| steps.iter().any(|s| s.effect == name && s.kept);
+    let kept = |name: &str| parts.steps.iter().any(|s| s.effect == name && s.kept);
+    let parameters = parameters(
+        &parts.run,
+        &parts.thresholds,
+        &kept,
+        parts.frames_unused.as_deref(),
+    );
+    let test = test_blocks(
+        parts.input,
+        parts.blocks,
+        parts.judging,
+        &parts.run,
+        parts.options,
+    );
+    let errors = test_errors(&test, &parts.model);
+    let events_only = details(
+        &parts.run,
+        &parts.thresholds,
+        parts.judging,
+        kept("thresholds"),
+    );
+    let mut assumptions = assumptions(
+        &parts.run,
+        &parts.thresholds,
+        parts.blocks,
+        parts.judging,
+        parts.options,
+        parts.frames_unused.as_deref(),
+    );
+    assumptions.push(test_errors_note(&errors));
+    if !parameters.hot.is_empty() {
+        assumptions.push(hot_pixels_note(parameters.hot.len()));
+    }
+    assembled(parts, parameters, errors, events_only, assumptions)
+}
+
+/// How the test errors were measured: simulated back, or (`why` not) from the parameters.
+fn test_errors_note(errors: &TestErrors) -> String {
+    let (predicted_before, predicted_after) = (errors.predicted_before, errors.predicted_after);
+    match &errors.why {
+        None => format!(
+            "error_before and error_after: the ideal pixel and the final model simulated back onto the test blocks' supported events (the scene as recorded) and measured like the recording (isolated rates, hot pixels); intervals and balance from the model's parameters. Read from the parameters alone they are {predicted_before:.4} and {predicted_after:.4}"
+        ),
+        Some(why) => format!(
+            "error_before and error_after from the model's parameters, not simulated back: {why}"
+        ),
+    }
+}
+
+/// How the `named` hot pixels were found and measured.
+fn hot_pixels_note(named: usize) -> String {
+    format!(
+        "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms); hot_pixel_fraction counts each 1 / the search's detection probability at its rate (Horvitz-Thompson, at least 1/2; Garwood's exact Poisson interval of the count); hot_pixel_rate_hz is the median of their rates beyond their 8 neighbours' median, its interval the median's order-statistic one (the pixels' Poisson errors where too few are named), reaching down to the rate the search names at 10 % of the pixels where it names that median at under 90 %; without frames no model of the scene at each pixel is simulated, so no count outliers of the model's own (a low threshold under mismatch) are subtracted",
+        named
+    )
+}
+
+/// The result from its stages: the parameters, the test errors (the parameters' reading
+/// of them joins the details) and the assumptions.
+fn assembled(
+    parts: Parts,
+    parameters: Parameters,
+    errors: TestErrors,
+    mut events_only: EventsOnly,
+    assumptions: Vec<String>,
+) -> FitResult {
     let Parameters {
         params,
         why,
         uncertainties,
         hot,
-    } = parameters(&run, &thresholds, &kept, frames_unused.as_deref());
-    let TestErrors {
-        before,
-        after,
-        predicted_before,
-        predicted_after,
-        why: not_simulated,
-    } = test_errors(&test_blocks(input, blocks, judging, &run, options), &model);
-    let identified = crate::fit::identified(&params, &why);
-    let mut events_only = details(&run, &thresholds, judging, kept("thresholds"));
-    events_only.predicted_error_before = predicted_before;
-    events_only.predicted_error_after = predicted_after;
-    let mut assumptions = assumptions(
-        &run,
-        &thresholds,
-        blocks,
-        judging,
-        options,
-        frames_unused.as_deref(),
-    );
-    assumptions.push(match &not_simulated {
-        None => format!(
-            "error_before and error_after: the ideal pixel and the final model simulated back onto the test blocks' supported events (the scene as recorded) and measured like the recording (isolated rates, hot pixels); intervals and balance from the model's parameters. Read from the parameters alone they are {predicted_before:.4} and {predicted_after:.4}"
-        ),
-        Some(why) => format!("error_before and error_after from the model's parameters, not simulated back: {why}"),
-    });
-    events_only.simulated_back_why = not_simulated;
-    if !hot.is_empty() {
-        assumptions.push(format!(
-            "hot pixels: {} named on the fit blocks (robust z against the busiest neighbour, their excess showing also where no neighbour fires within 30 ms); hot_pixel_fraction counts each 1 / the search's detection probability at its rate (Horvitz-Thompson, at least 1/2; Garwood's exact Poisson interval of the count); hot_pixel_rate_hz is the median of their rates beyond their 8 neighbours' median, its interval the median's order-statistic one (the pixels' Poisson errors where too few are named), reaching down to the rate the search names at 10 % of the pixels where it names that median at under 90 %; without frames no model of the scene at each pixel is simulated, so no count outliers of the model's own (a low threshold under mismatch) are subtracted",
-            hot.len()
-        ));
-    }
+    } = parameters;
+    events_only.predicted_error_before = errors.predicted_before;
+    events_only.predicted_error_after = errors.predicted_after;
+    events_only.simulated_back_why = errors.why;
     FitResult {
         biases: None,
+        identified: crate::fit::identified(&params, &why),
         params: FittedParams {
             model: params,
             not_identified: why.clone(),
         },
-        identified,
         why,
         uncertainties,
-        effects_added: added(&steps),
+        effects_added: added(&parts.steps),
         error_metric: ERROR_METRIC,
-        error_before: before.total,
-        error_after: after.total,
-        components_before: before,
-        components_after: after,
-        steps,
+        error_before: errors.before.total,
+        error_after: errors.after.total,
+        components_before: errors.before,
+        components_after: errors.after,
+        steps: parts.steps,
         ambiguities: Vec::new(),
         hot_pixels_masked: hot,
         hot_pixel_detection: None,
@@ -130,7 +157,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
         residuals_before: None,
         residuals_after: None,
         assumptions,
-        holdout: holdout(blocks, options),
+        holdout: holdout(parts.blocks, parts.options),
         simulations: 0,
         frame_exposure_us: None,
         events_only: Some(events_only),
@@ -603,6 +630,8 @@ fn details(
     }
 }
 
+/// Every assumption but the test errors' and the hot pixels': the thresholds' source
+/// and its own, the method's, the noise bound's, a distance without intervals.
 fn assumptions(
     run: &FitRun,
     thresholds: &Result<CtEstimate, String>,
@@ -623,8 +652,25 @@ fn assumptions(
                 .map(|a| format!("  {} : {a}", e.method)),
         );
     }
+    out.extend(method_assumptions(run, blocks, options, frames_unused));
+    out.extend(noise_bound_note(run));
+    if judging.reference.edge_us.is_none() {
+        out.push("too few same-pixel intervals for the interval component of the distance".into());
+    }
+    out
+}
+
+/// What a fit without frames assumes whatever it finds: the scene not simulated, the
+/// isolated events' support, the noise's polarities and brightness, the balance, the
+/// blocks and the keep rule.
+fn method_assumptions(
+    run: &FitRun,
+    blocks: &Blocks,
+    options: &FitOptions,
+    frames_unused: Option<&str>,
+) -> [String; 7] {
     let seconds = |r| blocks.seconds(&blocks.of(r));
-    out.extend([
+    [
         format!(
             "{}: the scene is not simulated; the pixel's own effects are measured from the events and checked as a noise model on held-out blocks",
             frames_unused.map_or("no grey frames".to_string(), |why| format!("grey frames not used ({why})"))
@@ -653,14 +699,18 @@ fn assumptions(
             "an effect is kept when its error on the selection blocks falls by more than twice the chance spread of the per-block relative fall (fit blocks, over sqrt of the selection blocks), and by at least {:.0} %",
             100.0 * PARSIMONY
         ),
-    ]);
-    match run.noise_bound {
-        Some(UpperBound::StillFalling) => out.push(format!(
+    ]
+}
+
+/// Why the noise rates are upper bounds ([`UpperBound`]), where they are.
+fn noise_bound_note(run: &FitRun) -> Option<String> {
+    match run.noise_bound? {
+        UpperBound::StillFalling => Some(format!(
             "the isolated-event rate was still falling as the support grew ({} ms, {} px) when the scene's events left too little quiet time or the widest neighbourhood was reached: part of the isolated events are the scene's own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
             run.isolation.window_us() / 1000,
             run.isolation.radius_px()
         )),
-        Some(UpperBound::Unconfirmed { quiet_share }) => out.push(format!(
+        UpperBound::Unconfirmed { quiet_share } => Some(format!(
             "the scene left {:.2} % of the pixel time quiet (below {:.0} %; noise alone keeps quiet pixels, uncovered half the time, on most of the sensor under this support up to {:.2} Hz a pixel, ON + OFF, and leaves under a tenth of the time quiet at 1.2-1.6 times that) and no wider support kept enough of it to check the isolated-event rate ({} ms, {} px): the quiet pixels are where the scene's activity thins out and their isolated events may be its own, so the shot-noise (and leak) rates are upper bounds, their intervals reaching down to none",
             100.0 * quiet_share,
             100.0 * CONFIRMING_QUIET_SHARE,
@@ -668,12 +718,7 @@ fn assumptions(
             run.isolation.window_us() / 1000,
             run.isolation.radius_px()
         )),
-        None => {}
     }
-    if judging.reference.edge_us.is_none() {
-        out.push("too few same-pixel intervals for the interval component of the distance".into());
-    }
-    out
 }
 
 fn holdout(blocks: &Blocks, options: &FitOptions) -> Holdout {
