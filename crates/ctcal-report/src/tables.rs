@@ -137,56 +137,13 @@ fn pixel_interval_frame_columns(sequences: &[&SequenceReport]) -> Vec<Column> {
     ]
 }
 
+/// A row of `thresholds`: sequence, method and [ct_on, its interval's ends, ct_off, its
+/// interval's ends, ct_sigma, the true ct_on, the true ct_off].
+type ThresholdRow = (String, String, [Option<f64>; 9]);
+
 /// One row per sequence and method: thresholds with their 95 % intervals, and the truth.
 pub fn thresholds(sequences: &[&SequenceReport]) -> Table {
-    let mut rows: Vec<(String, String, [Option<f64>; 9])> = Vec::new();
-    for q in sequences {
-        let truth = |k: &str| q.truth.as_ref().and_then(|t| t.params.get(k).copied());
-        for m in &q.methods {
-            if let Some(e) = &m.estimate {
-                rows.push((
-                    q.name.clone(),
-                    m.method.to_string(),
-                    [
-                        e.ct_on,
-                        e.ct_on_ci95.and_then(|c| c[0]),
-                        e.ct_on_ci95.and_then(|c| c[1]),
-                        e.ct_off,
-                        e.ct_off_ci95.and_then(|c| c[0]),
-                        e.ct_off_ci95.and_then(|c| c[1]),
-                        e.ct_sigma,
-                        truth("ct_on"),
-                        truth("ct_off"),
-                    ],
-                ));
-            }
-        }
-        if let Some(f) = &q.fit {
-            // thresholds the recording does not identify are empty, not start values
-            let fitted = q.fitted_thresholds();
-            let (on, off) = (fitted.map(|t| t.0), fitted.map(|t| t.1));
-            let side = |key: &str, v: Option<f64>, upper: bool| {
-                v.and(f.uncertainties.get(key))
-                    .and_then(|u| u.interval())
-                    .and_then(|c| c[usize::from(upper)])
-            };
-            rows.push((
-                q.name.clone(),
-                "fit".into(),
-                [
-                    on,
-                    side("ct_on", on, false),
-                    side("ct_on", on, true),
-                    off,
-                    side("ct_off", off, false),
-                    side("ct_off", off, true),
-                    f.params.ct_sigma,
-                    truth("ct_on"),
-                    truth("ct_off"),
-                ],
-            ));
-        }
-    }
+    let rows: Vec<ThresholdRow> = sequences.iter().flat_map(|q| threshold_rows(q)).collect();
     let column = |k: usize| -> Vec<Option<f64>> { rows.iter().map(|r| r.2[k]).collect() };
     table(
         "thresholds",
@@ -205,6 +162,67 @@ pub fn thresholds(sequences: &[&SequenceReport]) -> Table {
             floats("true_ct_off", column(8)),
         ],
     )
+}
+
+/// The true value of parameter `key`, where the recording carries its truth.
+fn true_param(q: &SequenceReport, key: &str) -> Option<f64> {
+    q.truth.as_ref().and_then(|t| t.params.get(key).copied())
+}
+
+/// A sequence's rows of `thresholds`: each method's estimate, then the fit's.
+fn threshold_rows(q: &SequenceReport) -> Vec<ThresholdRow> {
+    let mut rows: Vec<ThresholdRow> = q
+        .methods
+        .iter()
+        .filter_map(|m| {
+            let e = m.estimate.as_ref()?;
+            Some((
+                q.name.clone(),
+                m.method.to_string(),
+                [
+                    e.ct_on,
+                    e.ct_on_ci95.and_then(|c| c[0]),
+                    e.ct_on_ci95.and_then(|c| c[1]),
+                    e.ct_off,
+                    e.ct_off_ci95.and_then(|c| c[0]),
+                    e.ct_off_ci95.and_then(|c| c[1]),
+                    e.ct_sigma,
+                    true_param(q, "ct_on"),
+                    true_param(q, "ct_off"),
+                ],
+            ))
+        })
+        .collect();
+    rows.extend(fit_threshold_row(q));
+    rows
+}
+
+/// The fit's row of `thresholds`, where the sequence has a fit: thresholds the recording
+/// does not identify are empty, not start values.
+fn fit_threshold_row(q: &SequenceReport) -> Option<ThresholdRow> {
+    let f = q.fit.as_ref()?;
+    let fitted = q.fitted_thresholds();
+    let (on, off) = (fitted.map(|t| t.0), fitted.map(|t| t.1));
+    let side = |key: &str, v: Option<f64>, upper: bool| {
+        v.and(f.uncertainties.get(key))
+            .and_then(|u| u.interval())
+            .and_then(|c| c[usize::from(upper)])
+    };
+    Some((
+        q.name.clone(),
+        "fit".into(),
+        [
+            on,
+            side("ct_on", on, false),
+            side("ct_on", on, true),
+            off,
+            side("ct_off", off, false),
+            side("ct_off", off, true),
+            f.params.ct_sigma,
+            true_param(q, "ct_on"),
+            true_param(q, "ct_off"),
+        ],
+    ))
 }
 
 /// One row per sequence and fitted parameter.
