@@ -67,6 +67,17 @@ fn thresholds(r: &RunRecord) -> (f64, f64) {
 
 /// Every group the records have members in.
 pub fn groups(records: &[RunRecord]) -> Vec<Group> {
+    let mut all = kind_groups();
+    all.extend(effect_groups(records));
+    all.extend(prior_scope_groups());
+    all.extend(light_and_speed_groups());
+    all.extend(threshold_and_frame_groups());
+    all.retain(|g| records.iter().any(|r| (g.contains)(r)));
+    all
+}
+
+/// A group per scene family and per generator.
+fn kind_groups() -> Vec<Group> {
     let mut all = Vec::new();
     for family in crate::coverage::SceneFamily::ALL {
         all.push(group(format!("family {}", family.name()), move |r| {
@@ -78,6 +89,12 @@ pub fn groups(records: &[RunRecord]) -> Vec<Group> {
             r.case.generator == generator
         }));
     }
+    all
+}
+
+/// A group per effect some record has (mismatch and display aside), and the group of
+/// cases with none of them.
+fn effect_groups(records: &[RunRecord]) -> Vec<Group> {
     let mut effects: Vec<String> = records
         .iter()
         .flat_map(|r| crate::coverage::truth::effects_present(&r.case.params))
@@ -85,64 +102,84 @@ pub fn groups(records: &[RunRecord]) -> Vec<Group> {
         .collect();
     effects.sort();
     effects.dedup();
-    for effect in effects {
-        all.push(group(format!("with {effect}"), move |r| {
-            crate::coverage::truth::effects_present(&r.case.params).contains(&effect)
-        }));
-    }
+    let mut all: Vec<Group> = effects
+        .into_iter()
+        .map(|effect| {
+            group(format!("with {effect}"), move |r| {
+                crate::coverage::truth::effects_present(&r.case.params).contains(&effect)
+            })
+        })
+        .collect();
     all.push(group("no effect but mismatch (and display)", |r| {
         crate::coverage::truth::effects_present(&r.case.params)
             .iter()
             .all(|e| e == "mismatch" || e == "display")
     }));
-    let lowest = crate::estimate::eppps::prior::log_std_range().0;
-    all.push(group(
-        format!("procedural texture less contrasty than eppps' prior (log std < {lowest:.3})"),
-        |r| texture_log_std(r).is_some_and(below_prior),
-    ));
-    all.push(group(
-        format!("procedural texture, log std >= {lowest:.3}"),
-        |r| texture_log_std(r).is_some_and(|s| !below_prior(s)),
-    ));
-    all.push(group(
-        format!(
-            "in the scope of eppps' prior (contrast of its photographs or more, >= {PRIOR_DIMMEST_DN} DN)"
-        ),
-        in_prior_scope,
-    ));
-    all.push(group(
-        format!("outside it (a less contrasty texture, or < {PRIOR_DIMMEST_DN} DN; not a screen)"),
-        |r| !r.case.is_screen() && !in_prior_scope(r),
-    ));
-    all.push(group("dim (mean < 30 DN)", |r| mean_dn(r) < 30.0));
-    all.push(group("mid (30-100 DN)", |r| {
-        (30.0..=100.0).contains(&mean_dn(r))
-    }));
-    all.push(group("bright (> 100 DN)", |r| mean_dn(r) > 100.0));
-    all.push(group("slow (< 60 px/s)", |r| r.case.speed_px_s < 60.0));
-    all.push(group("medium (60-200 px/s)", |r| {
-        (60.0..=200.0).contains(&r.case.speed_px_s)
-    }));
-    all.push(group("fast (> 200 px/s)", |r| r.case.speed_px_s > 200.0));
-    all.push(group("small CT (min < 0.25)", |r| {
-        let (p, n) = thresholds(r);
-        p.min(n) < 0.25
-    }));
-    all.push(group("large CT (max > 0.6)", |r| {
-        let (p, n) = thresholds(r);
-        p.max(n) > 0.6
-    }));
-    all.push(group("asymmetric (|Cp - Cn| > 0.3)", |r| {
-        let (p, n) = thresholds(r);
-        (p - n).abs() > 0.3
-    }));
-    all.push(group("few APS frames (< 20)", |r| {
-        r.truth
-            .as_ref()
-            .is_some_and(|t| !r.case.is_screen() && t.aps_frames < 20)
-    }));
-    all.retain(|g| records.iter().any(|r| (g.contains)(r)));
     all
+}
+
+/// The procedural textures below and above the contrast of eppps' prior, and the cases in
+/// and outside the prior's scope.
+fn prior_scope_groups() -> Vec<Group> {
+    let lowest = crate::estimate::eppps::prior::log_std_range().0;
+    vec![
+        group(
+            format!("procedural texture less contrasty than eppps' prior (log std < {lowest:.3})"),
+            |r| texture_log_std(r).is_some_and(below_prior),
+        ),
+        group(format!("procedural texture, log std >= {lowest:.3}"), |r| {
+            texture_log_std(r).is_some_and(|s| !below_prior(s))
+        }),
+        group(
+            format!(
+                "in the scope of eppps' prior (contrast of its photographs or more, >= {PRIOR_DIMMEST_DN} DN)"
+            ),
+            in_prior_scope,
+        ),
+        group(
+            format!(
+                "outside it (a less contrasty texture, or < {PRIOR_DIMMEST_DN} DN; not a screen)"
+            ),
+            |r| !r.case.is_screen() && !in_prior_scope(r),
+        ),
+    ]
+}
+
+/// The cases by mean light (dim, mid, bright) and by speed (slow, medium, fast).
+fn light_and_speed_groups() -> Vec<Group> {
+    vec![
+        group("dim (mean < 30 DN)", |r| mean_dn(r) < 30.0),
+        group("mid (30-100 DN)", |r| (30.0..=100.0).contains(&mean_dn(r))),
+        group("bright (> 100 DN)", |r| mean_dn(r) > 100.0),
+        group("slow (< 60 px/s)", |r| r.case.speed_px_s < 60.0),
+        group("medium (60-200 px/s)", |r| {
+            (60.0..=200.0).contains(&r.case.speed_px_s)
+        }),
+        group("fast (> 200 px/s)", |r| r.case.speed_px_s > 200.0),
+    ]
+}
+
+/// The cases by threshold (small, large, asymmetric) and those with few APS frames.
+fn threshold_and_frame_groups() -> Vec<Group> {
+    vec![
+        group("small CT (min < 0.25)", |r| {
+            let (p, n) = thresholds(r);
+            p.min(n) < 0.25
+        }),
+        group("large CT (max > 0.6)", |r| {
+            let (p, n) = thresholds(r);
+            p.max(n) > 0.6
+        }),
+        group("asymmetric (|Cp - Cn| > 0.3)", |r| {
+            let (p, n) = thresholds(r);
+            (p - n).abs() > 0.3
+        }),
+        group("few APS frames (< 20)", |r| {
+            r.truth
+                .as_ref()
+                .is_some_and(|t| !r.case.is_screen() && t.aps_frames < 20)
+        }),
+    ]
 }
 
 /// One cell: covered of determinable, of cases.
