@@ -21,6 +21,7 @@ use super::frames::PreparedFrames;
 use super::root::{Crossing, Search, threshold_root};
 use crate::events::{EventChunk, Sensor, TimeUs};
 use crate::hint::{Analysis, Hint, Text};
+use crate::sim::log_response::LogMap;
 use crate::sim::{PixelMaps, PixelParams, Sample, Simulator};
 use crate::stats::support::supported;
 use argmin::core::{CostFunction, Error as ArgminError};
@@ -377,6 +378,19 @@ pub fn simulate(
     Ok(all)
 }
 
+/// `params` with the frames' log response `log_map`: the simulated pixel reads the
+/// upsampled frames (DN + b) as the event timing read them. A simulator's default response
+/// in its place (v2e's lin-log, linear below 20 DN) makes another log change of every dark
+/// pixel than the one the thresholds were measured in: on an ESIM recording at 13 DN read
+/// as a pure ln(DN + b), the re-simulation then matched the counts at no threshold.
+pub fn read_as_frames(params: &PixelParams, log_map: LogMap) -> PixelParams {
+    PixelParams {
+        log_response: Some(log_map.response()),
+        log_eps: Some(log_map.eps()),
+        ..params.clone()
+    }
+}
+
 /// The result of the re-simulation fit.
 #[derive(Clone, Debug, Serialize)]
 pub struct ResimEstimate {
@@ -405,18 +419,22 @@ pub struct Resimulation<'a> {
     pub real: &'a Counts,
     /// The recording's timestamp grid, applied to simulated events too.
     pub grid: Option<(TimeUs, TimeUs)>,
+    /// The frames' log response: every simulation reads the runs through it.
+    pub log_map: LogMap,
     pub evaluations: std::cell::Cell<usize>,
 }
 
 impl<'a> Resimulation<'a> {
     /// The re-simulation of `runs` (frames of `width` x `height` upsampled along the flow)
-    /// against the recording's `real` counts in `cells`, on the timestamp `grid`.
+    /// against the recording's `real` counts in `cells`, on the timestamp `grid`, the runs
+    /// read through the frames' `log_map` ([`read_as_frames`]).
     pub fn new(
         runs: &'a [Vec<Sample>],
         (width, height): (usize, usize),
         cells: &'a Cells,
         real: &'a Counts,
         grid: Option<(TimeUs, TimeUs)>,
+        log_map: LogMap,
     ) -> Self {
         Self {
             runs,
@@ -425,6 +443,7 @@ impl<'a> Resimulation<'a> {
             cells,
             real,
             grid,
+            log_map,
             evaluations: std::cell::Cell::new(0),
         }
     }
@@ -432,7 +451,8 @@ impl<'a> Resimulation<'a> {
     /// The cells' counts of the runs simulated with `params` (on the recording's grid).
     pub fn counts(&self, params: &PixelParams) -> Result<Counts, EstimateError> {
         self.evaluations.set(self.evaluations.get() + 1);
-        let mut events = simulate(self.runs, self.width, self.height, params)?;
+        let params = read_as_frames(params, self.log_map);
+        let mut events = simulate(self.runs, self.width, self.height, &params)?;
         if let Some(grid) = self.grid {
             super::quantise(&mut events, grid);
         }
@@ -588,8 +608,9 @@ fn polarity_root(
 
 #[cfg(test)]
 mod tests {
-    use super::simulate;
-    use crate::sim::{PixelParams, Sample, Transition};
+    use super::{read_as_frames, simulate};
+    use crate::sim::log_response::LogMap;
+    use crate::sim::{LogResponse, PixelParams, Sample, Transition};
 
     /// `n` samples 10 ms apart of a 16 x 16 sensor at `dn(k, pixel)`.
     fn run(n: usize, dn: impl Fn(usize, usize) -> f32) -> Vec<Sample> {
@@ -653,5 +674,24 @@ mod tests {
             .collect();
         assert!(first.len() > 1000);
         assert_eq!(first.into_iter().copied().collect::<Vec<_>>(), shifted);
+    }
+
+    #[test]
+    fn a_dark_ramp_is_simulated_through_the_frames_response() {
+        // every pixel from 5 to 10 DN: ln(10 / 5) = 0.693 under a pure ln(DN), six
+        // crossings of 0.1; v2e's lin-log is linear there, 5 * ln(20) / 20 = 0.749, seven
+        let params = PixelParams::ideal(0.1, 0.1);
+        let ramp = [run(11, |k, _| 5.0 + 0.5 * k as f32)];
+        let per_pixel = |p: &PixelParams| {
+            let events = simulate(&ramp, 16, 16, p).unwrap();
+            assert!(events.on.iter().all(|&on| on));
+            events.len() as f64 / 256.0
+        };
+        let pure_log = LogMap::new(LogResponse::Eps, 0.0);
+        assert_eq!(per_pixel(&read_as_frames(&params, pure_log)), 6.0);
+        let lin_log = LogMap::new(LogResponse::V2e, 0.001);
+        assert_eq!(per_pixel(&read_as_frames(&params, lin_log)), 7.0);
+        // the simulator's own default is the lin-log, which the frames need not be read with
+        assert_eq!(per_pixel(&params), 7.0);
     }
 }

@@ -129,6 +129,8 @@ pub struct Setup<'a> {
     pub grid: Option<(crate::events::TimeUs, crate::events::TimeUs)>,
     pub width: usize,
     pub height: usize,
+    /// The frames' log response the runs are simulated through.
+    pub log_map: crate::sim::log_response::LogMap,
 }
 
 /// The dark-bright difference of the re-simulation at the timing's offset, where it lies
@@ -223,6 +225,7 @@ impl OffsetProbe<'_, '_> {
             setup.cells,
             setup.real,
             setup.grid,
+            setup.log_map,
         );
         let r = fit_with(&resim, self.thresholds, self.sigma, None, 1).ok()?;
         self.thresholds = (r.ct_on, r.ct_off);
@@ -314,6 +317,7 @@ pub(super) fn offset_from_counts(
         grid,
         width: frames.width,
         height: frames.height,
+        log_map: frames.log_map,
     };
     let Some(at_own) = disagreement(&setup, &brightness) else {
         return Ok(None);

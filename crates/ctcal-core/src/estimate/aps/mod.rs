@@ -180,6 +180,7 @@ fn run_pass(
         &cells,
         &real,
         timestamp_grid(input.events),
+        frames.log_map,
     );
     let resim = super::resim::fit(&resim, (cp, cn), sigma).ok();
     let used: Vec<f64> = frames
@@ -750,6 +751,7 @@ fn slow_photoreceptor(
         &full.cells,
         &full.real,
         grid,
+        frames.log_map,
     );
     let [ron, roff] = found.threshold_ratios;
     let [qon, qoff] = found.quantiser_thresholds;
@@ -819,7 +821,7 @@ fn calibration_events(
     sigma: f64,
     grid: Option<(TimeUs, TimeUs)>,
 ) -> Option<EventChunk> {
-    let mut params = measured_model(timing, sigma);
+    let mut params = super::resim::read_as_frames(&measured_model(timing, sigma), frames.log_map);
     params.seed = Some(options.seed);
     let mut simulated = super::resim::simulate(runs, frames.width, frames.height, &params).ok()?;
     if let Some(grid) = grid {
