@@ -161,6 +161,38 @@ impl Observed {
             self.intervals[(block * INTERVAL_CLASSES + class) * INTERVAL_BINS + bin] += 1;
         }
     }
+
+    /// Counts an event at `t` in its timeline bin (none past the span's last).
+    fn count_time(&mut self, g: &Geometry, t: TimeUs) {
+        let slot = ((t - g.span.0) / TIMELINE_BIN_US) as usize;
+        if let Some(bin) = self.timeline.get_mut(slot) {
+            *bin += 1;
+        }
+    }
+
+    /// Counts an event of polarity `pol` at pixel `p` with a reliable intensity, in `block`
+    /// and frame interval `k`: as still where the brightness does not change, and by cell
+    /// and region where `supported`, else as background.
+    fn count_scene(
+        &mut self,
+        g: &Geometry,
+        (block, k): (usize, usize),
+        p: usize,
+        pol: usize,
+        supported: bool,
+    ) {
+        let intensity = g.intensity[k][p] as usize;
+        let change = g.change[k][p] as usize;
+        if change == 0 {
+            self.still[block][pol] += 1;
+        }
+        if supported {
+            self.cells[block * CELLS + cell_index(intensity, change, pol)] += 1;
+            self.by_region[(block * REGIONS + g.region[p] as usize) * 2 + pol] += 1;
+        } else {
+            self.background[(block * INTENSITY_BINS + intensity) * 2 + pol] += 1;
+        }
+    }
 }
 
 /// Counts the events of `range` as one pass in order would, except the intervals of each
@@ -177,11 +209,7 @@ fn count_stretch(
     let width = g.sensor.width as usize;
     let mut last = vec![TimeUs::MIN; pixels];
     let mut first_of_pixel = Vec::new();
-    // the frame interval of the first event: the last frame at or before it
-    let mut k = range.clone().next().map_or(0, |i| {
-        let t = events.t[i];
-        g.times.partition_point(|&s| s <= t).saturating_sub(1)
-    });
+    let mut k = first_interval(events, &range, g);
     for i in range {
         let t = events.t[i];
         let p = events.y[i] as usize * width + events.x[i] as usize;
@@ -190,15 +218,9 @@ fn count_stretch(
         while k + 1 < g.times.len() && g.times[k + 1] <= t {
             k += 1;
         }
-        if t < g.times[0] || k + 1 >= g.times.len() {
-            continue;
-        }
-        let Some(block) = g.interval_block[k] else {
+        let Some(block) = counted_block(g, k, t, p, masked) else {
             continue;
         };
-        if g.excluded[p] || masked[p] {
-            continue;
-        }
         let pol = events.on[i] as usize;
         o.pixel_counts[block * pixels + p] += 1;
         o.polarity[block][pol] += 1;
@@ -214,23 +236,9 @@ fn count_stretch(
         } else {
             o.count_interval(g, block, class, previous, t);
         }
-        let slot = ((t - g.span.0) / TIMELINE_BIN_US) as usize;
-        if let Some(bin) = o.timeline.get_mut(slot) {
-            *bin += 1;
-        }
-        if intensity == u8::MAX {
-            continue;
-        }
-        let intensity = intensity as usize;
-        let change = g.change[k][p] as usize;
-        if change == 0 {
-            o.still[block][pol] += 1;
-        }
-        if support[i] {
-            o.cells[block * CELLS + cell_index(intensity, change, pol)] += 1;
-            o.by_region[(block * REGIONS + g.region[p] as usize) * 2 + pol] += 1;
-        } else {
-            o.background[(block * INTENSITY_BINS + intensity) * 2 + pol] += 1;
+        o.count_time(g, t);
+        if intensity != u8::MAX {
+            o.count_scene(g, (block, k), p, pol, support[i]);
         }
     }
     Part {
@@ -238,6 +246,24 @@ fn count_stretch(
         first_of_pixel,
         last,
     }
+}
+
+/// The frame interval of the first event of `range`: the last frame at or before it.
+fn first_interval(events: &EventChunk, range: &std::ops::Range<usize>, g: &Geometry) -> usize {
+    range.clone().next().map_or(0, |i| {
+        let t = events.t[i];
+        g.times.partition_point(|&s| s <= t).saturating_sub(1)
+    })
+}
+
+/// The block an event at `t` of pixel `p` in frame interval `k` is counted in: `None`
+/// outside the frames, in an interval of no block, or at an excluded or `masked` pixel.
+fn counted_block(g: &Geometry, k: usize, t: TimeUs, p: usize, masked: &[bool]) -> Option<usize> {
+    if t < g.times[0] || k + 1 >= g.times.len() {
+        return None;
+    }
+    let block = g.interval_block[k]?;
+    (!g.excluded[p] && !masked[p]).then_some(block)
 }
 
 #[cfg(test)]
