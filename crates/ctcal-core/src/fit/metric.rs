@@ -178,35 +178,10 @@ pub fn distance(
 ) -> Components {
     let ratios = cell_ratios(real, sim, g, subset);
     let counts = weighted_rms(&cell_weights(sim, g, subset, &ratios));
-    // unsupported events: the rate ratio with the floor, weighted by events (a bin needs
-    // 20 events in the two, or exposure enough for the floor to make 20)
-    let (rb, sb) = (real.background_of(g, subset), sim.background_of(g, subset));
-    let background = weighted_rms(
-        &(0..rb.len())
-            .filter_map(|i| {
-                let exposure = g.exposure_of(i / 2, subset);
-                let floor = BACKGROUND_FLOOR_HZ * exposure;
-                let (r, s) = (rb[i] as f64, sb[i] as f64);
-                (r + s >= 20.0 || floor >= 20.0)
-                    .then(|| (((s + floor) / (r + floor)).ln(), 0.5 * (r + s) + floor))
-            })
-            .collect::<Vec<_>>(),
-    );
-    let (ri, si) = (
-        normalised(&real.intervals_of(g, subset)),
-        normalised(&sim.intervals_of(g, subset)),
-    );
-    let intervals = 0.5 * ri.iter().zip(&si).map(|(a, b)| (a - b).abs()).sum::<f64>();
-    let ([r_off, r_on], [s_off, s_on]) = (real.polarity_of(g, subset), sim.polarity_of(g, subset));
-    let polarity =
-        (log_ratio(s_on as f64, s_off as f64) - log_ratio(r_on as f64, r_off as f64)).abs();
-    let (rp, sp) = (real.pixels_of(g, subset), sim.pixels_of(g, subset));
-    let active_of = |c: &[u32]| c.iter().zip(kept).filter(|&(&n, &k)| k && n > 0).count() as f64;
-    let active = log_ratio(active_of(&sp), active_of(&rp)).abs();
-    let dispersion = match (dispersion(&rp, g, kept), dispersion(&sp, g, kept)) {
-        (Some(r), Some(s)) => dispersion_log_ratio(r, s).abs(),
-        _ => 0.0,
-    };
+    let background = background_component(real, sim, g, subset);
+    let intervals = interval_component(real, sim, g, subset);
+    let polarity = polarity_component(real, sim, g, subset);
+    let (active, dispersion) = pixel_components(real, sim, g, subset, kept);
     let lag = lag_component(sim, g, subset);
     let total = [
         counts,
@@ -232,6 +207,60 @@ pub fn distance(
         hot_pixels: None,
         total,
     }
+}
+
+/// The `background` component over `subset`: the unsupported events' rate ratio with the
+/// floor, weighted by events (a bin needs 20 events in the two, or exposure enough for the
+/// floor to make 20).
+fn background_component(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> f64 {
+    let (rb, sb) = (real.background_of(g, subset), sim.background_of(g, subset));
+    weighted_rms(
+        &(0..rb.len())
+            .filter_map(|i| {
+                let exposure = g.exposure_of(i / 2, subset);
+                let floor = BACKGROUND_FLOOR_HZ * exposure;
+                let (r, s) = (rb[i] as f64, sb[i] as f64);
+                (r + s >= 20.0 || floor >= 20.0)
+                    .then(|| (((s + floor) / (r + floor)).ln(), 0.5 * (r + s) + floor))
+            })
+            .collect::<Vec<_>>(),
+    )
+}
+
+/// The `intervals` component over `subset`: the total-variation distance of the normalised
+/// same-pixel interval histograms.
+fn interval_component(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> f64 {
+    let (ri, si) = (
+        normalised(&real.intervals_of(g, subset)),
+        normalised(&sim.intervals_of(g, subset)),
+    );
+    0.5 * ri.iter().zip(&si).map(|(a, b)| (a - b).abs()).sum::<f64>()
+}
+
+/// The `polarity` component over `subset`: the `|ln(ON/OFF)|` difference.
+fn polarity_component(real: &Observed, sim: &Observed, g: &Geometry, subset: Subset) -> f64 {
+    let ([r_off, r_on], [s_off, s_on]) = (real.polarity_of(g, subset), sim.polarity_of(g, subset));
+    (log_ratio(s_on as f64, s_off as f64) - log_ratio(r_on as f64, r_off as f64)).abs()
+}
+
+/// The `active` and `dispersion` components over `subset`, from the per-pixel counts of
+/// the `kept` pixels: the log ratio of the pixels that fired, and of their counts'
+/// within-tile dispersion (0 where either has none).
+fn pixel_components(
+    real: &Observed,
+    sim: &Observed,
+    g: &Geometry,
+    subset: Subset,
+    kept: &[bool],
+) -> (f64, f64) {
+    let (rp, sp) = (real.pixels_of(g, subset), sim.pixels_of(g, subset));
+    let active_of = |c: &[u32]| c.iter().zip(kept).filter(|&(&n, &k)| k && n > 0).count() as f64;
+    let active = log_ratio(active_of(&sp), active_of(&rp)).abs();
+    let dispersion = match (dispersion(&rp, g, kept), dispersion(&sp, g, kept)) {
+        (Some(r), Some(s)) => dispersion_log_ratio(r, s).abs(),
+        _ => 0.0,
+    };
+    (active, dispersion)
 }
 
 /// The `lag` component of `sim` (paired with the recording) over `subset`: `None` when it
