@@ -546,7 +546,6 @@ pub fn search_profiled(
     (fixed_thresholds, mismatch): (bool, bool),
     noise: f64,
 ) -> Result<Searched, EstimateError> {
-    let mismatch_profiled = mismatch && base.ct_sigma.is_some();
     let range = within_limit(valid_range(range), simulation.upper_limit(effect));
     let failure = RefCell::new(None);
     let problem = Search {
@@ -555,12 +554,23 @@ pub fn search_profiled(
         masked,
         kept,
         fixed_thresholds,
-        mismatch_profiled,
+        mismatch_profiled: mismatch && base.ct_sigma.is_some(),
         evaluations: RefCell::new(Vec::new()),
         best: RefCell::new(None),
         warm: RefCell::new(base.clone()),
         failure: &failure,
     };
+    let problem = minimised(problem, range)?;
+    searched(problem, range, noise)
+}
+
+/// `problem` after Brent's search in the logarithm of `range`, or the failure that
+/// stopped it.
+fn minimised<'a, 'b>(
+    problem: Search<'a, 'b>,
+    range: (f64, f64),
+) -> Result<Search<'a, 'b>, EstimateError> {
+    let (effect, failure) = (problem.effect, problem.failure);
     let solver = BrentOpt::new(range.0.ln(), range.1.ln()).set_tolerance(0.03, 0.01);
     let result = Executor::new(problem, solver)
         .configure(|s| s.max_iters(16))
@@ -568,15 +578,19 @@ pub fn search_profiled(
     if let Some(e) = failure.take() {
         return Err(e);
     }
-    let problem = match result {
-        Ok(r) => r.problem.problem.expect("the executor keeps its problem"),
-        Err(e) => {
-            return Err(EstimateError::new(
-                format!("the {effect} search failed: {e}"),
-                "report this as a bug",
-            ));
-        }
-    };
+    match result {
+        Ok(r) => Ok(r.problem.problem.expect("the executor keeps its problem")),
+        Err(e) => Err(EstimateError::new(
+            format!("the {effect} search failed: {e}"),
+            "report this as a bug",
+        )),
+    }
+}
+
+/// The best point of a finished search over `range`, with its standard error against
+/// `noise` (none at an end of the range).
+fn searched(problem: Search, range: (f64, f64), noise: f64) -> Result<Searched, EstimateError> {
+    let effect = problem.effect;
     let evaluations = problem.evaluations.into_inner();
     let Some((fit_error, model)) = problem.best.into_inner() else {
         return Err(EstimateError::new(
