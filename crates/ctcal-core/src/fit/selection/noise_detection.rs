@@ -175,6 +175,38 @@ impl Probe<'_> {
         );
         (Err(why), Some(isolated))
     }
+
+    /// The effect's limit: the rate found (none without pixel-time to count isolated
+    /// events), whether the loop tried it (`steps`), and for shot noise the most dark rate
+    /// the quiet pixels allow (`known`).
+    fn limit(&self, steps: &[Step], known: super::Known) -> NoiseLimit {
+        let tried = steps
+            .iter()
+            .any(|s| s.effect == self.effect.name() && s.simulations > 0);
+        let (found, isolated) = if self.evidence.exposure > 0.0 {
+            self.search()
+        } else {
+            (
+                Err("no reliable pixel-time to count isolated events".into()),
+                None,
+            )
+        };
+        NoiseLimit {
+            called_for_above_hz: found.as_ref().ok().copied(),
+            isolated_hz_per_hz: isolated,
+            tried,
+            why: found.err(),
+            at_most_hz: (self.effect == Effect::ShotNoise)
+                .then(|| {
+                    at_most_dark_hz(
+                        known.quiet_off,
+                        self.simulation.geometry,
+                        &self.state.model.params,
+                    )
+                })
+                .flatten(),
+        }
+    }
 }
 
 const ALREADY: &str = "the recording's isolated events call for it beside the final model (it was tried and not kept, or the model changed since)";
@@ -201,9 +233,6 @@ pub fn detect(
         if in_model.is_some_and(|r| r > 0.0) {
             continue;
         }
-        let tried = steps
-            .iter()
-            .any(|s| s.effect == effect.name() && s.simulations > 0);
         let probe = Probe {
             simulation,
             state,
@@ -215,24 +244,7 @@ pub fn detect(
                 relevant_hz,
             },
         };
-        let (found, isolated) = if exposure > 0.0 {
-            probe.search()
-        } else {
-            (
-                Err("no reliable pixel-time to count isolated events".into()),
-                None,
-            )
-        };
-        let limit = NoiseLimit {
-            called_for_above_hz: found.as_ref().ok().copied(),
-            isolated_hz_per_hz: isolated,
-            tried,
-            why: found.err(),
-            at_most_hz: (effect == Effect::ShotNoise)
-                .then(|| at_most_dark_hz(known.quiet_off, g, params))
-                .flatten(),
-        };
-        limits.insert(key.to_string(), limit);
+        limits.insert(key.to_string(), probe.limit(steps, known));
     }
     if limits.is_empty() {
         return None;
