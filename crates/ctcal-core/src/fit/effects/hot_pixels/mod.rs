@@ -98,58 +98,87 @@ pub fn independent_of_scene(
     if hot.is_empty() || range.is_empty() {
         return (hot.to_vec(), 0);
     }
-    let w = sensor.width as usize;
     let span = (events.t[range.start], events.t[range.end - 1] + 1);
-    // for each pixel, the named pixels whose 3 x 3 neighbourhood it is in (and whether it is
-    // their own)
-    let mut watchers: std::collections::HashMap<usize, Vec<(usize, bool)>> =
-        std::collections::HashMap::new();
-    for (k, h) in hot.iter().enumerate() {
-        for (p, is_own) in neighbourhood(h, sensor) {
-            watchers.entry(p).or_default().push((k, is_own));
-        }
-    }
-    let mut own: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
-    let mut neighbours: Vec<Vec<TimeUs>> = vec![Vec::new(); hot.len()];
-    let mut counts: std::collections::HashMap<usize, u64> = std::collections::HashMap::new();
-    for i in range.clone() {
-        let p = events.y[i] as usize * w + events.x[i] as usize;
-        if let Some(list) = watchers.get(&p) {
-            *counts.entry(p).or_default() += 1;
-            for &(k, is_own) in list {
-                if is_own {
-                    own[k].push(events.t[i]);
-                } else {
-                    neighbours[k].push(events.t[i]);
-                }
-            }
-        }
-    }
+    let around = Around::gathered(hot, events, range.clone(), sensor);
     let seconds = (span.1 - span.0) as f64 * 1e-6;
     let sensor_time = SensorTime::of(&events.t[range.clone()]);
     let mut kept = Vec::new();
     for (k, h) in hot.iter().enumerate() {
-        let (uncovered, unsupported) = uncovered_and_alone(&own[k], &neighbours[k], span);
-        let busiest = neighbourhood(h, sensor)
-            .filter(|&(_, is_own)| !is_own)
-            .map(|(p, _)| counts.get(&p).copied().unwrap_or(0))
-            .max()
-            .unwrap_or(0);
-        let excess = own[k].len().saturating_sub(busiest as usize) as f64;
+        let own = &around.own[k];
+        let (uncovered, unsupported) = uncovered_and_alone(own, &around.neighbours[k], span);
+        let busiest = around.busiest_neighbour(h, sensor);
+        let excess = own.len().saturating_sub(busiest as usize) as f64;
         let excess_hz = excess / seconds;
         // the train the excess would be, at the lower end of its count (two Poisson sigma)
-        let train_hz = (excess - 2.0 * (own[k].len() as f64).sqrt()).max(0.0) / seconds;
+        let train_hz = (excess - 2.0 * (own.len() as f64).sqrt()).max(0.0) / seconds;
         let predicted = excess_hz * uncovered;
         let fires_alone = predicted < 10.0 || unsupported as f64 >= 0.25 * predicted;
         if fires_alone
-            && !silent_beyond_a_train(&own[k], train_hz, &sensor_time)
-            && !scene.is_some_and(|s| s.explains(&own[k], h.x, h.y, train_hz))
+            && !silent_beyond_a_train(own, train_hz, &sensor_time)
+            && !scene.is_some_and(|s| s.explains(own, h.x, h.y, train_hz))
         {
             kept.push(h.clone());
         }
     }
     let left_out = hot.len() - kept.len();
     (kept, left_out)
+}
+
+/// The events at and around the named pixels: each one's own event times and its
+/// neighbours' (time-sorted), and the event count of every pixel in a neighbourhood.
+struct Around {
+    own: Vec<Vec<TimeUs>>,
+    neighbours: Vec<Vec<TimeUs>>,
+    counts: std::collections::HashMap<usize, u64>,
+}
+
+impl Around {
+    /// The events `range` of `events` at and around each of `hot`.
+    fn gathered(
+        hot: &[HotPixel],
+        events: &EventChunk,
+        range: std::ops::Range<usize>,
+        sensor: crate::events::Sensor,
+    ) -> Self {
+        let w = sensor.width as usize;
+        // for each pixel, the named pixels whose 3 x 3 neighbourhood it is in (and whether it
+        // is their own)
+        let mut watchers: std::collections::HashMap<usize, Vec<(usize, bool)>> =
+            std::collections::HashMap::new();
+        for (k, h) in hot.iter().enumerate() {
+            for (p, is_own) in neighbourhood(h, sensor) {
+                watchers.entry(p).or_default().push((k, is_own));
+            }
+        }
+        let mut around = Self {
+            own: vec![Vec::new(); hot.len()],
+            neighbours: vec![Vec::new(); hot.len()],
+            counts: std::collections::HashMap::new(),
+        };
+        for i in range {
+            let p = events.y[i] as usize * w + events.x[i] as usize;
+            if let Some(list) = watchers.get(&p) {
+                *around.counts.entry(p).or_default() += 1;
+                for &(k, is_own) in list {
+                    if is_own {
+                        around.own[k].push(events.t[i]);
+                    } else {
+                        around.neighbours[k].push(events.t[i]);
+                    }
+                }
+            }
+        }
+        around
+    }
+
+    /// The events of `h`'s busiest 8-neighbour.
+    fn busiest_neighbour(&self, h: &HotPixel, sensor: crate::events::Sensor) -> u64 {
+        neighbourhood(h, sensor)
+            .filter(|&(_, is_own)| !is_own)
+            .map(|(p, _)| self.counts.get(&p).copied().unwrap_or(0))
+            .max()
+            .unwrap_or(0)
+    }
 }
 
 /// The pixels (y * W + x) of the 3 x 3 neighbourhood of `h` on the sensor, each with
