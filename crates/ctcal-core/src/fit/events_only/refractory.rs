@@ -103,65 +103,19 @@ pub fn edge(intervals: &mut [u32], step_us: u32) -> Option<Edge> {
         return None;
     }
     intervals.sort_unstable();
-    let below = |e: f64| intervals.partition_point(|&v| (v as f64) < e);
-    let ratio_at = |e: f64| {
-        let (under, upto) = (below(e), below(2.0 * e));
-        (under, upto - under)
-    };
+    let sorted = Sorted(intervals);
     let candidates: Vec<f64> = (0..=6 * PER_DECADE)
         .map(|k| 10f64.powf(k as f64 / PER_DECADE as f64))
         .collect();
-    let gap = |e: f64| {
-        let (under, above) = ratio_at(e);
-        above >= MIN_PLATEAU && (under as f64) <= GAP_RATIO * above as f64
-    };
-    let Some(&found) = candidates.iter().rev().find(|&&e| gap(e)) else {
-        let shortest = intervals[0].max(1) as f64;
-        let (under, above) = ratio_at(shortest);
-        return Some(Edge {
-            edge_us: shortest,
-            range_us: [0.0, shortest],
-            below: under,
-            above,
-            found: false,
-            not_refractory: None,
-            intervals: intervals.len(),
-        });
+    let Some(&found) = candidates.iter().rev().find(|&&e| sorted.gap(e)) else {
+        return Some(sorted.no_gap());
     };
     // the edge itself: the lower end (2nd percentile) of the intervals around the gap
-    let near = &intervals[below(found / 2.0)..below(2.0 * found)];
+    let near = &intervals[sorted.below(found / 2.0)..sorted.below(2.0 * found)];
     let edge_us = near[(near.len() as f64 * 0.02) as usize].max(1) as f64;
-    let density = |from: f64, to: f64| (below(to) - below(from)) as f64 / (to - from);
-    let pile = density(edge_us, 1.25 * edge_us);
-    let rest = density(1.25 * edge_us, 2.0 * edge_us);
-    let not_refractory = if edge_us <= 2.0 * step_us as f64 {
-        Some(format!(
-            "the gap ends at {edge_us:.0} us, within two steps of the timestamps' {step_us} us grid"
-        ))
-    } else if pile < PILE_UP * rest {
-        Some(format!(
-            "no pile-up above the gap at {edge_us:.0} us (density {:.2} of the next three quarters'): periodic firing or a slow scene, not events held back",
-            pile / rest.max(1e-12)
-        ))
-    } else {
-        None
-    };
-    let share = |e: f64| {
-        let (under, above) = ratio_at(e);
-        under as f64 / above.max(1) as f64
-    };
-    let low = candidates
-        .iter()
-        .rev()
-        .find(|&&e| e <= found && share(e) <= GAP_RATIO / 5.0)
-        .copied()
-        .unwrap_or(found);
-    let high = candidates
-        .iter()
-        .find(|&&e| e > found && share(e) >= 1.0 / 3.0)
-        .copied()
-        .unwrap_or(found);
-    let (under, above) = ratio_at(edge_us);
+    let not_refractory = sorted.not_refractory(edge_us, step_us);
+    let [low, high] = sorted.range(&candidates, found);
+    let (under, above) = sorted.ratio_at(edge_us);
     Some(Edge {
         edge_us,
         range_us: [low.min(edge_us), high.max(edge_us)],
@@ -171,6 +125,92 @@ pub fn edge(intervals: &mut [u32], step_us: u32) -> Option<Edge> {
         not_refractory,
         intervals: intervals.len(),
     })
+}
+
+/// Same-pixel intervals (µs), sorted: counted below an edge and in the octave above it.
+struct Sorted<'a>(&'a [u32]);
+
+impl Sorted<'_> {
+    /// The intervals under `e`.
+    fn below(&self, e: f64) -> usize {
+        self.0.partition_point(|&v| (v as f64) < e)
+    }
+
+    /// The intervals under `e` and in `[e, 2e)`.
+    fn ratio_at(&self, e: f64) -> (usize, usize) {
+        let (under, upto) = (self.below(e), self.below(2.0 * e));
+        (under, upto - under)
+    }
+
+    /// Whether `e` has a gap below it: [`MIN_PLATEAU`] intervals in `[e, 2e)` and at most
+    /// [`GAP_RATIO`] of them under `e`.
+    fn gap(&self, e: f64) -> bool {
+        let (under, above) = self.ratio_at(e);
+        above >= MIN_PLATEAU && (under as f64) <= GAP_RATIO * above as f64
+    }
+
+    /// The intervals under `e` over those in `[e, 2e)`.
+    fn share(&self, e: f64) -> f64 {
+        let (under, above) = self.ratio_at(e);
+        under as f64 / above.max(1) as f64
+    }
+
+    /// Intervals per µs in `[from, to)`.
+    fn density(&self, from: f64, to: f64) -> f64 {
+        (self.below(to) - self.below(from)) as f64 / (to - from)
+    }
+
+    /// No gap at any candidate: the edge at the shortest interval, not found.
+    fn no_gap(&self) -> Edge {
+        let shortest = self.0[0].max(1) as f64;
+        let (under, above) = self.ratio_at(shortest);
+        Edge {
+            edge_us: shortest,
+            range_us: [0.0, shortest],
+            below: under,
+            above,
+            found: false,
+            not_refractory: None,
+            intervals: self.0.len(),
+        }
+    }
+
+    /// Why the gap ending at `edge_us` is not a refractory period: within two timestamp
+    /// steps of `step_us`, or without the pile-up above it ([`PILE_UP`]).
+    fn not_refractory(&self, edge_us: f64, step_us: u32) -> Option<String> {
+        let pile = self.density(edge_us, 1.25 * edge_us);
+        let rest = self.density(1.25 * edge_us, 2.0 * edge_us);
+        if edge_us <= 2.0 * step_us as f64 {
+            Some(format!(
+                "the gap ends at {edge_us:.0} us, within two steps of the timestamps' {step_us} us grid"
+            ))
+        } else if pile < PILE_UP * rest {
+            Some(format!(
+                "no pile-up above the gap at {edge_us:.0} us (density {:.2} of the next three quarters'): periodic firing or a slow scene, not events held back",
+                pile / rest.max(1e-12)
+            ))
+        } else {
+            None
+        }
+    }
+
+    /// Where the short intervals come back around the gap at `found`: the longest of the
+    /// `candidates` up to it with almost none (a fiftieth) below, the first beyond it with
+    /// a third (each `found` where there is none).
+    fn range(&self, candidates: &[f64], found: f64) -> [f64; 2] {
+        let low = candidates
+            .iter()
+            .rev()
+            .find(|&&e| e <= found && self.share(e) <= GAP_RATIO / 5.0)
+            .copied()
+            .unwrap_or(found);
+        let high = candidates
+            .iter()
+            .find(|&&e| e > found && self.share(e) >= 1.0 / 3.0)
+            .copied()
+            .unwrap_or(found);
+        [low, high]
+    }
 }
 
 #[cfg(test)]
