@@ -92,50 +92,14 @@ pub fn compare(
     blocks: &[&BlockMeasure],
     reference: Reference,
 ) -> Components {
-    let log = |p: f64, m: f64, floor: f64| ((p + floor) / (m + floor)).ln();
-    let background = match (
-        BlockMeasure::isolated_rate(blocks, reference.isolation, true),
-        BlockMeasure::isolated_rate(blocks, reference.isolation, false),
-    ) {
-        (Some((on, on_se)), Some((off, off_se))) => {
-            // rates are told apart down to twice their standard error on these blocks
-            let floor = |se: f64| (2.0 * se).clamp(RATE_FLOOR_HZ, BACKGROUND_FLOOR_HZ);
-            let a = log(predicted.on_hz, on, floor(on_se));
-            let b = log(predicted.off_hz, off, floor(off_se));
-            ((a * a + b * b) / 2.0).sqrt()
-        }
-        _ => 0.0,
-    };
-    let seconds: f64 = blocks.iter().map(|b| b.seconds).sum();
-    let hot = blocks.first().map_or(0, |b| b.hot_events.len());
-    let hot_pixels = (hot > 0 && seconds > 0.0).then(|| {
-        let base = blocks
-            .iter()
-            .map(|b| b.pixel_rate_hz * b.seconds)
-            .sum::<f64>()
-            / seconds;
-        let squares: f64 = (0..hot)
-            .map(|k| {
-                let measured = blocks.iter().map(|b| b.hot_events[k]).sum::<u64>() as f64 / seconds;
-                let predicted = predicted.hot_rates_hz.as_ref().map_or(base, |r| r[k]);
-                log(predicted, measured, base.max(BACKGROUND_FLOOR_HZ)).powi(2)
-            })
-            .sum();
-        (squares / hot as f64).sqrt()
-    });
+    let background = isolated_component(predicted, blocks, reference.isolation);
+    let hot_pixels = hot_pixel_component(predicted, blocks);
     let intervals = reference.edge_us.map_or(0.0, |e| {
         (predicted.short_share - short_share(blocks, e))
             .abs()
             .min(2.0)
     });
-    let (on, off): (u64, u64) = blocks
-        .iter()
-        .fold((0, 0), |(a, b), m| (a + m.signal_on, b + m.signal_off));
-    let polarity = if on > 0 && off > 0 {
-        ((off as f64 / on as f64).ln() - predicted.balance.ln()).abs()
-    } else {
-        0.0
-    };
+    let polarity = balance_component(predicted, blocks);
     let hot_value = hot_pixels.unwrap_or(0.0);
     let total = [background, hot_value, intervals, polarity]
         .iter()
@@ -149,6 +113,69 @@ pub fn compare(
         hot_pixels,
         total,
         ..Components::default()
+    }
+}
+
+/// The log ratio of a predicted rate to a measured one, each with `floor` added.
+fn floored_log_ratio(predicted: f64, measured: f64, floor: f64) -> f64 {
+    ((predicted + floor) / (measured + floor)).ln()
+}
+
+/// The isolated-event component: RMS over ON and OFF of the log ratio of the predicted
+/// rates to those measured under `isolation` (0 where either is not measured).
+fn isolated_component(
+    predicted: &Prediction,
+    blocks: &[&BlockMeasure],
+    isolation: Isolation,
+) -> f64 {
+    match (
+        BlockMeasure::isolated_rate(blocks, isolation, true),
+        BlockMeasure::isolated_rate(blocks, isolation, false),
+    ) {
+        (Some((on, on_se)), Some((off, off_se))) => {
+            // rates are told apart down to twice their standard error on these blocks
+            let floor = |se: f64| (2.0 * se).clamp(RATE_FLOOR_HZ, BACKGROUND_FLOOR_HZ);
+            let a = floored_log_ratio(predicted.on_hz, on, floor(on_se));
+            let b = floored_log_ratio(predicted.off_hz, off, floor(off_se));
+            ((a * a + b * b) / 2.0).sqrt()
+        }
+        _ => 0.0,
+    }
+}
+
+/// The hot-pixel component: RMS over the named hot pixels of the log ratio of the
+/// predicted rates (the blocks' mean pixel rate where the model has none) to those
+/// measured, floored at that mean; `None` without named pixels or time.
+fn hot_pixel_component(predicted: &Prediction, blocks: &[&BlockMeasure]) -> Option<f64> {
+    let seconds: f64 = blocks.iter().map(|b| b.seconds).sum();
+    let hot = blocks.first().map_or(0, |b| b.hot_events.len());
+    (hot > 0 && seconds > 0.0).then(|| {
+        let base = blocks
+            .iter()
+            .map(|b| b.pixel_rate_hz * b.seconds)
+            .sum::<f64>()
+            / seconds;
+        let squares: f64 = (0..hot)
+            .map(|k| {
+                let measured = blocks.iter().map(|b| b.hot_events[k]).sum::<u64>() as f64 / seconds;
+                let predicted = predicted.hot_rates_hz.as_ref().map_or(base, |r| r[k]);
+                floored_log_ratio(predicted, measured, base.max(BACKGROUND_FLOOR_HZ)).powi(2)
+            })
+            .sum();
+        (squares / hot as f64).sqrt()
+    })
+}
+
+/// The balance component: the `|ln|` difference of the scene's OFF/ON ratio from the
+/// predicted one (0 without events of both polarities).
+fn balance_component(predicted: &Prediction, blocks: &[&BlockMeasure]) -> f64 {
+    let (on, off): (u64, u64) = blocks
+        .iter()
+        .fold((0, 0), |(a, b), m| (a + m.signal_on, b + m.signal_off));
+    if on > 0 && off > 0 {
+        ((off as f64 / on as f64).ln() - predicted.balance.ln()).abs()
+    } else {
+        0.0
     }
 }
 
