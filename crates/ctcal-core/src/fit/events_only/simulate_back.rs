@@ -127,6 +127,37 @@ fn noise(
     model: &NoiseModel,
     ranges: &[(TimeUs, TimeUs)],
 ) -> Result<EventChunk, String> {
+    let pixels = noisy_pixels(r, model);
+    let pixel_seconds: f64 = pixels.len() as f64
+        * ranges
+            .iter()
+            .map(|r| (r.1 - r.0) as f64 * 1e-6)
+            .sum::<f64>();
+    let expected = (model.noise_on_hz + model.noise_off_hz) * pixel_seconds;
+    let bound = MAX_DRAWN_PER_EVENT * r.measuring.events.len() as f64 + 1e6;
+    if expected > bound {
+        return Err(format!(
+            "the model's noise would draw {expected:.0} events on the held-out blocks, over {bound:.0} (four times the recording's events plus a million): not simulated back"
+        ));
+    }
+    let mut out = drawn_noise(r, model, ranges, &pixels, expected);
+    if let Some(rates) = &model.hot_rates_hz {
+        let trains: Vec<HotTrain> = r
+            .trains
+            .iter()
+            .zip(rates)
+            .map(|(t, &rate_hz)| HotTrain { rate_hz, ..*t })
+            .collect();
+        for &range in ranges {
+            out = EventChunk::merged(&out, &hot_pixels::events(&trains, range, r.seed));
+        }
+    }
+    Ok(out)
+}
+
+/// The pixels (y * W + x) the noise is drawn at: the kept ones, and the named hot pixels
+/// when the model does not know them as hot.
+fn noisy_pixels(r: &Replaying, model: &NoiseModel) -> Vec<usize> {
     let m = r.measuring;
     let w = m.sensor.width as usize;
     let mut pixels: Vec<usize> = m
@@ -139,18 +170,20 @@ fn noise(
     if model.hot_rates_hz.is_none() {
         pixels.extend(m.hot.iter().map(|&(x, y)| y as usize * w + x as usize));
     }
-    let pixel_seconds: f64 = pixels.len() as f64
-        * ranges
-            .iter()
-            .map(|r| (r.1 - r.0) as f64 * 1e-6)
-            .sum::<f64>();
-    let expected = (model.noise_on_hz + model.noise_off_hz) * pixel_seconds;
-    let bound = MAX_DRAWN_PER_EVENT * m.events.len() as f64 + 1e6;
-    if expected > bound {
-        return Err(format!(
-            "the model's noise would draw {expected:.0} events on the held-out blocks, over {bound:.0} (four times the recording's events plus a million): not simulated back"
-        ));
-    }
+    pixels
+}
+
+/// The model's shot noise and leak over `ranges`, time-sorted: per range and polarity a
+/// Poisson number of events (about `expected` in all), each at a uniform time and one of
+/// `pixels` drawn uniformly.
+fn drawn_noise(
+    r: &Replaying,
+    model: &NoiseModel,
+    ranges: &[(TimeUs, TimeUs)],
+    pixels: &[usize],
+    expected: f64,
+) -> EventChunk {
+    let w = r.measuring.sensor.width as usize;
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(r.seed);
     let mut drawn: Vec<(TimeUs, u32, bool)> = Vec::with_capacity(expected as usize + 16);
     for &(a, b) in ranges {
@@ -172,18 +205,7 @@ fn noise(
     for (t, p, on) in drawn {
         out.push(t, (p as usize % w) as u16, (p as usize / w) as u16, on);
     }
-    if let Some(rates) = &model.hot_rates_hz {
-        let trains: Vec<HotTrain> = r
-            .trains
-            .iter()
-            .zip(rates)
-            .map(|(t, &rate_hz)| HotTrain { rate_hz, ..*t })
-            .collect();
-        for &range in ranges {
-            out = EventChunk::merged(&out, &hot_pixels::events(&trains, range, r.seed));
-        }
-    }
-    Ok(out)
+    out
 }
 
 /// The scene's events with the drawn ones laid over them, in time order. Under a
