@@ -419,60 +419,71 @@ fn leak_param(
     scene: Option<&super::candidates::SceneLike>,
     out: &mut Parameters,
 ) {
-    let Parameters {
-        params,
-        why,
-        uncertainties,
-        ..
-    } = out;
-    if let Some((excess, se)) = on_excess(run) {
-        // an onset only where the isolated events are not the scene's own: a scene whose
-        // unsupported events turn ON-heavy later would rise the same way
-        if let (Some(onset), None) = (&run.leak_onset, scene) {
-            // a lower bound, whether or not the loop kept leak: the model simulates the
-            // measured excess, the JSON says it is at least that
-            if kept {
-                params.leak_rate_hz = Some(excess);
-            }
-            let lo = (excess - 2.0 * se).max(0.0);
-            why.insert(
-                "leak_rate_hz".into(),
-                format!(
-                    "{}: at least {lo:.4} Hz (2 standard errors), upper end not determined",
-                    onset.evidence()
-                ),
-            );
-            uncertainties.insert(
-                "leak_rate_hz".into(),
-                Uncertain::with_interval(excess.max(0.0), Some(se), [Some(lo), None]),
-            );
-        } else if let (Some(scene), false) = (scene, kept) {
-            why.insert(
-                "leak_rate_hz".into(),
-                format!(
-                    "{}: the leak lies between 0 and {:.4} Hz (the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, with 2 standard errors)",
-                    scene.evidence(),
-                    excess.max(0.0) + 2.0 * se
-                ),
-            );
-        } else if kept {
-            params.leak_rate_hz = Some(excess);
-            let leak = down_to_none(Uncertain::positive(excess, Some(se)), run);
-            let leak = match super::candidates::scene_share(run) {
-                Some(share) => reach_down_to_scene_share(leak, share, se, excess, why),
-                None => leak,
-            };
-            uncertainties.insert("leak_rate_hz".into(), leak);
-        } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
-            why.insert(
-                "leak_rate_hz".into(),
-                format!(
-                    "the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, is not told apart from none: at most {:.4} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden; and where the recording starts at a reset, a simulator's first frame or a camera's start, a leak whose period is longer than the time since fires no event yet: the bound holds for leak phases spread at random, as in a camera that has been running)",
-                    excess.max(0.0) + 2.0 * se
-                ),
-            );
-        }
+    let Some((excess, se)) = on_excess(run) else {
+        return;
+    };
+    // an onset only where the isolated events are not the scene's own: a scene whose
+    // unsupported events turn ON-heavy later would rise the same way
+    if let (Some(onset), None) = (&run.leak_onset, scene) {
+        leak_after_onset(onset, (excess, se), kept, out);
+    } else if let (Some(scene), false) = (scene, kept) {
+        out.why.insert(
+            "leak_rate_hz".into(),
+            format!(
+                "{}: the leak lies between 0 and {:.4} Hz (the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, with 2 standard errors)",
+                scene.evidence(),
+                excess.max(0.0) + 2.0 * se
+            ),
+        );
+    } else if kept {
+        leak_measured(run, (excess, se), out);
+    } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
+        out.why.insert(
+            "leak_rate_hz".into(),
+            format!(
+                "the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, is not told apart from none: at most {:.4} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden; and where the recording starts at a reset, a simulator's first frame or a camera's start, a leak whose period is longer than the time since fires no event yet: the bound holds for leak phases spread at random, as in a camera that has been running)",
+                excess.max(0.0) + 2.0 * se
+            ),
+        );
     }
+}
+
+/// Leak after an `onset`: the ON `(excess, se)` a lower bound, whether or not the loop
+/// `kept` leak (the model simulates the measured excess, the JSON says it is at least
+/// that).
+fn leak_after_onset(
+    onset: &super::leak_onset::Onset,
+    (excess, se): (f64, f64),
+    kept: bool,
+    out: &mut Parameters,
+) {
+    if kept {
+        out.params.leak_rate_hz = Some(excess);
+    }
+    let lo = (excess - 2.0 * se).max(0.0);
+    out.why.insert(
+        "leak_rate_hz".into(),
+        format!(
+            "{}: at least {lo:.4} Hz (2 standard errors), upper end not determined",
+            onset.evidence()
+        ),
+    );
+    out.uncertainties.insert(
+        "leak_rate_hz".into(),
+        Uncertain::with_interval(excess.max(0.0), Some(se), [Some(lo), None]),
+    );
+}
+
+/// Leak kept: the ON `(excess, se)`, its interval reaching down to none under a noise
+/// bound and to the scene's share where the scene may hold the excess.
+fn leak_measured(run: &FitRun, (excess, se): (f64, f64), out: &mut Parameters) {
+    out.params.leak_rate_hz = Some(excess);
+    let leak = down_to_none(Uncertain::positive(excess, Some(se)), run);
+    let leak = match super::candidates::scene_share(run) {
+        Some(share) => reach_down_to_scene_share(leak, share, se, excess, &mut out.why),
+        None => leak,
+    };
+    out.uncertainties.insert("leak_rate_hz".into(), leak);
 }
 
 /// `leak`'s interval reaching down to the least leak the isolated events hold where the
