@@ -285,11 +285,7 @@ fn starting_point(
         frames.offset = offset;
         frames.offset_range = range;
     }
-    let params = PixelParams {
-        log_response: Some(frames.log_map.response()),
-        log_eps: Some(frames.log_map.eps()),
-        ..start.params.clone()
-    };
+    let params = crate::estimate::resim::read_as_frames(&start.params, frames.log_map);
     (start, params)
 }
 
