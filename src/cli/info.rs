@@ -41,38 +41,44 @@ pub fn run(args: &InfoArgs, global: &Global) -> anyhow::Result<()> {
         emit_json(&info, target, &global.outputs([args.input.input.as_path()]))?;
     }
     if !matches!(target, Some(JsonTarget::Stdout)) {
-        let mut format = info.format.to_string();
-        if let Some(layout) = info.layout {
-            format.push_str(&format!(" ({layout} layout)"));
-        }
-        output::print_table(&[
-            ("format".into(), format),
-            (
-                "sensor".into(),
-                format!("{}x{} ({})", info.width, info.height, info.sensor_source),
-            ),
-            (
-                "events".into(),
-                format!("{} ({} ON)", info.events, info.on_events),
-            ),
-            (
-                "time".into(),
-                format!("{} .. {} us", info.t_first_us, info.t_last_us),
-            ),
-            (
-                "duration".into(),
-                output::seconds((info.t_last_us - info.t_first_us) as f64 * 1e-6),
-            ),
-            (
-                "timestamps backwards".into(),
-                info.timestamps_backwards.to_string(),
-            ),
-            ("frames".into(), info.frames.to_string()),
-            output::biases_row(info.biases.as_ref()),
-        ])?;
-        if !info.topics.is_empty() {
-            print_topics(&info.topics)?;
-        }
+        print_info(&info)?;
+    }
+    Ok(())
+}
+
+/// The recording's summary as a table, then a bag's topics.
+fn print_info(info: &ctcal::io::info::Info) -> anyhow::Result<()> {
+    let mut format = info.format.to_string();
+    if let Some(layout) = info.layout {
+        format.push_str(&format!(" ({layout} layout)"));
+    }
+    output::print_table(&[
+        ("format".into(), format),
+        (
+            "sensor".into(),
+            format!("{}x{} ({})", info.width, info.height, info.sensor_source),
+        ),
+        (
+            "events".into(),
+            format!("{} ({} ON)", info.events, info.on_events),
+        ),
+        (
+            "time".into(),
+            format!("{} .. {} us", info.t_first_us, info.t_last_us),
+        ),
+        (
+            "duration".into(),
+            output::seconds((info.t_last_us - info.t_first_us) as f64 * 1e-6),
+        ),
+        (
+            "timestamps backwards".into(),
+            info.timestamps_backwards.to_string(),
+        ),
+        ("frames".into(), info.frames.to_string()),
+        output::biases_row(info.biases.as_ref()),
+    ])?;
+    if !info.topics.is_empty() {
+        print_topics(&info.topics)?;
     }
     Ok(())
 }
