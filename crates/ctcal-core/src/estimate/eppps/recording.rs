@@ -323,6 +323,52 @@ fn units(
         .collect()
 }
 
+/// The units summed: the patches' sums for the bootstrap, the travel and direction of
+/// each unit that counts, the noise tally over every unit, and how many units there are.
+struct Counted {
+    groups: Groups,
+    travels: Vec<f32>,
+    directions: Vec<(f32, f32)>,
+    noise: NoiseTally,
+    unit_count: usize,
+}
+
+impl Counted {
+    /// Sums the units of `tally` (see [`units`]): every unit into the noise rate, those
+    /// that count into their patch's group and the scans' travels.
+    fn sum(tally: &Tally, paths: &Paths, covered_s: &[f64], excluded: &[bool], w: usize) -> Self {
+        let tiles_x = w.div_ceil(PATCH_PX);
+        let mut groups: Groups = vec![[0.0; 3]; tiles_x * (excluded.len() / w).div_ceil(PATCH_PX)];
+        let (mut travels, mut directions) = (Vec::new(), Vec::new());
+        let mut noise = NoiseTally::default();
+        let mut unit_count = 0;
+        for (first, u) in units(tally, paths, covered_s, excluded, w) {
+            unit_count += 1;
+            // a tile counts where it has signal (a supported event: blank parts of the view
+            // travel without events); a reliable pixel counts whatever fired there, since
+            // choosing pixels by their own support would choose them by their noise too
+            let counts = paths.tile_px.is_none() || u.supported[0] + u.supported[1] > 0.0;
+            // the noise rate from every unit, its count where the unit counts
+            noise.add(&u, counts);
+            if !counts {
+                continue;
+            }
+            let all = u.all;
+            let g = &mut groups[(first / w / PATCH_PX) * tiles_x + (first % w) / PATCH_PX];
+            *g = [g[0] + all[0], g[1] + all[1], g[2] + u.travel];
+            travels.push((u.travel / u.pixels as f64) as f32);
+            directions.push(u.direction);
+        }
+        Counted {
+            groups,
+            travels,
+            directions,
+            noise,
+            unit_count,
+        }
+    }
+}
+
 /// Rates from a tally and the pixels' paths: per polarity, over the units that count
 /// (reliable pixels; tiles with a supported event), the geometric mean of all their events
 /// and all but the most noise they can hold (see the module docs).
@@ -333,28 +379,13 @@ fn finish(
     w: usize,
     f: Finish,
 ) -> Option<RecordingRates> {
-    let tiles_x = w.div_ceil(PATCH_PX);
-    let mut groups: Groups = vec![[0.0; 3]; tiles_x * (excluded.len() / w).div_ceil(PATCH_PX)];
-    let (mut travels, mut directions) = (Vec::new(), Vec::new());
-    let mut noise = NoiseTally::default();
-    let mut unit_count = 0;
-    for (first, u) in units(tally, paths, &f.covered_s, excluded, w) {
-        unit_count += 1;
-        // a tile counts where it has signal (a supported event: blank parts of the view
-        // travel without events); a reliable pixel counts whatever fired there, since
-        // choosing pixels by their own support would choose them by their noise too
-        let counts = paths.tile_px.is_none() || u.supported[0] + u.supported[1] > 0.0;
-        // the noise rate from every unit, its count where the unit counts
-        noise.add(&u, counts);
-        if !counts {
-            continue;
-        }
-        let all = u.all;
-        let g = &mut groups[(first / w / PATCH_PX) * tiles_x + (first % w) / PATCH_PX];
-        *g = [g[0] + all[0], g[1] + all[1], g[2] + u.travel];
-        travels.push((u.travel / u.pixels as f64) as f32);
-        directions.push(u.direction);
-    }
+    let Counted {
+        groups,
+        travels,
+        directions,
+        noise,
+        unit_count,
+    } = Counted::sum(tally, paths, &f.covered_s, excluded, w);
     let total = groups
         .iter()
         .fold([0.0; 3], |s, g| [s[0] + g[0], s[1] + g[1], s[2] + g[2]]);
@@ -689,15 +720,10 @@ fn median_reliable_dn(frames: &PreparedFrames) -> Option<f64> {
     crate::stats::robust::histogram_median(&histogram).map(|dn| dn as f64)
 }
 
-/// The recording's rates with travel from the frames' flow: every reliable pixel of every
-/// used interval counts (the scans follow the same paths, so nothing needs to have fired).
-pub fn from_frames(
-    events: &EventChunk,
-    frames: &PreparedFrames,
-    sensor: Sensor,
-    excluded: &[bool],
-) -> Option<RecordingRates> {
-    let (w, pixels) = (frames.width, frames.width * frames.height);
+/// Every reliable pixel's path over the intervals with a flow (travel, and the time it
+/// counts), and the median speed of every pixel's flow; `None` without a flow.
+fn frame_paths(frames: &PreparedFrames) -> Option<(Paths, f64)> {
+    let pixels = frames.width * frames.height;
     let mut speeds = Vec::new();
     let mut paths = Paths {
         travel: vec![0.0; pixels],
@@ -720,7 +746,39 @@ pub fn from_frames(
         return None;
     }
     speeds.sort_by(f64::total_cmp);
-    let median = speeds[speeds.len() / 2];
+    Some((paths, speeds[speeds.len() / 2]))
+}
+
+/// Each pixel's counted time (the intervals with a flow where it is reliable) within
+/// `window` of a neighbour's event, seconds.
+fn frames_covered_s(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    window: TimeUs,
+) -> Vec<f64> {
+    seconds(covered_time(events, sensor, window, |q, from, to| {
+        let first = frames
+            .times
+            .partition_point(|&s| s <= from)
+            .saturating_sub(1);
+        (first..frames.times.len().saturating_sub(1))
+            .take_while(|&k| frames.times[k] < to)
+            .filter(|&k| frames.flows[k].is_some() && frames.reliable(k, q))
+            .map(|k| (to.min(frames.times[k + 1]) - from.max(frames.times[k])).max(0))
+            .sum()
+    }))
+}
+
+/// The recording's rates with travel from the frames' flow: every reliable pixel of every
+/// used interval counts (the scans follow the same paths, so nothing needs to have fired).
+pub fn from_frames(
+    events: &EventChunk,
+    frames: &PreparedFrames,
+    sensor: Sensor,
+    excluded: &[bool],
+) -> Option<RecordingRates> {
+    let (paths, median) = frame_paths(frames)?;
     let window = support_window(median);
     let support = supported(events, sensor, window);
     let tally = Tally::new(events, sensor, excluded, &support, |i, pixel| {
@@ -745,19 +803,9 @@ pub fn from_frames(
             &paths.exposure_s,
             excluded,
         )),
-        covered_s: seconds(covered_time(events, sensor, window, |q, from, to| {
-            let first = frames
-                .times
-                .partition_point(|&s| s <= from)
-                .saturating_sub(1);
-            (first..frames.times.len().saturating_sub(1))
-                .take_while(|&k| frames.times[k] < to)
-                .filter(|&k| frames.flows[k].is_some() && frames.reliable(k, q))
-                .map(|k| (to.min(frames.times[k + 1]) - from.max(frames.times[k])).max(0))
-                .sum()
-        })),
+        covered_s: frames_covered_s(events, frames, sensor, window),
     };
-    finish(&tally, &paths, excluded, w, finish_with)
+    finish(&tally, &paths, excluded, frames.width, finish_with)
 }
 
 #[cfg(test)]
