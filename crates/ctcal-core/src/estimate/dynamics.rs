@@ -106,9 +106,7 @@ fn textured_speeds(frames: &PreparedFrames, k: usize, flow: &FlowField) -> Vec<f
 /// active events (at most `max_fits` fits, spread over the recording). `None` with too few
 /// good fits.
 pub fn edge_speed(events: &EventChunk, sensor: Sensor, max_fits: usize) -> Option<f64> {
-    const RADIUS: i32 = 2;
-    const WINDOW_US: TimeUs = 100_000;
-    let (w, h) = (sensor.width as i32, sensor.height as i32);
+    let w = sensor.width as i32;
     // latest event time per pixel and polarity
     let mut latest = vec![[TimeUs::MIN; 2]; sensor.pixels()];
     let stride = (events.len() / max_fits.max(1)).max(1);
@@ -120,49 +118,9 @@ pub fn edge_speed(events: &EventChunk, sensor: Sensor, max_fits: usize) -> Optio
         if i % stride != 0 {
             continue;
         }
-        // least-squares plane t_n - t = a dx + b dy + c over recent same-polarity neighbours
-        let (mut sxx, mut sxy, mut syy, mut sx, mut sy, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-        let (mut sxt, mut syt, mut st) = (0.0, 0.0, 0.0);
-        for dy in -RADIUS..=RADIUS {
-            for dx in -RADIUS..=RADIUS {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx < 0 || ny < 0 || nx >= w || ny >= h {
-                    continue;
-                }
-                let tn = latest[(ny * w + nx) as usize][p];
-                if tn == TimeUs::MIN || t - tn > WINDOW_US {
-                    continue;
-                }
-                let (fx, fy, ft) = (dx as f64, dy as f64, (tn - t) as f64 * 1e-6);
-                sxx += fx * fx;
-                sxy += fx * fy;
-                syy += fy * fy;
-                sx += fx;
-                sy += fy;
-                sxt += fx * ft;
-                syt += fy * ft;
-                st += ft;
-                n += 1.0;
-            }
-        }
-        if n < 6.0 {
-            continue;
-        }
-        // centre, then solve the 2x2 system for (a, b)
-        let (cxx, cxy, cyy) = (sxx - sx * sx / n, sxy - sx * sy / n, syy - sy * sy / n);
-        let (cxt, cyt) = (sxt - sx * st / n, syt - sy * st / n);
-        let det = cxx * cyy - cxy * cxy;
-        if det <= 1e-9 {
-            continue;
-        }
-        let a = (cyy * cxt - cxy * cyt) / det;
-        let b = (cxx * cyt - cxy * cxt) / det;
-        let gradient = a.hypot(b);
-        if gradient > 1e-5 {
-            let speed = 1.0 / gradient;
-            if speed < 1e4 {
-                speeds.push(speed);
-            }
+        let sums = PlaneSums::around(&latest, sensor, (x, y, t), p);
+        if let Some(speed) = sums.normal_speed() {
+            speeds.push(speed);
         }
     }
     if speeds.len() < 100 {
@@ -170,4 +128,93 @@ pub fn edge_speed(events: &EventChunk, sensor: Sensor, max_fits: usize) -> Optio
     }
     let mid = speeds.len() / 2;
     Some(*speeds.select_nth_unstable_by(mid, f64::total_cmp).1)
+}
+
+/// The sums of a least-squares plane `t_n - t = a dx + b dy + c` over an event's recent
+/// same-polarity neighbours (the surface of active events around it).
+#[derive(Clone, Copy, Default)]
+struct PlaneSums {
+    sxx: f64,
+    sxy: f64,
+    syy: f64,
+    sx: f64,
+    sy: f64,
+    sxt: f64,
+    syt: f64,
+    st: f64,
+    n: f64,
+}
+
+impl PlaneSums {
+    /// Neighbours within this many pixels of the event are fitted.
+    const RADIUS: i32 = 2;
+    /// Neighbours whose latest event of the polarity is older than this are left out.
+    const WINDOW_US: TimeUs = 100_000;
+
+    /// The sums over the neighbours of the event at `(x, y, t)` of polarity `p`, from each
+    /// pixel's `latest` event time per polarity.
+    fn around(
+        latest: &[[TimeUs; 2]],
+        sensor: Sensor,
+        (x, y, t): (i32, i32, TimeUs),
+        p: usize,
+    ) -> Self {
+        let (w, h) = (sensor.width as i32, sensor.height as i32);
+        let mut s = PlaneSums::default();
+        for dy in -Self::RADIUS..=Self::RADIUS {
+            for dx in -Self::RADIUS..=Self::RADIUS {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w || ny >= h {
+                    continue;
+                }
+                let tn = latest[(ny * w + nx) as usize][p];
+                if tn == TimeUs::MIN || t - tn > Self::WINDOW_US {
+                    continue;
+                }
+                let (fx, fy, ft) = (dx as f64, dy as f64, (tn - t) as f64 * 1e-6);
+                s.sxx += fx * fx;
+                s.sxy += fx * fy;
+                s.syy += fy * fy;
+                s.sx += fx;
+                s.sy += fy;
+                s.sxt += fx * ft;
+                s.syt += fy * ft;
+                s.st += ft;
+                s.n += 1.0;
+            }
+        }
+        s
+    }
+
+    /// The plane's normal speed `1 / |grad t|`, px/s; `None` with fewer than 6 neighbours,
+    /// a degenerate plane, or a speed of 10,000 px/s or more.
+    fn normal_speed(&self) -> Option<f64> {
+        let PlaneSums {
+            sxx,
+            sxy,
+            syy,
+            sx,
+            sy,
+            sxt,
+            syt,
+            st,
+            n,
+        } = *self;
+        if n < 6.0 {
+            return None;
+        }
+        // centre, then solve the 2x2 system for (a, b)
+        let (cxx, cxy, cyy) = (sxx - sx * sx / n, sxy - sx * sy / n, syy - sy * sy / n);
+        let (cxt, cyt) = (sxt - sx * st / n, syt - sy * st / n);
+        let det = cxx * cyy - cxy * cxy;
+        if det <= 1e-9 {
+            return None;
+        }
+        let a = (cyy * cxt - cxy * cyt) / det;
+        let b = (cxx * cyt - cxy * cxt) / det;
+        let gradient = a.hypot(b);
+        (gradient > 1e-5)
+            .then(|| 1.0 / gradient)
+            .filter(|&speed| speed < 1e4)
+    }
 }
