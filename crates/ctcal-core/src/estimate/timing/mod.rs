@@ -839,22 +839,6 @@ fn polarity(
         .filter(|(i, _)| weight[*i] > 0.0)
         .map(|v| v.1)
         .collect();
-    let mut deviations: Vec<f64> = kept.iter().map(|v| (v - ct).abs()).collect();
-    let sample_spread = if deviations.is_empty() {
-        f64::NAN
-    } else {
-        let mid = deviations.len() / 2;
-        1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1 / ct
-    };
-    let (distance, total) = pairs
-        .iter()
-        .zip(weight)
-        .filter(|(p, w)| p.on == on && **w > 0.0)
-        .fold((0.0, 0.0), |(d, t), (p, w)| {
-            (d + w * p.interpolation(), t + w)
-        });
-    let trend = if on { c.interp_on } else { c.interp_off };
-    let interpolation_share = -trend * distance / total.max(1e-300) / ct;
     let mut map = vec![(0.0, 0u32); sensor.pixels()];
     for ((s, n, _), &p) in sums.iter().zip(&which) {
         map[p] = (*s, *n);
@@ -872,11 +856,37 @@ fn polarity(
             samples: kept.len(),
             pixels: sums.len(),
             rejected: own.len() - kept.len(),
-            sample_spread,
-            interpolation_share,
+            sample_spread: sample_spread(&kept, ct),
+            interpolation_share: interpolation_share(pairs, weight, c, on, ct),
         },
         map,
     ))
+}
+
+/// The robust relative spread of the `kept` samples about `ct`: 1.4826 MAD over `ct`
+/// (NaN without samples).
+fn sample_spread(kept: &[f64], ct: f64) -> f64 {
+    let mut deviations: Vec<f64> = kept.iter().map(|v| (v - ct).abs()).collect();
+    if deviations.is_empty() {
+        f64::NAN
+    } else {
+        let mid = deviations.len() / 2;
+        1.4826 * *deviations.select_nth_unstable_by(mid, f64::total_cmp).1 / ct
+    }
+}
+
+/// The share of `ct` the frames' interpolation took from polarity `on`'s kept samples:
+/// the fitted trend at their mean distance from the frames (weighted as fitted) over `ct`.
+fn interpolation_share(pairs: &[Pair], weight: &[f64], c: &Coefficients, on: bool, ct: f64) -> f64 {
+    let (distance, total) = pairs
+        .iter()
+        .zip(weight)
+        .filter(|(p, w)| p.on == on && **w > 0.0)
+        .fold((0.0, 0.0), |(d, t), (p, w)| {
+            (d + w * p.interpolation(), t + w)
+        });
+    let trend = if on { c.interp_on } else { c.interp_off };
+    -trend * distance / total.max(1e-300) / ct
 }
 
 fn maps(sensor: Sensor, on: &[(f64, u32)], off: &[(f64, u32)]) -> ThresholdMaps {
