@@ -98,6 +98,57 @@ pub(super) fn timing_report(
     }
 }
 
+/// The share of the change the frames' interpolation misses, as pass `p`'s event timing
+/// found it for polarity `on`.
+fn missed_share(p: &Pass, on: bool) -> f64 {
+    let t = if on { &p.timing.on } else { &p.timing.off };
+    t.interpolation_share
+}
+
+/// The re-simulation's threshold of polarity `on` over the passes, each with its pass's
+/// missed share put back ([`interpolation_corrected`]).
+fn corrected_series(passes: &[(usize, &Pass)], on: bool) -> Vec<FrameRatePoint> {
+    series(passes, |p| {
+        p.resim.as_ref().map(|r| {
+            let ct = if on { r.ct_on } else { r.ct_off };
+            interpolation_corrected(ct, missed_share(p, on)).0
+        })
+    })
+}
+
+/// The assumption naming the interpolation's correction of the re-simulation `r`: the
+/// shares of the full pass, and the thresholds before and after (`corrected`, ON and OFF).
+fn interpolation_note(
+    r: &crate::estimate::resim::ResimEstimate,
+    full: &Pass,
+    [on_value, off_value]: [f64; 2],
+) -> String {
+    format!(
+        "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
+        100.0 * missed_share(full, true),
+        100.0 * missed_share(full, false),
+        r.ct_on,
+        r.ct_off,
+    )
+}
+
+/// A re-simulated threshold `value` with its standard error, and the frame-rate series',
+/// the `offset`'s and half the `applied` correction's systematics. The offset moves the
+/// re-simulation as it moves the timing (the same frames through the same log).
+fn resimulation_measured(
+    value: f64,
+    se: f64,
+    series: &[FrameRatePoint],
+    offset: f64,
+    applied: f64,
+) -> Measured {
+    let systematic = frame_rate_systematic(series)
+        .1
+        .hypot(offset)
+        .hypot(0.5 * applied);
+    Measured::new(value, se, systematic)
+}
+
 /// The re-simulation's thresholds `r` (of the full pass), with the share of the change the
 /// interpolation misses put back, and the frame-rate, offset and half-the-correction
 /// systematics in their intervals; and the assumption naming the correction where one was
@@ -107,48 +158,20 @@ pub(super) fn resimulation_report(
     r: &crate::estimate::resim::ResimEstimate,
 ) -> (EstimatorReport, Option<String>) {
     let full = passes[0].1;
-    let share = |p: &Pass, on: bool| {
-        let t = if on { &p.timing.on } else { &p.timing.off };
-        t.interpolation_share
-    };
-    let series_on = series(passes, |p| {
-        p.resim
-            .as_ref()
-            .map(|r| interpolation_corrected(r.ct_on, share(p, true)).0)
-    });
-    let series_off = series(passes, |p| {
-        p.resim
-            .as_ref()
-            .map(|r| interpolation_corrected(r.ct_off, share(p, false)).0)
-    });
-    let (on_value, on_applied) = interpolation_corrected(r.ct_on, share(full, true));
-    let (off_value, off_applied) = interpolation_corrected(r.ct_off, share(full, false));
-    let note = (on_applied > 0.0 || off_applied > 0.0).then(|| {
-        format!(
-            "the re-simulation's counts come from the same frames interpolated along the flow as the event timing's samples, so they miss the share of the change the timing found the interpolation to miss (ON {:.1} %, OFF {:.1} %): its thresholds are divided by one less that share (ON {:.4} -> {on_value:.4}, OFF {:.4} -> {off_value:.4}), and half the correction stays in their intervals",
-            100.0 * share(full, true),
-            100.0 * share(full, false),
-            r.ct_on,
-            r.ct_off,
-        )
-    });
-    // the offset moves the re-simulation as it moves the timing (the same frames through
-    // the same log)
-    let measure = |value: f64, se: f64, series: &[FrameRatePoint], offset: f64, applied: f64| {
-        let systematic = frame_rate_systematic(series)
-            .1
-            .hypot(offset)
-            .hypot(0.5 * applied);
-        Measured::new(value, se, systematic)
-    };
-    let on = measure(
+    let series_on = corrected_series(passes, true);
+    let series_off = corrected_series(passes, false);
+    let (on_value, on_applied) = interpolation_corrected(r.ct_on, missed_share(full, true));
+    let (off_value, off_applied) = interpolation_corrected(r.ct_off, missed_share(full, false));
+    let note = (on_applied > 0.0 || off_applied > 0.0)
+        .then(|| interpolation_note(r, full, [on_value, off_value]));
+    let on = resimulation_measured(
         on_value,
         r.standard_error_on,
         &series_on,
         full.timing.on.offset_systematic,
         on_applied,
     );
-    let off = measure(
+    let off = resimulation_measured(
         off_value,
         r.standard_error_off,
         &series_off,
