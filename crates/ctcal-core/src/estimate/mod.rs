@@ -138,63 +138,92 @@ fn checked(
     m: &Measured,
     range: Determinable,
 ) -> Result<(f64, Interval, Option<String>), String> {
+    if let Some(why) = why_not_determinable(name, m) {
+        return Err(why);
+    }
+    let lo = (m.ci95[0] > 0.0).then_some(m.ci95[0]);
+    if let Some((ci, note)) = range.extrapolation(name, m, lo) {
+        return Ok((m.value, ci, Some(note)));
+    }
+    let (ci, note) = range.clipped(name, m, lo);
+    Ok((m.value, ci, note))
+}
+
+/// Why the data do not determine `m` (named `name`): a value that is not finite or not
+/// positive, or an uncertainty that is not finite; `None` where they do.
+fn why_not_determinable(name: &str, m: &Measured) -> Option<String> {
     if !m.value.is_finite() {
-        return Err(format!(
+        return Some(format!(
             "the method gave no finite {name} ({}): the data do not determine it",
             m.value
         ));
     }
     if m.value <= 0.0 {
-        return Err(format!(
+        return Some(format!(
             "the method gave {name} = {:.4}, not a threshold (<= 0): the data do not determine it (too few or inconsistent events for this method)",
             m.value
         ));
     }
     let total = m.total_error();
     if !total.is_finite() {
-        return Err(format!(
+        return Some(format!(
             "{name} = {:.4} has no finite uncertainty: not determinable",
             m.value
         ));
     }
-    let lo = (m.ci95[0] > 0.0).then_some(m.ci95[0]);
-    if m.value < range.lo {
-        return Ok((
-            m.value,
-            [None, Some(m.ci95[1])],
-            Some(format!(
-                "{name} = {:.4} is an extrapolation below {} (down to {}): its interval is open below",
-                m.value, range.what, range.lo
-            )),
-        ));
+    None
+}
+
+impl Determinable {
+    /// The interval and note of a value `m` outside the range: an extrapolation, its
+    /// interval open on the far side (`lo`: its lower end where positive); `None` inside.
+    fn extrapolation(
+        &self,
+        name: &str,
+        m: &Measured,
+        lo: Option<f64>,
+    ) -> Option<(Interval, String)> {
+        if m.value < self.lo {
+            return Some((
+                [None, Some(m.ci95[1])],
+                format!(
+                    "{name} = {:.4} is an extrapolation below {} (down to {}): its interval is open below",
+                    m.value, self.what, self.lo
+                ),
+            ));
+        }
+        if m.value > self.hi {
+            return Some((
+                [lo, None],
+                format!(
+                    "{name} = {:.4} is an extrapolation above {} (up to {}): its interval is open above",
+                    m.value, self.what, self.hi
+                ),
+            ));
+        }
+        None
     }
-    if m.value > range.hi {
-        return Ok((
-            m.value,
-            [lo, None],
-            Some(format!(
-                "{name} = {:.4} is an extrapolation above {} (up to {}): its interval is open above",
-                m.value, range.what, range.hi
-            )),
-        ));
+
+    /// The interval of a value `m` inside the range (`lo`: its lower end where positive,
+    /// else 0): open on a side where it runs past the range, with the notes saying so.
+    fn clipped(&self, name: &str, m: &Measured, lo: Option<f64>) -> (Interval, Option<String>) {
+        let (mut ci, mut notes) = ([lo.or(Some(0.0)), Some(m.ci95[1])], Vec::new());
+        if m.ci95[1] > self.hi {
+            ci[1] = None;
+            notes.push(format!(
+                "the 95 % interval of {name} runs past {} (up to {}): open above",
+                self.what, self.hi
+            ));
+        }
+        if self.lo > 0.0 && m.ci95[0] < self.lo {
+            ci[0] = None;
+            notes.push(format!(
+                "the 95 % interval of {name} runs below {} (down to {}): open below",
+                self.what, self.lo
+            ));
+        }
+        (ci, (!notes.is_empty()).then(|| notes.join("; ")))
     }
-    // an interval that runs past the range is open on that side
-    let (mut ci, mut notes) = ([lo.or(Some(0.0)), Some(m.ci95[1])], Vec::new());
-    if m.ci95[1] > range.hi {
-        ci[1] = None;
-        notes.push(format!(
-            "the 95 % interval of {name} runs past {} (up to {}): open above",
-            range.what, range.hi
-        ));
-    }
-    if range.lo > 0.0 && m.ci95[0] < range.lo {
-        ci[0] = None;
-        notes.push(format!(
-            "the 95 % interval of {name} runs below {} (down to {}): open below",
-            range.what, range.lo
-        ));
-    }
-    Ok((m.value, ci, (!notes.is_empty()).then(|| notes.join("; "))))
 }
 
 impl CtEstimate {
