@@ -118,6 +118,15 @@ struct Intervals<'a> {
 }
 
 impl Intervals<'_> {
+    /// Every interval's flow ([`Intervals::flow`]), each on its own thread, kept in order.
+    fn every_flow(&self) -> (Vec<Option<FlowField>>, Vec<IntervalInfo>) {
+        let results: Vec<(Option<FlowField>, IntervalInfo)> = (0..self.times.len() - 1)
+            .into_par_iter()
+            .map(|k| self.flow(k))
+            .collect();
+        results.into_iter().unzip()
+    }
+
     /// Interval `k`'s optical flow where it is used, and why not where it is not: it
     /// crosses a span not read, a frame has a problem, the frames share a time, no event
     /// falls between them, or the motion (95th percentile of the flow) is too large to
@@ -175,6 +184,27 @@ impl Intervals<'_> {
     }
 }
 
+/// The refusal of a recording with fewer than two grey frames (`frames` of them).
+fn too_few_frames(frames: usize) -> EstimateError {
+    EstimateError::new(
+        format!("needs at least two grey frames; the recording has {frames}"),
+        Text::from("use ").name(Hint::Analysis(Analysis::Eppps)),
+    )
+}
+
+/// Each frame's log image through `log_map`, on every thread, kept in order.
+fn log_images(dn: &[Image], log_map: &LogMap) -> Vec<Image> {
+    dn.par_iter()
+        .map(|d| {
+            Image::new(
+                d.width,
+                d.height,
+                d.data.iter().map(|&v| log_map.apply(v)).collect(),
+            )
+        })
+        .collect()
+}
+
 /// Why no interval of a recording's frames can be used (its first three reasons), and
 /// what to do.
 fn no_usable_interval(intervals: &[IntervalInfo]) -> EstimateError {
@@ -213,13 +243,7 @@ impl PreparedFrames {
         options: &FrameOptions,
     ) -> Result<Self, EstimateError> {
         if frames.len() < 2 {
-            return Err(EstimateError::new(
-                format!(
-                    "needs at least two grey frames; the recording has {}",
-                    frames.len()
-                ),
-                Text::from("use ").name(Hint::Analysis(Analysis::Eppps)),
-            ));
+            return Err(too_few_frames(frames.len()));
         }
         let (width, height) = (frames[0].width as usize, frames[0].height as usize);
         let dn: Vec<Image> = frames
@@ -228,29 +252,16 @@ impl PreparedFrames {
             .collect();
         let times: Vec<TimeUs> = frames.iter().map(|f| f.t).collect();
         let frame_problems = frame_problems(&dn, options);
-        let logs: Vec<Image> = dn
-            .par_iter()
-            .map(|d| {
-                Image::new(
-                    width,
-                    height,
-                    d.data.iter().map(|&v| log_map.apply(v)).collect(),
-                )
-            })
-            .collect();
-        let intervals = Intervals {
+        let logs = log_images(&dn, &log_map);
+        let (flows, intervals) = Intervals {
             times: &times,
             logs: &logs,
             frame_problems: &frame_problems,
             event_times,
             unread,
             options,
-        };
-        let results: Vec<(Option<FlowField>, IntervalInfo)> = (0..frames.len() - 1)
-            .into_par_iter()
-            .map(|k| intervals.flow(k))
-            .collect();
-        let (flows, intervals) = results.into_iter().unzip();
+        }
+        .every_flow();
         let prepared = Self {
             width,
             height,
