@@ -39,42 +39,19 @@ pub fn align(
     if quarter < 100 {
         return None;
     }
-    const STEPS: i64 = 4;
-    let step = quarter / STEPS;
-    let evaluate = |shift: TimeUs| spread(events, frames, shift, sensor, excluded, options);
-    let tried: Vec<(TimeUs, Option<f64>)> = (-STEPS..=STEPS)
-        .into_par_iter()
-        .map(|k| (k * step, evaluate(k * step)))
-        .collect();
-    frames.replay_shifts(tried.iter().map(|t| t.0));
-    let grid: Vec<(TimeUs, f64)> = tried
-        .into_iter()
-        .filter_map(|(shift, value)| Some((shift, value?)))
-        .collect();
+    let step = quarter / GRID_STEPS;
+    let spread_at =
+        |frames: &PreparedFrames, shift| spread(events, frames, shift, sensor, excluded, options);
+    let grid = spread_grid(frames, step, &spread_at);
     let unshifted = grid.iter().find(|(s, _)| *s == 0)?.1;
     let best = grid
         .iter()
         .enumerate()
         .min_by(|a, b| a.1.1.total_cmp(&b.1.1))?
         .0;
-    // parabola through the best point and its neighbours (or the best point at an edge)
-    let (shift, curvature) = if best > 0 && best + 1 < grid.len() {
-        let (x0, y0) = grid[best - 1];
-        let (_, y1) = grid[best];
-        let (_, y2) = grid[best + 1];
-        let h = step as f64;
-        let denominator = y0 - 2.0 * y1 + y2;
-        let offset = if denominator > 0.0 {
-            (0.5 * (y0 - y2) / denominator).clamp(-1.0, 1.0)
-        } else {
-            0.0
-        };
-        (x0 as f64 + h * (1.0 + offset), denominator / (h * h))
-    } else {
-        (grid[best].0 as f64, 0.0)
-    };
+    let (shift, curvature) = parabola_minimum(&grid, best, step);
     let shift = shift.round() as TimeUs;
-    let aligned = spread(events, frames, shift, sensor, excluded, options);
+    let aligned = spread_at(frames, shift);
     frames.replay_shifts([shift]);
     let aligned = aligned.unwrap_or(grid[best].1);
     // the shift at which the spread rises by 2 %: y = a (x - x*)^2 / 2 ... a = curvature
@@ -89,4 +66,46 @@ pub fn align(
         spread_unshifted: unshifted,
         spread_aligned: aligned,
     })
+}
+
+/// Steps of the grid on either side of no shift, over a quarter of the frame interval.
+const GRID_STEPS: i64 = 4;
+
+/// The spread at each shift of the grid (`-GRID_STEPS..=GRID_STEPS` times `step`), tried on
+/// every thread, the frames then replaying the shifts in order; shifts without one left out.
+fn spread_grid(
+    frames: &mut PreparedFrames,
+    step: TimeUs,
+    spread_at: &(dyn Fn(&PreparedFrames, TimeUs) -> Option<f64> + Sync),
+) -> Vec<(TimeUs, f64)> {
+    let tried: Vec<(TimeUs, Option<f64>)> = (-GRID_STEPS..=GRID_STEPS)
+        .into_par_iter()
+        .map(|k| (k * step, spread_at(frames, k * step)))
+        .collect();
+    frames.replay_shifts(tried.iter().map(|t| t.0));
+    tried
+        .into_iter()
+        .filter_map(|(shift, value)| Some((shift, value?)))
+        .collect()
+}
+
+/// The shift of least spread, microseconds, and the spread's curvature there: of the
+/// parabola through the `best` grid point and its neighbours (or the best point, and no
+/// curvature, at an edge).
+fn parabola_minimum(grid: &[(TimeUs, f64)], best: usize, step: TimeUs) -> (f64, f64) {
+    if best > 0 && best + 1 < grid.len() {
+        let (x0, y0) = grid[best - 1];
+        let (_, y1) = grid[best];
+        let (_, y2) = grid[best + 1];
+        let h = step as f64;
+        let denominator = y0 - 2.0 * y1 + y2;
+        let offset = if denominator > 0.0 {
+            (0.5 * (y0 - y2) / denominator).clamp(-1.0, 1.0)
+        } else {
+            0.0
+        };
+        (x0 as f64 + h * (1.0 + offset), denominator / (h * h))
+    } else {
+        (grid[best].0 as f64, 0.0)
+    }
 }
