@@ -304,12 +304,34 @@ pub(super) fn offset_from_counts(
     let Some(timing_offset) = timing_offset.filter(|o| o.source == "fitted") else {
         return Ok(None);
     };
-    let Some(resim) = &full.resim else {
+    let Some(found) = searched(frames, runs, full, grid) else {
         return Ok(None);
     };
-    let Some(brightness) = Brightness::new(&full.cells, frames, &full.real) else {
-        return Ok(None);
-    };
+    let timing = (frames.offset, frames.offset_range);
+    let changed = reconciled(frames, timing_offset, found.as_ref(), full);
+    // the search shifted the runs, whether or not it found the offset
+    *runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
+    if changed {
+        *full = run_pass(input, excluded, frames, runs, options, None)?;
+    }
+    Ok(found.map(|found| FromCounts {
+        found,
+        timing_offset_dn: timing.0,
+        changed,
+    }))
+}
+
+/// The counts' offset ([`search`]) from the `full` pass's re-simulation, its `runs`
+/// shifted in place; `None` where it is not searched (no re-simulation, too few dark or
+/// bright cells, or the two agree at the timing's offset: `runs` as they were).
+fn searched(
+    frames: &PreparedFrames,
+    runs: &mut [Vec<Sample>],
+    full: &Pass,
+    grid: Option<(TimeUs, TimeUs)>,
+) -> Option<Option<CountOffset>> {
+    let resim = full.resim.as_ref()?;
+    let brightness = Brightness::new(&full.cells, frames, &full.real)?;
     let setup = Setup {
         cells: &full.cells,
         real: &full.real,
@@ -319,19 +341,27 @@ pub(super) fn offset_from_counts(
         height: frames.height,
         log_map: frames.log_map,
     };
-    let Some(at_own) = disagreement(&setup, &brightness) else {
-        return Ok(None);
-    };
-    let found = search(
+    let at_own = disagreement(&setup, &brightness)?;
+    Some(search(
         &setup,
         &brightness,
         (runs, frames.offset),
         at_own,
         (resim.ct_on, resim.ct_off),
         simulated_sigma(&full.timing),
-    );
+    ))
+}
+
+/// Moves the frames' offset and range to those [`reconcile`] gives for the counts' offset
+/// `found` against the timing's; whether they moved.
+fn reconciled(
+    frames: &mut PreparedFrames,
+    timing_offset: &crate::estimate::timing::Offset,
+    found: Option<&CountOffset>,
+    full: &Pass,
+) -> bool {
     let timing = (frames.offset, frames.offset_range);
-    let change = found.as_ref().and_then(|found| {
+    let change = found.and_then(|found| {
         reconcile(
             timing,
             timing_offset.ci95,
@@ -343,16 +373,7 @@ pub(super) fn offset_from_counts(
         frames.offset = offset;
         frames.offset_range = range;
     }
-    // the search shifted the runs, whether or not it found the offset
-    *runs = frames.upsample_runs(0.5, options.max_upsampled_bytes);
-    if change.is_some() {
-        *full = run_pass(input, excluded, frames, runs, options, None)?;
-    }
-    Ok(found.map(|found| FromCounts {
-        found,
-        timing_offset_dn: timing.0,
-        changed: change.is_some(),
-    }))
+    change.is_some()
 }
 
 /// The counts' offset, in words for the assumptions.
