@@ -331,20 +331,35 @@ impl<R: Rng> Sensor<'_, R> {
         mut emit: impl FnMut(u64, bool),
     ) {
         let end = time + dt;
-        let settle = |p: &Pixel, until: u64| {
-            p.cur_v
-                + (img_l - p.cur_v) * (1.0 - (-(until as f64 - p.time_px as f64) / p.tau_p).exp())
-        };
-        let end_refractory = |p: &mut Pixel| {
-            p.last_v = settle(p, p.cur_ref);
-            p.time_px = p.cur_ref;
-            p.cur_ref = NOT_REFRACTORY;
-            p.cur_v = p.last_v;
-        };
         if p.cur_ref < end {
-            end_refractory(p);
+            p.end_refractory(img_l);
         }
-        // background noise (check_noise, check_noise_hist)
+        self.background_noise(p, end, img_l, &mut emit);
+        let target = if lit { p.settle(img_l, end) } else { 0.0 };
+        let dif = target - p.last_v;
+        let idle = p.cur_ref == NOT_REFRACTORY;
+        self.fire(
+            p,
+            end,
+            img_l,
+            (idle && dif > p.th_pos, idle && dif < p.th_neg),
+            &mut emit,
+        );
+        if lit {
+            p.cur_v = p.settle(img_l, end);
+        }
+        p.time_px = end;
+    }
+
+    /// `check_noise`, `check_noise_hist`: each polarity's noise event due before `end`,
+    /// the next one scheduled, `v` and `v_ref` reset to the frame's `img_l`.
+    fn background_noise(
+        &mut self,
+        p: &mut Pixel,
+        end: u64,
+        img_l: f64,
+        emit: &mut impl FnMut(u64, bool),
+    ) {
         for (k, on) in [(0, true), (1, false)] {
             let next = if on { p.bgn_pos_next } else { p.bgn_neg_next };
             if end <= next {
@@ -362,10 +377,19 @@ impl<R: Rng> Sensor<'_, R> {
             p.cur_v = img_l;
             p.last_v = img_l;
         }
-        let target = if lit { settle(p, end) } else { 0.0 };
-        let dif = target - p.last_v;
-        let idle = p.cur_ref == NOT_REFRACTORY;
-        let (mut pos, mut neg) = (idle && dif > p.th_pos, idle && dif < p.th_neg);
+    }
+
+    /// The events of the interval ending at `end`, starting with the polarities that crossed
+    /// (`pos`, `neg`): each at its latency, its threshold redrawn, the pixel blind for the
+    /// refractory period; where that ends before `end`, the pixel compares again.
+    fn fire(
+        &mut self,
+        p: &mut Pixel,
+        end: u64,
+        img_l: f64,
+        (mut pos, mut neg): (bool, bool),
+        emit: &mut impl FnMut(u64, bool),
+    ) {
         while pos || neg {
             for on in [true, false] {
                 if !(if on { pos } else { neg }) {
@@ -382,17 +406,31 @@ impl<R: Rng> Sensor<'_, R> {
                 p.cur_ref = p.time_px + delay + self.params.ref_us;
             }
             if p.cur_ref < end {
-                end_refractory(p);
-                let dif = settle(p, end) - p.last_v;
+                p.end_refractory(img_l);
+                let dif = p.settle(img_l, end) - p.last_v;
                 (pos, neg) = (dif > p.th_pos, dif < p.th_neg);
             } else {
                 (pos, neg) = (false, false);
             }
         }
-        if lit {
-            p.cur_v = settle(p, end);
-        }
-        p.time_px = end;
+    }
+}
+
+impl Pixel {
+    /// The photoreceptor voltage at time `until`, settling from `cur_v` at `time_px`
+    /// towards the log input `img_l` with time constant `tau_p`.
+    fn settle(&self, img_l: f64, until: u64) -> f64 {
+        self.cur_v
+            + (img_l - self.cur_v)
+                * (1.0 - (-(until as f64 - self.time_px as f64) / self.tau_p).exp())
+    }
+
+    /// The refractory period's end: the reference reset to the voltage then.
+    fn end_refractory(&mut self, img_l: f64) {
+        self.last_v = self.settle(img_l, self.cur_ref);
+        self.time_px = self.cur_ref;
+        self.cur_ref = NOT_REFRACTORY;
+        self.cur_v = self.last_v;
     }
 }
 
