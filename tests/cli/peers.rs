@@ -307,3 +307,69 @@ fn aps_reads_a_dim_esim_recording_through_the_response_the_timing_chose() {
         .collect();
     assert_eq!(names, ["event_timing", "resimulation"]);
 }
+
+#[test]
+fn eppps_reads_the_contrast_of_frames_whose_flow_the_motion_outruns() {
+    // a texture (mean 60 DN, log contrast 0.5, 1/f^1.2) at 450 px/s with frames at 15 Hz:
+    // 30 px between frames, beyond what the optical flow follows (12 px), so the travel
+    // comes from the events; the frames' images still show the scene's contrast and stand
+    // in for the natural-image prior (which read coverage draws 15004 and 15010, smooth
+    // textures, 5-10 times high)
+    let mut scene = SceneSpec::moving_texture(128, 96, 0.6, 2000.0);
+    scene.seed = 11;
+    let texture = scene.texture.as_mut().unwrap();
+    texture.texture = ctcal::sim::scene::canvas::TextureParams {
+        canvas_px: 512,
+        mean_dn: 60.0,
+        log_std: 0.5,
+        min_dn: 0.5,
+        max_dn: 255.0,
+        spectrum_beta: 1.2,
+        blur_px: 1.0,
+    };
+    (texture.vx_px_s, texture.vy_px_s) = (-440.0, 95.0);
+    scene.aps = Some(ApsSpec {
+        rate_hz: 15.0,
+        exposure_s: 0.002,
+    });
+    let (on, off) = (0.25, 0.35);
+    let esim = Peer::Esim(esim::Params {
+        contrast_threshold_pos: on,
+        contrast_threshold_neg: off,
+        contrast_threshold_sigma_pos: 0.0,
+        contrast_threshold_sigma_neg: 0.0,
+        ..esim::Params::default()
+    });
+    let dir = tempfile::tempdir().unwrap();
+    write_case(dir.path(), &scene, &esim, 5).unwrap();
+    let e = json(&["estimate", "eppps", dir.path().to_str().unwrap()]);
+    let said = |words: &str| {
+        e["assumptions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|a| a.as_str().unwrap().contains(words))
+    };
+    assert!(
+        said("of the recording's own frames"),
+        "{}",
+        e["assumptions"]
+    );
+    assert!(!said("natural images (calib/priors/natural)"));
+    for (key, truth) in [("ct_on", on), ("ct_off", off)] {
+        let value = e[key]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{key}: {}", e["why"]));
+        assert!(
+            (value / truth).ln().abs() < 2f64.ln(),
+            "{key} {value} vs {truth}"
+        );
+        let ci = &e[format!("{key}_ci95")];
+        let lo = ci[0].as_f64().unwrap_or(0.0);
+        let hi = ci[1].as_f64().unwrap_or(f64::INFINITY);
+        assert!(
+            lo <= truth && truth <= hi,
+            "{key} [{lo}, {hi}] misses {truth}"
+        );
+    }
+}

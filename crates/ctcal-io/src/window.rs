@@ -829,6 +829,7 @@ pub fn eppps_of(
             response_known: prepared.as_ref().is_some_and(|(_, known, _)| *known),
             offset_fitted: prepared.as_ref().is_some_and(|(_, _, fitted)| *fitted),
             excluded,
+            frame_images: &loaded.frames,
         },
         &eppps_options,
         progress,

@@ -29,9 +29,11 @@ pub fn prior_blocks(image: &LogImage, rates: &RecordingRates, seed: u64) -> Vec<
     (0..BLOCKS_PER_IMAGE)
         .map(|_| {
             let k = rng.random_range(0..n);
-            let length = (rates.travels[k] as f64).min(MAX_SCAN_PX);
             let (dx, dy) = rates.directions.get(k).copied().unwrap_or((1.0, 0.0));
             let (dx, dy) = (dx as f64, dy as f64);
+            let length = (rates.travels[k] as f64)
+                .min(MAX_SCAN_PX)
+                .min(fitting_length(image, dx, dy));
             let span = |d: f64, size: usize| {
                 let (a, b) = (-BURN_IN_PX * d, length * d);
                 (1.0 - a.min(b), (size as f64 - 2.0 - side) - a.max(b))
@@ -58,6 +60,22 @@ pub fn prior_blocks(image: &LogImage, rates: &RecordingRates, seed: u64) -> Vec<
             }
         })
         .collect()
+}
+
+/// The longest counted stretch whose burn-in, scan and tile fit inside `image` along
+/// direction `(dx, dy)` (at least a pixel): never binding on the prior's photographs (256
+/// px wide, at least 150 high: room for 123 px where [`MAX_SCAN_PX`] is 100), it keeps
+/// scans through a small sensor's own frames from running off the frame into the clamped
+/// border, where they would find no contrast.
+fn fitting_length(image: &LogImage, dx: f64, dy: f64) -> f64 {
+    let room = |d: f64, size: usize| {
+        if d.abs() < 1e-9 {
+            f64::INFINITY
+        } else {
+            (size as f64 - 3.0 - TILE_PX as f64) / d.abs() - BURN_IN_PX
+        }
+    };
+    room(dx, image.width).min(room(dy, image.height)).max(1.0)
 }
 
 /// A log response the frames are read through: a map and the DN added before it.

@@ -88,8 +88,12 @@ fn dim_frames_dn(frames_median_dn: Option<f64>) -> Option<f64> {
 
 /// The method systematic of an estimate from `calibrations` (with frames or a prior) of a
 /// recording whose frames' median brightness is `frames_median_dn`.
-fn method_systematic(calibrations: &[Calibration], frames_median_dn: Option<f64>) -> f64 {
-    if images_read(calibrations) > 0 {
+fn method_systematic(
+    calibrations: &[Calibration],
+    frames_median_dn: Option<f64>,
+    frame_images: bool,
+) -> f64 {
+    if images_read(calibrations) > 0 && !frame_images {
         METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES
     } else if dim_frames_dn(frames_median_dn).is_some() {
         METHOD_LN_SYSTEMATIC_DIM
@@ -143,6 +147,11 @@ pub struct EpppsInput<'a> {
     /// [`OFFSET_NOT_BRACKETED`]).
     pub offset_fitted: bool,
     pub excluded: &'a [bool],
+    /// The recording's grey frames as images (empty: none, or not to be used): where the
+    /// prepared `frames` are absent (their flow could not be followed) or the motion
+    /// outruns their flow, their images stand in for the prior's photographs
+    /// ([`prior::frame_images`]).
+    pub frame_images: &'a [crate::events::Frame],
 }
 
 /// One calibration curve: what it ran through, and the curve.
@@ -184,7 +193,15 @@ pub fn estimate(
     let frames = input
         .frames
         .filter(|_| options.use_frames && outrun.is_none());
-    let rates = recording_rates(input, frames, &excluded)?;
+    // frames whose flow is not followed: their images stand in for the prior's photographs
+    let frame_images = (options.use_frames && frames.is_none())
+        .then(|| prior::frame_images(input.frame_images, options.scenes.max(1)))
+        .filter(|images| !images.is_empty());
+    let mut rates = recording_rates(input, frames, &excluded)?;
+    if frame_images.is_some() {
+        rates.frame_images = true;
+        rates.frames_median_dn = prior::median_reliable_dn(input.frame_images);
+    }
     let refractory = refractory_edge(input.events, input.sensor);
     let pixel = ScanPixel {
         ratio: 1.0,
@@ -200,7 +217,7 @@ pub fn estimate(
         }
         _ => FramesResponse::Unknown,
     };
-    let basis = Basis::new(frames, response, &excluded, options);
+    let basis = Basis::new(frames, frame_images, response, &excluded, options);
     let mut scanned = scan_thresholds(&basis, rates, pixel, progress);
     let mut slow = frames.and_then(|f| {
         progress("photoreceptor bandwidth", 0.8);
@@ -213,7 +230,7 @@ pub fn estimate(
     let mut result = assemble(&scanned, &basis, refractory.as_ref(), hot);
     if let Some((followed, too_fast)) = outrun.filter(|_| options.use_frames) {
         result.assumptions.push(format!(
-            "the frames are not used: the motion between them is too large for the optical flow on {too_fast} intervals and it follows {followed}, so travel and contrast are read from the events, as without frames"
+            "the frames' optical flow is not used: the motion between them is too large for it on {too_fast} intervals and it follows {followed}, so travel is read from the events, as without frames, and the scene's contrast from the frames' images, scanned as the prior's photographs are"
         ));
     }
     if let Some(slow) = &slow {
@@ -676,8 +693,12 @@ struct Basis<'a> {
 const MIN_BURST_PAIRS: usize = 200;
 
 impl<'a> Basis<'a> {
+    /// The basis of the recording's `frames` where their flow is followed, else of the
+    /// prior: the recording's `frame_images` (frames whose flow is not followed) or the
+    /// natural photographs.
     fn new(
         frames: Option<&'a PreparedFrames>,
+        frame_images: Option<Vec<prior::PriorImage>>,
         response: FramesResponse,
         excluded: &'a [bool],
         options: &'a EpppsOptions,
@@ -704,9 +725,10 @@ impl<'a> Basis<'a> {
                 .collect(),
             (None, _) => Vec::new(),
         };
-        let priors = match frames {
-            Some(_) => Vec::new(),
-            None => prior::images(options.scenes.max(1)),
+        let priors = match (frames, frame_images) {
+            (Some(_), _) => Vec::new(),
+            (None, Some(images)) => images,
+            (None, None) => prior::images(options.scenes.max(1)),
         };
         let tags = priors.iter().map(prior::PriorImage::tag).collect();
         Basis {
@@ -996,9 +1018,11 @@ fn combined_in_log(
     let mut measured = Measured::log_normal(
         value,
         stat,
-        prior_ln_sd
-            .hypot(travel)
-            .hypot(method_systematic(calibrations, rates.frames_median_dn)),
+        prior_ln_sd.hypot(travel).hypot(method_systematic(
+            calibrations,
+            rates.frames_median_dn,
+            rates.frame_images,
+        )),
     );
     if beyond.above > 0 {
         measured.ci95[1] = f64::INFINITY;
@@ -1155,7 +1179,10 @@ fn assumptions(
         "scans start from the state {} px of the same motion left (the recording is part of a longer one); ideal pixels: bandwidth, refractory period and noise of the real sensor are not in the scans",
         scans::BURN_IN_PX
     ));
-    out.push(method_systematic_assumption(rates, frames));
+    out.push(method_systematic_assumption(
+        rates,
+        frames || rates.frame_images,
+    ));
     out
 }
 
@@ -1167,6 +1194,11 @@ fn prior_assumptions(
     images: usize,
 ) -> Vec<String> {
     let mut out = Vec::new();
+    if rates.frame_images {
+        out.extend(frame_image_assumptions(calibrations, images));
+        out.push(flow_precision_assumption(rates));
+        return out;
+    }
     out.push(format!(
         "prior: events alone do not fix the scene's log contrast, so line scans through {images} natural images (calib/priors/natural) stand for it, with the recording's travel and flow directions; their spread is in the interval as a 95 % prediction interval for one more scene ({} images read: Student t with one degree of freedom fewer, and the spread of their mean, x {:.2} the spread); the interval holds for scenes of the photographs' contrast (log-luminance standard deviation {:.2}-{:.2} over the floors scanned): a scene k times less contrasty (a smooth texture, fog, a low-contrast pattern) reads a threshold k times too high, a more contrasty one (a printed pattern, a high-contrast lab scene) k times too low",
         images_read(calibrations),
@@ -1186,11 +1218,38 @@ fn prior_assumptions(
             .join(", "),
         calibrations.len()
     ));
-    out.push(format!(
+    out.push(flow_precision_assumption(rates));
+    out
+}
+
+/// What the recording's own frames, scanned in the photographs' place, stand for.
+fn frame_image_assumptions(calibrations: &[Calibration], images: usize) -> [String; 2] {
+    let (lo, hi) = prior::FLOOR_RANGE_OF_MEAN;
+    [
+        format!(
+            "contrast: line scans through {images} of the recording's own frames (evenly spread over it; their flow not followed) stand for the scene's log contrast in the natural photographs' place, with the travel and flow directions the events give; their spread is in the interval as the photographs' is (x {:.2}); a frame blurred by its exposure along the motion is smoother than the scene and reads the threshold low, a photoreceptor or refractory period that thins the events reads it high: the method systematic of frames holds both",
+            prediction_scale(calibrations),
+        ),
+        format!(
+            "the pixel's log response ln(DN + floor), the floor (the frames' offset b, dark current and glare) {:.0}-{:.0} % of each frame's mean (log-uniform; scanned at {}): the events' timing that measures b needs the frames' flow; its spread is in the interval ({} calibrations)",
+            100.0 * lo,
+            100.0 * hi,
+            prior::FLOORS_OF_MEAN
+                .iter()
+                .map(|f| format!("{:.1} %", 100.0 * f))
+                .collect::<Vec<_>>()
+                .join(", "),
+            calibrations.len()
+        ),
+    ]
+}
+
+/// How precisely the events' flow gives the travel.
+fn flow_precision_assumption(rates: &RecordingRates) -> String {
+    format!(
         "flow precision: half a pixel of displacement per window, or the split-half spread where larger: {:.1} % of the travel, a systematic error",
         100.0 * rates.travel_relative_error
-    ));
-    out
+    )
 }
 
 /// The method systematic term in every interval, and what it was measured on.
@@ -1391,11 +1450,12 @@ mod tests {
         let options = EpppsOptions::default();
         let excluded = vec![false; 16];
         let response = FramesResponse::Known(offset_bracket(&frames, Some(11.0)));
-        let basis = Basis::new(Some(&frames), response, &excluded, &options);
+        let basis = Basis::new(Some(&frames), None, response, &excluded, &options);
         let offsets: Vec<f32> = basis.responses.iter().map(|(r, _)| r.offset_dn).collect();
         assert_eq!(offsets, vec![0.0, 35.1, 60.0]);
         let single = Basis::new(
             Some(&frames),
+            None,
             FramesResponse::Known(None),
             &excluded,
             &options,
@@ -1475,15 +1535,30 @@ mod tests {
         };
         let frames = [calibration(None)];
         assert_eq!(
-            method_systematic(&frames, Some(19.0)),
+            method_systematic(&frames, Some(19.0), false),
             METHOD_LN_SYSTEMATIC_DIM
         );
-        assert_eq!(method_systematic(&frames, Some(20.0)), METHOD_LN_SYSTEMATIC);
-        assert_eq!(method_systematic(&frames, None), METHOD_LN_SYSTEMATIC);
+        assert_eq!(
+            method_systematic(&frames, Some(20.0), false),
+            METHOD_LN_SYSTEMATIC
+        );
+        assert_eq!(
+            method_systematic(&frames, None, false),
+            METHOD_LN_SYSTEMATIC
+        );
         let prior = [calibration(Some(0)), calibration(Some(1))];
         assert_eq!(
-            method_systematic(&prior, Some(5.0)),
+            method_systematic(&prior, Some(5.0), false),
             METHOD_LN_SYSTEMATIC_WITHOUT_FRAMES
+        );
+        // the recording's own frames scanned as photographs keep the frames' terms
+        assert_eq!(
+            method_systematic(&prior, Some(15.0), true),
+            METHOD_LN_SYSTEMATIC_DIM
+        );
+        assert_eq!(
+            method_systematic(&prior, Some(80.0), true),
+            METHOD_LN_SYSTEMATIC
         );
     }
 

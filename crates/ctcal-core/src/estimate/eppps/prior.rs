@@ -15,6 +15,7 @@
 //! as much as the choice of image does, so it is a prior of its own ([`FLOORS_OF_MEAN`]).
 
 use super::scans::LogImage;
+use crate::events::Frame;
 
 /// The range of the floor `f` (as a fraction of the scene's mean luminance) the prior
 /// spans, log-uniform: from veiling glare alone in a bright scene (glare indices of camera
@@ -117,18 +118,90 @@ pub fn images(n: usize) -> Vec<PriorImage> {
         .flat_map(|(image, (name, bytes))| {
             let linear =
                 decode(bytes).expect("the embedded prior images are valid PGM (unit test)");
-            BLUR_PX.into_iter().flat_map(move |blur_px| {
-                let blurred = linear.blurred(blur_px);
-                FLOORS_OF_MEAN.map(|floor_of_mean| PriorImage {
-                    name,
-                    image,
-                    blur_px,
-                    floor_of_mean,
-                    log: blurred.log_above(floor_of_mean),
-                })
-            })
+            under_blurs_and_floors(name, image, linear)
         })
         .collect()
+}
+
+/// The names of the recording's frames read in the photographs' place.
+const FRAME_NAMES: [&str; COUNT] = [
+    "the recording's frame 1",
+    "the recording's frame 2",
+    "the recording's frame 3",
+    "the recording's frame 4",
+    "the recording's frame 5",
+    "the recording's frame 6",
+];
+
+/// Up to `n` (at most [`COUNT`]) of the recording's own frames, evenly spread over it, in
+/// the photographs' place, each under every blur and floor as a photograph is: where the
+/// motion outruns the frames' optical flow their pixels cannot be followed, but each frame
+/// still shows the scene's contrast, which is what the photographs stand in for. A frame's
+/// DN is linear in the light up to the sensor's offset (`ln(DN + b)`), which the floors'
+/// range holds as it holds a photograph's dark current and glare.
+pub fn frame_images(frames: &[Frame], n: usize) -> Vec<PriorImage> {
+    spread_over(frames, n)
+        .enumerate()
+        .flat_map(|(i, frame)| {
+            let linear = LinearImage {
+                width: frame.width as usize,
+                height: frame.height as usize,
+                data: frame.pixels.iter().map(|&v| v as f32).collect(),
+            };
+            under_blurs_and_floors(FRAME_NAMES[i], i, linear)
+        })
+        .collect()
+}
+
+/// Up to `n` (at most [`COUNT`]) of `frames`, evenly spread over them.
+fn spread_over(frames: &[Frame], n: usize) -> impl Iterator<Item = &Frame> {
+    let count = frames.len();
+    let k = n.min(COUNT).min(count);
+    (0..k).map(move |i| {
+        &frames[if k > 1 {
+            i * (count - 1) / (k - 1)
+        } else {
+            count / 2
+        }]
+    })
+}
+
+/// The median DN of the pixels of the frames [`frame_images`] reads that are reliable
+/// intensities (neither near black, at most 3 DN, nor clipped, at least 254 DN, as
+/// [`crate::estimate::frames::reliable_pair`]); `None` where none is.
+pub fn median_reliable_dn(frames: &[Frame]) -> Option<f64> {
+    let mut histogram = [0u64; 256];
+    for frame in spread_over(frames, COUNT) {
+        for &v in &frame.pixels {
+            histogram[v as usize] += 1;
+        }
+    }
+    let reliable = &histogram[4..254];
+    let total: u64 = reliable.iter().sum();
+    let mut seen = 0;
+    reliable.iter().enumerate().find_map(|(dn, &n)| {
+        seen += n;
+        (total > 0 && 2 * seen >= total).then_some(dn as f64 + 4.0)
+    })
+}
+
+/// `linear` (image number `image`, called `name`) under every blur of [`BLUR_PX`] and
+/// floor of [`FLOORS_OF_MEAN`], blur by blur.
+fn under_blurs_and_floors(
+    name: &'static str,
+    image: usize,
+    linear: LinearImage,
+) -> impl Iterator<Item = PriorImage> {
+    BLUR_PX.into_iter().flat_map(move |blur_px| {
+        let blurred = linear.blurred(blur_px);
+        FLOORS_OF_MEAN.map(|floor_of_mean| PriorImage {
+            name,
+            image,
+            blur_px,
+            floor_of_mean,
+            log: blurred.log_above(floor_of_mean),
+        })
+    })
 }
 
 /// The lowest and highest log-luminance standard deviation of the prior's photographs
@@ -254,6 +327,49 @@ fn decode(bytes: &[u8]) -> Option<LinearImage> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn frame(t: i64, pixels: Vec<u8>) -> Frame {
+        Frame {
+            t,
+            width: 4,
+            height: 2,
+            pixels,
+            exposure_us: None,
+        }
+    }
+
+    #[test]
+    fn the_recordings_frames_are_read_evenly_spread_as_photographs_are() {
+        // ten frames, each one DN: the six read are 0, 1, 3, 5, 7 and 9 (i * 9 / 5)
+        let frames: Vec<Frame> = (0..10).map(|k| frame(k, vec![10 + k as u8; 8])).collect();
+        let images = frame_images(&frames, 6);
+        assert_eq!(images.len(), 6 * BLUR_PX.len() * FLOORS_OF_MEAN.len());
+        let levels: Vec<f32> = images
+            .iter()
+            .filter(|i| i.blur_px == 0.0 && i.floor_of_mean == FLOORS_OF_MEAN[0])
+            .map(|i| (i.log.data[0].exp() / (1.0 + FLOORS_OF_MEAN[0])).round())
+            .collect();
+        assert_eq!(levels, [10.0, 11.0, 13.0, 15.0, 17.0, 19.0]);
+        assert_eq!(images[0].name, "the recording's frame 1");
+        // fewer frames than images asked for: each once; one frame: that one
+        assert_eq!(frame_images(&frames[..2], 6).len(), 2 * 12);
+        assert_eq!(
+            frame_images(&frames[..1], 6)[0].log.data[0],
+            images[0].log.data[0]
+        );
+        assert!(frame_images(&[], 6).is_empty());
+    }
+
+    #[test]
+    fn the_frames_median_leaves_out_black_and_clipped_pixels() {
+        // 0, 2, 3 (near black) and 255 (clipped) left out: the median of 5, 7, 9, 200
+        let frames = [frame(0, vec![0, 2, 3, 5, 7, 9, 200, 255])];
+        assert_eq!(median_reliable_dn(&frames), Some(7.0));
+        assert_eq!(
+            median_reliable_dn(&[frame(0, vec![0, 1, 2, 3, 254, 255, 255, 0])]),
+            None
+        );
+    }
 
     #[test]
     fn every_prior_image_decodes_under_every_blur_and_floor() {

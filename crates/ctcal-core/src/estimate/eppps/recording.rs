@@ -80,6 +80,9 @@ pub struct RecordingRates {
     /// travel was measured on (`None` without frames): how dim the scene is, where a
     /// photoreceptor's bandwidth and leak weigh most.
     pub frames_median_dn: Option<f64>,
+    /// Whether the recording's own frames stand in for the prior's photographs (frames whose
+    /// flow the motion outruns: travel from the events, contrast from the frames).
+    pub frame_images: bool,
     /// The pixels whose frames show a still scene, and their events (with frames only),
     /// and per polarity (ON, OFF) whether their rate decided the noise bracket.
     pub still: Option<StillPixels>,
@@ -420,6 +423,7 @@ fn finish(
         support_window_us: f.window,
         bursts: f.bursts,
         frames_median_dn: f.frames_median_dn,
+        frame_images: false,
         still: f.still,
         still_decides: [false; 2],
         counted_events: noise.all,

@@ -220,7 +220,7 @@ impl Reading {
         } else {
             if sharper > 0 {
                 text += &format!(
-                    "; {sharper} of {n} are smoother than the recording even unblurred, and too few images match to leave them out: read unblurred, a sharper scene than these photographs, which makes more events, so they read it low"
+                    "; {sharper} of {n} are smoother than the recording even unblurred, and too few images match to leave them out: read unblurred, a sharper scene than these images, which makes more events, so they read it low"
                 );
             }
             if smoother > 0 {

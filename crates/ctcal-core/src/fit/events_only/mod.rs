@@ -181,7 +181,7 @@ pub(super) fn fit_from_events(
         ..judging
     };
     progress("absolute thresholds", 0.3);
-    let thresholds = thresholds(input, options, &blocks);
+    let thresholds = thresholds(input, options, &blocks, frames_unused.is_some());
     progress("the loop", 0.9);
     let (steps, model) = candidates::run_loop(&judging, &run);
     Ok(result::result(result::Parts {
@@ -436,11 +436,18 @@ fn thresholds(
     input: &FitInput,
     options: &FitOptions,
     blocks: &Blocks,
+    frames_not_followed: bool,
 ) -> Result<CtEstimate, String> {
     if let Some(given) = &options.thresholds {
         return Ok(given.clone());
     }
     let fit_events = input.events.between(input.events.t[0], blocks.fit_end());
+    // frames whose flow is not followed still show the scene's contrast: the fit run's
+    let frame_images: &[crate::events::Frame] = if frames_not_followed {
+        &input.frames[..input.frames.partition_point(|f| f.t <= blocks.fit_end())]
+    } else {
+        &[]
+    };
     crate::estimate::eppps::estimate(
         &EpppsInput {
             sensor: input.sensor,
@@ -449,6 +456,7 @@ fn thresholds(
             response_known: false,
             offset_fitted: false,
             excluded: input.excluded,
+            frame_images,
         },
         &EpppsOptions {
             seed: options.seed,
