@@ -11,7 +11,9 @@
 //!    recording's own travel and directions, through the recording's frames when it has them
 //!    (its contrast measured, through the log response the events' timing measured, or
 //!    through both ends of what sensors use where it does not, [`calibration::Response`])
-//!    and otherwise through natural images ([`prior`]), at 31
+//!    and otherwise through natural images ([`prior`]) -- or, where the recording has
+//!    frames whose flow cannot be followed, through those frames' images scanned as the
+//!    photographs are ([`prior::frame_images`]) -- at 31
 //!    thresholds from 0.03 to 9.5; without frames each image is read at the recording's
 //!    own sharpness, the blur at which its scans burst as often as the recording's events
 //!    do ([`sharpness`]);

@@ -4,7 +4,10 @@
 //! threshold, and their spread is the prior's share of the interval. The images, their
 //! sources and licences are in `calib/priors/natural/README.md`; the spread of natural-scene
 //! contrast they stand for is documented there (Tolhurst, Tadmor & Chao 1992; Frazor &
-//! Geisler 2006).
+//! Geisler 2006). A recording whose frames show the scene but move too far between them for
+//! the optical flow has its own frames scanned in the photographs' place
+//! ([`frame_images`]): the contrast measured where the recording allows, the same prior of
+//! the response's floor kept.
 //!
 //! The photographs are 8-bit sRGB; they are decoded to linear luminance `Y` and taken as
 //! `ln(Y + f m)`, `m` the image's mean luminance: a DVS photoreceptor responds to the log of
