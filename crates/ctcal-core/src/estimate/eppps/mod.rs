@@ -195,15 +195,8 @@ pub fn estimate(
     let frames = input
         .frames
         .filter(|_| options.use_frames && outrun.is_none());
-    // frames whose flow is not followed: their images stand in for the prior's photographs
-    let frame_images = (options.use_frames && frames.is_none())
-        .then(|| prior::frame_images(input.frame_images, options.scenes.max(1)))
-        .filter(|images| !images.is_empty());
     let mut rates = recording_rates(input, frames, &excluded)?;
-    if frame_images.is_some() {
-        rates.frame_images = true;
-        rates.frames_median_dn = prior::median_reliable_dn(input.frame_images);
-    }
+    let frame_images = frames_as_prior(input, options, frames, &mut rates);
     let refractory = refractory_edge(input.events, input.sensor);
     let pixel = ScanPixel {
         ratio: 1.0,
@@ -244,6 +237,23 @@ pub fn estimate(
     );
     progress("done", 1.0);
     Ok(result)
+}
+
+/// Where the recording's frames are not followed (`frames` not used) but there are frames
+/// to use, their images in the prior's place ([`prior::frame_images`]), and `rates` marked
+/// as read against them, with their median brightness.
+fn frames_as_prior(
+    input: &EpppsInput,
+    options: &EpppsOptions,
+    frames: Option<&PreparedFrames>,
+    rates: &mut RecordingRates,
+) -> Option<Vec<prior::PriorImage>> {
+    let images = (options.use_frames && frames.is_none())
+        .then(|| prior::frame_images(input.frame_images, options.scenes.max(1)))
+        .filter(|images| !images.is_empty())?;
+    rates.frame_images = true;
+    rates.frames_median_dn = prior::median_reliable_dn(input.frame_images);
+    Some(images)
 }
 
 /// The recording's events per pixel of travel, through its frames where they are used.
