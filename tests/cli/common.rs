@@ -161,6 +161,16 @@ pub fn strings(value: &serde_json::Value) -> Vec<&str> {
         .collect()
 }
 
+/// The names of an estimate's `estimators`, in order.
+pub fn estimator_names(e: &serde_json::Value) -> Vec<&str> {
+    e["estimators"]
+        .as_array()
+        .expect("estimators")
+        .iter()
+        .map(|x| x["name"].as_str().expect("a name"))
+        .collect()
+}
+
 /// The region note in `output`'s `assumptions` that starts with `verb` ("fitted on the
 /// region x X0..X1, y Y0..Y1 of ..."), and its bounds `[x0, x1, y0, y1]`.
 pub fn region_of(output: &serde_json::Value, verb: &str) -> (String, [u64; 4]) {

@@ -47,13 +47,11 @@ fn aps_recovers(case: &str, tolerance: f64, interval_contains_truth: bool) -> se
     assert_eq!(e["method"], "aps");
     assert!(!e["intervals_used"].as_array().unwrap().is_empty());
     assert!(!e["assumptions"].as_array().unwrap().is_empty());
-    let names: Vec<&str> = e["estimators"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x["name"].as_str().unwrap())
-        .collect();
-    assert_eq!(names, ["event_timing", "resimulation"], "{case}");
+    assert_eq!(
+        estimator_names(&e),
+        ["event_timing", "resimulation"],
+        "{case}"
+    );
     e
 }
 

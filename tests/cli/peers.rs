@@ -176,13 +176,7 @@ fn esim_without_threshold_noise_matches_ctcals_ideal_pixel_in_eps_mode() {
     let dir = tempfile::tempdir().unwrap();
     write_case(dir.path(), &side_by_side_scene(), &peers()[0], 1).unwrap();
     let frames = frames(dir.path());
-    let esim = Peer::Esim(esim::Params {
-        contrast_threshold_pos: 0.3,
-        contrast_threshold_neg: 0.3,
-        contrast_threshold_sigma_pos: 0.0,
-        contrast_threshold_sigma_neg: 0.0,
-        ..esim::Params::default()
-    });
+    let esim = noiseless_esim(0.3, 0.3);
     let esim_events = run(&esim, &frames, 1);
     // peers()[0]: the same with ESIM's default threshold noise
     let stranded = run(&peers()[0], &frames, 1);
@@ -237,27 +231,96 @@ fn esim_without_threshold_noise_matches_ctcals_ideal_pixel_in_eps_mode() {
     );
 }
 
+/// ESIM without its threshold noise (every crossing fired) at thresholds `on` and `off`.
+fn noiseless_esim(on: f64, off: f64) -> Peer {
+    Peer::Esim(esim::Params {
+        contrast_threshold_pos: on,
+        contrast_threshold_neg: off,
+        contrast_threshold_sigma_pos: 0.0,
+        contrast_threshold_sigma_neg: 0.0,
+        ..esim::Params::default()
+    })
+}
+
+/// A moving-texture case: a texture of `canvas_px` (mean `mean_dn`, log contrast
+/// `log_std`, 1/f^`beta` spectrum, 1 px blur) moving at `velocity` px/s over a `size`
+/// sensor for `duration_s`, rendered at `render_hz`, with APS frames at `aps_hz` exposed
+/// `exposure_s`.
+struct TextureCase {
+    size: (usize, usize),
+    duration_s: f64,
+    render_hz: f64,
+    seed: u64,
+    canvas_px: usize,
+    mean_dn: f64,
+    log_std: f64,
+    beta: f64,
+    velocity: (f64, f64),
+    aps_hz: f64,
+    exposure_s: f64,
+}
+
+impl TextureCase {
+    fn scene(&self) -> SceneSpec {
+        let mut scene =
+            SceneSpec::moving_texture(self.size.0, self.size.1, self.duration_s, self.render_hz);
+        scene.seed = self.seed;
+        let texture = scene.texture.as_mut().unwrap();
+        texture.texture = ctcal::sim::scene::canvas::TextureParams {
+            canvas_px: self.canvas_px,
+            mean_dn: self.mean_dn,
+            log_std: self.log_std,
+            min_dn: 0.5,
+            max_dn: 255.0,
+            spectrum_beta: self.beta,
+            blur_px: 1.0,
+        };
+        (texture.vx_px_s, texture.vy_px_s) = self.velocity;
+        scene.aps = Some(ApsSpec {
+            rate_hz: self.aps_hz,
+            exposure_s: self.exposure_s,
+        });
+        scene
+    }
+}
+
+/// `e`'s reading of `key`, after checking that its 95 % interval holds `truth` (an open
+/// side only where `open_allowed`; otherwise both ends must be numbers).
+fn reading_holding(e: &serde_json::Value, key: &str, truth: f64, open_allowed: bool) -> f64 {
+    let value = e[key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{key}: {}", e["why"]));
+    let ci = &e[format!("{key}_ci95")];
+    let end = |i: usize, open: f64| match ci[i].as_f64() {
+        Some(v) => v,
+        None if open_allowed => open,
+        None => panic!("{key}: a closed interval expected, got {ci}"),
+    };
+    let (lo, hi) = (end(0, 0.0), end(1, f64::INFINITY));
+    assert!(
+        lo <= truth && truth <= hi,
+        "{key} [{lo}, {hi}] misses {truth}"
+    );
+    value
+}
+
 /// A dim texture (mean 12 DN, log contrast 0.6, 1/f^0.7 spectrum; none of the oracle
 /// cases' texture), 96x72 for 0.5 s, rendered at 400 Hz with APS frames at 50 Hz.
 fn dim_scene() -> SceneSpec {
-    let mut scene = SceneSpec::moving_texture(96, 72, 0.5, 400.0);
-    scene.seed = 7;
-    let texture = scene.texture.as_mut().unwrap();
-    texture.texture = ctcal::sim::scene::canvas::TextureParams {
+    TextureCase {
+        size: (96, 72),
+        duration_s: 0.5,
+        render_hz: 400.0,
+        seed: 7,
         canvas_px: 256,
         mean_dn: 12.0,
         log_std: 0.6,
-        min_dn: 0.5,
-        max_dn: 255.0,
-        spectrum_beta: 0.7,
-        blur_px: 1.0,
-    };
-    (texture.vx_px_s, texture.vy_px_s) = (70.0, -30.0);
-    scene.aps = Some(ApsSpec {
-        rate_hz: 50.0,
+        beta: 0.7,
+        velocity: (70.0, -30.0),
+        aps_hz: 50.0,
         exposure_s: 0.0,
-    });
-    scene
+    }
+    .scene()
 }
 
 #[test]
@@ -269,43 +332,20 @@ fn aps_reads_a_dim_esim_recording_through_the_response_the_timing_chose() {
     // pushed from 0.109 / 0.245 to 0.162 / 0.362 for 0.114 / 0.237)
     let dir = tempfile::tempdir().unwrap();
     let (on, off) = (0.15, 0.25);
-    let esim = Peer::Esim(esim::Params {
-        contrast_threshold_pos: on,
-        contrast_threshold_neg: off,
-        contrast_threshold_sigma_pos: 0.0,
-        contrast_threshold_sigma_neg: 0.0,
-        ..esim::Params::default()
-    });
-    write_case(dir.path(), &dim_scene(), &esim, 3).unwrap();
+    write_case(dir.path(), &dim_scene(), &noiseless_esim(on, off), 3).unwrap();
     let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
-    let chosen = e["assumptions"]
-        .as_array()
-        .unwrap()
+    let chosen = strings(&e["assumptions"])
         .iter()
-        .any(|a| a.as_str().unwrap().contains("a pure ln(DN + b) explains"));
+        .any(|a| a.contains("a pure ln(DN + b) explains"));
     assert!(chosen, "{}", e["assumptions"]);
     for (key, truth) in [("ct_on", on), ("ct_off", off)] {
-        let value = e[key]
-            .as_f64()
-            .unwrap_or_else(|| panic!("{key}: {}", e["why"]));
+        let value = reading_holding(&e, key, truth, false);
         assert!(
             (value / truth - 1.0).abs() < 0.1,
             "{key} {value} vs {truth}"
         );
-        let ci = &e[format!("{key}_ci95")];
-        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
-        assert!(
-            lo <= truth && truth <= hi,
-            "{key} [{lo}, {hi}] misses {truth}"
-        );
     }
-    let names: Vec<&str> = e["estimators"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x["name"].as_str().unwrap())
-        .collect();
-    assert_eq!(names, ["event_timing", "resimulation"]);
+    assert_eq!(estimator_names(&e), ["event_timing", "resimulation"]);
 }
 
 #[test]
@@ -315,41 +355,26 @@ fn eppps_reads_the_contrast_of_frames_whose_flow_the_motion_outruns() {
     // comes from the events; the frames' images still show the scene's contrast and stand
     // in for the natural-image prior (which read coverage draws 15004 and 15010, smooth
     // textures, 5-10 times high)
-    let mut scene = SceneSpec::moving_texture(128, 96, 0.6, 2000.0);
-    scene.seed = 11;
-    let texture = scene.texture.as_mut().unwrap();
-    texture.texture = ctcal::sim::scene::canvas::TextureParams {
+    let scene = TextureCase {
+        size: (128, 96),
+        duration_s: 0.6,
+        render_hz: 2000.0,
+        seed: 11,
         canvas_px: 512,
         mean_dn: 60.0,
         log_std: 0.5,
-        min_dn: 0.5,
-        max_dn: 255.0,
-        spectrum_beta: 1.2,
-        blur_px: 1.0,
-    };
-    (texture.vx_px_s, texture.vy_px_s) = (-440.0, 95.0);
-    scene.aps = Some(ApsSpec {
-        rate_hz: 15.0,
+        beta: 1.2,
+        velocity: (-440.0, 95.0),
+        aps_hz: 15.0,
         exposure_s: 0.002,
-    });
+    }
+    .scene();
     let (on, off) = (0.25, 0.35);
-    let esim = Peer::Esim(esim::Params {
-        contrast_threshold_pos: on,
-        contrast_threshold_neg: off,
-        contrast_threshold_sigma_pos: 0.0,
-        contrast_threshold_sigma_neg: 0.0,
-        ..esim::Params::default()
-    });
     let dir = tempfile::tempdir().unwrap();
-    write_case(dir.path(), &scene, &esim, 5).unwrap();
+    write_case(dir.path(), &scene, &noiseless_esim(on, off), 5).unwrap();
     let e = json(&["estimate", "eppps", dir.path().to_str().unwrap()]);
-    let said = |words: &str| {
-        e["assumptions"]
-            .as_array()
-            .unwrap()
-            .iter()
-            .any(|a| a.as_str().unwrap().contains(words))
-    };
+    let assumptions = strings(&e["assumptions"]);
+    let said = |words: &str| assumptions.iter().any(|a| a.contains(words));
     assert!(
         said("of the recording's own frames"),
         "{}",
@@ -357,19 +382,10 @@ fn eppps_reads_the_contrast_of_frames_whose_flow_the_motion_outruns() {
     );
     assert!(!said("natural images (calib/priors/natural)"));
     for (key, truth) in [("ct_on", on), ("ct_off", off)] {
-        let value = e[key]
-            .as_f64()
-            .unwrap_or_else(|| panic!("{key}: {}", e["why"]));
+        let value = reading_holding(&e, key, truth, true);
         assert!(
             (value / truth).ln().abs() < 2f64.ln(),
             "{key} {value} vs {truth}"
-        );
-        let ci = &e[format!("{key}_ci95")];
-        let lo = ci[0].as_f64().unwrap_or(0.0);
-        let hi = ci[1].as_f64().unwrap_or(f64::INFINITY);
-        assert!(
-            lo <= truth && truth <= hi,
-            "{key} [{lo}, {hi}] misses {truth}"
         );
     }
 }

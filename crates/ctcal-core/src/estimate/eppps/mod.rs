@@ -1223,11 +1223,7 @@ fn prior_assumptions(
         "prior: the pixel's log response ln(light + floor), the floor (dark current and lens glare) {:.0}-{:.0} % of the scene's mean light (log-uniform; scanned at {}); not measured without frames, its spread is in the interval: sRGB photographs decoded to linear luminance, each under every floor ({} calibrations)",
         100.0 * lo,
         100.0 * hi,
-        prior::FLOORS_OF_MEAN
-            .iter()
-            .map(|f| format!("{:.1} %", 100.0 * f))
-            .collect::<Vec<_>>()
-            .join(", "),
+        prior::floors_scanned(),
         calibrations.len()
     ));
     out.push(flow_precision_assumption(rates));
@@ -1246,11 +1242,7 @@ fn frame_image_assumptions(calibrations: &[Calibration], images: usize) -> [Stri
             "the pixel's log response ln(DN + floor), the floor (the frames' offset b, dark current and glare) {:.0}-{:.0} % of each frame's mean (log-uniform; scanned at {}): the events' timing that measures b needs the frames' flow; its spread is in the interval ({} calibrations)",
             100.0 * lo,
             100.0 * hi,
-            prior::FLOORS_OF_MEAN
-                .iter()
-                .map(|f| format!("{:.1} %", 100.0 * f))
-                .collect::<Vec<_>>()
-                .join(", "),
+            prior::floors_scanned(),
             calibrations.len()
         ),
     ]
