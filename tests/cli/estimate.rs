@@ -893,6 +893,46 @@ fn aps_refuses_a_static_scene_whose_events_are_noise() {
     assert!(e.contains("static scene") && e.contains("ctcal fit"), "{e}");
 }
 
+/// Coverage draw 15007: a dim, low-contrast texture (54 DN, log contrast 0.22) moving at
+/// 81 px/s through pixels with thresholds 0.48 / 0.62 and 0.76 Hz of shot noise: about 88 %
+/// of its events are noise, and the ON samples hold no crossing at all (all below 0.3).
+/// aps read ON 0.195 [0.067, 0.324] from the noise (a miss); it now says ON is not
+/// determinable and why, and keeps OFF, whose samples peak at its threshold.
+#[test]
+fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
+    let case: ctcal::coverage::CaseSpec = serde_json::from_str(
+        r#"{"id": "case-15007", "seed": 15007, "generator": "ctcal", "family": "texture",
+            "params": {"ct_on": 0.481336, "ct_off": 0.621281, "ct_sigma": 0.0125011,
+                "refractory_s": 0.000163932, "leak_rate_hz": 0.0307561,
+                "shot_noise_rate_hz": 0.763781, "timestamp_jitter_s": 0.000239525,
+                "log_response": "eps", "log_eps": 0.00725859, "seed": 15007},
+            "speed_px_s": 81.0491, "brightness_dn": 53.5027,
+            "recording": {"kind": "scene", "scene": {"kind": "texture", "width": 128,
+                "height": 96, "duration_s": 0.9, "seed": 15007,
+                "aps": {"rate_hz": 29.0, "exposure_s": 0.0082},
+                "texture": {"canvas_px": 256, "mean_dn": 53.5027, "log_std": 0.215907,
+                    "min_dn": 0.5, "max_dn": 255.0, "spectrum_beta": 1.55086, "blur_px": 1.0,
+                    "vx_px_s": -72.3775, "vy_px_s": 36.4755, "omega_deg_s": 0.0,
+                    "offset_px": [204.277, 235.912], "mod_amp_ln": 0.0, "mod_hz": 0.0}}}}"#,
+    )
+    .unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    ctcal::coverage::write_case(&case, dir.path()).unwrap();
+    let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
+    assert!(e["ct_on"].is_null(), "{}", e["ct_on"]);
+    let why = e["why"]["ct_on"].as_str().unwrap();
+    assert!(why.contains("no threshold peak above the noise"), "{why}");
+    let peak = &e["estimators"][0]["details"]["on"]["peak"];
+    assert!(peak["z"].as_f64().unwrap() < 3.0, "{peak}");
+    // OFF stands out of its noise and holds the truth; the spread rests on both maps
+    let off_peak = &e["estimators"][0]["details"]["off"]["peak"];
+    assert!(off_peak["z"].as_f64().unwrap() > 3.0, "{off_peak}");
+    let ci = &e["ct_off_ci95"];
+    let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+    assert!(lo <= 0.621281 && 0.621281 <= hi, "ct_off {ci}");
+    assert!(e["ct_sigma"].is_null() && e["why"]["ct_sigma"].is_string());
+}
+
 /// A recording with more frames than the estimator takes is measured on blocks of
 /// consecutive frames (not every k-th frame, whose flow would no longer hold): 75 frames
 /// at 25 Hz and a limit of 60 give three blocks of 20, one in each third, only their events

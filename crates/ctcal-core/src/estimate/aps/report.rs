@@ -323,11 +323,41 @@ pub(super) fn assemble(
             estimators[0].ct_on.value, estimators[0].ct_off.value
         ));
     }
+    withhold_noise_polarities(&mut estimate, &full.timing);
     estimate.estimators = estimators;
     for (key, value) in extra_reports(frames, full, findings) {
         estimate.extra.insert(key.into(), value);
     }
     estimate
+}
+
+/// Withholds each threshold whose samples show no peak above the noise beneath them
+/// ([`crate::estimate::timing::peak::Peak`]): its events are mostly noise, which both the
+/// event timing and the re-simulation's counts read as crossings. The spread goes with it,
+/// as it rests on both polarities' maps.
+fn withhold_noise_polarities(estimate: &mut CtEstimate, timing: &TimingEstimate) {
+    for (on, polarity) in [(true, &timing.on), (false, &timing.off)] {
+        let Some(peak) = polarity.peak.filter(|p| !p.stands_out()) else {
+            continue;
+        };
+        let name = if on { "ON" } else { "OFF" };
+        estimate.withhold_polarity(
+            on,
+            &format!(
+                "{}, and the re-simulation counts them alike. A method that models the noise (the fit) or a stretch with more motion or contrast can measure it",
+                peak.describe(name)
+            ),
+        );
+        estimate.ct_sigma = None;
+        estimate.ct_sigma_ci95 = None;
+        estimate.why.insert(
+            "ct_sigma".into(),
+            format!(
+                "the per-pixel spread rests on both polarities' maps, and the {name} samples show no threshold peak above the noise (see ct_{})",
+                name.to_lowercase()
+            ),
+        );
+    }
 }
 
 /// ON and OFF thresholds combined over the `estimators`, each with the method's systematic

@@ -21,6 +21,7 @@
 
 pub mod model;
 pub mod moments;
+pub mod peak;
 pub mod pixels;
 pub mod response;
 pub mod samples;
@@ -109,6 +110,10 @@ pub struct PolarityEstimate {
     /// distance, over `ct`; 0 where the trend was not fitted). Taken out of `ct`, whose
     /// samples are read at the frames.
     pub interpolation_share: f64,
+    /// How far the polarity's samples peak at their mode above the noise beneath it
+    /// ([`peak::Peak`]; `None` without a positive mode): where they do not, its events are
+    /// mostly noise and `ct` is not a threshold.
+    pub peak: Option<peak::Peak>,
 }
 
 /// Per-pixel thresholds (NaN without a sample) and sample counts, row-major.
@@ -298,6 +303,21 @@ impl Central {
         })
     }
 
+    /// Each polarity's peak (`[on, off]`) at the mode its kept samples were chosen around
+    /// ([`model::kept`]: the mode at half the window).
+    fn peaks(&self, window: f64) -> [Option<peak::Peak>; 2] {
+        [true, false].map(|on| {
+            let own: Vec<f64> = self
+                .pairs
+                .iter()
+                .zip(&self.values.y)
+                .filter(|(p, _)| p.on == on)
+                .map(|(_, &y)| y)
+                .collect();
+            peak::Peak::of(&own, model::mode(&own, window / 2.0)?)
+        })
+    }
+
     fn fitted(&self) -> Fitted<'_> {
         Fitted {
             pairs: &self.pairs,
@@ -395,7 +415,17 @@ pub fn estimate(
         ends: &ends,
         central: &central.coefficients,
     };
-    let polarities = [errors.polarity(on, true), errors.polarity(off, false)];
+    let peaks = central.peaks(options.mode_window);
+    let polarities = [
+        PolarityEstimate {
+            peak: peaks[0],
+            ..errors.polarity(on, true)
+        },
+        PolarityEstimate {
+            peak: peaks[1],
+            ..errors.polarity(off, false)
+        },
+    ];
     Some(central.into_estimate(
         polarities,
         maps(sensor, &on_map, &off_map),
@@ -858,6 +888,7 @@ fn polarity(
             rejected: own.len() - kept.len(),
             sample_spread: sample_spread(&kept, ct),
             interpolation_share: interpolation_share(pairs, weight, c, on, ct),
+            peak: None,
         },
         map,
     ))

@@ -216,6 +216,7 @@ mod tests {
             rejected: 0,
             sample_spread: 0.1,
             interpolation_share: 0.0,
+            peak: None,
         }
     }
 
