@@ -151,8 +151,11 @@ impl Row {
     /// points of the level. `FILTER`: the low-pass is on; `HOLD`: the input holds, then steps
     /// at the end; `EFFECTS`: leak, shot noise or hot pixels are on (otherwise their arrays
     /// are neither read nor written, and neither is the intensity, which only the filter and
-    /// shot noise use). Slices are cut to one length and stores are selects, so that the
-    /// compiler drops bounds checks and vectorises.
+    /// shot noise use). The pass runs in three stages, each a loop of its own over slices
+    /// cut to one length, with stores as selects, so that the compiler drops bounds checks
+    /// and vectorises: the pixels an interruption falls on ([`Self::mark_interrupted`]), the
+    /// filter ([`Self::filter_ends`]), and the quiet test with the quiet pixels' advance
+    /// ([`Self::advance_quiet`]).
     #[inline(always)]
     fn quiet_pass<const FILTER: bool, const HOLD: bool, const EFFECTS: bool>(
         &mut self,
@@ -162,31 +165,65 @@ impl Row {
         h: f32,
         cutoff: f32,
     ) {
+        if EFFECTS {
+            self.mark_interrupted(t1);
+        }
+        if FILTER {
+            // the filter in a loop of its own: fewer live registers in each loop
+            self.filter_ends::<HOLD>(u1, dn1, h, cutoff);
+        }
+        self.advance_quiet::<FILTER, HOLD, EFFECTS>(u1, dn1, h);
+    }
+
+    /// Marks busy the pixels whose next shot-noise or hot-pixel event falls before `t1`
+    /// (and clears the mark of every other pixel).
+    #[inline(always)]
+    fn mark_interrupted(&mut self, t1: f64) {
+        let n = self.reference.len();
+        let busy = &mut self.busy[..n];
+        for (b, &next) in busy.iter_mut().zip(&self.next_interrupt[..n]) {
+            *b = (next < t1) as u32;
+        }
+    }
+
+    /// The filter output at the end of the interval, of every pixel, into `filter_end`
+    /// (the input held at its start value when `HOLD`, else linear to `u1`).
+    #[inline(always)]
+    fn filter_ends<const HOLD: bool>(&mut self, u1: &[f32], dn1: &[f32], h: f32, cutoff: f32) {
+        let n = self.reference.len();
+        let (u1, dn1) = (&u1[..n], &dn1[..n]);
+        let (input, filtered, dn) = (&self.input[..n], &self.filtered[..n], &self.dn[..n]);
+        let filter_end = &mut self.filter_end[..n];
+        let inverse_h = 1.0 / h;
+        for x in 0..n {
+            let (u0, y0, dn0) = (input[x], filtered[x], dn[x]);
+            let (u_end, dn_end) = if HOLD { (u0, dn0) } else { (u1[x], dn1[x]) };
+            let rate = bandwidth::rate_per_us(0.5 * (dn0 + dn_end), cutoff);
+            filter_end[x] = bandwidth::advance_with_rate(y0, u0, u_end, h, inverse_h, rate);
+        }
+    }
+
+    /// The quiet test of every pixel ([`stays_inside`], and with `EFFECTS` not marked
+    /// busy), with the quiet pixels advanced to the end of the interval (reference drifted
+    /// by the leak, input, filter and intensity at their new values) and `busy` set for the
+    /// others.
+    #[inline(always)]
+    fn advance_quiet<const FILTER: bool, const HOLD: bool, const EFFECTS: bool>(
+        &mut self,
+        u1: &[f32],
+        dn1: &[f32],
+        h: f32,
+    ) {
         let n = self.reference.len();
         let (u1, dn1) = (&u1[..n], &dn1[..n]);
         let busy = &mut self.busy[..n];
-        if EFFECTS {
-            for (b, &next) in busy.iter_mut().zip(&self.next_interrupt[..n]) {
-                *b = (next < t1) as u32;
-            }
-        }
         let reference = &mut self.reference[..n];
         let filtered = &mut self.filtered[..n];
         let input = &mut self.input[..n];
         let dn = &mut self.dn[..n];
         let (theta_on, theta_off, leak) =
             (&self.theta_on[..n], &self.theta_off[..n], &self.leak[..n]);
-        let filter_end = &mut self.filter_end[..n];
-        if FILTER {
-            // the filter in a loop of its own: fewer live registers in each loop
-            let inverse_h = 1.0 / h;
-            for x in 0..n {
-                let (u0, y0, dn0) = (input[x], filtered[x], dn[x]);
-                let (u_end, dn_end) = if HOLD { (u0, dn0) } else { (u1[x], dn1[x]) };
-                let rate = bandwidth::rate_per_us(0.5 * (dn0 + dn_end), cutoff);
-                filter_end[x] = bandwidth::advance_with_rate(y0, u0, u_end, h, inverse_h, rate);
-            }
-        }
+        let filter_end = &self.filter_end[..n];
         for x in 0..n {
             let (u0, r) = (input[x], reference[x]);
             let u_end = if HOLD { u0 } else { u1[x] };
@@ -196,21 +233,8 @@ impl Row {
             } else {
                 (u0, u_end)
             };
-            // comparisons only (no min/max), so the loop vectorises
             let (top, bottom) = (theta_on[x] + r - drift, r - theta_off[x]);
-            let inside = |v: f32| ((v < top) & (v > bottom)) as u32;
-            let mut quiet = if FILTER {
-                // Behind the filter the level moves monotonically between its end points
-                // unless it meets the input, which is a maximum only when the input falls
-                // (then it lies below the input's start u0), a minimum only when it rises.
-                let interior = ((u_end < u0) & (y0 < u0)) | ((u_end > u0) & (y0 > u0));
-                inside(y0) & inside(y1) & (inside(u0) | !interior as u32)
-            } else {
-                inside(u0) & inside(u_end)
-            };
-            if HOLD && !FILTER {
-                quiet &= inside(u1[x]);
-            }
+            let mut quiet = stays_inside::<FILTER, HOLD>([u0, u_end, u1[x]], [y0, y1], top, bottom);
             if EFFECTS {
                 quiet &= 1 - busy[x];
             }
@@ -339,4 +363,32 @@ impl Row {
 fn select(quiet: u32, new: f32, old: f32) -> f32 {
     let mask = 0u32.wrapping_sub(quiet);
     f32::from_bits((new.to_bits() & mask) | (old.to_bits() & !mask))
+}
+
+/// 1 where a pixel's level stays strictly between `bottom` and `top` over the interval,
+/// judged on its extreme points: the input `[u0, u_end, u1]` (at the start, at the end of
+/// the piece before the step, and after the step when `HOLD`) and the filter output
+/// `[y0, y1]` at the start and end. Comparisons only (no min/max), so the loop around it
+/// vectorises.
+#[inline(always)]
+fn stays_inside<const FILTER: bool, const HOLD: bool>(
+    [u0, u_end, u1]: [f32; 3],
+    [y0, y1]: [f32; 2],
+    top: f32,
+    bottom: f32,
+) -> u32 {
+    let inside = |v: f32| ((v < top) & (v > bottom)) as u32;
+    let mut quiet = if FILTER {
+        // Behind the filter the level moves monotonically between its end points
+        // unless it meets the input, which is a maximum only when the input falls
+        // (then it lies below the input's start u0), a minimum only when it rises.
+        let interior = ((u_end < u0) & (y0 < u0)) | ((u_end > u0) & (y0 > u0));
+        inside(y0) & inside(y1) & (inside(u0) | !interior as u32)
+    } else {
+        inside(u0) & inside(u_end)
+    };
+    if HOLD && !FILTER {
+        quiet &= inside(u1);
+    }
+    quiet
 }
