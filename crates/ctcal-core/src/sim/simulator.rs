@@ -153,6 +153,24 @@ impl Simulator {
     /// times, each from its own seeded stream (so that one effect's draws do not move
     /// another's).
     fn draw_pixels(&self) -> PixelDraws {
+        let (theta_on, theta_off) = self.draw_thresholds();
+        let leak_factors = self.draw_leak_factors();
+        let hot_next = self.draw_hot_trains();
+        let (rates, next_noise) = self.draw_noise(&theta_on, &theta_off);
+        PixelDraws {
+            theta_on,
+            theta_off,
+            leak_factors,
+            hot_next,
+            rates,
+            next_noise,
+        }
+    }
+
+    /// Every pixel's ON and OFF thresholds: the given map (each value at least
+    /// [`mismatch::MIN_THRESHOLD`]), or draws around the nominal threshold with the
+    /// mismatch `ct_sigma`, ON then OFF from the one thresholds stream.
+    fn draw_thresholds(&self) -> (Vec<f32>, Vec<f32>) {
         let params = &self.params;
         let n = self.width * self.height;
         let mut threshold_rng = generator(self.seed, Stream::Thresholds, 0);
@@ -170,7 +188,15 @@ impl Simulator {
         };
         let theta_on = draw_map(&self.maps.ct_on, params.ct_on);
         let theta_off = draw_map(&self.maps.ct_off, params.ct_off);
-        let leak_factors: Vec<f32> = match (&self.maps.leak_factor, params.leak_rate_hz() > 0.0) {
+        (theta_on, theta_off)
+    }
+
+    /// Every pixel's leak-rate factor: the given map, or draws from the leak stream when
+    /// leak is on, or 1.
+    fn draw_leak_factors(&self) -> Vec<f32> {
+        let params = &self.params;
+        let n = self.width * self.height;
+        match (&self.maps.leak_factor, params.leak_rate_hz() > 0.0) {
             (Some(map), _) => map.clone(),
             (None, true) => {
                 let mut rng = generator(self.seed, Stream::Leak, 0);
@@ -179,18 +205,32 @@ impl Simulator {
                     .collect()
             }
             (None, false) => vec![1.0; n],
-        };
-        let mut noise_rng = generator(self.seed, Stream::Rows, self.noise_index(u64::MAX));
-        let noise_rate = params.shot_noise_rate_hz();
+        }
+    }
+
+    /// The first event time of every pixel's hot train (infinite where the pixel is not
+    /// hot): the hot pixels chosen, then their first times drawn, from the hot-pixel
+    /// stream.
+    fn draw_hot_trains(&self) -> Vec<f64> {
+        let n = self.width * self.height;
         let mut hot_next = vec![f64::INFINITY; n];
-        if let Some((fraction, _)) = params.hot_pixels() {
+        if let Some((fraction, _)) = self.params.hot_pixels() {
             let mut rng = generator(self.seed, Stream::HotPixels, 0);
             for index in hot_pixels::choose(n, fraction, &mut rng) {
                 hot_next[index] = exponential_us(self.model.hot_rate_per_us, &mut rng);
             }
         }
-        // each pixel's noise rate (on the pool), then the first noise time of every pixel
-        // drawn in pixel order from the one set-up generator
+        hot_next
+    }
+
+    /// Every pixel's shot-noise rate per microsecond and ON share (from its thresholds,
+    /// on the pool), then its first noise time, drawn in pixel order from the one set-up
+    /// generator of this simulation's noise stream.
+    fn draw_noise(&self, theta_on: &[f32], theta_off: &[f32]) -> (Vec<(f64, f32)>, Vec<f64>) {
+        let params = &self.params;
+        let n = self.width * self.height;
+        let mut noise_rng = generator(self.seed, Stream::Rows, self.noise_index(u64::MAX));
+        let noise_rate = params.shot_noise_rate_hz();
         let rates: Vec<(f64, f32)> = (0..n)
             .into_par_iter()
             .map(|i| {
@@ -211,14 +251,7 @@ impl Simulator {
             .iter()
             .map(|&(rate, _)| exponential_us(rate, &mut noise_rng))
             .collect();
-        PixelDraws {
-            theta_on,
-            theta_off,
-            leak_factors,
-            hot_next,
-            rates,
-            next_noise,
-        }
+        (rates, next_noise)
     }
 
     /// Row `y` at the first sample `dn`: its references and filters at the frame, its
