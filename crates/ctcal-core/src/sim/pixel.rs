@@ -163,7 +163,8 @@ impl PixelState {
         }
     }
 
-    /// A piece of input linear from `(sa, ua)` to `(sb, ub)`.
+    /// A piece of input linear from `(sa, ua)` to `(sb, ub)`: one segment without the
+    /// filter, else the filter's sub-steps ([`Self::filtered_piece`]).
     #[allow(clippy::too_many_arguments)]
     fn piece(
         &mut self,
@@ -182,39 +183,33 @@ impl PixelState {
             self.filtered = ub;
             return;
         };
-        let h = sb - sa;
-        if h <= 0.0 {
+        if sb - sa <= 0.0 {
             // the filter cannot move in no time: a step is seen over the next piece
             return;
         }
-        // Adaptive sub-steps. Behind the filter y = U(s) + T e^(-s/tau): a line U tracking
-        // the input with lag b*tau plus a decaying transient T. A chord over a sub-step of
-        // length h misses the exponential by at most |T| (h/tau)^2 / 8, so h is chosen to
-        // keep that below `tolerance`; once the transient has decayed, one sub-step
-        // spans the rest of the piece.
-        let slope = (ub - ua) / h as f32;
         let tolerance = model.substep_tolerance * self.theta_on.min(self.theta_off);
-        let min_step = h / model.max_substeps as f64;
-        let mut s = sa;
+        let piece = FilteredPiece::new(model, cutoff, tolerance, (sa, sb), (ua, ub), (dna, dnb));
+        self.filtered_piece(model, &piece, rng, sink);
+    }
+
+    /// A piece of input behind the filter, in adaptive sub-steps
+    /// ([`FilteredPiece::substep_end`]): each advances the filter output and passes the
+    /// straight line between its ends to [`Self::segment`].
+    fn filtered_piece(
+        &mut self,
+        model: &PixelModel,
+        piece: &FilteredPiece,
+        rng: &mut Xoshiro256PlusPlus,
+        sink: &mut EventSink,
+    ) {
+        let (ua, ub) = (piece.ua, piece.ub);
+        let mut s = piece.sa;
         let mut y = self.filtered;
-        while s < sb {
-            let f_s = ((s - sa) / h) as f32;
-            let dn_s = lerp(dna, dnb, f_s);
-            let tau = bandwidth::tau_us(dn_s, cutoff);
-            let transient = (y - (lerp(ua, ub, f_s) - slope * tau)).abs();
-            let allowed = if transient > 0.0 {
-                tau as f64 * (8.0 * tolerance as f64 / transient as f64).sqrt()
-            } else {
-                f64::INFINITY
-            };
-            let next = if sb - s <= allowed.max(min_step) {
-                sb
-            } else {
-                s + allowed.max(min_step)
-            };
-            let f_next = ((next - sa) / h) as f32;
-            let dn_next = lerp(dna, dnb, f_next);
-            let tau_mid = bandwidth::tau_us(0.5 * (dn_s + dn_next), cutoff);
+        while s < piece.sb {
+            let (f_s, dn_s) = piece.at(s);
+            let next = piece.substep_end(s, f_s, dn_s, y);
+            let (f_next, dn_next) = piece.at(next);
+            let tau_mid = bandwidth::tau_us(0.5 * (dn_s + dn_next), piece.cutoff);
             let y_next = bandwidth::advance(
                 y,
                 lerp(ua, ub, f_s),
@@ -340,6 +335,83 @@ impl PixelState {
             }
         }
         self.reference -= drift;
+    }
+}
+
+/// A piece of input linear in time from `(sa, ua)` (intensity `dna`) to `(sb, ub)`
+/// (`dnb`), of length `h > 0`, as the filter's sub-steps see it: its slope, the filter's
+/// cutoff, the largest error allowed of a sub-step's straight line (log units) and the
+/// shortest sub-step.
+#[derive(Clone, Copy, Debug)]
+struct FilteredPiece {
+    sa: f64,
+    sb: f64,
+    h: f64,
+    ua: f32,
+    ub: f32,
+    dna: f32,
+    dnb: f32,
+    slope: f32,
+    cutoff: f32,
+    tolerance: f32,
+    min_step: f64,
+}
+
+impl FilteredPiece {
+    /// The piece from `sa` to `sb` with the input `(ua, ub)` and intensity `(dna, dnb)` at
+    /// its ends, sub-stepped to within `tolerance` (log units) in at most
+    /// `model.max_substeps` sub-steps.
+    fn new(
+        model: &PixelModel,
+        cutoff: f32,
+        tolerance: f32,
+        (sa, sb): (f64, f64),
+        (ua, ub): (f32, f32),
+        (dna, dnb): (f32, f32),
+    ) -> Self {
+        let h = sb - sa;
+        Self {
+            sa,
+            sb,
+            h,
+            ua,
+            ub,
+            dna,
+            dnb,
+            slope: (ub - ua) / h as f32,
+            cutoff,
+            tolerance,
+            min_step: h / model.max_substeps as f64,
+        }
+    }
+
+    /// The fraction of the piece at time `s`, and the intensity there.
+    #[inline(always)]
+    fn at(&self, s: f64) -> (f32, f32) {
+        let f = ((s - self.sa) / self.h) as f32;
+        (f, lerp(self.dna, self.dnb, f))
+    }
+
+    /// The end of the sub-step that starts at time `s` (fraction `f_s` of the piece,
+    /// intensity `dn_s`) with filter output `y`. Behind the filter y = U(s) + T e^(-s/tau):
+    /// a line U tracking the input with lag b*tau plus a decaying transient T. A chord
+    /// over a sub-step of length h misses the exponential by at most |T| (h/tau)^2 / 8, so
+    /// h is chosen to keep that below `tolerance`; once the transient has decayed, one
+    /// sub-step spans the rest of the piece.
+    #[inline(always)]
+    fn substep_end(&self, s: f64, f_s: f32, dn_s: f32, y: f32) -> f64 {
+        let tau = bandwidth::tau_us(dn_s, self.cutoff);
+        let transient = (y - (lerp(self.ua, self.ub, f_s) - self.slope * tau)).abs();
+        let allowed = if transient > 0.0 {
+            tau as f64 * (8.0 * self.tolerance as f64 / transient as f64).sqrt()
+        } else {
+            f64::INFINITY
+        };
+        if self.sb - s <= allowed.max(self.min_step) {
+            self.sb
+        } else {
+            s + allowed.max(self.min_step)
+        }
     }
 }
 
