@@ -246,14 +246,7 @@ impl StatsAccumulator {
             return;
         }
         if self.stream_first.is_none() {
-            let t0 = self.options.origin_us.unwrap_or(chunk.t[0]);
-            self.stream_first = Some(t0);
-            if let Some(s) = self.options.start_s {
-                self.select_from = t0 + (s * 1e6).round() as TimeUs;
-            }
-            if let Some(e) = self.options.end_s {
-                self.select_to = t0 + (e * 1e6).round() as TimeUs;
-            }
+            self.start_stream(chunk.t[0]);
         }
         let lo = chunk.t.partition_point(|&t| t < self.select_from);
         let hi = chunk.t.partition_point(|&t| t <= self.select_to);
@@ -267,31 +260,52 @@ impl StatsAccumulator {
         if !self.grow_to(max_x, max_y) {
             return;
         }
-        let Some(kept_cells) = &self.kept_cells else {
-            if self.first.is_none() {
-                self.first = Some(ts[0]);
-                self.windows.end = ts[0].saturating_add(self.window_us);
-            }
-            self.accumulate::<false>(ts, xs, ys);
-            self.events += ts.len() as u64;
-            self.on += on.iter().map(|&p| p as u64).sum::<u64>();
-            self.last = *ts.last().expect("non-empty");
-            return;
-        };
-        // a selection: every event updates its pixel (support, per-pixel counts), only the
-        // kept ones count towards the totals, the timeline and the intervals
-        let grid = &self.pixels;
-        self.kept.clear();
-        self.kept.extend(
-            xs.iter()
-                .zip(ys)
-                .map(|(&x, &y)| kept_cells[grid.index(x, y)]),
-        );
-        if let Some(i) = self.kept.iter().position(|&k| k)
-            && self.first.is_none()
-        {
-            self.first = Some(ts[i]);
-            self.windows.end = ts[i].saturating_add(self.window_us);
+        if self.kept_cells.is_some() {
+            self.add_selected(ts, xs, ys, on);
+        } else {
+            self.add_all(ts, xs, ys, on);
+        }
+    }
+
+    /// Fixes the stream's origin at its first event `t_first` (or at
+    /// [`StatsOptions::origin_us`]) and the selected time span from it.
+    fn start_stream(&mut self, t_first: TimeUs) {
+        let t0 = self.options.origin_us.unwrap_or(t_first);
+        self.stream_first = Some(t0);
+        if let Some(s) = self.options.start_s {
+            self.select_from = t0 + (s * 1e6).round() as TimeUs;
+        }
+        if let Some(e) = self.options.end_s {
+            self.select_to = t0 + (e * 1e6).round() as TimeUs;
+        }
+    }
+
+    /// Sets the first counted event's time `t` and the end of its timeline window, unless
+    /// an earlier event set them.
+    fn note_first(&mut self, t: TimeUs) {
+        if self.first.is_none() {
+            self.first = Some(t);
+            self.windows.end = t.saturating_add(self.window_us);
+        }
+    }
+
+    /// Adds a selected, non-empty run of events without a pixel selection: every event
+    /// counts.
+    fn add_all(&mut self, ts: &[TimeUs], xs: &[u16], ys: &[u16], on: &[bool]) {
+        self.note_first(ts[0]);
+        self.accumulate::<false>(ts, xs, ys);
+        self.events += ts.len() as u64;
+        self.on += on.iter().map(|&p| p as u64).sum::<u64>();
+        self.last = *ts.last().expect("non-empty");
+    }
+
+    /// Adds a selected, non-empty run of events with a pixel selection: every event
+    /// updates its pixel (support, per-pixel counts), only the kept ones count towards the
+    /// totals, the timeline and the intervals.
+    fn add_selected(&mut self, ts: &[TimeUs], xs: &[u16], ys: &[u16], on: &[bool]) {
+        self.flag_kept(xs, ys);
+        if let Some(i) = self.kept.iter().position(|&k| k) {
+            self.note_first(ts[i]);
         }
         self.accumulate::<true>(ts, xs, ys);
         let kept = &self.kept;
@@ -300,6 +314,19 @@ impl StatsAccumulator {
         if let Some(i) = kept.iter().rposition(|&k| k) {
             self.last = ts[i];
         }
+    }
+
+    /// Fills `kept` with whether each event's pixel is in the selection.
+    fn flag_kept(&mut self, xs: &[u16], ys: &[u16]) {
+        let (Some(kept_cells), grid) = (&self.kept_cells, &self.pixels) else {
+            return;
+        };
+        self.kept.clear();
+        self.kept.extend(
+            xs.iter()
+                .zip(ys)
+                .map(|(&x, &y)| kept_cells[grid.index(x, y)]),
+        );
     }
 
     /// The per-event kernel over one run of events (see [`kernel`]; with `SELECTED`,
