@@ -900,7 +900,7 @@ fn aps_refuses_a_static_scene_whose_events_are_noise() {
 /// determinable and why, and keeps OFF, whose samples peak at its threshold.
 #[test]
 fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
-    let case: ctcal::coverage::CaseSpec = serde_json::from_str(
+    let dir = coverage_case(
         r#"{"id": "case-15007", "seed": 15007, "generator": "ctcal", "family": "texture",
             "params": {"ct_on": 0.481336, "ct_off": 0.621281, "ct_sigma": 0.0125011,
                 "refractory_s": 0.000163932, "leak_rate_hz": 0.0307561,
@@ -914,10 +914,7 @@ fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
                     "min_dn": 0.5, "max_dn": 255.0, "spectrum_beta": 1.55086, "blur_px": 1.0,
                     "vx_px_s": -72.3775, "vy_px_s": 36.4755, "omega_deg_s": 0.0,
                     "offset_px": [204.277, 235.912], "mod_amp_ln": 0.0, "mod_hz": 0.0}}}}"#,
-    )
-    .unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    ctcal::coverage::write_case(&case, dir.path()).unwrap();
+    );
     let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
     assert!(e["ct_on"].is_null(), "{}", e["ct_on"]);
     let why = e["why"]["ct_on"].as_str().unwrap();
@@ -931,6 +928,67 @@ fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
     let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
     assert!(lo <= 0.621281 && 0.621281 <= hi, "ct_off {ci}");
     assert!(e["ct_sigma"].is_null() && e["why"]["ct_sigma"].is_string());
+}
+
+/// A coverage study's case (`case.json`, [`ctcal::coverage::CaseSpec`]) written into a
+/// temporary folder with its truth.
+fn coverage_case(spec: &str) -> tempfile::TempDir {
+    let case: ctcal::coverage::CaseSpec = serde_json::from_str(spec).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    ctcal::coverage::write_case(&case, dir.path()).unwrap();
+    dir
+}
+
+/// Coverage draw 15006: IEBCS pixels (thresholds 0.32 / 0.47) whose photoreceptor time
+/// constant goes as one over the light (25 ms at the scene's median DN, 5.6-6.4 Hz), under
+/// natural-image objects moving at up to 38 px/s. The timing's first-order lag term saw a
+/// 64 Hz lag, and the offset absorbed the rest: b = 29 DN for a true 0 (IEBCS reads
+/// ln(E + 1), E in lux = 39 DN), and aps read ON 0.214 [0.151, 0.273]. The photoreceptor
+/// check finds the slow pixel on the frames at that offset, so the offset is not
+/// determined, the frames' own kept and the prior range carried: both thresholds held.
+#[test]
+fn aps_does_not_take_an_offset_a_slow_photoreceptor_may_have_moved() {
+    let dir = coverage_case(
+        r#"{"id": "case-15006", "seed": 15006, "generator": "iebcs",
+            "family": "multi_object_natural", "params": {"ct_on": 0.320626,
+                "ct_off": 0.470205, "seed": 15006},
+            "speed_px_s": 37.7639, "brightness_dn": 188.292,
+            "recording": {"kind": "scene", "scene": {"kind": "multi_object", "width": 96,
+                "height": 72, "duration_s": 0.71, "seed": 15006,
+                "aps": {"rate_hz": 32.0, "exposure_s": 0.00341},
+                "multi_object": {"objects": [1, 8],
+                    "background_velocity_px_s": [7.55278, 18.8819],
+                    "background_angular_velocity_deg_s": [0.0, 20.0],
+                    "background_scale": [0.9, 1.1],
+                    "object_velocity_px_s": [18.8819, 37.7639],
+                    "object_angular_velocity_deg_s": [0.0, 90.0], "object_scale": [0.8, 1.2],
+                    "object_size_px": [8.0, 18.0],
+                    "textures_dir": "calib/scenes/textures/natural",
+                    "background_texture": {"canvas_px": 256, "mean_dn": 188.292,
+                        "log_std": 0.485535, "min_dn": 0.5, "max_dn": 255.0,
+                        "spectrum_beta": 0.532029, "blur_px": 1.0}}}},
+            "peer": {"simulator": "iebcs", "params": {"th_pos": 0.320626,
+                "th_neg": 0.470205, "th_noise": 0.0130485, "lat_us": 56.2422,
+                "jit_us": 2.43265, "ref_us": 232, "tau_us": 107083.0, "bgnp_hz": 0.753884,
+                "bgnn_hz": 0.183327, "lux_at_255": 10000.0}}}"#,
+    );
+    let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
+    let offset = &e["frame_offset_dn"]["estimate"];
+    assert_eq!(
+        offset["source"], "not determined: a photoreceptor slower than the scene",
+        "{offset}"
+    );
+    assert_eq!(offset["offset_dn"].as_f64(), Some(0.0));
+    assert!(
+        strings(&e["assumptions"])
+            .iter()
+            .any(|a| a.contains("the timing fitted b = "))
+    );
+    for (key, truth) in [("ct_on", 0.320626), ("ct_off", 0.470205)] {
+        let ci = &e[format!("{key}_ci95")];
+        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        assert!(lo <= truth && truth <= hi, "{key} {ci} misses {truth}");
+    }
 }
 
 /// A recording with more frames than the estimator takes is measured on blocks of

@@ -694,12 +694,71 @@ fn offset_found(
             assumptions.push(format!("the frames' response: a pure ln(DN + b) explains the events' timing better than the lin-log response (its linear part below 20 DN){}; used throughout", if t.other_response.is_some() { ", though not beyond the pixels' noise: the thresholds the other gives are carried into the intervals" } else { "" }));
             frames.log_map = t.log_map;
         }
+        let own = frames.offset;
         frames.offset = t.offset.offset_dn;
         frames.offset_range = t.offset.systematic_range;
-        assumptions.push(offset_assumption(&t.offset));
+        let offset = match masked_by_slow_photoreceptor(input, excluded, frames, &t.offset, own) {
+            Some((offset, why)) => {
+                frames.offset = offset.offset_dn;
+                frames.offset_range = offset.systematic_range;
+                assumptions.push(why);
+                offset
+            }
+            None => {
+                assumptions.push(offset_assumption(&t.offset));
+                t.offset.clone()
+            }
+        };
         other_response = t.other_response.clone();
+        return (Some(offset), other_response);
     }
-    (found.map(|t| t.offset), other_response)
+    (None, other_response)
+}
+
+/// [`super::timing::Offset::source`] of a fitted offset that a photoreceptor slower than
+/// the scene makes untrustworthy ([`masked_by_slow_photoreceptor`]).
+pub const SLOW_MASKS_OFFSET: &str = "not determined: a photoreceptor slower than the scene";
+
+/// The offset not determined where the timing fitted one but the events follow the frames
+/// low-passed better than the frames themselves ([`photoreceptor::check`] on the frames at
+/// the fitted offset): a photoreceptor whose time constant nears the time the light takes
+/// to change, beyond what the timing's first-order lag term holds, makes dark pixels'
+/// thresholds look larger as a too small offset would, and the fitted offset absorbs it
+/// (IEBCS draw 15006, `tau` 25 ms at its median DN: the check found 5.6 Hz there, the
+/// timing's lag term 64 Hz; the fitted b = 29 DN for a true 0 read ON 0.214 [0.151, 0.273]
+/// for 0.321, b = 0 reads 0.283 [0.208, 0.358]). The frames' own offset `own` is kept and
+/// the prior range spanned; with it the assumption. `None` where the offset stands.
+fn masked_by_slow_photoreceptor(
+    input: &ApsInput,
+    excluded: &[bool],
+    frames: &PreparedFrames,
+    fitted: &super::timing::Offset,
+    own: f32,
+) -> Option<(super::timing::Offset, String)> {
+    if fitted.source != "fitted" {
+        return None;
+    }
+    let slow = photoreceptor::check(input.events, frames, excluded)?;
+    let prior = super::timing::OFFSET_PRIOR;
+    let range = (prior.0.min(own), prior.1.max(own));
+    let why = format!(
+        "the frames' log offset b in ln(DN + b) is not determined: the timing fitted b = {:.1} DN (95 % {} .. {}), but the events follow the frames low-passed at {:.1} Hz at their median DN better than the frames themselves ({:.1} standard errors), and a photoreceptor that slow makes dark pixels' thresholds look larger as a too small offset would; b = {own:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",
+        fitted.offset_dn,
+        fitted.ci95[0].map_or("open".into(), |v| format!("{v:.1}")),
+        fitted.ci95[1].map_or("open".into(), |v| format!("{v:.1}")),
+        slow.cutoff_at_median_dn_hz,
+        slow.significance,
+        range.0,
+        range.1,
+    );
+    let offset = super::timing::Offset {
+        offset_dn: own,
+        ci95: [None, None],
+        systematic_range: range,
+        by_polarity: fitted.by_polarity,
+        source: SLOW_MASKS_OFFSET,
+    };
+    Some((offset, why))
 }
 
 /// The model event timing measured: its thresholds and mismatch, and the photoreceptor's
