@@ -874,39 +874,77 @@ fn time_precision(
     layout: Layout,
     n: usize,
 ) -> Result<Option<String>, InputError> {
-    let (name, column) = match layout {
-        Layout::EventUtils => ("events/ts".to_string(), None),
-        Layout::Mvsec(side) => (format!("{}/events", side.group()), Some(2)),
-        _ => return Ok(None),
+    let Some(times) = FloatTimes::float32(path, file, layout)? else {
+        return Ok(None);
     };
-    let ds = file.dataset(&name).map_err(|e| h5_error(path, &name, e))?;
-    let is_float32 = matches!(
-        ds.dtype().and_then(|d| d.to_descriptor()),
-        Ok(TypeDescriptor::Float(hdf5::types::FloatSize::U4))
-    );
-    if !is_float32 || n == 0 {
+    if n == 0 {
         return Ok(None);
     }
-    let time_at = |row: usize| -> Result<f64, InputError> {
-        let v = match column {
-            None => element::<f64>(file, &name, row),
-            Some(c) => ds
-                .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, c..c + 1])
-                .map(|a| a.iter().next().copied().unwrap_or(0.0)),
-        };
-        v.map_err(|e| h5_error(path, &name, e))
-    };
-    let (first, last) = (time_at(0)?, time_at(n - 1)?);
+    let (first, last) = (times.at(path, file, 0)?, times.at(path, file, n - 1)?);
     if !first.is_finite() || !last.is_finite() {
         // reported with its index by the reader
         return Ok(None);
     }
+    precision_of(path, &times.field(), (first, last), n)
+}
+
+/// A layout's times stored as float seconds: the dataset's name, the column of a table
+/// (`None`: a column of its own) and the dataset.
+struct FloatTimes {
+    name: String,
+    column: Option<usize>,
+    ds: hdf5::Dataset,
+}
+
+impl FloatTimes {
+    /// The times of `layout` where they are float32 seconds (event_utils' `events/ts`, the
+    /// third column of MVSEC's events); `None` for other layouts and types.
+    fn float32(path: &Path, file: &hdf5::File, layout: Layout) -> Result<Option<Self>, InputError> {
+        let (name, column) = match layout {
+            Layout::EventUtils => ("events/ts".to_string(), None),
+            Layout::Mvsec(side) => (format!("{}/events", side.group()), Some(2)),
+            _ => return Ok(None),
+        };
+        let ds = file.dataset(&name).map_err(|e| h5_error(path, &name, e))?;
+        let is_float32 = matches!(
+            ds.dtype().and_then(|d| d.to_descriptor()),
+            Ok(TypeDescriptor::Float(hdf5::types::FloatSize::U4))
+        );
+        Ok(is_float32.then_some(Self { name, column, ds }))
+    }
+
+    /// The time stored at `row`, seconds.
+    fn at(&self, path: &Path, file: &hdf5::File, row: usize) -> Result<f64, InputError> {
+        let v = match self.column {
+            None => element::<f64>(file, &self.name, row),
+            Some(c) => self
+                .ds
+                .read_slice_2d::<f64, _>(ndarray::s![row..row + 1, c..c + 1])
+                .map(|a| a.iter().next().copied().unwrap_or(0.0)),
+        };
+        v.map_err(|e| h5_error(path, &self.name, e))
+    }
+
+    /// The times' name in messages: the dataset, with the column of a table.
+    fn field(&self) -> String {
+        match self.column {
+            None => self.name.clone(),
+            Some(c) => format!("{}[:, {c}]", self.name),
+        }
+    }
+}
+
+/// Whether the `n` float32 times from `first` to `last` of `field` keep their precision:
+/// refused where the spacing of float32 values at the larger is coarser than
+/// [`MAX_TIME_RESOLUTION_S`], a note where coarser than a microsecond, else `None`.
+fn precision_of(
+    path: &Path,
+    field: &str,
+    (first, last): (f64, f64),
+    n: usize,
+) -> Result<Option<String>, InputError> {
     let t = first.abs().max(last.abs());
     let spacing = float32_spacing(t);
-    let field = match column {
-        None => name.clone(),
-        Some(c) => format!("{name}[:, {c}]"),
-    };
     let problem = format!(
         "{field} stores times as float32 seconds, which near {t:.6e} s only take values {spacing:.3e} s apart: events closer than that share one time (the {} events from {first} s to {last} s)",
         n
