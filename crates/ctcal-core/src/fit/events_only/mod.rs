@@ -383,28 +383,6 @@ fn fit_run(
         .collect();
     let edge = refractory::edge(&mut intervals, timestamp_step_us);
     let (isolation, noise_bound) = measure::choose_isolation(&fit);
-    let ratio = |b: &[&BlockMeasure]| {
-        let (on, off) = b.iter().fold((0u64, 0u64), |(a, c), m| {
-            (a + m.signal_on, c + m.signal_off)
-        });
-        (on >= 20 && off >= 20).then(|| off as f64 / on as f64)
-    };
-    // the balance's standard error: jackknife over the fit blocks (each block's own
-    // brightness history moves it, which Poisson counting alone would not show)
-    let balance = ratio(&fit).map(|all| {
-        let n = fit.len();
-        let leave_one_out: Vec<f64> = (0..n)
-            .filter_map(|k| {
-                let rest: Vec<&BlockMeasure> = (0..n).filter(|&j| j != k).map(|j| fit[j]).collect();
-                ratio(&rest)
-            })
-            .collect();
-        let se = (leave_one_out.len() >= 3)
-            .then(|| sample_std_dev(&leave_one_out))
-            .flatten()
-            .map_or(f64::INFINITY, |s| s * (n as f64 - 1.0) / (n as f64).sqrt());
-        (all, se)
-    });
     FitRun {
         hot_positions: hot.iter().map(|h| (h.x, h.y)).collect(),
         hot,
@@ -419,15 +397,49 @@ fn fit_run(
         leak_onset: leak_onset::onset(&fit, &judging.of(Role::Selection), isolation),
         edge,
         timestamp_step_us,
-        balance,
+        balance: balance(&fit),
         quiet_pixel_seconds: BlockMeasure::isolated(&fit, isolation).pixel_seconds,
         quiet_share: measure::quiet_share(&fit, isolation),
-        signal_rate_hz: fit
-            .iter()
-            .map(|b| b.signal_rate_hz * b.seconds)
-            .sum::<f64>()
-            / fit.iter().map(|b| b.seconds).sum::<f64>().max(1e-9),
+        signal_rate_hz: signal_rate_hz(&fit),
     }
+}
+
+/// The ON/OFF balance of the supported events of `blocks`, `N_off / N_on`; `None` with
+/// fewer than 20 of either.
+fn signal_ratio(blocks: &[&BlockMeasure]) -> Option<f64> {
+    let (on, off) = blocks.iter().fold((0u64, 0u64), |(a, c), m| {
+        (a + m.signal_on, c + m.signal_off)
+    });
+    (on >= 20 && off >= 20).then(|| off as f64 / on as f64)
+}
+
+/// The balance over the fit blocks ([`signal_ratio`]) and its standard error: a jackknife
+/// over the blocks (each block's own brightness history moves it, which Poisson counting
+/// alone would not show), infinite with fewer than 3 leave-one-out values.
+fn balance(fit: &[&BlockMeasure]) -> Option<(f64, f64)> {
+    signal_ratio(fit).map(|all| {
+        let n = fit.len();
+        let leave_one_out: Vec<f64> = (0..n)
+            .filter_map(|k| {
+                let rest: Vec<&BlockMeasure> = (0..n).filter(|&j| j != k).map(|j| fit[j]).collect();
+                signal_ratio(&rest)
+            })
+            .collect();
+        let se = (leave_one_out.len() >= 3)
+            .then(|| sample_std_dev(&leave_one_out))
+            .flatten()
+            .map_or(f64::INFINITY, |s| s * (n as f64 - 1.0) / (n as f64).sqrt());
+        (all, se)
+    })
+}
+
+/// Supported events per kept pixel per second over the fit blocks, each block weighted by
+/// its length.
+fn signal_rate_hz(fit: &[&BlockMeasure]) -> f64 {
+    fit.iter()
+        .map(|b| b.signal_rate_hz * b.seconds)
+        .sum::<f64>()
+        / fit.iter().map(|b| b.seconds).sum::<f64>().max(1e-9)
 }
 
 /// The absolute thresholds: given (a method that measured them), else eppps with its
