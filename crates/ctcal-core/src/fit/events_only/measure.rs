@@ -425,9 +425,8 @@ fn isolated(
     kept: &[bool],
 ) -> (Isolated, (u64, u64)) {
     let (w, h) = (near.sensor.width as usize, near.sensor.height as usize);
-    let (window, r) = (near.window, near.radius);
-    let mut until = vec![span.0; w * h];
-    let mut covered = vec![0 as TimeUs; w * h];
+    let window = near.window;
+    let mut cover = Cover::new(w * h, span.0);
     let mut alone = vec![[0u32; 2]; w * h];
     let mut signal = (0u64, 0u64);
     let from = clean.t.partition_point(|&t| t < span.0 - window);
@@ -448,24 +447,66 @@ fn isolated(
                 (false, _) => alone[p][on as usize] += 1,
             }
         }
-        let (lo, hi) = ((t - window).max(span.0), (t + window).min(span.1));
+        let lit = ((t - window).max(span.0), (t + window).min(span.1));
+        cover.around((x, y), lit, near.radius, (w, h));
+    }
+    (quiet_isolated(&cover.covered, &alone, kept, span), signal)
+}
+
+/// How long each pixel was covered by its neighbours' events within a span, µs: the union
+/// of their ±window spans, counted up to `until`, the end of the cover counted so far.
+struct Cover {
+    until: Vec<TimeUs>,
+    covered: Vec<TimeUs>,
+}
+
+impl Cover {
+    /// No pixel of `pixels` covered yet, the span starting at `start`.
+    fn new(pixels: usize, start: TimeUs) -> Self {
+        Self {
+            until: vec![start; pixels],
+            covered: vec![0 as TimeUs; pixels],
+        }
+    }
+
+    /// Covers the pixels within `r` of `(x, y)`, itself left out, over `(lo, hi)` (the
+    /// part not covered already: events come in time order).
+    #[inline]
+    fn around(
+        &mut self,
+        (x, y): (usize, usize),
+        (lo, hi): (TimeUs, TimeUs),
+        r: usize,
+        (w, h): (usize, usize),
+    ) {
+        let p = y * w + x;
         for ny in y.saturating_sub(r)..(y + r + 1).min(h) {
             for nx in x.saturating_sub(r)..(x + r + 1).min(w) {
                 let n = ny * w + nx;
                 if n == p {
                     continue;
                 }
-                let start = lo.max(until[n]);
+                let start = lo.max(self.until[n]);
                 if hi > start {
-                    covered[n] += hi - start;
-                    until[n] = hi;
+                    self.covered[n] += hi - start;
+                    self.until[n] = hi;
                 }
             }
         }
     }
+}
+
+/// The isolated events (`alone`, OFF then ON per pixel) of the kept pixels left uncovered
+/// at least [`QUIET_SHARE`] of `span`, and the seconds they were uncovered.
+fn quiet_isolated(
+    covered: &[TimeUs],
+    alone: &[[u32; 2]],
+    kept: &[bool],
+    span: (TimeUs, TimeUs),
+) -> Isolated {
     let span_us = span.1 - span.0;
     let mut out = Isolated::default();
-    for p in (0..w * h).filter(|&p| kept[p]) {
+    for p in (0..covered.len()).filter(|&p| kept[p]) {
         let uncovered = span_us - covered[p].min(span_us);
         if uncovered as f64 >= QUIET_SHARE * span_us as f64 {
             out.on += alone[p][1] as u64;
@@ -473,7 +514,7 @@ fn isolated(
             out.pixel_seconds += uncovered as f64 * 1e-6;
         }
     }
-    (out, signal)
+    out
 }
 
 #[cfg(test)]
