@@ -69,51 +69,15 @@ pub fn judge(
     profiles: &NoiseProfiles,
     uncertainty: &mut BTreeMap<String, Uncertain>,
 ) -> NoiseShare {
-    let show = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
     let mut parts = Vec::new();
     let mut undetermined = Vec::new();
     for (key, name, values) in [
         ("ct_off", "OFF", profiles.off),
         ("ct_on", "ON", profiles.on),
     ] {
-        let said = format!(
-            "{name} {} / {} / {}",
-            show(values[0]),
-            show(values[1]),
-            show(values[2])
-        );
-        let Some(mid) = values[1] else {
-            parts.push(format!("{said} (not profiled at the fitted rate)"));
-            continue;
-        };
-        let at_bound = values
-            .iter()
-            .flatten()
-            .any(|v| *v <= THRESHOLD_RANGE.0 * 1.0001 || *v >= THRESHOLD_RANGE.1 * 0.9999);
-        let ln_change = values
-            .iter()
-            .flatten()
-            .map(|v| (v / mid).ln().abs())
-            .fold(0.0, f64::max);
-        if at_bound {
-            let why = format!(
-                "the events of this polarity are mostly the shot noise's: profiled again with the noise rate at its 95 % interval's ends and at the fitted rate ({} Hz), {key} reads {} / {} / {}, reaching an end of the profile's range ({} to {}): within the noise rate's interval the noise alone may make the recording's events of this polarity, so the counts do not fix the threshold",
-                rate_list(profiles.rates_hz),
-                show(values[0]),
-                show(values[1]),
-                show(values[2]),
-                THRESHOLD_RANGE.0,
-                THRESHOLD_RANGE.1
-            );
-            undetermined.push((key.to_string(), why));
-            parts.push(format!("{said}: not determined"));
-            continue;
-        }
-        let widened = widen_ln(uncertainty, key, ln_change / z95());
-        parts.push(match widened {
-            Some(w) if ln_change > 0.0 => format!("{said}: {w}"),
-            _ => said,
-        });
+        let (part, why) = judge_one(key, name, values, profiles.rates_hz, uncertainty);
+        parts.push(part);
+        undetermined.extend(why.map(|why| (key.to_string(), why)));
     }
     let note = format!(
         "noise-rate check: the final model's thresholds profiled again with the shot noise at the low end of its 95 % interval, at the fitted rate and at the high end ({} Hz): {}; a threshold's largest log change, read as 1.96 standard deviations, widens its interval in quadrature, and one that reaches an end of the profile's range is not determined",
@@ -121,6 +85,60 @@ pub fn judge(
         parts.join("; ")
     );
     NoiseShare { note, undetermined }
+}
+
+/// One threshold's verdict (`key` in `uncertainty`, `name` in the note) from its `values`
+/// profiled at `rates_hz`: its part of the note, and why it is not determined where it
+/// reaches an end of the profile's range; otherwise its interval widened by its largest
+/// log change.
+fn judge_one(
+    key: &str,
+    name: &str,
+    values: [Option<f64>; 3],
+    rates_hz: [Option<f64>; 3],
+    uncertainty: &mut BTreeMap<String, Uncertain>,
+) -> (String, Option<String>) {
+    let said = format!(
+        "{name} {} / {} / {}",
+        shown(values[0]),
+        shown(values[1]),
+        shown(values[2])
+    );
+    let Some(mid) = values[1] else {
+        return (format!("{said} (not profiled at the fitted rate)"), None);
+    };
+    let at_bound = values
+        .iter()
+        .flatten()
+        .any(|v| *v <= THRESHOLD_RANGE.0 * 1.0001 || *v >= THRESHOLD_RANGE.1 * 0.9999);
+    if at_bound {
+        let why = format!(
+            "the events of this polarity are mostly the shot noise's: profiled again with the noise rate at its 95 % interval's ends and at the fitted rate ({} Hz), {key} reads {} / {} / {}, reaching an end of the profile's range ({} to {}): within the noise rate's interval the noise alone may make the recording's events of this polarity, so the counts do not fix the threshold",
+            rate_list(rates_hz),
+            shown(values[0]),
+            shown(values[1]),
+            shown(values[2]),
+            THRESHOLD_RANGE.0,
+            THRESHOLD_RANGE.1
+        );
+        return (format!("{said}: not determined"), Some(why));
+    }
+    let ln_change = values
+        .iter()
+        .flatten()
+        .map(|v| (v / mid).ln().abs())
+        .fold(0.0, f64::max);
+    let widened = widen_ln(uncertainty, key, ln_change / z95());
+    let part = match widened {
+        Some(w) if ln_change > 0.0 => format!("{said}: {w}"),
+        _ => said,
+    };
+    (part, None)
+}
+
+/// A profiled threshold to four decimals, `-` where there is none.
+fn shown(v: Option<f64>) -> String {
+    v.map_or("-".to_string(), |v| format!("{v:.4}"))
 }
 
 fn rate_list(rates: [Option<f64>; 3]) -> String {
