@@ -105,6 +105,42 @@ fn profiled_on(
     model: &Simulated,
     variant: Variant,
 ) -> Option<(f64, Simulated, usize)> {
+    let own = own_frames(check, variant)?;
+    let frames = own.frames.as_ref().unwrap_or(check.frames);
+    let geometry_used = own.geometry.as_ref().unwrap_or(fine.geometry);
+    let coarse = Simulation {
+        runs: own.runs.as_deref().unwrap_or(fine.runs),
+        width: frames.width,
+        height: frames.height,
+        geometry: geometry_used,
+        events: fine.events,
+        real: match &own.geometry {
+            Some(g) => Observed::new(fine.events, g, check.masked),
+            None => fine.real.clone(),
+        },
+        grid: fine.grid,
+        seed: fine.seed,
+        count: Cell::new(0),
+        hot_events: fine.hot_events.clone(),
+        lag_keys: Default::default(),
+    };
+    let profiled = coarse.profile(&model.params, check.masked, false).ok()?;
+    let count = coarse.count.get();
+    let interval_s = frames.median_interval_us() as f64 * 1e-6;
+    Some((interval_s, profiled, count))
+}
+
+/// What a variant of the frames brings of its own; `None` in a field where it keeps the
+/// fit's (its frames, their simulation runs, their geometry and statistics).
+struct OwnFrames {
+    frames: Option<PreparedFrames>,
+    runs: Option<Vec<Vec<Sample>>>,
+    geometry: Option<Geometry>,
+}
+
+/// The frames, runs and geometry of `variant` that differ from the fit's; `None` where
+/// too few frame intervals remain usable.
+fn own_frames(check: &Check, variant: Variant) -> Option<OwnFrames> {
     let (frames, runs, geometry) = match variant {
         // the fit's own frames, runs and statistics: only the profile is run again
         Variant::Step(1) => (None, None, None),
@@ -133,28 +169,11 @@ fn profiled_on(
             (Some(frames), Some(runs), None)
         }
     };
-    let frames = frames.as_ref().unwrap_or(check.frames);
-    let geometry_used = geometry.as_ref().unwrap_or(fine.geometry);
-    let coarse = Simulation {
-        runs: runs.as_deref().unwrap_or(fine.runs),
-        width: frames.width,
-        height: frames.height,
-        geometry: geometry_used,
-        events: fine.events,
-        real: match &geometry {
-            Some(g) => Observed::new(fine.events, g, check.masked),
-            None => fine.real.clone(),
-        },
-        grid: fine.grid,
-        seed: fine.seed,
-        count: Cell::new(0),
-        hot_events: fine.hot_events.clone(),
-        lag_keys: Default::default(),
-    };
-    let profiled = coarse.profile(&model.params, check.masked, false).ok()?;
-    let count = coarse.count.get();
-    let interval_s = frames.median_interval_us() as f64 * 1e-6;
-    Some((interval_s, profiled, count))
+    Some(OwnFrames {
+        frames,
+        runs,
+        geometry,
+    })
 }
 
 /// The checks of the final `model` (fitted on `simulation`'s frames); the simulations they
