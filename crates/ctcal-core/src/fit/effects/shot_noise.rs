@@ -19,26 +19,29 @@ use super::{Context, Effect, Evidence, background_totals};
 use crate::fit::observe::INTENSITY_BINS;
 use crate::sim::effects::shot_noise::brightness_factor;
 
+/// The evidence for shot noise: the isolated events of all pixels
+/// (`isolated_evidence`), then the quiet pixels' count, which rules it out or calls for
+/// it whatever those show (`with_quiet_pixels`).
 pub fn evidence(c: &Context) -> Evidence {
-    let ([r_off, r_on, s_off, s_on], exposure) = background_totals(c);
+    let (totals, exposure) = background_totals(c);
     if exposure <= 0.0 {
         return Evidence::none(
             Effect::ShotNoise,
             "no reliable pixel-time to count isolated events",
         );
     }
+    with_quiet_pixels(c, isolated_evidence(c, totals, exposure))
+}
+
+/// The evidence of the isolated events of all pixels, `[real OFF, real ON, model OFF,
+/// model ON]` over `exposure` pixel-seconds: the smaller excess in standard errors
+/// ([`score`]), relevant above [`RELEVANT_HZ`], the search started at the dark rate.
+fn isolated_evidence(c: &Context, [r_off, r_on, s_off, s_on]: [f64; 4], exposure: f64) -> Evidence {
     let (excess_on, excess_off) = (r_on - s_on, r_off - s_off);
     let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
     // the dark rate: the observed rate is the dark rate times the brightness factor
-    let bright = c.model.shot_noise_bright_factor() as f32;
-    let factor = (0..INTENSITY_BINS)
-        .map(|b| {
-            let e = c.geometry.exposure_of(b, c.subset);
-            e * brightness_factor(c.geometry.intensity_centres[b] as f32, bright) as f64
-        })
-        .sum::<f64>()
-        / exposure;
-    let evidence = Evidence {
+    let factor = mean_brightness_factor(c, exposure);
+    Evidence {
         effect: Effect::ShotNoise,
         score,
         relevant: rate > RELEVANT_HZ,
@@ -49,7 +52,27 @@ pub fn evidence(c: &Context) -> Evidence {
         ),
         other_start: None,
         start: Some((rate / factor.max(0.1) / 0.9).max(1e-3)),
-    };
+    }
+}
+
+/// The simulator's shot-noise brightness factor averaged over the recording's
+/// intensities, each bin weighted by its pixel-seconds (`exposure` in all).
+fn mean_brightness_factor(c: &Context, exposure: f64) -> f64 {
+    let bright = c.model.shot_noise_bright_factor() as f32;
+    (0..INTENSITY_BINS)
+        .map(|b| {
+            let e = c.geometry.exposure_of(b, c.subset);
+            e * brightness_factor(c.geometry.intensity_centres[b] as f32, bright) as f64
+        })
+        .sum::<f64>()
+        / exposure
+}
+
+/// `evidence` as the isolated OFF events at the recording's quiet pixels change it:
+/// ruled out where they find no noise that matters (its start kept for a listed try),
+/// called for where they find more than the model has (the stronger score, searched from
+/// their dark rate), else as it is.
+fn with_quiet_pixels(c: &Context, evidence: Evidence) -> Evidence {
     // ruled out by the quiet pixels: not called for, its start kept for a listed try
     if let Some(why) = super::quiet_noise::rules_out(c, RELEVANT_HZ) {
         return Evidence {
