@@ -68,7 +68,29 @@ struct Template {
     origin: (f64, f64),
 }
 
+/// The [`Template`] of `predicted` at `pose` on a grid of `factor` sensor pixels; `None`
+/// where it would be empty or larger than 2^22 pixels.
 fn template(predicted: &Stack, pose: &Pose, factor: usize) -> Option<Template> {
+    let (lo, hi) = mapped_bounds(predicted, pose);
+    let f = factor as f64;
+    let (width, height) = (
+        ((hi.0 - lo.0) / f).ceil() as usize,
+        ((hi.1 - lo.1) / f).ceil() as usize,
+    );
+    if width == 0 || height == 0 || width * height > 1 << 22 {
+        return None;
+    }
+    Some(Template {
+        images: sampled(predicted, pose, lo, f, (width, height)),
+        width,
+        height,
+        origin: lo,
+    })
+}
+
+/// The bounding box (lowest and highest corner) of the stimulus mapped by `pose`, relative
+/// to its translation.
+fn mapped_bounds(predicted: &Stack, pose: &Pose) -> ((f64, f64), (f64, f64)) {
     let (sw, sh) = (predicted.width as f64, predicted.height as f64);
     let centre = (sw / 2.0, sh / 2.0);
     let mapped: Vec<(f64, f64)> = [(0.0, 0.0), (sw, 0.0), (sw, sh), (0.0, sh)]
@@ -86,14 +108,21 @@ fn template(predicted: &Stack, pose: &Pose, factor: usize) -> Option<Template> {
         .fold((f64::NEG_INFINITY, f64::NEG_INFINITY), |a, p| {
             (a.0.max(p.0), a.1.max(p.1))
         });
-    let f = factor as f64;
-    let (width, height) = (
-        ((hi.0 - lo.0) / f).ceil() as usize,
-        ((hi.1 - lo.1) / f).ceil() as usize,
-    );
-    if width == 0 || height == 0 || width * height > 1 << 22 {
-        return None;
-    }
+    (lo, hi)
+}
+
+/// The template's images: each of its `width x height` pixels (`f` sensor pixels a side,
+/// the first at `lo`) sums k x k samples of every window's predicted activity, each at the
+/// nearest stimulus pixel (k from the pixel's size in stimulus pixels, 1 to 6).
+fn sampled(
+    predicted: &Stack,
+    pose: &Pose,
+    lo: (f64, f64),
+    f: f64,
+    (width, height): (usize, usize),
+) -> Vec<Vec<f32>> {
+    let (sw, sh) = (predicted.width as f64, predicted.height as f64);
+    let centre = (sw / 2.0, sh / 2.0);
     // k x k samples per template pixel, nearest stimulus pixel
     let k = ((f / pose.scale).ceil() as usize).clamp(1, 6);
     let mut images = vec![vec![0f32; width * height]; predicted.windows()];
@@ -118,12 +147,7 @@ fn template(predicted: &Stack, pose: &Pose, factor: usize) -> Option<Template> {
             }
         }
     }
-    Some(Template {
-        images,
-        width,
-        height,
-        origin: lo,
-    })
+    images
 }
 
 /// The sensor side at one resolution: block-summed activity with its sums.
