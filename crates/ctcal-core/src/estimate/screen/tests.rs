@@ -243,41 +243,18 @@ fn events_without_the_stimulus_are_not_registered() {
 /// the truth and the values lie within 15 %.
 #[test]
 fn a_dark_offset_in_the_log_response_is_fitted_declared_or_not() {
-    let truth = (0.654571, 0.461429);
-    let display = DisplayParams {
-        refresh_hz: 75.0,
-        gamma: 2.43327,
-        black_level: 0.0262927,
-        white_dn: 124.475,
-        blur_px: Some(0.85),
-        time_offset_s: None,
-    };
-    let params = PixelParams {
-        log_response: Some(LogResponse::Eps),
-        log_eps: Some(0.00276233),
-        ..PixelParams::ideal(truth.0, truth.1)
-    };
     let stimulus = stimulus();
-    let one_to_one = geometry([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 0.0);
-    let events = record_through(&one_to_one, &stimulus, &display, &params);
+    let events = dark_offset_recording(&stimulus);
     let excluded = vec![false; SENSOR.0 * SENSOR.1];
-    let typical_lcd = DisplayParams {
-        refresh_hz: 75.0,
-        gamma: 2.2,
-        black_level: 0.001,
-        white_dn: 220.0,
-        blur_px: Some(0.7),
-        time_offset_s: None,
-    };
     for response in [
-        ResponsePrior::Declared(LogMap::new(LogResponse::Eps, 0.00276233)),
+        ResponsePrior::Declared(LogMap::new(LogResponse::Eps, DARK_OFFSET_EPS)),
         ResponsePrior::Unknown,
     ] {
         let input = ScreenInput {
             sensor: Sensor::new(SENSOR.0 as u16, SENSOR.1 as u16),
             events: &events,
             stimulus: &stimulus,
-            screen: typical_lcd.clone(),
+            screen: typical_lcd(),
             gamma_prior: GammaPrior::Displays,
             response,
             refresh_hz: None,
@@ -288,22 +265,66 @@ fn a_dark_offset_in_the_log_response_is_fitted_declared_or_not() {
             "{response:?}: ON {:?} {:?}, OFF {:?} {:?}",
             e.ct_on, e.ct_on_ci95, e.ct_off, e.ct_off_ci95
         );
-        for (value, ci, truth) in [
-            (e.ct_on, e.ct_on_ci95, truth.0),
-            (e.ct_off, e.ct_off_ci95, truth.1),
-        ] {
-            let value = value.unwrap_or_else(|| panic!("{response:?}: {:?}", e.why));
-            let [lo, hi] = ci.unwrap();
-            let (lo, hi) = (lo.unwrap(), hi.unwrap());
-            assert!(
-                lo <= truth && truth <= hi,
-                "{response:?}: {value} [{lo}, {hi}] misses {truth}"
-            );
-            assert!(
-                (value / truth - 1.0).abs() < 0.15,
-                "{response:?}: {value} vs {truth}"
-            );
-        }
+        assert_holds_dark_offset_truth(&e, &response);
+    }
+}
+
+/// The thresholds (ON, OFF) draw 3035 was simulated with.
+const DARK_OFFSET_TRUTH: (f64, f64) = (0.654571, 0.461429);
+/// The dark offset of its log response, `ln(DN / 255 + eps)`.
+const DARK_OFFSET_EPS: f64 = 0.00276233;
+
+/// The events of `stimulus` shown 1:1 on draw 3035's display (black level 2.6 % of white,
+/// gamma 2.43) to ideal pixels of its thresholds, through `ln(DN / 255 + 0.0028)`.
+fn dark_offset_recording(stimulus: &[Frame]) -> EventChunk {
+    let display = DisplayParams {
+        refresh_hz: 75.0,
+        gamma: 2.43327,
+        black_level: 0.0262927,
+        white_dn: 124.475,
+        blur_px: Some(0.85),
+        time_offset_s: None,
+    };
+    let params = PixelParams {
+        log_response: Some(LogResponse::Eps),
+        log_eps: Some(DARK_OFFSET_EPS),
+        ..PixelParams::ideal(DARK_OFFSET_TRUTH.0, DARK_OFFSET_TRUTH.1)
+    };
+    let one_to_one = geometry([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], 0.0);
+    record_through(&one_to_one, stimulus, &display, &params)
+}
+
+/// The screen model the estimate starts from where the display is not measured: a
+/// typical 75 Hz LCD.
+fn typical_lcd() -> DisplayParams {
+    DisplayParams {
+        refresh_hz: 75.0,
+        gamma: 2.2,
+        black_level: 0.001,
+        white_dn: 220.0,
+        blur_px: Some(0.7),
+        time_offset_s: None,
+    }
+}
+
+/// Asserts that both thresholds of `e` (estimated with `response`) have intervals that hold
+/// [`DARK_OFFSET_TRUTH`] and values within 15 % of it.
+fn assert_holds_dark_offset_truth(e: &CtEstimate, response: &ResponsePrior) {
+    for (value, ci, truth) in [
+        (e.ct_on, e.ct_on_ci95, DARK_OFFSET_TRUTH.0),
+        (e.ct_off, e.ct_off_ci95, DARK_OFFSET_TRUTH.1),
+    ] {
+        let value = value.unwrap_or_else(|| panic!("{response:?}: {:?}", e.why));
+        let [lo, hi] = ci.unwrap();
+        let (lo, hi) = (lo.unwrap(), hi.unwrap());
+        assert!(
+            lo <= truth && truth <= hi,
+            "{response:?}: {value} [{lo}, {hi}] misses {truth}"
+        );
+        assert!(
+            (value / truth - 1.0).abs() < 0.15,
+            "{response:?}: {value} vs {truth}"
+        );
     }
 }
 
