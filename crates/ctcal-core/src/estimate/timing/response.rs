@@ -88,23 +88,8 @@ impl Candidate {
 /// scatters [`REPLACE_MARGIN`] less; the other kept where the ratio's 95 % interval reaches
 /// across that margin.
 pub(super) fn choose(pairs: &[Pair], frames: &PreparedFrames, options: &TimingOptions) -> Chosen {
-    let pixels = frames.width * frames.height;
-    let mut maps = vec![frames.log_map];
-    if options.fit_offset
-        && options.choose_response
-        && frames.log_map.response() != LogResponse::Eps
-    {
-        maps.push(LogMap::new(LogResponse::Eps, 0.0));
-    }
     let slots = PixelSlots::new(pairs);
-    let mut candidates: Vec<Candidate> = maps
-        .into_par_iter()
-        .map(|map| {
-            let fit = whole_fit(pairs, &map, pixels, options);
-            let offset = find_offset(pairs, frames, options, &fit);
-            candidate(pairs, &slots, map, offset, &fit)
-        })
-        .collect();
+    let mut candidates = fitted_candidates(pairs, frames, options, &slots);
     let own = candidates.remove(0);
     let Some(pure) = candidates.pop() else {
         return Chosen {
@@ -122,9 +107,58 @@ pub(super) fn choose(pairs: &[Pair], frames: &PreparedFrames, options: &TimingOp
         ci[0] >= REPLACE_MARGIN
     };
     let (chosen, other) = if replace { (pure, own) } else { (own, pure) };
+    let other = if clear {
+        None
+    } else {
+        other_response(&chosen, other, replace, ratio, ci)
+    };
+    Chosen {
+        log_map: chosen.map,
+        offset: chosen.offset,
+        other,
+    }
+}
+
+/// The candidate responses, each fitted at its own offset in parallel: the frames' own
+/// first, then (with `fit_offset` and `choose_response`, where the frames' own is not
+/// already one) a pure `ln(DN + b)`.
+fn fitted_candidates(
+    pairs: &[Pair],
+    frames: &PreparedFrames,
+    options: &TimingOptions,
+    slots: &PixelSlots,
+) -> Vec<Candidate> {
+    let pixels = frames.width * frames.height;
+    let mut maps = vec![frames.log_map];
+    if options.fit_offset
+        && options.choose_response
+        && frames.log_map.response() != LogResponse::Eps
+    {
+        maps.push(LogMap::new(LogResponse::Eps, 0.0));
+    }
+    maps.into_par_iter()
+        .map(|map| {
+            let fit = whole_fit(pairs, &map, pixels, options);
+            let offset = find_offset(pairs, frames, options, &fit);
+            candidate(pairs, slots, map, offset, &fit)
+        })
+        .collect()
+}
+
+/// The response not chosen, kept where the events could not rule it out: its thresholds
+/// beside the chosen one's, and the score ratio (with its interval `ci` of the pure log's
+/// over the frames' own) turned to the other's over the chosen's. `None` where either
+/// response's thresholds are missing or not positive.
+fn other_response(
+    chosen: &Candidate,
+    other: Candidate,
+    replace: bool,
+    ratio: f64,
+    ci: [f64; 2],
+) -> Option<OtherResponse> {
     let positive = |c: &Coefficients| [c.c_on, c.c_off].iter().all(|v| v.is_finite() && *v > 0.0);
-    let other = match (clear, &chosen.coefficients, &other.coefficients) {
-        (false, Some(c), Some(o)) if positive(c) && positive(o) => Some(OtherResponse {
+    match (&chosen.coefficients, &other.coefficients) {
+        (Some(c), Some(o)) if positive(c) && positive(o) => Some(OtherResponse {
             log_map: other.map,
             response: response_name(other.map.response()),
             offset_dn: other.offset.offset_dn,
@@ -140,11 +174,6 @@ pub(super) fn choose(pairs: &[Pair], frames: &PreparedFrames, options: &TimingOp
             },
         }),
         _ => None,
-    };
-    Chosen {
-        log_map: chosen.map,
-        offset: chosen.offset,
-        other,
     }
 }
 
