@@ -135,32 +135,75 @@ pub fn image(bytes: &[u8], max_side: u32) -> Result<GreyImage, String> {
             "the image is {width}x{height}; ctcal reads images of 1..={max_side} pixels a side"
         ));
     }
-    let (w, h) = (width as usize, height as usize);
-    let channels: usize = match encoding.as_str() {
-        "mono8" | "8UC1" => 1,
-        "mono16" | "16UC1" => 2,
-        "rgb8" | "bgr8" => 3,
-        "rgba8" | "bgra8" => 4,
-        other => {
+    let layout = ImageLayout {
+        width: width as usize,
+        height: height as usize,
+        channels: channels(&encoding)?,
+        step,
+        big_endian,
+    };
+    let pixels = layout.grey(data, &encoding)?;
+    Ok(GreyImage {
+        t,
+        width,
+        height,
+        pixels,
+    })
+}
+
+/// Bytes per pixel of an image encoding ctcal reads.
+fn channels(encoding: &str) -> Result<usize, String> {
+    match encoding {
+        "mono8" | "8UC1" => Ok(1),
+        "mono16" | "16UC1" => Ok(2),
+        "rgb8" | "bgr8" => Ok(3),
+        "rgba8" | "bgra8" => Ok(4),
+        other => Err(format!(
+            "the image encoding is `{other}`; ctcal reads mono8, mono16, rgb8, bgr8, rgba8 and bgra8"
+        )),
+    }
+}
+
+/// How an image's pixels lie in its data: its size, bytes per pixel, bytes per row
+/// (`step`, padding included) and the byte order of 16-bit values.
+struct ImageLayout {
+    width: usize,
+    height: usize,
+    channels: usize,
+    step: usize,
+    big_endian: bool,
+}
+
+impl ImageLayout {
+    /// The 8-bit grey pixels of `data` in `encoding`, row by row without the rows'
+    /// padding; refused where `data` is too short for the image.
+    fn grey(&self, data: &[u8], encoding: &str) -> Result<Vec<u8>, String> {
+        let (w, h, channels, step) = (self.width, self.height, self.channels, self.step);
+        if step < w * channels || data.len() < step * (h - 1) + w * channels {
             return Err(format!(
-                "the image encoding is `{other}`; ctcal reads mono8, mono16, rgb8, bgr8, rgba8 and bgra8"
+                "the image data ({} bytes, step {step}) is too short for {w}x{h} {encoding}",
+                data.len()
             ));
         }
-    };
-    if step < w * channels || data.len() < step * (h - 1) + w * channels {
-        return Err(format!(
-            "the image data ({} bytes, step {step}) is too short for {w}x{h} {encoding}",
-            data.len()
-        ));
+        let mut pixels = Vec::with_capacity(w * h);
+        for row in 0..h {
+            self.grey_row(
+                &data[row * step..row * step + w * channels],
+                encoding,
+                &mut pixels,
+            );
+        }
+        Ok(pixels)
     }
-    let mut pixels = Vec::with_capacity(w * h);
-    for row in 0..h {
-        let line = &data[row * step..row * step + w * channels];
-        match encoding.as_str() {
+
+    /// Appends one row's grey pixels: mono8 as it is, mono16 by its high byte, colour with
+    /// the ITU-R BT.601 weights.
+    fn grey_row(&self, line: &[u8], encoding: &str, pixels: &mut Vec<u8>) {
+        match encoding {
             "mono8" | "8UC1" => pixels.extend_from_slice(line),
             "mono16" | "16UC1" => pixels.extend(
                 line.chunks_exact(2)
-                    .map(|p| if big_endian { p[0] } else { p[1] }),
+                    .map(|p| if self.big_endian { p[0] } else { p[1] }),
             ),
             _ => {
                 let (r, b) = if encoding.starts_with("rgb") {
@@ -168,18 +211,12 @@ pub fn image(bytes: &[u8], max_side: u32) -> Result<GreyImage, String> {
                 } else {
                     (2, 0)
                 };
-                pixels.extend(line.chunks_exact(channels).map(|p| {
+                pixels.extend(line.chunks_exact(self.channels).map(|p| {
                     (0.299 * p[r] as f32 + 0.587 * p[1] as f32 + 0.114 * p[b] as f32).round() as u8
                 }));
             }
         }
     }
-    Ok(GreyImage {
-        t,
-        width,
-        height,
-        pixels,
-    })
 }
 
 #[cfg(test)]
