@@ -174,33 +174,70 @@ pub fn refine(
     let mut g = start;
     let mut radius = first_radius;
     let mut last = None;
-    for iteration in 1..=8 {
-        let warp = ScreenWarp::new(&g);
-        let predicted = images::predicted(stimulus, bounds, through, Some(&warp));
-        let pairs = matching::correspondences(real, &predicted, &warp.on_screen(), &g, radius);
-        if pairs.len() < MIN_POINTS {
-            return Err(format!(
-                "only {} patches of the screen matched the stimulus (at least {MIN_POINTS} needed)",
-                pairs.len()
-            ));
-        }
-        let Robust {
-            fit,
-            p_value,
-            outliers,
-            support,
-        } = robust_fit(&g, &pairs)
-            .ok_or("the matched points do not determine a homography (too few consistent ones)")?;
-        let change = corner_change(&g, &fit.geometry);
-        g = fit.geometry.clone();
-        last = Some((fit, p_value, outliers, pairs.len(), iteration, support));
+    for number in 1..=8 {
+        let (robust, count) = match_and_fit(real, bounds, stimulus, through, &g, radius)?;
+        let change = corner_change(&g, &robust.fit.geometry);
+        g = robust.fit.geometry.clone();
+        last = Some(Iteration {
+            robust,
+            count,
+            number,
+        });
         if change < 0.02 {
             break;
         }
         radius = ((2.0 * change).ceil() as usize + 2).clamp(3, first_radius);
     }
-    let (fit, p_value, outliers, count, iterations, support) =
-        last.expect("at least one iteration");
+    registered(last.expect("at least one iteration"))
+}
+
+/// One iteration of [`refine`]: the correspondences between the events' images and the
+/// stimulus predicted through the geometry `g` (searched within `radius` px), and the
+/// robust fit to them, with how many there were.
+fn match_and_fit(
+    real: &Stack,
+    bounds: &[(usize, usize)],
+    stimulus: &[Frame],
+    through: Through,
+    g: &ScreenGeometry,
+    radius: usize,
+) -> Result<(Robust, usize), String> {
+    let warp = ScreenWarp::new(g);
+    let predicted = images::predicted(stimulus, bounds, through, Some(&warp));
+    let pairs = matching::correspondences(real, &predicted, &warp.on_screen(), g, radius);
+    if pairs.len() < MIN_POINTS {
+        return Err(format!(
+            "only {} patches of the screen matched the stimulus (at least {MIN_POINTS} needed)",
+            pairs.len()
+        ));
+    }
+    let robust = robust_fit(g, &pairs)
+        .ok_or("the matched points do not determine a homography (too few consistent ones)")?;
+    Ok((robust, pairs.len()))
+}
+
+/// The last iteration of [`refine`]: its robust fit, the correspondences it was fitted to
+/// and its number (counted from 1).
+struct Iteration {
+    robust: Robust,
+    count: usize,
+    number: usize,
+}
+
+/// The registration the last iteration gives; refused where its reprojection error is
+/// above [`MAX_RMS_PX`].
+fn registered(last: Iteration) -> Result<Registration, String> {
+    let Iteration {
+        robust:
+            Robust {
+                fit,
+                p_value,
+                outliers,
+                support,
+            },
+        count,
+        number,
+    } = last;
     let mut norms: Vec<f64> = fit.residuals.iter().map(|r| r.0.hypot(r.1)).collect();
     let registration = Registration {
         warp: Arc::new(ScreenWarp::new(&fit.geometry)),
@@ -211,7 +248,7 @@ pub fn refine(
         outliers,
         k1_p_value: p_value,
         coarse_score: f64::NAN,
-        iterations,
+        iterations: number,
         support,
     };
     if registration.rms_px > MAX_RMS_PX {
