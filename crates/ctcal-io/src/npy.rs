@@ -36,44 +36,52 @@ impl NpyHeader {
 pub fn read_header(path: &Path) -> Result<NpyHeader, String> {
     use std::io::Read;
     let mut file = std::fs::File::open(path).map_err(|e| format!("cannot read: {e}"))?;
-    let mut start = [0u8; 12];
-    file.read_exact(&mut start[..10])
-        .map_err(|_| "shorter than a .npy header".to_string())?;
-    if &start[..6] != b"\x93NUMPY" {
-        return Err("not a .npy file (no \\x93NUMPY magic)".into());
-    }
-    let (len, prefix) = match start[6] {
-        1 => (u16::from_le_bytes([start[8], start[9]]) as u64, 10),
-        2 | 3 => {
-            file.read_exact(&mut start[10..12])
-                .map_err(|_| "shorter than a .npy header".to_string())?;
-            (
-                u32::from_le_bytes([start[8], start[9], start[10], start[11]]) as u64,
-                12,
-            )
-        }
-        v => return Err(format!(".npy format version {v} is not known")),
-    };
+    let (len, prefix) = header_length(&mut file)?;
     if len > 1 << 16 {
         return Err(format!("the .npy header claims {len} bytes"));
     }
     let mut text = vec![0u8; len as usize];
     file.read_exact(&mut text)
         .map_err(|_| "the .npy header is cut short".to_string())?;
-    let text = String::from_utf8_lossy(&text);
-    let value_after = |key: &str| -> Option<&str> {
-        let at = text.find(&format!("'{key}'"))? + key.len() + 2;
-        Some(text[at..].trim_start().strip_prefix(':')?.trim_start())
-    };
-    let descr = value_after("descr")
+    parse_header(&String::from_utf8_lossy(&text), prefix + len)
+}
+
+/// Reads the magic and version at the start of a `.npy` file: the length of the header's
+/// text that follows, and the bytes before that text (10 in version 1, 12 in 2 and 3).
+fn header_length(file: &mut std::fs::File) -> Result<(u64, u64), String> {
+    use std::io::Read;
+    let mut start = [0u8; 12];
+    file.read_exact(&mut start[..10])
+        .map_err(|_| "shorter than a .npy header".to_string())?;
+    if &start[..6] != b"\x93NUMPY" {
+        return Err("not a .npy file (no \\x93NUMPY magic)".into());
+    }
+    match start[6] {
+        1 => Ok((u16::from_le_bytes([start[8], start[9]]) as u64, 10)),
+        2 | 3 => {
+            file.read_exact(&mut start[10..12])
+                .map_err(|_| "shorter than a .npy header".to_string())?;
+            Ok((
+                u32::from_le_bytes([start[8], start[9], start[10], start[11]]) as u64,
+                12,
+            ))
+        }
+        v => Err(format!(".npy format version {v} is not known")),
+    }
+}
+
+/// The header whose text (a Python dict literal) is `text`, its data starting at
+/// `data_offset`: the element type, the order and the shape.
+fn parse_header(text: &str, data_offset: u64) -> Result<NpyHeader, String> {
+    let descr = value_after(text, "descr")
         .and_then(|v| {
             let quote = v.chars().next().filter(|&c| c == '\'' || c == '"')?;
             v[1..].split(quote).next()
         })
         .ok_or("the .npy header has no 'descr'")?
         .to_string();
-    let fortran_order = value_after("fortran_order").is_some_and(|v| v.starts_with("True"));
-    let shape = value_after("shape")
+    let fortran_order = value_after(text, "fortran_order").is_some_and(|v| v.starts_with("True"));
+    let shape = value_after(text, "shape")
         .and_then(|v| v.strip_prefix('('))
         .and_then(|v| v.split(')').next())
         .ok_or("the .npy header has no 'shape'")?;
@@ -88,8 +96,15 @@ pub fn read_header(path: &Path) -> Result<NpyHeader, String> {
         descr,
         fortran_order,
         shape,
-        data_offset: prefix + len,
+        data_offset,
     })
+}
+
+/// The text after `'key':` in a header's dict literal (leading spaces left out), if the
+/// key is there.
+fn value_after<'t>(text: &'t str, key: &str) -> Option<&'t str> {
+    let at = text.find(&format!("'{key}'"))? + key.len() + 2;
+    Some(text[at..].trim_start().strip_prefix(':')?.trim_start())
 }
 
 /// Checks what a `.npy` file claims before it is read: a 2-D (H, W) array of `sensor`'s size
