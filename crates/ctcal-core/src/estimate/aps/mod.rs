@@ -744,8 +744,8 @@ fn masked_by_slow_photoreceptor(
     let why = format!(
         "the frames' log offset b in ln(DN + b) is not determined: the timing fitted b = {:.1} DN (95 % {} .. {}), but the events follow the frames low-passed at {:.1} Hz at their median DN better than the frames themselves ({:.1} standard errors), and a photoreceptor that slow makes dark pixels' thresholds look larger as a too small offset would; b = {own:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",
         fitted.offset_dn,
-        fitted.ci95[0].map_or("open".into(), |v| format!("{v:.1}")),
-        fitted.ci95[1].map_or("open".into(), |v| format!("{v:.1}")),
+        offset_end(fitted.ci95[0]),
+        offset_end(fitted.ci95[1]),
         slow.cutoff_at_median_dn_hz,
         slow.significance,
         range.0,
@@ -832,9 +832,14 @@ fn lag_resolved(lag: &super::timing::Lag) -> Option<f64> {
         .filter(|&f| lag.tau_times_dn > 3.0 * lag.standard_error && f < 1000.0)
 }
 
+/// One end of an offset's interval in words: DN to one decimal, or `open`.
+fn offset_end(end: Option<f32>) -> String {
+    end.map_or("open".to_string(), |v| format!("{v:.1}"))
+}
+
 /// The offset, in words for the assumptions.
 fn offset_assumption(o: &super::timing::Offset) -> String {
-    let side = |v: Option<f32>| v.map_or("open".to_string(), |v| format!("{v:.1}"));
+    let side = offset_end;
     match o.source {
         "fitted" => format!(
             "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval and both polarities' offsets: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing) is in their intervals",
