@@ -991,6 +991,58 @@ fn aps_does_not_take_an_offset_a_slow_photoreceptor_may_have_moved() {
     }
 }
 
+/// Coverage draw 13025: IEBCS pixels (thresholds 0.44 / 0.82; IEBCS reads ln(E + 1), an
+/// offset of 0.03 DN) under natural-image objects rotating and moving at up to 44 px/s,
+/// 11 Hz frames. Something besides the offset makes the samples depend on brightness: the ON
+/// samples alone put the offset at 9.6 DN, the OFF samples at 44.8, the joint fit at 23.4
+/// (95 % 17.4 .. 30.6), where OFF read 0.62 [0.44, 0.80]. One offset belongs to the frames,
+/// so that disagreement widens the offsets the intervals span by itself on each side: they
+/// reach 0 DN, where the samples read 0.45 and 0.80, and both thresholds are held.
+#[test]
+fn aps_carries_the_offsets_its_polarities_disagree_over_into_the_intervals() {
+    let dir = coverage_case(
+        r#"{"id": "case-13025", "seed": 13025, "generator": "iebcs",
+            "family": "multi_object_natural", "params": {"ct_on": 0.440698,
+                "ct_off": 0.815278, "seed": 13025},
+            "speed_px_s": 44.4593, "brightness_dn": 58.1745,
+            "recording": {"kind": "scene", "scene": {"kind": "multi_object", "width": 240,
+                "height": 180, "duration_s": 0.67, "seed": 13025,
+                "aps": {"rate_hz": 11.0, "exposure_s": 0.00504},
+                "multi_object": {"objects": [1, 7],
+                    "background_velocity_px_s": [8.89187, 22.2297],
+                    "background_angular_velocity_deg_s": [0.0, 20.0],
+                    "background_scale": [0.9, 1.1],
+                    "object_velocity_px_s": [22.2297, 44.4593],
+                    "object_angular_velocity_deg_s": [0.0, 90.0], "object_scale": [0.8, 1.2],
+                    "object_size_px": [8.0, 45.0],
+                    "textures_dir": "calib/scenes/textures/natural",
+                    "background_texture": {"canvas_px": 256, "mean_dn": 58.1745,
+                        "log_std": 0.271991, "min_dn": 0.5, "max_dn": 255.0,
+                        "spectrum_beta": 1.18142, "blur_px": 1.0}}}},
+            "peer": {"simulator": "iebcs", "params": {"th_pos": 0.440698,
+                "th_neg": 0.815278, "th_noise": 0.0437525, "lat_us": 97.4506,
+                "jit_us": 4.38421, "ref_us": 100, "tau_us": 40.0, "bgnp_hz": 0.1,
+                "bgnn_hz": 0.01, "lux_at_255": 10000.0}}}"#,
+    );
+    let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
+    let offset = &e["frame_offset_dn"]["estimate"];
+    assert_eq!(offset["source"], "fitted", "{offset}");
+    let b = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (on, off) = (b(&offset["by_polarity"][0]), b(&offset["by_polarity"][1]));
+    let (joint, range) = (b(&offset["offset_dn"]), &offset["systematic_range"]);
+    assert!((off - on).abs() > 20.0, "{offset}");
+    assert!(joint > 10.0, "{offset}");
+    // the joint offset -+ the polarities' difference, cut at the prior's 0 and 60 DN
+    assert_eq!(b(&range[0]), 0.0, "{offset}");
+    let hi = (joint + (off - on).abs()).min(60.0);
+    assert!((b(&range[1]) - hi).abs() < 1e-3, "{offset}");
+    for (key, truth) in [("ct_on", 0.440698), ("ct_off", 0.815278)] {
+        let ci = &e[format!("{key}_ci95")];
+        let (lo, hi) = (b(&ci[0]), b(&ci[1]));
+        assert!(lo <= truth && truth <= hi, "{key} {ci} misses {truth}");
+    }
+}
+
 /// A recording with more frames than the estimator takes is measured on blocks of
 /// consecutive frames (not every k-th frame, whose flow would no longer hold): 75 frames
 /// at 25 Hz and a limit of 60 give three blocks of 20, one in each third, only their events

@@ -361,7 +361,8 @@ fn reconciled(
     full: &Pass,
 ) -> bool {
     let timing = (frames.offset, frames.offset_range);
-    let change = found.and_then(|found| {
+    // a root at the prior's end is no offset met in practice: it moves nothing
+    let change = found.filter(|f| !f.at_bound).and_then(|found| {
         reconcile(
             timing,
             timing_offset.ci95,
@@ -379,17 +380,21 @@ fn reconciled(
 /// The counts' offset, in words for the assumptions.
 pub(super) fn assumption(c: &FromCounts, frames: &PreparedFrames) -> String {
     let f = &c.found;
-    let found = if f.at_bound {
-        format!(
-            "at or beyond {:.1} DN, the end of the prior range",
+    if f.at_bound {
+        // the search stopped at the prior's end: the counts place the offset nowhere a
+        // black level is met in practice, so they neither confirm nor move the timing's
+        return format!(
+            "the frames' log offset from the counts: at the event timing's b = {:.1} DN the re-simulation's dark cells differ from its bright ones by {:+.3} (+- {:.3}) in mean log ratio of simulated to real counts, and the difference keeps its sign up to {:.1} DN, the end of the prior range: the counts agree only beyond it, where no black level is met in practice, so they do not move the timing's offset (kept)",
+            c.timing_offset_dn,
+            f.at_timing_offset.difference,
+            f.at_timing_offset.standard_error,
             f.offset_dn
-        )
-    } else {
-        format!(
-            "at b = {:.1} DN (95 % {:.1} .. {:.1})",
-            f.offset_dn, f.ci95[0], f.ci95[1]
-        )
-    };
+        );
+    }
+    let found = format!(
+        "at b = {:.1} DN (95 % {:.1} .. {:.1})",
+        f.offset_dn, f.ci95[0], f.ci95[1]
+    );
     let head = format!(
         "the frames' log offset from the counts: at the event timing's b = {:.1} DN the re-simulation's dark cells differ from its bright ones by {:+.3} (+- {:.3}) in mean log ratio of simulated to real counts; they agree {found}",
         c.timing_offset_dn, f.at_timing_offset.difference, f.at_timing_offset.standard_error

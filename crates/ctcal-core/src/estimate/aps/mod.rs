@@ -842,14 +842,16 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
     let side = offset_end;
     match o.source {
         "fitted" => format!(
-            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval and both polarities' offsets: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing) is in their intervals",
+            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval, both polarities' offsets, and the offset -+ their difference within the prior range {:.0} .. {:.0} DN: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing) is in their intervals",
             o.offset_dn,
             side(o.ci95[0]),
             side(o.ci95[1]),
             o.by_polarity[0].map_or("none".into(), |b| format!("{b:.1}")),
             o.by_polarity[1].map_or("none".into(), |b| format!("{b:.1}")),
             o.systematic_range.0,
-            o.systematic_range.1
+            o.systematic_range.1,
+            super::timing::OFFSET_PRIOR.0,
+            super::timing::OFFSET_PRIOR.1,
         ),
         "not determined: the photoreceptor's lag" => format!(
             "the frames' log offset b in ln(DN + b) is not determined: the photoreceptor's lag (a bandwidth limit) makes dark pixels' thresholds look larger as a too small offset would; b = {:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",

@@ -624,7 +624,8 @@ fn search_range(pairs: &[Pair]) -> (f32, f32) {
 
 /// A fitted offset with the offsets the ON and the OFF samples each give (within
 /// [`OFFSET_PRIOR`]: beyond, no black level, as for the joint one) joined to its systematic
-/// range; found for the chosen response only. Other offsets are returned as they are.
+/// range, and that range widened by their disagreement ([`disagreement_range`]); found for
+/// the chosen response only. Other offsets are returned as they are.
 fn with_polarity_offsets(
     offset: Offset,
     pairs: &[Pair],
@@ -639,7 +640,13 @@ fn with_polarity_offsets(
     let systematic_range = by_polarity
         .iter()
         .flatten()
-        .fold(offset.systematic_range, |(lo, hi), &b| {
+        .copied()
+        .chain(
+            disagreement_range(offset.offset_dn, by_polarity)
+                .into_iter()
+                .flatten(),
+        )
+        .fold(offset.systematic_range, |(lo, hi), b| {
             (lo.min(b), hi.max(b))
         });
     Offset {
@@ -647,6 +654,29 @@ fn with_polarity_offsets(
         by_polarity,
         ..offset
     }
+}
+
+/// The offsets an effect other than the offset may have moved the joint `offset` over,
+/// given the ON and the OFF samples' own offsets `by_polarity`: `offset -+ |on - off|`,
+/// within [`OFFSET_PRIOR`]. One offset belongs to the frames, so the polarities part only
+/// where something else that depends on brightness moves their samples (a scene whose
+/// dark and bright parts move or occlude differently, a noise that grows with
+/// brightness). If it moves each polarity's root by an independent error of one size `s`,
+/// their difference has a standard deviation of `s sqrt(2)` and the joint root's error
+/// (their mean) one of `s / sqrt(2)`: half the difference as one standard deviation,
+/// about the whole difference as 95 %. On IEBCS coverage draw 13025 (true offset 0.03 DN)
+/// the ON samples gave 9.6 DN and the OFF samples 44.8, the joint 23.4 (95 % 17.4 .. 30.6),
+/// and the thresholds read at 23.4 lay 15 % (ON) and 24 % (OFF) below the truth; at 0 DN
+/// they are 2 % above and 2 % below it. `None` where a polarity gives no offset.
+fn disagreement_range(offset: f32, by_polarity: [Option<f32>; 2]) -> Option<[f32; 2]> {
+    let [Some(on), Some(off)] = by_polarity else {
+        return None;
+    };
+    let apart = (on - off).abs();
+    Some([
+        (offset - apart).max(OFFSET_PRIOR.0),
+        (offset + apart).min(OFFSET_PRIOR.1),
+    ])
 }
 
 /// The offset the ON and the OFF samples each give: the root of each polarity's own level
@@ -1082,6 +1112,24 @@ mod tests {
         assert!((mean - 0.3).abs() < 1e-9, "{mean}");
         assert!(excess < -0.001, "{excess}");
         assert_eq!(mean_and_sigma(&pixels).1, 0.0);
+    }
+
+    #[test]
+    fn polarities_that_disagree_widen_the_offsets_range_by_their_difference_within_the_prior() {
+        // draw 13025: the joint 23.4, ON 9.6, OFF 44.8: 35.2 apart, cut at the prior's ends
+        let [lo, hi] = disagreement_range(23.4, [Some(9.6), Some(44.8)]).unwrap();
+        assert!(lo == 0.0 && (hi - 58.6).abs() < 1e-4, "{lo} {hi}");
+        // polarities within a DN of each other move the range by that DN
+        let [lo, hi] = disagreement_range(2.9, [Some(2.2), Some(3.5)]).unwrap();
+        assert!(
+            (lo - 1.6).abs() < 1e-5 && (hi - 4.2).abs() < 1e-5,
+            "{lo} {hi}"
+        );
+        assert_eq!(
+            disagreement_range(60.0, [Some(59.0), Some(61.0)]),
+            Some([58.0, 60.0])
+        );
+        assert_eq!(disagreement_range(5.0, [None, Some(3.0)]), None);
     }
 
     #[test]
