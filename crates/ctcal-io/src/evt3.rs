@@ -9,13 +9,34 @@
 //! blocks are carried over by the block reader. Reference: Prophesee, "EVT 3.0 format"
 //! (Metavision SDK documentation). Written here because the `evt3` crate decodes only this
 //! one format and ctcal needs the same streaming and error conventions for all of them.
+//!
+//! **Fast path.** Recordings are mostly `ADDR_Y`, `ADDR_X` and `TIME_LOW` words in an order
+//! that follows the scene (a new time before some events, not others), so a `match` per word
+//! mispredicts about once an event, and checking each event (sensor bounds, time order) as it
+//! is made costs as much again. A block of words is therefore decoded optimistically first
+//! ([`Position::run`]): without checks, and without a data-dependent branch for those
+//! words (each word writes an event at the chunk's next slot, only `ADDR_X` advances past
+//! it; y and the time are selected, not branched on). Then the block's events are checked
+//! at once ([`State::all_valid`]: the largest x and y inside the sensor, times in order from
+//! the last block's). Only if a check fails (or the block starts before the first
+//! `TIME_HIGH`, or the clock nears [`TIME_LIMIT_US`]) is the block decoded again from its
+//! start by the plain decoder ([`State::decode`]), which checks each event and gives the
+//! same errors and order records as before, naming the byte offset of the word.
 
 use super::blocks::BlockReader;
 use super::error::InputError;
 use super::order::OrderCheck;
 use super::{EventDecoder, Progress};
-use crate::events::{CHUNK_EVENTS, EventChunk, Sensor};
+use crate::events::{CHUNK_EVENTS, EventChunk, MAX_SENSOR_SIDE, Sensor, TIME_LIMIT_US, TimeUs};
+use std::mem::MaybeUninit;
 use std::path::{Path, PathBuf};
+
+/// Word types that leave the fast path's branch-free step: `VECT_BASE_X`, `VECT_12`,
+/// `VECT_8` (a `TIME_HIGH` leaves it only when it changes the time).
+const VECTOR_KINDS: u16 = 1 << 0x3 | 1 << 0x4 | 1 << 0x5;
+
+/// While `loops` stays below this, every time of the clock lies within [`TIME_LIMIT_US`].
+const SAFE_LOOPS: u64 = TIME_LIMIT_US as u64 >> 24;
 
 /// Streaming EVT3 decoder.
 pub struct Evt3Decoder {
@@ -27,6 +48,13 @@ struct State {
     path: PathBuf,
     sensor: Option<Sensor>,
     order: OrderCheck,
+    at: Position,
+}
+
+/// What the words decoded so far leave for the next: the clock, the position and the
+/// polarity (a copy is kept to decode a block again).
+#[derive(Clone, Copy)]
+struct Position {
     time_high: u64,
     time_low: u64,
     loops: u64,
@@ -45,79 +73,313 @@ impl Evt3Decoder {
                 path: path.to_path_buf(),
                 sensor,
                 order: OrderCheck::default(),
-                time_high: 0,
-                time_low: 0,
-                loops: 0,
-                seen_time_high: false,
-                x: 0,
-                y: 0,
-                on: false,
+                at: Position {
+                    time_high: 0,
+                    time_low: 0,
+                    loops: 0,
+                    seen_time_high: false,
+                    x: 0,
+                    y: 0,
+                    on: false,
+                },
             },
         })
     }
 }
 
-impl State {
+impl Position {
     #[inline(always)]
     fn time(&self) -> i64 {
         ((self.loops << 24) | (self.time_high << 12) | self.time_low) as i64
     }
 
+    /// A `TIME_HIGH` word's high 12 bits: counts a loop when they step back by more than
+    /// half their range.
+    #[inline]
+    fn time_high(&mut self, high: u64) {
+        if self.seen_time_high && high < self.time_high && self.time_high - high > 2048 {
+            self.loops += 1;
+        }
+        if high != self.time_high || !self.seen_time_high {
+            self.time_low = 0;
+        }
+        self.time_high = high;
+        self.seen_time_high = true;
+    }
+
+    /// Decodes `words` into `out` without checking the events (the fast path; see the
+    /// module documentation): the number of events, or `None` when it had to stop (the
+    /// clock neared [`TIME_LIMIT_US`], or a vector reached beyond x 2047; then the block
+    /// must be decoded again the plain way).
+    fn run(&mut self, words: &[u8], mut out: Sink) -> Option<usize> {
+        let (mut t, mut y, mut n) = (self.time(), self.y, 0);
+        let mut high_word = 0x8000 | self.time_high as u16;
+        let known = (0, self.on);
+        let mut rare = Rare {
+            at: self,
+            words,
+            known,
+        };
+        // the `i`-th word: without a branch on its type for `ADDR_Y`, `ADDR_X`, `TIME_LOW`,
+        // an unchanged `TIME_HIGH` and the types without events; `Rare::word` for the rest
+        // (a macro, not a closure: the locals must stay in registers)
+        macro_rules! step {
+            ($word:expr, $i:expr) => {{
+                let word: u16 = $word;
+                let kind = word >> 12;
+                out.write(n, t, word, y);
+                if ((VECTOR_KINDS >> kind) & 1 != 0) | ((kind == 0x8) & (word != high_word)) {
+                    (t, high_word, n) = rare.word(word, $i, (t, y, n), out.reborrow())?;
+                } else {
+                    y = if kind == 0x0 { word & 0x7ff } else { y };
+                    let t_low = (t & !0xfff) | (word & 0xfff) as TimeUs;
+                    t = if kind == 0x6 { t_low } else { t };
+                    n += (kind == 0x2) as usize;
+                }
+            }};
+        }
+        let quads = words.chunks_exact(8);
+        let rest = quads.remainder();
+        for (q, bytes) in quads.enumerate() {
+            let quad = u64::from_le_bytes(bytes.try_into().expect("8 bytes"));
+            for k in 0..4 {
+                step!((quad >> (16 * k)) as u16, 4 * q + k);
+            }
+        }
+        let done = words.len() / 2 - rest.len() / 2;
+        for (k, bytes) in rest.chunks_exact(2).enumerate() {
+            step!(u16::from_le_bytes([bytes[0], bytes[1]]), done + k);
+        }
+        let (from, before) = rare.known;
+        (self.time_low, self.y) = ((t & 0xfff) as u64, y);
+        self.on = polarity(&words[from..], before);
+        Some(n)
+    }
+
+    /// A `VECT_BASE_X`, `VECT_12` or `VECT_8` word on the fast path: its events unchecked
+    /// from slot `n` on, each x with its polarity in bit 11 as an `ADDR_X` word has them;
+    /// the number of events after them (`None` if an x does not fit in 11 bits).
+    fn vector(&mut self, word: u16, mut n: usize, out: &mut Sink) -> Option<usize> {
+        let kind = word >> 12;
+        if kind == 0x3 {
+            self.x = word & 0x7ff;
+            self.on = word & 0x800 != 0;
+            return Some(n);
+        }
+        let width = if kind == 0x4 { 12 } else { 8 };
+        let mut bits = word & ((1u16 << width) - 1);
+        let t = self.time();
+        let on = (self.on as u16) << 11;
+        while bits != 0 {
+            let x = self.x.wrapping_add(bits.trailing_zeros() as u16);
+            if x > 0x7ff {
+                return None;
+            }
+            out.write(n, t, x | on, self.y);
+            n += 1;
+            bits &= bits - 1;
+        }
+        self.x = self.x.wrapping_add(width);
+        Some(n)
+    }
+}
+
+/// What the fast path's rare words need besides its registers: the decoder's position, the
+/// block, and where in it the polarity was last known (bytes up to there, and its value;
+/// the fast path does not carry it from word to word).
+struct Rare<'a> {
+    at: &'a mut Position,
+    words: &'a [u8],
+    known: (usize, bool),
+}
+
+impl Rare<'_> {
+    /// The `i`-th word, a vector word or a `TIME_HIGH` that changes the time, given the
+    /// fast path's time, y and event count; its new time, `TIME_HIGH` word and count.
+    #[inline(never)]
+    fn word(
+        &mut self,
+        word: u16,
+        i: usize,
+        (t, y, n): (TimeUs, u16, usize),
+        mut out: Sink,
+    ) -> Option<(TimeUs, u16, usize)> {
+        let at = &mut *self.at;
+        (at.time_low, at.y) = ((t & 0xfff) as u64, y);
+        if word >> 12 == 0x8 {
+            at.time_high((word & 0xfff) as u64);
+            return (at.loops < SAFE_LOOPS).then_some((at.time(), word, n));
+        }
+        at.on = polarity(&self.words[self.known.0..2 * i], self.known.1);
+        let n = at.vector(word, n, &mut out)?;
+        self.known = (2 * i + 2, at.on);
+        Some((t, 0x8000 | at.time_high as u16, n))
+    }
+}
+
+/// The polarity after `words`: that of the last `ADDR_X` or `VECT_BASE_X` word among them,
+/// else `before`.
+fn polarity(words: &[u8], before: bool) -> bool {
+    words
+        .chunks_exact(2)
+        .rev()
+        .find(|bytes| matches!(bytes[1] >> 4, 0x2 | 0x3))
+        .map_or(before, |bytes| bytes[1] & 0x08 != 0)
+}
+
+/// The chunk's unwritten tail, written by index (all three of one length). x holds the
+/// `ADDR_X` word's 12 low bits: x and the polarity in bit 11.
+struct Sink<'a> {
+    t: &'a mut [MaybeUninit<TimeUs>],
+    x: &'a mut [MaybeUninit<u16>],
+    y: &'a mut [MaybeUninit<u16>],
+}
+
+impl Sink<'_> {
+    /// Writes an event at slot `n`.
+    #[inline(always)]
+    fn write(&mut self, n: usize, t: TimeUs, x_on: u16, y: u16) {
+        self.t[n].write(t);
+        self.x[n].write(x_on);
+        self.y[n].write(y);
+    }
+
+    /// The same slices, passed by value (so that the caller's stay in registers).
+    fn reborrow(&mut self) -> Sink<'_> {
+        Sink {
+            t: self.t,
+            x: self.x,
+            y: self.y,
+        }
+    }
+}
+
+/// Decodes `words` onto the end of `out` with [`Position::run`] (`false` when it stopped),
+/// then splits x and the polarity.
+fn run_into(at: &mut Position, words: &[u8], out: &mut EventChunk) -> bool {
+    // a vector word emits at most 12 events (and the last word's write is at most at slot
+    // 12 * (words - 1))
+    let most = 12 * (words.len() / 2);
+    let len = out.len();
+    out.t.reserve(most);
+    out.x.reserve(most);
+    out.y.reserve(most);
+    let sink = Sink {
+        t: &mut out.t.spare_capacity_mut()[..most],
+        x: &mut out.x.spare_capacity_mut()[..most],
+        y: &mut out.y.spare_capacity_mut()[..most],
+    };
+    let Some(n) = at.run(words, sink) else {
+        return false;
+    };
+    // SAFETY: the fast path wrote slot `n` of the sink before it counted an event there,
+    // so the `n` elements after `len` are initialised, and they lie within the capacity
+    // reserved.
+    unsafe {
+        out.t.set_len(len + n);
+        out.x.set_len(len + n);
+        out.y.set_len(len + n);
+    }
+    let x_on = &mut out.x[len..];
+    out.on.extend(x_on.iter().map(|&x| x & 0x800 != 0));
+    x_on.iter_mut().for_each(|x| *x &= 0x7ff);
+    true
+}
+
+impl State {
     #[inline(always)]
     fn emit(&mut self, x: u16, offset: u64, out: &mut EventChunk) -> Result<(), InputError> {
-        if !self.seen_time_high {
+        if !self.at.seen_time_high {
             return Ok(());
         }
-        if !super::within(self.sensor, x as u32, self.y as u32) {
+        if !super::within(self.sensor, x as u32, self.at.y as u32) {
             return Err(super::outside_sensor(
                 &self.path,
                 format!("byte offset {offset}"),
                 x as i64,
-                self.y as i64,
+                self.at.y as i64,
                 self.sensor,
             ));
         }
-        let t = self.time();
+        let t = self.at.time();
         self.order.check(t, || format!("byte offset {offset}"));
-        out.push(t, x, self.y, self.on);
+        out.push(t, x, self.at.y, self.at.on);
         Ok(())
     }
 
+    /// The plain decoder of one word, checking each event.
     #[inline]
     fn decode(&mut self, word: u16, offset: u64, out: &mut EventChunk) -> Result<(), InputError> {
         match word >> 12 {
-            0x0 => self.y = word & 0x7ff,
+            0x0 => self.at.y = word & 0x7ff,
             0x2 => {
-                self.on = word & 0x800 != 0;
+                self.at.on = word & 0x800 != 0;
                 self.emit(word & 0x7ff, offset, out)?;
             }
             0x3 => {
-                self.x = word & 0x7ff;
-                self.on = word & 0x800 != 0;
+                self.at.x = word & 0x7ff;
+                self.at.on = word & 0x800 != 0;
             }
             kind @ (0x4 | 0x5) => {
                 let width = if kind == 0x4 { 12 } else { 8 };
                 let mut bits = word & ((1u16 << width) - 1);
                 while bits != 0 {
                     let bit = bits.trailing_zeros() as u16;
-                    self.emit(self.x + bit, offset, out)?;
+                    self.emit(self.at.x.wrapping_add(bit), offset, out)?;
                     bits &= bits - 1;
                 }
-                self.x += width;
+                self.at.x = self.at.x.wrapping_add(width);
             }
-            0x6 => self.time_low = (word & 0xfff) as u64,
-            0x8 => {
-                let high = (word & 0xfff) as u64;
-                if self.seen_time_high && high < self.time_high && self.time_high - high > 2048 {
-                    self.loops += 1;
-                }
-                if high != self.time_high || !self.seen_time_high {
-                    self.time_low = 0;
-                }
-                self.time_high = high;
-                self.seen_time_high = true;
-            }
+            0x6 => self.at.time_low = (word & 0xfff) as u64,
+            0x8 => self.at.time_high((word & 0xfff) as u64),
             _ => {}
+        }
+        Ok(())
+    }
+
+    /// Whether the events from `start` on pass every check of [`Self::emit`]: inside the
+    /// sensor, and times in order from the last checked one (within [`TIME_LIMIT_US`] as
+    /// the fast path ran only below [`SAFE_LOOPS`]).
+    fn all_valid(&self, out: &EventChunk, start: usize) -> bool {
+        let Some(&first) = out.t.get(start) else {
+            return true;
+        };
+        let (width, height) = self
+            .sensor
+            .map_or((MAX_SENSOR_SIDE, MAX_SENSOR_SIDE), |s| (s.width, s.height));
+        let max_x = out.x[start..].iter().fold(0, |m, &x| m.max(x));
+        let max_y = out.y[start..].iter().fold(0, |m, &y| m.max(y));
+        let t = &out.t[start..];
+        let sorted = t.windows(2).fold(true, |ok, w| ok & (w[0] <= w[1]));
+        max_x < width && max_y < height && first >= self.order.last() && sorted
+    }
+
+    /// Decodes `words` (read from file offset `base`) onto the end of `out`: the fast path,
+    /// and again the plain way if it cannot vouch for the events.
+    fn decode_words(
+        &mut self,
+        words: &[u8],
+        base: u64,
+        out: &mut EventChunk,
+    ) -> Result<(), InputError> {
+        let start = out.len();
+        if self.at.seen_time_high && self.at.loops < SAFE_LOOPS {
+            let saved = self.at;
+            if run_into(&mut self.at, words, out) && self.all_valid(out, start) {
+                if let Some(&t) = out.t.last().filter(|_| out.len() > start) {
+                    self.order.skip_checked(t);
+                }
+                return Ok(());
+            }
+            self.at = saved;
+            out.t.truncate(start);
+            out.x.truncate(start);
+            out.y.truncate(start);
+            out.on.truncate(start);
+        }
+        for (i, bytes) in words.chunks_exact(2).enumerate() {
+            let word = u16::from_le_bytes([bytes[0], bytes[1]]);
+            self.decode(word, base + 2 * i as u64, out)?;
         }
         Ok(())
     }
@@ -129,10 +391,7 @@ impl EventDecoder for Evt3Decoder {
             // a vector word emits at most 12 events
             let room = (CHUNK_EVENTS.saturating_sub(out.len()) / 12).max(1);
             let (words, base) = self.reader.records(2, room);
-            for (i, bytes) in words.chunks_exact(2).enumerate() {
-                let word = u16::from_le_bytes([bytes[0], bytes[1]]);
-                self.state.decode(word, base + 2 * i as u64, out)?;
-            }
+            self.state.decode_words(words, base, out)?;
             let consumed = words.len();
             self.reader.consume(consumed);
             if out.len() + 12 > CHUNK_EVENTS {
