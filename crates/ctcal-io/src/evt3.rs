@@ -69,21 +69,27 @@ impl Evt3Decoder {
     pub fn open(path: &Path, data_offset: u64, sensor: Option<Sensor>) -> Result<Self, InputError> {
         Ok(Self {
             reader: BlockReader::open(path, data_offset)?,
-            state: State {
-                path: path.to_path_buf(),
-                sensor,
-                order: OrderCheck::default(),
-                at: Position {
-                    time_high: 0,
-                    time_low: 0,
-                    loops: 0,
-                    seen_time_high: false,
-                    x: 0,
-                    y: 0,
-                    on: false,
-                },
-            },
+            state: State::new(path, sensor),
         })
+    }
+}
+
+impl State {
+    fn new(path: &Path, sensor: Option<Sensor>) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            sensor,
+            order: OrderCheck::default(),
+            at: Position {
+                time_high: 0,
+                time_low: 0,
+                loops: 0,
+                seen_time_high: false,
+                x: 0,
+                y: 0,
+                on: false,
+            },
+        }
     }
 }
 
@@ -409,5 +415,117 @@ impl EventDecoder for Evt3Decoder {
 
     fn progress(&self) -> Progress {
         self.reader.progress()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A random stream of every word type (xorshift, seeded): times mostly rising, now and
+    /// then stepping back or looping; x and y inside 640x480 but for one word in
+    /// `outside_odds` (and vectors far from their base); vectors with and without a base;
+    /// the types without events.
+    fn random_words(seed: u64, count: usize, outside_odds: u64) -> Vec<u8> {
+        let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+        let mut next = move |below: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % below) as u16
+        };
+        let (mut high, mut low) = (next(4096), 0);
+        let mut words = Vec::with_capacity(count);
+        if next(8) != 0 {
+            words.push(0x8000 | high);
+        }
+        while words.len() < count {
+            let wide = next(outside_odds) == 0;
+            let word = match next(100) {
+                0..20 => next(if wide { 2048 } else { 480 }),
+                20..45 => 0x2000 | next(2) << 11 | next(if wide { 2048 } else { 640 }),
+                45..50 => 0x3000 | next(2) << 11 | next(if wide { 2048 } else { 560 }),
+                50..55 => 0x4000 | next(4096),
+                55..58 => 0x5000 | next(256),
+                58..80 => {
+                    low = if next(100) == 0 {
+                        next(4096)
+                    } else {
+                        (low + next(3)).min(4095)
+                    };
+                    0x6000 | low
+                }
+                80..90 => {
+                    high = match next(40) {
+                        0 => next(4096),
+                        1..8 => (high + 1) % 4096,
+                        _ => high,
+                    };
+                    0x8000 | high
+                }
+                _ => {
+                    [0x1, 0x7, 0x9, 0xa, 0xb, 0xc, 0xd, 0xe, 0xf][next(9) as usize] << 12
+                        | next(4096)
+                }
+            };
+            words.push(word);
+        }
+        words.iter().flat_map(|w| w.to_le_bytes()).collect()
+    }
+
+    /// Decodes `bytes` in blocks as `read_chunk` does, each block by `decode_block`; the
+    /// events, the order record and the error, if any.
+    fn decode_all(
+        sensor: Option<Sensor>,
+        bytes: &[u8],
+        decode_block: impl Fn(&mut State, &[u8], u64, &mut EventChunk) -> Result<(), InputError>,
+    ) -> (EventChunk, String, Option<String>) {
+        let mut state = State::new(Path::new("random.raw"), sensor);
+        let mut out = EventChunk::default();
+        let mut error = None;
+        for (b, block) in bytes.chunks(1234).enumerate() {
+            if let Err(e) = decode_block(&mut state, block, 1234 * b as u64, &mut out) {
+                error = Some(format!("{e:?}"));
+                break;
+            }
+        }
+        let order = &state.order;
+        let record = format!(
+            "{:?} {:?} {:?}",
+            order.backwards, order.first, order.out_of_range
+        );
+        (out, record, error)
+    }
+
+    #[test]
+    fn the_fast_path_decodes_as_the_plain_decoder() {
+        let plain = |state: &mut State, block: &[u8], base: u64, out: &mut EventChunk| {
+            for (i, bytes) in block.chunks_exact(2).enumerate() {
+                let word = u16::from_le_bytes([bytes[0], bytes[1]]);
+                state.decode(word, base + 2 * i as u64, out)?;
+            }
+            Ok(())
+        };
+        let (mut errors, mut in_order) = (0, 0);
+        for seed in 0..300 {
+            let bytes = random_words(seed, 20_000, [100, 10_000, 1 << 40][seed as usize % 3]);
+            for sensor in [Some(Sensor::new(640, 480)), None] {
+                let fast = decode_all(sensor, &bytes, State::decode_words);
+                let slow = decode_all(sensor, &bytes, plain);
+                assert_eq!(fast.2, slow.2, "error, seed {seed}");
+                assert_eq!(fast.1, slow.1, "order record, seed {seed}");
+                if fast.2.is_none() {
+                    assert_eq!(fast.0, slow.0, "events, seed {seed}");
+                }
+                errors += fast.2.is_some() as usize;
+                in_order += fast.1.starts_with('0') as usize;
+            }
+        }
+        // both outcomes are exercised
+        assert!((100..500).contains(&errors), "{errors} of 600 streams fail");
+        assert!(
+            (50..550).contains(&in_order),
+            "{in_order} of 600 streams in order"
+        );
     }
 }
