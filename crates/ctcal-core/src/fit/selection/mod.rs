@@ -129,19 +129,29 @@ pub fn fit(
     progress("frames: selection and optical flow", 0.0);
     let end = start::fit_end(input.frames, options.holdout);
     let run = start::FitRun::new(input, end);
+    match prepare_frames(input, &run, options)? {
+        Ok(prepared) => fit_with_frames(input, options, progress, (&run, end), prepared),
+        Err(why) => super::events_only::fit_from_events(input, options, progress, Some(why)),
+    }
+}
+
+/// The fit that re-simulates the frames `prepared` on the fit run `run` (ending at
+/// `end`): stages 2-6 of the module docs, from the starting thresholds to the result.
+fn fit_with_frames(
+    input: &FitInput,
+    options: &FitOptions,
+    progress: Progress,
+    (run, end): (&start::FitRun, TimeUs),
+    prepared: FramesToSimulate,
+) -> Result<FitResult, FitError> {
     let FramesToSimulate {
         mut frames,
         mut assumptions,
         aligned: frames_aligned,
         other_response,
-    } = match prepare_frames(input, &run, options)? {
-        Ok(prepared) => prepared,
-        Err(why) => {
-            return super::events_only::fit_from_events(input, options, progress, Some(why));
-        }
-    };
+    } = prepared;
     progress("starting thresholds (estimate aps on the fit run)", 0.05);
-    let (start, start_params) = starting_point(input, &run, options, &mut frames, &mut assumptions);
+    let (start, start_params) = starting_point(input, run, options, &mut frames, &mut assumptions);
 
     progress("the ideal model", 0.2);
     let geometry = Geometry::new(&frames, input.excluded, options.blocks, end);
@@ -157,7 +167,7 @@ pub fn fit(
     let mut state = ideal.state;
     let loop_run = LoopRun {
         known: Known::of(
-            &run,
+            run,
             input,
             &state,
             start.mismatch,
@@ -177,39 +187,52 @@ pub fn fit(
         &mut steps,
         progress,
     )?;
+    let parts = finish::Parts {
+        before: ideal.before,
+        residuals_before: ideal.residuals_before,
+        added,
+        steps,
+        ambiguities,
+        assumptions,
+        fixed: ideal.fixed,
+        start: start.measured,
+        known: loop_run.known,
+        interpolation_share: start.interpolation_share,
+        other_response,
+        frame_quality: frame_quality::FrameQuality::default(),
+        frames_aligned,
+        options,
+        input,
+    };
+    Ok(concluded(
+        &simulation,
+        state,
+        parts,
+        (&frames, end),
+        progress,
+    ))
+}
+
+/// The fit's result from the final `state`: the frame checks (unless the thresholds are
+/// given) put into `parts`, then the final model measured on the test blocks.
+fn concluded(
+    simulation: &Simulation,
+    state: State,
+    mut parts: finish::Parts,
+    frames: (&PreparedFrames, TimeUs),
+    progress: Progress,
+) -> FitResult {
     progress(
         "frame checks (every 2nd and 3rd frame, a doubled exposure)",
         0.96,
     );
-    let frame_quality = if ideal.fixed {
-        frame_quality::FrameQuality::default()
-    } else {
-        frame_checks(input, options, (&frames, end), &simulation, &state)
-    };
+    if !parts.fixed {
+        parts.frame_quality = frame_checks(parts.input, parts.options, frames, simulation, &state);
+    }
     progress("the final model on the test blocks", 0.97);
-    let result = finish::result(
-        &simulation,
-        state,
-        finish::Parts {
-            before: ideal.before,
-            residuals_before: ideal.residuals_before,
-            added,
-            steps,
-            ambiguities,
-            assumptions,
-            fixed: ideal.fixed,
-            start: start.measured,
-            known: loop_run.known,
-            interpolation_share: start.interpolation_share,
-            other_response,
-            frame_quality,
-            frames_aligned,
-            options,
-            input,
-        },
-    );
+    let result = finish::result(simulation, state, parts);
     progress("done", 1.0);
-    Ok(result)
+    result
 }
 
 /// What every simulation of the fit runs on: the frames' upsampled runs, the blocks, and
