@@ -900,21 +900,7 @@ fn aps_refuses_a_static_scene_whose_events_are_noise() {
 /// determinable and why, and keeps OFF, whose samples peak at its threshold.
 #[test]
 fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
-    let dir = coverage_case(
-        r#"{"id": "case-15007", "seed": 15007, "generator": "ctcal", "family": "texture",
-            "params": {"ct_on": 0.481336, "ct_off": 0.621281, "ct_sigma": 0.0125011,
-                "refractory_s": 0.000163932, "leak_rate_hz": 0.0307561,
-                "shot_noise_rate_hz": 0.763781, "timestamp_jitter_s": 0.000239525,
-                "log_response": "eps", "log_eps": 0.00725859, "seed": 15007},
-            "speed_px_s": 81.0491, "brightness_dn": 53.5027,
-            "recording": {"kind": "scene", "scene": {"kind": "texture", "width": 128,
-                "height": 96, "duration_s": 0.9, "seed": 15007,
-                "aps": {"rate_hz": 29.0, "exposure_s": 0.0082},
-                "texture": {"canvas_px": 256, "mean_dn": 53.5027, "log_std": 0.215907,
-                    "min_dn": 0.5, "max_dn": 255.0, "spectrum_beta": 1.55086, "blur_px": 1.0,
-                    "vx_px_s": -72.3775, "vy_px_s": 36.4755, "omega_deg_s": 0.0,
-                    "offset_px": [204.277, 235.912], "mod_amp_ln": 0.0, "mod_hz": 0.0}}}}"#,
-    );
+    let dir = coverage_case("case-15007");
     let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
     assert!(e["ct_on"].is_null(), "{}", e["ct_on"]);
     let why = e["why"]["ct_on"].as_str().unwrap();
@@ -930,10 +916,12 @@ fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
     assert!(e["ct_sigma"].is_null() && e["why"]["ct_sigma"].is_string());
 }
 
-/// A coverage study's case (`case.json`, [`ctcal::coverage::CaseSpec`]) written into a
-/// temporary folder with its truth.
-fn coverage_case(spec: &str) -> tempfile::TempDir {
-    let case: ctcal::coverage::CaseSpec = serde_json::from_str(spec).unwrap();
+/// A coverage study's case (its `case.json`, [`ctcal::coverage::CaseSpec`], kept as
+/// `tests/cli/cases/{id}.json`) written into a temporary folder with its truth.
+fn coverage_case(id: &str) -> tempfile::TempDir {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cli/cases/{id}.json"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    let case: ctcal::coverage::CaseSpec = serde_json::from_str(&text).unwrap();
     let dir = tempfile::tempdir().unwrap();
     ctcal::coverage::write_case(&case, dir.path()).unwrap();
     dir
@@ -948,30 +936,7 @@ fn coverage_case(spec: &str) -> tempfile::TempDir {
 /// determined, the frames' own kept and the prior range carried: both thresholds held.
 #[test]
 fn aps_does_not_take_an_offset_a_slow_photoreceptor_may_have_moved() {
-    let dir = coverage_case(
-        r#"{"id": "case-15006", "seed": 15006, "generator": "iebcs",
-            "family": "multi_object_natural", "params": {"ct_on": 0.320626,
-                "ct_off": 0.470205, "seed": 15006},
-            "speed_px_s": 37.7639, "brightness_dn": 188.292,
-            "recording": {"kind": "scene", "scene": {"kind": "multi_object", "width": 96,
-                "height": 72, "duration_s": 0.71, "seed": 15006,
-                "aps": {"rate_hz": 32.0, "exposure_s": 0.00341},
-                "multi_object": {"objects": [1, 8],
-                    "background_velocity_px_s": [7.55278, 18.8819],
-                    "background_angular_velocity_deg_s": [0.0, 20.0],
-                    "background_scale": [0.9, 1.1],
-                    "object_velocity_px_s": [18.8819, 37.7639],
-                    "object_angular_velocity_deg_s": [0.0, 90.0], "object_scale": [0.8, 1.2],
-                    "object_size_px": [8.0, 18.0],
-                    "textures_dir": "calib/scenes/textures/natural",
-                    "background_texture": {"canvas_px": 256, "mean_dn": 188.292,
-                        "log_std": 0.485535, "min_dn": 0.5, "max_dn": 255.0,
-                        "spectrum_beta": 0.532029, "blur_px": 1.0}}}},
-            "peer": {"simulator": "iebcs", "params": {"th_pos": 0.320626,
-                "th_neg": 0.470205, "th_noise": 0.0130485, "lat_us": 56.2422,
-                "jit_us": 2.43265, "ref_us": 232, "tau_us": 107083.0, "bgnp_hz": 0.753884,
-                "bgnn_hz": 0.183327, "lux_at_255": 10000.0}}}"#,
-    );
+    let dir = coverage_case("case-15006");
     let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
     let offset = &e["frame_offset_dn"]["estimate"];
     assert_eq!(
@@ -1000,30 +965,7 @@ fn aps_does_not_take_an_offset_a_slow_photoreceptor_may_have_moved() {
 /// reach 0 DN, where the samples read 0.45 and 0.80, and both thresholds are held.
 #[test]
 fn aps_carries_the_offsets_its_polarities_disagree_over_into_the_intervals() {
-    let dir = coverage_case(
-        r#"{"id": "case-13025", "seed": 13025, "generator": "iebcs",
-            "family": "multi_object_natural", "params": {"ct_on": 0.440698,
-                "ct_off": 0.815278, "seed": 13025},
-            "speed_px_s": 44.4593, "brightness_dn": 58.1745,
-            "recording": {"kind": "scene", "scene": {"kind": "multi_object", "width": 240,
-                "height": 180, "duration_s": 0.67, "seed": 13025,
-                "aps": {"rate_hz": 11.0, "exposure_s": 0.00504},
-                "multi_object": {"objects": [1, 7],
-                    "background_velocity_px_s": [8.89187, 22.2297],
-                    "background_angular_velocity_deg_s": [0.0, 20.0],
-                    "background_scale": [0.9, 1.1],
-                    "object_velocity_px_s": [22.2297, 44.4593],
-                    "object_angular_velocity_deg_s": [0.0, 90.0], "object_scale": [0.8, 1.2],
-                    "object_size_px": [8.0, 45.0],
-                    "textures_dir": "calib/scenes/textures/natural",
-                    "background_texture": {"canvas_px": 256, "mean_dn": 58.1745,
-                        "log_std": 0.271991, "min_dn": 0.5, "max_dn": 255.0,
-                        "spectrum_beta": 1.18142, "blur_px": 1.0}}}},
-            "peer": {"simulator": "iebcs", "params": {"th_pos": 0.440698,
-                "th_neg": 0.815278, "th_noise": 0.0437525, "lat_us": 97.4506,
-                "jit_us": 4.38421, "ref_us": 100, "tau_us": 40.0, "bgnp_hz": 0.1,
-                "bgnn_hz": 0.01, "lux_at_255": 10000.0}}}"#,
-    );
+    let dir = coverage_case("case-13025");
     let e = json(&["estimate", "aps", dir.path().to_str().unwrap()]);
     let offset = &e["frame_offset_dn"]["estimate"];
     assert_eq!(offset["source"], "fitted", "{offset}");
