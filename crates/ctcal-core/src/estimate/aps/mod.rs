@@ -113,6 +113,9 @@ pub struct ApsResult {
     /// systematic error spans (the timing's, or the counts' where they disagree:
     /// [`count_offset::reconcile`]).
     pub frame_offset_dn: (f32, (f32, f32)),
+    /// The memorised level's drift the event timing measured (leak's signature in the
+    /// events' timing: ON events early, OFF events late).
+    pub leak_drift: super::timing::Drift,
 }
 
 /// The fewest usable frame intervals the frame-based thresholds rest on.
@@ -359,6 +362,7 @@ impl FullPass {
             ],
             maps: full.timing.maps,
             frame_offset_dn: (frames.offset, frames.offset_range),
+            leak_drift: full.timing.drift,
         }
     }
 }

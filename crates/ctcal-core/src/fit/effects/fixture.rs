@@ -145,6 +145,7 @@ impl Fixture {
             timestamp_grid_us: None,
             shortest_interval_s: None,
             quiet_off: None,
+            leak_drift: None,
             subset: Subset::Fit,
         }
     }

@@ -4,9 +4,17 @@
 //!
 //! Signature: an excess of ON events among the events without spatio-temporal support
 //! (isolated events), beyond any excess of OFF events (which shot noise would make
-//! alike), growing with the time since a pixel's last event. Evidence: the ON excess
-//! minus the OFF excess, in Poisson standard errors; it matters above 0.005 events per
-//! pixel-second. Start: that excess rate (one leak event per period, most of them isolated),
+//! alike), growing with the time since a pixel's last event; ON beyond OFF at pixels whose
+//! light does not change (still pixels), which only leak makes; and, in the events' timing,
+//! ON events early and OFF events late in proportion to the time between a pixel's events
+//! (the event timing's drift, [`crate::estimate::timing`]). Evidence: the strongest of the
+//! three, each in its standard errors ([`TimingDrift`] for the drift's); it matters above
+//! 0.005 events per pixel-second. A leak that fires every pixel at once (DVS-Voltmeter's
+//! drift, which grows with the light) leaves few isolated events: on coverage draw 15036
+//! (DVS-Voltmeter, thresholds 0.325) the isolated excess was -1.2 standard errors and the
+//! still pixels' 0.49 Hz of ON beyond OFF 3.0, while the timing's drift stood for 3.2 Hz
+//! at 304 of its standard errors; the fit, without leak, read ON 0.209 [0.145, 0.300] and
+//! took a refractory period of 14 ms. Start: that excess rate (one leak event per period, most of them isolated),
 //! and a second start at the still pixels' ON-beyond-OFF excess where that is over twice
 //! it (a leak that fires every pixel at once); the search runs from both and keeps the
 //! lower fit error ([`still_excess`]).
@@ -24,8 +32,47 @@
 //! first frame, and shot-noise events reset the drift), the recording cannot confirm the
 //! rate, which is then not determinable, whatever the distance preferred.
 
-use super::{Context, Effect, Evidence, background_totals};
+use super::{Context, EVIDENCE_THRESHOLD, Effect, Evidence, background_totals};
 use crate::fit::observe::{Geometry, Observed, Subset};
+
+/// The memorised level's drift the event timing measured
+/// ([`crate::estimate::timing::Drift`]) as evidence of leak: the rate it stands for and its
+/// size in its bootstrap standard errors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimingDrift {
+    /// The drift at the frames' median DN over the ON threshold: leak events per second.
+    pub rate_hz: f64,
+    /// The drift in its bootstrap standard errors.
+    pub z: f64,
+}
+
+/// How many of its bootstrap standard errors the timing's drift reaches without any leak,
+/// over [`EVIDENCE_THRESHOLD`]: on the 62 coverage draws without leak of seeds 13001-16040
+/// (ctcal, ESIM, DVS-Voltmeter, IEBCS) it reached 31.4 (ctcal draw 15037), 25.1 (IEBCS
+/// 13004) and 21.5 (ctcal 13040); the bootstrap over pixels does not see what else the
+/// timing model lacks. In these units the largest drift seen without leak is at the
+/// threshold; the leak draws' drifts reached 11-443 (`benches/coverage/fit-leak-timing-2026-12-07`).
+const TIMING_DRIFT_DISPERSION: f64 = 31.4 / EVIDENCE_THRESHOLD;
+
+impl TimingDrift {
+    /// The reading of `drift` with the ON threshold `ct_on`.
+    pub fn of(drift: &crate::estimate::timing::Drift, ct_on: f64) -> Self {
+        Self {
+            rate_hz: if ct_on > 0.0 {
+                drift.at_median_dn / ct_on
+            } else {
+                0.0
+            },
+            z: drift.at_median_dn / drift.standard_error.max(1e-12),
+        }
+    }
+
+    /// Its evidence, in standard errors a leak-free recording does not exceed
+    /// ([`TIMING_DRIFT_DISPERSION`]).
+    fn score(&self) -> f64 {
+        self.z / TIMING_DRIFT_DISPERSION
+    }
+}
 
 pub fn evidence(c: &Context) -> Evidence {
     let ([r_off, r_on, s_off, s_on], exposure) = background_totals(c);
@@ -37,26 +84,43 @@ pub fn evidence(c: &Context) -> Evidence {
     }
     let excess_on = r_on - s_on;
     let excess_off = (r_off - s_off).max(0.0);
-    let (score, rate) = score([r_off, r_on, s_off, s_on], exposure);
+    let (isolated, rate) = score([r_off, r_on, s_off, s_on], exposure);
     let start = (rate / 0.9).max(1e-3);
     let still = still_excess(c);
     let other_start = still
         .filter(|e| e.z >= STILL_Z)
         .map(|e| e.hz / 0.9)
         .filter(|&s| s > start * OTHER_START_RATIO);
-    let still = still.map(|e| e.hz);
+    // a reading that calls for leak by itself and is stronger than the isolated excess
+    // decides, with its own rate for relevance; the timing's drift also gives the search
+    // its start, since it does not depend on how often the pixels' leak events find their
+    // neighbours' (the isolated excess) or on a recording longer than the leak's period
+    // (the still pixels)
+    let timing = c.leak_drift;
+    let strong = |z: f64| z >= EVIDENCE_THRESHOLD && z > isolated;
+    let (score, relevant, start) = match (still, timing) {
+        (_, Some(t)) if strong(t.score()) && still.is_none_or(|e| t.score() > e.z) => {
+            (t.score(), t.rate_hz > RELEVANT_HZ, t.rate_hz.max(1e-3))
+        }
+        (Some(e), _) if strong(e.z) => (e.z, e.hz > RELEVANT_HZ, start),
+        _ => (isolated, rate > RELEVANT_HZ, start),
+    };
     Evidence {
         effect: Effect::Leak,
         score,
-        relevant: rate > RELEVANT_HZ,
+        relevant,
         text: format!(
-            "isolated ON events exceed the model's by {:.4} Hz per pixel beyond the OFF excess ({:.4} Hz): {score:.1} standard errors{}",
+            "isolated ON events exceed the model's by {:.4} Hz per pixel beyond the OFF excess ({:.4} Hz): {isolated:.1} standard errors{}",
             excess_on / exposure,
             excess_off / exposure,
-            still.map_or(String::new(), |hz| format!(
-                "; at still pixels ON exceeds OFF by {hz:.4} Hz per pixel beyond the model"
+            still.map_or(String::new(), |e| format!(
+                "; at still pixels ON exceeds OFF by {:.4} Hz per pixel beyond the model: {:.1} standard errors",
+                e.hz, e.z
             )),
-        ),
+        ) + &timing.map_or(String::new(), |t| format!(
+            "; the event timing's drift stands for {:.4} Hz: {:.1} of its standard errors, {:.1} in those a recording without leak reaches",
+            t.rate_hz, t.z, t.score()
+        )),
         start: Some(start),
         other_start,
     }
@@ -348,6 +412,31 @@ mod tests {
         assert!(e.start.unwrap() < 0.2, "isolated start {:?}", e.start);
         let other = e.other_start.unwrap();
         assert!(other > 1.0 && other < 4.0, "{other}");
+        // the still pixels' excess calls for it, whatever the isolated events say
+        assert!(e.calls_for(), "{e:?}");
+    }
+
+    /// A drift in the events' timing that no leak-free recording reaches calls for leak
+    /// and starts its search at the rate it stands for, though no isolated or still-pixel
+    /// excess shows (DVS-Voltmeter's drift, coverage draw 15036: 3.2 Hz at 304 standard
+    /// errors); one within what leak-free recordings reach (31.4) does not.
+    #[test]
+    fn a_drift_in_the_events_timing_calls_for_leak_beyond_what_recordings_without_it_reach() {
+        let model = chunk(noise_floor());
+        let f = Fixture::new(&static_frames(16, 12, 10.0, 100.0), &model, &model);
+        let drifting = |z: f64| {
+            evidence(&Context {
+                leak_drift: Some(TimingDrift { rate_hz: 3.2, z }),
+                ..f.context()
+            })
+        };
+        let e = drifting(304.0);
+        assert!(e.calls_for(), "{e:?}");
+        assert_eq!(e.start, Some(3.2));
+        assert!((e.score - 304.0 / 31.4 * 5.0).abs() < 1e-9, "{e:?}");
+        let within = drifting(31.0);
+        assert!(!within.calls_for(), "{within:?}");
+        assert_eq!(within.score, evidence(&f.context()).score);
     }
 
     /// A leak that fires at random times (v2e's and ctcal's, each pixel from its own

@@ -187,6 +187,9 @@ pub struct Context<'a> {
     /// The recording's OFF isolated-event rate at quiet pixels on the fit run
     /// ([`crate::fit::events_only::QuietOff`]), where measured.
     pub quiet_off: Option<crate::fit::events_only::QuietOff>,
+    /// The leak drift the event timing of the starting estimate measured
+    /// ([`leak::TimingDrift`]), where it ran.
+    pub leak_drift: Option<leak::TimingDrift>,
     pub subset: Subset,
 }
 

@@ -67,6 +67,8 @@ pub(super) struct Known {
     quiet_off: Option<super::events_only::QuietOff>,
     /// The same on the judging blocks' events, for shot noise's signature there.
     quiet_off_judging: Option<super::events_only::QuietOff>,
+    /// The leak drift the starting estimate's event timing measured.
+    leak_drift: Option<effects::leak::TimingDrift>,
 }
 
 /// The fit's state between steps.
@@ -170,7 +172,7 @@ fn fit_with_frames(
             run,
             input,
             &state,
-            start.mismatch,
+            (start.mismatch, start.leak_drift),
             (&simulation, planned(options).contains(&Effect::ShotNoise)),
         ),
         fixed: ideal.fixed,
@@ -367,7 +369,7 @@ impl Known {
         run: &start::FitRun,
         input: &FitInput,
         state: &State,
-        mismatch: Option<(f64, [f64; 2])>,
+        (mismatch, leak_drift): (Option<(f64, [f64; 2])>, Option<effects::leak::TimingDrift>),
         (simulation, shot_noise_planned): (&Simulation, bool),
     ) -> Self {
         let geometry = simulation.geometry;
@@ -412,6 +414,7 @@ impl Known {
                 .then(|| counted(&run.events, (TimeUs::MIN, fit_end)))
                 .flatten(),
             quiet_off_judging: shot_noise_planned.then(judging).flatten(),
+            leak_drift,
         }
     }
 }
@@ -941,6 +944,7 @@ fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) ->
         timestamp_grid_us: known.grid.map(|g| g.0),
         shortest_interval_s: known.shortest_interval_s,
         quiet_off: known.quiet_off,
+        leak_drift: known.leak_drift,
         subset: Subset::Fit,
     }
 }

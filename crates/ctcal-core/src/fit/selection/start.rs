@@ -65,6 +65,8 @@ pub struct Start {
     /// The frames' log offset the start's thresholds were read at, and the range their
     /// systematic spans ([`aps::ApsResult::frame_offset_dn`]; none for a start value).
     pub frame_offset_dn: Option<(f32, (f32, f32))>,
+    /// The leak drift the estimate's event timing measured (none for a start value).
+    pub leak_drift: Option<crate::fit::effects::leak::TimingDrift>,
     pub step: Step,
     pub assumptions: Vec<String>,
 }
@@ -104,6 +106,7 @@ pub fn thresholds(
         measured: None,
         interpolation_share: None,
         frame_offset_dn: None,
+        leak_drift: None,
         assumptions: vec![format!(
             "thresholds start at {default} (a start value, not a measurement): {reason}"
         )],
@@ -117,11 +120,16 @@ pub fn thresholds(
         );
     }
     let found = aps::estimate(&run.aps_input(input), &options.aps, &|_, _| {});
-    match found.map(|f| (f.estimate, f.interpolation_share, f.frame_offset_dn)) {
-        Ok((e, share, offset)) => match e.thresholds() {
+    let found = found.map(|f| {
+        let drift = f.leak_drift;
+        (f.estimate, f.interpolation_share, f.frame_offset_dn, drift)
+    });
+    match found {
+        Ok((e, share, offset, drift)) => match e.thresholds() {
             Some((on, off)) => Start {
                 interpolation_share: Some(share),
                 frame_offset_dn: Some(offset),
+                leak_drift: Some(crate::fit::effects::leak::TimingDrift::of(&drift, on)),
                 ..measured(&e, on, off)
             },
             None => fallback(
@@ -174,6 +182,7 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
         ]),
         interpolation_share: None,
         frame_offset_dn: None,
+        leak_drift: None,
         assumptions: Vec::new(),
         step: step(
             format!(
