@@ -10,14 +10,15 @@
 //! (the event timing's drift, [`crate::estimate::timing`]). Evidence: the isolated excess
 //! or the drift, whichever is stronger, each in its standard errors ([`TimingDrift`] for
 //! the drift's); it matters above 0.005 events per pixel-second. The still pixels' excess
-//! gives a second start and judges a leak found (below), but does not call for one. A leak that fires every pixel at once (DVS-Voltmeter's
-//! drift, which grows with the light) leaves few isolated events: on coverage draw 15036
-//! (DVS-Voltmeter, thresholds 0.325) the isolated excess was -1.2 standard errors, while
-//! the timing's drift stood for 3.2 Hz at 304 of its standard errors; the fit, without
-//! leak, read ON 0.209 [0.145, 0.300] and took a refractory period of 14 ms. Start: that excess rate (one leak event per period, most of them isolated),
-//! and a second start at the still pixels' ON-beyond-OFF excess where that is over twice
-//! it (a leak that fires every pixel at once); the search runs from both and keeps the
-//! lower fit error ([`still_excess`]).
+//! gives a second start and judges a leak found (below), but does not call for one. A leak
+//! that fires every pixel at once (DVS-Voltmeter's drift, which grows with the light)
+//! leaves few isolated events: on coverage draw 15036 (DVS-Voltmeter, thresholds 0.325) the
+//! isolated excess was -1.2 standard errors, while the timing's drift stood for 3.2 Hz at
+//! 304 of its standard errors; the fit, without leak, read ON 0.209 [0.145, 0.300] and took
+//! a refractory period of 14 ms. Start: that excess rate (one leak event per period, most
+//! of them isolated), or the drift's where it decides, and a second start at the still
+//! pixels' ON-beyond-OFF excess where that is over twice it (a leak that fires every pixel
+//! at once); the search runs from both and keeps the lower fit error ([`still_excess`]).
 //!
 //! The isolated events of all pixels are also the misses of every other effect the model
 //! lacks or gets wrong, and a leak's drift moves the scene's own ON and OFF crossings, so
@@ -51,7 +52,8 @@ pub struct TimingDrift {
 /// (ctcal, ESIM, DVS-Voltmeter, IEBCS) it reached 31.4 (ctcal draw 15037), 25.1 (IEBCS
 /// 13004) and 21.5 (ctcal 13040); the bootstrap over pixels does not see what else the
 /// timing model lacks. In these units the largest drift seen without leak is at the
-/// threshold; the leak draws' drifts reached 11-443 (`benches/coverage/fit-leak-timing-2026-12-07`).
+/// threshold; the leak draws' drifts reached 11-443
+/// (`benches/coverage/fit-leak-timing-2026-12-07`).
 const TIMING_DRIFT_DISPERSION: f64 = 31.4 / EVIDENCE_THRESHOLD;
 
 impl TimingDrift {

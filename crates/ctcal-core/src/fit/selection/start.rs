@@ -121,8 +121,12 @@ pub fn thresholds(
     }
     let found = aps::estimate(&run.aps_input(input), &options.aps, &|_, _| {});
     let found = found.map(|f| {
-        let drift = f.leak_drift;
-        (f.estimate, f.interpolation_share, f.frame_offset_dn, drift)
+        (
+            f.estimate,
+            f.interpolation_share,
+            f.frame_offset_dn,
+            f.leak_drift,
+        )
     });
     match found {
         Ok((e, share, offset, drift)) => match e.thresholds() {
