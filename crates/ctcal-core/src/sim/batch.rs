@@ -270,6 +270,7 @@ mod tests {
             timestamp_jitter_s: Some(150e-6),
             cutoff_hz: Some(400.0),
             leak_rate_hz: Some(0.5),
+            leak_rate_hz_per_dn: Some(0.004),
             hot_pixel_fraction: Some(0.02),
             hot_pixel_rate_hz: Some(80.0),
             ..ideal.clone()

@@ -114,7 +114,8 @@ impl EffectWork {
         let pixels = work.pixels;
         let span = span_s.max(0.0);
         let mut noise = Vec::new();
-        let leak = params.leak_rate_hz();
+        // the leak that grows with the light counted at full white (255 DN), its most
+        let leak = params.leak_rate_hz() + params.leak_rate_hz_per_dn() * 255.0;
         if leak > 0.0 {
             // the mean of the per-pixel lognormal factor 10^(s N(0, 1))
             let s = params.leak_spread_decades() * std::f64::consts::LN_10;

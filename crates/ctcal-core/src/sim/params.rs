@@ -82,6 +82,12 @@ pub struct PixelParams {
     /// Leak: the reference drifts down by `leak_rate_hz * ct_on` per second.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub leak_rate_hz: Option<f64>,
+    /// Leak that grows with the light: ON leak events per second for each DN of the
+    /// pixel's present intensity, beside `leak_rate_hz` (parasitic photocurrent in the
+    /// reset switch, Nozaki & Delbruck, IEEE TED 2017; DVS-Voltmeter's `k5`). The
+    /// reference falls by `(leak_rate_hz + leak_rate_hz_per_dn * DN) * ct_on` per second.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leak_rate_hz_per_dn: Option<f64>,
     /// Pixel-to-pixel spread of the leak rate, decades (log10 standard deviation; default
     /// 0.1 as v2e's `noise_rate_cov_decades`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -139,6 +145,7 @@ impl PixelParams {
             refractory_s: None,
             cutoff_hz: None,
             leak_rate_hz: None,
+            leak_rate_hz_per_dn: None,
             leak_spread_decades: None,
             shot_noise_rate_hz: None,
             shot_noise_bright_factor: None,
@@ -174,7 +181,7 @@ impl PixelParams {
                 })
                 .unwrap_or_default(),
             problem: format!("cannot be read: {}", e.message()),
-            fix: "PARAMS.toml needs ct_on and ct_off; optional keys: ct_sigma, ct_sigma_temporal, refractory_s, cutoff_hz, leak_rate_hz, leak_spread_decades, shot_noise_rate_hz, shot_noise_bright_factor, hot_pixel_fraction, hot_pixel_rate_hz, timestamp_jitter_s, log_response (\"v2e\"|\"eps\"), log_eps, seed, [display]".into(),
+            fix: "PARAMS.toml needs ct_on and ct_off; optional keys: ct_sigma, ct_sigma_temporal, refractory_s, cutoff_hz, leak_rate_hz, leak_rate_hz_per_dn, leak_spread_decades, shot_noise_rate_hz, shot_noise_bright_factor, hot_pixel_fraction, hot_pixel_rate_hz, timestamp_jitter_s, log_response (\"v2e\"|\"eps\"), log_eps, seed, [display]".into(),
         })?;
         params.validate(source_name)?;
         Ok(params)
@@ -214,6 +221,7 @@ impl PixelParams {
             ("refractory_s", self.refractory_s),
             ("cutoff_hz", self.cutoff_hz),
             ("leak_rate_hz", self.leak_rate_hz),
+            ("leak_rate_hz_per_dn", self.leak_rate_hz_per_dn),
             ("leak_spread_decades", self.leak_spread_decades),
             ("shot_noise_rate_hz", self.shot_noise_rate_hz),
             ("shot_noise_bright_factor", self.shot_noise_bright_factor),
@@ -239,6 +247,18 @@ impl PixelParams {
                     "give a rate per pixel per second (real sensors: well below 1e3)",
                 ));
             }
+        }
+        if let Some(g) = self.leak_rate_hz_per_dn
+            && g * 255.0 > MAX_PIXEL_RATE_HZ
+        {
+            return Err(check.fail(
+                "leak_rate_hz_per_dn",
+                format!(
+                    "is {g:e} events per pixel per second per DN, {:e} at full white (255 DN); events are timed to the microsecond, so no pixel fires more than {MAX_PIXEL_RATE_HZ:e} times a second",
+                    g * 255.0
+                ),
+                "give the leak's growth per DN of the pixel's intensity (DVS-Voltmeter's DAVIS346 fit: 0.005)",
+            ));
         }
         if let Some(j) = self.timestamp_jitter_s
             && j > MAX_JITTER_S
@@ -286,6 +306,15 @@ impl PixelParams {
 
     pub fn leak_rate_hz(&self) -> f64 {
         self.leak_rate_hz.unwrap_or(0.0)
+    }
+
+    pub fn leak_rate_hz_per_dn(&self) -> f64 {
+        self.leak_rate_hz_per_dn.unwrap_or(0.0)
+    }
+
+    /// Whether the reference leaks, in the dark or with the light.
+    pub fn has_leak(&self) -> bool {
+        self.leak_rate_hz() > 0.0 || self.leak_rate_hz_per_dn() > 0.0
     }
 
     pub fn leak_spread_decades(&self) -> f64 {
@@ -478,6 +507,26 @@ mod tests {
         );
     }
 
+    /// A leak that grows with the light past a microsecond's events at full white, or
+    /// below zero, is refused by name.
+    #[test]
+    fn a_leak_growth_no_pixel_could_fire_at_is_refused() {
+        for bad in ["2e4", "-0.01"] {
+            let e = PixelParams::from_toml(
+                &format!("ct_on = 0.3\nct_off = 0.3\nleak_rate_hz_per_dn = {bad}\n"),
+                "p.toml",
+            )
+            .unwrap_err();
+            assert!(e.to_string().contains("`leak_rate_hz_per_dn`"), "{e}");
+        }
+        let p = PixelParams::from_toml(
+            "ct_on = 0.3\nct_off = 0.3\nleak_rate_hz_per_dn = 0.005\n",
+            "p",
+        )
+        .unwrap();
+        assert!(p.has_leak() && p.leak_rate_hz() == 0.0);
+    }
+
     #[test]
     fn thresholds_alone_make_an_ideal_pixel() {
         let p = PixelParams::from_toml("ct_on = 0.3\nct_off = 0.4\n", "t").unwrap();
@@ -497,6 +546,7 @@ ct_sigma_temporal = 0.01
 refractory_s = 0.0005
 cutoff_hz = 300.0
 leak_rate_hz = 0.1
+leak_rate_hz_per_dn = 0.005
 shot_noise_rate_hz = 1.0
 shot_noise_bright_factor = 0.25
 hot_pixel_fraction = 0.001

@@ -68,8 +68,10 @@ pub struct PixelState {
     /// Frozen per-pixel thresholds (temporal noise is drawn around these).
     pub frozen_on: f32,
     pub frozen_off: f32,
-    /// Reference drift (leak), log units per microsecond.
+    /// Reference drift (leak), log units per microsecond, and its growth per DN of the
+    /// present intensity (the leak that grows with the light).
     pub leak_per_us: f32,
+    pub leak_per_dn_per_us: f32,
     /// Shot-noise candidate rate per microsecond and the ON share of its events.
     pub noise_rate_per_us: f64,
     pub noise_on_share: f32,
@@ -128,6 +130,7 @@ impl PixelState {
             frozen_on: theta_on,
             frozen_off: theta_off,
             leak_per_us: 0.0,
+            leak_per_dn_per_us: 0.0,
             noise_rate_per_us: 0.0,
             noise_on_share: 0.5,
             last_event_us: f64::NEG_INFINITY,
@@ -240,6 +243,7 @@ impl PixelState {
         sink: &mut EventSink,
     ) {
         let (mut t, mut y) = (ta, ya);
+        let leak = self.leak_per_us + self.leak_per_dn_per_us * 0.5 * (dna + dnb);
         let at = |time: f64, a: f32, b: f32| {
             if tb > ta {
                 lerp(a, b, ((time - ta) / (tb - ta)) as f32)
@@ -250,12 +254,12 @@ impl PixelState {
         loop {
             let interrupt = self.next_noise_us.min(self.next_hot_us);
             if interrupt >= tb {
-                self.crossings(model, t, tb, y, yb, rng, sink);
+                self.crossings(model, (t, tb), (y, yb), leak, rng, sink);
                 return;
             }
             let ti = interrupt.max(t);
             let yi = at(ti, ya, yb);
-            self.crossings(model, t, ti, y, yi, rng, sink);
+            self.crossings(model, (t, ti), (y, yi), leak, rng, sink);
             if self.next_hot_us <= self.next_noise_us {
                 sink.emit(ti, true);
                 self.next_hot_us = ti + exponential_us(model.hot_rate_per_us, rng);
@@ -275,21 +279,19 @@ impl PixelState {
         }
     }
 
-    /// Threshold crossings of `d = y - reference` on a straight segment, with leak drift
-    /// and the refractory period.
-    #[allow(clippy::too_many_arguments)]
+    /// Threshold crossings of `d = y - reference` on a straight segment, with the leak's
+    /// drift (`leak_per_us`, log units per microsecond) and the refractory period.
     fn crossings(
         &mut self,
         model: &PixelModel,
-        ta: f64,
-        tb: f64,
-        ya: f32,
-        yb: f32,
+        (ta, tb): (f64, f64),
+        (ya, yb): (f32, f32),
+        leak_per_us: f32,
         rng: &mut Xoshiro256PlusPlus,
         sink: &mut EventSink,
     ) {
         let h = tb - ta;
-        let drift = self.leak_per_us * h as f32;
+        let drift = leak_per_us * h as f32;
         let mut da = ya - self.reference;
         let mut db = yb - (self.reference - drift);
         let mut now = ta;

@@ -63,6 +63,8 @@ pub(super) struct Row {
     pub theta_on: Vec<f32>,
     pub theta_off: Vec<f32>,
     pub leak: Vec<f32>,
+    /// The leak's growth per DN of the present intensity, log units per microsecond.
+    pub leak_per_dn: Vec<f32>,
     /// Intensity window of the quiet test (window mode only).
     pub window_low: Vec<f32>,
     pub window_high: Vec<f32>,
@@ -100,6 +102,7 @@ impl Row {
         p.reference = self.reference[x];
         p.filtered = filtered;
         p.leak_per_us = self.leak[x];
+        p.leak_per_dn_per_us = self.leak_per_dn[x];
         if model.per_pixel_history {
             let c = &self.cold[x];
             p.frozen_on = c.frozen_on;
@@ -221,13 +224,19 @@ impl Row {
         let filtered = &mut self.filtered[..n];
         let input = &mut self.input[..n];
         let dn = &mut self.dn[..n];
-        let (theta_on, theta_off, leak) =
-            (&self.theta_on[..n], &self.theta_off[..n], &self.leak[..n]);
+        let (theta_on, theta_off) = (&self.theta_on[..n], &self.theta_off[..n]);
+        let (leak, leak_per_dn) = (&self.leak[..n], &self.leak_per_dn[..n]);
         let filter_end = &self.filter_end[..n];
         for x in 0..n {
             let (u0, r) = (input[x], reference[x]);
             let u_end = if HOLD { u0 } else { u1[x] };
-            let drift = if EFFECTS { leak[x] * h } else { 0.0 };
+            let drift = if EFFECTS {
+                // the intensity's mean over the interval, as the busy path's segments
+                let dn_end = if HOLD { dn[x] } else { dn1[x] };
+                (leak[x] + leak_per_dn[x] * 0.5 * (dn[x] + dn_end)) * h
+            } else {
+                0.0
+            };
             let (y0, y1) = if FILTER {
                 (filtered[x], filter_end[x])
             } else {

@@ -64,11 +64,11 @@ impl Simulator {
             hot_rate_per_us: params.hot_pixels().map_or(0.0, |(_, r)| r * 1e-6),
             substep_tolerance: 0.002,
             max_substeps: 256,
-            fast_path_effects: params.leak_rate_hz() > 0.0
+            fast_path_effects: params.has_leak()
                 || params.shot_noise_rate_hz() > 0.0
                 || params.hot_pixels().is_some(),
             intensity_window: params.cutoff_hz().is_none()
-                && params.leak_rate_hz() <= 0.0
+                && !params.has_leak()
                 && params.shot_noise_rate_hz() <= 0.0
                 && params.hot_pixels().is_none(),
             per_pixel_history: params.refractory_s() > 0.0
@@ -196,7 +196,7 @@ impl Simulator {
     fn draw_leak_factors(&self) -> Vec<f32> {
         let params = &self.params;
         let n = self.width * self.height;
-        match (&self.maps.leak_factor, params.leak_rate_hz() > 0.0) {
+        match (&self.maps.leak_factor, params.has_leak()) {
             (Some(map), _) => map.clone(),
             (None, true) => {
                 let mut rng = generator(self.seed, Stream::Leak, 0);
@@ -258,7 +258,10 @@ impl Simulator {
     /// pixels' draws.
     fn row_at_start(&self, y: usize, dn: &[f32], draws: &PixelDraws) -> Row {
         let (width, log_map) = (self.width, self.log_map);
-        let leak_rate = self.params.leak_rate_hz();
+        let (leak_rate, leak_per_dn) = (
+            self.params.leak_rate_hz(),
+            self.params.leak_rate_hz_per_dn(),
+        );
         let range = y * width..(y + 1) * width;
         let input: Vec<f32> = dn[range.clone()]
             .iter()
@@ -287,6 +290,10 @@ impl Simulator {
             leak: range
                 .clone()
                 .map(|i| leak::drift_per_us(leak_rate, draws.leak_factors[i], draws.theta_on[i]))
+                .collect(),
+            leak_per_dn: range
+                .clone()
+                .map(|i| leak::drift_per_us(leak_per_dn, draws.leak_factors[i], draws.theta_on[i]))
                 .collect(),
             next_interrupt: cold
                 .iter()

@@ -109,6 +109,7 @@ pub fn numeric_params(p: &PixelParams) -> Vec<(String, f64)> {
         ("refractory_s", p.refractory_s),
         ("cutoff_hz", p.cutoff_hz),
         ("leak_rate_hz", p.leak_rate_hz),
+        ("leak_rate_hz_per_dn", p.leak_rate_hz_per_dn),
         ("leak_spread_decades", p.leak_spread_decades),
         ("shot_noise_rate_hz", p.shot_noise_rate_hz),
         ("shot_noise_bright_factor", p.shot_noise_bright_factor),
@@ -148,11 +149,12 @@ pub fn combine(fits: &[PixelParams]) -> Option<PixelParams> {
     out.ct_on = median(&mut fits.iter().map(|p| p.ct_on).collect::<Vec<_>>());
     out.ct_off = median(&mut fits.iter().map(|p| p.ct_off).collect::<Vec<_>>());
     type Slot = fn(&mut PixelParams) -> &mut Option<f64>;
-    let slots: [Slot; 8] = [
+    let slots: [Slot; 9] = [
         |p| &mut p.ct_sigma,
         |p| &mut p.refractory_s,
         |p| &mut p.cutoff_hz,
         |p| &mut p.leak_rate_hz,
+        |p| &mut p.leak_rate_hz_per_dn,
         |p| &mut p.shot_noise_rate_hz,
         |p| &mut p.hot_pixel_fraction,
         |p| &mut p.hot_pixel_rate_hz,
@@ -274,7 +276,12 @@ fn esim_inexpressible(p: &PixelParams) -> Option<String> {
         ),
         (
             "leak",
-            p.leak_rate_hz.map(|r| format!("leak_rate_hz {r:.4}")),
+            p.leak_rate_hz.map(|r| {
+                format!("leak_rate_hz {r:.4}")
+                    + &p.leak_rate_hz_per_dn.map_or(String::new(), |g| {
+                        format!(" + leak_rate_hz_per_dn {g:.3e} per DN")
+                    })
+            }),
         ),
         (
             "shot noise",

@@ -143,7 +143,7 @@ fn identified(fit: &serde_json::Value, file: &str, prefix: &str) -> Result<()> {
 /// The largest magnitude each numeric fit parameter may have (the PARAMS.toml keys; the
 /// `display` table's as `display.KEY`): what a camera can have, far beyond what a fit finds,
 /// so that a damaged or hand-edited fit never reaches a simulator's configuration.
-const PLAUSIBLE: [(&str, f64); 20] = [
+const PLAUSIBLE: [(&str, f64); 21] = [
     // contrast thresholds and their spreads, natural-log units
     ("ct_on", 10.0),
     ("ct_off", 10.0),
@@ -152,6 +152,7 @@ const PLAUSIBLE: [(&str, f64); 20] = [
     ("refractory_s", 10.0),
     ("cutoff_hz", 1e6),
     ("leak_rate_hz", 1e6),
+    ("leak_rate_hz_per_dn", 1e4),
     ("leak_spread_decades", 10.0),
     ("shot_noise_rate_hz", 1e6),
     ("shot_noise_bright_factor", 100.0),

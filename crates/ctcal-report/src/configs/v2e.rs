@@ -48,6 +48,12 @@ fn notes(p: &PixelParams, setup: &Setup) -> Vec<String> {
     if p.hot_pixel_fraction.is_some() || p.timestamp_jitter_s.is_some() {
         notes.push("v2e has no hot pixels or timestamp jitter; ctcal simulate has both".into());
     }
+    if let Some(g) = p.leak_rate_hz_per_dn.filter(|&g| g > 0.0) {
+        notes.push(format!(
+            "v2e's leak does not grow with the light: --leak_rate_hz is the fitted dark part; the fitted growth, {g:.3e} Hz per DN ({:.3} Hz more at 128 DN), is not in these arguments (ctcal simulate has it)",
+            g * 128.0
+        ));
+    }
     if setup.sensor.is_none() {
         notes.push(format!(
             "the sensor size is not known: add {} and {}",

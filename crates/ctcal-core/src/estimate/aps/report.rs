@@ -585,9 +585,11 @@ fn lag_report(lag: &crate::estimate::timing::Lag) -> serde_json::Value {
 fn drift_report(drift: &crate::estimate::timing::Drift) -> serde_json::Value {
     json!({
         "log_units_per_second_at_median_dn": drift.at_median_dn,
+        "median_dn": drift.median_dn,
         "standard_error": drift.standard_error,
         "resolved": resolved(drift.at_median_dn, drift.standard_error),
         "per_dn": drift.per_dn,
+        "per_dn_standard_error": drift.per_dn_standard_error,
         "meaning": "the memorised level's drift the event timing measured, positive downward (leak: ON events come early, OFF late); a negative value is an upward drift, which leak does not make: noise, or an effect the timing lacks; taken out of the thresholds either way",
     })
 }
@@ -673,8 +675,10 @@ mod tests {
         let drift = crate::estimate::timing::Drift {
             at_zero_dn: -0.3,
             per_dn: 0.0001,
+            median_dn: 100.0,
             at_median_dn: -0.29,
             standard_error: 0.1,
+            per_dn_standard_error: 0.001,
         };
         let report = drift_report(&drift);
         assert_eq!(report["resolved"], "resolved: differs from zero at 95 %");

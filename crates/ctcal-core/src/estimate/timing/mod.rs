@@ -166,9 +166,12 @@ pub struct Drift {
     /// Log units per second at DN 0, and its growth per DN.
     pub at_zero_dn: f64,
     pub per_dn: f64,
-    /// At the frames' median DN, with its bootstrap standard error.
+    /// At the frames' median DN (`median_dn`), with its bootstrap standard error.
+    pub median_dn: f64,
     pub at_median_dn: f64,
     pub standard_error: f64,
+    /// The growth's bootstrap standard error.
+    pub per_dn_standard_error: f64,
 }
 
 /// Result of the timing estimator.
@@ -357,8 +360,10 @@ impl Central {
             drift: Drift {
                 at_zero_dn: coefficients.drift,
                 per_dn: coefficients.drift_per_dn,
+                median_dn,
                 at_median_dn: drift_at_median(coefficients),
                 standard_error: boot.drift,
+                per_dn_standard_error: boot.drift_per_dn,
             },
         }
     }
@@ -752,6 +757,7 @@ struct Bootstrap {
     excess_on: f64,
     excess_off: f64,
     drift: f64,
+    drift_per_dn: f64,
     lag: f64,
 }
 
@@ -774,7 +780,7 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
     } = *fitted;
     let median_dn = median_level(pairs);
     let resampler = Resampler::new(pairs, slots, values, weights, pixels);
-    let draw = |k: usize| -> Option<[f64; 8]> {
+    let draw = |k: usize| -> Option<[f64; 9]> {
         let (c, sums) = resampler.fit_and_sums(&resampler.draw(11 + k as u64), options.fit_leak)?;
         let [off, on] = sums.map(|sums| sums.map_or(0.0, |s| mean_and_excess(&s).1));
         Some([
@@ -786,9 +792,10 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
             c.lag,
             on,
             off,
+            c.drift_per_dn,
         ])
     };
-    let draws: Vec<[f64; 8]> = in_order(options.bootstrap, draw);
+    let draws: Vec<[f64; 9]> = in_order(options.bootstrap, draw);
     let sd = |k: usize| std_dev(&draws.iter().map(|d| d[k]).collect::<Vec<_>>());
     Bootstrap {
         on: sd(0),
@@ -798,6 +805,7 @@ fn bootstrap(fitted: &Fitted, pixels: usize, options: &TimingOptions) -> Bootstr
         excess_on: sd(6),
         excess_off: sd(7),
         drift: sd(4),
+        drift_per_dn: sd(8),
         lag: sd(5),
     }
 }
