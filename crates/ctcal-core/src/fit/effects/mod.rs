@@ -110,7 +110,16 @@ impl Effect {
             Effect::Mismatch => &mut params.ct_sigma,
             Effect::Refractory => &mut params.refractory_s,
             Effect::Bandwidth => &mut params.cutoff_hz,
-            Effect::Leak => &mut params.leak_rate_hz,
+            Effect::Leak => {
+                // a leak that grows with the light keeps its growth's ratio to the dark part
+                if let (Some(dark), Some(per_dn)) =
+                    (params.leak_rate_hz, params.leak_rate_hz_per_dn)
+                    && dark > 0.0
+                {
+                    params.leak_rate_hz_per_dn = Some(per_dn * value / dark);
+                }
+                &mut params.leak_rate_hz
+            }
             Effect::ShotNoise => &mut params.shot_noise_rate_hz,
             Effect::TimestampJitter => &mut params.timestamp_jitter_s,
             Effect::HotPixels | Effect::Display => return,
@@ -124,7 +133,10 @@ impl Effect {
             Effect::Mismatch => params.ct_sigma = None,
             Effect::Refractory => params.refractory_s = None,
             Effect::Bandwidth => params.cutoff_hz = None,
-            Effect::Leak => params.leak_rate_hz = None,
+            Effect::Leak => {
+                params.leak_rate_hz = None;
+                params.leak_rate_hz_per_dn = None;
+            }
             Effect::ShotNoise => params.shot_noise_rate_hz = None,
             Effect::TimestampJitter => params.timestamp_jitter_s = None,
             Effect::HotPixels | Effect::Display => {}

@@ -108,8 +108,10 @@ const REFRACTORY_OR_BANDWIDTH: &str = "a refractory period drops events of fast 
 const MISMATCH_OR_SHOT_NOISE: &str = "threshold mismatch scales each pixel's events with the motion it sees, shot noise adds events where nothing moves: a stretch of the same scene held still separates them";
 const LEAK_OR_SHOT_NOISE: &str = "leak adds ON events only, shot noise both polarities: the polarity of the events of a still scene separates them";
 
+const REFRACTORY_OR_LEAK: &str = "a refractory period thins each pixel's shortest intervals whatever the polarity, leak makes ON events come early and OFF events late in proportion to the time since the pixel's last event and fires ON where the light does not change: a stretch of the same scene held still separates them";
+
 /// (kept effect, look-alike, what separates them).
-const LOOK_ALIKES: [(Effect, Effect, &str); 6] = [
+const LOOK_ALIKES: [(Effect, Effect, &str); 8] = [
     (
         Effect::Refractory,
         Effect::Bandwidth,
@@ -124,6 +126,8 @@ const LOOK_ALIKES: [(Effect, Effect, &str); 6] = [
     (Effect::ShotNoise, Effect::Mismatch, MISMATCH_OR_SHOT_NOISE),
     (Effect::Leak, Effect::ShotNoise, LEAK_OR_SHOT_NOISE),
     (Effect::ShotNoise, Effect::Leak, LEAK_OR_SHOT_NOISE),
+    (Effect::Refractory, Effect::Leak, REFRACTORY_OR_LEAK),
+    (Effect::Leak, Effect::Refractory, REFRACTORY_OR_LEAK),
 ];
 
 /// Where a look-alike's search starts when its evidence gives no start: a middle value of
@@ -319,7 +323,7 @@ fn beside(
         evidence.score,
     );
     step.parameters = super::steps::thresholds_of(&searched.model);
-    step.parameters.insert(key.into(), searched.value);
+    super::steps::record_searched(&mut step, key, &searched);
     super::steps::record(&mut step, verdict);
     step.simulations = simulation.count.get() - count_before;
     if step.kept {
@@ -487,7 +491,7 @@ fn compare_one(
         ),
         evidence.score,
     );
-    step.parameters.insert(key.into(), searched.value);
+    super::steps::record_searched(&mut step, key, &searched);
     step.error_before = Some(outcome.wins.before.total);
     step.error_after = Some(outcome.wins.after.total);
     step.components_after = Some(outcome.wins.after.clone());

@@ -281,6 +281,7 @@ fn judged(
             steps: &parts.steps,
             measured_spread: parts.known.mismatch,
             noise,
+            leak_growth: parts.known.leak_drift.and_then(|d| d.growth),
         },
         &mut parts.ambiguities,
         &mut parts.assumptions,
@@ -467,6 +468,8 @@ struct Undetermined<'a> {
     /// The threshold spread event timing measured (value, interval), if it did.
     measured_spread: Option<(f64, [f64; 2])>,
     noise: NoiseIntervals,
+    /// The leak's growth with the light the search held, if the timing measured one.
+    leak_growth: Option<crate::fit::effects::leak::LeakGrowth>,
 }
 
 /// The parameters the data do not identify, with why: the model's unidentified settings,
@@ -481,7 +484,8 @@ fn undetermined(
     assumptions: &mut Vec<String>,
 ) -> BTreeMap<String, String> {
     let mut not_identified = not_identified(state, from.fixed);
-    if let Some((note, unmeasured)) = super::leak_report::check(simulation, state) {
+    if let Some((note, unmeasured)) = super::leak_report::check(simulation, state, from.leak_growth)
+    {
         assumptions.push(note);
         if let Some(why) = unmeasured {
             not_identified
@@ -510,6 +514,11 @@ fn undetermined(
         &mut state.uncertainty,
         ambiguities,
         (&not_identified, from.noise.measured),
+    ));
+    assumptions.extend(super::leak_report::growth(
+        state,
+        from.leak_growth,
+        &mut not_identified,
     ));
     for k in ["ct_on", "ct_off"] {
         if not_identified.contains_key(k) {

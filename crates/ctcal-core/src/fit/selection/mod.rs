@@ -919,10 +919,11 @@ fn search_counted(
     known: Known,
     (fixed, noise): (bool, f64),
 ) -> Result<super::search::Searched, FitError> {
-    let (range, counted) = search_range(effect, range, known, simulation.geometry, params);
+    let (params, range) = shaped_for_search(effect, params, range, known);
+    let (range, counted) = search_range(effect, range, known, simulation.geometry, &params);
     let searched = super::search::search(
         simulation,
-        params,
+        &params,
         effect,
         range,
         &state.masked,
@@ -931,6 +932,26 @@ fn search_counted(
         noise,
     )?;
     Ok(within_count(searched, counted))
+}
+
+/// `params` and `range` ready for a search of `effect`: a leak that grows with the light
+/// (the event timing's [`effects::leak::LeakGrowth`]) is searched through its dark part with
+/// the growth's ratio to it held, so a range of rates at the frames' median DN becomes one
+/// of dark parts. Any other search, or a leak already in `params`, as given.
+fn shaped_for_search(
+    effect: Effect,
+    params: &PixelParams,
+    range: (f64, f64),
+    known: Known,
+) -> (PixelParams, (f64, f64)) {
+    let shaped = (effect == Effect::Leak)
+        .then(|| known.leak_drift.and_then(|d| d.growth))
+        .flatten()
+        .and_then(|g| g.shaped(params));
+    match shaped {
+        Some((shaped, dark_share)) => (shaped, (range.0 * dark_share, range.1 * dark_share)),
+        None => (params.clone(), range),
+    }
 }
 
 fn context_of<'a>(state: &'a State, simulation: &'a Simulation, known: Known) -> Context<'a> {

@@ -150,9 +150,20 @@ fn search_effect(
             )),
         }
     }
-    step.parameters.insert(key.into(), searched.value);
+    record_searched(step, key, &searched);
     let uncertain = uncertain_of(key, &searched);
     Ok((searched.model, Some(uncertain)))
+}
+
+/// The searched value in `step`'s parameters under `key`, and a leak's growth with the
+/// light beside it where the search held one (the search sets the dark part).
+pub(super) fn record_searched(step: &mut Step, key: &str, searched: &Searched) {
+    step.parameters.insert(key.into(), searched.value);
+    if key == "leak_rate_hz"
+        && let Some(g) = searched.model.params.leak_rate_hz_per_dn
+    {
+        step.parameters.insert("leak_rate_hz_per_dn".into(), g);
+    }
 }
 
 /// The better of two searches of one parameter from different starts: the one with the
@@ -188,16 +199,12 @@ fn search_from(
     start: f64,
     run: &LoopRun,
 ) -> Result<crate::fit::search::Searched, FitError> {
-    let (range, counted) = search_range(
-        effect,
-        effect.range(start),
-        run.known,
-        simulation.geometry,
-        &state.model.params,
-    );
+    let (base, range) =
+        super::shaped_for_search(effect, &state.model.params, effect.range(start), run.known);
+    let (range, counted) = search_range(effect, range, run.known, simulation.geometry, &base);
     let searched = search_profiled(
         simulation,
-        &state.model.params,
+        &base,
         effect,
         range,
         (&state.masked, &state.kept),
@@ -379,7 +386,7 @@ pub fn refit(
         0.0,
     );
     step.parameters = thresholds_of(&searched.model);
-    step.parameters.insert(key.into(), searched.value);
+    record_searched(&mut step, key, &searched);
     step.simulations = simulation.count.get() - count_before;
     let value = searched.value;
     record(&mut step, verdict);
