@@ -43,7 +43,7 @@ pub fn effects_present(params: &PixelParams) -> Vec<String> {
         ("mismatch", on(params.ct_sigma)),
         ("refractory", on(params.refractory_s)),
         ("bandwidth", params.cutoff_hz().is_some()),
-        ("leak", on(params.leak_rate_hz)),
+        ("leak", params.has_leak()),
         ("shot_noise", on(params.shot_noise_rate_hz)),
         ("hot_pixels", params.hot_pixels().is_some()),
         ("timestamp_jitter", on(params.timestamp_jitter_s)),

@@ -114,12 +114,22 @@ impl EffectWork {
         let pixels = work.pixels;
         let span = span_s.max(0.0);
         let mut noise = Vec::new();
-        // the leak that grows with the light counted at full white (255 DN), its most
-        let leak = params.leak_rate_hz() + params.leak_rate_hz_per_dn() * 255.0;
+        // the leak that grows with the light counted at full white (255 DN, or a display's
+        // white where that is brighter), its most
+        let white = params
+            .display
+            .as_ref()
+            .map_or(255.0, |d| d.white_dn.max(255.0));
+        let leak = params.leak_rate_hz() + params.leak_rate_hz_per_dn() * white;
         if leak > 0.0 {
             // the mean of the per-pixel lognormal factor 10^(s N(0, 1))
             let s = params.leak_spread_decades() * std::f64::consts::LN_10;
-            noise.push(("leak_rate_hz", pixels * span * leak * (s * s / 2.0).exp()));
+            let key = if params.leak_rate_hz_per_dn() * white > params.leak_rate_hz() {
+                "leak_rate_hz_per_dn"
+            } else {
+                "leak_rate_hz"
+            };
+            noise.push((key, pixels * span * leak * (s * s / 2.0).exp()));
         }
         let shot = params.shot_noise_rate_hz();
         if shot > 0.0 {

@@ -149,12 +149,10 @@ pub fn combine(fits: &[PixelParams]) -> Option<PixelParams> {
     out.ct_on = median(&mut fits.iter().map(|p| p.ct_on).collect::<Vec<_>>());
     out.ct_off = median(&mut fits.iter().map(|p| p.ct_off).collect::<Vec<_>>());
     type Slot = fn(&mut PixelParams) -> &mut Option<f64>;
-    let slots: [Slot; 9] = [
+    let slots: [Slot; 7] = [
         |p| &mut p.ct_sigma,
         |p| &mut p.refractory_s,
         |p| &mut p.cutoff_hz,
-        |p| &mut p.leak_rate_hz,
-        |p| &mut p.leak_rate_hz_per_dn,
         |p| &mut p.shot_noise_rate_hz,
         |p| &mut p.hot_pixel_fraction,
         |p| &mut p.hot_pixel_rate_hz,
@@ -171,7 +169,45 @@ pub fn combine(fits: &[PixelParams]) -> Option<PixelParams> {
             .count();
         *slot(&mut out) = (2 * present >= fits.len() && present > 0).then(|| median(&mut values));
     }
+    (out.leak_rate_hz, out.leak_rate_hz_per_dn) = combined_leak(fits);
     Some(out)
+}
+
+/// The leak of several fits, counted as every other effect (present when at least half the
+/// fits have it; absent ones count as zero), its parts taken together: a flat leak's rate
+/// is its whole rate at every brightness, a growing leak's `leak_rate_hz` only its dark
+/// part, so the fits of the form fewer leaky fits have (flat on a tie: growing) are left
+/// out of the medians.
+fn combined_leak(fits: &[PixelParams]) -> (Option<f64>, Option<f64>) {
+    let leaky = fits.iter().filter(|p| p.has_leak()).count();
+    if leaky == 0 || 2 * leaky < fits.len() {
+        return (None, None);
+    }
+    let growing = fits
+        .iter()
+        .filter(|p| p.leak_rate_hz_per_dn.is_some())
+        .count();
+    let grows = 2 * growing >= leaky;
+    let pool: Vec<&PixelParams> = fits
+        .iter()
+        .filter(|p| !p.has_leak() || p.leak_rate_hz_per_dn.is_some() == grows)
+        .collect();
+    let mut dark: Vec<f64> = pool.iter().map(|p| p.leak_rate_hz()).collect();
+    let mut per_dn: Vec<f64> = pool.iter().map(|p| p.leak_rate_hz_per_dn()).collect();
+    (Some(median(&mut dark)), grows.then(|| median(&mut per_dn)))
+}
+
+/// The fitted leak's parts, where it has any: the dark rate and the growth per DN.
+fn leak_parts(p: &PixelParams) -> Option<String> {
+    let parts: Vec<String> = [
+        p.leak_rate_hz.map(|r| format!("leak_rate_hz {r:.4}")),
+        p.leak_rate_hz_per_dn
+            .map(|g| format!("leak_rate_hz_per_dn {g:.3e}")),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    (!parts.is_empty()).then(|| parts.join(" + "))
 }
 
 /// A line of an ESIM flagfile: ESIM's flag `name` set to `value`.
@@ -274,15 +310,7 @@ fn esim_inexpressible(p: &PixelParams) -> Option<String> {
             "photoreceptor bandwidth",
             p.cutoff_hz.map(|c| format!("cutoff_hz {c:.1}")),
         ),
-        (
-            "leak",
-            p.leak_rate_hz.map(|r| {
-                format!("leak_rate_hz {r:.4}")
-                    + &p.leak_rate_hz_per_dn.map_or(String::new(), |g| {
-                        format!(" + leak_rate_hz_per_dn {g:.3e} per DN")
-                    })
-            }),
-        ),
+        ("leak", leak_parts(p)),
         (
             "shot noise",
             p.shot_noise_rate_hz
@@ -397,6 +425,27 @@ mod tests {
         assert_eq!(c.cutoff_hz, Some(300.0));
         // two of three fits have shot noise (median of 1, 0, 1)
         assert_eq!(c.shot_noise_rate_hz, Some(1.0));
+        // a flat leak (0.4 Hz) among two that grow with the light (dark 0.1 and 0.3 Hz,
+        // 0.01 and 0.03 Hz per DN) is left out of the medians of both parts, and a fit
+        // without leak counts as none
+        let leak = |dark: f64, per_dn: Option<f64>| PixelParams {
+            leak_rate_hz: Some(dark),
+            leak_rate_hz_per_dn: per_dn,
+            ..fitted()
+        };
+        let fits = [
+            leak(0.1, Some(0.01)),
+            leak(0.4, None),
+            leak(0.3, Some(0.03)),
+            fitted(),
+        ];
+        let c = combine(&fits).unwrap();
+        assert_eq!(
+            (c.leak_rate_hz, c.leak_rate_hz_per_dn),
+            (Some(0.1), Some(0.01))
+        );
+        let c = combine(&[leak(0.4, None), leak(0.2, None), fitted()]).unwrap();
+        assert_eq!((c.leak_rate_hz, c.leak_rate_hz_per_dn), (Some(0.2), None));
         let generator =
             esim_generator(&[PixelParams::ideal(0.2, 0.3), fitted()], &setup()).unwrap();
         let v: serde_json::Value = serde_json::from_str(&generator).unwrap();

@@ -57,7 +57,8 @@ pub struct Ambiguity {
 /// Widens the interval of each kept effect the data do not separate from a look-alike down
 /// to 0: the model with the look-alike in its place (and this effect absent) explains the
 /// recording as well, so the recording does not say the effect is there, only how large it
-/// is if it is (kept as the ambiguity's `kept_ci95_if_present`). Parameters without an
+/// is if it is (kept as the ambiguity's `kept_ci95_if_present`, the first of its
+/// parameters' that has one: a leak's dark part, else its growth). Parameters without an
 /// interval or already withheld (`why`) are left, and so are those `measured` present by a
 /// direct count (shot noise at the quiet pixels: the look-alike may be there beside it). Returns the assumption to list, if any
 /// interval was widened.
@@ -74,26 +75,28 @@ pub fn reach_zero_where_not_separated(
 ) -> Option<String> {
     let mut widened = Vec::new();
     for a in ambiguities.iter_mut() {
-        let Some(key) = Effect::parse(&a.kept).and_then(Effect::parameter) else {
+        let Some(effect) = Effect::parse(&a.kept) else {
             continue;
         };
-        if why.contains_key(key) {
-            continue;
-        }
-        let Some(u) = uncertainty.get_mut(key) else {
-            continue;
-        };
-        let Some(interval) = u.interval() else {
-            continue;
-        };
-        a.kept_ci95_if_present = Some(interval);
-        // measured present by a direct count: the look-alike may be there beside it
-        if interval[0] != Some(0.0) && !measured.contains(&key) {
-            u.ci95 = Some([Some(0.0), interval[1]]);
-            widened.push(format!(
-                "{key} (kept) or {} ({})",
-                a.parameter, a.alternative
-            ));
+        for key in reported_keys(effect) {
+            if why.contains_key(key) {
+                continue;
+            }
+            let Some(u) = uncertainty.get_mut(key) else {
+                continue;
+            };
+            let Some(interval) = u.interval() else {
+                continue;
+            };
+            a.kept_ci95_if_present.get_or_insert(interval);
+            // measured present by a direct count: the look-alike may be there beside it
+            if interval[0] != Some(0.0) && !measured.contains(&key) {
+                u.ci95 = Some([Some(0.0), interval[1]]);
+                widened.push(format!(
+                    "{key} (kept) or {} ({})",
+                    a.parameter, a.alternative
+                ));
+            }
         }
     }
     (!widened.is_empty()).then(|| {
@@ -102,6 +105,16 @@ pub fn reach_zero_where_not_separated(
             widened.join("; ")
         )
     })
+}
+
+/// The reported parameters that size `effect`: its searched one, and a leak's growth with
+/// the light beside it.
+fn reported_keys(effect: Effect) -> Vec<&'static str> {
+    let mut keys: Vec<&'static str> = effect.parameter().into_iter().collect();
+    if effect == Effect::Leak {
+        keys.push("leak_rate_hz_per_dn");
+    }
+    keys
 }
 
 const REFRACTORY_OR_BANDWIDTH: &str = "a refractory period drops events of fast changes at every brightness, a slow photoreceptor only in dim light: the same motion recorded at another brightness separates them";

@@ -495,6 +495,11 @@ fn undetermined(
             state.uncertainty.remove("leak_rate_hz");
         }
     }
+    assumptions.extend(super::leak_report::growth(
+        state,
+        from.leak_growth,
+        &mut not_identified,
+    ));
     for (key, why) in from.noise.undetermined {
         not_identified.entry(key).or_insert(why);
     }
@@ -515,11 +520,6 @@ fn undetermined(
         ambiguities,
         (&not_identified, from.noise.measured),
     ));
-    assumptions.extend(super::leak_report::growth(
-        state,
-        from.leak_growth,
-        &mut not_identified,
-    ));
     for k in ["ct_on", "ct_off"] {
         if not_identified.contains_key(k) {
             state.uncertainty.remove(k);
@@ -538,7 +538,7 @@ pub const UNMEASURED_SPAN: f64 = 50.0;
 /// below, to open above: no effect and as much as the search allowed both explain the
 /// recording within chance, as for draw 6029's shot noise, [0, open] beside a value of
 /// 1.86 Hz where the draw has none). An interval with one side bounded is a bound, kept.
-fn unmeasured(u: &Uncertain) -> Option<String> {
+pub(super) fn unmeasured(u: &Uncertain) -> Option<String> {
     match u.ci95? {
         [Some(lo), Some(hi)] if lo > 0.0 && hi / lo > UNMEASURED_SPAN => Some(format!(
             "its 95 % interval, {lo:.4e} to {hi:.4e}, spans more than a factor {UNMEASURED_SPAN:.0}: the fit error changes by no more than chance over that range, so the recording does not measure it (the model keeps the effect at {:.4e})",

@@ -48,52 +48,70 @@ pub fn check(
     Some((note, still.unmeasured(rate)))
 }
 
+/// `leak_rate_hz_per_dn`: the leak's growth with the light.
+const GROWTH_KEY: &str = "leak_rate_hz_per_dn";
+
 /// The leak's growth with the light in the report, where the final model's leak has one
-/// (the search held the event timing's growth, [`LeakGrowth`]): `leak_rate_hz_per_dn`
-/// takes the interval of the searched dark part scaled by the growth, widened by the
-/// growth's own bootstrap error (in the logarithm, in quadrature), and the dark part's own
-/// interval is widened by what that error moves between the parts. Where the dark part is
-/// not identified, neither is the growth (the same reason); where the floor held the dark
-/// part ([`DARK_SHARE_FLOOR`]) the dark part is not a measurement. Returns the assumption.
+/// (the search held the event timing's growth, [`LeakGrowth`]). The search measured the
+/// leak's scale, which pins the leak near the frames' median DN; the ratio it held has its
+/// own error `e` (relative), which at that leak moves the dark part by `e` times the
+/// light's share and the growth by `e` times the dark part's (in the logarithm). So
+/// `leak_rate_hz_per_dn` takes the searched dark part's interval scaled by the ratio and
+/// widened by the second, the dark part's widened by the first (in quadrature); either is
+/// then not identified if it spans more than [`super::finish::UNMEASURED_SPAN`]. Where
+/// the dark part is not identified otherwise, neither is the growth (the same reason);
+/// where the floor held the dark part ([`DARK_SHARE_FLOOR`]) the dark part alone is not a
+/// measurement (the growth, which then carries nearly all the leak, keeps its interval).
+/// Returns the assumption.
 pub fn growth(
     state: &mut State,
     growth: Option<LeakGrowth>,
     not_identified: &mut BTreeMap<String, String>,
 ) -> Option<String> {
-    const GROWTH_KEY: &str = "leak_rate_hz_per_dn";
-    let per_dn = state
-        .model
-        .params
-        .leak_rate_hz_per_dn
-        .filter(|&g| g > 0.0)?;
-    let dark = state.model.params.leak_rate_hz.filter(|&r| r > 0.0)?;
+    let params = &state.model.params;
+    let per_dn = params.leak_rate_hz_per_dn.filter(|&g| g > 0.0)?;
+    let dark = params.leak_rate_hz.filter(|&r| r > 0.0)?;
     let g = growth?;
     if let Some(why) = not_identified.get("leak_rate_hz").cloned() {
         not_identified.insert(GROWTH_KEY.into(), why);
     } else if let Some(u) = state.uncertainty.get("leak_rate_hz").cloned() {
-        let light_share = 1.0 - g.dark_share();
-        let split = g.relative_error * light_share / g.dark_share();
-        state
-            .uncertainty
-            .insert(GROWTH_KEY.into(), widened(&u, per_dn, g.relative_error));
-        state
-            .uncertainty
-            .insert("leak_rate_hz".into(), widened(&u, dark, split));
+        let e = g.ratio_relative_error;
+        for (key, value, moved) in [
+            (GROWTH_KEY, per_dn, e * g.dark_share()),
+            ("leak_rate_hz", dark, e * (1.0 - g.dark_share())),
+        ] {
+            let w = widened(&u, value, moved);
+            match super::finish::unmeasured(&w) {
+                Some(why) => {
+                    not_identified.insert(key.into(), why);
+                    state.uncertainty.remove(key);
+                }
+                None => {
+                    state.uncertainty.insert(key.into(), w);
+                }
+            }
+        }
     }
     if g.dark_floored {
-        not_identified.entry("leak_rate_hz".into()).or_insert(format!(
-            "the event timing reads the leak as growing with the light alone (its dark part at or below zero within its error): the dark part was held at {DARK_SHARE_FLOOR} of the leak at the frames' median DN, a floor, not a measurement"
-        ));
+        let why = format!(
+            "the event timing's drift at DN 0 is below {DARK_SHARE_FLOOR} of its drift at the frames' median DN ({:.0} DN): the dark part was held at that share of the leak there, a floor, not a measurement",
+            g.median_dn
+        );
+        not_identified
+            .entry("leak_rate_hz".into())
+            .and_modify(|w| *w = format!("{w}; and {why}"))
+            .or_insert(why);
         state.uncertainty.remove("leak_rate_hz");
     }
     Some(format!(
-        "the leak grows with the light as the event timing's drift measured it: leak_rate_hz_per_dn / leak_rate_hz = {:.4} per DN ({} DN median), held while the search scaled the leak; its own error ({:.0} %) widens both parts' intervals{}",
+        "the leak grows with the light as the event timing's drift measured it: leak_rate_hz_per_dn / leak_rate_hz = {:.4} per DN ({:.0} % of the leak at the frames' median, {:.0} DN, is the dark part), held while the search scaled the leak; the ratio's error ({:.0} %) widens both parts' intervals{}",
         g.per_dn_over_dark,
-        g.median_dn.round(),
-        100.0 * g.relative_error,
+        100.0 * g.dark_share(),
+        g.median_dn,
+        100.0 * g.ratio_relative_error,
         if g.dark_floored {
             format!(
-                "; the dark part was held at {DARK_SHARE_FLOOR} of the rate at the median DN, where the timing read none"
+                "; the dark part was held at {DARK_SHARE_FLOOR} of the leak at the median DN, a floor: the timing's drift at DN 0 was below that share"
             )
         } else {
             String::new()
