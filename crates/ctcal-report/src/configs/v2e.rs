@@ -50,8 +50,11 @@ fn notes(p: &PixelParams, setup: &Setup) -> Vec<String> {
     }
     if let Some(g) = p.leak_rate_hz_per_dn.filter(|&g| g > 0.0) {
         let dark = match p.leak_rate_hz {
-            Some(r) => format!("--leak_rate_hz is its dark part ({r:.4} Hz)"),
-            None => "its dark part is not identified, so --leak_rate_hz is 0".into(),
+            Some(r) => format!("{} is its dark part ({r:.4} Hz)", flag("leak_rate_hz")),
+            None => format!(
+                "its dark part is not identified, so {} is 0",
+                flag("leak_rate_hz")
+            ),
         };
         notes.push(format!(
             "v2e's leak does not grow with the light: {dark}; the fitted growth, {g:.3e} Hz per DN ({:.3} Hz more at 128 DN), is not in these arguments (ctcal simulate has it)",

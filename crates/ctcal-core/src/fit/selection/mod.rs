@@ -914,21 +914,35 @@ fn within_count(
 /// own), shot noise's within the quiet count ([`search_range`], [`within_count`]).
 fn search_counted(
     simulation: &Simulation,
-    (params, effect, range): (&PixelParams, Effect, (f64, f64)),
+    searched: (&PixelParams, Effect, (f64, f64)),
     state: &State,
     known: Known,
     (fixed, noise): (bool, f64),
 ) -> Result<super::search::Searched, FitError> {
+    search_shaped(simulation, searched, state, known, (fixed, false), noise)
+}
+
+/// [`search_profiled`](super::search::search_profiled) of `effect` from `params` over
+/// `range`, a leak shaped by its growth with the light ([`shaped_for_search`]) and shot
+/// noise kept within the quiet count ([`search_range`], [`within_count`]); with `mismatch`
+/// the threshold mismatch profiled at every point.
+fn search_shaped(
+    simulation: &Simulation,
+    (params, effect, range): (&PixelParams, Effect, (f64, f64)),
+    state: &State,
+    known: Known,
+    (fixed, mismatch): (bool, bool),
+    noise: f64,
+) -> Result<super::search::Searched, FitError> {
     let (params, range) = shaped_for_search(effect, params, range, known);
     let (range, counted) = search_range(effect, range, known, simulation.geometry, &params);
-    let searched = super::search::search(
+    let searched = super::search::search_profiled(
         simulation,
         &params,
         effect,
         range,
-        &state.masked,
-        &state.kept,
-        fixed,
+        (&state.masked, &state.kept),
+        (fixed, mismatch),
         noise,
     )?;
     Ok(within_count(searched, counted))

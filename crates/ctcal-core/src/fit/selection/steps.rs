@@ -7,10 +7,10 @@ use super::super::effects::leak::StillBalance;
 use super::super::effects::{self, Effect, hot_pixels::HotTrain};
 use super::super::observe::Subset;
 use super::super::residuals::residuals;
-use super::super::search::{Searched, Simulated, Simulation, search, search_profiled};
+use super::super::search::{Searched, Simulated, Simulation, search};
 use super::super::{FitError, Step, StepResiduals, Uncertain};
 use super::keep::{Verdict, by_signature, by_still_pixels, judge};
-use super::{Known, LoopRun, State, judging_evidence, search_counted, search_range, within_count};
+use super::{Known, LoopRun, State, judging_evidence, search_counted};
 use crate::stats::hot_pixels::HotPixel;
 use std::collections::BTreeMap;
 
@@ -199,19 +199,14 @@ fn search_from(
     start: f64,
     run: &LoopRun,
 ) -> Result<crate::fit::search::Searched, FitError> {
-    let (base, range) =
-        super::shaped_for_search(effect, &state.model.params, effect.range(start), run.known);
-    let (range, counted) = search_range(effect, range, run.known, simulation.geometry, &base);
-    let searched = search_profiled(
+    super::search_shaped(
         simulation,
-        &base,
-        effect,
-        range,
-        (&state.masked, &state.kept),
+        (&state.model.params, effect, effect.range(start)),
+        state,
+        run.known,
         (run.fixed, effect.searched_with_mismatch()),
         run.noise,
-    )?;
-    Ok(within_count(searched, counted))
+    )
 }
 
 /// A searched effect judged on the selection blocks and recorded (kept into `state` where
