@@ -36,10 +36,13 @@ fn disagreement(fitted: &Uncertain, start: (f64, Interval)) -> Option<f64> {
 
 /// Widens the thresholds' intervals to span the start's where the fit and the start
 /// disagree (beyond 1.96 standard errors of their log ratio, for either polarity: one cause
-/// acts on both); returns the assumption that says so, with the sizes.
+/// acts on both); returns the assumption that says so, with the sizes. `what` names the
+/// start's measurement in the assumption (the start's thresholds, or its event timing's).
+/// A start value that is not a positive number spans nothing.
 pub fn reconcile(
     uncertainty: &mut BTreeMap<String, Uncertain>,
     start: &Measured,
+    what: &str,
 ) -> Option<String> {
     let keys = ["ct_on", "ct_off"];
     let z: Vec<Option<f64>> = keys
@@ -57,6 +60,9 @@ pub fn reconcile(
         let Some(u) = uncertainty.get_mut(*key) else {
             continue;
         };
+        if !(value.is_finite() && *value > 0.0) {
+            continue;
+        }
         let Some([Some(lo), Some(hi)]) = u.interval() else {
             continue;
         };
@@ -75,7 +81,7 @@ pub fn reconcile(
         ));
     }
     Some(format!(
-        "the fitted thresholds ({}) and the start's event timing disagree by {worst:.1} standard errors of their log ratio: an effect neither models (frames blurred by motion, optical flow failing between frames far apart, noise the frames carry) biases one of them and these data do not say which, so each threshold's 95 % interval spans both methods' intervals ({}); the standard errors given are the fit's alone",
+        "the fitted thresholds ({}) and {what} disagree by {worst:.1} standard errors of their log ratio: an effect neither models (frames blurred by motion, optical flow failing between frames far apart, noise the frames carry, events lost or added where the counts are matched) biases one of them and these data do not say which, so each threshold's 95 % interval spans both methods' intervals ({}); the standard errors given are the fit's alone",
         fitted.join(", "),
         spans.join(", ")
     ))
@@ -158,7 +164,8 @@ mod tests {
             (0.2759, [Some(0.2174), Some(0.3345)]),
             (0.1310, [Some(0.1234), Some(0.1386)]),
         ];
-        let note = reconcile(&mut u, &start).expect("OFF disagrees by about 5 standard errors");
+        let note = reconcile(&mut u, &start, "the start's event timing")
+            .expect("OFF disagrees by about 5 standard errors");
         assert!(note.contains("disagree by 4.8 standard errors"), "{note}");
         assert_eq!(u["ct_on"].ci95, Some([Some(0.1944), Some(0.3345)]));
         assert_eq!(u["ct_off"].ci95, Some([Some(0.1015), Some(0.1386)]));
@@ -184,10 +191,50 @@ mod tests {
             (0.236, [Some(0.230), Some(0.242)]),
             (0.370, [Some(0.351), Some(0.390)]),
         ];
-        assert_eq!(reconcile(&mut u, &start), None);
+        assert_eq!(reconcile(&mut u, &start, "the start"), None);
         assert_eq!(u, before);
         // an open side of the start's interval measures no disagreement
         let open = [(0.5, [Some(0.4), None]), (0.9, [None, Some(1.0)])];
-        assert_eq!(reconcile(&mut u, &open), None);
+        assert_eq!(reconcile(&mut u, &open, "the start"), None);
+    }
+
+    /// Coverage draw 13034 (ESIM at 20 DN, thresholds 0.191 / 0.567 redrawn every sample
+    /// interval with a spread of 0.080: a draw below the change already gained strands the
+    /// pixel, so ESIM loses events and the count fit reads ON 0.313). `estimate aps` reported
+    /// no thresholds, but its event timing read ON 0.152 [0.139, 0.165], OFF 0.537
+    /// [0.457, 0.616] (on the whole recording): the fit's interval reaches it, and the truth.
+    #[test]
+    fn count_thresholds_far_from_the_event_timing_span_it() {
+        let mut u = BTreeMap::from([
+            ("ct_on".to_string(), fitted(0.3126, 0.2213, 0.4416)),
+            ("ct_off".to_string(), fitted(0.9070, 0.4385, 1.7549)),
+        ]);
+        let timing = [
+            (0.152, [Some(0.139), Some(0.165)]),
+            (0.537, [Some(0.457), Some(0.616)]),
+        ];
+        let note = reconcile(&mut u, &timing, "the start's event timing").expect("ON disagrees");
+        assert!(note.contains("ON 0.3126 (start 0.1520)"), "{note}");
+        assert_eq!(u["ct_on"].ci95, Some([Some(0.139), Some(0.4416)]));
+        assert_eq!(u["ct_off"].ci95, Some([Some(0.4385), Some(1.7549)]));
+        let [lo, hi] = u["ct_on"].ci95.unwrap();
+        assert!(lo.unwrap() <= 0.191 && 0.191 <= hi.unwrap());
+    }
+
+    /// A start value that is not a positive number (an event timing that failed) measures
+    /// no disagreement and spans nothing, though the other polarity's does.
+    #[test]
+    fn a_start_value_that_is_not_positive_spans_nothing() {
+        let mut u = BTreeMap::from([
+            ("ct_on".to_string(), fitted(0.3126, 0.2213, 0.4416)),
+            ("ct_off".to_string(), fitted(0.9070, 0.4385, 1.7549)),
+        ]);
+        let timing = [
+            (0.152, [Some(0.139), Some(0.165)]),
+            (f64::NAN, [None, None]),
+        ];
+        let note = reconcile(&mut u, &timing, "the start's event timing").expect("ON disagrees");
+        assert!(!note.contains("NaN") && !note.contains("OFF"), "{note}");
+        assert_eq!(u["ct_off"].ci95, Some([Some(0.4385), Some(1.7549)]));
     }
 }

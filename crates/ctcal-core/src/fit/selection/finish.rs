@@ -136,6 +136,9 @@ pub struct Parts<'a> {
     pub fixed: bool,
     /// The starting thresholds as measured (the intervals widen where the fit disagrees).
     pub start: Option<super::agreement::Measured>,
+    /// The start's event timing's thresholds, whether or not the start reported a value
+    /// (the intervals widen where the fit disagrees with them too).
+    pub timing: Option<super::agreement::Measured>,
     /// What the fit run told before any effect was tried (the threshold spread event
     /// timing measures, the timestamp grid, the shortest same-pixel interval).
     pub known: super::Known,
@@ -228,6 +231,7 @@ fn intervals(simulation: &Simulation, state: &mut State, parts: &mut Parts) -> W
         interpolation_share: parts.interpolation_share,
         other_response: parts.other_response.as_ref(),
         start: parts.start.as_ref(),
+        timing: parts.timing.as_ref(),
     };
     let assumptions = &mut parts.assumptions;
     assumptions.extend(threshold_intervals(simulation, state, widening));
@@ -304,6 +308,7 @@ struct Widening<'a> {
     interpolation_share: Option<[f64; 2]>,
     other_response: Option<&'a crate::estimate::timing::OtherResponse>,
     start: Option<&'a super::agreement::Measured>,
+    timing: Option<&'a super::agreement::Measured>,
 }
 
 /// The thresholds' intervals: their standard errors on the fit blocks, widened by the
@@ -331,7 +336,22 @@ fn threshold_intervals(
         assumptions.push(note);
     }
     if let Some(start) = widening.start
-        && let Some(note) = super::agreement::reconcile(&mut state.uncertainty, start)
+        && let Some(note) =
+            super::agreement::reconcile(&mut state.uncertainty, start, "the start's thresholds")
+    {
+        assumptions.push(note);
+    }
+    if let Some(timing) = widening.timing
+        && widening.start != Some(timing)
+        && let Some(note) = super::agreement::reconcile(
+            &mut state.uncertainty,
+            timing,
+            if widening.start.is_some() {
+                "the start's event timing (the log change between a pixel's consecutive events, read from the frames; the start's thresholds differ from it)"
+            } else {
+                "the start's event timing (the log change between a pixel's consecutive events, read from the frames; `estimate aps` on the fit run computed it but reported no thresholds)"
+            },
+        )
     {
         assumptions.push(note);
     }

@@ -198,6 +198,7 @@ fn fit_with_frames(
         assumptions,
         fixed: ideal.fixed,
         start: start.measured,
+        timing: start.timing,
         known: loop_run.known,
         interpolation_share: start.interpolation_share,
         other_response,

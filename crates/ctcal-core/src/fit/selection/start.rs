@@ -59,6 +59,9 @@ pub struct Start {
     /// The thresholds as `estimate aps` measured them, with their intervals (none for a
     /// start value).
     pub measured: Option<super::agreement::Measured>,
+    /// The thresholds as the start's event timing measured them, where `estimate aps`
+    /// computed it, whether or not aps reported a value ([`event_timing`]).
+    pub timing: Option<super::agreement::Measured>,
     /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
     /// miss ([`aps::ApsResult::interpolation_share`]; none for a start value).
     pub interpolation_share: Option<[f64; 2]>,
@@ -104,6 +107,7 @@ pub fn thresholds(
         fixed,
         mismatch: None,
         measured: None,
+        timing: None,
         interpolation_share: None,
         frame_offset_dn: None,
         leak_drift: None,
@@ -134,16 +138,20 @@ pub fn thresholds(
                 interpolation_share: Some(share),
                 frame_offset_dn: Some(offset),
                 leak_drift: Some(crate::fit::effects::leak::TimingDrift::of(&drift, on)),
+                timing: event_timing(&e),
                 ..measured(&e, on, off)
             },
-            None => fallback(
-                format!(
-                    "estimate aps on the fit run determined no thresholds: {}",
-                    reasons_once(&e.why)
-                ),
-                "fitted to the counts from there".into(),
-                false,
-            ),
+            None => Start {
+                timing: event_timing(&e),
+                ..fallback(
+                    format!(
+                        "estimate aps on the fit run determined no thresholds: {}",
+                        reasons_once(&e.why)
+                    ),
+                    "fitted to the counts from there".into(),
+                    false,
+                )
+            },
         },
         Err(error) => fallback(
             format!("estimate aps on the fit run: {}", error.problem),
@@ -170,6 +178,23 @@ fn reasons_once(why: &BTreeMap<String, String>) -> String {
         .join("; ")
 }
 
+/// The thresholds (value, 95 % interval) of the event timing among `e`'s estimators: the
+/// log change between a pixel's consecutive events read from the frames, which counts no
+/// events, so that an effect that loses or adds events (ESIM's threshold redrawn per
+/// sample interval strands pixels on a ramp; a random walk of the reference) leaves it
+/// where the count-matched thresholds move. aps may report no value of its own (its
+/// re-simulation check failing) and still have this one.
+fn event_timing(e: &CtEstimate) -> Option<super::agreement::Measured> {
+    let timing = e.estimators.iter().find(|r| r.name == "event_timing")?;
+    // a side that is not a positive number bounds nothing (as an open side)
+    let bound = |v: f64| (v.is_finite() && v > 0.0).then_some(v);
+    let side = |m: &crate::estimate::interval::Measured| match bound(m.value) {
+        Some(value) => (value, [bound(m.ci95[0]), bound(m.ci95[1])]),
+        None => (m.value, [None, None]),
+    };
+    Some([side(&timing.ct_on), side(&timing.ct_off)])
+}
+
 fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
     let ci = |c: Option<Interval>| {
         let [lo, hi] = c.unwrap_or([None, None]);
@@ -184,6 +209,7 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
             (on, e.ct_on_ci95.unwrap_or([None, None])),
             (off, e.ct_off_ci95.unwrap_or([None, None])),
         ]),
+        timing: None,
         interpolation_share: None,
         frame_offset_dn: None,
         leak_drift: None,
