@@ -30,13 +30,14 @@ const THRESHOLDS: [&str; 3] = ["ct_on", "ct_off", "ct_sigma"];
 
 /// The parameters the fit reports (the PARAMS.toml keys the study has truth for), and
 /// [`CUTOFF_LIMIT`].
-const FITTED: [&str; 11] = [
+const FITTED: [&str; 12] = [
     "ct_on",
     "ct_off",
     "ct_sigma",
     "cutoff_hz",
     CUTOFF_LIMIT,
     "leak_rate_hz",
+    "leak_rate_hz_per_dn",
     "shot_noise_rate_hz",
     "refractory_s",
     "timestamp_jitter_s",
@@ -113,7 +114,7 @@ pub fn effect_of(parameter: &str) -> Option<&'static str> {
     Some(match parameter {
         "ct_sigma" => "mismatch",
         "cutoff_hz" | CUTOFF_LIMIT => "bandwidth",
-        "leak_rate_hz" => "leak",
+        "leak_rate_hz" | "leak_rate_hz_per_dn" => "leak",
         "shot_noise_rate_hz" => "shot_noise",
         "refractory_s" => "refractory",
         "timestamp_jitter_s" => "timestamp_jitter",

@@ -71,6 +71,7 @@ pub fn true_values(params: &PixelParams) -> BTreeMap<String, f64> {
     put("ct_sigma", params.ct_sigma.unwrap_or(0.0));
     put("refractory_s", params.refractory_s());
     put("leak_rate_hz", params.leak_rate_hz());
+    put("leak_rate_hz_per_dn", params.leak_rate_hz_per_dn());
     put("shot_noise_rate_hz", params.shot_noise_rate_hz());
     put(
         "timestamp_jitter_s",
@@ -87,11 +88,13 @@ pub fn true_values(params: &PixelParams) -> BTreeMap<String, f64> {
     values
 }
 
-/// The effects and scored values of a peer's case. Only the thresholds are scored: the
+/// The effects and scored values of a peer's case: the thresholds, and a leak's two parts
+/// (DVS-Voltmeter's drift `k4 + k5 L` is ctcal's `leak_rate_hz` and `leak_rate_hz_per_dn`
+/// in ON events a second, its thresholds being 1 V; 0 for the peers without a leak). The
 /// peers' threshold noise (redrawn per interval or per event), refractory period (changes
-/// dropped, not delayed), leak (brightness dependent) and noise (diffusion, measured
-/// distributions) are not the parameters ctcal's fit reports, so their values are listed
-/// as effects for the breakdown, not scored.
+/// dropped, not delayed) and noise (diffusion, measured distributions) are not the
+/// parameters ctcal's fit reports, so they are listed as effects for the breakdown, not
+/// scored.
 fn peer_truth(peer: &Peer) -> (Vec<String>, BTreeMap<String, f64>) {
     let truth = peer.truth().expect("a case's peer reads no noise files");
     let effects = [
@@ -115,10 +118,15 @@ fn peer_truth(peer: &Peer) -> (Vec<String>, BTreeMap<String, f64>) {
     .filter(|(_, present)| *present)
     .map(|(name, _)| name.to_string())
     .collect();
-    let values = [("ct_on", truth.ct_on), ("ct_off", truth.ct_off)]
-        .into_iter()
-        .map(|(k, v)| (k.to_string(), v))
-        .collect();
+    let values = [
+        ("ct_on", truth.ct_on),
+        ("ct_off", truth.ct_off),
+        ("leak_rate_hz", truth.leak.on_rate_hz),
+        ("leak_rate_hz_per_dn", truth.leak.on_rate_hz_per_dn),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), v))
+    .collect();
     (effects, values)
 }
 
@@ -156,5 +164,36 @@ impl Truth {
 
     pub fn has_effect(&self, effect: &str) -> bool {
         self.effects.iter().any(|e| e == effect)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::coverage::Generator;
+    use crate::coverage::method::Method;
+    use crate::coverage::record::{Outcome, RunRecord};
+    use crate::coverage::summary::score::in_population;
+
+    /// A DVS-Voltmeter draw's leak is scored in ctcal's units: its drift `k4 + k5 L` in
+    /// volts per microsecond against thresholds of 1 V is `k4 * 1e6` ON events a second in
+    /// the dark and `k5 * 1e6` more per DN; a ctcal draw without a growing leak has 0.
+    #[test]
+    fn a_voltmeter_leak_is_scored_as_its_two_parts() {
+        let case = CaseSpec::draw_from(13014, &[Generator::Voltmeter]);
+        let Some(Peer::Voltmeter(peer)) = &case.peer else {
+            panic!("a DVS-Voltmeter draw: {:?}", case.peer);
+        };
+        let truth = Truth::of(&case);
+        assert_eq!(truth.value("leak_rate_hz"), Some(peer.k[3] * 1e6));
+        assert_eq!(truth.value("leak_rate_hz_per_dn"), Some(peer.k[4] * 1e6));
+        assert!(truth.value("leak_rate_hz_per_dn").unwrap() > 0.0);
+        let outcome = Outcome::Ok {
+            output: Some(serde_json::json!({"params": {}})),
+        };
+        let record = RunRecord::new(case, Some(truth), Method::Fit, 1.0, outcome);
+        assert!(in_population(&record, "leak_rate_hz_per_dn"));
+        let ctcal = Truth::of(&CaseSpec::draw(13014));
+        assert_eq!(ctcal.value("leak_rate_hz_per_dn"), Some(0.0));
     }
 }
