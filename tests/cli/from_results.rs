@@ -12,7 +12,7 @@ fn results(dir: &Path) -> Value {
 }
 
 /// The results without what differs between runs (the command line, the stage timings).
-fn comparable(dir: &Path) -> Value {
+pub(crate) fn comparable(dir: &Path) -> Value {
     let mut r = results(dir);
     r.as_object_mut().unwrap().remove("command_line");
     for s in r["sequences"].as_array_mut().unwrap() {

@@ -847,6 +847,11 @@ fn the_committed_sample_report_is_what_ctcal_makes_today() {
             .join("\n")
     };
     assert_eq!(body(&committed), body(fresh));
+    // every number and reason of the results, but for the command line and the timings
+    assert!(
+        crate::from_results::comparable(&committed) == crate::from_results::comparable(fresh),
+        "reports/sample/results.json differs: run `cargo run --release -- report data_samples --out reports/sample`"
+    );
     // the PNG plots are all there (rendering is checked in the browser test)
     for file in files(fresh).iter().filter(|f| f.ends_with(".png")) {
         assert!(committed.join(file).is_file(), "{file} in reports/sample");
