@@ -347,6 +347,7 @@ impl StatsAccumulator {
             &self.kept,
             &settings,
             &mut self.pixels.cells,
+            &mut self.pixels.neighbours_last,
             &mut self.intervals,
             &mut self.windows,
         );
@@ -759,6 +760,33 @@ mod tests {
             "{background}"
         );
         assert_eq!(s.support_window_s, 0.01);
+    }
+
+    /// Support across a grid that grows (no sensor size given): pixels (63, 0) and (1, 63)
+    /// fire while the grid is 64 x 64, so their neighbours (64, 0) and (1, 64) are border
+    /// cells; the grid then grows over them, and their events 1 ms later are supported.
+    #[test]
+    fn support_holds_across_a_grid_that_grows_over_the_border() {
+        let mut acc = StatsAccumulator::new(StatsOptions::default(), None);
+        let first = [event(0, 0, 5), event(100, 63, 0), event(200, 1, 63)];
+        acc.add(&first.into_iter().collect());
+        assert_eq!((acc.pixels.width, acc.pixels.height), (64, 64));
+        let then = [
+            event(1_100, 64, 0),
+            event(1_200, 1, 64),
+            event(100_000, 0, 5),
+        ];
+        acc.add(&then.into_iter().collect());
+        assert!(acc.pixels.width > 64 && acc.pixels.height > 64);
+        let s = acc.finish(Sensor::new(65, 65), "test", &[]).unwrap();
+        // unsupported: (0, 5) twice (alone, and 100 ms after itself), (63, 0) and (1, 63)
+        // (nothing near them had fired); the two after the growth are supported: 4 over
+        // 4225 pixels and 0.1 s
+        let background = s.background_rate_hz.unwrap();
+        assert!(
+            (background - 4.0 / (4225.0 * 0.1)).abs() < 1e-12,
+            "{background}"
+        );
     }
 
     #[test]

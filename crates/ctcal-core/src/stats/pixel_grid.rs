@@ -1,7 +1,10 @@
 //! Per-pixel running state of the statistics pass: last event time, count and the count of
 //! events without spatio-temporal support, together in one 16-byte cell so that each event
-//! touches one cache line of its own row. The grid has a one-pixel border of cells that
-//! never fire, so that the 8 neighbours of any pixel can be read without bounds checks.
+//! touches one cache line of its own row; beside the cells, the newest event among each
+//! cell's neighbours (8 bytes a cell), which each event writes into its 8 neighbours so
+//! that its own support is one read. The grid has a one-cell border of cells that never
+//! fire (they are written, and kept when the grid grows over them), so that the 8
+//! neighbours of any pixel are reached without bounds checks.
 //! It grows when the sensor size is not known in advance (it is inferred from the
 //! coordinates at the end); readers bound coordinates by `MAX_SENSOR_SIDE`, and so is the
 //! grid. A sensor given larger than [`PIXEL_BUDGET`] pixels is not allocated up front
@@ -12,11 +15,12 @@ use crate::events::{MAX_SENSOR_SIDE, TimeUs};
 
 /// Pixels of per-pixel state the statistics (and the estimators) keep without being told
 /// otherwise: 4096 x 4096, the largest sensor ctcal accepts from a file (more than any
-/// sensor sold), about [`BYTES_PER_PIXEL`] bytes each (0.5 GB).
+/// sensor sold), about [`BYTES_PER_PIXEL`] bytes each (0.7 GB).
 pub const PIXEL_BUDGET: usize = MAX_SENSOR_SIDE as usize * MAX_SENSOR_SIDE as usize;
 
-/// Bytes per pixel of the statistics pass: the 16-byte cell and the maps of its final step.
-pub const BYTES_PER_PIXEL: usize = 32;
+/// Bytes per pixel of the statistics pass: the 16-byte cell, the neighbours' newest event
+/// (8 bytes) and the maps of its final step.
+pub const BYTES_PER_PIXEL: usize = 40;
 
 /// One pixel's running state.
 #[derive(Clone, Copy, Debug)]
@@ -45,6 +49,11 @@ pub struct PixelGrid {
     pub width: usize,
     pub height: usize,
     pub cells: Vec<PixelCell>,
+    /// Per cell, the time of the last event of any of its 8 neighbours (`TimeUs::MIN`
+    /// before the first): each event writes it into its neighbours, so that an event's
+    /// support is read from its own cell (the newest neighbour, events arriving in time
+    /// order). Apart from the cells, so that the eight writes touch 8 bytes a cell.
+    pub neighbours_last: Vec<TimeUs>,
 }
 
 impl PixelGrid {
@@ -53,6 +62,7 @@ impl PixelGrid {
             width,
             height,
             cells: vec![PixelCell::default(); (width + 2) * (height + 2)],
+            neighbours_last: vec![TimeUs::MIN; (width + 2) * (height + 2)],
         }
     }
 
@@ -103,10 +113,16 @@ impl PixelGrid {
             height = need_h.max(self.height);
         }
         let mut grown = Self::new(width, height);
-        for y in 0..self.height {
-            let from = (y + 1) * self.stride() + 1;
-            let to = (y + 1) * grown.stride() + 1;
-            grown.cells[to..to + self.width].copy_from_slice(&self.cells[from..from + self.width]);
+        // the border too: a border cell holds the newest event of the pixels beside it,
+        // and becomes a pixel of the grown grid
+        if !self.cells.is_empty() {
+            let stride = self.stride();
+            for y in 0..self.height + 2 {
+                let (from, to) = (y * stride, y * grown.stride());
+                grown.cells[to..to + stride].copy_from_slice(&self.cells[from..from + stride]);
+                grown.neighbours_last[to..to + stride]
+                    .copy_from_slice(&self.neighbours_last[from..from + stride]);
+            }
         }
         *self = grown;
     }
