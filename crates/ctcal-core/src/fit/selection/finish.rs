@@ -347,7 +347,7 @@ fn threshold_intervals(
             &mut state.uncertainty,
             timing,
             if widening.start.is_some() {
-                "the start's event timing (the log change between a pixel's consecutive events, read from the frames; the start's thresholds differ from it)"
+                "the start's event timing on its own (the log change between a pixel's consecutive events, read from the frames; the start's thresholds, with their interval, are not it alone)"
             } else {
                 "the start's event timing (the log change between a pixel's consecutive events, read from the frames; `estimate aps` on the fit run computed it but reported no thresholds)"
             },
