@@ -12,7 +12,7 @@
 //! compiler cannot prove apart from the histogram's bins is stored back every event).
 
 use super::intervals::IntervalHistogram;
-use super::pixel_grid::PixelCell;
+use super::pixel_grid::PixelGrid;
 use super::timeline::SparseTimeline;
 use crate::events::TimeUs;
 
@@ -89,7 +89,7 @@ fn tell_neighbours(neighbours_last: &mut [TimeUs], k: usize, stride: usize, t: T
     here[2] = t;
 }
 
-/// Adds the events at `ts` with cell `indices` to `cells`, `intervals` and `windows`.
+/// Adds the events at `ts` with cell `indices` to `grid`, `intervals` and `windows`.
 /// With `SELECTED`, intervals and the timeline count only the events `kept` flags (every
 /// event still updates its pixel, so that support sees every neighbour).
 #[inline(never)]
@@ -98,8 +98,7 @@ pub(super) fn accumulate<const SELECTED: bool>(
     indices: &[u32],
     kept: &[bool],
     settings: &Settings,
-    cells: &mut [PixelCell],
-    neighbours_last: &mut [TimeUs],
+    grid: &mut PixelGrid,
     intervals: &mut IntervalHistogram,
     windows: &mut WindowCounter,
 ) {
@@ -111,6 +110,11 @@ pub(super) fn accumulate<const SELECTED: bool>(
     const AHEAD: usize = 16;
     // the addresses to prefetch are computed, not indexed: with six bounds checks an
     // event the kernel took 15-25 % longer
+    let PixelGrid {
+        cells,
+        neighbours_last,
+        ..
+    } = grid;
     let base = cells.as_ptr();
     let told = neighbours_last.as_ptr();
     for (i, (&t, &k)) in ts.iter().zip(indices).enumerate() {

@@ -346,8 +346,7 @@ impl StatsAccumulator {
             &self.indices,
             &self.kept,
             &settings,
-            &mut self.pixels.cells,
-            &mut self.pixels.neighbours_last,
+            &mut self.pixels,
             &mut self.intervals,
             &mut self.windows,
         );
