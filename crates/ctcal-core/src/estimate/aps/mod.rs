@@ -116,6 +116,10 @@ pub struct ApsResult {
     /// The memorised level's drift the event timing measured (leak's signature in the
     /// events' timing: ON events early, OFF events late).
     pub leak_drift: super::timing::Drift,
+    /// Whether each polarity's (ON, OFF) event-timing samples show no threshold peak above
+    /// the noise ([`super::timing::peak::Peak::stands_out`]): its events are mostly noise,
+    /// and its threshold is withheld.
+    pub noise_polarities: [bool; 2],
 }
 
 /// The fewest usable frame intervals the frame-based thresholds rest on.
@@ -362,6 +366,8 @@ impl FullPass {
             ],
             maps: full.timing.maps,
             frame_offset_dn: (frames.offset, frames.offset_range),
+            noise_polarities: [&full.timing.on, &full.timing.off]
+                .map(|p| p.peak.is_some_and(|peak| !peak.stands_out())),
             leak_drift: full.timing.drift,
         }
     }

@@ -37,12 +37,13 @@ fn disagreement(fitted: &Uncertain, start: (f64, Interval)) -> Option<f64> {
 /// Widens the thresholds' intervals to span the start's where the fit and the start
 /// disagree (beyond 1.96 standard errors of their log ratio, for either polarity: one cause
 /// acts on both); returns the assumption that says so, with the sizes. `what` names the
-/// start's measurement in the assumption (the start's thresholds, or its event timing's).
-/// A start value that is not a positive number spans nothing.
+/// start's measurement in the assumption (the start's thresholds, or its event timing's),
+/// `short` beside each value. A start value that is not a positive number spans nothing,
+/// nor does a fitted interval that is not closed, positive and finite.
 pub fn reconcile(
     uncertainty: &mut BTreeMap<String, Uncertain>,
     start: &Measured,
-    what: &str,
+    (short, what): (&str, &str),
 ) -> Option<String> {
     let keys = ["ct_on", "ct_off"];
     let z: Vec<Option<f64>> = keys
@@ -66,6 +67,9 @@ pub fn reconcile(
         let Some([Some(lo), Some(hi)]) = u.interval() else {
             continue;
         };
+        if !(lo > 0.0 && hi.is_finite()) {
+            continue;
+        }
         let [s_lo, s_hi] = *interval;
         let span = [
             Some(s_lo.map_or(lo, |s| s.min(lo))),
@@ -73,7 +77,7 @@ pub fn reconcile(
         ];
         u.ci95 = Some(span);
         let name = if *key == "ct_on" { "ON" } else { "OFF" };
-        fitted.push(format!("{name} {:.4} (start {value:.4})", u.value));
+        fitted.push(format!("{name} {:.4} ({short} {value:.4})", u.value));
         spans.push(format!(
             "{name} {:.4} .. {:.4}",
             span[0].unwrap_or(lo),
@@ -164,7 +168,7 @@ mod tests {
             (0.2759, [Some(0.2174), Some(0.3345)]),
             (0.1310, [Some(0.1234), Some(0.1386)]),
         ];
-        let note = reconcile(&mut u, &start, "the start's event timing")
+        let note = reconcile(&mut u, &start, ("start", "the start's event timing"))
             .expect("OFF disagrees by about 5 standard errors");
         assert!(note.contains("disagree by 4.8 standard errors"), "{note}");
         assert_eq!(u["ct_on"].ci95, Some([Some(0.1944), Some(0.3345)]));
@@ -191,11 +195,11 @@ mod tests {
             (0.236, [Some(0.230), Some(0.242)]),
             (0.370, [Some(0.351), Some(0.390)]),
         ];
-        assert_eq!(reconcile(&mut u, &start, "the start"), None);
+        assert_eq!(reconcile(&mut u, &start, ("start", "the start")), None);
         assert_eq!(u, before);
         // an open side of the start's interval measures no disagreement
         let open = [(0.5, [Some(0.4), None]), (0.9, [None, Some(1.0)])];
-        assert_eq!(reconcile(&mut u, &open, "the start"), None);
+        assert_eq!(reconcile(&mut u, &open, ("start", "the start")), None);
     }
 
     /// Coverage draw 13034 (ESIM at 20 DN, thresholds 0.191 / 0.567 redrawn every sample
@@ -213,8 +217,13 @@ mod tests {
             (0.152, [Some(0.139), Some(0.165)]),
             (0.537, [Some(0.457), Some(0.616)]),
         ];
-        let note = reconcile(&mut u, &timing, "the start's event timing").expect("ON disagrees");
-        assert!(note.contains("ON 0.3126 (start 0.1520)"), "{note}");
+        let note = reconcile(
+            &mut u,
+            &timing,
+            ("event timing", "the start's event timing"),
+        )
+        .expect("ON disagrees");
+        assert!(note.contains("ON 0.3126 (event timing 0.1520)"), "{note}");
         assert_eq!(u["ct_on"].ci95, Some([Some(0.139), Some(0.4416)]));
         assert_eq!(u["ct_off"].ci95, Some([Some(0.4385), Some(1.7549)]));
         let [lo, hi] = u["ct_on"].ci95.unwrap();
@@ -233,7 +242,12 @@ mod tests {
             (0.152, [Some(0.139), Some(0.165)]),
             (f64::NAN, [None, None]),
         ];
-        let note = reconcile(&mut u, &timing, "the start's event timing").expect("ON disagrees");
+        let note = reconcile(
+            &mut u,
+            &timing,
+            ("event timing", "the start's event timing"),
+        )
+        .expect("ON disagrees");
         assert!(!note.contains("NaN") && !note.contains("OFF"), "{note}");
         assert_eq!(u["ct_off"].ci95, Some([Some(0.4385), Some(1.7549)]));
     }

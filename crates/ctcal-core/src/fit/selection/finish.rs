@@ -335,22 +335,28 @@ fn threshold_intervals(
     {
         assumptions.push(note);
     }
-    if let Some(start) = widening.start
-        && let Some(note) =
-            super::agreement::reconcile(&mut state.uncertainty, start, "the start's thresholds")
+    // (thresholds held at a start value are not fitted: nothing to reconcile)
+    if let Some(start) = widening.start.filter(|_| !widening.fixed)
+        && let Some(note) = super::agreement::reconcile(
+            &mut state.uncertainty,
+            start,
+            ("start", "the start's thresholds"),
+        )
     {
         assumptions.push(note);
     }
-    if let Some(timing) = widening.timing
-        && widening.start != Some(timing)
+    if let Some(timing) = widening.timing.filter(|_| !widening.fixed)
         && let Some(note) = super::agreement::reconcile(
             &mut state.uncertainty,
             timing,
-            if widening.start.is_some() {
-                "the start's event timing on its own (the log change between a pixel's consecutive events, read from the frames; the start's thresholds, with their interval, are not it alone)"
-            } else {
-                "the start's event timing (the log change between a pixel's consecutive events, read from the frames; `estimate aps` on the fit run computed it but reported no thresholds)"
-            },
+            (
+                "event timing",
+                if widening.start.is_some() {
+                    "the start's event timing on its own (the log change between a pixel's consecutive events, read from the frames; the start's thresholds, with their interval, are not it alone)"
+                } else {
+                    "the start's event timing (the log change between a pixel's consecutive events, read from the frames; `estimate aps` on the fit run computed it but reported no thresholds)"
+                },
+            ),
         )
     {
         assumptions.push(note);

@@ -130,19 +130,20 @@ pub fn thresholds(
             f.interpolation_share,
             f.frame_offset_dn,
             f.leak_drift,
+            f.noise_polarities,
         )
     });
     match found {
-        Ok((e, share, offset, drift)) => match e.thresholds() {
+        Ok((e, share, offset, drift, noise)) => match e.thresholds() {
             Some((on, off)) => Start {
                 interpolation_share: Some(share),
                 frame_offset_dn: Some(offset),
                 leak_drift: Some(crate::fit::effects::leak::TimingDrift::of(&drift, on)),
-                timing: event_timing(&e),
+                timing: event_timing(&e, noise),
                 ..measured(&e, on, off)
             },
             None => Start {
-                timing: event_timing(&e),
+                timing: event_timing(&e, noise),
                 ..fallback(
                     format!(
                         "estimate aps on the fit run determined no thresholds: {}",
@@ -183,16 +184,24 @@ fn reasons_once(why: &BTreeMap<String, String>) -> String {
 /// events, so that an effect that loses or adds events (ESIM's threshold redrawn per
 /// sample interval strands pixels on a ramp; a random walk of the reference) leaves it
 /// where the count-matched thresholds move. aps may report no value of its own (its
-/// re-simulation check failing) and still have this one.
-fn event_timing(e: &CtEstimate) -> Option<super::agreement::Measured> {
+/// re-simulation check failing) and still have this one. A polarity whose samples are
+/// mostly noise (`noise`, ON and OFF: aps withheld it for that) is left out, as a value
+/// that is not a number, and so is one whose interval reaches 0 or is not finite: it
+/// bounds nothing below, so the fit has nothing to disagree with or to span.
+fn event_timing(e: &CtEstimate, noise: [bool; 2]) -> Option<super::agreement::Measured> {
     let timing = e.estimators.iter().find(|r| r.name == "event_timing")?;
-    // a side that is not a positive number bounds nothing (as an open side)
-    let bound = |v: f64| (v.is_finite() && v > 0.0).then_some(v);
-    let side = |m: &crate::estimate::interval::Measured| match bound(m.value) {
-        Some(value) => (value, [bound(m.ci95[0]), bound(m.ci95[1])]),
-        None => (m.value, [None, None]),
+    let side = |m: &crate::estimate::interval::Measured, noise: bool| {
+        let [lo, hi] = m.ci95;
+        if !noise && m.value.is_finite() && lo > 0.0 && hi.is_finite() {
+            (m.value, [Some(lo), Some(hi)])
+        } else {
+            (f64::NAN, [None, None])
+        }
     };
-    Some([side(&timing.ct_on), side(&timing.ct_off)])
+    Some([
+        side(&timing.ct_on, noise[0]),
+        side(&timing.ct_off, noise[1]),
+    ])
 }
 
 fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
