@@ -135,15 +135,25 @@ mod tests {
         Uncertain::with_interval(value, None, [Some(lo), Some(hi)])
     }
 
+    /// Fitted ON and OFF thresholds, each `(value, lo, hi)`, as the fit's uncertainties.
+    fn thresholds(on: (f64, f64, f64), off: (f64, f64, f64)) -> BTreeMap<String, Uncertain> {
+        BTreeMap::from([
+            ("ct_on".to_string(), fitted(on.0, on.1, on.2)),
+            ("ct_off".to_string(), fitted(off.0, off.1, off.2)),
+        ])
+    }
+
+    /// The count fit of coverage draw 13034 (before the method systematic).
+    fn draw_13034() -> BTreeMap<String, Uncertain> {
+        thresholds((0.3126, 0.2213, 0.4416), (0.9070, 0.4385, 1.7549))
+    }
+
     /// The coverage study's case 85 (natural-image objects at 50 Hz): the fit's OFF 0.330
     /// [0.317, 0.343] for a true 0.343; the start's timing found the interpolation to miss
     /// 4 % of ON and 3 % of OFF.
     #[test]
     fn the_intervals_reach_up_by_what_the_interpolation_misses() {
-        let mut u = BTreeMap::from([
-            ("ct_on".to_string(), fitted(0.805, 0.703, 0.923)),
-            ("ct_off".to_string(), fitted(0.330, 0.317, 0.343)),
-        ]);
+        let mut u = thresholds((0.805, 0.703, 0.923), (0.330, 0.317, 0.343));
         let note = reach_for_interpolation(&mut u, [0.04, 0.03]).unwrap();
         assert!(note.contains("ct_on 4.0 %, ct_off 3.0 %"), "{note}");
         let [lo, hi] = u["ct_off"].ci95.unwrap();
@@ -160,10 +170,7 @@ mod tests {
     /// at 0.220 / 0.1075 for a true 0.309 / 0.131, the start at 0.276 / 0.131.
     #[test]
     fn methods_that_disagree_give_an_interval_spanning_both() {
-        let mut u = BTreeMap::from([
-            ("ct_on".to_string(), fitted(0.2200, 0.1944, 0.2489)),
-            ("ct_off".to_string(), fitted(0.1075, 0.1015, 0.1138)),
-        ]);
+        let mut u = thresholds((0.2200, 0.1944, 0.2489), (0.1075, 0.1015, 0.1138));
         let start = [
             (0.2759, [Some(0.2174), Some(0.3345)]),
             (0.1310, [Some(0.1234), Some(0.1386)]),
@@ -186,10 +193,7 @@ mod tests {
     /// fit 0.246 / 0.398, start 0.236 / 0.370).
     #[test]
     fn methods_that_agree_leave_the_interval_alone() {
-        let before = BTreeMap::from([
-            ("ct_on".to_string(), fitted(0.246, 0.212, 0.286)),
-            ("ct_off".to_string(), fitted(0.398, 0.348, 0.454)),
-        ]);
+        let before = thresholds((0.246, 0.212, 0.286), (0.398, 0.348, 0.454));
         let mut u = before.clone();
         let start = [
             (0.236, [Some(0.230), Some(0.242)]),
@@ -209,10 +213,7 @@ mod tests {
     /// [0.457, 0.616] (on the whole recording): the fit's interval reaches it, and the truth.
     #[test]
     fn count_thresholds_far_from_the_event_timing_span_it() {
-        let mut u = BTreeMap::from([
-            ("ct_on".to_string(), fitted(0.3126, 0.2213, 0.4416)),
-            ("ct_off".to_string(), fitted(0.9070, 0.4385, 1.7549)),
-        ]);
+        let mut u = draw_13034();
         let timing = [
             (0.152, [Some(0.139), Some(0.165)]),
             (0.537, [Some(0.457), Some(0.616)]),
@@ -234,10 +235,7 @@ mod tests {
     /// no disagreement and spans nothing, though the other polarity's does.
     #[test]
     fn a_start_value_that_is_not_positive_spans_nothing() {
-        let mut u = BTreeMap::from([
-            ("ct_on".to_string(), fitted(0.3126, 0.2213, 0.4416)),
-            ("ct_off".to_string(), fitted(0.9070, 0.4385, 1.7549)),
-        ]);
+        let mut u = draw_13034();
         let timing = [
             (0.152, [Some(0.139), Some(0.165)]),
             (f64::NAN, [None, None]),
