@@ -208,3 +208,14 @@ pub fn events_inside(case: &Path, [x0, x1, y0, y1]: [u64; 4]) -> usize {
         .filter(|&inside| inside)
         .count()
 }
+
+/// A coverage study's case (its `case.json`, [`ctcal::coverage::CaseSpec`], kept as
+/// `tests/cli/cases/{id}.json`) written into a temporary folder with its truth.
+pub fn coverage_case(id: &str) -> tempfile::TempDir {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cli/cases/{id}.json"));
+    let text = std::fs::read_to_string(&path).unwrap();
+    let case: ctcal::coverage::CaseSpec = serde_json::from_str(&text).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    ctcal::coverage::write_case(&case, dir.path()).unwrap();
+    dir
+}

@@ -916,17 +916,6 @@ fn aps_withholds_a_threshold_whose_samples_show_no_peak_above_the_noise() {
     assert!(e["ct_sigma"].is_null() && e["why"]["ct_sigma"].is_string());
 }
 
-/// A coverage study's case (its `case.json`, [`ctcal::coverage::CaseSpec`], kept as
-/// `tests/cli/cases/{id}.json`) written into a temporary folder with its truth.
-fn coverage_case(id: &str) -> tempfile::TempDir {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/cli/cases/{id}.json"));
-    let text = std::fs::read_to_string(&path).unwrap();
-    let case: ctcal::coverage::CaseSpec = serde_json::from_str(&text).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    ctcal::coverage::write_case(&case, dir.path()).unwrap();
-    dir
-}
-
 /// Coverage draw 15006: IEBCS pixels (thresholds 0.32 / 0.47) whose photoreceptor time
 /// constant goes as one over the light (25 ms at the scene's median DN, 5.6-6.4 Hz), under
 /// natural-image objects moving at up to 38 px/s. The timing's first-order lag term saw a

@@ -186,6 +186,34 @@ fn leak_is_added_to_a_static_scene_at_its_rate() {
     );
 }
 
+/// Coverage draw 13010: DVS-Voltmeter pixels (thresholds 0.47, a leak that grows with the
+/// light) under objects drifting at 10 px/s, so that 127,291 of its 127,304 events are ON,
+/// nearly all of them the leak's. The fit kept a leak of 8.6 Hz [4.4, 17.0] and read ON
+/// 0.98 [0.55, 1.77] from the counts with the leak held at 8.6 Hz: a miss. Profiled again
+/// at the leak's interval ends, ON runs from about 0.07 to the end of the profile's range
+/// (the leak alone outnumbers the events), so the threshold is not determinable, and says
+/// why, instead of a confident miss.
+#[test]
+fn a_threshold_whose_events_a_kept_leak_makes_is_not_determinable() {
+    let dir = coverage_case("case-13010");
+    let f = fit(dir.path(), &[]);
+    assert!(added(&f).contains(&"leak".to_string()), "{:?}", added(&f));
+    assert!(f["params"]["ct_on"].is_null(), "{}", f["params"]["ct_on"]);
+    let why = f["why"]["ct_on"].as_str().unwrap();
+    assert!(
+        why.starts_with("the events of this polarity are mostly the leak's"),
+        "{why}"
+    );
+    let check = strings(&f["assumptions"])
+        .into_iter()
+        .find(|a| a.starts_with("leak-rate check:"))
+        .expect("the leak-rate check");
+    assert!(
+        check.contains("ON ") && check.contains("not determined"),
+        "{check}"
+    );
+}
+
 /// Also the human table: a parameter the data leave undetermined shows its why, never its
 /// interval as if it were a result (the JSON keeps the model's setting in `uncertainties`).
 #[test]

@@ -52,6 +52,10 @@ pub struct Ambiguity {
     /// its reported interval reaches 0 ([`reach_zero_where_not_separated`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub kept_ci95_if_present: Option<crate::estimate::Interval>,
+    /// The thresholds (`ct_on`, `ct_off`) profiled in the model with the look-alike in the
+    /// kept effect's place: the thresholds' intervals reach them (empty where not known).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub alternative_thresholds: BTreeMap<String, f64>,
 }
 
 /// Widens the interval of each kept effect the data do not separate from a look-alike down
@@ -393,10 +397,15 @@ fn settle(
     // named even where the quiet count keeps shot noise: the count says shot noise is
     // there, not that the look-alike is not (coverage draw 8026: a true 0.50 Hz leak beside
     // it, its fall of 29 % within a chance of 41 %)
-    let (named, alternative, value) = if lower {
-        (other, kept, kept_value(kept, state))
+    let (named, alternative, value, thresholds) = if lower {
+        (
+            other,
+            kept,
+            kept_value(kept, state),
+            super::steps::thresholds_of(&state.model),
+        )
     } else {
-        (kept, other, value)
+        (kept, other, value, super::steps::thresholds_of(alternative))
     };
     found.push(Ambiguity {
         kept: named.name().into(),
@@ -408,6 +417,7 @@ fn settle(
         chance: step.chance,
         separated_by: separated_by.into(),
         kept_ci95_if_present: None,
+        alternative_thresholds: thresholds,
     });
     let both = "both named";
     step.reason = if lower {
@@ -669,6 +679,7 @@ mod tests {
             chance: Some(0.1),
             separated_by: LEAK_OR_SHOT_NOISE.into(),
             kept_ci95_if_present: None,
+            alternative_thresholds: BTreeMap::new(),
         }
     }
 

@@ -232,6 +232,7 @@ fn intervals(simulation: &Simulation, state: &mut State, parts: &mut Parts) -> W
         other_response: parts.other_response.as_ref(),
         start: parts.start.as_ref(),
         timing: parts.timing.as_ref(),
+        ambiguities: &parts.ambiguities,
     };
     let assumptions = &mut parts.assumptions;
     assumptions.extend(threshold_intervals(simulation, state, widening));
@@ -309,6 +310,8 @@ struct Widening<'a> {
     other_response: Option<&'a crate::estimate::timing::OtherResponse>,
     start: Option<&'a super::agreement::Measured>,
     timing: Option<&'a super::agreement::Measured>,
+    /// The look-alikes the data do not separate from a kept effect, with their thresholds.
+    ambiguities: &'a [super::Ambiguity],
 }
 
 /// The thresholds' intervals: their standard errors on the fit blocks, widened by the
@@ -361,6 +364,13 @@ fn threshold_intervals(
     {
         assumptions.push(note);
     }
+    if !widening.fixed {
+        assumptions.extend(super::look_alikes::widen(
+            &mut state.uncertainty,
+            widening.ambiguities,
+            &state.model.params,
+        ));
+    }
     if !widening.fixed
         && let Some(other) = widening.other_response
     {
@@ -406,12 +416,13 @@ fn reach_for_other_response(
 struct NoiseIntervals {
     /// Parameters measured directly (by counting), kept out of the look-alikes' reach to 0.
     measured: &'static [&'static str],
-    /// Parameters the noise share leaves undetermined, with why.
+    /// Thresholds the count effects' checks leave undetermined, with why.
     undetermined: Vec<(String, String)>,
 }
 
-/// Shot noise's interval from the quiet pixels' count, and the check that the model's
-/// noise does not take up the thresholds' share of the events.
+/// Shot noise's interval from the quiet pixels' count, then the check that no count effect
+/// (shot noise, leak, a slow photoreceptor, a refractory period) takes up the thresholds'
+/// share of the events within its own interval ([`super::count_effects`]).
 fn noise_intervals(
     simulation: &Simulation,
     state: &mut State,
@@ -431,13 +442,13 @@ fn noise_intervals(
         &[]
     };
     assumptions.extend(counted);
-    let noise_share = (!fixed)
-        .then(|| super::noise_share::check(simulation, state))
-        .flatten();
-    let undetermined = noise_share.map_or(Vec::new(), |share| {
-        assumptions.push(share.note);
-        share.undetermined
-    });
+    let mut undetermined = Vec::new();
+    if !fixed {
+        for share in super::count_effects::check(simulation, state) {
+            assumptions.push(share.note);
+            undetermined.extend(share.undetermined);
+        }
+    }
     NoiseIntervals {
         measured,
         undetermined,
@@ -567,7 +578,7 @@ pub const UNMEASURED_SPAN: f64 = 50.0;
 pub(super) fn unmeasured(u: &Uncertain) -> Option<String> {
     match u.ci95? {
         [Some(lo), Some(hi)] if lo > 0.0 && hi / lo > UNMEASURED_SPAN => Some(format!(
-            "its 95 % interval, {lo:.4e} to {hi:.4e}, spans more than a factor {UNMEASURED_SPAN:.0}: the fit error changes by no more than chance over that range, so the recording does not measure it (the model keeps the effect at {:.4e})",
+            "its 95 % interval, {lo:.4e} to {hi:.4e}, spans more than a factor {UNMEASURED_SPAN:.0} (its standard error and the terms that widen it, each in `assumptions`): the recording does not pin it down, so it is not a measurement (the model keeps the value {:.4e})",
             u.value
         )),
         [lo, None] if lo.is_none_or(|lo| lo <= 0.0) => Some(format!(
@@ -633,16 +644,6 @@ fn not_identified(state: &State, fixed: bool) -> BTreeMap<String, String> {
     why
 }
 
-/// The effects whose parameters trade against the thresholds in the counts: a slow
-/// photoreceptor and a refractory period thin the events as a higher threshold does,
-/// leak and shot noise add events as a lower one does.
-const COUNT_EFFECTS: [Effect; 4] = [
-    Effect::Bandwidth,
-    Effect::Refractory,
-    Effect::Leak,
-    Effect::ShotNoise,
-];
-
 /// Why each fitted count effect is not a measurement when a threshold of a moving scene is
 /// not determined (`why` holds it): the effect was fitted against a threshold the data did
 /// not fix, so it absorbed that threshold's error. On the coverage study's draws (seeds 1-100
@@ -660,7 +661,7 @@ fn confounded_with_thresholds(
     if undetermined.is_empty() {
         return Vec::new();
     }
-    COUNT_EFFECTS
+    super::count_effects::COUNT_EFFECTS
         .into_iter()
         .filter_map(Effect::parameter)
         .filter(|k| uncertainty.contains_key(*k))

@@ -26,6 +26,7 @@
 mod agreement;
 mod alternatives;
 mod bandwidth_detection;
+mod count_effects;
 pub use alternatives::Ambiguity;
 pub(in crate::fit) mod finish;
 mod frame_quality;
@@ -33,9 +34,9 @@ pub(in crate::fit) mod hot_excess;
 mod hot_report;
 pub(in crate::fit) mod keep;
 mod leak_report;
+mod look_alikes;
 mod method_systematic;
 mod noise_detection;
-mod noise_share;
 mod spread_report;
 mod start;
 mod steps;

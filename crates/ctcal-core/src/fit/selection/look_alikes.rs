@@ -1,0 +1,122 @@
+//! The thresholds of the models the data do not separate from the fitted one.
+//!
+//! Where a kept effect and its look-alike explain the recording equally well within chance
+//! ([`super::alternatives`]), both models are named, and the kept effect's interval
+//! reaches 0. The thresholds were read from the counts with the kept effect in the model.
+//! The model with the look-alike in its place reads them again (a slow photoreceptor
+//! thins the fast changes' events where a refractory period drops each pixel's bursts), so
+//! the choice between the two models is an uncertainty of the thresholds as well. Each
+//! threshold's interval reaches the look-alike model's value on its side, in quadrature in
+//! ln C (model uncertainty carried as the span of the models the data allow: Draper,
+//! *Assessment and propagation of model uncertainty*, JRSS B 57, 1995). Its thresholds
+//! were profiled when it was compared, so this costs no simulation.
+//!
+//! Measured on the coverage study's draws in `benches/coverage/fit-count-effects-2026-12-07`.
+
+use super::super::Uncertain;
+use super::alternatives::Ambiguity;
+use super::method_systematic::reach_ln;
+use std::collections::BTreeMap;
+
+/// The thresholds (ON, OFF) divided by the model's.
+type Ratios = [f64; 2];
+
+/// Each look-alike the data do not separate from a kept effect, in its place: each
+/// threshold's interval reaches the thresholds of that model (recorded when it was
+/// compared), in ln C in quadrature. Returns the assumption (none without such a model).
+pub(super) fn widen(
+    uncertainty: &mut BTreeMap<String, Uncertain>,
+    ambiguities: &[Ambiguity],
+    model: &crate::sim::PixelParams,
+) -> Option<String> {
+    let mut tried = Vec::new();
+    let mut ratios = Vec::new();
+    for a in ambiguities {
+        let (Some(&on), Some(&off)) = (
+            a.alternative_thresholds.get("ct_on"),
+            a.alternative_thresholds.get("ct_off"),
+        ) else {
+            continue;
+        };
+        tried.push(format!(
+            "{} in place of {}: ON {on:.4}, OFF {off:.4}",
+            a.alternative, a.kept
+        ));
+        ratios.push([on / model.ct_on, off / model.ct_off]);
+    }
+    if tried.is_empty() {
+        return None;
+    }
+    let widened = reach_all(uncertainty, &ratios);
+    Some(format!(
+        "the thresholds of the models the data do not separate from the fitted one: {}; {}",
+        tried.join("; "),
+        widened_text(&widened)
+    ))
+}
+
+/// Each threshold's interval reaching the furthest ratio on each side among `ratios`, once
+/// per side (in quadrature in ln C); returns what changed.
+fn reach_all(uncertainty: &mut BTreeMap<String, Uncertain>, ratios: &[Ratios]) -> Vec<String> {
+    let mut widened = Vec::new();
+    for (pol, key) in ["ct_on", "ct_off"].into_iter().enumerate() {
+        let valid = || {
+            ratios
+                .iter()
+                .map(move |r| r[pol])
+                .filter(|r| r.is_finite() && *r > 0.0)
+        };
+        let up = valid().fold(1.0, f64::max);
+        let down = valid().fold(1.0, f64::min);
+        for r in [up, down] {
+            if r != 1.0
+                && let Some(change) = reach_ln(uncertainty, key, r)
+            {
+                widened.push(change);
+            }
+        }
+    }
+    widened
+}
+
+fn widened_text(widened: &[String]) -> String {
+    if widened.is_empty() {
+        "within the intervals already".into()
+    } else {
+        format!(
+            "the intervals reach them in quadrature in ln C: {}",
+            widened.join("; ")
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn threshold(value: f64, lo: f64, hi: f64) -> Uncertain {
+        Uncertain {
+            value,
+            standard_error: None,
+            ci95: Some([Some(lo), Some(hi)]),
+        }
+    }
+
+    #[test]
+    fn each_side_reaches_its_furthest_ratio_once_in_quadrature() {
+        // ON 1.0 [0.8, 1.25]: ln half-widths 0.2231 each side
+        let mut u = BTreeMap::from([
+            ("ct_on".to_string(), threshold(1.0, 0.8, 1.25)),
+            ("ct_off".to_string(), threshold(0.5, 0.4, 0.625)),
+        ]);
+        // ON moved to 0.5 and 0.6 (down) and 1.1 (up): the furthest each way, the lower side
+        // sqrt(0.22314^2 + ln 2^2) = 0.72818 -> 0.48279, the upper sqrt(0.22314^2 +
+        // ln 1.1^2) = 0.24272 -> 1.27462. OFF unmoved.
+        let changed = reach_all(&mut u, &[[0.5, 1.0], [0.6, 1.0], [1.1, 1.0]]);
+        assert_eq!(changed.len(), 2, "{changed:?}");
+        let [lo, hi] = u["ct_on"].ci95.unwrap();
+        assert!((lo.unwrap() - 0.48279).abs() < 1e-4, "{lo:?}");
+        assert!((hi.unwrap() - 1.27462).abs() < 1e-4, "{hi:?}");
+        assert_eq!(u["ct_off"].ci95, Some([Some(0.4), Some(0.625)]));
+    }
+}
