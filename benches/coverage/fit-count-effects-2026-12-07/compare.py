@@ -24,7 +24,6 @@ for p in sorted(glob.glob(B+'/case-*.json')):
     split='held' if n.startswith('case-17') else 'study'
     line=[]
     fired=[k for k,s in (('leak','leak-rate check'),('cutoff','cutoff check'),('refr','refractory check'),('noise','noise-rate check'),('alike','the thresholds of the models the data do not separate')) if any(s in x for x in b.get('assumptions',[]))]
-    widened=[x for x in b.get('assumptions',[]) if ('the thresholds across the kept' in x or 'models the data do not separate' in x) and 'reach them' in x]
     for key in ('ct_on','ct_off'):
         (ca,wa),(cb,wb)=cov(a,key,t['values'][key]),cov(b,key,t['values'][key])
         tally[(split,key,'before')][ca]+=1; tally[(split,key,'after')][cb]+=1

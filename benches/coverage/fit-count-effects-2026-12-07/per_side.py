@@ -9,8 +9,12 @@ num=r'(-|[0-9.]+)'
 pat=re.compile(r'(OFF|ON) '+num+' / '+num+' / '+num+r'(?:: (ct_o(?:n|ff)) \[([0-9.]+|open), ([0-9.]+|open)\] -> \[([0-9.]+|open), ([0-9.]+|open)\])?')
 def f(x): return None if x in ('-','open') else float(x)
 def cov(ci,t):
+    # as compare.py: an interval open below is a bound, scored apart (not determinable)
     lo,hi=ci
-    return (lo is None or lo<=t) and (hi is None or t<=hi)
+    return lo is not None and lo<=t and (hi is None or t<=hi)
+def scored(u,key,d,t):
+    if not u or not u.get('ci95') or key in d.get('why',{}) or u['ci95'][0] is None: return 'nd'
+    return 'ok' if cov(u['ci95'],t) else 'MISS'
 tally=collections.defaultdict(collections.Counter); widths=[]
 for p in sorted(glob.glob(B+'/case-*.json')):
     n=os.path.basename(p)[:-5]
@@ -43,8 +47,8 @@ for p in sorted(glob.glob(B+'/case-*.json')):
     for key in ('ct_on','ct_off'):
         tv=t['values'][key]
         ua=a['uncertainties'].get(key)
-        ca='nd' if not ua or not ua.get('ci95') or key in a.get('why',{}) else ('ok' if cov(ua['ci95'],tv) else 'MISS')
-        if final[key] is None: cs=cb='nd'
+        ca=scored(ua,key,a,tv)
+        if final[key] is None or final[key][1][0] is None: cs=cb='nd'
         else:
             v,ci=final[key]; cb='ok' if cov(ci,tv) else 'MISS'
             if key in side:

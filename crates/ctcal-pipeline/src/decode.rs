@@ -291,7 +291,7 @@ structs! {
     Uncertain { value, standard_error, ci95 }
     AddedEffect { effect, evidence, error_after }
     Ambiguity { kept, alternative, parameter, value, error_kept, error_alternative, chance,
-        separated_by, kept_ci95_if_present, alternative_thresholds }
+        separated_by, kept_ci95_if_present, kept_thresholds, alternative_thresholds }
     StepResiduals { by_intensity, by_rate_of_change }
     Step { effect, evidence, score, parameters, error_before, error_after, components_after,
         chance, kept, reason, simulations, residuals_before, residuals_after }

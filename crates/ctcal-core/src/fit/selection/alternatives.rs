@@ -52,8 +52,13 @@ pub struct Ambiguity {
     /// its reported interval reaches 0 ([`reach_zero_where_not_separated`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub kept_ci95_if_present: Option<crate::estimate::Interval>,
-    /// The thresholds (`ct_on`, `ct_off`) profiled in the model with the look-alike in the
-    /// kept effect's place: the thresholds' intervals reach them (empty where not known).
+    /// The thresholds (`ct_on`, `ct_off`) of the model with the kept effect when the two
+    /// were compared (the loop may have changed the model since; empty where not known).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub kept_thresholds: BTreeMap<String, f64>,
+    /// The thresholds profiled in the model with the look-alike in the kept effect's
+    /// place: the final thresholds' intervals reach them scaled by their ratio to
+    /// `kept_thresholds` ([`super::look_alikes`]; empty where not known).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub alternative_thresholds: BTreeMap<String, f64>,
 }
@@ -397,27 +402,29 @@ fn settle(
     // named even where the quiet count keeps shot noise: the count says shot noise is
     // there, not that the look-alike is not (coverage draw 8026: a true 0.50 Hz leak beside
     // it, its fall of 29 % within a chance of 41 %)
-    let (named, alternative, value, thresholds) = if lower {
-        (
-            other,
-            kept,
-            kept_value(kept, state),
-            super::steps::thresholds_of(&state.model),
-        )
+    let (named, unnamed, value) = if lower {
+        (other, kept, kept_value(kept, state))
     } else {
-        (kept, other, value, super::steps::thresholds_of(alternative))
+        (kept, other, value)
+    };
+    // the two models' thresholds, each read from the counts with its own effect
+    let (with_named, with_unnamed) = if lower {
+        (alternative, &state.model)
+    } else {
+        (&state.model, alternative)
     };
     found.push(Ambiguity {
         kept: named.name().into(),
-        alternative: alternative.name().into(),
-        parameter: alternative.parameter().unwrap_or_default().into(),
+        alternative: unnamed.name().into(),
+        parameter: unnamed.parameter().unwrap_or_default().into(),
         value,
         error_kept: if lower { after } else { before },
         error_alternative: if lower { before } else { after },
         chance: step.chance,
         separated_by: separated_by.into(),
         kept_ci95_if_present: None,
-        alternative_thresholds: thresholds,
+        kept_thresholds: super::steps::thresholds_of(with_named),
+        alternative_thresholds: super::steps::thresholds_of(with_unnamed),
     });
     let both = "both named";
     step.reason = if lower {
@@ -679,6 +686,7 @@ mod tests {
             chance: Some(0.1),
             separated_by: LEAK_OR_SHOT_NOISE.into(),
             kept_ci95_if_present: None,
+            kept_thresholds: BTreeMap::new(),
             alternative_thresholds: BTreeMap::new(),
         }
     }

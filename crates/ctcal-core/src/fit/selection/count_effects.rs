@@ -71,19 +71,19 @@ pub struct Profiles {
 
 /// What one effect's check found: the note for `assumptions`, and the thresholds it leaves
 /// undetermined with why.
-pub struct Share {
+pub struct CountCheck {
     pub note: String,
     pub undetermined: Vec<(String, String)>,
 }
 
 /// Profiles the final model's thresholds at the ends of each count effect's interval
-/// ([`COUNT_EFFECTS`]) and applies [`judge`]: one [`Share`] for each effect the model has
+/// ([`COUNT_EFFECTS`]) and applies [`judge`]: one [`CountCheck`] for each effect the model has
 /// with an interval. The profile at the fitted values is run once for all of them.
-pub fn check(simulation: &Simulation, state: &mut State) -> Vec<Share> {
+pub fn check(simulation: &Simulation, state: &mut State) -> Vec<CountCheck> {
     let mut fitted: Option<Option<PixelParams>> = None;
     let mut shares = Vec::new();
     for effect in COUNT_EFFECTS {
-        let Some(ends) = ends_of(effect, state) else {
+        let Some(ends) = ends_for(effect, state) else {
             continue;
         };
         let mid = fitted
@@ -121,21 +121,30 @@ fn profiled(simulation: &Simulation, state: &State, params: &PixelParams) -> Opt
         .map(|s| s.params)
 }
 
-/// The low end, the fitted value and the high end of `effect`'s parameter to profile at
-/// (see the module docs); `None` where the model lacks the effect or it has no interval.
-fn ends_of(effect: Effect, state: &State) -> Option<[Option<End>; 3]> {
+/// The ends to profile `effect` at, where the model has it with an interval.
+fn ends_for(effect: Effect, state: &State) -> Option<[Option<End>; 3]> {
     let value = effect.value(&state.model.params).filter(|v| *v > 0.0)?;
-    let key = effect.parameter()?;
-    let [lo, hi] = state.uncertainty.get(key)?.interval()?;
-    let lo = lo.unwrap_or(0.0).max(0.0);
-    Some(match effect {
+    let interval = state.uncertainty.get(effect.parameter()?)?.interval()?;
+    Some(ends_of(effect, value, interval))
+}
+
+/// The low end, the fitted `value` and the high end of `effect`'s parameter to profile at
+/// (see the module docs). An end that is not a finite number counts as open, and the ends
+/// are kept on their sides of the value.
+fn ends_of(effect: Effect, value: f64, [lo, hi]: [Option<f64>; 2]) -> [Option<End>; 3] {
+    let lo = lo
+        .filter(|v| v.is_finite())
+        .unwrap_or(0.0)
+        .clamp(0.0, value);
+    let hi = hi.filter(|v| v.is_finite()).map(|hi| hi.max(value));
+    match effect {
         Effect::Bandwidth => [
-            Some(End::At(lo.max(effect.range(value).0))),
+            Some(End::At(lo.max(effect.range(value).0).min(value))),
             Some(End::At(value)),
             Some(hi.map_or(End::Absent, End::At)),
         ],
         _ => [Some(End::At(lo)), Some(End::At(value)), hi.map(End::At)],
-    })
+    }
 }
 
 /// How the notes and reasons name an effect's check.
@@ -149,22 +158,40 @@ struct Words {
     /// Its parameter, as what has an interval.
     parameter: &'static str,
     unit: &'static str,
-    /// What a threshold at the profile's end says about the polarity's events.
-    lead: &'static str,
-    /// What the effect may do within its interval, where a threshold reaches an end.
-    within: &'static str,
+    /// What a threshold at the profile's end says about the polarity's events (OFF, ON).
+    lead: [&'static str; 2],
+    /// What the effect may do within its interval, where a threshold reaches an end (OFF,
+    /// ON).
+    within: [&'static str; 2],
 }
 
 fn words(effect: Effect) -> Words {
+    let both = |s: &'static str| [s, s];
     match effect {
+        Effect::ShotNoise => Words {
+            check: "noise-rate check",
+            subject: "the shot noise",
+            quantity: "rate",
+            parameter: "the noise rate",
+            unit: " Hz",
+            lead: both("the events of this polarity are mostly the shot noise's"),
+            within: both("the noise alone may make the recording's events of this polarity"),
+        },
+        // a leak fires ON events; its drift holds back the OFF ones
         Effect::Leak => Words {
             check: "leak-rate check",
             subject: "the leak",
             quantity: "rate",
             parameter: "the leak rate",
             unit: " Hz",
-            lead: "the events of this polarity are mostly the leak's",
-            within: "the leak alone may make the recording's events of this polarity",
+            lead: [
+                "the leak's drift decides how many events of this polarity there are",
+                "the events of this polarity are mostly the leak's",
+            ],
+            within: [
+                "the leak's drift may hold back the recording's events of this polarity as much as any threshold does",
+                "the leak alone may make the recording's events of this polarity",
+            ],
         },
         Effect::Bandwidth => Words {
             check: "cutoff check",
@@ -172,8 +199,12 @@ fn words(effect: Effect) -> Words {
             quantity: "cutoff",
             parameter: "the cutoff",
             unit: " Hz",
-            lead: "the photoreceptor's filter decides how many events of this polarity there are",
-            within: "the filter may thin the recording's events of this polarity as much as any threshold does",
+            lead: both(
+                "the photoreceptor's filter decides how many events of this polarity there are",
+            ),
+            within: both(
+                "the filter may thin the recording's events of this polarity as much as any threshold does",
+            ),
         },
         Effect::Refractory => Words {
             check: "refractory check",
@@ -181,17 +212,22 @@ fn words(effect: Effect) -> Words {
             quantity: "period",
             parameter: "the refractory period",
             unit: " s",
-            lead: "the refractory period decides how many events of this polarity there are",
-            within: "the period may drop the recording's events of this polarity as much as any threshold does",
+            lead: both("the refractory period decides how many events of this polarity there are"),
+            within: both(
+                "the period may drop the recording's events of this polarity as much as any threshold does",
+            ),
         },
-        _ => Words {
-            check: "noise-rate check",
-            subject: "the shot noise",
-            quantity: "rate",
-            parameter: "the noise rate",
-            unit: " Hz",
-            lead: "the events of this polarity are mostly the shot noise's",
-            within: "the noise alone may make the recording's events of this polarity",
+        // not count effects: never checked, named by their own names
+        Effect::Mismatch | Effect::TimestampJitter | Effect::HotPixels | Effect::Display => Words {
+            check: effect.name(),
+            subject: effect.name(),
+            quantity: "value",
+            parameter: effect.name(),
+            unit: "",
+            lead: both("this effect decides how many events of this polarity there are"),
+            within: both(
+                "the effect may change the recording's events of this polarity as much as any threshold does",
+            ),
         },
     }
 }
@@ -201,15 +237,24 @@ pub fn judge(
     effect: Effect,
     profiles: &Profiles,
     uncertainty: &mut BTreeMap<String, Uncertain>,
-) -> Share {
+) -> CountCheck {
     let words = words(effect);
     let mut parts = Vec::new();
     let mut undetermined = Vec::new();
-    for (key, name, values) in [
+    for (pol, (key, name, values)) in [
         ("ct_off", "OFF", profiles.off),
         ("ct_on", "ON", profiles.on),
-    ] {
-        let (part, why) = judge_one((key, name), values, (profiles.at, &words), uncertainty);
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let said = Said {
+            key,
+            name,
+            lead: words.lead[pol],
+            within: words.within[pol],
+        };
+        let (part, why) = judge_one(&said, values, (profiles.at, &words), uncertainty);
         parts.push(part);
         undetermined.extend(why.map(|why| (key.to_string(), why)));
     }
@@ -221,18 +266,33 @@ pub fn judge(
         end_list(profiles.at, words.unit),
         parts.join("; ")
     );
-    Share { note, undetermined }
+    CountCheck { note, undetermined }
 }
 
-/// One threshold's verdict (`key` in `uncertainty`, `name` in the note) from its `values`
-/// profiled at `at`: its part of the note, and why it is not determined where it reaches
-/// an end of the profile's range; otherwise its interval widened by its largest log change.
+/// One threshold as the check names it: `key` in `uncertainty`, `name` in the note, and
+/// the polarity's words for why it is not determined.
+struct Said<'a> {
+    key: &'a str,
+    name: &'a str,
+    lead: &'a str,
+    within: &'a str,
+}
+
+/// One threshold's verdict from its `values` profiled at `at`: its part of the note, and
+/// why it is not determined where it reaches an end of the profile's range; otherwise its
+/// interval widened by its largest log change.
 fn judge_one(
-    (key, name): (&str, &str),
+    said_as: &Said,
     values: [Option<f64>; 3],
     (at, words): ([Option<End>; 3], &Words),
     uncertainty: &mut BTreeMap<String, Uncertain>,
 ) -> (String, Option<String>) {
+    let Said {
+        key,
+        name,
+        lead,
+        within,
+    } = *said_as;
     let said = format!(
         "{name} {} / {} / {}",
         shown(values[0]),
@@ -252,7 +312,7 @@ fn judge_one(
     if at_bound {
         let why = format!(
             "{}: profiled again with {} at its 95 % interval's ends and at the fitted {} ({}), {key} reads {} / {} / {}, reaching an end of the profile's range ({} to {}): within {}'s interval {}, so the counts do not fix the threshold",
-            words.lead,
+            lead,
             words.parameter,
             words.quantity,
             end_list(at, words.unit),
@@ -262,7 +322,7 @@ fn judge_one(
             THRESHOLD_RANGE.0,
             THRESHOLD_RANGE.1,
             words.parameter,
-            words.within,
+            within,
         );
         return (format!("{said}: not determined"), Some(why));
     }
@@ -377,11 +437,11 @@ mod tests {
         assert!(share.note.contains("0.0000 / 0.2000 / open Hz"));
     }
 
-    /// Draw 16001's kind: a cutoff of 250 Hz whose interval reaches 0 and is open above,
-    /// profiled from the searched range's bottom (2 Hz) to no filter at all. OFF reaches
-    /// the profile's lower end at 2 Hz (the filter leaves too few events for any
+    /// A cutoff of 250 Hz whose interval reaches 0 and is open above (as draw 16001's
+    /// did), profiled from the searched range's bottom (2 Hz) to no filter at all. Here OFF
+    /// reaches the profile's lower end at 2 Hz (the filter leaves too few events for any
     /// threshold): not determined. ON moves 3.0 / 4.42 / 4.6: ln(4.42 / 3.0) = 0.38752
-    /// in quadrature with ln(7.60 / 4.42) = 0.54203 above: 4.42 exp(0.66631) = 8.6058.
+    /// in quadrature with ln(7.60 / 4.42) = 0.54201 above: 4.42 exp(0.66631) = 8.6058.
     #[test]
     fn a_cutoff_open_above_is_profiled_without_a_filter_and_named_so() {
         let mut u = uncertainty();
@@ -410,5 +470,57 @@ mod tests {
         );
         let [_, hi] = u["ct_on"].ci95.unwrap();
         assert!((hi.unwrap() - 8.6058).abs() < 1e-3, "{hi:?}");
+    }
+
+    #[test]
+    fn the_ends_profiled_are_the_intervals_on_their_sides_of_the_value() {
+        let at = |v| Some(End::At(v));
+        // a rate from 0 (the effect off) to open above: its open end is not taken
+        assert_eq!(
+            ends_of(Effect::Leak, 8.6, [Some(0.0), None]),
+            [at(0.0), at(8.6), None]
+        );
+        assert_eq!(
+            ends_of(Effect::Leak, 8.6, [Some(4.36), Some(17.0)]),
+            [at(4.36), at(8.6), at(17.0)]
+        );
+        // a cutoff from below the searched range to open above: 2 Hz to no filter
+        assert_eq!(
+            ends_of(Effect::Bandwidth, 250.0, [Some(0.0), None]),
+            [at(2.0), at(250.0), Some(End::Absent)]
+        );
+        // ends that are not numbers are open; ends on the wrong side stop at the value
+        assert_eq!(
+            ends_of(Effect::Refractory, 0.01, [Some(f64::NAN), Some(f64::NAN)]),
+            [at(0.0), at(0.01), None]
+        );
+        assert_eq!(
+            ends_of(Effect::ShotNoise, 1.0, [Some(1.5), Some(0.5)]),
+            [at(1.0), at(1.0), at(1.0)]
+        );
+        assert_eq!(
+            ends_of(Effect::Bandwidth, 1.5, [Some(0.5), Some(3.0)]),
+            [at(1.5), at(1.5), at(3.0)]
+        );
+    }
+
+    /// A leak fires ON events and holds back OFF ones: each polarity's reason says which.
+    #[test]
+    fn a_leak_names_what_it_does_to_each_polarity() {
+        let mut u = uncertainty();
+        let profiles = Profiles {
+            at: [Some(End::At(4.4)), Some(End::At(8.6)), Some(End::At(17.0))],
+            off: [Some(0.40), Some(0.40), Some(5.0)],
+            on: [Some(0.07), Some(4.42), Some(5.0)],
+        };
+        let check = judge(Effect::Leak, &profiles, &mut u);
+        let why: BTreeMap<_, _> = check.undetermined.into_iter().collect();
+        assert!(why["ct_on"].starts_with("the events of this polarity are mostly the leak's"));
+        assert!(
+            why["ct_off"].starts_with("the leak's drift decides"),
+            "{}",
+            why["ct_off"]
+        );
+        assert!(check.note.starts_with("leak-rate check:"), "{}", check.note);
     }
 }

@@ -315,8 +315,9 @@ struct Widening<'a> {
 }
 
 /// The thresholds' intervals: their standard errors on the fit blocks, widened by the
-/// frames' quality checks, the interpolation the frames miss, the start's disagreement and
-/// the method systematics (thresholds and cutoff); returns the assumptions each adds.
+/// frames' quality checks, the interpolation the frames miss, the start's disagreement,
+/// the look-alike models' thresholds and the method systematics (thresholds and cutoff);
+/// returns the assumptions each adds.
 fn threshold_intervals(
     simulation: &Simulation,
     state: &mut State,
@@ -444,9 +445,9 @@ fn noise_intervals(
     assumptions.extend(counted);
     let mut undetermined = Vec::new();
     if !fixed {
-        for share in super::count_effects::check(simulation, state) {
-            assumptions.push(share.note);
-            undetermined.extend(share.undetermined);
+        for check in super::count_effects::check(simulation, state) {
+            assumptions.push(check.note);
+            undetermined.extend(check.undetermined);
         }
     }
     NoiseIntervals {
@@ -510,7 +511,7 @@ struct Undetermined<'a> {
 }
 
 /// The parameters the data do not identify, with why: the model's unidentified settings,
-/// leak the recording cannot measure, the noise share's, a spread unseen or measured but
+/// leak the recording cannot measure, the count effects' checks', a spread unseen or measured but
 /// not modelled; intervals reach 0 where a look-alike or an undetermined threshold leaves
 /// a parameter free, and an undetermined threshold loses its interval.
 fn undetermined(
