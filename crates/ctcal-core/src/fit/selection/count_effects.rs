@@ -81,7 +81,7 @@ pub struct CountCheck {
 /// with an interval. The profile at the fitted values is run once for all of them.
 pub fn check(simulation: &Simulation, state: &mut State) -> Vec<CountCheck> {
     let mut fitted: Option<Option<PixelParams>> = None;
-    let mut shares = Vec::new();
+    let mut checks = Vec::new();
     for effect in COUNT_EFFECTS {
         let Some(ends) = ends_for(effect, state) else {
             continue;
@@ -108,9 +108,9 @@ pub fn check(simulation: &Simulation, state: &mut State) -> Vec<CountCheck> {
             on[k] = found.as_ref().map(|p| p.ct_on);
         }
         let profiles = Profiles { at: ends, off, on };
-        shares.push(judge(effect, &profiles, &mut state.uncertainty));
+        checks.push(judge(effect, &profiles, &mut state.uncertainty));
     }
-    shares
+    checks
 }
 
 /// `params` with the thresholds profiled on the fit blocks (`None` where the profile fails).
