@@ -6,9 +6,10 @@
 //! Input: the first natural image of the prior (`calib/priors/natural`), unblurred, under
 //! the middle floor; 20 blocks scanning 40 px at 200 px/s in four directions.
 //!
-//! Also the two-sided support filter (`stats::support::supported_two_sided`), which eppps,
-//! the fit's observation, the re-simulation and the event timing run on every recording and
-//! simulation: 1 M events on 240 x 180, four to a microsecond (as EVT3 packs them).
+//! Also the support filter: two-sided (`stats::support::supported_two_sided`), which eppps
+//! and the screen's lag run, and causal in stretches on the pool (`stats::support::supported`),
+//! which the fit's observation of every simulation, the re-simulation and the event timing
+//! run: 1 M events on 240 x 180, four to a microsecond (as EVT3 packs them).
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use ctcal::estimate::eppps::prior;
@@ -72,6 +73,9 @@ fn support_filter(c: &mut Criterion) {
     let sensor = Sensor::new(240, 180);
     c.bench_function("support filter, two-sided (1 M events, 240x180)", |b| {
         b.iter(|| ctcal::stats::support::supported_two_sided(&events, sensor, 10_000))
+    });
+    c.bench_function("support filter, causal (1 M events, 240x180)", |b| {
+        b.iter(|| ctcal::stats::support::supported(&events, sensor, 10_000))
     });
 }
 

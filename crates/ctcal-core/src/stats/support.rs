@@ -6,6 +6,11 @@
 //! estimators use the flags to keep noise out of their samples. Events with the same
 //! timestamp support each other whatever their order in the file (a display refresh makes
 //! whole regions fire at one instant).
+//!
+//! The 8-neighbourhood's passes keep, for every cell, the time of its neighbours' newest
+//! event: each event writes its time into its neighbours' cells and reads its support from
+//! its own (as the statistics kernel does; the events come in time order, so the last time
+//! written is the newest). The events of one timestamp all write before any of them reads.
 
 use crate::events::{EventChunk, Sensor, TimeUs};
 use rayon::prelude::*;
@@ -30,10 +35,14 @@ fn supported_in(
     window_us: TimeUs,
     threads: usize,
 ) -> Vec<bool> {
+    debug_assert!(
+        events.is_time_sorted(),
+        "the support filter needs time-sorted events"
+    );
     let grid = Grid::new(events, sensor);
     let stretches = events.time_stretches(threads, MIN_STRETCH);
     if stretches.len() == 1 {
-        return grid.pass(events, window_us, Direction::Forward);
+        return grid.pass::<FORWARD>(&events.t, window_us);
     }
     let parts: Vec<Vec<bool>> = stretches
         .into_par_iter()
@@ -48,13 +57,16 @@ fn supported_in(
 /// start of a short recording, is not taken for noise for want of a past. The two passes
 /// run on two threads where there are.
 pub fn supported_two_sided(events: &EventChunk, sensor: Sensor, window_us: TimeUs) -> Vec<bool> {
+    debug_assert!(
+        events.is_time_sorted(),
+        "the support filter needs time-sorted events"
+    );
     let grid = Grid::new(events, sensor);
     let (mut flags, backward) = rayon::join(
-        || grid.pass(events, window_us, Direction::Forward),
-        || grid.pass(events, window_us, Direction::Backward),
+        || grid.pass::<FORWARD>(&events.t, window_us),
+        || grid.pass::<BACKWARD>(&events.t, window_us),
     );
-    // the backward pass flags events in reversed order
-    for (flag, &b) in flags.iter_mut().zip(backward.iter().rev()) {
+    for (flag, &b) in flags.iter_mut().zip(&backward) {
         *flag |= b;
     }
     flags
@@ -158,11 +170,8 @@ impl WideGrid {
 
 /// Which way a pass walks the events: backwards it reads them from the last, with times
 /// negated (so that they still grow).
-#[derive(Clone, Copy, PartialEq)]
-enum Direction {
-    Forward,
-    Backward,
-}
+const FORWARD: bool = false;
+const BACKWARD: bool = true;
 
 /// The cell of every event in a grid with a one-cell border (so that every event has eight
 /// neighbour cells), computed once for both passes.
@@ -170,6 +179,16 @@ struct Grid {
     stride: usize,
     size: usize,
     cells: Vec<u32>,
+}
+
+/// Tells the 8 neighbours of cell `k` (in `told`, the time of each cell's neighbours' newest
+/// event) that one of theirs fired at `t`; its own cell is not told.
+#[inline(always)]
+fn tell_neighbours(told: &mut [TimeUs], k: usize, stride: usize, t: TimeUs) {
+    told[k - stride - 1..k - stride + 2].fill(t);
+    told[k - 1] = t;
+    told[k + 1] = t;
+    told[k + stride - 1..k + stride + 2].fill(t);
 }
 
 impl Grid {
@@ -189,90 +208,83 @@ impl Grid {
     }
 
     /// The forward pass's flags of the events in `stretch` (which begins where the
-    /// timestamp changes), its marks first set by the events of the window before it.
+    /// timestamp changes), its cells first told by the events of the window before it.
     fn forward_stretch(
         &self,
         events: &EventChunk,
         window_us: TimeUs,
         stretch: std::ops::Range<usize>,
     ) -> Vec<bool> {
-        let mut last = vec![TimeUs::MIN; self.size];
+        let mut told = vec![TimeUs::MIN; self.size];
         let Some(&first) = events.t.get(stretch.start) else {
             return Vec::new();
         };
         let from =
             events.t[..stretch.start].partition_point(|&t| t < first.saturating_sub(window_us));
         for j in from..stretch.start {
-            last[self.cells[j] as usize] = events.t[j];
+            tell_neighbours(&mut told, self.cells[j] as usize, self.stride, events.t[j]);
         }
-        self.flag(
-            &mut last,
-            stretch.len(),
-            |j| stretch.start + j,
-            |j| events.t[stretch.start + j],
-            window_us,
-        )
+        self.flag::<FORWARD>(&mut told, &events.t, stretch, window_us)
     }
 
-    /// One causal pass: each event's flag, in the order the pass reads them. The events of
-    /// one timestamp are marked first, so that they see each other.
-    fn pass(&self, events: &EventChunk, window_us: TimeUs, direction: Direction) -> Vec<bool> {
-        let n = events.len();
-        let index = |j: usize| match direction {
-            Direction::Forward => j,
-            Direction::Backward => n - 1 - j,
-        };
-        let time = |j: usize| match direction {
-            Direction::Forward => events.t[j],
-            Direction::Backward => -events.t[n - 1 - j],
-        };
-        let mut last = vec![TimeUs::MIN; self.size];
-        self.flag(&mut last, n, index, time, window_us)
+    /// One causal pass over the events at `times`, forwards or [`BACKWARD`]: each event's
+    /// flag, in the events' order.
+    fn pass<const BACKWARDS: bool>(&self, times: &[TimeUs], window_us: TimeUs) -> Vec<bool> {
+        let mut told = vec![TimeUs::MIN; self.size];
+        self.flag::<BACKWARDS>(&mut told, times, 0..times.len(), window_us)
     }
 
-    /// Flags `n` events read in order (`index(j)` the `j`-th read, `time(j)` its time)
-    /// against the marks in `last`, marking each.
-    fn flag(
+    /// Flags the events of `range` read forwards or backwards (each flag at its event's
+    /// place in the range) against the newest neighbour times in `told`, each event
+    /// telling its neighbours. The events of one timestamp all tell before any reads, so
+    /// that they see each other whatever their order.
+    fn flag<const BACKWARDS: bool>(
         &self,
-        last: &mut [TimeUs],
-        n: usize,
-        index: impl Fn(usize) -> usize,
-        time: impl Fn(usize) -> TimeUs,
+        told: &mut [TimeUs],
+        times: &[TimeUs],
+        range: std::ops::Range<usize>,
         window_us: TimeUs,
     ) -> Vec<bool> {
         let stride = self.stride;
-        let mut flags = Vec::with_capacity(n);
-        // the marks the events of one timestamp replaced (reused: runs are short)
-        let mut own = Vec::new();
-        let mut start = 0;
-        while start < n {
-            let t = time(start);
-            let mut end = start + 1;
+        let n = range.len();
+        let cells = &self.cells[range.clone()];
+        let times = &times[range];
+        // the place in the range of the `j`-th event read, and its time as the pass sees it
+        let place = |j: usize| if BACKWARDS { n - 1 - j } else { j };
+        let time = |j: usize| {
+            if BACKWARDS {
+                -times[n - 1 - j]
+            } else {
+                times[j]
+            }
+        };
+        let mut flags = vec![false; n];
+        let mut j = 0;
+        while j < n {
+            let t = time(j);
+            let oldest = t.saturating_sub(window_us);
+            if j + 1 == n || time(j + 1) != t {
+                // alone at its time (most events): it tells only its neighbours, so it may
+                // read first
+                let i = place(j);
+                let k = cells[i] as usize;
+                flags[i] = told[k] >= oldest;
+                tell_neighbours(told, k, stride, t);
+                j += 1;
+                continue;
+            }
+            let mut end = j + 2;
             while end < n && time(end) == t {
                 end += 1;
             }
-            own.clear();
-            for j in start..end {
-                let k = self.cells[index(j)] as usize;
-                own.push(last[k]);
-                last[k] = t;
+            for r in j..end {
+                tell_neighbours(told, cells[place(r)] as usize, stride, t);
             }
-            for (j, &before) in (start..end).zip(&own) {
-                let k = self.cells[index(j)] as usize;
-                // the pixel's own mark is not a neighbour's: restore it while looking around
-                let mark = std::mem::replace(&mut last[k], before);
-                let newest = last[k - stride - 1]
-                    .max(last[k - stride])
-                    .max(last[k - stride + 1])
-                    .max(last[k - 1])
-                    .max(last[k + 1])
-                    .max(last[k + stride - 1])
-                    .max(last[k + stride])
-                    .max(last[k + stride + 1]);
-                last[k] = mark;
-                flags.push(newest >= t.saturating_sub(window_us));
+            for r in j..end {
+                let i = place(r);
+                flags[i] = told[cells[i] as usize] >= oldest;
             }
-            start = end;
+            j = end;
         }
         flags
     }
@@ -404,6 +416,88 @@ mod tests {
                 one,
                 "{threads} stretches"
             );
+        }
+    }
+
+    /// `n` events on `sensor` (small, so that many lie on its border) with runs of equal
+    /// timestamps of random length (seven in ten events share the time of the one before).
+    fn crowded(seed: u64, n: usize, sensor: Sensor) -> EventChunk {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut t = 1_000;
+        (0..n)
+            .map(|_| {
+                if rng.random_bool(0.3) {
+                    t += rng.random_range(1..300);
+                }
+                Event {
+                    t,
+                    x: rng.random_range(0..sensor.width),
+                    y: rng.random_range(0..sensor.height),
+                    on: rng.random(),
+                }
+            })
+            .collect()
+    }
+
+    /// The definition by brute force: whether another pixel within `radius` fired within
+    /// `window` before the event or at its time (or after it, `two_sided`).
+    fn by_definition(
+        events: &EventChunk,
+        radius: i32,
+        window: TimeUs,
+        two_sided: bool,
+    ) -> Vec<bool> {
+        (0..events.len())
+            .map(|i| {
+                let ti = events.t[i];
+                let from = events.t.partition_point(|&t| t < ti - window);
+                let to = events
+                    .t
+                    .partition_point(|&t| t <= if two_sided { ti + window } else { ti });
+                (from..to).any(|j| {
+                    let dx = events.x[j] as i32 - events.x[i] as i32;
+                    let dy = events.y[j] as i32 - events.y[i] as i32;
+                    (dx, dy) != (0, 0) && dx.abs() <= radius && dy.abs() <= radius
+                })
+            })
+            .collect()
+    }
+
+    #[test]
+    fn flags_are_the_definition_with_many_equal_timestamps_and_at_the_borders() {
+        for (seed, sensor) in [
+            (1, Sensor::new(6, 5)),
+            (2, Sensor::new(1, 9)),
+            (3, Sensor::new(9, 1)),
+            (4, Sensor::new(2, 2)),
+            (5, Sensor::new(24, 13)),
+        ] {
+            let events = crowded(seed, 3000, sensor);
+            let grid = Grid::new(&events, sensor);
+            for window in [0, 40, 300, 2_000] {
+                let causal = by_definition(&events, 1, window, false);
+                assert_eq!(supported(&events, sensor, window), causal);
+                // the stretches' passes, each told by the window before it
+                for count in [2, 7] {
+                    let stretches = events.time_stretches(count, 100);
+                    assert!(stretches.len() > 1);
+                    let parts: Vec<Vec<bool>> = stretches
+                        .into_iter()
+                        .map(|s| grid.forward_stretch(&events, window, s))
+                        .collect();
+                    assert_eq!(parts.concat(), causal, "{count} stretches");
+                }
+                let two_sided = by_definition(&events, 1, window, true);
+                assert_eq!(supported_two_sided(&events, sensor, window), two_sided);
+                assert!(two_sided.iter().zip(&causal).all(|(&a, &b)| a || !b));
+                for radius in [2, 3] {
+                    assert_eq!(
+                        supported_two_sided_within(&events, sensor, window, radius),
+                        by_definition(&events, radius as i32, window, true),
+                        "{sensor:?} window {window} radius {radius}"
+                    );
+                }
+            }
         }
     }
 }
