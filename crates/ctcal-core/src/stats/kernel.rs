@@ -13,6 +13,7 @@
 
 use super::intervals::IntervalHistogram;
 use super::pixel_grid::PixelGrid;
+use super::support::tell_neighbours;
 use super::timeline::SparseTimeline;
 use crate::events::TimeUs;
 
@@ -73,20 +74,6 @@ pub(super) fn cell_indices(xs: &[u16], ys: &[u16], stride: usize, indices: &mut 
             .zip(ys)
             .map(|(&x, &y)| ((y as usize + 1) * stride + x as usize + 1) as u32),
     );
-}
-
-/// Tells the 8 neighbours of cell `k` that one of theirs fired at `t` (border cells
-/// never fire; they are told, and keep it for when the grid grows over them).
-#[inline(always)]
-fn tell_neighbours(neighbours_last: &mut [TimeUs], k: usize, stride: usize, t: TimeUs) {
-    for start in [k - stride - 1, k + stride - 1] {
-        neighbours_last[start..start + 3].fill(t);
-    }
-    let here: &mut [TimeUs; 3] = (&mut neighbours_last[k - 1..k + 2])
-        .try_into()
-        .expect("three cells");
-    here[0] = t;
-    here[2] = t;
 }
 
 /// Adds the events at `ts` with cell `indices` to `grid`, `intervals` and `windows`.

@@ -402,16 +402,17 @@ fn settle(
     // named even where the quiet count keeps shot noise: the count says shot noise is
     // there, not that the look-alike is not (coverage draw 8026: a true 0.50 Hz leak beside
     // it, its fall of 29 % within a chance of 41 %)
-    let (named, unnamed, value) = if lower {
-        (other, kept, kept_value(kept, state))
-    } else {
-        (kept, other, value)
-    };
     // the two models' thresholds, each read from the counts with its own effect
-    let (with_named, with_unnamed) = if lower {
-        (alternative, &state.model)
+    let (named, unnamed, value, with_named, with_unnamed) = if lower {
+        (
+            other,
+            kept,
+            kept_value(kept, state),
+            alternative,
+            &state.model,
+        )
     } else {
-        (&state.model, alternative)
+        (kept, other, value, &state.model, alternative)
     };
     found.push(Ambiguity {
         kept: named.name().into(),
