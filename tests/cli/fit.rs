@@ -216,6 +216,33 @@ fn a_threshold_whose_events_a_kept_leak_makes_is_not_determinable() {
     assert!(on.ends_with(": not determined"), "{check}");
 }
 
+/// Coverage draw 13008 (ctcal: a dim, low-contrast rotating texture whose events are
+/// nearly all a leak's ON events, 2 of 2,480 OFF): its OFF threshold has no count cells to
+/// fix it and is left at its search's start, where the ideal model makes 11,060 OFF events.
+/// The read-noise note compares isolated events only of the polarities whose threshold is
+/// measured, so it no longer blames those OFF events on the frames' noise (it had said
+/// "572 % more isolated events than the recording").
+#[test]
+fn the_read_noise_note_leaves_out_a_polarity_whose_threshold_is_not_measured() {
+    let dir = coverage_case("case-13008");
+    let f = fit(dir.path(), &[]);
+    assert!(f["params"]["ct_off"].is_null(), "{}", f["params"]["ct_off"]);
+    let why = f["why"]["ct_off"].as_str().unwrap();
+    assert!(
+        why.starts_with("the fit blocks have too few events"),
+        "{why}"
+    );
+    let off = &f["residuals_before"]["by_polarity"][0];
+    assert_eq!(off["label"], "OFF");
+    assert!(off["real"].as_u64().unwrap() < 10, "{off}");
+    assert!(off["simulated"].as_u64().unwrap() > 1000, "{off}");
+    let notes: Vec<&str> = strings(&f["assumptions"])
+        .into_iter()
+        .filter(|a| a.starts_with("the ideal model already makes"))
+        .collect();
+    assert!(notes.is_empty(), "{notes:?}");
+}
+
 /// Also the human table: a parameter the data leave undetermined shows its why, never its
 /// interval as if it were a result (the JSON keeps the model's setting in `uncertainties`).
 #[test]

@@ -342,9 +342,19 @@ impl Ideal {
         let before = simulation.distance(&ideal.observed, geometry.testing(), &kept);
         let residuals_before = residuals(&simulation.real, &ideal.observed, geometry, Subset::Fit);
         let noise = distance_noise(simulation, &ideal.observed, &kept);
-        finish::read_noise_note(simulation, &ideal, assumptions);
+        let uncertainty = finish::threshold_uncertainty(simulation, &ideal);
+        // given thresholds are known; thresholds kept at their start (the frames explain
+        // almost no events) or without count cells to fix them are not
+        let measured = ["ct_off", "ct_on"].map(|k| {
+            start_fixed
+                || (!fixed
+                    && uncertainty
+                        .get(k)
+                        .is_some_and(|u| u.standard_error.is_some()))
+        });
+        finish::read_noise_note(simulation, &ideal, measured, assumptions);
         let state = State {
-            uncertainty: finish::threshold_uncertainty(simulation, &ideal),
+            uncertainty,
             model: ideal,
             masked: vec![false; input.sensor.pixels()],
             kept,
