@@ -28,16 +28,6 @@
 //! range, not fixed at its value (profile likelihood, e.g. Cox & Hinkley, *Theoretical
 //! Statistics*, 1974, sec. 9.3).
 //!
-//! An effect the final model lacks can still be there below what the recording would have
-//! shown: the fit's detections say how much shot noise or leak its isolated events would
-//! not have called for, and which photoreceptor cutoff the bandwidth evidence would not
-//! have ([`unseen`]). Such an effect moves the thresholds as a fitted one does, so the
-//! thresholds are profiled again with it at that limit ([`check_unseen`]) and judged by the
-//! same rule, the profile without it as the reference. A photoreceptor that no cutoff
-//! detection bounds (a scene too slow or too dim for any cutoff to show) is not profiled:
-//! the searched range's 2 Hz would withhold most thresholds on a prior no measurement
-//! supports; `bandwidth_detection` says so.
-//!
 //! A first rule for shot noise that also withheld a threshold moving by more than a
 //! factor 2 withheld two that covered the truth (draws 10006 and 10020: OFF 0.857 and
 //! 0.475 for 0.795 and 0.489, moving to 1.71 and 1.20 at the noise's upper end). Widened,
@@ -45,7 +35,7 @@
 //! (`benches/coverage/fit-count-effects-2026-12-07`).
 
 use super::super::Uncertain;
-use super::super::effects::{Effect, leak, shot_noise};
+use super::super::effects::Effect;
 use super::super::search::{Simulation, THRESHOLD_RANGE};
 use super::State;
 use super::method_systematic::widen_ln;
@@ -121,142 +111,6 @@ pub fn check(simulation: &Simulation, state: &mut State) -> Vec<CountCheck> {
         checks.push(judge(effect, &profiles, &mut state.uncertainty));
     }
     checks
-}
-
-/// An effect the final model lacks, set at the most of it the recording would not have
-/// shown: a noise rate just below the one at which its isolated events would have called
-/// for it ([`crate::fit::NoiseLimit`]; for shot noise also the most the quiet pixels allow),
-/// a cutoff at white just above the one at which the bandwidth evidence would have
-/// ([`crate::fit::BandwidthDetection`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Unseen {
-    pub effect: Effect,
-    pub at: f64,
-}
-
-/// The count effects the final model lacks that this recording could hide, each at the
-/// most it would not have shown ([`Unseen`]). A noise limit below the rate that matters
-/// ([`leak::RELEVANT_HZ`], [`shot_noise::RELEVANT_HZ`]) is left out, as is an effect the
-/// loop tried and did not keep (the look-alikes' reach covers those), and a photoreceptor
-/// no cutoff detection bounds (named in the note of `bandwidth_detection`).
-pub fn unseen(
-    params: &PixelParams,
-    noise: Option<&crate::fit::NoiseDetection>,
-    bandwidth: Option<&crate::fit::BandwidthDetection>,
-) -> Vec<Unseen> {
-    let lacks = |effect: Effect| effect.value(params).is_none_or(|v| v <= 0.0);
-    let usable = |v: &f64| v.is_finite() && *v > 0.0;
-    let limit = |key: &str| noise?.limits.get(key).filter(|l| !l.tried);
-    let mut found = Vec::new();
-    if lacks(Effect::ShotNoise)
-        && let Some(l) = limit("shot_noise_rate_hz")
-        && let Some(at) = [l.called_for_above_hz, l.at_most_hz]
-            .into_iter()
-            .flatten()
-            .filter(usable)
-            .reduce(f64::min)
-            .filter(|&at| at > shot_noise::RELEVANT_HZ)
-    {
-        found.push(Unseen {
-            effect: Effect::ShotNoise,
-            at,
-        });
-    }
-    if lacks(Effect::Leak)
-        && let Some(at) = limit("leak_rate_hz")
-            .and_then(|l| l.called_for_above_hz)
-            .filter(|at| usable(at) && *at > leak::RELEVANT_HZ)
-    {
-        found.push(Unseen {
-            effect: Effect::Leak,
-            at,
-        });
-    }
-    if lacks(Effect::Bandwidth)
-        && let Some(at) = bandwidth
-            .filter(|b| !b.tried)
-            .and_then(|b| b.called_for_below_hz)
-            .filter(usable)
-    {
-        found.push(Unseen {
-            effect: Effect::Bandwidth,
-            at,
-        });
-    }
-    found
-}
-
-/// Profiles the final model's thresholds again without each [`Unseen`] effect (as the
-/// model is) and with it at the most the recording would not have shown, and applies the
-/// same verdict as [`judge`]: what an effect the recording cannot rule out would do to the
-/// thresholds is part of their intervals, or leaves them undetermined (coverage draws
-/// 17002 and 17008, DVS-Voltmeter: a drift the model lacked made most ON events, and the
-/// counts read ON 0.17 and 0.08 for 0.82 and 0.52, where a leak of 6.1 and 3.5 Hz would not
-/// have shown in their isolated events).
-pub fn check_unseen(
-    simulation: &Simulation,
-    state: &mut State,
-    unseen: &[Unseen],
-) -> Vec<CountCheck> {
-    if unseen.is_empty() {
-        return Vec::new();
-    }
-    let without = profiled(simulation, state, &state.model.params);
-    unseen
-        .iter()
-        .map(|u| {
-            let mut params = state.model.params.clone();
-            u.effect.set(&mut params, u.at);
-            let with = profiled(simulation, state, &params);
-            let pair = |f: fn(&PixelParams) -> f64| [without.as_ref().map(f), with.as_ref().map(f)];
-            judge_unseen(
-                *u,
-                [pair(|p| p.ct_off), pair(|p| p.ct_on)],
-                &mut state.uncertainty,
-            )
-        })
-        .collect()
-}
-
-/// [`judge`] for an [`Unseen`] effect: `values` (OFF, ON) profiled without it and with it.
-pub fn judge_unseen(
-    unseen: Unseen,
-    values: [[Option<f64>; 2]; 2],
-    uncertainty: &mut BTreeMap<String, Uncertain>,
-) -> CountCheck {
-    let words = words(unseen.effect);
-    let (most, source) = match unseen.effect {
-        Effect::Bandwidth => ("the lowest", "`bandwidth_detection`"),
-        _ => ("the most", "`noise_detection`"),
-    };
-    let how = format!(
-        "{} at {:.4}{}, {most} this recording would not have shown ({source}), and without it",
-        words.subject, unseen.at, words.unit
-    );
-    let mut parts = Vec::new();
-    let mut undetermined = Vec::new();
-    for (pol, (key, name)) in [("ct_off", "OFF"), ("ct_on", "ON")].into_iter().enumerate() {
-        let said = Said {
-            key,
-            name,
-            lead: words.lead[pol],
-            within: words.within[pol],
-        };
-        let profiled = Profiled {
-            how: how.clone(),
-            within: format!("unseen in this recording, {}", said.within),
-            model_setting: format!("without {}", words.subject),
-        };
-        let (part, why) = judge_one(&said, &values[pol], 0, &profiled, uncertainty);
-        parts.push(part);
-        undetermined.extend(why.map(|why| (key.to_string(), why)));
-    }
-    let note = format!(
-        "unseen {}: the final model has none; its thresholds profiled again without it and with {how} (each threshold without / with): {}; a threshold's log change, read as 1.96 standard deviations, widens its interval in quadrature, and one that reaches an end of the profile's range is not determined",
-        words.check,
-        parts.join("; ")
-    );
-    CountCheck { note, undetermined }
 }
 
 /// `params` with the thresholds profiled on the fit blocks (`None` where the profile fails).
@@ -400,17 +254,7 @@ pub fn judge(
             lead: words.lead[pol],
             within: words.within[pol],
         };
-        let profiled = Profiled {
-            how: format!(
-                "{} at its 95 % interval's ends and at the fitted {} ({})",
-                words.parameter,
-                words.quantity,
-                end_list(profiles.at, words.unit)
-            ),
-            within: format!("within {}'s interval {}", words.parameter, said.within),
-            model_setting: format!("at the fitted {}", words.quantity),
-        };
-        let (part, why) = judge_one(&said, &values, 1, &profiled, uncertainty);
+        let (part, why) = judge_one(&said, values, (profiles.at, &words), uncertainty);
         parts.push(part);
         undetermined.extend(why.map(|why| (key.to_string(), why)));
     }
@@ -434,39 +278,30 @@ struct Said<'a> {
     within: &'a str,
 }
 
-/// How a threshold was profiled, for its part of the note and its reason: `how` the
-/// effect was set ("the leak rate at its 95 % interval's ends and at the fitted rate
-/// (...)"), `within` what the effect may do there, `model_setting` where the model holds
-/// it ("at the fitted rate").
-struct Profiled {
-    how: String,
-    within: String,
-    model_setting: String,
-}
-
-/// One threshold's verdict from its `values` profiled as `profiled` says, `values[mid]` at
-/// the model's own setting: its part of the note, and why it is not determined where it
-/// reaches an end of the profile's range; otherwise its interval widened by its largest
-/// log change.
+/// One threshold's verdict from its `values` profiled at `at`: its part of the note, and
+/// why it is not determined where it reaches an end of the profile's range; otherwise its
+/// interval widened by its largest log change.
 fn judge_one(
     said_as: &Said,
-    values: &[Option<f64>],
-    mid: usize,
-    profiled: &Profiled,
+    values: [Option<f64>; 3],
+    (at, words): ([Option<End>; 3], &Words),
     uncertainty: &mut BTreeMap<String, Uncertain>,
 ) -> (String, Option<String>) {
     let Said {
-        key, name, lead, ..
+        key,
+        name,
+        lead,
+        within,
     } = *said_as;
-    let listed = values
-        .iter()
-        .map(|v| shown(*v))
-        .collect::<Vec<_>>()
-        .join(" / ");
-    let said = format!("{name} {listed}");
-    let Some(mid) = values[mid] else {
+    let said = format!(
+        "{name} {} / {} / {}",
+        shown(values[0]),
+        shown(values[1]),
+        shown(values[2])
+    );
+    let Some(mid) = values[1] else {
         return (
-            format!("{said} (not profiled {})", profiled.model_setting),
+            format!("{said} (not profiled at the fitted {})", words.quantity),
             None,
         );
     };
@@ -476,8 +311,18 @@ fn judge_one(
         .any(|v| *v <= THRESHOLD_RANGE.0 * 1.0001 || *v >= THRESHOLD_RANGE.1 * 0.9999);
     if at_bound {
         let why = format!(
-            "{lead}: profiled again with {}, {key} reads {listed}, reaching an end of the profile's range ({} to {}): {}, so the counts do not fix the threshold",
-            profiled.how, THRESHOLD_RANGE.0, THRESHOLD_RANGE.1, profiled.within,
+            "{}: profiled again with {} at its 95 % interval's ends and at the fitted {} ({}), {key} reads {} / {} / {}, reaching an end of the profile's range ({} to {}): within {}'s interval {}, so the counts do not fix the threshold",
+            lead,
+            words.parameter,
+            words.quantity,
+            end_list(at, words.unit),
+            shown(values[0]),
+            shown(values[1]),
+            shown(values[2]),
+            THRESHOLD_RANGE.0,
+            THRESHOLD_RANGE.1,
+            words.parameter,
+            within,
         );
         return (format!("{said}: not determined"), Some(why));
     }
@@ -523,7 +368,6 @@ fn end_list(at: [Option<End>; 3], unit: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::{BandwidthDetection, NoiseDetection, NoiseLimit};
 
     fn uncertainty() -> BTreeMap<String, Uncertain> {
         BTreeMap::from([
@@ -657,131 +501,6 @@ mod tests {
         assert_eq!(
             ends_of(Effect::Bandwidth, 1.5, [Some(0.5), Some(3.0)]),
             [at(1.5), at(1.5), at(3.0)]
-        );
-    }
-
-    fn noise_limit(called: Option<f64>, at_most: Option<f64>, tried: bool) -> NoiseLimit {
-        NoiseLimit {
-            called_for_above_hz: called,
-            isolated_hz_per_hz: None,
-            tried,
-            why: None,
-            at_most_hz: at_most,
-        }
-    }
-
-    fn detections(
-        shot: NoiseLimit,
-        leak: NoiseLimit,
-        cutoff: Option<f64>,
-    ) -> (NoiseDetection, BandwidthDetection) {
-        let noise = NoiseDetection {
-            limits: BTreeMap::from([
-                ("shot_noise_rate_hz".to_string(), shot),
-                ("leak_rate_hz".to_string(), leak),
-            ]),
-            probe_hz: 1.0,
-            meaning: "",
-        };
-        let bandwidth = BandwidthDetection {
-            called_for_below_hz: cutoff,
-            evidence: Vec::new(),
-            recording_evidence: None,
-            simulations: 0,
-            tried: false,
-            why: None,
-            meaning: "",
-        };
-        (noise, bandwidth)
-    }
-
-    /// Shot noise at the lower of its two limits (the rate its isolated events would call
-    /// for it at, the most the quiet pixels allow), a leak at its limit, a cutoff at its
-    /// limit; none for an effect the model has, one tried and not kept, or a limit below
-    /// the rate that matters.
-    #[test]
-    fn unseen_effects_are_the_ones_the_model_lacks_at_their_detection_limits() {
-        let ideal = PixelParams::ideal(0.3, 0.4);
-        let (noise, bandwidth) = detections(
-            noise_limit(Some(1.39), Some(0.0175), false),
-            noise_limit(Some(6.14), None, false),
-            Some(136.9),
-        );
-        let found = unseen(&ideal, Some(&noise), Some(&bandwidth));
-        let at = |effect| found.iter().find(|u| u.effect == effect).map(|u| u.at);
-        assert_eq!(at(Effect::ShotNoise), Some(0.0175));
-        assert_eq!(at(Effect::Leak), Some(6.14));
-        assert_eq!(at(Effect::Bandwidth), Some(136.9));
-        assert_eq!(found.len(), 3);
-        // a model with shot noise and a cutoff: only the leak is unseen
-        let mut model = ideal.clone();
-        model.shot_noise_rate_hz = Some(0.5);
-        model.cutoff_hz = Some(300.0);
-        let found = unseen(&model, Some(&noise), Some(&bandwidth));
-        assert_eq!(
-            found,
-            vec![Unseen {
-                effect: Effect::Leak,
-                at: 6.14
-            }]
-        );
-        // tried and not kept, below what matters, not a number, or no limit: none
-        let (noise, mut bandwidth) = detections(
-            noise_limit(Some(1.39), Some(0.002), false),
-            noise_limit(Some(6.14), None, true),
-            Some(f64::NAN),
-        );
-        assert!(unseen(&ideal, Some(&noise), Some(&bandwidth)).is_empty());
-        bandwidth.called_for_below_hz = None;
-        assert!(unseen(&ideal, None, Some(&bandwidth)).is_empty());
-        assert!(unseen(&ideal, None, None).is_empty());
-    }
-
-    /// A leak of 6.1429 Hz the recording would not have shown: OFF does not move (its
-    /// interval stays), ON moves 4.42 -> 4.9: ln(4.9 / 4.42) = 0.10310 in quadrature with
-    /// ln(4.42 / 2.57) = 0.54223 below and ln(7.60 / 4.42) = 0.54201 above: 4.42
-    /// exp(-0.55195) = 2.54516 and 4.42 exp(0.55173) = 7.67422. With ON reaching the
-    /// profile's upper end (5.0) it is not determined, with why.
-    #[test]
-    fn an_unseen_leak_widens_or_withholds_the_threshold_it_moves() {
-        let leak = Unseen {
-            effect: Effect::Leak,
-            at: 6.1429,
-        };
-        let mut u = uncertainty();
-        let check = judge_unseen(
-            leak,
-            [[Some(0.40), Some(0.40)], [Some(4.42), Some(4.9)]],
-            &mut u,
-        );
-        assert!(check.undetermined.is_empty());
-        assert_eq!(u["ct_off"].ci95, Some([Some(0.30), Some(0.55)]));
-        let [lo, hi] = u["ct_on"].ci95.unwrap();
-        assert!((lo.unwrap() - 2.54516).abs() < 1e-4, "{lo:?}");
-        assert!((hi.unwrap() - 7.67422).abs() < 1e-4, "{hi:?}");
-        assert!(
-            check.note.starts_with(
-                "unseen leak-rate check: the final model has none; its thresholds profiled again without it and with the leak at 6.1429 Hz, the most this recording would not have shown (`noise_detection`), and without it (each threshold without / with): OFF 0.4000 / 0.4000; ON 4.4200 / 4.9000: ct_on"
-            ),
-            "{}",
-            check.note
-        );
-        let mut u = uncertainty();
-        let check = judge_unseen(
-            leak,
-            [[Some(0.40), Some(0.40)], [Some(0.17), Some(5.0)]],
-            &mut u,
-        );
-        assert_eq!(check.undetermined.len(), 1);
-        let (key, why) = &check.undetermined[0];
-        assert_eq!(key, "ct_on");
-        assert!(
-            why.starts_with("the events of this polarity are mostly the leak's: profiled again with the leak at 6.1429 Hz"),
-            "{why}"
-        );
-        assert!(
-            why.ends_with("unseen in this recording, the leak alone may make the recording's events of this polarity, so the counts do not fix the threshold"),
-            "{why}"
         );
     }
 

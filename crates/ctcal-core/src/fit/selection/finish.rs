@@ -288,14 +288,13 @@ struct Judged {
     not_identified: BTreeMap<String, String>,
 }
 
-/// The detections, the count effects the recording could hide ([`super::count_effects::unseen`]),
-/// the parameters the data do not identify, then the assumptions of the
+/// The detections, the parameters the data do not identify, then the assumptions of the
 /// blocks' split; each appends its assumptions to the parts'.
 fn judged(
     simulation: &Simulation,
     state: &mut State,
     parts: &mut Parts,
-    mut noise: NoiseIntervals,
+    noise: NoiseIntervals,
 ) -> Judged {
     let (noise_detection, bandwidth_detection) = detections(
         simulation,
@@ -305,17 +304,6 @@ fn judged(
         parts.frames_aligned,
         &mut parts.assumptions,
     );
-    if !parts.fixed {
-        let unseen = super::count_effects::unseen(
-            &state.model.params,
-            noise_detection.as_ref(),
-            bandwidth_detection.as_ref(),
-        );
-        for check in super::count_effects::check_unseen(simulation, state, &unseen) {
-            parts.assumptions.push(check.note);
-            noise.undetermined.extend(check.undetermined);
-        }
-    }
     let not_identified = undetermined(
         simulation,
         state,
