@@ -348,6 +348,14 @@ unsafe fn cells(coords: &[f64], size: usize, stride: usize, out: &mut Cells) {
 /// is exact, so both are the rounding of the same real number, the same bits, without a
 /// division per point.
 ///
+/// With `POW2` three more steps are shorter, with the same results (about a fifth of the
+/// time of a sample). The wrapped `r = x - n k` is never below 0 (exact for `k != -1`, and
+/// for `k = -1` the rounded `x + n` of `x` in `[-n, 0)`, at least 0; see [`wrap`]), so the
+/// `+ n` below zero is left out. The cell `i` is in `[0, n]`, and `i & (n - 1)` is `i`
+/// below `n` and 0 at `n`, which is `if i >= n { i - n }`; likewise `(i + 1) & (n - 1)` for
+/// the next cell of an `i` below `n`. The stride is 1 or `n`, a power of two, so the
+/// product is a shift by its trailing zeros.
+///
 /// # Safety
 /// As [`cells`].
 #[cfg(target_arch = "x86_64")]
@@ -361,18 +369,22 @@ unsafe fn cells_with<const POW2: bool>(
     let n = size as f64;
     let inverse = 1.0 / n;
     let (size, stride) = (size as u32, stride as u32);
+    let (mask, shift) = (size.wrapping_sub(1), stride.trailing_zeros());
     let lanes = out.c0.iter_mut().zip(&mut out.c1).zip(&mut out.f);
     for (((c0, c1), f), &x) in lanes.zip(coords) {
         let quotient = if POW2 { x * inverse } else { x / n };
         let x = x - n * (quotient.floor() + 0.0);
-        let x = if x < 0.0 { x + n } else { x };
+        let x = if !POW2 && x < 0.0 { x + n } else { x };
         // SAFETY: x is in [0, n], n <= 2^15 (the caller's contract)
         let i = unsafe { x.to_int_unchecked::<i32>() } as u32;
         *f = (x - i as f64) as f32;
-        let i = if i >= size { i - size } else { i };
-        let next = if i + 1 >= size { i + 1 - size } else { i + 1 };
-        *c0 = i * stride;
-        *c1 = next * stride;
+        if POW2 {
+            (*c0, *c1) = ((i & mask) << shift, ((i + 1) & mask) << shift);
+        } else {
+            let i = if i >= size { i - size } else { i };
+            let next = if i + 1 >= size { i + 1 - size } else { i + 1 };
+            (*c0, *c1) = (i * stride, next * stride);
+        }
     }
 }
 
@@ -478,6 +490,51 @@ mod tests {
                 let b = c.sample_reference(x, y).to_bits();
                 assert_eq!(out[k].to_bits(), b, "size {size} at ({x:e}, {y:e})");
                 assert_eq!(pieces[k].to_bits(), b, "size {size} at ({x:e}, {y:e})");
+            }
+        }
+    }
+
+    /// The shortcuts of `cells_with::<true>` (no `+ n` below zero, a mask for the wrap, a
+    /// shift for the stride) against the general path `cells_with::<false>` (which takes
+    /// `x / n` as a division, the same bits on a power of two): the same cells and
+    /// fractions to the bit on random, edge and far coordinates.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn cells_of_a_power_of_two_are_the_general_cells_to_the_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        for size in [8usize, 64, 128, 256, 512, 1 << 15] {
+            let (_, points) = canvas_and_points(size.min(512), 11 + size as u64);
+            let n = size as f64;
+            let mut coords: Vec<f64> = points.iter().flat_map(|&(x, y)| [x, y]).collect();
+            // past 4e15 is not the fast path's: the edges of a canvas of this size instead
+            coords.retain(|c| c.abs() < 4.0e15);
+            for k in -4..=4 {
+                let e = k as f64 * n;
+                for d in [
+                    0.0, -0.0, 1e-300, -1e-300, 1e-13, -1e-13, 0.5, -0.5, 1.0, -1.0,
+                ] {
+                    coords.push(e + d);
+                }
+                coords.push(f64::from_bits((e - 1.0).to_bits() + 1));
+            }
+            for stride in [1, size] {
+                let (mut fast, mut general) = (Cells::new(), Cells::new());
+                for block in coords.chunks(BLOCK) {
+                    // SAFETY: AVX2 (checked above), a canvas up to 2^15, every coordinate
+                    // finite and within 4e15
+                    unsafe {
+                        cells_with::<true>(block, size, stride, &mut fast);
+                        cells_with::<false>(block, size, stride, &mut general);
+                    }
+                    for (k, x) in block.iter().enumerate() {
+                        let at = format!("size {size} stride {stride} at {x:e}");
+                        assert_eq!(fast.c0[k], general.c0[k], "{at}");
+                        assert_eq!(fast.c1[k], general.c1[k], "{at}");
+                        assert_eq!(fast.f[k].to_bits(), general.f[k].to_bits(), "{at}");
+                    }
+                }
             }
         }
     }
