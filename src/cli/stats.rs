@@ -224,6 +224,9 @@ fn finish(
     accumulator
         .finish(resolved.sensor, &resolved.source, &frame_times)
         .ok_or_else(|| {
+            if args.start.is_none() && args.end.is_none() && args.selection.is_set() {
+                return selection_empty(recording, &args.selection);
+            }
             ctcal::InputError::EmptyWindow {
                 path: recording.path.clone(),
                 detail: [window("--start", args.start), window("--end", args.end)]
@@ -234,6 +237,31 @@ fn finish(
             }
             .into()
         })
+}
+
+/// The error for a pixel selection that holds none of the recording's events (no time
+/// window was asked for, so the window is not what emptied it).
+fn selection_empty(recording: &Recording, selection: &super::SelectionArgs) -> anyhow::Error {
+    let what = [
+        selection.roi.map(|r| format!("--roi {r}")),
+        selection
+            .mask
+            .as_ref()
+            .map(|m| format!("--mask {}", m.display())),
+        selection
+            .exclude_hot_pixels
+            .then(|| "--exclude-hot-pixels".to_string()),
+    ]
+    .into_iter()
+    .flatten()
+    .collect::<Vec<_>>()
+    .join(", ");
+    ctcal::InputError::invalid(
+        &recording.path,
+        format!("no event lies in the selected pixels ({what})"),
+        "select pixels where the recording has events, or leave the selection out",
+    )
+    .into()
 }
 
 /// The error for events that reach further than the per-pixel budget.

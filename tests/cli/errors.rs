@@ -207,6 +207,14 @@ fn bad_options_are_usage_errors() {
         e.contains("no events lie in the selected time window"),
         "{e}"
     );
+    // a region without events, no time window asked for: the region is named, not a
+    // window ("no events lie in the selected time window ()", "widen --start/--end")
+    let e = bad_input(&["stats", input.to_str().unwrap(), "--roi", "0,0,1,1"]);
+    assert!(
+        e.contains("no event lies in the selected pixels (--roi 0,0,1,1)")
+            && !e.contains("--start"),
+        "{e}"
+    );
 }
 
 /// slider_depth's events rewritten in microseconds, its frames left in seconds: no event

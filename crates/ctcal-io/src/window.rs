@@ -835,6 +835,7 @@ pub fn eppps_of(
         progress,
     )?;
     estimate.assumptions.extend(notes);
+    estimate.span_events(&loaded.events);
     Ok(estimate)
 }
 
@@ -869,6 +870,7 @@ pub fn screen_of(
         progress,
     )?;
     estimate.assumptions.extend(loaded.notes.iter().cloned());
+    estimate.span_events(&loaded.events);
     Ok(estimate)
 }
 

@@ -187,7 +187,7 @@ impl Determinable {
             return Some((
                 [None, Some(m.ci95[1])],
                 format!(
-                    "{name} = {:.4} is an extrapolation below {} (down to {}): its interval is open below",
+                    "{name} = {:.4} is an extrapolation below {} (down to {:.4}): its interval is open below",
                     m.value, self.what, self.lo
                 ),
             ));
@@ -196,7 +196,7 @@ impl Determinable {
             return Some((
                 [lo, None],
                 format!(
-                    "{name} = {:.4} is an extrapolation above {} (up to {}): its interval is open above",
+                    "{name} = {:.4} is an extrapolation above {} (up to {:.4}): its interval is open above",
                     m.value, self.what, self.hi
                 ),
             ));
@@ -211,14 +211,14 @@ impl Determinable {
         if m.ci95[1] > self.hi {
             ci[1] = None;
             notes.push(format!(
-                "the 95 % interval of {name} runs past {} (up to {}): open above",
+                "the 95 % interval of {name} runs past {} (up to {:.4}): open above",
                 self.what, self.hi
             ));
         }
         if self.lo > 0.0 && m.ci95[0] < self.lo {
             ci[0] = None;
             notes.push(format!(
-                "the 95 % interval of {name} runs below {} (down to {}): open below",
+                "the 95 % interval of {name} runs below {} (down to {:.4}): open below",
                 self.what, self.lo
             ));
         }
@@ -227,6 +227,16 @@ impl Determinable {
 }
 
 impl CtEstimate {
+    /// Adds `time_span_s`, the first and the last event's times in seconds, where the
+    /// method has not given its own (`aps` gives its frames' span); none without events.
+    pub fn span_events(&mut self, events: &crate::events::EventChunk) {
+        if let (Some(&first), Some(&last)) = (events.t.first(), events.t.last()) {
+            self.extra.entry("time_span_s").or_insert_with(|| {
+                serde_json::json!([crate::events::us_to_s(first), crate::events::us_to_s(last)])
+            });
+        }
+    }
+
     /// An estimate from ON and OFF values, each checked: a value that is not finite or not
     /// positive is not determinable (`None`, with the reason under `why`); one outside
     /// `range` is an extrapolation (kept, its interval open on that side, and said in the
@@ -269,6 +279,10 @@ impl CtEstimate {
         self.ct_ci95 = None;
         self.ct_sigma = None;
         self.ct_sigma_ci95 = None;
+        // written as `null` beside its reason (the field itself is left out where a method
+        // does not measure the spread)
+        self.extra
+            .insert("ct_sigma".into(), serde_json::Value::Null);
     }
 
     /// Withdraws one threshold (ON when `on`, else OFF) for `reason`; the mean goes with it.

@@ -348,10 +348,9 @@ fn withhold_noise_polarities(estimate: &mut CtEstimate, timing: &TimingEstimate)
                 peak.describe(name)
             ),
         );
-        estimate.ct_sigma = None;
-        estimate.ct_sigma_ci95 = None;
-        estimate.why.insert(
-            "ct_sigma".into(),
+        spread_not_determined(
+            estimate,
+            None,
             format!(
                 "the per-pixel spread rests on both polarities' maps, and the {name} samples show no threshold peak above the noise (see ct_{})",
                 name.to_lowercase()
@@ -518,8 +517,17 @@ fn sigma_result(
 
 /// `ct_sigma` not resolved: `null`, `[0, upper]` and the reason.
 fn not_resolved(estimate: &mut CtEstimate, upper: f64, why: String) {
+    spread_not_determined(estimate, Some([0.0, upper]), why);
+}
+
+/// `ct_sigma` written as `null` (not left out: the contract's not-determinable value), with
+/// `interval` (an upper bound, or none) and the reason under `why`.
+fn spread_not_determined(estimate: &mut CtEstimate, interval: Option<[f64; 2]>, why: String) {
     estimate.ct_sigma = None;
-    estimate.ct_sigma_ci95 = Some([0.0, upper]);
+    estimate.ct_sigma_ci95 = interval;
+    estimate
+        .extra
+        .insert("ct_sigma".into(), serde_json::Value::Null);
     estimate.why.insert("ct_sigma".into(), why);
 }
 
