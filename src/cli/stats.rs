@@ -361,7 +361,7 @@ fn rate_rows(s: &SequenceStats) -> Vec<(String, String)> {
                 s,
                 s.background_rate_hz.map(|r| {
                     format!(
-                        "{r:.4} Hz per pixel (events with no neighbour event in the {} before; hot pixels excluded)",
+                        "{r:.4} Hz per pixel (events with no neighbour event in the {} before, from one such window after the first event; hot pixels excluded)",
                         output::seconds(s.support_window_s)
                     )
                 }),

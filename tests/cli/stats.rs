@@ -195,6 +195,25 @@ fn real_recordings_have_background_activity() {
     }
 }
 
+/// The 13 ms IJRR boxes chunk: 3,456 of its 3,562 events without support fell in the first
+/// 10 ms support window, where no event has a history, and read as 6.2 Hz of background
+/// activity per pixel. Judged only after that window, an independent recount (of the same
+/// definition, a sweep of 2026-12-07) gives 0.75 Hz.
+#[test]
+fn the_first_support_window_is_not_background_activity() {
+    let s = json(&["stats", real("ijrr_boxes_rotation_chunk").to_str().unwrap()]);
+    let rate = s["background_rate_hz"].as_f64().unwrap();
+    assert!((0.6..0.9).contains(&rate), "{rate}");
+    assert!(
+        s["background_rate_method"]
+            .as_str()
+            .unwrap()
+            .contains("the first support window after the first event"),
+        "{}",
+        s["background_rate_method"]
+    );
+}
+
 #[test]
 fn window_selection_counts_the_events_inside() {
     let path = oracle("e_ct030_texture");

@@ -49,6 +49,9 @@ pub(super) struct Settings {
     /// The first counted event's time (the timeline's origin).
     pub first: TimeUs,
     pub support_us: TimeUs,
+    /// The first time an event has a whole support window of history before it (the
+    /// first event fed plus the window): earlier events are not judged as unsupported.
+    pub judged_from: TimeUs,
     pub window_us: TimeUs,
 }
 
@@ -91,6 +94,7 @@ pub(super) fn accumulate<const SELECTED: bool>(
 ) {
     let stride = settings.stride;
     let (first, support_us, window_us) = (settings.first, settings.support_us, settings.window_us);
+    let judged_from = settings.judged_from;
     let indices = &indices[..ts.len()];
     let mut window_end = windows.end;
     let mut window_count = windows.count;
@@ -124,7 +128,7 @@ pub(super) fn accumulate<const SELECTED: bool>(
             intervals.add(t.wrapping_sub(cell.last) as u64);
         }
         cell.count += 1;
-        cell.unsupported += (newest < t.saturating_sub(support_us)) as u32;
+        cell.unsupported += (newest < t.saturating_sub(support_us) && t >= judged_from) as u32;
         cell.last = t;
         if !counted {
             continue;
