@@ -338,11 +338,16 @@ impl Decode for CtEstimate {
         let Value::Object(all) = v else {
             return Err(expected("an object", v));
         };
-        let extra = all
+        let mut extra: serde_json::Map<String, Value> = all
             .iter()
             .filter(|(k, _)| !ESTIMATE_KEYS.contains(&k.as_str()) && *k != "intervals_dropped")
             .map(|(k, v)| (k.clone(), v.clone()))
             .collect();
+        // a spread written as `null` beside its reason rides in `extra` (the field is left
+        // out where a method does not measure it): read back the same way
+        if all.get("ct_sigma") == Some(&Value::Null) {
+            extra.insert("ct_sigma".into(), Value::Null);
+        }
         Ok(CtEstimate {
             method: field(v, "method")?,
             ct_on: field(v, "ct_on")?,

@@ -46,7 +46,8 @@ pub fn header(name: &str) -> String {
     format!("{}{unit}", stem.replace('_', " "))
 }
 
-/// `t` without its empty columns, headers in words.
+/// `t` without its empty columns (but an interval's end beside its value), headers in
+/// words.
 pub fn shown(t: &Table) -> Shown {
     let (names, cells) = rows(t);
     let numeric: Vec<bool> = t
@@ -55,8 +56,25 @@ pub fn shown(t: &Table) -> Shown {
         .iter()
         .map(|c| c.dtype().is_primitive_numeric())
         .collect();
+    let filled: Vec<bool> = (0..names.len())
+        .map(|i| cells.iter().any(|row| row[i].is_some()))
+        .collect();
+    let has = |name: &str| {
+        names
+            .iter()
+            .position(|n| n == name)
+            .is_some_and(|i| filled[i])
+    };
+    // an interval's end stays beside its value or its other end, empty or not: a column of
+    // dashes says the interval is open there (left out, an open side looked like none)
+    let interval_end = |name: &str| {
+        [("_lo", "_hi"), ("_hi", "_lo")].iter().any(|(end, other)| {
+            name.strip_suffix(end)
+                .is_some_and(|stem| has(stem) || has(&format!("{stem}{other}")))
+        })
+    };
     let keep: Vec<usize> = (0..names.len())
-        .filter(|&i| cells.iter().any(|row| row[i].is_some()))
+        .filter(|&i| filled[i] || interval_end(&names[i]))
         .collect();
     Shown {
         headers: keep.iter().map(|&i| header(&names[i])).collect(),
@@ -153,5 +171,39 @@ mod tests {
         assert_eq!(s.headers, ["a"]);
         assert_eq!(s.rows, [[Some("1.500".to_string())], [None]]);
         assert_eq!(markdown(&t), "| a |\n|---:|\n| 1.500 |\n| – |\n");
+    }
+
+    /// An interval open below in every row (the Gen3 recording of expelliarmus: eppps read
+    /// ON 0.122 [open, 1.55]): its empty `_lo` column stays beside the value, so the page
+    /// shows the open side as a dash instead of no lower end at all.
+    #[test]
+    fn an_interval_end_stays_beside_its_value_when_it_is_open() {
+        let column = |name: &str, values: Vec<Option<f64>>| {
+            polars::prelude::Column::new(name.into(), values)
+        };
+        let frame = polars::prelude::DataFrame::new_infer_height(vec![
+            column("ct_on", vec![Some(0.122)]),
+            column("ct_on_lo", vec![None]),
+            column("ct_on_hi", vec![Some(1.553)]),
+            column("ci95_lo", vec![None]),
+            column("ci95_hi", vec![Some(1.0)]),
+            column("other_lo", vec![None]),
+        ])
+        .unwrap();
+        let t = Table {
+            name: "t",
+            caption: "c",
+            frame,
+        };
+        assert_eq!(
+            shown(&t).headers,
+            [
+                "ct on (ln)",
+                "ct on lo (ln)",
+                "ct on hi (ln)",
+                "95 % low",
+                "95 % high"
+            ]
+        );
     }
 }

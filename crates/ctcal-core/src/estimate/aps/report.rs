@@ -496,8 +496,9 @@ fn sigma_result(
         .hypot(offset)
         .hypot(SIGMA_METHOD_SYSTEMATIC);
     let measure = Measured::new(value, spread.sigma_standard_error, systematic);
+    let said = spread_said(spread);
     assumptions.push(format!(
-        "ct_sigma: the per-pixel spread {sigma:.4} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}), across the frames' offset range ({offset:.4}) and the method systematic {SIGMA_METHOD_SYSTEMATIC} (what the spread misses on simulated recordings with known mismatch and random sensor effects, coverage study, 53 draws: the smallest term that covers 95 % of them) as systematic ({systematic:.4})"
+        "ct_sigma: the per-pixel spread {said} less the self-calibration's bias {sigma_bias:+.4}; its interval holds that whole bias and at least 10 % of the value ({floor:.4}) and, in quadrature, how far the spread moves when every 2nd and 3rd frame is used ({frame_rate:.4}), across the frames' offset range ({offset:.4}) and the method systematic {SIGMA_METHOD_SYSTEMATIC} (what the spread misses on simulated recordings with known mismatch and random sensor effects, coverage study, 53 draws: the smallest term that covers 95 % of them) as systematic ({systematic:.4})"
     ));
     let hi = spread.raised(measure.ci95[1]);
     if measure.ci95[0] > 0.0 {
@@ -509,9 +510,23 @@ fn sigma_result(
             estimate,
             upper,
             format!(
-                "not resolved: the per-pixel spread {sigma:.4} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors, the method systematic included; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
+                "not resolved: the per-pixel spread {said} is within the method's own spread on a mismatch-free simulation ({sigma_bias:.4}) and its errors, the method systematic included; 95 % upper bound {upper:.4} (the excess variance of the per-pixel thresholds over their estimation noise, plus 1.96 of its standard errors)"
             ),
         );
+    }
+}
+
+/// The per-pixel spread as the notes give it: its value, or, where the thresholds spread
+/// no more than their estimation noise (the spread is then 0, `sqrt(max(v, 0))`), that
+/// excess variance, which 0.0000 alone would not tell.
+fn spread_said(spread: &Spread) -> String {
+    if spread.sigma > 0.0 {
+        format!("{:.4}", spread.sigma)
+    } else {
+        format!(
+            "0 (the per-pixel thresholds' variance less their estimation noise's is {:.2e} +- {:.2e}, not above 0)",
+            spread.excess_variance, spread.excess_variance_standard_error
+        )
     }
 }
 
