@@ -1,5 +1,6 @@
 # compare.py BEFORE AFTER CASES: threshold coverage before/after, the log-width ratio of each
-# threshold interval, which count-effect check or look-alike term fired, and the simulations' count before/after.
+# threshold interval, which count-effect check, look-alike term or unseen-effect check (an assumption
+# starting with its name) fired, and the simulations' count before/after.
 import json,glob,os,sys,collections,math
 A,B,C=sys.argv[1],sys.argv[2],sys.argv[3]
 def load(p):
@@ -23,7 +24,7 @@ for p in sorted(glob.glob(B+'/case-*.json')):
     t=json.load(open(f'{C}/{n}/truth.json'))
     split='held' if n.startswith('case-17') else 'study'
     line=[]
-    fired=[k for k,s in (('leak','leak-rate check'),('cutoff','cutoff check'),('refr','refractory check'),('noise','noise-rate check'),('alike','the thresholds of the models the data do not separate')) if any(s in x for x in b.get('assumptions',[]))]
+    fired=[k for k,s in (('leak','leak-rate check'),('cutoff','cutoff check'),('refr','refractory check'),('noise','noise-rate check'),('alike','the thresholds of the models the data do not separate'),('u-leak','unseen leak-rate check'),('u-noise','unseen noise-rate check'),('u-cut','unseen cutoff check')) if any(x.startswith(s) for x in b.get('assumptions',[]))]
     for key in ('ct_on','ct_off'):
         (ca,wa),(cb,wb)=cov(a,key,t['values'][key]),cov(b,key,t['values'][key])
         tally[(split,key,'before')][ca]+=1; tally[(split,key,'after')][cb]+=1
