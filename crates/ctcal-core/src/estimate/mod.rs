@@ -268,7 +268,7 @@ impl CtEstimate {
     /// `reason`: each becomes not determinable; the estimators' own values stay under
     /// `estimators` for inspection.
     pub fn withhold(&mut self, reason: &str) {
-        for key in ["ct_on", "ct_off", "ct", "ct_sigma"] {
+        for key in ["ct_on", "ct_off", "ct"] {
             self.why.insert(key.into(), reason.to_string());
         }
         self.ct_on = None;
@@ -277,12 +277,18 @@ impl CtEstimate {
         self.ct_off_ci95 = None;
         self.ct = None;
         self.ct_ci95 = None;
+        self.spread_not_determined(None, reason.to_string());
+    }
+
+    /// `ct_sigma` not determined: written as `null` (not left out, as it is where a method
+    /// does not measure the spread; it rides in `extra`, and the decoder reads it back so),
+    /// with `interval` (an upper bound, or none) and `why`.
+    pub fn spread_not_determined(&mut self, interval: Option<[f64; 2]>, why: String) {
         self.ct_sigma = None;
-        self.ct_sigma_ci95 = None;
-        // written as `null` beside its reason (the field itself is left out where a method
-        // does not measure the spread)
+        self.ct_sigma_ci95 = interval;
         self.extra
             .insert("ct_sigma".into(), serde_json::Value::Null);
+        self.why.insert("ct_sigma".into(), why);
     }
 
     /// Withdraws one threshold (ON when `on`, else OFF) for `reason`; the mean goes with it.

@@ -348,8 +348,7 @@ fn withhold_noise_polarities(estimate: &mut CtEstimate, timing: &TimingEstimate)
                 peak.describe(name)
             ),
         );
-        spread_not_determined(
-            estimate,
+        estimate.spread_not_determined(
             None,
             format!(
                 "the per-pixel spread rests on both polarities' maps, and the {name} samples show no threshold peak above the noise (see ct_{})",
@@ -532,18 +531,7 @@ fn spread_said(spread: &Spread) -> String {
 
 /// `ct_sigma` not resolved: `null`, `[0, upper]` and the reason.
 fn not_resolved(estimate: &mut CtEstimate, upper: f64, why: String) {
-    spread_not_determined(estimate, Some([0.0, upper]), why);
-}
-
-/// `ct_sigma` written as `null` (not left out: the contract's not-determinable value), with
-/// `interval` (an upper bound, or none) and the reason under `why`.
-fn spread_not_determined(estimate: &mut CtEstimate, interval: Option<[f64; 2]>, why: String) {
-    estimate.ct_sigma = None;
-    estimate.ct_sigma_ci95 = interval;
-    estimate
-        .extra
-        .insert("ct_sigma".into(), serde_json::Value::Null);
-    estimate.why.insert("ct_sigma".into(), why);
+    estimate.spread_not_determined(Some([0.0, upper]), why);
 }
 
 /// What a polarity whose noise subtraction overshoots does to `ct_sigma`, in words.
