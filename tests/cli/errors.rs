@@ -215,6 +215,19 @@ fn bad_options_are_usage_errors() {
             && !e.contains("--start"),
         "{e}"
     );
+    // the estimates and the fit said "no motion to measure" or "too few events between
+    // frames ... (--start/--end)" of the same empty region
+    for command in [&["estimate", "eppps"][..], &["estimate", "aps"], &["fit"]] {
+        let mut args = command.to_vec();
+        args.extend([input.to_str().unwrap(), "--roi", "0,0,1,1"]);
+        let e = bad_input(&args);
+        assert!(
+            e.contains("no event lies in the selected pixels (region x 0..1, y 0..1")
+                && !e.contains("--start")
+                && !e.contains("motion"),
+            "{command:?}: {e}"
+        );
+    }
 }
 
 /// slider_depth's events rewritten in microseconds, its frames left in seconds: no event

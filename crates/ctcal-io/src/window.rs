@@ -156,6 +156,33 @@ impl SelectionSpec {
     }
 }
 
+/// Refuses a pixel selection that holds none of the window's events: every estimate would
+/// otherwise fail on it for a reason that is not the one (no motion, too few frames' worth
+/// of events), and name a fix that does not help.
+fn check_selection_has_events(
+    path: &Path,
+    events: &EventChunk,
+    kept: &PixelSelection,
+    window: &Window,
+) -> Result<(), LoadError> {
+    let sensor = kept.sensor();
+    let inside = |x: u16, y: u16| x < sensor.width && y < sensor.height && kept.keeps(x, y);
+    if kept.is_all() || events.x.iter().zip(&events.y).any(|(&x, &y)| inside(x, y)) {
+        return Ok(());
+    }
+    let windowed = window.start_s.is_some() || window.end_s.is_some();
+    Err(LoadError::Selection {
+        path: path.to_path_buf(),
+        problem: format!(
+            "no event {}lies in the selected pixels ({})",
+            if windowed { "of the time window " } else { "" },
+            kept.description()
+        )
+        .into(),
+        fix: "select pixels where the recording has events, or leave the selection out".into(),
+    })
+}
+
 /// Where a load reports what it warns of and how far it has read.
 pub trait LoadObserver {
     /// A warning about the recording (sensor size guessed, an index rebuilt, ...), which
@@ -198,6 +225,7 @@ pub fn load(
     let sensor = resolved.sensor;
     check_sensor_fits(&recording, &read, sensor, force)?;
     let kept = selection.build(sensor, &recording.path, force)?;
+    check_selection_has_events(&recording.path, &read.events, &kept, window)?;
     let mut recording_notes: Vec<String> = area_note.into_iter().collect();
     if let Some(note) = repeats_note(&read.events, sensor) {
         observer.warn(&Text::from(format!("{}: {note}", recording.path.display())));

@@ -20,11 +20,17 @@ pub fn of_estimate(e: &CtEstimate) -> Vec<String> {
 
 /// The caveats of a fit: the parameters it does not identify, then its assumptions.
 pub fn of_fit(f: &FitResult) -> Vec<String> {
+    // without frames the absolute thresholds come from elsewhere: say where first
     let mut out: Vec<String> = f
-        .why
+        .events_only
         .iter()
-        .map(|(key, why)| format!("{key} not identified: {why}"))
+        .map(|e| format!("thresholds from {}", e.thresholds_source))
         .collect();
+    out.extend(
+        f.why
+            .iter()
+            .map(|(key, why)| format!("{key} not identified: {why}")),
+    );
     out.extend(f.ambiguities.iter().map(|a| {
         format!(
             "{} or {}: not separated by this recording (selection error {:.4} with {}, {:.4} with {} = {:.4} instead); {}",

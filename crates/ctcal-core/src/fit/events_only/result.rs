@@ -55,6 +55,27 @@ pub(super) struct Parts<'a> {
     pub frames_unused: Option<String>,
 }
 
+/// Where the absolute thresholds come from. eppps runs on the fit run only (the blocks
+/// before the first held-out one), so it is said which part of the recording that is: the
+/// same method on the whole recording measures other events and may differ.
+fn thresholds_source(thresholds: &Result<CtEstimate, String>, blocks: &Blocks) -> String {
+    match thresholds {
+        Ok(e) if e.method == "eppps" => {
+            let start = blocks.spans[0].0;
+            let end = blocks.spans[blocks.count() - 1].1;
+            let fit_end = blocks.fit_end().min(end);
+            format!(
+                "estimate eppps on the fit run only, the recording's first {:.3} s of {:.3} s ({:.0} %; the selection and test blocks are left out, so it can differ from eppps on the whole recording): events per pixel of travel against calibration scenes drawn from its natural-image prior (the prior's spread is in the interval); not a measurement of this sensor's thresholds",
+                crate::events::us_to_s(fit_end - start),
+                crate::events::us_to_s(end - start),
+                100.0 * (fit_end - start) as f64 / (end - start).max(1) as f64
+            )
+        }
+        Ok(e) => format!("estimate {} (given)", e.method),
+        Err(reason) => format!("none: {reason}"),
+    }
+}
+
 /// The result in stages: the parameters, the test errors, the details, then the
 /// assumptions (the test errors' and the hot pixels' last).
 pub(super) fn result(parts: Parts) -> FitResult {
@@ -75,7 +96,7 @@ pub(super) fn result(parts: Parts) -> FitResult {
     let errors = test_errors(&test, &parts.model);
     let events_only = details(
         &parts.run,
-        &parts.thresholds,
+        (&parts.thresholds, parts.blocks),
         parts.judging,
         kept("thresholds"),
     );
@@ -594,7 +615,7 @@ fn added(steps: &[Step]) -> Vec<AddedEffect> {
 
 fn details(
     run: &FitRun,
-    thresholds: &Result<CtEstimate, String>,
+    (thresholds, blocks): (&Result<CtEstimate, String>, &Blocks),
     judging: &Judging,
     ratio_confirmed: bool,
 ) -> EventsOnly {
@@ -607,11 +628,7 @@ fn details(
         None => (None, Some("too few supported events of one polarity on the fit blocks".to_string())),
     };
     EventsOnly {
-        thresholds_source: match thresholds {
-            Ok(e) if e.method == "eppps" => "estimate eppps on the fit run: events per pixel of travel against calibration scenes drawn from its natural-image prior (the prior's spread is in the interval); not a measurement of this sensor's thresholds".into(),
-            Ok(e) => format!("estimate {} (given)", e.method),
-            Err(reason) => format!("none: {reason}"),
-        },
+        thresholds_source: thresholds_source(thresholds, blocks),
         ct_on_ci95: thresholds.as_ref().ok().and_then(|e| e.ct_on_ci95),
         ct_off_ci95: thresholds.as_ref().ok().and_then(|e| e.ct_off_ci95),
         ct_ratio,
