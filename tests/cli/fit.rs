@@ -75,6 +75,26 @@ fn check_contract(f: &serde_json::Value) {
             }
         }
     }
+    // each effect's parameter is set, not identified (why), or off and said why (a
+    // configuration writes it as zero, which is not a measurement)
+    for key in [
+        "ct_sigma",
+        "refractory_s",
+        "cutoff_hz",
+        "leak_rate_hz",
+        "shot_noise_rate_hz",
+        "timestamp_jitter_s",
+        "hot_pixel_fraction",
+    ] {
+        let set = !f["params"][key].is_null();
+        let unidentified = f["why"][key].is_string();
+        let off = f["not_detected"][key].is_string();
+        assert_eq!(
+            [set, unidentified, off].iter().filter(|&&b| b).count(),
+            1,
+            "{key}: set {set}, why {unidentified}, not_detected {off}"
+        );
+    }
     let h = &f["holdout"];
     let (fit, sel, test) = (
         h["fit_seconds"].as_f64().unwrap(),
@@ -400,6 +420,12 @@ fn ideal_recordings_get_no_effect_and_their_thresholds() {
         assert!(rate > 0.01 && rate < 1.0, "{case}: {shot}");
         let [off, on] = [0, 1].map(|k| shot["isolated_hz_per_hz"][k].as_f64().unwrap());
         assert!(off > 0.05 && on > 0.05, "{case}: {shot}");
+        // and the configuration's zero says so
+        let off_why = f["not_detected"]["shot_noise_rate_hz"].as_str().unwrap();
+        assert!(
+            off_why.contains("would have called for it at") && off_why.contains("so any is weaker"),
+            "{case}: {off_why}"
+        );
         assert_eq!(f["error_before"], f["error_after"]);
     }
 }

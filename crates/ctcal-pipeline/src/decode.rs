@@ -273,7 +273,7 @@ structs! {
     Measured { value, standard_error, systematic, ci95 }
     FrameRatePoint { frame_step, frame_interval_s, value }
     IntervalInfo { t_start_s, t_end_s, used, reason, motion_px }
-    FitResult { biases, params, identified, why, uncertainties, effects_added, error_metric,
+    FitResult { biases, params, identified, why, not_detected, uncertainties, effects_added, error_metric,
         error_before, error_after, components_before, components_after, steps, ambiguities,
         hot_pixels_masked, hot_pixel_detection, noise_detection, bandwidth_detection, residuals_before,
         residuals_after, assumptions,

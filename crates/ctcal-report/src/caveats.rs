@@ -31,6 +31,13 @@ pub fn of_fit(f: &FitResult) -> Vec<String> {
             .iter()
             .map(|(key, why)| format!("{key} not identified: {why}")),
     );
+    // an effect of two parameters (hot pixels) has one reason: said once
+    let mut off: Vec<&String> = f.not_detected.values().collect();
+    off.dedup();
+    out.extend(
+        off.into_iter()
+            .map(|why| format!("off in the fitted model: {why}")),
+    );
     out.extend(f.ambiguities.iter().map(|a| {
         format!(
             "{} or {}: not separated by this recording (selection error {:.4} with {}, {:.4} with {} = {:.4} instead); {}",

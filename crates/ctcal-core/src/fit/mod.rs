@@ -21,6 +21,7 @@
 pub mod effects;
 pub mod events_only;
 pub mod metric;
+pub mod not_detected;
 pub mod observe;
 pub mod residuals;
 pub mod search;
@@ -359,6 +360,12 @@ pub struct FitResult {
     /// Why a parameter is not identified (`null` in `params`).
     #[serde(skip_serializing_if = "BTreeMap::is_empty")]
     pub why: BTreeMap<String, String>,
+    /// Per parameter of an effect the final model lacks (absent from `params`, so off in a
+    /// configuration): why it is off, and the strength at which this recording would have
+    /// shown it where that was measured ([`not_detected`]). Off is not a measurement of
+    /// zero.
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub not_detected: BTreeMap<String, String>,
     pub uncertainties: BTreeMap<String, Uncertain>,
     pub effects_added: Vec<AddedEffect>,
     pub error_metric: &'static str,

@@ -18,6 +18,7 @@ fn setup_of(s: &SequenceReport, seed: u64) -> Option<Setup> {
         seed,
         sensor: Some((s.stats.width as u32, s.stats.height as u32)),
         not_identified: f.params.not_identified.clone(),
+        not_detected: f.not_detected.clone(),
     })
 }
 
@@ -42,8 +43,10 @@ fn combined_setup(members: &[&SequenceReport], seed: u64) -> Option<Setup> {
     let setups: Vec<Setup> = members.iter().filter_map(|s| setup_of(s, seed)).collect();
     let first = setups.first()?;
     let mut not_identified = BTreeMap::new();
+    let mut not_detected = BTreeMap::new();
     for s in &setups {
         not_identified.extend(s.not_identified.clone());
+        not_detected.extend(s.not_detected.clone());
     }
     Some(Setup {
         exposure_ms: setups
@@ -54,6 +57,7 @@ fn combined_setup(members: &[&SequenceReport], seed: u64) -> Option<Setup> {
         seed,
         sensor: first.sensor,
         not_identified,
+        not_detected,
     })
 }
 

@@ -32,19 +32,36 @@ pub struct Setup {
     pub sensor: Option<(u32, u32)>,
     /// Parameters (PARAMS.toml keys) the fits do not identify, with why.
     pub not_identified: BTreeMap<String, String>,
+    /// Parameters of effects a fit's final model lacks (written as off), with why and the
+    /// strength the recording would have shown (the fit's `not_detected`).
+    pub not_detected: BTreeMap<String, String>,
 }
 
-/// One note per parameter the fits do not identify.
+impl Setup {
+    /// This setup for the parameter set `p` written: only the effects `p` lacks are
+    /// said to be off (a combined set has an effect when half its fits do).
+    fn for_model(&self, p: &PixelParams) -> Setup {
+        let set: Vec<String> = numeric_params(p).into_iter().map(|(k, _)| k).collect();
+        let mut out = self.clone();
+        out.not_detected.retain(|key, _| !set.contains(key));
+        out
+    }
+}
+
+/// One note per parameter the fits do not identify, then one per effect written as off
+/// that no fit detected.
 pub fn not_identified_notes(setup: &Setup) -> Vec<String> {
-    setup
-        .not_identified
-        .iter()
-        .map(|(key, why)| {
-            format!(
-                "NOT IDENTIFIED: {key}: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement ({why})"
-            )
-        })
-        .collect()
+    let unidentified = setup.not_identified.iter().map(|(key, why)| {
+        format!(
+            "NOT IDENTIFIED: {key}: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement ({why})"
+        )
+    });
+    let undetected = setup.not_detected.iter().map(|(key, why)| {
+        format!(
+            "NOT DETECTED: {key}: written as off (zero), which is not a measurement of zero: {why}"
+        )
+    });
+    unidentified.chain(undetected).collect()
 }
 
 /// The notes as `#` comment lines.
@@ -359,6 +376,7 @@ pub fn ctcal_params(p: &PixelParams, setup: &Setup) -> String {
 /// The configuration of `format` for `fits` (combined by median where the format takes
 /// one parameter set).
 pub fn render(format: ConfigFormat, fits: &[PixelParams], setup: &Setup) -> Option<String> {
+    let setup = &setup.for_model(&combine(fits)?);
     match format {
         ConfigFormat::EsimGenerator => esim_generator(fits, setup),
         ConfigFormat::Esim => combine(fits).map(|p| esim_flagfile(&p, setup)),
@@ -379,6 +397,7 @@ mod tests {
             seed: 7,
             sensor: Some((240, 180)),
             not_identified: [("ct_on".to_string(), "a static scene".to_string())].into(),
+            not_detected: BTreeMap::new(),
         }
     }
 
@@ -411,6 +430,41 @@ mod tests {
         assert!(text.contains(
             "# ESIM cannot express: photoreceptor bandwidth (cutoff_hz 300.0), shot noise"
         ));
+    }
+
+    /// An effect no fit detected is written as off with a note saying that the zero is
+    /// not a measurement; an effect the combined set has (half the fits detected it) is
+    /// not called off.
+    #[test]
+    fn effects_written_as_off_are_said_to_be_undetected() {
+        let mut setup = setup();
+        setup.not_detected = [
+            ("leak_rate_hz", "leak not kept: not called for"),
+            ("shot_noise_rate_hz", "shot_noise not kept: not called for"),
+        ]
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .into();
+        // fitted() has shot noise, no leak
+        for format in ConfigFormat::ALL {
+            let text = render(format, &[fitted()], &setup).unwrap();
+            assert!(
+                text.contains(
+                    "NOT DETECTED: leak_rate_hz: written as off (zero), which is not a measurement of zero: leak not kept: not called for"
+                ),
+                "{format:?}:\n{text}"
+            );
+            assert!(
+                !text.contains("NOT DETECTED: shot_noise_rate_hz"),
+                "{format:?}"
+            );
+        }
+        let json: serde_json::Value =
+            serde_json::from_str(&render(ConfigFormat::V2eJson, &[fitted()], &setup).unwrap())
+                .unwrap();
+        assert_eq!(
+            json["not_detected"],
+            serde_json::json!({"leak_rate_hz": "leak not kept: not called for"})
+        );
     }
 
     #[test]

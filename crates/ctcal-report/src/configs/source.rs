@@ -23,15 +23,22 @@ pub struct FitSet {
     pub sensors: Vec<(String, String)>,
     /// Parameters a fit does not identify, with why (its `why`).
     pub not_identified: std::collections::BTreeMap<String, String>,
+    /// Parameters of effects a fit's model lacks, with why (its `not_detected`).
+    pub not_detected: std::collections::BTreeMap<String, String>,
 }
 
 impl FitSet {
-    /// Keeps what the fit `json` says it does not identify.
+    /// Keeps what the fit `json` says it does not identify (`why`) and which effects its
+    /// model lacks undetected (`not_detected`).
     fn note_unidentified(&mut self, json: &serde_json::Value) {
-        if let Some(why) = json.get("why").and_then(|w| w.as_object()) {
-            for (key, reason) in why {
+        for (field, into) in [
+            ("why", &mut self.not_identified),
+            ("not_detected", &mut self.not_detected),
+        ] {
+            let reasons = json.get(field).and_then(|w| w.as_object());
+            for (key, reason) in reasons.into_iter().flatten() {
                 if let Some(reason) = reason.as_str() {
-                    self.not_identified.insert(key.clone(), reason.to_string());
+                    into.insert(key.clone(), reason.to_string());
                 }
             }
         }
@@ -93,6 +100,7 @@ impl FitSet {
             seed: seed.or(self.seed).unwrap_or(2020),
             sensor: one_sensor(self, files)?,
             not_identified: self.not_identified.clone(),
+            not_detected: self.not_detected.clone(),
         })
     }
 }

@@ -97,6 +97,9 @@ struct V2eJson {
     arguments: serde_json::Map<String, serde_json::Value>,
     argv: Vec<String>,
     not_identified: std::collections::BTreeMap<String, String>,
+    /// Effects written as off that no fit detected, with why (the fit's `not_detected`).
+    #[serde(skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    not_detected: std::collections::BTreeMap<String, String>,
     notes: Vec<String>,
 }
 
@@ -124,6 +127,7 @@ pub fn json(p: &PixelParams, setup: &Setup) -> String {
         arguments: by_name,
         argv,
         not_identified: setup.not_identified.clone(),
+        not_detected: setup.not_detected.clone(),
         notes: notes(p, setup),
     };
     serde_json::to_string_pretty(&doc).expect("JSON of numbers and strings") + "\n"

@@ -162,6 +162,7 @@ fn assembled(
             not_identified: why.clone(),
         },
         why,
+        not_detected: BTreeMap::new(),
         uncertainties,
         effects_added: added(&parts.steps),
         error_metric: ERROR_METRIC,

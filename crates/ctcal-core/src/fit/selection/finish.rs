@@ -196,6 +196,7 @@ pub fn result(simulation: &Simulation, mut state: State, mut parts: Parts) -> Fi
     FitResult {
         biases: None,
         why: judged.not_identified.clone(),
+        not_detected: std::collections::BTreeMap::new(),
         identified,
         params: FittedParams {
             model: params,

@@ -97,7 +97,6 @@ impl State {
     }
 }
 
-/// Fits the simulator to `input` (see the module docs of [`crate::fit`]).
 /// Refuses a fit whose kept pixels (the region, less the mask) hold fewer events than
 /// [`super::events_only::MIN_EVENTS`]: too few for any count cell to fix a threshold, so
 /// every number would be the search's start (a one-pixel region of slider_depth held 14).
@@ -119,7 +118,20 @@ fn check_events(input: &FitInput) -> Result<(), FitError> {
     Ok(())
 }
 
+/// Fits the simulator to `input` (see the module docs of [`crate::fit`]), and says of each
+/// effect the final model lacks why it is off ([`super::not_detected`]).
 pub fn fit(
+    input: &FitInput,
+    options: &FitOptions,
+    progress: Progress,
+) -> Result<FitResult, FitError> {
+    let mut result = fit_as_the_data_allow(input, options, progress)?;
+    result.not_detected = super::not_detected::of(&result);
+    Ok(result)
+}
+
+/// The fit with frames where they can be followed, else from the events alone.
+fn fit_as_the_data_allow(
     input: &FitInput,
     options: &FitOptions,
     progress: Progress,

@@ -1,0 +1,120 @@
+//! What a fit's "off" means for each effect the final model lacks. A simulator
+//! configuration written from the fit sets such an effect to zero (no mismatch, no noise,
+//! no bandwidth limit), and that zero is not a measurement: the loop did not call for the
+//! effect, or tried it and found its fall in error within chance. Where the fit measured
+//! how strong the effect would have had to be for this recording to show it (the noise and
+//! bandwidth detection limits, the hot-pixel search's reach), that bound is the honest
+//! statement: the effect, if present, is weaker than it.
+
+use super::effects::Effect;
+use super::{FitResult, Step};
+use std::collections::BTreeMap;
+
+/// Per parameter (PARAMS.toml key) of an effect the final model lacks and the data do not
+/// leave unidentified: why it is off and, where measured, the strength this recording
+/// would have shown.
+pub fn of(result: &FitResult) -> BTreeMap<String, String> {
+    let set = serde_json::to_value(&result.params.model).unwrap_or_default();
+    let is_set = |key: &str| set.get(key).is_some_and(|v| !v.is_null());
+    let mut out = BTreeMap::new();
+    for effect in Effect::ALL {
+        let keys = parameters(effect);
+        let unexplained = keys
+            .iter()
+            .all(|k| !is_set(k) && !result.why.contains_key(*k));
+        if keys.is_empty() || !unexplained {
+            continue;
+        }
+        let why = note(effect, result);
+        for key in keys {
+            out.insert(key.to_string(), why.clone());
+        }
+    }
+    out
+}
+
+/// The PARAMS.toml keys that turn `effect` on (none for the display, which a configuration
+/// does not carry).
+fn parameters(effect: Effect) -> Vec<&'static str> {
+    match effect {
+        Effect::HotPixels => vec!["hot_pixel_fraction", "hot_pixel_rate_hz"],
+        Effect::Display => Vec::new(),
+        other => other.parameter().into_iter().collect(),
+    }
+}
+
+/// Why `effect` is off, and the bound the recording sets on it where one was measured.
+fn note(effect: Effect, result: &FitResult) -> String {
+    let step = result.steps.iter().find(|s| s.effect == effect.name());
+    let decision = step.map_or_else(
+        || "not tried (not among the effects fitted)".to_string(),
+        decision,
+    );
+    match bound(effect, result) {
+        Some(bound) => format!("{} {decision}; {bound}", effect.name()),
+        None => format!(
+            "{} {decision}; how strong it would have to be for this recording to show it was not measured",
+            effect.name()
+        ),
+    }
+}
+
+/// What the loop decided about a step's effect.
+fn decision(step: &Step) -> String {
+    if step.reason.is_empty() {
+        "not kept".to_string()
+    } else {
+        format!("not kept: {}", step.reason)
+    }
+}
+
+/// The strength at which this recording would have shown `effect`, where the fit measured
+/// it.
+fn bound(effect: Effect, result: &FitResult) -> Option<String> {
+    match effect {
+        Effect::ShotNoise | Effect::Leak => {
+            let key = effect.parameter()?;
+            let limit = result.noise_detection.as_ref()?.limits.get(key)?;
+            let above = match (limit.called_for_above_hz, &limit.why) {
+                (Some(hz), _) => Some(format!(
+                    "the recording would have called for it at {} Hz or more, so any is weaker",
+                    significant(hz)
+                )),
+                (None, Some(why)) => Some(format!("no rate it would have shown at: {why}")),
+                (None, None) => None,
+            };
+            let at_most = limit.at_most_hz.map(|hz| {
+                format!(
+                    "its quiet pixels allow at most {} Hz (95 %)",
+                    significant(hz)
+                )
+            });
+            let parts: Vec<String> = [above, at_most].into_iter().flatten().collect();
+            (!parts.is_empty()).then(|| parts.join("; "))
+        }
+        Effect::Bandwidth => {
+            let hz = result.bandwidth_detection.as_ref()?.called_for_below_hz?;
+            Some(format!(
+                "a cutoff at white of {} Hz or lower would have shown, so any cutoff is higher",
+                significant(hz)
+            ))
+        }
+        Effect::HotPixels => {
+            let hz = result.hot_pixel_detection.as_ref()?.detectable_above_hz;
+            Some(format!(
+                "hot pixels at {} Hz or faster would have been named, so any are slower",
+                significant(hz)
+            ))
+        }
+        _ => None,
+    }
+}
+
+/// `value` to three significant digits (a noise rate spans decades).
+fn significant(value: f64) -> String {
+    if value == 0.0 || !value.is_finite() {
+        return format!("{value}");
+    }
+    let decimals = (2 - value.abs().log10().floor() as i32).max(0) as usize;
+    format!("{value:.decimals$}")
+}
