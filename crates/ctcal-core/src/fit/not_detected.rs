@@ -7,13 +7,15 @@
 //! statement: the effect, if present, is weaker than it.
 
 use super::effects::Effect;
+use super::events_only::refractory::Edge;
 use super::{FitResult, Step};
 use std::collections::BTreeMap;
 
 /// Per parameter (PARAMS.toml key) of an effect the final model lacks and the data do not
 /// leave unidentified: why it is off and, where measured, the strength this recording
-/// would have shown.
-pub fn of(result: &FitResult) -> BTreeMap<String, String> {
+/// would have shown. `interval_edge`, the lower edge of the fit run's same-pixel
+/// intervals, bounds a refractory period.
+pub fn of(result: &FitResult, interval_edge: Option<&Edge>) -> BTreeMap<String, String> {
     let set = serde_json::to_value(&result.params.model).unwrap_or_default();
     let is_set = |key: &str| set.get(key).is_some_and(|v| !v.is_null());
     let mut out = BTreeMap::new();
@@ -25,7 +27,7 @@ pub fn of(result: &FitResult) -> BTreeMap<String, String> {
         if keys.is_empty() || !unexplained {
             continue;
         }
-        let why = note(effect, result);
+        let why = note(effect, result, interval_edge);
         for key in keys {
             out.insert(key.to_string(), why.clone());
         }
@@ -44,13 +46,17 @@ fn parameters(effect: Effect) -> Vec<&'static str> {
 }
 
 /// Why `effect` is off, and the bound the recording sets on it where one was measured.
-fn note(effect: Effect, result: &FitResult) -> String {
+fn note(effect: Effect, result: &FitResult, interval_edge: Option<&Edge>) -> String {
     let step = result.steps.iter().find(|s| s.effect == effect.name());
     let decision = step.map_or_else(
         || "not tried (not among the effects fitted)".to_string(),
         decision,
     );
-    match bound(effect, result) {
+    let bound = match effect {
+        Effect::Refractory => interval_edge.and_then(refractory_bound),
+        _ => bound(effect, result),
+    };
+    match bound {
         Some(bound) => format!("{} {decision}; {bound}", effect.name()),
         None => format!(
             "{} {decision}; how strong it would have to be for this recording to show it was not measured",
@@ -110,6 +116,20 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
     }
 }
 
+/// What the lower edge of the same-pixel intervals says of a refractory period the loop
+/// did not keep: a gap with the pile-up a refractory period leaves is named. The shortest
+/// interval is no bound: a simulator (v2e, ctcal's own) lets shot-noise events through the
+/// refractory period, so a recording made with a 0.5 ms period can hold 27 us intervals
+/// (`data_samples/texture_davis240c`).
+fn refractory_bound(edge: &Edge) -> Option<String> {
+    (edge.found && edge.not_refractory.is_none()).then(|| {
+        format!(
+            "the fit run's same-pixel intervals have a lower edge at {:.0} us with the pile-up above it that a refractory period leaves (range {:.0}-{:.0} us): a refractory period near it is not ruled out",
+            edge.edge_us, edge.range_us[0], edge.range_us[1]
+        )
+    })
+}
+
 /// `value` to three significant digits (a noise rate spans decades).
 fn significant(value: f64) -> String {
     if value == 0.0 || !value.is_finite() {
@@ -117,4 +137,41 @@ fn significant(value: f64) -> String {
     }
     let decimals = (2 - value.abs().log10().floor() as i32).max(0) as usize;
     format!("{value:.decimals$}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn edge(found: bool, not_refractory: Option<&str>) -> Edge {
+        Edge {
+            edge_us: 480.0,
+            range_us: [420.0, 530.0],
+            below: 3,
+            above: 200,
+            found,
+            not_refractory: not_refractory.map(str::to_string),
+            intervals: 5000,
+        }
+    }
+
+    /// Only a gap with its pile-up speaks of a refractory period the loop did not keep;
+    /// no gap, or a gap without the pile-up, bounds nothing (a simulator's noise events
+    /// pass through the period).
+    #[test]
+    fn only_an_edge_with_its_pile_up_is_said_of_a_refractory_period() {
+        let said = refractory_bound(&edge(true, None)).unwrap();
+        assert!(said.contains("lower edge at 480 us") && said.contains("420-530 us"));
+        assert_eq!(refractory_bound(&edge(false, None)), None);
+        assert_eq!(refractory_bound(&edge(false, Some("no pile-up"))), None);
+    }
+
+    #[test]
+    fn rates_keep_three_significant_digits() {
+        assert_eq!(significant(0.0236), "0.0236");
+        assert_eq!(significant(0.693), "0.693");
+        assert_eq!(significant(32.46), "32.5");
+        assert_eq!(significant(1203.4), "1203");
+        assert_eq!(significant(0.0), "0");
+    }
 }

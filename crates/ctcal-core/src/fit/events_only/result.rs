@@ -577,7 +577,7 @@ fn refractory_param(
         Some(edge) => {
             let reason = match &edge.not_refractory {
                 Some(why) => format!(
-                    "{why}; a refractory period, if any, is at most {:.0} us",
+                    "{why}; a refractory period, if any, is at most {:.0} us where every event respects it (a camera's pixel resets at each; v2e and ctcal's simulator let shot-noise events through it)",
                     edge.edge_us
                 ),
                 None if edge.found => format!(
@@ -585,7 +585,7 @@ fn refractory_param(
                     edge.edge_us
                 ),
                 None => format!(
-                    "no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most {:.0} us",
+                    "no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most {:.0} us where every event respects it (a camera's pixel resets at each; v2e and ctcal's simulator let shot-noise events through it)",
                     edge.edge_us
                 ),
             };

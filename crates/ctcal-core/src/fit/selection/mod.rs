@@ -126,8 +126,31 @@ pub fn fit(
     progress: Progress,
 ) -> Result<FitResult, FitError> {
     let mut result = fit_as_the_data_allow(input, options, progress)?;
-    result.not_detected = super::not_detected::of(&result);
+    let edge = result
+        .events_only
+        .is_none()
+        .then(|| fit_run_interval_edge(input, options))
+        .flatten();
+    result.not_detected = super::not_detected::of(&result, edge.as_ref());
     Ok(result)
+}
+
+/// The lower edge of the fit run's same-pixel intervals at the kept pixels
+/// ([`super::events_only::refractory::edge`]): what bounds a refractory period the fit
+/// with frames did not add (a fit without frames measures it itself).
+fn fit_run_interval_edge(
+    input: &FitInput,
+    options: &FitOptions,
+) -> Option<super::events_only::refractory::Edge> {
+    use super::events_only::refractory;
+    let end = start::fit_end(input.frames, options.holdout);
+    let events = input.events.between(TimeUs::MIN, end);
+    let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
+    let mut last = vec![TimeUs::MIN; input.sensor.pixels()];
+    let width = input.sensor.width as usize;
+    let mut intervals =
+        refractory::intervals(&events, 0..events.len(), width, &mut last, Some(&kept));
+    refractory::edge(&mut intervals, refractory::timestamp_step(&events))
 }
 
 /// The fit with frames where they can be followed, else from the events alone.
