@@ -172,6 +172,11 @@ def test_errors_carry_the_commands_message() -> None:
     frameless = REAL / "evk4_faery_evt3.raw"
     with pytest.raises(ctcal.CtcalError, match="needs grey frames"):
         ctcal.estimate(frameless, "aps")
+    # a region without events is named as the cause, as the command names it
+    slider = REAL / "ijrr_slider_depth_50k"
+    with pytest.raises(ctcal.CtcalError, match="no event lies in the selected pixels") as empty:
+        ctcal.estimate(slider, "eppps", roi="0,0,1,1")
+    assert str(empty.value) == cli_error("estimate", "eppps", str(slider), "--roi", "0,0,1,1")
 
 
 def test_simulate_is_deterministic_and_follows_the_frames() -> None:
