@@ -83,7 +83,7 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
             let limit = result.noise_detection.as_ref()?.limits.get(key)?;
             let above = match (limit.called_for_above_hz, &limit.why) {
                 (Some(hz), _) => Some(format!(
-                    "the recording would have called for it at {} Hz or more, so any is weaker",
+                    "a recording of this scene would have called for it at {} Hz or more (in about 95 % of such recordings), so any is likely weaker",
                     significant(hz)
                 )),
                 (None, Some(why)) => Some(format!("no rate it would have shown at: {why}")),
@@ -101,14 +101,14 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
         Effect::Bandwidth => {
             let hz = result.bandwidth_detection.as_ref()?.called_for_below_hz?;
             Some(format!(
-                "a cutoff at white of {} Hz or lower would have shown, so any cutoff is higher",
+                "a cutoff at white of {} Hz or lower would have shown (in about 95 % of recordings of this scene), so any cutoff is likely higher",
                 significant(hz)
             ))
         }
         Effect::HotPixels => {
             let hz = result.hot_pixel_detection.as_ref()?.detectable_above_hz;
             Some(format!(
-                "hot pixels at {} Hz or faster would have been named, so any are slower",
+                "hot pixels at {} Hz or faster would have been named (at half the kept pixels or more), so any are likely slower",
                 significant(hz)
             ))
         }

@@ -4,10 +4,10 @@
 #   sh v2e_args.sh -i video.mp4 --output_folder out
 # (V2E=/path/to/v2e.py sh v2e_args.sh ... runs another v2e.)
 # NOT IDENTIFIED: ct_sigma: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (the recording does not show a threshold spread: event timing measured none and the fit blocks have too few events per pixel to compare the counts' dispersion with the model's; the model has no mismatch, which is not a measurement)
-# NOT DETECTED: cutoff_hz: written as off (zero), which is not a measurement of zero: bandwidth not kept: not called for by the residuals; a cutoff at white of 24.3 Hz or lower would have shown, so any cutoff is higher
+# NOT DETECTED: cutoff_hz: written as off (zero), which is not a measurement of zero: bandwidth not kept: not called for by the residuals; a cutoff at white of 24.3 Hz or lower would have shown (in about 95 % of recordings of this scene), so any cutoff is likely higher
 # NOT DETECTED: hot_pixel_fraction: written as off (zero), which is not a measurement of zero: hot_pixels not kept: not called for by the residuals; how strong it would have to be for this recording to show it was not measured
 # NOT DETECTED: hot_pixel_rate_hz: written as off (zero), which is not a measurement of zero: hot_pixels not kept: not called for by the residuals; how strong it would have to be for this recording to show it was not measured
-# NOT DETECTED: leak_rate_hz: written as off (zero), which is not a measurement of zero: leak not kept: not called for by the residuals; the recording would have called for it at 0.693 Hz or more, so any is weaker
+# NOT DETECTED: leak_rate_hz: written as off (zero), which is not a measurement of zero: leak not kept: not called for by the residuals; a recording of this scene would have called for it at 0.693 Hz or more (in about 95 % of such recordings), so any is likely weaker
 # NOT DETECTED: refractory_s: written as off (zero), which is not a measurement of zero: refractory not kept: not called for by the residuals; how strong it would have to be for this recording to show it was not measured
 # NOT DETECTED: timestamp_jitter_s: written as off (zero), which is not a measurement of zero: timestamp_jitter not kept: not called for by the residuals; how strong it would have to be for this recording to show it was not measured
 exec "${V2E:-v2e}" \
