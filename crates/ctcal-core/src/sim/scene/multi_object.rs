@@ -408,9 +408,27 @@ impl MultiObjectWorld {
                 row.column[..m].iter().zip(&row.values).zip(&row.coverage)
             {
                 let pixel = &mut line[x];
-                *pixel += (value - *pixel) * coverage;
+                *pixel = blend(*pixel, value, coverage);
             }
         }
+    }
+}
+
+/// The pixel `below` with an object's `value` over it at `coverage` (in 0..=1): `below +
+/// (value - below) * coverage`, and exactly `value` at coverage 1.
+///
+/// Why the case: `below + (value - below) * 1` is `value` when `value - below` is exact
+/// (Sterbenz: `below / 2 <= value <= 2 below`), else it may be an ulp off (about 15 % of
+/// pairs of values in 5-250 DN), so what is under a covered pixel still counted. Taken as
+/// `value`, the pixel no longer depends on anything drawn before it, so that what a later
+/// object covers need not be drawn at all (changed from the plain blend on 2026-12-07, see
+/// benches/README.md).
+#[inline(always)]
+fn blend(below: f32, value: f32, coverage: f32) -> f32 {
+    if coverage == 1.0 {
+        value
+    } else {
+        below + (value - below) * coverage
     }
 }
 
@@ -937,6 +955,16 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_blend_at_coverage_one_is_the_value() {
+        // 0.1 - 3.0 is not exact in f32: the plain blend is an ulp off
+        let (below, value) = (3.0f32, 0.1f32);
+        assert_ne!((below + (value - below) * 1.0).to_bits(), value.to_bits());
+        assert_eq!(blend(below, value, 1.0).to_bits(), value.to_bits());
+        assert_eq!(blend(f32::NAN, value, 1.0).to_bits(), value.to_bits());
+        assert_eq!(blend(2.0, 4.0, 0.5), 3.0);
     }
 
     #[test]
