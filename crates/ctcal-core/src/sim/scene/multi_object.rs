@@ -12,6 +12,7 @@
 use super::canvas::{Canvas, TextureParams};
 use rand::{Rng, RngExt};
 use serde::{Deserialize, Serialize};
+use std::ops::Range;
 use std::path::PathBuf;
 
 /// Parameters of a multi-object scene.
@@ -304,53 +305,118 @@ impl MultiObjectWorld {
     }
 
     /// Renders rows `rows` into `out` (those rows only): the background, then every object
-    /// over it in depth order. Coordinates are computed a row at a time and the textures
-    /// sampled along the row at once ([`Canvas::sample_many`]).
-    pub fn render(&self, width: usize, rows: std::ops::Range<usize>, t: f64, out: &mut [f32]) {
-        self.render_with(width, rows, t, out, true);
+    /// over it in depth order, leaving out what a later object covers with coverage 1
+    /// ([`Mode::Culled`]: the same frame). Coordinates are computed a row at a time and the
+    /// textures sampled along the row at once ([`Canvas::sample_many`]).
+    pub fn render(&self, width: usize, rows: Range<usize>, t: f64, out: &mut [f32]) {
+        self.render_with(width, rows, t, out, Mode::Culled);
     }
 
-    /// [`Self::render`], with [`Bounds`] or (`bounded` false) the exact distance at every
-    /// pixel of each object's bounding square.
+    /// [`Self::render`] in `mode`: first the pieces of rows to draw, objects from the front
+    /// (so that each knows what the objects above it cover), then the background and the
+    /// pieces from the back (depth order, as [`blend`] needs). Returns the number of texture
+    /// samples taken.
     fn render_with(
         &self,
         width: usize,
-        rows: std::ops::Range<usize>,
+        rows: Range<usize>,
         t: f64,
         out: &mut [f32],
-        bounded: bool,
-    ) {
+        mode: Mode,
+    ) -> usize {
+        let placed: Vec<Placed> = self
+            .objects
+            .iter()
+            .filter_map(|o| Placed::new(o, &self.textures, width, &rows, t, mode))
+            .collect();
+        let mut covered = vec![Covered::default(); rows.len()];
+        let mut pieces = Vec::new();
+        for (index, object) in placed.iter().enumerate().rev() {
+            let cull = mode == Mode::Culled;
+            object.pieces(index, rows.start, cull, &mut covered, &mut pieces);
+        }
         let mut row = RowBuffers::new(width);
-        // background: the image is the texture seen through the inverse of its motion
-        let (centre, angle, scale) = self.background.pose(t);
-        let (s, c) = angle.sin_cos();
-        for (y, out) in rows.clone().zip(out.chunks_exact_mut(width)) {
-            let dy = y as f64 - centre[1];
-            for (x, (qx, qy)) in row.xs.iter_mut().zip(&mut row.ys).enumerate() {
-                let dx = x as f64 - centre[0];
-                (*qx, *qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
-            }
-            self.textures[0].sample_many(&row.xs, &row.ys, out);
+        let mut samples = self.render_background(width, rows.clone(), t, &covered, &mut row, out);
+        for piece in pieces.iter().rev() {
+            let line = &mut out[(piece.y - rows.start) * width..][..width];
+            samples += placed[piece.object].render_piece(piece, &mut row, line);
         }
-        for object in &self.objects {
-            self.render_object(object, width, rows.clone(), t, &mut row, out, bounded);
-        }
+        samples
     }
 
-    /// Blends one object over rows `rows` of `out`, by its pixel coverage. `bounded` decides
-    /// the pixels clearly inside or outside the object from [`Bounds`] (the same values as
-    /// without: see there), else every pixel of the bounding square takes the exact distance.
-    #[allow(clippy::too_many_arguments)]
-    fn render_object(
+    /// The background over rows `rows` of `out`, but for the columns of each row that
+    /// `covered` holds: the image is the texture seen through the inverse of its motion.
+    /// Returns the number of pixels drawn.
+    fn render_background(
         &self,
-        object: &Object,
         width: usize,
-        rows: std::ops::Range<usize>,
+        rows: Range<usize>,
         t: f64,
+        covered: &[Covered],
         row: &mut RowBuffers,
         out: &mut [f32],
-        bounded: bool,
-    ) {
+    ) -> usize {
+        let mut drawn = 0;
+        let (centre, angle, scale) = self.background.pose(t);
+        let (s, c) = angle.sin_cos();
+        let lines = rows.zip(out.chunks_exact_mut(width)).zip(covered);
+        for ((y, line), covered) in lines {
+            let dy = y as f64 - centre[1];
+            covered.gaps(0..width, |gap| {
+                let (xs, ys) = (&mut row.xs[..gap.len()], &mut row.ys[..gap.len()]);
+                for (x, (qx, qy)) in gap.clone().zip(xs.iter_mut().zip(ys.iter_mut())) {
+                    let dx = x as f64 - centre[0];
+                    (*qx, *qy) = ((c * dx + s * dy) / scale, (-s * dx + c * dy) / scale);
+                }
+                drawn += gap.len();
+                self.textures[0].sample_many(xs, ys, &mut line[gap]);
+            });
+        }
+        drawn
+    }
+}
+
+/// How [`MultiObjectWorld::render_with`] decides an object's pixels. `render` takes
+/// `Culled`; `Exact` and `Bounded` are the references the tests compare it with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(not(test), allow(dead_code))]
+enum Mode {
+    /// The exact distance at every pixel of each object's bounding square.
+    Exact,
+    /// [`Bounds`] decide the pixels clearly inside or outside (the same values: see there).
+    Bounded,
+    /// As `Bounded`, and a pixel that a later object covers with coverage 1 (as [`Bounds`]
+    /// decide it) is neither sampled nor blended, for the background and every object
+    /// under it. The same frame to the bit as `Bounded`: at coverage 1 [`blend`] gives the
+    /// covering object's value whatever is below, so nothing drawn before it there can
+    /// show; and the pixels still drawn get the same points, coverages and samples (each
+    /// pixel's values depend on its column alone, not on which others are drawn with it).
+    Culled,
+}
+
+/// An object at one time, within a band of rows: its shape, texture, pose, the columns and
+/// rows of its bounding square and its [`Bounds`] (none in [`Mode::Exact`] or outside their
+/// guard).
+struct Placed<'a> {
+    shape: &'a Shape,
+    texture: &'a Canvas,
+    pose: Pose,
+    square: (usize, usize),
+    ys: std::ops::RangeInclusive<usize>,
+    bounds: Option<Bounds>,
+}
+
+impl<'a> Placed<'a> {
+    /// `object` at `t` on rows `rows` of a frame `width` wide, or `None` if its bounding
+    /// square misses them.
+    fn new(
+        object: &'a Object,
+        textures: &'a [Canvas],
+        width: usize,
+        rows: &Range<usize>,
+        t: f64,
+        mode: Mode,
+    ) -> Option<Self> {
         let (centre, angle, scale) = object.trajectory.pose(t);
         let reach = object.shape.radius() * scale + 1.0;
         let (x_lo, x_hi) = (
@@ -362,55 +428,152 @@ impl MultiObjectWorld {
             (centre[1] + reach).ceil().min(rows.end as f64 - 1.0),
         );
         if x_lo > x_hi || y_lo > y_hi {
-            return;
+            return None;
         }
-        let (s, c) = angle.sin_cos();
-        let texture = &self.textures[object.texture];
+        let (sin, cos) = angle.sin_cos();
         let pose = Pose {
             centre,
-            sin: s,
-            cos: c,
+            sin,
+            cos,
             scale,
         };
-        let square = (x_lo as usize, x_hi as usize);
-        let bounds = if bounded {
-            Bounds::new(&object.shape, &pose, reach)
-        } else {
-            None
+        let bounds = match mode {
+            Mode::Exact => None,
+            Mode::Bounded | Mode::Culled => Bounds::new(&object.shape, &pose, reach),
         };
-        for y in y_lo as usize..=y_hi as usize {
-            let dy = y as f64 - centre[1];
-            let cover = match &bounds {
-                Some(b) => match b.row(dy, square) {
-                    Some(cover) => cover,
-                    None => continue,
-                },
-                None => RowCover {
-                    lo: square.0,
-                    hi: square.1,
-                    inner: 0..0,
-                },
+        Some(Self {
+            shape: &object.shape,
+            texture: &textures[object.texture],
+            pose,
+            square: (x_lo as usize, x_hi as usize),
+            ys: y_lo as usize..=y_hi as usize,
+            bounds,
+        })
+    }
+
+    /// Appends to `pieces` (tagged `index`) the parts of its rows to draw: the columns it
+    /// may cover but those `covered` holds (row `y` at `covered[y - first_row]`); with
+    /// `cull`, then adds to `covered` the columns it covers with coverage 1.
+    fn pieces(
+        &self,
+        index: usize,
+        first_row: usize,
+        cull: bool,
+        covered: &mut [Covered],
+        pieces: &mut Vec<Piece>,
+    ) {
+        for y in self.ys.clone() {
+            let Some(cover) = self.row(y) else {
+                continue;
             };
-            let (x_lo, span) = (cover.lo, cover.hi - cover.lo + 1);
-            cover_row(&object.shape, &pose, dy, x_lo, span, cover.inner, row);
-            // the pixels the object covers, gathered (written at `m` always, kept where
-            // covered: no branch), then sampled at once and blended
-            let mut m = 0;
-            for i in 0..span {
-                let coverage = row.coverage[i];
-                (row.xs[m], row.ys[m]) = (row.qx[i] + 64.0, row.qy[i] + 64.0);
-                (row.coverage[m], row.column[m]) = (coverage, x_lo + i);
-                m += usize::from(coverage > 0.0);
-            }
-            texture.sample_many(&row.xs[..m], &row.ys[..m], &mut row.values[..m]);
-            let line = &mut out[(y - rows.start) * width..][..width];
-            for ((&x, &value), &coverage) in
-                row.column[..m].iter().zip(&row.values).zip(&row.coverage)
-            {
-                let pixel = &mut line[x];
-                *pixel = blend(*pixel, value, coverage);
+            let inner = cover.lo + cover.inner.start..cover.lo + cover.inner.end;
+            let covered = &mut covered[y - first_row];
+            covered.gaps(cover.lo..cover.hi + 1, |columns| {
+                let inner = inner.start.max(columns.start)..inner.end.min(columns.end);
+                pieces.push(Piece {
+                    object: index,
+                    y,
+                    columns,
+                    inner,
+                });
+            });
+            if cull && !inner.is_empty() {
+                covered.insert(inner);
             }
         }
+    }
+
+    /// The columns of row `y` to render: [`Bounds::row`], or the whole bounding square.
+    fn row(&self, y: usize) -> Option<RowCover> {
+        let dy = y as f64 - self.pose.centre[1];
+        match &self.bounds {
+            Some(b) => b.row(dy, self.square),
+            None => Some(RowCover {
+                lo: self.square.0,
+                hi: self.square.1,
+                inner: 0..0,
+            }),
+        }
+    }
+
+    /// Blends `piece` of this object over `line` (its row of the frame) by pixel coverage;
+    /// returns the number of pixels sampled.
+    fn render_piece(&self, piece: &Piece, row: &mut RowBuffers, line: &mut [f32]) -> usize {
+        let dy = piece.y as f64 - self.pose.centre[1];
+        let (x_lo, span) = (piece.columns.start, piece.columns.len());
+        let inner = if piece.inner.is_empty() {
+            0..0
+        } else {
+            piece.inner.start - x_lo..piece.inner.end - x_lo
+        };
+        cover_row(self.shape, &self.pose, dy, x_lo, span, inner, row);
+        // the pixels the object covers, gathered (written at `m` always, kept where
+        // covered: no branch), then sampled at once and blended
+        let mut m = 0;
+        for i in 0..span {
+            let coverage = row.coverage[i];
+            (row.xs[m], row.ys[m]) = (row.qx[i] + 64.0, row.qy[i] + 64.0);
+            (row.coverage[m], row.column[m]) = (coverage, x_lo + i);
+            m += usize::from(coverage > 0.0);
+        }
+        self.texture
+            .sample_many(&row.xs[..m], &row.ys[..m], &mut row.values[..m]);
+        for ((&x, &value), &coverage) in row.column[..m].iter().zip(&row.values).zip(&row.coverage)
+        {
+            let pixel = &mut line[x];
+            *pixel = blend(*pixel, value, coverage);
+        }
+        m
+    }
+}
+
+/// Columns `columns` of row `y` of the placed object `object` to draw, of which those in
+/// `inner` (columns too, empty or not within `columns` if none) have coverage 1.
+struct Piece {
+    object: usize,
+    y: usize,
+    columns: Range<usize>,
+    inner: Range<usize>,
+}
+
+/// The columns of one row that objects already placed (those above) cover with coverage
+/// 1: sorted, disjoint ranges with a gap between each two.
+#[derive(Clone, Debug, Default)]
+struct Covered(Vec<Range<usize>>);
+
+impl Covered {
+    /// Calls `f` with each largest range of `span` outside the set (never empty), left to
+    /// right.
+    fn gaps(&self, span: Range<usize>, mut f: impl FnMut(Range<usize>)) {
+        let mut start = span.start;
+        for r in &self.0 {
+            if r.start >= span.end {
+                break;
+            }
+            if r.end <= start {
+                continue;
+            }
+            if r.start > start {
+                f(start..r.start);
+            }
+            start = r.end;
+        }
+        if start < span.end {
+            f(start..span.end);
+        }
+    }
+
+    /// Adds the columns `add` (not empty), merging the ranges it overlaps or touches.
+    fn insert(&mut self, add: Range<usize>) {
+        // the ranges before `i` end before `add` with a gap, those from `j` start after it
+        let i = self.0.partition_point(|r| r.end < add.start);
+        let j = self.0.partition_point(|r| r.start <= add.end);
+        let merged = if i < j {
+            self.0[i].start.min(add.start)..self.0[j - 1].end.max(add.end)
+        } else {
+            add
+        };
+        self.0.splice(i..j, [merged]);
     }
 }
 
@@ -420,9 +583,9 @@ impl MultiObjectWorld {
 /// Why the case: `below + (value - below) * 1` is `value` when `value - below` is exact
 /// (Sterbenz: `below / 2 <= value <= 2 below`), else it may be an ulp off (about 15 % of
 /// pairs of values in 5-250 DN), so what is under a covered pixel still counted. Taken as
-/// `value`, the pixel no longer depends on anything drawn before it, so that what a later
-/// object covers need not be drawn at all (changed from the plain blend on 2026-12-07, see
-/// benches/README.md).
+/// `value`, the pixel no longer depends on anything drawn before it, and
+/// [`MultiObjectWorld::render`] leaves out what a later object covers ([`Mode::Culled`];
+/// changed from the plain blend on 2026-12-07, see benches/README.md).
 #[inline(always)]
 fn blend(below: f32, value: f32, coverage: f32) -> f32 {
     if coverage == 1.0 {
@@ -916,10 +1079,9 @@ mod tests {
         assert_eq!(b.row(1.2, (8, 12)), None);
     }
 
-    #[test]
-    fn rendering_with_bounds_is_the_exact_rendering_to_the_bit() {
-        use rand::SeedableRng;
-        let scene = MultiObjectScene {
+    /// A scene of 25-30 objects of 0.5-40 px (scaled 0.05-1.5), many overlapping.
+    fn crowded_scene() -> MultiObjectScene {
+        MultiObjectScene {
             objects: [25, 30],
             background_velocity_px_s: [0.1, 40.0],
             background_angular_velocity_deg_s: [0.0, 45.0],
@@ -933,26 +1095,166 @@ mod tests {
                 canvas_px: 128,
                 ..Default::default()
             },
-        };
+        }
+    }
+
+    /// `world` at `t` in `mode`, in bands of `band` rows (as the parallel renderer draws),
+    /// into a frame that holds `fill` before.
+    fn rendered(world: &MultiObjectWorld, t: f64, mode: Mode, band: usize, fill: f32) -> Vec<f32> {
+        let (width, height) = (240, 180);
+        let mut out = vec![fill; width * height];
+        for (k, out) in out.chunks_mut(width * band).enumerate() {
+            let rows = k * band..(k * band + band).min(height);
+            world.render_with(width, rows, t, out, mode);
+        }
+        out
+    }
+
+    #[test]
+    fn rendering_with_bounds_is_the_exact_rendering_to_the_bit() {
+        use rand::SeedableRng;
+        let scene = crowded_scene();
         let (width, height) = (240, 180);
         for seed in 0..4 {
             let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
             let world = scene.realise(width, height, 1.0, Vec::new(), &mut rng);
             for k in 0..20 {
                 let t = k as f64 / 19.0;
-                let (mut a, mut b) = (vec![0f32; width * height], vec![0f32; width * height]);
-                world.render(width, 0..height, t, &mut a);
-                world.render_with(width, 0..height, t, &mut b, false);
+                let a = rendered(&world, t, Mode::Bounded, height, 0.0);
+                let b = rendered(&world, t, Mode::Exact, height, 0.0);
                 // and in bands, as the parallel renderer does
-                let mut c = vec![0f32; width * height];
-                for (band, out) in c.chunks_mut(width * 7).enumerate() {
-                    let rows = band * 7..(band * 7 + 7).min(height);
-                    world.render(width, rows, t, out);
-                }
+                let c = rendered(&world, t, Mode::Bounded, 7, 0.0);
                 for (i, ((a, b), c)) in a.iter().zip(&b).zip(&c).enumerate() {
                     assert_eq!(a.to_bits(), b.to_bits(), "seed {seed} t {t} pixel {i}");
                     assert_eq!(c.to_bits(), b.to_bits(), "seed {seed} t {t} pixel {i}");
                 }
+            }
+        }
+    }
+
+    /// Culling (`render`) against the same bounds without it, whole frames to the bit: the
+    /// crowded scene and scenes of 1-60 objects up to 80 px, whole and in bands, into frames
+    /// that hold NaN before (a pixel left out and never drawn over would show).
+    #[test]
+    fn culling_is_the_rendering_without_it_to_the_bit() {
+        use rand::SeedableRng;
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(20);
+        let (width, height) = (240, 180);
+        let (mut all, mut culled) = (0usize, 0usize);
+        for case in 0..12 {
+            let mut scene = crowded_scene();
+            if case % 3 != 0 {
+                let count = rng.random_range(1..=60);
+                scene.objects = [count, count];
+                scene.object_size_px = [rng.random_range(0.5..10.0), rng.random_range(10.0..80.0)];
+                scene.object_scale = [0.2, rng.random_range(0.2..2.0)];
+            }
+            let world = scene.realise(width, height, 1.0, Vec::new(), &mut rng);
+            for k in 0..10 {
+                let t = k as f64 / 9.0;
+                let mut whole = vec![f32::NAN; width * height];
+                culled += world.render_with(width, 0..height, t, &mut whole, Mode::Culled);
+                let mut reference = vec![0f32; width * height];
+                all += world.render_with(width, 0..height, t, &mut reference, Mode::Bounded);
+                let bands = rendered(&world, t, Mode::Culled, [1, 7, 8][k % 3], f32::NAN);
+                for (i, ((a, b), c)) in whole.iter().zip(&reference).zip(&bands).enumerate() {
+                    assert_eq!(a.to_bits(), b.to_bits(), "case {case} t {t} pixel {i}");
+                    assert_eq!(c.to_bits(), b.to_bits(), "case {case} t {t} pixel {i}");
+                }
+            }
+        }
+        // and it leaves out a good part of the samples
+        assert!(culled * 10 < all * 9, "{culled} of {all} samples");
+    }
+
+    /// How many texture samples a frame of each multi-object scene of `calib/scenes` takes
+    /// with and without culling (`cargo test ... samples_of_the_calib_scenes -- --nocapture`
+    /// prints them): culling leaves out at least a fifth of them in the crowded ones.
+    #[test]
+    fn samples_of_the_calib_scenes() {
+        let scenes = [
+            (
+                "slow",
+                include_str!("../../../../../calib/scenes/multi_object_slow.toml"),
+            ),
+            (
+                "medium",
+                include_str!("../../../../../calib/scenes/multi_object_medium.toml"),
+            ),
+            (
+                "fast",
+                include_str!("../../../../../calib/scenes/multi_object_fast.toml"),
+            ),
+            (
+                "variety",
+                include_str!("../../../../../calib/scenes/multi_object_variety.toml"),
+            ),
+        ];
+        for (name, text) in scenes {
+            let spec = super::super::SceneSpec::from_toml(text, name.as_ref()).unwrap();
+            let super::super::Scene::MultiObject(world) = spec.realise().unwrap() else {
+                panic!("{name} is a multi-object scene");
+            };
+            let (width, height) = (spec.width, spec.height);
+            let (mut all, mut culled) = (0usize, 0usize);
+            let mut out = vec![0f32; width * height];
+            for k in 0..20 {
+                let t = spec.duration_s * k as f64 / 19.0;
+                all += world.render_with(width, 0..height, t, &mut out, Mode::Bounded);
+                culled += world.render_with(width, 0..height, t, &mut out, Mode::Culled);
+            }
+            let objects = world.object_count();
+            println!(
+                "{name} ({objects} objects): {} -> {} samples per frame",
+                all / 20,
+                culled / 20
+            );
+            if objects >= 10 {
+                assert!(culled * 5 < all * 4, "{name}: {culled} of {all}");
+            }
+        }
+    }
+
+    #[test]
+    fn covered_columns_are_a_set_of_ranges() {
+        use rand::SeedableRng;
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(21);
+        for _ in 0..2000 {
+            let mut covered = Covered::default();
+            let mut bits = [false; 64];
+            for _ in 0..rng.random_range(0..12) {
+                let start = rng.random_range(0..63);
+                let add = start..rng.random_range(start + 1..=64);
+                bits[add.clone()].fill(true);
+                covered.insert(add);
+                // sorted, disjoint, a gap between each two, and the columns of `bits`
+                assert!(
+                    covered.0.windows(2).all(|w| w[0].end < w[1].start),
+                    "{covered:?}"
+                );
+                let mut set = [false; 64];
+                covered.0.iter().for_each(|r| set[r.clone()].fill(true));
+                assert_eq!(set, bits);
+            }
+            let start = rng.random_range(0..64);
+            let span = start..rng.random_range(start..=64);
+            let mut outside = [false; 64];
+            let mut last_end = None;
+            covered.gaps(span.clone(), |gap| {
+                assert!(!gap.is_empty() && span.start <= gap.start && gap.end <= span.end);
+                // largest: a gap neither touches the one before nor runs on past its end
+                assert!(last_end.is_none_or(|end| end < gap.start));
+                assert!(gap.end == span.end || bits[gap.end]);
+                assert!(gap.start == span.start || bits[gap.start - 1]);
+                last_end = Some(gap.end);
+                outside[gap].fill(true);
+            });
+            for x in 0..64 {
+                assert_eq!(
+                    outside[x],
+                    span.contains(&x) && !bits[x],
+                    "{covered:?} {span:?}"
+                );
             }
         }
     }
