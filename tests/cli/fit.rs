@@ -423,8 +423,8 @@ fn ideal_recordings_get_no_effect_and_their_thresholds() {
         // and the configuration's zero says so
         let off_why = f["not_detected"]["shot_noise_rate_hz"].as_str().unwrap();
         assert!(
-            off_why.contains("would have called for it at")
-                && off_why.contains("so any is likely weaker"),
+            off_why.contains("its detection limit on this recording is")
+                && off_why.contains("a rate above that is unlikely"),
             "{case}: {off_why}"
         );
         assert_eq!(f["error_before"], f["error_after"]);

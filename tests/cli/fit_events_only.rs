@@ -51,7 +51,7 @@ fn hot_pixels_are_named_exactly_without_frames() {
     // measures): which part is said
     let source = fit["events_only"]["thresholds_source"].as_str().unwrap();
     assert!(
-        source.contains("prior") && source.contains("fit run only, the recording's first"),
+        source.contains("prior") && source.contains("fit run only, the events' first"),
         "{source}"
     );
 }

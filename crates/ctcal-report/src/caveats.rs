@@ -18,7 +18,8 @@ pub fn of_estimate(e: &CtEstimate) -> Vec<String> {
     out
 }
 
-/// The caveats of a fit: the parameters it does not identify, then its assumptions.
+/// The caveats of a fit: where a fit without frames took its thresholds, the parameters it
+/// does not identify, the effects it leaves off (`not_detected`), then its assumptions.
 pub fn of_fit(f: &FitResult) -> Vec<String> {
     // without frames the absolute thresholds come from elsewhere: say where first
     let mut out: Vec<String> = f

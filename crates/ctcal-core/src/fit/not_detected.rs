@@ -1,10 +1,11 @@
 //! What a fit's "off" means for each effect the final model lacks. A simulator
 //! configuration written from the fit sets such an effect to zero (no mismatch, no noise,
 //! no bandwidth limit), and that zero is not a measurement: the loop did not call for the
-//! effect, or tried it and found its fall in error within chance. Where the fit measured
-//! how strong the effect would have had to be for this recording to show it (the noise and
-//! bandwidth detection limits, the hot-pixel search's reach), that bound is the honest
-//! statement: the effect, if present, is weaker than it.
+//! effect, tried it and found its fall in error within chance, or kept it and later took it
+//! out (no longer needed, or a look-alike in its place). Where the fit measured how strong
+//! the effect would have had to be for this recording to show it (the noise and bandwidth
+//! detection limits; a refractory period's edge in the intervals), that is said: the
+//! effect, if present, is likely weaker.
 
 use super::effects::Effect;
 use super::events_only::refractory::Edge;
@@ -47,11 +48,7 @@ fn parameters(effect: Effect) -> Vec<&'static str> {
 
 /// Why `effect` is off, and the bound the recording sets on it where one was measured.
 fn note(effect: Effect, result: &FitResult, interval_edge: Option<&Edge>) -> String {
-    let step = result.steps.iter().find(|s| s.effect == effect.name());
-    let decision = step.map_or_else(
-        || "not tried (not among the effects fitted)".to_string(),
-        decision,
-    );
+    let decision = decision(effect, &result.steps);
     let bound = match effect {
         Effect::Refractory => interval_edge.and_then(refractory_bound),
         _ => bound(effect, result),
@@ -65,12 +62,26 @@ fn note(effect: Effect, result: &FitResult, interval_edge: Option<&Edge>) -> Str
     }
 }
 
-/// What the loop decided about a step's effect.
-fn decision(step: &Step) -> String {
-    if step.reason.is_empty() {
-        "not kept".to_string()
+/// What the loop last decided about `effect`: its own step (`EFFECT`, `EFFECT (refit)`,
+/// `EFFECT (again, with ... in)`), or a later step that took it out (`EFFECT (still
+/// needed?)`, an alternative `OTHER in place of EFFECT?` kept).
+fn decision(effect: Effect, steps: &[Step]) -> String {
+    let name = effect.name();
+    let own = |s: &&Step| s.effect == name || s.effect.starts_with(&format!("{name} ("));
+    let replaced = |s: &&Step| s.kept && s.effect.ends_with(&format!(" in place of {name}?"));
+    let Some(last) = steps.iter().rev().find(|s| own(s) || replaced(s)) else {
+        return "not tried (not among the effects fitted)".to_string();
+    };
+    let was_kept = steps.iter().filter(own).any(|s| s.kept);
+    let because = if last.reason.is_empty() {
+        String::new()
     } else {
-        format!("not kept: {}", step.reason)
+        format!(": {}", last.reason)
+    };
+    match (was_kept, replaced(&last)) {
+        (_, true) => format!("kept, then replaced ({}){because}", last.effect),
+        (true, false) => format!("kept, then removed ({}){because}", last.effect),
+        (false, false) => format!("not kept{because}"),
     }
 }
 
@@ -83,10 +94,10 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
             let limit = result.noise_detection.as_ref()?.limits.get(key)?;
             let above = match (limit.called_for_above_hz, &limit.why) {
                 (Some(hz), _) => Some(format!(
-                    "a recording of this scene would have called for it at {} Hz or more (in about 95 % of such recordings), so any is likely weaker",
+                    "its detection limit on this recording is {} Hz (noise_detection: a rate at which the model's evidence calls for it), so a rate above that is unlikely",
                     significant(hz)
                 )),
-                (None, Some(why)) => Some(format!("no rate it would have shown at: {why}")),
+                (None, Some(why)) => Some(format!("no detection limit: {why}")),
                 (None, None) => None,
             };
             let at_most = limit.at_most_hz.map(|hz| {
@@ -99,19 +110,18 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
             (!parts.is_empty()).then(|| parts.join("; "))
         }
         Effect::Bandwidth => {
-            let hz = result.bandwidth_detection.as_ref()?.called_for_below_hz?;
-            Some(format!(
-                "a cutoff at white of {} Hz or lower would have shown (in about 95 % of recordings of this scene), so any cutoff is likely higher",
-                significant(hz)
-            ))
+            let detection = result.bandwidth_detection.as_ref()?;
+            match (detection.called_for_below_hz, &detection.why) {
+                (Some(hz), _) => Some(format!(
+                    "a cutoff at white of {} Hz or lower would have shown (in about 95 % of recordings of this scene: bandwidth_detection), so any cutoff is likely higher",
+                    significant(hz)
+                )),
+                (None, Some(why)) => Some(format!("no detection limit: {why}")),
+                (None, None) => None,
+            }
         }
-        Effect::HotPixels => {
-            let hz = result.hot_pixel_detection.as_ref()?.detectable_above_hz;
-            Some(format!(
-                "hot pixels at {} Hz or faster would have been named (at half the kept pixels or more), so any are likely slower",
-                significant(hz)
-            ))
-        }
+        // hot pixels: the search's reach is measured only where it names some (which are
+        // then in the model); mismatch and timestamp jitter have no detection limit yet
         _ => None,
     }
 }
@@ -164,6 +174,51 @@ mod tests {
         assert!(said.contains("lower edge at 480 us") && said.contains("420-530 us"));
         assert_eq!(refractory_bound(&edge(false, None)), None);
         assert_eq!(refractory_bound(&edge(false, Some("no pile-up"))), None);
+    }
+
+    fn step(effect: &str, kept: bool, reason: &str) -> Step {
+        let mut s = Step::untried(effect.to_string(), String::new(), 0.0);
+        s.kept = kept;
+        s.reason = reason.to_string();
+        s
+    }
+
+    /// The loop's last word on an effect: an effect kept and then taken out is not called
+    /// "not kept" with the reason it was kept for.
+    #[test]
+    fn the_last_decision_on_an_effect_is_said() {
+        let steps = [
+            step("thresholds", true, "the starting point"),
+            step("leak", true, "error falls 8 %"),
+            step("shot_noise", true, "error falls 30 %"),
+            step(
+                "leak (still needed?)",
+                true,
+                "without it the error rises 0.1 %: removed",
+            ),
+            step(
+                "bandwidth in place of shot_noise?",
+                true,
+                "as good within chance",
+            ),
+            step("mismatch", false, "needs a fall of 0.08"),
+        ];
+        assert_eq!(
+            decision(Effect::Leak, &steps),
+            "kept, then removed (leak (still needed?)): without it the error rises 0.1 %: removed"
+        );
+        assert_eq!(
+            decision(Effect::ShotNoise, &steps),
+            "kept, then replaced (bandwidth in place of shot_noise?): as good within chance"
+        );
+        assert_eq!(
+            decision(Effect::Mismatch, &steps),
+            "not kept: needs a fall of 0.08"
+        );
+        assert_eq!(
+            decision(Effect::Refractory, &steps),
+            "not tried (not among the effects fitted)"
+        );
     }
 
     #[test]

@@ -43,11 +43,16 @@ fn combined_setup(members: &[&SequenceReport], seed: u64) -> Option<Setup> {
     let setups: Vec<Setup> = members.iter().filter_map(|s| setup_of(s, seed)).collect();
     let first = setups.first()?;
     let mut not_identified = BTreeMap::new();
-    let mut not_detected = BTreeMap::new();
-    for s in &setups {
+    let named = members
+        .iter()
+        .filter(|s| s.fit.is_some())
+        .map(|s| s.name.clone());
+    let mut per_fit = Vec::new();
+    for (s, name) in setups.iter().zip(named) {
         not_identified.extend(s.not_identified.clone());
-        not_detected.extend(s.not_detected.clone());
+        per_fit.push((name, s.not_detected.clone()));
     }
+    let not_detected = super::merged_reasons(&per_fit);
     Some(Setup {
         exposure_ms: setups
             .iter()

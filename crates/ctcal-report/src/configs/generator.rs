@@ -3,7 +3,7 @@
 //! and `camera_params` covering every given fit with margin for training: ON and OFF
 //! thresholds are drawn as `C`, `C * N(1, ct_diff_sigma)`.
 
-use super::{Setup, combine, not_identified_notes};
+use super::{Setup, combine, unmeasured_notes};
 use crate::sim::PixelParams;
 use serde::Serialize;
 use serde_json::json;
@@ -90,7 +90,7 @@ pub fn esim_generator(fits: &[PixelParams], setup: &Setup) -> Option<String> {
             "the fitted sensor is {w}x{h}: give the generator and ESIM that image size"
         ));
     }
-    notes.extend(not_identified_notes(setup));
+    notes.extend(unmeasured_notes(setup));
     let config = EsimGenerator {
         ctcal_version: env!("CARGO_PKG_VERSION"),
         name: "ctcal_fitted_camera",

@@ -48,9 +48,30 @@ impl Setup {
     }
 }
 
+/// The reasons of several fits, by key: one fit's as they are; of several, each named by
+/// its fit (a combined configuration's numbers are each one fit's) and joined.
+pub fn merged_reasons(per_fit: &[(String, BTreeMap<String, String>)]) -> BTreeMap<String, String> {
+    if let [(_, only)] = per_fit {
+        return only.clone();
+    }
+    let mut out: BTreeMap<String, String> = BTreeMap::new();
+    for (fit, reasons) in per_fit {
+        for (key, why) in reasons {
+            let said = format!("{fit}: {why}");
+            out.entry(key.clone())
+                .and_modify(|r| {
+                    r.push_str("; ");
+                    r.push_str(&said);
+                })
+                .or_insert(said);
+        }
+    }
+    out
+}
+
 /// One note per parameter the fits do not identify, then one per effect written as off
 /// that no fit detected.
-pub fn not_identified_notes(setup: &Setup) -> Vec<String> {
+pub fn unmeasured_notes(setup: &Setup) -> Vec<String> {
     let unidentified = setup.not_identified.iter().map(|(key, why)| {
         format!(
             "NOT IDENTIFIED: {key}: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement ({why})"
@@ -58,7 +79,7 @@ pub fn not_identified_notes(setup: &Setup) -> Vec<String> {
     });
     let undetected = setup.not_detected.iter().map(|(key, why)| {
         format!(
-            "NOT DETECTED: {key}: written as off (zero), which is not a measurement of zero: {why}"
+            "NOT DETECTED: {key}: written as off (zero, or the simulator's smallest value where it takes no zero), which is not a measurement of zero: {why}"
         )
     });
     unidentified.chain(undetected).collect()
@@ -255,7 +276,7 @@ fn esim_header(setup: &Setup) -> Vec<String> {
         ));
     }
     lines.extend(
-        comments(&not_identified_notes(setup))
+        comments(&unmeasured_notes(setup))
             .lines()
             .map(str::to_string),
     );
@@ -365,7 +386,7 @@ pub fn ctcal_params(p: &PixelParams, setup: &Setup) -> String {
             "the fitted sensor is {w}x{h}: simulate a sensor of that size"
         ));
     }
-    notes.extend(not_identified_notes(setup));
+    notes.extend(unmeasured_notes(setup));
     format!(
         "# ctcal PARAMS.toml written from a fit of the simulator to a recording\n{}{}",
         comments(&notes),
@@ -449,7 +470,7 @@ mod tests {
             let text = render(format, &[fitted()], &setup).unwrap();
             assert!(
                 text.contains(
-                    "NOT DETECTED: leak_rate_hz: written as off (zero), which is not a measurement of zero: leak not kept: not called for"
+                    "NOT DETECTED: leak_rate_hz: written as off (zero, or the simulator's smallest value where it takes no zero), which is not a measurement of zero: leak not kept: not called for"
                 ),
                 "{format:?}:\n{text}"
             );

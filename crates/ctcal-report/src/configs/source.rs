@@ -23,25 +23,26 @@ pub struct FitSet {
     pub sensors: Vec<(String, String)>,
     /// Parameters a fit does not identify, with why (its `why`).
     pub not_identified: std::collections::BTreeMap<String, String>,
-    /// Parameters of effects a fit's model lacks, with why (its `not_detected`).
-    pub not_detected: std::collections::BTreeMap<String, String>,
+    /// Per fit (named by its file or sequence), the parameters of effects its model lacks,
+    /// with why (its `not_detected`).
+    pub not_detected: Vec<(String, std::collections::BTreeMap<String, String>)>,
 }
 
 impl FitSet {
-    /// Keeps what the fit `json` says it does not identify (`why`) and which effects its
-    /// model lacks undetected (`not_detected`).
-    fn note_unidentified(&mut self, json: &serde_json::Value) {
-        for (field, into) in [
-            ("why", &mut self.not_identified),
-            ("not_detected", &mut self.not_detected),
-        ] {
-            let reasons = json.get(field).and_then(|w| w.as_object());
-            for (key, reason) in reasons.into_iter().flatten() {
-                if let Some(reason) = reason.as_str() {
-                    into.insert(key.clone(), reason.to_string());
-                }
-            }
-        }
+    /// Keeps what the fit `json` (named `fit`) says it does not identify (`why`) and which
+    /// effects its model lacks undetected (`not_detected`, each fit's reason named).
+    fn note_unidentified(&mut self, json: &serde_json::Value, fit: &str) {
+        let reasons = |field: &str| {
+            let object = json.get(field).and_then(|w| w.as_object());
+            object
+                .into_iter()
+                .flatten()
+                .filter_map(|(key, why)| Some((key.clone(), why.as_str()?.to_string())))
+                .collect::<Vec<_>>()
+        };
+        self.not_identified.extend(reasons("why"));
+        let not_detected = reasons("not_detected").into_iter().collect();
+        self.not_detected.push((fit.to_string(), not_detected));
     }
 }
 
@@ -51,7 +52,7 @@ impl FitSet {
     pub fn add(&mut self, file: &str, json: &serde_json::Value) -> Result<()> {
         let Some(sequences) = json.get("sequences").and_then(|s| s.as_array()) else {
             let (p, exposure) = fit_params(json, file, "")?;
-            self.note_unidentified(json);
+            self.note_unidentified(json, file);
             self.params.push(p);
             self.exposures_us.push(exposure);
             return Ok(());
@@ -68,7 +69,7 @@ impl FitSet {
             )?;
             self.params.push(p);
             self.exposures_us.push(exposure);
-            self.note_unidentified(fit);
+            self.note_unidentified(fit, name);
             let (w, h) = (&s["stats"]["width"], &s["stats"]["height"]);
             if let (Some(w), Some(h)) = (w.as_u64(), h.as_u64()) {
                 self.sensors.push((format!("{w}x{h}"), name.to_string()));
@@ -100,7 +101,7 @@ impl FitSet {
             seed: seed.or(self.seed).unwrap_or(2020),
             sensor: one_sensor(self, files)?,
             not_identified: self.not_identified.clone(),
-            not_detected: self.not_detected.clone(),
+            not_detected: super::merged_reasons(&self.not_detected),
         })
     }
 }

@@ -2,7 +2,7 @@
 //! v2e with the fitted parameters and the sensor size as it is (`sh v2e_args.sh -i IN ...`,
 //! v2e's own input and output arguments appended), and the same arguments as JSON.
 
-use super::{Setup, not_identified_notes};
+use super::{Setup, unmeasured_notes};
 use crate::sim::PixelParams;
 use serde_json::json;
 
@@ -68,7 +68,7 @@ fn notes(p: &PixelParams, setup: &Setup) -> Vec<String> {
             flag("output_height")
         ));
     }
-    notes.extend(not_identified_notes(setup));
+    notes.extend(unmeasured_notes(setup));
     notes
 }
 

@@ -59,7 +59,7 @@ impl Calibration {
         let (lo, hi) = cts.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), c| {
             (lo.min(c), hi.max(c))
         });
-        !(lo..=hi).contains(&self.estimate)
+        !self.curve.is_empty() && !(lo..=hi).contains(&self.estimate)
     }
 }
 

@@ -9,8 +9,8 @@
 # NOT IDENTIFIED: refractory_s: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most 1 us where every event respects it (a camera's pixel resets at each; v2e and ctcal's simulator let shot-noise events through it))
 # NOT IDENTIFIED: shot_noise_rate_hz: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (not told apart from none: at most 0.0023 Hz (2 standard errors))
 # NOT IDENTIFIED: timestamp_jitter_s: the value written (the simulator's default or off, or the start value the fit simulated) is not a measurement (timestamp jitter shows against a stimulus of known timing: that needs a screen recording or frames)
-# NOT DETECTED: hot_pixel_fraction: written as off (zero), which is not a measurement of zero: hot_pixels not kept: the fit blocks do not call for it; how strong it would have to be for this recording to show it was not measured
-# NOT DETECTED: hot_pixel_rate_hz: written as off (zero), which is not a measurement of zero: hot_pixels not kept: the fit blocks do not call for it; how strong it would have to be for this recording to show it was not measured
+# NOT DETECTED: hot_pixel_fraction: written as off (zero, or the simulator's smallest value where it takes no zero), which is not a measurement of zero: hot_pixels not kept: the fit blocks do not call for it; how strong it would have to be for this recording to show it was not measured
+# NOT DETECTED: hot_pixel_rate_hz: written as off (zero, or the simulator's smallest value where it takes no zero), which is not a measurement of zero: hot_pixels not kept: the fit blocks do not call for it; how strong it would have to be for this recording to show it was not measured
 exec "${V2E:-v2e}" \
   --pos_thres 0.325233 \
   --neg_thres 0.323379 \

@@ -33,6 +33,17 @@ pub fn shortest_interval_s(
     kept: &[bool],
     step_us: u32,
 ) -> Option<f64> {
+    interval_edge(events, width, kept, step_us).map(|e| e.edge_us * 1e-6)
+}
+
+/// The lower edge of the same-pixel intervals of `events` at the pixels `kept`
+/// ([`crate::fit::events_only::refractory::edge`]).
+pub fn interval_edge(
+    events: &EventChunk,
+    width: usize,
+    kept: &[bool],
+    step_us: u32,
+) -> Option<crate::fit::events_only::refractory::Edge> {
     let mut last = vec![TimeUs::MIN; kept.len()];
     let mut intervals = crate::fit::events_only::refractory::intervals(
         events,
@@ -41,7 +52,7 @@ pub fn shortest_interval_s(
         &mut last,
         Some(kept),
     );
-    crate::fit::events_only::refractory::edge(&mut intervals, step_us).map(|e| e.edge_us * 1e-6)
+    crate::fit::events_only::refractory::edge(&mut intervals, step_us)
 }
 
 pub fn evidence(c: &Context) -> Evidence {

@@ -65,7 +65,7 @@ fn thresholds_source(thresholds: &Result<CtEstimate, String>, blocks: &Blocks) -
             let end = blocks.spans[blocks.count() - 1].1;
             let fit_end = blocks.fit_end().min(end);
             format!(
-                "estimate eppps on the fit run only, the recording's first {:.3} s of {:.3} s ({:.0} %; the selection and test blocks are left out, so it can differ from eppps on the whole recording): events per pixel of travel against calibration scenes drawn from its natural-image prior (the prior's spread is in the interval); not a measurement of this sensor's thresholds",
+                "estimate eppps on the fit run only, the events' first {:.3} s of {:.3} s ({:.0} %; the selection and test blocks are left out, so it can differ from eppps on the whole recording): events per pixel of travel against calibration scenes drawn from its natural-image prior (the prior's spread is in the interval); not a measurement of this sensor's thresholds",
                 crate::events::us_to_s(fit_end - start),
                 crate::events::us_to_s(end - start),
                 100.0 * (fit_end - start) as f64 / (end - start).max(1) as f64
@@ -555,6 +555,9 @@ fn dark_rate(measured: f64, se: f64) -> Uncertain {
     Uncertain::with_interval(measured, Some(se), [lo, hi.map(|h| h / white)])
 }
 
+/// When the shortest same-pixel interval bounds a refractory period.
+const ONLY_IF_RESPECTED: &str = " where every event respects it (a camera's pixel resets at each; v2e and ctcal's simulator let shot-noise events through it)";
+
 fn refractory_param(
     run: &FitRun,
     kept: bool,
@@ -577,7 +580,7 @@ fn refractory_param(
         Some(edge) => {
             let reason = match &edge.not_refractory {
                 Some(why) => format!(
-                    "{why}; a refractory period, if any, is at most {:.0} us where every event respects it (a camera's pixel resets at each; v2e and ctcal's simulator let shot-noise events through it)",
+                    "{why}; a refractory period, if any, is at most {:.0} us{ONLY_IF_RESPECTED}",
                     edge.edge_us
                 ),
                 None if edge.found => format!(
@@ -585,7 +588,7 @@ fn refractory_param(
                     edge.edge_us
                 ),
                 None => format!(
-                    "no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most {:.0} us where every event respects it (a camera's pixel resets at each; v2e and ctcal's simulator let shot-noise events through it)",
+                    "no gap at the short end of the same-pixel intervals: a refractory period, if any, is at most {:.0} us{ONLY_IF_RESPECTED}",
                     edge.edge_us
                 ),
             };

@@ -126,31 +126,36 @@ pub fn fit(
     progress: Progress,
 ) -> Result<FitResult, FitError> {
     let mut result = fit_as_the_data_allow(input, options, progress)?;
-    let edge = result
-        .events_only
-        .is_none()
-        .then(|| fit_run_interval_edge(input, options))
+    let refractory_unexplained = result.params.refractory_s.is_none()
+        && !result.why.contains_key("refractory_s")
+        && result.events_only.is_none();
+    let edge = refractory_unexplained
+        .then(|| fit_run_interval_edge(input, options, &result.hot_pixels_masked))
         .flatten();
     result.not_detected = super::not_detected::of(&result, edge.as_ref());
     Ok(result)
 }
 
-/// The lower edge of the fit run's same-pixel intervals at the kept pixels
-/// ([`super::events_only::refractory::edge`]): what bounds a refractory period the fit
-/// with frames did not add (a fit without frames measures it itself).
+/// The lower edge of the fit run's same-pixel intervals at the kept pixels, the named hot
+/// pixels left out: whether the fit run shows the edge a refractory period leaves, which
+/// the fit with frames did not add (a fit without frames measures it itself).
 fn fit_run_interval_edge(
     input: &FitInput,
     options: &FitOptions,
+    hot: &[crate::stats::hot_pixels::HotPixel],
 ) -> Option<super::events_only::refractory::Edge> {
-    use super::events_only::refractory;
     let end = start::fit_end(input.frames, options.holdout);
-    let events = input.events.between(TimeUs::MIN, end);
-    let kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
-    let mut last = vec![TimeUs::MIN; input.sensor.pixels()];
+    let first = input.frames.first().map_or(TimeUs::MIN, |f| f.t);
+    let events = input.events.between(first, end);
     let width = input.sensor.width as usize;
-    let mut intervals =
-        refractory::intervals(&events, 0..events.len(), width, &mut last, Some(&kept));
-    refractory::edge(&mut intervals, refractory::timestamp_step(&events))
+    let mut kept: Vec<bool> = input.excluded.iter().map(|&e| !e).collect();
+    for h in hot.iter().filter(|h| (h.x as usize) < width) {
+        if let Some(k) = kept.get_mut(h.y as usize * width + h.x as usize) {
+            *k = false;
+        }
+    }
+    let step = super::events_only::refractory::timestamp_step(&events);
+    effects::refractory::interval_edge(&events, width, &kept, step)
 }
 
 /// The fit with frames where they can be followed, else from the events alone.
