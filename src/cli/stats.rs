@@ -256,12 +256,11 @@ fn selection_empty(recording: &Recording, selection: &super::SelectionArgs) -> a
     .flatten()
     .collect::<Vec<_>>()
     .join(", ");
-    ctcal::InputError::invalid(
+    super::load::hinted(ctcal::window::empty_selection(
         &recording.path,
-        format!("no event lies in the selected pixels ({what})"),
-        "select pixels where the recording has events, or leave the selection out",
-    )
-    .into()
+        &what,
+        false,
+    ))
 }
 
 /// The error for events that reach further than the per-pixel budget.

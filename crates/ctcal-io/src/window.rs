@@ -171,16 +171,22 @@ fn check_selection_has_events(
         return Ok(());
     }
     let windowed = window.start_s.is_some() || window.end_s.is_some();
-    Err(LoadError::Selection {
+    Err(empty_selection(path, &kept.description(), windowed))
+}
+
+/// The error for a pixel selection (`what`: the region, the mask, ...) that holds none of
+/// the events (of the time window, where `windowed`); `stats`, which streams rather than
+/// loads, gives the same.
+pub fn empty_selection(path: &Path, what: &str, windowed: bool) -> LoadError {
+    LoadError::Selection {
         path: path.to_path_buf(),
         problem: format!(
-            "no event {}lies in the selected pixels ({})",
+            "no event {}lies in the selected pixels ({what})",
             if windowed { "of the time window " } else { "" },
-            kept.description()
         )
         .into(),
         fix: "select pixels where the recording has events, or leave the selection out".into(),
-    })
+    }
 }
 
 /// Where a load reports what it warns of and how far it has read.

@@ -32,11 +32,13 @@ pub fn of_fit(f: &FitResult) -> Vec<String> {
             .iter()
             .map(|(key, why)| format!("{key} not identified: {why}")),
     );
-    // an effect of two parameters (hot pixels) has one reason: said once
-    let mut off: Vec<&String> = f.not_detected.values().collect();
-    off.dedup();
+    // an effect of two parameters (hot pixels) has one reason: said once, wherever its
+    // keys sort
+    let mut said = std::collections::BTreeSet::new();
     out.extend(
-        off.into_iter()
+        f.not_detected
+            .values()
+            .filter(|why| said.insert(why.as_str()))
             .map(|why| format!("off in the fitted model: {why}")),
     );
     out.extend(f.ambiguities.iter().map(|a| {
