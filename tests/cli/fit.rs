@@ -85,6 +85,7 @@ fn check_contract(f: &serde_json::Value) {
         "shot_noise_rate_hz",
         "timestamp_jitter_s",
         "hot_pixel_fraction",
+        "hot_pixel_rate_hz",
     ] {
         let set = !f["params"][key].is_null();
         let unidentified = f["why"][key].is_string();

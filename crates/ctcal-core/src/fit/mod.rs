@@ -26,6 +26,7 @@ pub mod observe;
 pub mod residuals;
 pub mod search;
 pub mod selection;
+mod wording;
 
 use crate::estimate::EstimateError;
 use crate::events::{EventChunk, Frame, Sensor, TimeUs};
@@ -459,9 +460,11 @@ pub struct NoiseLimit {
     pub tried: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub why: Option<String>,
-    /// Shot noise only: the most dark rate (95 %) the recording's isolated OFF events at
-    /// quiet pixels allow ([`effects::quiet_noise::at_most_dark_hz`]), a limit on the noise
-    /// present whatever the scene hides; absent where they were not counted.
+    /// The most the recording allows (95 %) whatever the scene hides: shot noise's dark
+    /// rate its isolated OFF events at quiet pixels allow
+    /// ([`effects::quiet_noise::at_most_dark_hz`]), a leak's rate at the frames' median DN
+    /// the event timing's drift allows ([`effects::leak::TimingDrift::at_most_hz`]);
+    /// absent where not measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub at_most_hz: Option<f64>,
 }

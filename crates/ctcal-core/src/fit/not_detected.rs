@@ -9,7 +9,9 @@
 
 use super::effects::Effect;
 use super::events_only::refractory::Edge;
-use super::{FitResult, Step};
+use super::selection::noise_detection::at_most_in_words;
+use super::wording::significant;
+use super::{FitResult, HotPixelDetection, Step};
 use std::collections::BTreeMap;
 
 /// Per parameter (PARAMS.toml key) of an effect the final model lacks and the data do not
@@ -100,12 +102,9 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
                 (None, Some(why)) => Some(format!("no detection limit: {why}")),
                 (None, None) => None,
             };
-            let at_most = limit.at_most_hz.map(|hz| {
-                format!(
-                    "its quiet pixels allow at most {} Hz (95 %)",
-                    significant(hz)
-                )
-            });
+            let at_most = limit
+                .at_most_hz
+                .map(|hz| at_most_in_words(key, &significant(hz)));
             let parts: Vec<String> = [above, at_most].into_iter().flatten().collect();
             (!parts.is_empty()).then(|| parts.join("; "))
         }
@@ -120,10 +119,21 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
                 (None, None) => None,
             }
         }
-        // hot pixels: the search's reach is measured only where it names some (which are
-        // then in the model); mismatch and timestamp jitter have no detection limit yet
+        Effect::HotPixels => hot_pixels_bound(result.hot_pixel_detection.as_ref()?),
+        // mismatch and timestamp jitter have no detection limit yet
         _ => None,
     }
+}
+
+/// The slowest hot pixel the search names at 95 % of the kept pixels or more, read off
+/// `detection`'s curve at its first rate there (eight a decade: the exact rate is at or
+/// below it).
+fn hot_pixels_bound(detection: &HotPixelDetection) -> Option<String> {
+    let [rate, _] = *detection.probability.iter().find(|[_, p]| *p >= 0.95)?;
+    Some(format!(
+        "the hot-pixel search would name a pixel whose train fires {} Hz or faster beyond its scene at 95 % or more of the kept pixels (hot_pixel_detection, on this recording's counts: the search's test alone, which the fit's later checks can only lower), so a hot pixel that fast would likely have been named; slower ones hide among the scene's events",
+        significant(rate)
+    ))
 }
 
 /// What the lower edge of the same-pixel intervals says of a refractory period the loop
@@ -138,15 +148,6 @@ fn refractory_bound(edge: &Edge) -> Option<String> {
             edge.edge_us, edge.range_us[0], edge.range_us[1]
         )
     })
-}
-
-/// `value` to three significant digits (a noise rate spans decades).
-fn significant(value: f64) -> String {
-    if value == 0.0 || !value.is_finite() {
-        return format!("{value}");
-    }
-    let decimals = (2 - value.abs().log10().floor() as i32).max(0) as usize;
-    format!("{value:.decimals$}")
 }
 
 #[cfg(test)]
@@ -174,6 +175,26 @@ mod tests {
         assert!(said.contains("lower edge at 480 us") && said.contains("420-530 us"));
         assert_eq!(refractory_bound(&edge(false, None)), None);
         assert_eq!(refractory_bound(&edge(false, Some("no pile-up"))), None);
+    }
+
+    /// Where the search named no hot pixel, the slowest train it names at 95 % of the
+    /// pixels is said, at the curve's first rate there; a curve that never gets there
+    /// bounds nothing.
+    #[test]
+    fn hot_pixels_are_bounded_where_the_search_names_them_at_95_percent() {
+        let detection = |curve: Vec<[f64; 2]>| HotPixelDetection::new(7.0, curve);
+        let said = hot_pixels_bound(&detection(vec![
+            [1.0, 0.02],
+            [7.0, 0.5],
+            [13.3, 0.93],
+            [17.8, 0.97],
+        ]))
+        .unwrap();
+        assert!(said.contains("17.8 Hz or faster"), "{said}");
+        assert_eq!(
+            hot_pixels_bound(&detection(vec![[1.0, 0.2], [5623.0, 0.9]])),
+            None
+        );
     }
 
     fn step(effect: &str, kept: bool, reason: &str) -> Step {
@@ -219,14 +240,5 @@ mod tests {
             decision(Effect::Refractory, &steps),
             "not tried (not among the effects fitted)"
         );
-    }
-
-    #[test]
-    fn rates_keep_three_significant_digits() {
-        assert_eq!(significant(0.0236), "0.0236");
-        assert_eq!(significant(0.693), "0.693");
-        assert_eq!(significant(32.46), "32.5");
-        assert_eq!(significant(1203.4), "1203");
-        assert_eq!(significant(0.0), "0");
     }
 }

@@ -46,6 +46,8 @@ pub struct TimingDrift {
     pub rate_hz: f64,
     /// The drift in its bootstrap standard errors.
     pub z: f64,
+    /// The rate's bootstrap standard error, Hz (the drift's over the ON threshold).
+    pub standard_error_hz: f64,
     /// How the leak grows with the light, where the timing resolves a growth.
     pub growth: Option<LeakGrowth>,
 }
@@ -152,6 +154,11 @@ impl TimingDrift {
                 0.0
             },
             z: drift.at_median_dn / drift.standard_error.max(1e-12),
+            standard_error_hz: if ct_on > 0.0 {
+                drift.standard_error / ct_on
+            } else {
+                f64::INFINITY
+            },
             growth: LeakGrowth::of(drift),
         }
     }
@@ -160,6 +167,23 @@ impl TimingDrift {
     /// ([`TIMING_DRIFT_DISPERSION`]).
     fn score(&self) -> f64 {
         self.z / TIMING_DRIFT_DISPERSION
+    }
+
+    /// The most leak at the frames' median DN the drift allows: its rate plus 1.96 of its
+    /// standard errors, each [`TIMING_DRIFT_DISPERSION`] of the bootstrap's. The drift is
+    /// read from the timing of every event, so unlike the isolated or still-pixel counts it
+    /// does not wait for a pixel's first leak event. On 60 coverage draws with a leak that
+    /// gave one (seeds 13001-16040, where the dispersion was measured, and 1-100 and
+    /// 17001-17040, which it was not) it lay above the true leak on 56; the drift read the
+    /// leak at 0.0-0.8 of its rate on the other four, ctcal's own draws 14010, 14021, 16010
+    /// and 35, so this is a limit at about 93 %, not 95 %
+    /// (`benches/coverage/leak-drift-limit-2026-12-08`). `None` where the bootstrap gave no
+    /// error or the end is not above zero (a drift that far below none is another misfit of
+    /// the timing model, as on draw 49, a leak of 0.17 Hz read as -1.4 Hz).
+    pub fn at_most_hz(&self) -> Option<f64> {
+        let error = TIMING_DRIFT_DISPERSION * self.standard_error_hz;
+        let end = self.rate_hz + crate::estimate::interval::z95() * error;
+        (error > 0.0 && end.is_finite() && end > 0.0).then_some(end)
     }
 }
 
@@ -517,6 +541,7 @@ mod tests {
                 leak_drift: Some(TimingDrift {
                     rate_hz: 3.2,
                     z,
+                    standard_error_hz: 3.2 / z,
                     growth: None,
                 }),
                 ..f.context()
@@ -529,6 +554,31 @@ mod tests {
         let within = drifting(31.0);
         assert!(!within.calls_for(), "{within:?}");
         assert_eq!(within.score, evidence(&f.context()).score);
+    }
+
+    /// The drift bounds a leak at its rate plus 1.96 of its standard errors, each 6.28 of
+    /// the bootstrap's: coverage draw 13035's 0.015 Hz at 2.0 bootstrap errors allows at
+    /// most 0.107 Hz; a drift with no bootstrap error, or whose end is below none, bounds
+    /// nothing.
+    #[test]
+    fn the_drift_bounds_a_leak_at_its_upper_end_in_the_dispersion_s_errors() {
+        let drift = |rate_hz: f64, standard_error_hz: f64| TimingDrift {
+            rate_hz,
+            z: rate_hz / standard_error_hz,
+            standard_error_hz,
+            growth: None,
+        };
+        let at_most = drift(0.015, 0.0075).at_most_hz().unwrap();
+        // 6.28 of the bootstrap's errors make one: 31.4 over 5
+        let dispersion = 31.4 / 5.0;
+        assert!(
+            (at_most - (0.015 + 1.959964 * dispersion * 0.0075)).abs() < 1e-6,
+            "{at_most}"
+        );
+        assert!((at_most - 0.107).abs() < 5e-4, "{at_most}");
+        assert_eq!(drift(0.015, 0.0).at_most_hz(), None);
+        assert_eq!(drift(-1.0, 0.01).at_most_hz(), None);
+        assert_eq!(drift(0.5, f64::INFINITY).at_most_hz(), None);
     }
 
     /// A leak that fires at random times (v2e's and ctcal's, each pixel from its own

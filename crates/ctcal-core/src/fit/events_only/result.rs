@@ -9,7 +9,7 @@ use super::measure::{
     BlockMeasure, CONFIRMING_QUIET_SHARE, Isolation, QUIET_SHARE, SUPPORT_RADII_PX,
     SUPPORT_WINDOWS_US, UpperBound,
 };
-use super::model::{ERROR_METRIC, NoiseModel, RATE_FLOOR_HZ, compare, distance};
+use super::model::{ERROR_METRIC, NoiseModel, compare, distance};
 use super::simulate_back::{Replaying, simulated};
 use super::steps::Judging;
 use super::{EventsOnly, FitRun, IntervalEdge};
@@ -19,6 +19,7 @@ use crate::fit::metric::Components;
 use crate::fit::observe::Role;
 use crate::fit::selection::finish::{HOT_FRACTION, HOT_RATE, hot_rate_unmeasured};
 use crate::fit::selection::keep::PARSIMONY;
+use crate::fit::wording::significant;
 use crate::fit::{
     AddedEffect, FitInput, FitOptions, FitResult, FittedParams, Holdout, Step, Uncertain,
 };
@@ -173,7 +174,8 @@ fn assembled(
         steps: parts.steps,
         ambiguities: Vec::new(),
         hot_pixels_masked: hot,
-        hot_pixel_detection: None,
+        // which hot pixels the search sees, whether or not it named some
+        hot_pixel_detection: parts.run.hot_found.detection.clone(),
         noise_detection: None,
         bandwidth_detection: None,
         residuals_before: None,
@@ -421,12 +423,12 @@ fn shot_noise_param(
                 "shot_noise_bright_factor".into(),
                 "how the noise rate depends on brightness needs each pixel's intensity (grey frames); the rate given is the one at the recording's brightness".into(),
             );
-        } else if 2.0 * (rate + 2.0 * se) > RATE_FLOOR_HZ {
+        } else {
             why.insert(
                 "shot_noise_rate_hz".into(),
                 format!(
-                    "not told apart from none: at most {:.4} Hz (2 standard errors)",
-                    2.0 * (rate + 2.0 * se)
+                    "not told apart from none: at most {} Hz (2 standard errors)",
+                    significant(2.0 * (rate + 2.0 * se))
                 ),
             );
         }
@@ -459,12 +461,14 @@ fn leak_param(
         );
     } else if kept {
         leak_measured(run, (excess, se), out);
-    } else if excess.max(0.0) + 2.0 * se > RATE_FLOOR_HZ {
+    } else {
         out.why.insert(
             "leak_rate_hz".into(),
             format!(
-                "the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, is not told apart from none: at most {:.4} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden; and where the recording starts at a reset, a simulator's first frame or a camera's start, a leak whose period is longer than the time since fires no event yet: the bound holds for leak phases spread at random, as in a camera that has been running)",
-                excess.max(0.0) + 2.0 * se
+                "the ON excess of isolated events, {} +- {} Hz, is not told apart from none: at most {} Hz (shot-noise events reset the pixel, so a leak much slower than the shot noise is hidden; and where the recording starts at a reset, a simulator's first frame or a camera's start, a leak whose period is longer than the time since fires no event yet: the bound holds for leak phases spread at random, as in a camera that has been running)",
+                significant(excess),
+                significant(se),
+                significant(excess.max(0.0) + 2.0 * se)
             ),
         );
     }

@@ -273,6 +273,8 @@ fn intervals(simulation: &Simulation, state: &mut State, parts: &mut Parts) -> W
             parts.known.mismatch,
             &mut params,
         ));
+    } else {
+        state.hot_detection = super::hot_report::search_reach(simulation, state);
     }
     // after the hot pixels, whose excess is counted across the profile's own interval
     assumptions.extend(super::method_systematic::widen_spread(
@@ -741,7 +743,8 @@ fn threshold_at_bound(value: f64) -> Option<f64> {
 pub(in crate::fit) const HOT_FRACTION: &str = "hot_pixel_fraction";
 pub(in crate::fit) const HOT_RATE: &str = "hot_pixel_rate_hz";
 
-/// Why the hot pixels' rate is not a measurement, when the count of hot pixels is not
+/// Why the hot pixels' rate is not a measurement: no pixel is counted as hot (the fraction
+/// is measured, the rate of none is not), or the count of hot pixels is not
 /// determined (its interval spans more than [`UNMEASURED_SPAN`]) or reaches none: the named
 /// pixels may then be none of them hot, and their rate is that of pixels a low threshold of
 /// the scene can make as well (on the 38 hot-pixel coverage draws, 2 of the 5 fits that
@@ -751,8 +754,13 @@ pub(in crate::fit) fn hot_rate_unmeasured(
     why: &BTreeMap<String, String>,
     uncertainty: &BTreeMap<String, Uncertain>,
 ) -> Option<String> {
-    let rate = uncertainty.get(HOT_RATE)?;
     let fraction = uncertainty.get(HOT_FRACTION)?;
+    let Some(rate) = uncertainty.get(HOT_RATE) else {
+        return Some(format!(
+            "no named pixel is counted as hot beyond the model's own outliers (hot_pixel_fraction {}), so there is no hot pixels' rate to report",
+            fraction.value
+        ));
+    };
     let reaches_none = matches!(fraction.ci95, Some([Some(lo), _]) if lo <= 0.0);
     if !why.contains_key(HOT_FRACTION) && !reaches_none {
         return None;
@@ -901,7 +909,8 @@ mod tests {
     }
 
     /// Draw 59's single named pixel (a fraction spanning a factor 200) and draw 94's five
-    /// (a fraction reaching 0) leave the rate unmeasured; draw 62's 18 pixels do not.
+    /// (a fraction reaching 0) leave the rate unmeasured; draw 62's 18 pixels do not; no
+    /// pixel in excess of the model's outliers has no rate.
     #[test]
     fn the_rate_of_hot_pixels_is_measured_only_where_their_count_is() {
         let rate = uncertain(435.0, 337.0, 533.0);
@@ -927,5 +936,9 @@ mod tests {
         ]);
         assert_eq!(hot_rate_unmeasured(&BTreeMap::new(), &many), None);
         assert_eq!(hot_rate_unmeasured(&spans, &BTreeMap::new()), None);
+        // every named pixel within the model's own outliers: a fraction of 0, no rate
+        let none_hot = BTreeMap::from([(HOT_FRACTION.to_string(), uncertain(0.0, 0.0, 1e-4))]);
+        let why = hot_rate_unmeasured(&BTreeMap::new(), &none_hot).unwrap();
+        assert!(why.contains("no hot pixels' rate"), "{why}");
     }
 }

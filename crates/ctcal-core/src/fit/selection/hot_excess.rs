@@ -181,6 +181,19 @@ fn model_outliers(model: &[u32], c: &Counts) -> usize {
         .count()
 }
 
+/// What the search sees on a recording where it named no hot pixel: the reach of the
+/// search on the recording's per-pixel counts `real` (0 outside the `kept` pixels) over
+/// `duration_s`, so that the fit can say which hot pixels it would have named.
+pub fn search_reach(
+    real: &[u32],
+    kept: &[bool],
+    (width, height): (usize, usize),
+    duration_s: f64,
+) -> Option<HotPixelDetection> {
+    let d = Detectability::new(real, kept, width, height, duration_s)?;
+    Some(detection(d.rate_at(0.5)?, &d))
+}
+
 /// What the search sees: the half-detection rate and `pi` on
 /// [`HotPixelDetection::rates_hz`] with the half-detection rate among them (the curve is
 /// steep there, and the coverage study reads it between its points).

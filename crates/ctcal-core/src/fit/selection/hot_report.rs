@@ -25,15 +25,7 @@ pub(super) fn hot_pixels(
     params: &mut crate::sim::PixelParams,
 ) -> String {
     let g = simulation.geometry;
-    let kept_counts = |observed: &Observed| {
-        let mut counts = observed.pixels_of(g, Subset::Fit);
-        for (count, kept) in counts.iter_mut().zip(&state.kept) {
-            if !kept {
-                *count = 0;
-            }
-        }
-        counts
-    };
+    let kept_counts = |observed: &Observed| kept_counts(observed, simulation, state);
     let model = kept_counts(&state.model.observed);
     let real = kept_counts(&simulation.real);
     let (spreads, source) = allowed_spreads(state, measured_spread);
@@ -67,6 +59,32 @@ pub(super) fn hot_pixels(
     }
     state.hot_detection = found.detection.clone();
     hot_pixels_assumption(state.hot.len(), &found, &spreads, source)
+}
+
+/// `observed`'s per-pixel counts on the fit blocks, 0 outside the kept pixels.
+fn kept_counts(observed: &Observed, simulation: &Simulation, state: &State) -> Vec<u32> {
+    let mut counts = observed.pixels_of(simulation.geometry, Subset::Fit);
+    for (count, kept) in counts.iter_mut().zip(&state.kept) {
+        if !kept {
+            *count = 0;
+        }
+    }
+    counts
+}
+
+/// Which hot pixels the search would have named, where the final model has none: its
+/// reach on the recording's counts of the fit blocks ([`super::hot_excess::search_reach`]).
+pub(super) fn search_reach(
+    simulation: &Simulation,
+    state: &State,
+) -> Option<crate::fit::HotPixelDetection> {
+    let g = simulation.geometry;
+    super::hot_excess::search_reach(
+        &kept_counts(&simulation.real, simulation, state),
+        &state.kept,
+        (g.sensor.width as usize, g.sensor.height as usize),
+        g.duration_of(Subset::Fit),
+    )
 }
 
 /// Threshold spreads (ln units) taken as possible where the recording measures none: from

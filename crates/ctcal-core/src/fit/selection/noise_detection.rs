@@ -13,7 +13,13 @@
 //! [`PROBE_HZ`] (same seed, same blocks), and the isolated events it adds, scaled
 //! linearly, give a candidate rate: the one whose expected evidence is [`MARGIN_Z`]
 //! standard errors above the threshold, so that Poisson chance leaves it below the
-//! threshold about 5 % of the time. Shot noise is memoryless and scales; leak does not: a
+//! threshold about 5 % of the time. Beside that trigger, each effect has a limit that does
+//! not depend on how many of its events stand out (`at_most_hz`): for shot noise the quiet
+//! pixels' isolated OFF events, for leak the event timing's drift, which a leak moves from
+//! a pixel's first event on. A leak's isolated-event limit can lie far above what the
+//! recording allows: on coverage draws 13015 and 13035 the trigger needed 7.8 and 5.1 Hz
+//! where the drift bounds the leak below about 0.7 and 0.1 Hz
+//! (`benches/coverage/fit-unseen-effects-2026-12-07`). Shot noise is memoryless and scales; leak does not: a
 //! pixel's first leak event comes one leak period after the recording starts (the
 //! simulator's reference starts at the first frame, as v2e's does), so a slow leak adds no
 //! isolated event to a short recording at all. The candidate is therefore simulated in
@@ -196,15 +202,20 @@ impl Probe<'_> {
             isolated_hz_per_hz: isolated,
             tried,
             why: found.err(),
-            at_most_hz: (self.effect == Effect::ShotNoise)
-                .then(|| {
-                    at_most_dark_hz(
-                        known.quiet_off,
-                        self.simulation.geometry,
-                        &self.state.model.params,
-                    )
-                })
-                .flatten(),
+            at_most_hz: self.at_most_hz(known),
+        }
+    }
+
+    /// The most of the effect the recording allows whatever the scene hides: for shot
+    /// noise the quiet pixels' isolated OFF events, for leak the event timing's drift.
+    fn at_most_hz(&self, known: super::Known) -> Option<f64> {
+        match self.effect {
+            Effect::ShotNoise => at_most_dark_hz(
+                known.quiet_off,
+                self.simulation.geometry,
+                &self.state.model.params,
+            ),
+            _ => known.leak_drift?.at_most_hz(),
         }
     }
 }
@@ -260,7 +271,7 @@ pub fn detect(
     ))
 }
 
-const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz (shot noise): the most dark rate, 95 %, that the recording's isolated OFF events at quiet pixels allow (their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), whatever the scene hides";
+const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz: the most the recording allows, 95 %, whatever the scene hides: for shot noise the dark rate its isolated OFF events at quiet pixels allow (their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), for leak the rate at the frames' median DN the event timing's drift allows (the drift over the ON threshold plus 1.96 of its standard errors, each 6.28 of its bootstrap's: the most a leak-free recording's drift reached on the coverage draws; above the true leak on 56 of 60 coverage draws with a leak, 93 %: the drift can read a leak low)";
 
 fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
     let parts: Vec<String> = limits
@@ -273,7 +284,7 @@ fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
             };
             let tried = if l.tried { "; tried and not kept" } else { "" };
             let at_most = l.at_most_hz.map_or(String::new(), |m| {
-                format!(", and the quiet pixels' isolated OFF events allow at most {m:.3} Hz (95 %)")
+                format!(", and {}", at_most_in_words(key, &format!("{m:.3}")))
             });
             match (l.called_for_above_hz, &l.why) {
                 (Some(r), _) => {
@@ -291,6 +302,18 @@ fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
         "noise the recording would show: {} would have made its isolated events call for the effect in about 95 % of such recordings (5 standard errors; the final model simulated again with the effect, {PROBE_HZ} Hz first, then the rate found, doubled until it calls for it, at most {CHECKS} times); a noise effect not in the model may be present below that rate, which this recording does not determine",
         parts.join("; ")
     )
+}
+
+/// `limit` (Hz), a noise effect's `at_most_hz`, in words: what measures it and how often
+/// such a limit held.
+pub(in crate::fit) fn at_most_in_words(key: &str, limit: &str) -> String {
+    if key == "shot_noise_rate_hz" {
+        format!("the quiet pixels' isolated OFF events allow at most {limit} Hz (95 %)")
+    } else {
+        format!(
+            "the event timing's drift allows at most {limit} Hz at the frames' median DN (such a limit held on 56 of 60 coverage draws with a leak)"
+        )
+    }
 }
 
 #[cfg(test)]
