@@ -5,6 +5,7 @@
 //! seed whatever the thread count, documents each effect's equation and source in
 //! [`effects`], and is validated against the v2e oracle cases (`../shared/data/oracle`).
 
+pub mod ahead;
 mod batch;
 pub mod budget;
 pub mod display;
