@@ -6,6 +6,11 @@
 //! none, and the producer waits with its finished sample until the simulator takes it.
 //! The samples, their order and any error are the inner source's; a panic on the
 //! producer's thread is raised again in the caller's.
+//!
+//! `simulate --scene` does not use it: on two cores the rendering and the simulation
+//! already share both, and pipelining them was not measurably faster; the measurement
+//! (`examples/render_hidden.rs`, `benches/README.md`, "Rendering pipelined with the
+//! simulation") uses it to show what a pipeline could hide.
 
 use super::SimError;
 use super::source::{FrameSource, Sample};
