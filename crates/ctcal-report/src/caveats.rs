@@ -6,6 +6,7 @@
 use super::model::SequenceReport;
 use crate::estimate::CtEstimate;
 use crate::fit::FitResult;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The caveats of one method's estimate, each as one line.
 pub fn of_estimate(e: &CtEstimate) -> Vec<String> {
@@ -32,15 +33,7 @@ pub fn of_fit(f: &FitResult) -> Vec<String> {
             .iter()
             .map(|(key, why)| format!("{key} not identified: {why}")),
     );
-    // an effect of two parameters (hot pixels) has one reason: said once, wherever its
-    // keys sort
-    let mut said = std::collections::BTreeSet::new();
-    out.extend(
-        f.not_detected
-            .values()
-            .filter(|why| said.insert(why.as_str()))
-            .map(|why| format!("off in the fitted model: {why}")),
-    );
+    out.extend(off_in_the_model(&f.not_detected));
     out.extend(f.ambiguities.iter().map(|a| {
         format!(
             "{} or {}: not separated by this recording (selection error {:.4} with {}, {:.4} with {} = {:.4} instead); {}",
@@ -49,6 +42,17 @@ pub fn of_fit(f: &FitResult) -> Vec<String> {
     }));
     out.extend(f.assumptions.iter().cloned());
     out
+}
+
+/// One line per reason of `not_detected`: an effect of two parameters (hot pixels) has one
+/// reason, said once wherever its keys sort.
+fn off_in_the_model(not_detected: &BTreeMap<String, String>) -> Vec<String> {
+    let mut said = BTreeSet::new();
+    not_detected
+        .values()
+        .filter(|why| said.insert(why.as_str()))
+        .map(|why| format!("off in the fitted model: {why}"))
+        .collect()
 }
 
 /// The caveats of a sequence as a whole: what reading it warned of, and its plots that
@@ -67,4 +71,27 @@ pub fn of_sequence(s: &SequenceReport) -> Vec<String> {
 /// One line of a caveat (Markdown list items and HTML list items are one line).
 pub fn one_line(text: &str) -> String {
     text.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A reason shared by keys that do not sort side by side is said once, in the order of
+    /// its first key.
+    #[test]
+    fn a_reason_of_several_parameters_is_said_once() {
+        let not_detected = BTreeMap::from([
+            ("a_first".to_string(), "hot pixels off".to_string()),
+            ("b_between".to_string(), "leak off".to_string()),
+            ("c_last".to_string(), "hot pixels off".to_string()),
+        ]);
+        assert_eq!(
+            off_in_the_model(&not_detected),
+            [
+                "off in the fitted model: hot pixels off",
+                "off in the fitted model: leak off"
+            ]
+        );
+    }
 }

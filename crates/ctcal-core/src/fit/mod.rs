@@ -460,11 +460,12 @@ pub struct NoiseLimit {
     pub tried: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub why: Option<String>,
-    /// The most the recording allows (95 %) whatever the scene hides: shot noise's dark
-    /// rate its isolated OFF events at quiet pixels allow
-    /// ([`effects::quiet_noise::at_most_dark_hz`]), a leak's rate at the frames' median DN
-    /// the event timing's drift allows ([`effects::leak::TimingDrift::at_most_hz`]);
-    /// absent where not measured.
+    /// The most the recording allows whatever the scene hides: shot noise's dark rate its
+    /// isolated OFF events at quiet pixels allow (95 %,
+    /// [`effects::quiet_noise::at_most_dark_hz`]), a leak's rate at the frames' median DN
+    /// the event timing's drift allows ([`effects::leak::TimingDrift::at_most_hz`], with
+    /// its record on the coverage draws, [`effects::leak::DRIFT_LIMIT_HELD`]); absent where
+    /// not measured.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub at_most_hz: Option<f64>,
 }

@@ -4,13 +4,13 @@
 //! effect, tried it and found its fall in error within chance, or kept it and later took it
 //! out (no longer needed, or a look-alike in its place). Where the fit measured how strong
 //! the effect would have had to be for this recording to show it (the noise and bandwidth
-//! detection limits; a refractory period's edge in the intervals), that is said: the
-//! effect, if present, is likely weaker.
+//! detection limits, and what the quiet pixels or the event timing's drift allow of the
+//! noise; the hot-pixel search's reach; a refractory period's edge in the intervals), that
+//! is said: the effect, if present, is likely weaker.
 
 use super::effects::Effect;
 use super::events_only::refractory::Edge;
-use super::selection::noise_detection::at_most_in_words;
-use super::wording::significant;
+use super::wording::{at_most_in_words, significant};
 use super::{FitResult, HotPixelDetection, Step};
 use std::collections::BTreeMap;
 
@@ -102,9 +102,7 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
                 (None, Some(why)) => Some(format!("no detection limit: {why}")),
                 (None, None) => None,
             };
-            let at_most = limit
-                .at_most_hz
-                .map(|hz| at_most_in_words(key, &significant(hz)));
+            let at_most = limit.at_most_hz.map(|hz| at_most_in_words(effect, hz));
             let parts: Vec<String> = [above, at_most].into_iter().flatten().collect();
             (!parts.is_empty()).then(|| parts.join("; "))
         }
@@ -129,7 +127,14 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
 /// `detection`'s curve at its first rate there (eight a decade: the exact rate is at or
 /// below it).
 fn hot_pixels_bound(detection: &HotPixelDetection) -> Option<String> {
-    let [rate, _] = *detection.probability.iter().find(|[_, p]| *p >= 0.95)?;
+    let Some(&[rate, _]) = detection.probability.iter().find(|[_, p]| *p >= 0.95) else {
+        let &[fastest, share] = detection.probability.last()?;
+        return Some(format!(
+            "the hot-pixel search names even a pixel whose train fires {} Hz beyond its scene at only {:.0} % of the kept pixels (hot_pixel_detection, on this recording's counts): the recording does not bound hot pixels",
+            significant(fastest),
+            100.0 * share
+        ));
+    };
     Some(format!(
         "the hot-pixel search would name a pixel whose train fires {} Hz or faster beyond its scene at 95 % or more of the kept pixels (hot_pixel_detection, on this recording's counts: the search's test alone, which the fit's later checks can only lower), so a hot pixel that fast would likely have been named; slower ones hide among the scene's events",
         significant(rate)
@@ -178,8 +183,8 @@ mod tests {
     }
 
     /// Where the search named no hot pixel, the slowest train it names at 95 % of the
-    /// pixels is said, at the curve's first rate there; a curve that never gets there
-    /// bounds nothing.
+    /// pixels is said, at the curve's first rate there; a curve that never gets there says
+    /// that the recording does not bound them.
     #[test]
     fn hot_pixels_are_bounded_where_the_search_names_them_at_95_percent() {
         let detection = |curve: Vec<[f64; 2]>| HotPixelDetection::new(7.0, curve);
@@ -191,10 +196,12 @@ mod tests {
         ]))
         .unwrap();
         assert!(said.contains("17.8 Hz or faster"), "{said}");
-        assert_eq!(
-            hot_pixels_bound(&detection(vec![[1.0, 0.2], [5623.0, 0.9]])),
-            None
+        let unbounded = hot_pixels_bound(&detection(vec![[1.0, 0.2], [5623.0, 0.9]])).unwrap();
+        assert!(
+            unbounded.contains("5623 Hz") && unbounded.contains("only 90 %"),
+            "{unbounded}"
         );
+        assert_eq!(hot_pixels_bound(&detection(Vec::new())), None);
     }
 
     fn step(effect: &str, kept: bool, reason: &str) -> Step {

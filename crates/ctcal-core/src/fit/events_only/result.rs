@@ -404,9 +404,13 @@ fn shot_noise_param(
             let upper = 2.0 * (rate + 2.0 * se);
             let lower = 2.0 * scene.noise_at_least_hz;
             let range = if lower < upper {
-                format!("lies between {lower:.4} and {upper:.4} Hz")
+                format!(
+                    "lies between {} and {} Hz",
+                    significant(lower),
+                    significant(upper)
+                )
             } else {
-                format!("is at most {upper:.4} Hz")
+                format!("is at most {} Hz", significant(upper))
             };
             why.insert(
                 "shot_noise_rate_hz".into(),
@@ -454,9 +458,11 @@ fn leak_param(
         out.why.insert(
             "leak_rate_hz".into(),
             format!(
-                "{}: the leak lies between 0 and {:.4} Hz (the ON excess of isolated events, {excess:.4} +- {se:.4} Hz, with 2 standard errors)",
+                "{}: the leak lies between 0 and {} Hz (the ON excess of isolated events, {} +- {} Hz, with 2 standard errors)",
                 scene.evidence(),
-                excess.max(0.0) + 2.0 * se
+                significant(excess.max(0.0) + 2.0 * se),
+                significant(excess),
+                significant(se)
             ),
         );
     } else if kept {

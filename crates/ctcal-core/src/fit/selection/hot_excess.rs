@@ -109,14 +109,13 @@ pub fn excess(c: &Counts) -> HotExcess {
     let mut hot = c.real_named.to_vec();
     hot.sort_by(|a, b| b.z.total_cmp(&a.z));
     hot.truncate(k);
-    // the scene without the named pixels' own trains: each at its neighbours' median
-    let mut scene = c.real.to_vec();
-    for h in c.real_named {
-        let (x, y) = (h.x as usize, h.y as usize);
-        scene[y * c.width + x] = neighbour_median(c.real, c.width, c.height, x, y) as u32;
-    }
-    let detectability = Detectability::new(&scene, c.kept, c.width, c.height, c.duration_s)
-        .and_then(|d| Some((d.rate_at(0.5)?, d)));
+    let detectability = detectability(
+        c.real,
+        c.real_named,
+        c.kept,
+        (c.width, c.height),
+        c.duration_s,
+    );
     let weight = mean_weight(&hot, c, detectability.as_ref().map(|(_, d)| d));
     HotExcess {
         rate: median_rate(&hot, c)
@@ -181,17 +180,36 @@ fn model_outliers(model: &[u32], c: &Counts) -> usize {
         .count()
 }
 
-/// What the search sees on a recording where it named no hot pixel: the reach of the
-/// search on the recording's per-pixel counts `real` (0 outside the `kept` pixels) over
-/// `duration_s`, so that the fit can say which hot pixels it would have named.
+/// What the search sees, where the final model has no hot pixels: its reach on the
+/// recording's per-pixel counts `real` (0 outside the `kept` pixels) over `duration_s`,
+/// the `named` pixels' trains left out, so that the fit can say which hot pixels it would
+/// have named.
 pub fn search_reach(
     real: &[u32],
+    named: &[HotPixel],
+    kept: &[bool],
+    size: (usize, usize),
+    duration_s: f64,
+) -> Option<HotPixelDetection> {
+    detectability(real, named, kept, size, duration_s).map(|(half, d)| detection(half, &d))
+}
+
+/// The search's detectability on the scene without the `named` pixels' own trains (each at
+/// its neighbours' median), with the rate it names at half the kept pixels.
+fn detectability(
+    real: &[u32],
+    named: &[HotPixel],
     kept: &[bool],
     (width, height): (usize, usize),
     duration_s: f64,
-) -> Option<HotPixelDetection> {
-    let d = Detectability::new(real, kept, width, height, duration_s)?;
-    Some(detection(d.rate_at(0.5)?, &d))
+) -> Option<(f64, Detectability)> {
+    let mut scene = real.to_vec();
+    for h in named {
+        let (x, y) = (h.x as usize, h.y as usize);
+        scene[y * width + x] = neighbour_median(real, width, height, x, y) as u32;
+    }
+    let d = Detectability::new(&scene, kept, width, height, duration_s)?;
+    Some((d.rate_at(0.5)?, d))
 }
 
 /// What the search sees: the half-detection rate and `pi` on

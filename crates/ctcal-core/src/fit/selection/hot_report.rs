@@ -74,6 +74,8 @@ fn kept_counts(observed: &Observed, simulation: &Simulation, state: &State) -> V
 
 /// Which hot pixels the search would have named, where the final model has none: its
 /// reach on the recording's counts of the fit blocks ([`super::hot_excess::search_reach`]).
+/// Pixels the search named and the loop did not keep as hot are the scene's, as the fit
+/// found them.
 pub(super) fn search_reach(
     simulation: &Simulation,
     state: &State,
@@ -81,6 +83,7 @@ pub(super) fn search_reach(
     let g = simulation.geometry;
     super::hot_excess::search_reach(
         &kept_counts(&simulation.real, simulation, state),
+        &[],
         &state.kept,
         (g.sensor.width as usize, g.sensor.height as usize),
         g.duration_of(Subset::Fit),

@@ -36,7 +36,7 @@ pub(in crate::fit) mod keep;
 mod leak_report;
 mod look_alikes;
 mod method_systematic;
-pub(in crate::fit) mod noise_detection;
+mod noise_detection;
 mod spread_report;
 mod start;
 mod steps;

@@ -33,6 +33,7 @@ use super::super::observe::Subset;
 use super::super::search::Simulation;
 use super::super::{NoiseDetection, NoiseLimit, Step};
 use super::State;
+use crate::fit::wording::{at_most_in_words, significant};
 use std::collections::BTreeMap;
 
 /// The rate the effect is first simulated at to measure how many of its events stay
@@ -215,7 +216,8 @@ impl Probe<'_> {
                 self.simulation.geometry,
                 &self.state.model.params,
             ),
-            _ => known.leak_drift?.at_most_hz(),
+            Effect::Leak => known.leak_drift?.at_most_hz(),
+            _ => None,
         }
     }
 }
@@ -271,49 +273,58 @@ pub fn detect(
     ))
 }
 
-const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz: the most the recording allows, 95 %, whatever the scene hides: for shot noise the dark rate its isolated OFF events at quiet pixels allow (their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), for leak the rate at the frames' median DN the event timing's drift allows (the drift over the ON threshold plus 1.96 of its standard errors, each 6.28 of its bootstrap's: the most a leak-free recording's drift reached on the coverage draws; above the true leak on 56 of 60 coverage draws with a leak, 93 %: the drift can read a leak low)";
+const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz: the most the recording allows whatever the scene hides: for shot noise the dark rate its isolated OFF events at quiet pixels allow (95 %: their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), for leak the rate at the frames' median DN the event timing's drift allows (the drift over the ON threshold plus 1.96 times its standard error, each 6.28 of its bootstrap's (the most a leak-free recording's drift reached on the coverage draws), and a share of the rate for how low the drift reads a leak, in quadrature; how often it held is said beside it)";
+
+/// The noise effect whose parameter is `key`.
+fn effect_of(key: &str) -> Effect {
+    NOISE
+        .iter()
+        .find(|(_, k, _, _)| *k == key)
+        .map_or(Effect::ShotNoise, |(effect, ..)| *effect)
+}
 
 fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
+    let name = |key: &str| match effect_of(key) {
+        Effect::ShotNoise => "shot noise (dark rate)",
+        _ => "leak",
+    };
     let parts: Vec<String> = limits
         .iter()
         .map(|(key, l)| {
-            let name = if key == "shot_noise_rate_hz" {
-                "shot noise (dark rate)"
-            } else {
-                "leak"
-            };
-            let tried = if l.tried { "; tried and not kept" } else { "" };
-            let at_most = l.at_most_hz.map_or(String::new(), |m| {
-                format!(", and {}", at_most_in_words(key, &format!("{m:.3}")))
-            });
+            let (name, tried) = (name(key), if l.tried { "; tried and not kept" } else { "" });
             match (l.called_for_above_hz, &l.why) {
                 (Some(r), _) => {
                     let [off, on] = l.isolated_hz_per_hz.unwrap_or([0.0; 2]);
                     format!(
-                        "{name} at {r:.3} Hz (isolated OFF / ON events {off:.3} / {on:.3} per pixel-second per Hz{tried}){at_most}"
+                        "{name} at {} Hz (isolated OFF / ON events {off:.3} / {on:.3} per pixel-second per Hz{tried})",
+                        significant(r)
                     )
                 }
-                (None, Some(why)) => format!("{name}: no rate ({why}{tried}){at_most}"),
-                (None, None) => format!("{name}: no rate{tried}{at_most}"),
+                (None, Some(why)) => format!("{name}: no rate ({why}{tried})"),
+                (None, None) => format!("{name}: no rate{tried}"),
             }
         })
         .collect();
+    let allowed: Vec<String> = limits
+        .iter()
+        .filter_map(|(key, l)| {
+            let m = l.at_most_hz?;
+            Some(format!(
+                "{}: {}",
+                name(key),
+                at_most_in_words(effect_of(key), m)
+            ))
+        })
+        .collect();
+    let allowed = if allowed.is_empty() {
+        String::new()
+    } else {
+        format!(". Whatever the scene hides, {}", allowed.join("; "))
+    };
     format!(
-        "noise the recording would show: {} would have made its isolated events call for the effect in about 95 % of such recordings (5 standard errors; the final model simulated again with the effect, {PROBE_HZ} Hz first, then the rate found, doubled until it calls for it, at most {CHECKS} times); a noise effect not in the model may be present below that rate, which this recording does not determine",
+        "noise the recording would show: {} would have made its isolated events call for the effect in about 95 % of such recordings (5 standard errors; the final model simulated again with the effect, {PROBE_HZ} Hz first, then the rate found, doubled until it calls for it, at most {CHECKS} times); a noise effect not in the model may be present below that rate, which this recording does not determine{allowed}",
         parts.join("; ")
     )
-}
-
-/// `limit` (Hz), a noise effect's `at_most_hz`, in words: what measures it and how often
-/// such a limit held.
-pub(in crate::fit) fn at_most_in_words(key: &str, limit: &str) -> String {
-    if key == "shot_noise_rate_hz" {
-        format!("the quiet pixels' isolated OFF events allow at most {limit} Hz (95 %)")
-    } else {
-        format!(
-            "the event timing's drift allows at most {limit} Hz at the frames' median DN (such a limit held on 56 of 60 coverage draws with a leak)"
-        )
-    }
 }
 
 #[cfg(test)]
