@@ -13,19 +13,20 @@
 //! [`PROBE_HZ`] (same seed, same blocks), and the isolated events it adds, scaled
 //! linearly, give a candidate rate: the one whose expected evidence is [`MARGIN_Z`]
 //! standard errors above the threshold, so that Poisson chance leaves it below the
-//! threshold about 5 % of the time. Beside that trigger, each effect has a limit that does
-//! not depend on how many of its events stand out (`at_most_hz`): for shot noise the quiet
-//! pixels' isolated OFF events, for leak the event timing's drift, which a leak moves from
-//! a pixel's first event on. A leak's isolated-event limit can lie far above what the
-//! recording allows: on coverage draws 13015 and 13035 the trigger needed 7.8 and 5.1 Hz
-//! where the drift bounds the leak below about 0.7 and 0.1 Hz
-//! (`benches/coverage/fit-unseen-effects-2026-12-07`). Shot noise is memoryless and scales; leak does not: a
+//! threshold about 5 % of the time. Shot noise is memoryless and scales; leak does not: a
 //! pixel's first leak event comes one leak period after the recording starts (the
 //! simulator's reference starts at the first frame, as v2e's does), so a slow leak adds no
 //! isolated event to a short recording at all. The candidate is therefore simulated in
 //! turn and given only where it does call for the effect; otherwise the rate is doubled,
 //! up to [`CHECKS`] simulations. A noise effect not in the model may be present below the
 //! rate given.
+//!
+//! Beside that trigger, each effect has a limit that does not depend on how many of its
+//! events stand out (`at_most_hz`): for shot noise the quiet pixels' isolated OFF events,
+//! for leak the event timing's drift, which a leak moves from a pixel's first event on. A
+//! leak's isolated-event limit can lie far above what the recording allows: on coverage
+//! draws 13015 and 13035 the trigger needed 7.8 and 5.1 Hz where the drift bounds the leak
+//! below about 0.7 and 0.1 Hz (`benches/coverage/fit-unseen-effects-2026-12-07`).
 
 use super::super::effects::quiet_noise::at_most_dark_hz;
 use super::super::effects::{EVIDENCE_THRESHOLD, Effect, isolated_totals, leak, shot_noise};
@@ -275,6 +276,26 @@ pub fn detect(
 
 const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz: the most the recording allows whatever the scene hides: for shot noise the dark rate its isolated OFF events at quiet pixels allow (95 %: their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), for leak the rate at the frames' median DN the event timing's drift allows (the drift over the ON threshold plus 1.96 times its standard error, each 6.28 of its bootstrap's (the most a leak-free recording's drift reached on the coverage draws), and a share of the rate for how low the drift reads a leak, in quadrature; how often it held is said beside it)";
 
+/// The assumption's last sentence: each limit's `at_most_hz` in words (empty where none
+/// was measured).
+fn allowed_whatever_the_scene_hides(limits: &BTreeMap<String, NoiseLimit>) -> String {
+    let allowed: Vec<String> = limits
+        .iter()
+        .filter_map(|(key, l)| {
+            let m = l.at_most_hz?;
+            Some(format!(
+                "{}: {}",
+                name(key),
+                at_most_in_words(effect_of(key), m)
+            ))
+        })
+        .collect();
+    if allowed.is_empty() {
+        return String::new();
+    }
+    format!(". Whatever the scene hides, {}", allowed.join("; "))
+}
+
 /// The noise effect whose parameter is `key`.
 fn effect_of(key: &str) -> Effect {
     NOISE
@@ -283,11 +304,15 @@ fn effect_of(key: &str) -> Effect {
         .map_or(Effect::ShotNoise, |(effect, ..)| *effect)
 }
 
-fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
-    let name = |key: &str| match effect_of(key) {
+/// How the assumption names the noise effect of `key`.
+fn name(key: &str) -> &'static str {
+    match effect_of(key) {
         Effect::ShotNoise => "shot noise (dark rate)",
         _ => "leak",
-    };
+    }
+}
+
+fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
     let parts: Vec<String> = limits
         .iter()
         .map(|(key, l)| {
@@ -305,22 +330,7 @@ fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
             }
         })
         .collect();
-    let allowed: Vec<String> = limits
-        .iter()
-        .filter_map(|(key, l)| {
-            let m = l.at_most_hz?;
-            Some(format!(
-                "{}: {}",
-                name(key),
-                at_most_in_words(effect_of(key), m)
-            ))
-        })
-        .collect();
-    let allowed = if allowed.is_empty() {
-        String::new()
-    } else {
-        format!(". Whatever the scene hides, {}", allowed.join("; "))
-    };
+    let allowed = allowed_whatever_the_scene_hides(limits);
     format!(
         "noise the recording would show: {} would have made its isolated events call for the effect in about 95 % of such recordings (5 standard errors; the final model simulated again with the effect, {PROBE_HZ} Hz first, then the rate found, doubled until it calls for it, at most {CHECKS} times); a noise effect not in the model may be present below that rate, which this recording does not determine{allowed}",
         parts.join("; ")
@@ -330,6 +340,46 @@ fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn limit(called_for_above_hz: Option<f64>, at_most_hz: Option<f64>) -> NoiseLimit {
+        NoiseLimit {
+            called_for_above_hz,
+            isolated_hz_per_hz: Some([0.4, 0.5]),
+            tried: false,
+            why: called_for_above_hz.is_none().then(|| NEVER.to_string()),
+            at_most_hz,
+        }
+    }
+
+    /// The trigger's rates in one sentence, then what the recording allows whatever the
+    /// scene hides, each with what measured it (the DAVIS346's fit: shot noise 0.0241 Hz
+    /// with its quiet pixels' 0.00106 Hz, leak with no rate and the drift's 1.06 Hz).
+    #[test]
+    fn the_assumption_gives_the_trigger_s_rates_then_what_the_recording_allows() {
+        let limits = BTreeMap::from([
+            ("leak_rate_hz".to_string(), limit(None, Some(1.06))),
+            (
+                "shot_noise_rate_hz".to_string(),
+                limit(Some(0.0241), Some(0.00106)),
+            ),
+        ]);
+        let text = assumption(&limits);
+        let (trigger, allowed) = text.split_once(". Whatever the scene hides, ").unwrap();
+        assert!(
+            trigger.contains("leak: no rate (no rate up to 10 kHz would")
+                && trigger.contains("shot noise (dark rate) at 0.0241 Hz"),
+            "{trigger}"
+        );
+        assert!(
+            allowed.starts_with("leak: the event timing's drift allows at most 1.06 Hz")
+                && allowed.contains(
+                    "shot noise (dark rate): the quiet pixels' isolated OFF events allow at most 0.00106 Hz (95 %)"
+                ),
+            "{allowed}"
+        );
+        let without = BTreeMap::from([("leak_rate_hz".to_string(), limit(Some(0.7), None))]);
+        assert!(!assumption(&without).contains("Whatever the scene hides"));
+    }
 
     fn evidence(base: [f64; 4], score: Score) -> Evidence {
         Evidence {
