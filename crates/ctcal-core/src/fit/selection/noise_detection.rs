@@ -17,8 +17,11 @@
 //! pixel's first leak event comes one leak period after the recording starts (the
 //! simulator's reference starts at the first frame, as v2e's does), so a slow leak adds no
 //! isolated event to a short recording at all. The candidate is therefore simulated in
-//! turn and given only where it does call for the effect; otherwise the rate is doubled,
-//! up to [`CHECKS`] simulations. A noise effect not in the model may be present below the
+//! turn and given only where its evidence reaches the threshold plus the margin, as the
+//! candidate was scaled (checked at the threshold alone, one simulation just over it would
+//! call for the effect in only about half of such recordings); otherwise the rate grows by
+//! [`next_step`] (the square root of 2 where the threshold was reached, else 2), up to
+//! [`CHECKS`] simulations. A noise effect not in the model may be present below the
 //! rate given.
 //!
 //! Beside that trigger, each effect has a limit that does not depend on how many of its
@@ -43,6 +46,18 @@ pub const PROBE_HZ: f64 = 1.0;
 
 /// The most simulations that check a candidate rate, per effect.
 pub const CHECKS: usize = 4;
+
+/// The factor to the next candidate rate after one whose evidence fell short of the margin:
+/// the square root of 2 where it reached the threshold (the margin is 1.645 standard errors
+/// further; shot noise's isolated events grow in proportion to its rate), else 2 (a leak
+/// may add no isolated events at all until its period fits in the recording).
+fn next_step(reached_threshold: bool) -> f64 {
+    if reached_threshold {
+        std::f64::consts::SQRT_2
+    } else {
+        2.0
+    }
+}
 
 /// How far above the evidence threshold the candidate rate's expected evidence is, in
 /// standard errors: the one-sided 95 % normal quantile.
@@ -166,20 +181,26 @@ impl Probe<'_> {
             Limit::AlreadyCalledFor => return (Err(ALREADY.into()), Some(isolated)),
             Limit::Never => return (Err(NEVER.into()), Some(isolated)),
         };
+        let mut checked = rate;
         for _ in 0..CHECKS {
             let added = match self.added(rate) {
                 Ok(a) => a,
                 Err(e) => return (Err(e), Some(isolated)),
             };
             isolated = self.per_hz(added, rate);
-            if self.evidence.calls(added, 1.0, EVIDENCE_THRESHOLD) {
+            // at the margin, as the candidate was scaled: one recording's evidence there
+            // leaves the threshold behind in about 95 % of such recordings
+            if self
+                .evidence
+                .calls(added, 1.0, EVIDENCE_THRESHOLD + MARGIN_Z)
+            {
                 return (Ok(rate), Some(isolated));
             }
-            rate *= 2.0;
+            checked = rate;
+            rate *= next_step(self.evidence.calls(added, 1.0, EVIDENCE_THRESHOLD));
         }
         let why = format!(
-            "not called for at any rate checked (up to {:.3} Hz): its isolated events grow more slowly than its rate (a leak's first event comes one period after the recording starts)",
-            rate / 2.0
+            "not called for at any rate checked (up to {checked:.3} Hz): its isolated events grow more slowly than its rate (a leak's first event comes one period after the recording starts)"
         );
         (Err(why), Some(isolated))
     }
@@ -274,7 +295,7 @@ pub fn detect(
     ))
 }
 
-const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, doubled until it calls for the effect); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz: the most the recording allows whatever the scene hides: for shot noise the dark rate its isolated OFF events at quiet pixels allow (95 %: their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), for leak the rate at the frames' median DN the event timing's drift allows (the drift over the ON threshold plus 1.96 times its standard error, each 6.28 of its bootstrap's (the most a leak-free recording's drift reached on the coverage draws), and a share of the rate for how low the drift reads a leak, in quadrature; how often it held is said beside it)";
+const MEANING: &str = "per noise effect the final model lacks: a rate (shot noise: its dark rate; leak: events per pixel-second) at which the recording's isolated events would have called for it in about 95 % of recordings like this one (its evidence at 5 standard errors, the rule that decides which effects are tried), found by simulating the final model again with the effect (first at probe_hz, its added isolated events scaled to 1.645 standard errors above the threshold, then at that rate, raised by the square root of 2 (where the threshold was reached) or 2 until its evidence reaches those 1.645 standard errors above the threshold); isolated_hz_per_hz: the isolated OFF and ON events the effect adds per pixel-second of the fit blocks per Hz, at the last rate simulated; tried: the effect was called for and tried, and not kept; a slower one does not show in this recording and is not determinable from it; at_most_hz: the most the recording allows whatever the scene hides: for shot noise the dark rate its isolated OFF events at quiet pixels allow (95 %: their exact Poisson upper end over an OFF share of 1/2 and the smallest brightness factor of the frames), for leak the rate at the frames' median DN the event timing's drift allows (the drift over the ON threshold plus 1.96 times its standard error, each 6.28 of its bootstrap's (the most a leak-free recording's drift reached on the coverage draws), and a share of the rate for how low the drift reads a leak, in quadrature; how often it held is said beside it)";
 
 /// The assumption's last sentence: each limit's `at_most_hz` in words (empty where none
 /// was measured).
@@ -332,7 +353,7 @@ fn assumption(limits: &BTreeMap<String, NoiseLimit>) -> String {
         .collect();
     let allowed = allowed_whatever_the_scene_hides(limits);
     format!(
-        "noise the recording would show: {} would have made its isolated events call for the effect in about 95 % of such recordings (5 standard errors; the final model simulated again with the effect, {PROBE_HZ} Hz first, then the rate found, doubled until it calls for it, at most {CHECKS} times); a noise effect not in the model may be present below that rate, which this recording does not determine{allowed}",
+        "noise the recording would show: {} would have made its isolated events call for the effect in about 95 % of such recordings (5 standard errors; the final model simulated again with the effect, {PROBE_HZ} Hz first, then the rate found, raised by the square root of 2 or 2 until its evidence is 1.645 standard errors above the threshold, at most {CHECKS} times); a noise effect not in the model may be present below that rate, which this recording does not determine{allowed}",
         parts.join("; ")
     )
 }
