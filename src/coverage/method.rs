@@ -29,11 +29,12 @@ pub enum Method {
 const THRESHOLDS: [&str; 3] = ["ct_on", "ct_off", "ct_sigma"];
 
 /// The parameters the fit reports (the PARAMS.toml keys the study has truth for), and
-/// [`CUTOFF_LIMIT`].
-const FITTED: [&str; 12] = [
+/// [`CUTOFF_LIMIT`] and [`MISMATCH_LIMIT`].
+const FITTED: [&str; 13] = [
     "ct_on",
     "ct_off",
     "ct_sigma",
+    MISMATCH_LIMIT,
     "cutoff_hz",
     CUTOFF_LIMIT,
     "leak_rate_hz",
@@ -100,19 +101,24 @@ pub fn label(parameter: &str) -> &str {
 /// limit would have been called for, so a silent fit's true cutoff lies above it.
 pub const CUTOFF_LIMIT: &str = "cutoff_hz_limit";
 
-/// The truth a parameter is scored against: its own, but [`CUTOFF_LIMIT`]'s is the cutoff.
+/// A fit's `mismatch_detection.at_most` where its model has no spread and event timing
+/// resolved none, scored as the interval `[0, at_most]` against the true spread.
+pub const MISMATCH_LIMIT: &str = "ct_sigma_limit";
+
+/// The truth a parameter is scored against: its own, but [`CUTOFF_LIMIT`]'s is the cutoff
+/// and [`MISMATCH_LIMIT`]'s the spread.
 pub fn truth_key(parameter: &str) -> &str {
-    if parameter == CUTOFF_LIMIT {
-        "cutoff_hz"
-    } else {
-        parameter
+    match parameter {
+        CUTOFF_LIMIT => "cutoff_hz",
+        MISMATCH_LIMIT => "ct_sigma",
+        other => other,
     }
 }
 
 /// The effect a parameter belongs to (the fit's effect names); thresholds have none.
 pub fn effect_of(parameter: &str) -> Option<&'static str> {
     Some(match parameter {
-        "ct_sigma" => "mismatch",
+        "ct_sigma" | MISMATCH_LIMIT => "mismatch",
         "cutoff_hz" | CUTOFF_LIMIT => "bandwidth",
         "leak_rate_hz" | "leak_rate_hz_per_dn" => "leak",
         "shot_noise_rate_hz" => "shot_noise",

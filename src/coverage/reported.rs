@@ -7,7 +7,7 @@
 //! `uncertainties` (a spread the model lacks but event timing measured, a leak read as a
 //! lower bound) is scored as that interval: the JSON states it.
 
-use super::method::{CUTOFF_LIMIT, Method};
+use super::method::{CUTOFF_LIMIT, MISMATCH_LIMIT, Method};
 use serde::{Deserialize, Serialize};
 use serde_json::Value;
 use std::collections::BTreeMap;
@@ -142,9 +142,33 @@ fn cutoff_limit(output: &Value) -> Reported {
     }
 }
 
+/// A fit's most event timing allows of a spread its model lacks, as `[0, at_most]`: absent
+/// where the model has a spread or event timing resolved one (or no frames), `null` with
+/// its reason where event timing gave no interval.
+fn mismatch_limit(output: &Value) -> Reported {
+    let Some(detection) = output.get("mismatch_detection") else {
+        return Reported::NotReported;
+    };
+    match detection["at_most"].as_f64() {
+        Some(limit) => Reported::Interval {
+            value: limit,
+            lo: Some(0.0),
+            hi: Some(limit),
+        },
+        None => Reported::NotDeterminable {
+            why: detection["why"]
+                .as_str()
+                .unwrap_or("null without a reason")
+                .to_string(),
+        },
+    }
+}
+
 fn fit_parameter(output: &Value, key: &str) -> Reported {
-    if key == CUTOFF_LIMIT {
-        return cutoff_limit(output);
+    match key {
+        CUTOFF_LIMIT => return cutoff_limit(output),
+        MISMATCH_LIMIT => return mismatch_limit(output),
+        _ => {}
     }
     let params = &output["params"];
     let Some(value) = params.get(key) else {
@@ -217,6 +241,26 @@ mod tests {
         assert_eq!(r["leak_rate_hz"], Reported::NoInterval { value: 0.1 });
         assert_eq!(r["cutoff_hz"], Reported::NotReported);
         assert_eq!(r[CUTOFF_LIMIT], Reported::NotReported);
+        assert_eq!(r[MISMATCH_LIMIT], Reported::NotReported);
+    }
+
+    #[test]
+    fn a_fit_s_unresolved_spread_is_scored_as_the_spreads_up_to_its_limit() {
+        let out = json!({"params": {"ct_on": 0.3},
+            "mismatch_detection": {"at_most": 0.0317, "timing_ci95": [0.0, 0.0317]}});
+        let r = extract(Method::Fit, &out);
+        // draw 49's aps interval [0, 0.0317] against its true 0.0561: missed; a true 0.02
+        // or no spread at all: covered
+        assert!(r[MISMATCH_LIMIT].covers(0.02) && r[MISMATCH_LIMIT].covers(0.0));
+        assert!(!r[MISMATCH_LIMIT].covers(0.0561));
+        let out = json!({"params": {"ct_on": 0.3},
+            "mismatch_detection": {"at_most": null, "why": "no interval"}});
+        assert_eq!(
+            extract(Method::Fit, &out)[MISMATCH_LIMIT],
+            Reported::NotDeterminable {
+                why: "no interval".into()
+            }
+        );
     }
 
     #[test]

@@ -17,7 +17,8 @@ use crate::fit::metric::Components;
 use crate::fit::residuals::{BackgroundBin, Bin, IntervalDistributions, Residuals, Spectrum};
 use crate::fit::{
     AddedEffect, Ambiguity, BandwidthDetection, FitResult, FittedParams, Holdout,
-    HotPixelDetection, NoiseDetection, NoiseLimit, Step, StepResiduals, Uncertain,
+    HotPixelDetection, MismatchDetection, NoiseDetection, NoiseLimit, Step, StepResiduals,
+    Uncertain,
 };
 use crate::model::{
     InputFile, MethodResult, PlotEntry, PresetLevel, SequenceOutputs, SequenceReport, Truth,
@@ -275,13 +276,15 @@ structs! {
     IntervalInfo { t_start_s, t_end_s, used, reason, motion_px }
     FitResult { biases, params, identified, why, not_detected, uncertainties, effects_added, error_metric,
         error_before, error_after, components_before, components_after, steps, ambiguities,
-        hot_pixels_masked, hot_pixel_detection, noise_detection, bandwidth_detection, residuals_before,
+        hot_pixels_masked, hot_pixel_detection, noise_detection, bandwidth_detection, mismatch_detection, residuals_before,
         residuals_after, assumptions,
         holdout, simulations, frame_exposure_us, events_only }
     HotPixelDetection { detectable_above_hz, probability, meaning }
     NoiseDetection { limits, probe_hz, meaning }
     BandwidthDetection { called_for_below_hz, evidence, recording_evidence, simulations, tried,
         why, meaning }
+    MismatchDetection { at_most, timing_ci95, recording_evidence, counts_call_for_it, evidence,
+        tried_spread, why, meaning }
     NoiseLimit { called_for_above_hz, isolated_hz_per_hz, tried, why, at_most_hz }
     EventsOnly { thresholds_source, ct_on_ci95, ct_off_ci95, ct_ratio, ct_ratio_why,
         noise_on_hz, noise_off_hz, noise_on_test_hz, noise_upper_bound, noise_off_test_hz,

@@ -1,7 +1,7 @@
 //! Scoring one parameter of one run against the truth: which population it belongs to,
 //! and whether its interval covered the true value.
 
-use crate::coverage::method::{effect_of, truth_key};
+use crate::coverage::method::{MISMATCH_LIMIT, effect_of, truth_key};
 use crate::coverage::record::RunRecord;
 use crate::coverage::reported::Reported;
 use crate::coverage::truth::Truth;
@@ -31,7 +31,9 @@ pub fn in_population(record: &RunRecord, parameter: &str) -> bool {
     let Some(truth) = &record.truth else {
         return true;
     };
-    let effect_needed = record.method.is_fit() && parameter != "ct_sigma";
+    // a spread is scored whether or not the draw has one (0 is a true spread)
+    let effect_needed =
+        record.method.is_fit() && !["ct_sigma", MISMATCH_LIMIT].contains(&parameter);
     truth.value(truth_key(parameter)).is_some()
         && (!effect_needed || effect_of(parameter).is_none_or(|e| truth.has_effect(e)))
 }

@@ -393,6 +393,10 @@ pub struct FitResult {
     /// (a fit with frames).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bandwidth_detection: Option<BandwidthDetection>,
+    /// What bounds or questions a threshold mismatch the final model lacks, where event
+    /// timing resolved no spread (a fit with frames).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mismatch_detection: Option<MismatchDetection>,
     /// Residuals of the ideal model and of the final one (fit blocks; a fit without
     /// frames simulates no scene and has none).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -441,6 +445,31 @@ pub struct BandwidthDetection {
     pub simulations: usize,
     /// The effect was called for and tried, and not kept.
     pub tried: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub why: Option<String>,
+    pub meaning: &'static str,
+}
+
+/// What bounds or questions a threshold mismatch the final model of a fit with frames
+/// lacks, where event timing resolved no spread (`fit::selection::mismatch_detection`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MismatchDetection {
+    /// The most event timing on the fit run allows: the upper end of its 95 % interval of
+    /// the frozen per-pixel threshold spread (log units); `null` with `why` where it gave
+    /// no interval.
+    pub at_most: Option<f64>,
+    /// That interval.
+    pub timing_ci95: Option<[f64; 2]>,
+    /// The per-pixel counts' dispersion within tiles against the final model's, standard
+    /// errors; `null` where too few events per pixel to compare.
+    pub recording_evidence: Option<f64>,
+    /// That evidence calls for mismatch: a spread may be present that the selection did not
+    /// keep.
+    pub counts_call_for_it: bool,
+    /// The evidence in words.
+    pub evidence: String,
+    /// The spread the fit blocks chose where the loop tried mismatch and did not keep it.
+    pub tried_spread: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub why: Option<String>,
     pub meaning: &'static str,

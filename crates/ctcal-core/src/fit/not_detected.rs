@@ -5,12 +5,14 @@
 //! out (no longer needed, or a look-alike in its place). Where the fit measured how strong
 //! the effect would have had to be for this recording to show it (the noise and bandwidth
 //! detection limits, and what the quiet pixels or the event timing's drift allow of the
-//! noise; the hot-pixel search's reach; a refractory period's edge in the intervals), that
-//! is said: the effect, if present, is likely weaker.
+//! noise; the hot-pixel search's reach; a refractory period's edge in the intervals; the
+//! most event timing allows of a threshold spread), that is said: the effect, if present,
+//! is likely weaker. Where the recording's own evidence still calls for a threshold spread
+//! the loop did not keep, that is said too.
 
 use super::effects::Effect;
 use super::events_only::refractory::Edge;
-use super::wording::{at_most_in_words, significant};
+use super::wording::{at_most_in_words, significant, spread_in_words};
 use super::{FitResult, HotPixelDetection, Step};
 use std::collections::BTreeMap;
 
@@ -118,7 +120,8 @@ fn bound(effect: Effect, result: &FitResult) -> Option<String> {
             }
         }
         Effect::HotPixels => hot_pixels_bound(result.hot_pixel_detection.as_ref()?),
-        // mismatch and timestamp jitter have no detection limit yet
+        Effect::Mismatch => Some(spread_in_words(result.mismatch_detection.as_ref()?)),
+        // timestamp jitter has no detection limit yet
         _ => None,
     }
 }

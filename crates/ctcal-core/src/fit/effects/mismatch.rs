@@ -16,6 +16,15 @@ use crate::fit::metric::{dispersion, dispersion_log_ratio};
 /// Posch & Delbruck 2008).
 pub const RANGE: (f64, f64) = (0.002, 0.3);
 
+/// How often the upper end of event timing's 95 % interval of a spread it did not resolve
+/// held the true spread, on the coverage draws with a spread where a fit with frames, run
+/// as a user runs it, gave one (held, draws): seeds 1-100 (ctcal) and 13001-14040 (ctcal,
+/// ESIM, DVS-Voltmeter, IEBCS), `benches/coverage/mismatch-limit-2026-12-08`. The misses
+/// are draw 2 (0.0593 against a limit of 0.0586) and draw 49 (0.0561 against 0.0343, a
+/// dim scene whose frames' log offset was misread). With the 20 draws without a spread,
+/// which any limit holds, 42 of 44.
+pub const TIMING_LIMIT_HELD: (usize, usize) = (22, 24);
+
 /// The evidence's text where neither event timing nor the counts can show a spread.
 pub const TOO_FEW_TO_COMPARE: &str = "too few events per pixel to compare dispersion";
 
@@ -50,8 +59,9 @@ pub fn evidence(c: &Context) -> Evidence {
                 score: excess / 0.02,
                 relevant: excess > 0.05,
                 text: format!(
-                    "per-pixel counts are {:.0} % more dispersed within tiles than the model's",
-                    100.0 * (excess.exp() - 1.0)
+                    "per-pixel counts are {:.0} % {} dispersed within tiles than the model's",
+                    100.0 * (excess.exp() - 1.0).abs(),
+                    if excess < 0.0 { "less" } else { "more" }
                 ),
                 other_start: None,
                 start: Some(0.03),
@@ -62,7 +72,7 @@ pub fn evidence(c: &Context) -> Evidence {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::events::EventChunk;
     use crate::fit::effects::EVIDENCE_THRESHOLD;
@@ -73,7 +83,7 @@ mod tests {
     /// (about 1000 events each, Poisson). The recording: the same arrivals thinned to
     /// `500 / (1 + sigma z)` Hz at each pixel (threshold `theta (1 + sigma z)`, z standard
     /// normal, clamped to 4), so that `sigma = 0` gives the model's events.
-    fn model_and_mismatched(sigma: f64) -> (EventChunk, EventChunk) {
+    pub(crate) fn model_and_mismatched(sigma: f64) -> (EventChunk, EventChunk) {
         let mut rng = rng(41);
         let top = 500.0 / (1.0 - 4.0 * sigma);
         let (mut model, mut recording) = (Vec::new(), Vec::new());

@@ -178,6 +178,7 @@ fn assembled(
         hot_pixel_detection: parts.run.hot_found.detection.clone(),
         noise_detection: None,
         bandwidth_detection: None,
+        mismatch_detection: None,
         residuals_before: None,
         residuals_after: None,
         assumptions,

@@ -215,6 +215,7 @@ pub fn result(simulation: &Simulation, mut state: State, mut parts: Parts) -> Fi
         hot_pixel_detection: state.hot_detection,
         noise_detection: judged.noise_detection,
         bandwidth_detection: judged.bandwidth_detection,
+        mismatch_detection: judged.mismatch_detection,
         residuals_before: Some(parts.residuals_before),
         residuals_after: Some(tested.residuals_after),
         events_only: None,
@@ -288,6 +289,7 @@ fn intervals(simulation: &Simulation, state: &mut State, parts: &mut Parts) -> W
 struct Judged {
     noise_detection: Option<crate::fit::NoiseDetection>,
     bandwidth_detection: Option<crate::fit::BandwidthDetection>,
+    mismatch_detection: Option<crate::fit::MismatchDetection>,
     not_identified: BTreeMap<String, String>,
 }
 
@@ -299,7 +301,11 @@ fn judged(
     parts: &mut Parts,
     noise: NoiseIntervals,
 ) -> Judged {
-    let (noise_detection, bandwidth_detection) = detections(
+    let Detections {
+        noise: noise_detection,
+        bandwidth: bandwidth_detection,
+        mismatch: mismatch_detection,
+    } = detections(
         simulation,
         state,
         &parts.steps,
@@ -314,6 +320,7 @@ fn judged(
             fixed: parts.fixed,
             steps: &parts.steps,
             measured_spread: parts.known.mismatch,
+            spread_unresolved: parts.known.spread_unresolved,
             noise,
             leak_growth: parts.known.leak_drift.and_then(|d| d.growth),
         },
@@ -326,6 +333,7 @@ fn judged(
     Judged {
         noise_detection,
         bandwidth_detection,
+        mismatch_detection,
         not_identified,
     }
 }
@@ -497,8 +505,16 @@ fn params_to_write(state: &State) -> crate::sim::params::PixelParams {
     params
 }
 
-/// The two detections the final model is checked with: sensor noise below what the loop
-/// could add, and a photoreceptor cutoff the loop did not add (with its limit).
+/// What the final model is checked with for the effects it lacks.
+struct Detections {
+    noise: Option<crate::fit::NoiseDetection>,
+    bandwidth: Option<crate::fit::BandwidthDetection>,
+    mismatch: Option<crate::fit::MismatchDetection>,
+}
+
+/// The detections the final model is checked with: sensor noise below what the loop could
+/// add, a photoreceptor cutoff the loop did not add (with its limit), and a threshold
+/// spread it left out (what event timing allows, what the counts still call for).
 fn detections(
     simulation: &Simulation,
     state: &State,
@@ -506,26 +522,30 @@ fn detections(
     known: super::Known,
     frames_aligned: bool,
     assumptions: &mut Vec<String>,
-) -> (
-    Option<crate::fit::NoiseDetection>,
-    Option<crate::fit::BandwidthDetection>,
-) {
-    let noise = super::noise_detection::detect(simulation, state, steps, known).map(|(d, note)| {
-        assumptions.push(note);
-        d
-    });
+) -> Detections {
+    let context = super::context_of(state, simulation, known);
+    let noise = super::noise_detection::detect(simulation, state, steps, known);
     let bandwidth = super::bandwidth_detection::detect(
         simulation,
-        &super::context_of(state, simulation, known),
+        &context,
         &state.masked,
         steps,
         frames_aligned,
-    )
-    .map(|(d, note)| {
+    );
+    let mismatch = super::mismatch_detection::detect(&context, steps, known.spread_unresolved);
+    Detections {
+        noise: noted(noise, assumptions),
+        bandwidth: noted(bandwidth, assumptions),
+        mismatch: noted(mismatch, assumptions),
+    }
+}
+
+/// A detection, its assumption appended to `assumptions`.
+fn noted<D>(found: Option<(D, String)>, assumptions: &mut Vec<String>) -> Option<D> {
+    found.map(|(detection, note)| {
         assumptions.push(note);
-        d
-    });
-    (noise, bandwidth)
+        detection
+    })
 }
 
 /// What decides which parameters are undetermined.
@@ -534,6 +554,8 @@ struct Undetermined<'a> {
     steps: &'a [Step],
     /// The threshold spread event timing measured (value, interval), if it did.
     measured_spread: Option<(f64, [f64; 2])>,
+    /// Event timing's interval of a spread it did not resolve.
+    spread_unresolved: Option<[f64; 2]>,
     noise: NoiseIntervals,
     /// The leak's growth with the light the search held, if the timing measured one.
     leak_growth: Option<crate::fit::effects::leak::LeakGrowth>,
@@ -571,7 +593,11 @@ fn undetermined(
         not_identified.entry(key).or_insert(why);
     }
     let spread = state.model.params.ct_sigma;
-    not_identified.extend(super::spread_report::unseen(spread, from.steps));
+    not_identified.extend(super::spread_report::unseen(
+        spread,
+        from.steps,
+        from.spread_unresolved,
+    ));
     if let Some((why, measured)) =
         super::spread_report::measured_not_modelled(spread, from.steps, from.measured_spread)
     {

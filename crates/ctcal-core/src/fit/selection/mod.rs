@@ -36,6 +36,7 @@ pub(in crate::fit) mod keep;
 mod leak_report;
 mod look_alikes;
 mod method_systematic;
+mod mismatch_detection;
 mod noise_detection;
 mod spread_report;
 mod start;
@@ -62,6 +63,8 @@ use std::collections::BTreeMap;
 #[derive(Clone, Copy)]
 pub(super) struct Known {
     mismatch: Option<(f64, [f64; 2])>,
+    /// The 95 % interval of the spread where the estimators' event timing resolved none.
+    spread_unresolved: Option<[f64; 2]>,
     grid: Option<(i64, i64)>,
     shortest_interval_s: Option<f64>,
     /// The OFF isolated-event rate at quiet pixels of the fit run.
@@ -213,7 +216,7 @@ fn fit_with_frames(
             run,
             input,
             &state,
-            (start.mismatch, start.leak_drift),
+            &start,
             (&simulation, planned(options).contains(&Effect::ShotNoise)),
         ),
         fixed: ideal.fixed,
@@ -413,15 +416,15 @@ impl Ideal {
 }
 
 impl Known {
-    /// What the fit run tells before any effect is tried: the mismatch's evidence, the
-    /// timestamp grid, the shortest same-pixel interval of the kept pixels and, where shot
-    /// noise may be tried, the isolated OFF events at quiet pixels (on the fit run and on
-    /// the judging blocks).
+    /// What the fit run tells before any effect is tried: the mismatch's evidence (or the
+    /// most an unresolved spread allows), the timestamp grid, the shortest same-pixel
+    /// interval of the kept pixels and, where shot noise may be tried, the isolated OFF
+    /// events at quiet pixels (on the fit run and on the judging blocks).
     fn of(
         run: &start::FitRun,
         input: &FitInput,
         state: &State,
-        (mismatch, leak_drift): (Option<(f64, [f64; 2])>, Option<effects::leak::TimingDrift>),
+        start: &start::Start,
         (simulation, shot_noise_planned): (&Simulation, bool),
     ) -> Self {
         let geometry = simulation.geometry;
@@ -454,7 +457,8 @@ impl Known {
         };
         let fit_end = run.events.t.last().map_or(TimeUs::MIN, |&t| t + 1);
         Known {
-            mismatch,
+            mismatch: start.mismatch,
+            spread_unresolved: start.spread_unresolved,
             grid,
             shortest_interval_s: effects::refractory::shortest_interval_s(
                 &run.events,
@@ -466,7 +470,7 @@ impl Known {
                 .then(|| counted(&run.events, (TimeUs::MIN, fit_end)))
                 .flatten(),
             quiet_off_judging: shot_noise_planned.then(judging).flatten(),
-            leak_drift,
+            leak_drift: start.leak_drift,
         }
     }
 }

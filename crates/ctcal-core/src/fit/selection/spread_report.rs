@@ -23,6 +23,7 @@
 use super::super::Step;
 use super::super::Uncertain;
 use super::super::effects::{EVIDENCE_THRESHOLD, Effect, mismatch::TOO_FEW_TO_COMPARE};
+use super::super::wording::timing_limit_in_words;
 
 /// The last step that judged mismatch, if any.
 fn mismatch_step(steps: &[Step]) -> Option<&Step> {
@@ -41,17 +42,24 @@ fn has_spread(model_spread: Option<f64>) -> bool {
 /// event timing measured no spread and the fit blocks have too few events per pixel to
 /// compare the counts' dispersion with the model's. The model's spread of none is then not
 /// a measurement, and the configurations write the simulator's default with the reason.
-pub(super) fn unseen(model_spread: Option<f64>, steps: &[Step]) -> Option<(String, String)> {
+pub(super) fn unseen(
+    model_spread: Option<f64>,
+    steps: &[Step],
+    unresolved: Option<[f64; 2]>,
+) -> Option<(String, String)> {
     if has_spread(model_spread) {
         return None;
     }
     let unseen = steps
         .iter()
         .any(|s| s.effect == Effect::Mismatch.name() && s.evidence == TOO_FEW_TO_COMPARE);
+    let timing = unresolved.map_or("event timing measured none and".to_string(), |interval| {
+        format!("{} and", timing_limit_in_words(interval))
+    });
     unseen.then(|| {
         (
             "ct_sigma".to_string(),
-            "the recording does not show a threshold spread: event timing measured none and the fit blocks have too few events per pixel to compare the counts' dispersion with the model's; the model has no mismatch, which is not a measurement".to_string(),
+            format!("the recording does not show a threshold spread: {timing} the fit blocks have too few events per pixel to compare the counts' dispersion with the model's; the model has no mismatch, which is not a measurement"),
         )
     })
 }
@@ -136,7 +144,19 @@ mod tests {
 
     #[test]
     fn too_few_events_to_compare_leaves_the_spread_unseen() {
-        assert!(unseen(None, &[step(TOO_FEW_TO_COMPARE, 0.0, false)]).is_some());
-        assert!(unseen(None, &[step("per-pixel counts are alike", 0.5, false)]).is_none());
+        let too_few = [step(TOO_FEW_TO_COMPARE, 0.0, false)];
+        let (_, why) = unseen(None, &too_few, None).unwrap();
+        assert!(
+            why.contains(": event timing measured none and the fit blocks have too few"),
+            "{why}"
+        );
+        // coverage draw 5: event timing's interval [0, 0.0909] on the fit run
+        let (_, why) = unseen(None, &too_few, Some([0.0, 0.0909])).unwrap();
+        assert!(
+            why.contains("allows at most 0.0909 (such a limit held on"),
+            "{why}"
+        );
+        let alike = [step("per-pixel counts are alike", 0.5, false)];
+        assert!(unseen(None, &alike, None).is_none());
     }
 }

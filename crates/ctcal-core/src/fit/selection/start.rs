@@ -56,6 +56,9 @@ pub struct Start {
     pub params: PixelParams,
     pub fixed: bool,
     pub mismatch: Option<(f64, [f64; 2])>,
+    /// The 95 % interval of the spread where the estimator's event timing resolved none
+    /// (its value `null`, the interval reaching 0): the most it allows.
+    pub spread_unresolved: Option<[f64; 2]>,
     /// The thresholds as `estimate aps` measured them, with their intervals (none for a
     /// start value).
     pub measured: Option<super::agreement::Measured>,
@@ -106,6 +109,7 @@ pub fn thresholds(
         params: PixelParams::ideal(default, default),
         fixed,
         mismatch: None,
+        spread_unresolved: None,
         measured: None,
         timing: None,
         interpolation_share: None,
@@ -214,6 +218,9 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
         params: PixelParams::ideal(on, off),
         fixed: false,
         mismatch: e.ct_sigma.zip(e.ct_sigma_ci95),
+        spread_unresolved: e
+            .ct_sigma_ci95
+            .filter(|[lo, hi]| e.ct_sigma.is_none() && *lo >= 0.0 && hi.is_finite() && hi > lo),
         measured: Some([
             (on, e.ct_on_ci95.unwrap_or([None, None])),
             (off, e.ct_off_ci95.unwrap_or([None, None])),
