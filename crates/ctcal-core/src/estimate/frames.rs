@@ -100,6 +100,10 @@ pub struct PreparedFrames {
     /// The offsets the thresholds' systematic error spans (the offset's 95 % interval, or
     /// its prior range where the data do not bound it).
     pub offset_range: (f32, f32),
+    /// The thresholds' intervals reach the thresholds at `offset_range`'s ends, not only
+    /// spread by them: the offset was fitted and one polarity gave none
+    /// ([`super::timing::Offset::unconfirmed`]).
+    pub offset_reached: bool,
     /// Event-time spans between blocks of frames read from a longer recording whose events
     /// were not read (time-sorted; empty when the recording was read whole): a pixel's
     /// change across one is unknown.
@@ -272,6 +276,7 @@ impl PreparedFrames {
             log_map,
             offset: 0.0,
             offset_range: (0.0, 0.0),
+            offset_reached: false,
             unread: unread.to_vec(),
         };
         if !prepared.intervals.iter().any(|i| i.used) {
@@ -335,6 +340,7 @@ impl PreparedFrames {
             log_map: self.log_map,
             offset: self.offset,
             offset_range: self.offset_range,
+            offset_reached: self.offset_reached,
             unread: self.unread.clone(),
         })
     }
@@ -373,6 +379,7 @@ impl PreparedFrames {
             log_map: self.log_map,
             offset: self.offset,
             offset_range: self.offset_range,
+            offset_reached: self.offset_reached,
             unread: self.unread.clone(),
         }
     }

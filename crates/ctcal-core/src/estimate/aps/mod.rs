@@ -113,6 +113,10 @@ pub struct ApsResult {
     /// systematic error spans (the timing's, or the counts' where they disagree:
     /// [`count_offset::reconcile`]).
     pub frame_offset_dn: (f32, (f32, f32)),
+    /// Where a polarity gave no offset, each threshold (ON, OFF) at the ends of the
+    /// offset's range (reaching down to no offset) over the value, lower first
+    /// ([`super::timing::PolarityEstimate::offset_reach`]); `[1, 1]` otherwise.
+    pub offset_reach: [[f64; 2]; 2],
     /// The memorised level's drift the event timing measured (leak's signature in the
     /// events' timing: ON events early, OFF events late).
     pub leak_drift: super::timing::Drift,
@@ -366,6 +370,7 @@ impl FullPass {
             ],
             maps: full.timing.maps,
             frame_offset_dn: (frames.offset, frames.offset_range),
+            offset_reach: [full.timing.on.offset_reach, full.timing.off.offset_reach],
             noise_polarities: [&full.timing.on, &full.timing.off]
                 .map(|p| p.peak.is_some_and(|peak| !peak.stands_out())),
             leak_drift: full.timing.drift,
@@ -707,10 +712,12 @@ fn offset_found(
         let own = frames.offset;
         frames.offset = t.offset.offset_dn;
         frames.offset_range = t.offset.systematic_range;
+        frames.offset_reached = t.offset.unconfirmed();
         let offset = match masked_by_slow_photoreceptor(input, excluded, frames, &t.offset, own) {
             Some((offset, why)) => {
                 frames.offset = offset.offset_dn;
                 frames.offset_range = offset.systematic_range;
+                frames.offset_reached = offset.unconfirmed();
                 assumptions.push(why);
                 offset
             }
@@ -852,7 +859,7 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
     let side = offset_end;
     match o.source {
         "fitted" => format!(
-            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval, both polarities' offsets, and the offset -+ their difference within the prior range {:.0} .. {:.0} DN: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing) is in their intervals",
+            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval, both polarities' offsets, and the offset -+ their difference within the prior range {:.0} .. {:.0} DN: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing; down to no offset where a polarity gives none, and the intervals then reach the thresholds read at the range's ends: the offset is a compromise, not a measurement) is in their intervals",
             o.offset_dn,
             side(o.ci95[0]),
             side(o.ci95[1]),

@@ -296,7 +296,8 @@ pub(super) fn assemble(
     full: &Pass,
     findings: Findings,
 ) -> CtEstimate {
-    let [on, off] = combined_thresholds(&estimators, &findings, &mut assumptions);
+    let offset_reach = [full.timing.on.offset_reach, full.timing.off.offset_reach];
+    let [on, off] = combined_thresholds(&estimators, &findings, offset_reach, &mut assumptions);
     let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames
@@ -359,24 +360,31 @@ fn withhold_noise_polarities(estimate: &mut CtEstimate, timing: &TimingEstimate)
 }
 
 /// ON and OFF thresholds combined over the `estimators`, each with the method's systematic
-/// error and reaching to what the other log response and a slow photoreceptor ask for;
-/// their assumptions added.
+/// error and reaching to what the other log response, a slow photoreceptor and, where a
+/// polarity gave no offset, event timing at the ends of the whole offset prior
+/// (`offset_reach`, ratios to the value, ON then OFF) ask for; their assumptions added.
 fn combined_thresholds(
     estimators: &[EstimatorReport],
     findings: &Findings,
+    offset_reach: [[f64; 2]; 2],
     assumptions: &mut Vec<String>,
 ) -> [Measured; 2] {
     let response = response_ratios(findings.other_response.as_ref());
     // the thresholds a photoreceptor much slower than the scene asks for, where the
     // re-simulation with its cutoff found them
     let slow = findings.slow.as_ref().and_then(|s| s.thresholds);
-    let combined = |pick: fn(&EstimatorReport) -> &Measured, response: f64, slow: Option<f64>| {
+    let combined = |pick: fn(&EstimatorReport) -> &Measured,
+                    response: f64,
+                    slow: Option<f64>,
+                    [offset_lo, offset_hi]: [f64; 2]| {
         let refs: Vec<&Measured> = estimators.iter().map(pick).collect();
         match combine(&refs) {
             Some((value, error)) => Measured::new(value, error, METHOD_SYSTEMATIC * value)
                 .reaching(response)
                 // a slow photoreceptor reads thresholds high only: the reach goes down
-                .reaching(slow.map_or(1.0, |c| (c / value).min(1.0))),
+                .reaching(slow.map_or(1.0, |c| (c / value).min(1.0)))
+                .reaching(offset_lo)
+                .reaching(offset_hi),
             None => Measured::new(f64::NAN, f64::NAN, 0.0),
         }
     };
@@ -384,8 +392,18 @@ fn combined_thresholds(
     assumptions.extend(findings.other_response.as_ref().map(response_assumption));
     assumptions.extend(findings.slow.as_ref().map(slow_assumption));
     [
-        combined(|e| &e.ct_on, response[0], slow.map(|s| s[0])),
-        combined(|e| &e.ct_off, response[1], slow.map(|s| s[1])),
+        combined(
+            |e| &e.ct_on,
+            response[0],
+            slow.map(|s| s[0]),
+            offset_reach[0],
+        ),
+        combined(
+            |e| &e.ct_off,
+            response[1],
+            slow.map(|s| s[1]),
+            offset_reach[1],
+        ),
     ]
 }
 

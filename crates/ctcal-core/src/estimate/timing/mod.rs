@@ -84,8 +84,15 @@ pub struct PolarityEstimate {
     /// (delete-one-block jackknife, scaled to a 95 % interval of `+-1.96` of it).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub between_blocks_standard_error: Option<f64>,
-    /// How far `ct` moves across the offset's 95 % interval (half the range), a systematic.
+    /// How far `ct` moves across the offset's 95 % interval (half the range), a systematic
+    /// (0 where the range's ends are reached instead: `offset_reach`).
     pub offset_systematic: f64,
+    /// Where a polarity gave no offset (the joint one a compromise, its range reaching
+    /// down to none: [`with_polarity_offsets`]), `ct` at the range's two ends over `ct`,
+    /// lower first: the thresholds' interval reaches them on their side
+    /// ([`crate::estimate::interval::Measured::reaching`]); `[1, 1]` otherwise.
+    #[serde(skip)]
+    pub offset_reach: [f64; 2],
     /// Frozen mismatch, estimation noise removed.
     pub sigma: f64,
     pub sigma_standard_error: f64,
@@ -159,6 +166,14 @@ pub const NOT_BOUNDED: &str =
 /// and 23 (DVS240) in 8-bit DN (Lin et al., ECCV 2022, `config.py`); DAVIS APS frames are
 /// written with a black level of some tens of DN subtracted.
 pub const OFFSET_PRIOR: (f32, f32) = (0.0, 60.0);
+
+impl Offset {
+    /// A fitted offset one polarity's samples do not give (none within the prior): the
+    /// joint offset is a compromise, not a measurement ([`with_polarity_offsets`]).
+    pub fn unconfirmed(&self) -> bool {
+        self.source == "fitted" && self.by_polarity.iter().any(Option::is_none)
+    }
+}
 
 /// The leak drift the timing found.
 #[derive(Clone, Debug, Serialize)]
@@ -419,6 +434,7 @@ pub fn estimate(
         blocks,
         ends: &ends,
         central: &central.coefficients,
+        unconfirmed: central.offset.unconfirmed() || frames.offset_reached,
     };
     let peaks = central.peaks(options.mode_window);
     let polarities = [
@@ -475,6 +491,8 @@ struct Errors<'a> {
     ends: &'a [OffsetEnd],
     /// The coefficients at the offset.
     central: &'a Coefficients,
+    /// A polarity gave no offset: the ends' thresholds are reached, not only spread.
+    unconfirmed: bool,
 }
 
 impl Errors<'_> {
@@ -495,10 +513,18 @@ impl Errors<'_> {
             .map(|e| (pick(&e.0) - pick(self.central)).abs())
             .fold(0.0, f64::max)
             / 1.96;
+        let ratios = self
+            .ends
+            .iter()
+            .map(|e| pick(&e.0) / pick(self.central))
+            .filter(|r| self.unconfirmed && r.is_finite() && *r > 0.0);
+        let offset_reach = ratios.fold([1.0f64; 2], |[lo, hi], r| [lo.min(r), hi.max(r)]);
         PolarityEstimate {
             standard_error: block.map_or(se, |b| b.hypot(se)),
             between_blocks_standard_error: block,
-            offset_systematic: shift,
+            // a reached end is the systematic on its side alone, not a spread both ways
+            offset_systematic: if self.unconfirmed { 0.0 } else { shift },
+            offset_reach,
             sigma_standard_error: sigma_se,
             excess_variance_standard_error: excess_se,
             ..estimate
@@ -631,6 +657,20 @@ fn search_range(pairs: &[Pair]) -> (f32, f32) {
 /// [`OFFSET_PRIOR`]: beyond, no black level, as for the joint one) joined to its systematic
 /// range, and that range widened by their disagreement ([`disagreement_range`]); found for
 /// the chosen response only. Other offsets are returned as they are.
+///
+/// Where one polarity gives no offset within the prior, no black level makes its
+/// thresholds stop depending on brightness: something else that depends on brightness
+/// moves its samples, and the joint offset is a compromise between that and the other
+/// polarity, not a measurement. The systematic range then reaches down to no offset, the
+/// frames as written (the prior's lower end), and the thresholds' intervals reach the
+/// thresholds at its ends ([`PolarityEstimate::offset_reach`]). Coverage draw 49 (ctcal: a
+/// 19 DN natural image, a 4.85 ms refractory period, no offset): the ON samples' slope
+/// stays below zero from -0.9 of the darkest DN to 255 DN, the joint offset came out at
+/// 27.6 DN (95 % 26.9 .. 28.4) and the thresholds at 0.133 [0.089, 0.178] and 0.121 for a
+/// true 0.711 and 0.602; read at b = 0 they are 0.751 and 0.671. Reaching the prior's upper
+/// end as well (60 DN) widened the five other such draws of seeds 1-100, all covered, by
+/// 1.5-2.5 times, for nothing the data showed
+/// (`benches/coverage/mismatch-limit-2026-12-08/offset.md`).
 fn with_polarity_offsets(
     offset: Offset,
     pairs: &[Pair],
@@ -654,6 +694,12 @@ fn with_polarity_offsets(
         .fold(offset.systematic_range, |(lo, hi), b| {
             (lo.min(b), hi.max(b))
         });
+    let systematic_range = if by_polarity.iter().any(Option::is_none) {
+        // no black level explains one polarity: down to none, the frames as written
+        (systematic_range.0.min(OFFSET_PRIOR.0), systematic_range.1)
+    } else {
+        systematic_range
+    };
     Offset {
         systematic_range,
         by_polarity,
@@ -917,6 +963,7 @@ fn polarity(
             standard_error: 0.0,
             between_blocks_standard_error: None,
             offset_systematic: 0.0,
+            offset_reach: [1.0; 2],
             sigma: sigma_of(excess),
             sigma_standard_error: 0.0,
             excess_variance: excess,
@@ -1072,6 +1119,30 @@ fn std_dev(values: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Coverage draw 49's offset: fitted at 27.6 DN, the ON samples giving none; one with
+    /// both polarities, or one not fitted, is confirmed or not a fit at all.
+    #[test]
+    fn a_fitted_offset_one_polarity_does_not_give_is_unconfirmed() {
+        let fitted = Offset {
+            offset_dn: 27.6,
+            ci95: [Some(26.9), Some(28.4)],
+            systematic_range: (0.0, 60.0),
+            by_polarity: [None, Some(30.4)],
+            source: "fitted",
+        };
+        assert!(fitted.unconfirmed());
+        let both = Offset {
+            by_polarity: [Some(24.1), Some(26.0)],
+            ..fitted.clone()
+        };
+        assert!(!both.unconfirmed());
+        let given = Offset {
+            source: "given",
+            ..fitted
+        };
+        assert!(!given.unconfirmed());
+    }
 
     #[test]
     fn sigma_removes_the_estimation_noise_of_each_pixel() {

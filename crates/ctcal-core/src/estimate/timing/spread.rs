@@ -207,6 +207,7 @@ mod tests {
             standard_error: 0.01,
             between_blocks_standard_error: None,
             offset_systematic: 0.0,
+            offset_reach: [1.0; 2],
             sigma: excess_variance.max(0.0).sqrt(),
             sigma_standard_error: 0.0,
             excess_variance,

@@ -56,6 +56,7 @@ pub fn frames(
         log_map: LogMap::new(LogResponse::V2e, 0.0),
         offset: 0.0,
         offset_range: (0.0, 0.0),
+        offset_reached: false,
         unread: Vec::new(),
     }
 }

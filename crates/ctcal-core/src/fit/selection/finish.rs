@@ -171,6 +171,10 @@ pub struct Parts<'a> {
     /// The share of each threshold (ON, OFF) the start found the frames' interpolation to
     /// miss (the intervals reach up by it).
     pub interpolation_share: Option<[f64; 2]>,
+    /// Where the start's frames' offset was not confirmed by both polarities, each
+    /// threshold at the ends of the offset's range (down to no offset) over the value (the
+    /// intervals reach them).
+    pub offset_reach: Option<[[f64; 2]; 2]>,
     /// The log response not chosen, where the events cannot rule it out (the intervals
     /// reach the thresholds it gives).
     pub other_response: Option<crate::estimate::timing::OtherResponse>,
@@ -257,6 +261,7 @@ fn intervals(simulation: &Simulation, state: &mut State, parts: &mut Parts) -> W
         fixed: parts.fixed,
         frame_quality: &parts.frame_quality,
         interpolation_share: parts.interpolation_share,
+        offset_reach: parts.offset_reach,
         other_response: parts.other_response.as_ref(),
         start: parts.start.as_ref(),
         timing: parts.timing.as_ref(),
@@ -344,6 +349,7 @@ struct Widening<'a> {
     fixed: bool,
     frame_quality: &'a super::frame_quality::FrameQuality,
     interpolation_share: Option<[f64; 2]>,
+    offset_reach: Option<[[f64; 2]; 2]>,
     other_response: Option<&'a crate::estimate::timing::OtherResponse>,
     start: Option<&'a super::agreement::Measured>,
     timing: Option<&'a super::agreement::Measured>,
@@ -414,6 +420,11 @@ fn threshold_intervals(
     {
         assumptions.extend(reach_for_other_response(&mut state.uncertainty, other));
     }
+    if !widening.fixed
+        && let Some(reach) = widening.offset_reach
+    {
+        assumptions.extend(reach_for_unconfirmed_offset(&mut state.uncertainty, reach));
+    }
     if !widening.fixed {
         assumptions.extend(super::method_systematic::widen(&mut state.uncertainty));
     }
@@ -445,6 +456,41 @@ fn reach_for_other_response(
             other.score_ratio,
             other.score_ratio_ci95[0],
             other.score_ratio_ci95[1],
+            widened.join("; ")
+        )
+    })
+}
+
+/// Widens each threshold's interval, in ln C in quadrature on each side, to reach the
+/// thresholds the start's event timing read at the ends of the offset's range (down to no
+/// offset, the frames as written), where
+/// one polarity gave no offset (`reach`: ON, OFF, each the lower and the higher ratio to
+/// the value; [`crate::estimate::aps::ApsResult::offset_reach`]): the fit simulates the
+/// frames at the start's offset, which is then a compromise, not a measurement; returns the
+/// assumption that says so.
+fn reach_for_unconfirmed_offset(
+    uncertainty: &mut BTreeMap<String, crate::fit::Uncertain>,
+    reach: [[f64; 2]; 2],
+) -> Option<String> {
+    let widened: Vec<String> = ["ct_on", "ct_off"]
+        .into_iter()
+        .zip(reach)
+        .filter_map(|(key, ratios)| {
+            // each side reached in turn, said once: the first interval -> the last
+            let steps: Vec<String> = ratios
+                .into_iter()
+                .filter(|r| r.is_finite() && *r > 0.0 && *r != 1.0)
+                .filter_map(|r| super::method_systematic::reach_ln(uncertainty, key, r))
+                .collect();
+            let before = steps.first()?.split(" -> ").next()?;
+            let after = steps.last()?.rsplit(" -> ").next()?;
+            Some(format!("{before} -> {after}"))
+        })
+        .collect();
+    (!widened.is_empty()).then(|| {
+        let [[on_lo, on_hi], [off_lo, off_hi]] = reach;
+        format!(
+            "frames' log offset not confirmed: one polarity of the start's event timing gives no offset within 0 .. 60 DN (something else that depends on brightness moves its samples), so the offset the frames are simulated at is a compromise; the thresholds event timing reads at the ends of the offset's range, down to no offset (the frames as written), ON {on_lo:.2} .. {on_hi:.2} and OFF {off_lo:.2} .. {off_hi:.2} times the start's, are in the intervals: {}",
             widened.join("; ")
         )
     })
@@ -872,6 +918,37 @@ mod tests {
 
     fn uncertain(value: f64, lo: f64, hi: f64) -> Uncertain {
         Uncertain::with_interval(value, None, [Some(lo), Some(hi)])
+    }
+
+    /// Coverage draw 49's start: ON 0.133 where event timing at the ends of the offset
+    /// prior reads 0.5 and 5.9 times that; the interval [0.089, 0.178] reaches 0.0665 and
+    /// 0.785 in quadrature in ln C (ln 2 and ln 5.9 against the interval's own half-widths)
+    /// and holds the true 0.711; OFF with no reach is unchanged.
+    #[test]
+    fn an_unconfirmed_offset_s_ends_are_reached() {
+        let mut u = BTreeMap::from([
+            ("ct_on".to_string(), uncertain(0.133, 0.089, 0.178)),
+            ("ct_off".to_string(), uncertain(0.121, 0.077, 0.164)),
+        ]);
+        let note = reach_for_unconfirmed_offset(&mut u, [[0.5, 5.9], [1.0, 1.0]]).unwrap();
+        let [Some(lo), Some(hi)] = u["ct_on"].ci95.unwrap() else {
+            panic!("{:?}", u["ct_on"])
+        };
+        let lo_expected = 0.133 * (-(0.133f64 / 0.089).ln().hypot(2f64.ln())).exp();
+        let hi_expected = 0.133 * (0.178f64 / 0.133).ln().hypot(5.9f64.ln()).exp();
+        assert!((lo - lo_expected).abs() < 1e-12 && (hi - hi_expected).abs() < 1e-12);
+        assert!(lo < 0.0665 * 1.01 && hi > 0.711, "[{lo}, {hi}]");
+        assert_eq!(u["ct_off"].ci95, Some([Some(0.077), Some(0.164)]));
+        assert!(
+            note.contains("ON 0.50 .. 5.90 and OFF 1.00 .. 1.00"),
+            "{note}"
+        );
+        assert!(
+            note.ends_with(&format!("ct_on [0.0890, 0.1780] -> [{lo:.4}, {hi:.4}]")),
+            "{note}"
+        );
+        // no reach, no note
+        assert!(reach_for_unconfirmed_offset(&mut u, [[1.0; 2]; 2]).is_none());
     }
 
     /// A threshold the profile left at an end of its range (draw 1028 of the coverage study:

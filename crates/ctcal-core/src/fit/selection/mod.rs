@@ -245,6 +245,7 @@ fn fit_with_frames(
         timing: start.timing,
         known: loop_run.known,
         interpolation_share: start.interpolation_share,
+        offset_reach: start.offset_reach,
         other_response,
         frame_quality: frame_quality::FrameQuality::default(),
         frames_aligned,

@@ -71,6 +71,9 @@ pub struct Start {
     /// The frames' log offset the start's thresholds were read at, and the range their
     /// systematic spans ([`aps::ApsResult::frame_offset_dn`]; none for a start value).
     pub frame_offset_dn: Option<(f32, (f32, f32))>,
+    /// Where the start's offset was not confirmed by both polarities, each threshold at the
+    /// ends of the offset's range (down to no offset) over the value ([`aps::ApsResult::offset_reach`]).
+    pub offset_reach: Option<[[f64; 2]; 2]>,
     /// The leak drift the estimate's event timing measured (none for a start value).
     pub leak_drift: Option<crate::fit::effects::leak::TimingDrift>,
     pub step: Step,
@@ -114,6 +117,7 @@ pub fn thresholds(
         timing: None,
         interpolation_share: None,
         frame_offset_dn: None,
+        offset_reach: None,
         leak_drift: None,
         assumptions: vec![format!(
             "thresholds start at {default} (a start value, not a measurement): {reason}"
@@ -132,16 +136,17 @@ pub fn thresholds(
         (
             f.estimate,
             f.interpolation_share,
-            f.frame_offset_dn,
+            (f.frame_offset_dn, f.offset_reach),
             f.leak_drift,
             f.noise_polarities,
         )
     });
     match found {
-        Ok((e, share, offset, drift, noise)) => match e.thresholds() {
+        Ok((e, share, (offset, reach), drift, noise)) => match e.thresholds() {
             Some((on, off)) => Start {
                 interpolation_share: Some(share),
                 frame_offset_dn: Some(offset),
+                offset_reach: (reach != [[1.0; 2]; 2]).then_some(reach),
                 leak_drift: Some(crate::fit::effects::leak::TimingDrift::of(&drift, on)),
                 timing: event_timing(&e, noise),
                 ..measured(&e, on, off)
@@ -228,6 +233,7 @@ fn measured(e: &CtEstimate, on: f64, off: f64) -> Start {
         timing: None,
         interpolation_share: None,
         frame_offset_dn: None,
+        offset_reach: None,
         leak_drift: None,
         assumptions: Vec::new(),
         step: step(
