@@ -249,7 +249,8 @@ mod tests {
         let out = json!({"params": {"ct_on": 0.3},
             "mismatch_detection": {"at_most": 0.0317, "timing_ci95": [0.0, 0.0317]}});
         let r = extract(Method::Fit, &out);
-        // draw 49's aps interval [0, 0.0317] against its true 0.0561: missed; a true 0.02
+        // draw 49's interval from `estimate aps` on the whole recording, [0, 0.0317],
+        // against its true 0.0561: missed; a true 0.02
         // or no spread at all: covered
         assert!(r[MISMATCH_LIMIT].covers(0.02) && r[MISMATCH_LIMIT].covers(0.0));
         assert!(!r[MISMATCH_LIMIT].covers(0.0561));

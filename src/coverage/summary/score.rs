@@ -31,7 +31,8 @@ pub fn in_population(record: &RunRecord, parameter: &str) -> bool {
     let Some(truth) = &record.truth else {
         return true;
     };
-    // a spread is scored whether or not the draw has one (0 is a true spread)
+    // a spread is scored whether or not the draw has one (a ctcal draw without mismatch
+    // has a true spread of 0; the other simulators' truths give none, and are not scored)
     let effect_needed =
         record.method.is_fit() && !["ct_sigma", MISMATCH_LIMIT].contains(&parameter);
     truth.value(truth_key(parameter)).is_some()

@@ -712,12 +712,12 @@ fn offset_found(
         let own = frames.offset;
         frames.offset = t.offset.offset_dn;
         frames.offset_range = t.offset.systematic_range;
-        frames.offset_reached = t.offset.unconfirmed();
+        frames.offset_reached = t.offset.unconfirmed;
         let offset = match masked_by_slow_photoreceptor(input, excluded, frames, &t.offset, own) {
             Some((offset, why)) => {
                 frames.offset = offset.offset_dn;
                 frames.offset_range = offset.systematic_range;
-                frames.offset_reached = offset.unconfirmed();
+                frames.offset_reached = offset.unconfirmed;
                 assumptions.push(why);
                 offset
             }
@@ -773,6 +773,7 @@ fn masked_by_slow_photoreceptor(
         ci95: [None, None],
         systematic_range: range,
         by_polarity: fitted.by_polarity,
+        unconfirmed: false,
         source: SLOW_MASKS_OFFSET,
     };
     Some((offset, why))
@@ -859,7 +860,7 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
     let side = offset_end;
     match o.source {
         "fitted" => format!(
-            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval, both polarities' offsets, and the offset -+ their difference within the prior range {:.0} .. {:.0} DN: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing; down to no offset where a polarity gives none, and the intervals then reach the thresholds read at the range's ends: the offset is a compromise, not a measurement) is in their intervals",
+            "frames read as ln(DN + b), b = {:.1} DN (95 % {} .. {}; the ON samples alone give {}, the OFF samples {}): the offset at which thresholds do not depend on brightness; the thresholds' change over {:.1} .. {:.1} DN (the interval, both polarities' offsets, and the offset -+ their difference within the prior range {:.0} .. {:.0} DN: anything else that depends on brightness moves the fitted offset, and shows as the two disagreeing{}) is in their intervals",
             o.offset_dn,
             side(o.ci95[0]),
             side(o.ci95[1]),
@@ -869,6 +870,11 @@ fn offset_assumption(o: &super::timing::Offset) -> String {
             o.systematic_range.1,
             super::timing::OFFSET_PRIOR.0,
             super::timing::OFFSET_PRIOR.1,
+            if o.unconfirmed {
+                "; a polarity that gives no offset anywhere in the search makes the offset a compromise, not a measurement: the range reaches down to no offset, and the intervals reach the thresholds read at its ends"
+            } else {
+                ""
+            },
         ),
         "not determined: the photoreceptor's lag" => format!(
             "the frames' log offset b in ln(DN + b) is not determined: the photoreceptor's lag (a bandwidth limit) makes dark pixels' thresholds look larger as a too small offset would; b = {:.1} DN kept, and the thresholds' change over the prior range {:.0} .. {:.0} DN is in their intervals",

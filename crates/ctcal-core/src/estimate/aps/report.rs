@@ -361,8 +361,9 @@ fn withhold_noise_polarities(estimate: &mut CtEstimate, timing: &TimingEstimate)
 
 /// ON and OFF thresholds combined over the `estimators`, each with the method's systematic
 /// error and reaching to what the other log response, a slow photoreceptor and, where a
-/// polarity gave no offset, event timing at the ends of the whole offset prior
-/// (`offset_reach`, ratios to the value, ON then OFF) ask for; their assumptions added.
+/// polarity gave no offset, event timing at the ends of the offset's range, down to no
+/// offset (`offset_reach`, ratios to the value, ON then OFF) ask for; their assumptions
+/// added.
 fn combined_thresholds(
     estimators: &[EstimatorReport],
     findings: &Findings,

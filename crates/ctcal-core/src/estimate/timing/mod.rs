@@ -148,6 +148,11 @@ pub struct Offset {
     /// [`OFFSET_PRIOR`] makes them independent of brightness). One offset belongs to the frames, so their
     /// difference is what other brightness-dependent errors do to the fit.
     pub by_polarity: [Option<f32>; 2],
+    /// A fitted offset one polarity's samples give no offset for anywhere in the search
+    /// (no root of its level slope from -0.9 of the darkest DN to 255 DN; a root outside the
+    /// prior is not this): the joint offset is a compromise, not a measurement
+    /// ([`with_polarity_offsets`]).
+    pub unconfirmed: bool,
     /// `fitted`, `given` (by the caller), or `not determined...` (the thresholds do not
     /// become independent of brightness at any offset, the photoreceptor's lag hides what
     /// the offset does, the root lies outside [`OFFSET_PRIOR`], or its interval spans the
@@ -166,14 +171,6 @@ pub const NOT_BOUNDED: &str =
 /// and 23 (DVS240) in 8-bit DN (Lin et al., ECCV 2022, `config.py`); DAVIS APS frames are
 /// written with a black level of some tens of DN subtracted.
 pub const OFFSET_PRIOR: (f32, f32) = (0.0, 60.0);
-
-impl Offset {
-    /// A fitted offset one polarity's samples do not give (none within the prior): the
-    /// joint offset is a compromise, not a measurement ([`with_polarity_offsets`]).
-    pub fn unconfirmed(&self) -> bool {
-        self.source == "fitted" && self.by_polarity.iter().any(Option::is_none)
-    }
-}
 
 /// The leak drift the timing found.
 #[derive(Clone, Debug, Serialize)]
@@ -434,7 +431,7 @@ pub fn estimate(
         blocks,
         ends: &ends,
         central: &central.coefficients,
-        unconfirmed: central.offset.unconfirmed() || frames.offset_reached,
+        unconfirmed: central.offset.unconfirmed || frames.offset_reached,
     };
     let peaks = central.peaks(options.mode_window);
     let polarities = [
@@ -550,6 +547,7 @@ pub(super) fn find_offset(
             ci95: [Some(frames.offset); 2],
             systematic_range: frames.offset_range,
             by_polarity: [None; 2],
+            unconfirmed: false,
             source: "given",
         };
     }
@@ -558,6 +556,7 @@ pub(super) fn find_offset(
         ci95: [None, None],
         systematic_range: OFFSET_PRIOR,
         by_polarity: [None; 2],
+        unconfirmed: false,
         source: "not determined",
     };
     // a strong lag also makes dark pixels' thresholds look larger; the offset would absorb it
@@ -639,6 +638,7 @@ fn classified(root: f32, ci95: [Option<f32>; 2], not_determined: Offset) -> Offs
             ci95[1].unwrap_or(OFFSET_PRIOR.1.max(root)),
         ),
         by_polarity: [None; 2],
+        unconfirmed: false,
         source: "fitted",
     }
 }
@@ -658,8 +658,8 @@ fn search_range(pairs: &[Pair]) -> (f32, f32) {
 /// range, and that range widened by their disagreement ([`disagreement_range`]); found for
 /// the chosen response only. Other offsets are returned as they are.
 ///
-/// Where one polarity gives no offset within the prior, no black level makes its
-/// thresholds stop depending on brightness: something else that depends on brightness
+/// Where one polarity gives no offset anywhere in the search (a root outside the prior is
+/// not this), no black level makes its thresholds stop depending on brightness: something else that depends on brightness
 /// moves its samples, and the joint offset is a compromise between that and the other
 /// polarity, not a measurement. The systematic range then reaches down to no offset, the
 /// frames as written (the prior's lower end), and the thresholds' intervals reach the
@@ -680,8 +680,9 @@ fn with_polarity_offsets(
     if offset.source != "fitted" {
         return offset;
     }
-    let by_polarity = polarity_offsets(pairs, options, fit, search_range(pairs))
-        .map(|b| b.filter(|b| (OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(b)));
+    let found = polarity_offsets(pairs, options, fit, search_range(pairs));
+    let unconfirmed = found.iter().any(Option::is_none);
+    let by_polarity = found.map(|b| b.filter(|b| (OFFSET_PRIOR.0..=OFFSET_PRIOR.1).contains(b)));
     let systematic_range = by_polarity
         .iter()
         .flatten()
@@ -694,7 +695,7 @@ fn with_polarity_offsets(
         .fold(offset.systematic_range, |(lo, hi), b| {
             (lo.min(b), hi.max(b))
         });
-    let systematic_range = if by_polarity.iter().any(Option::is_none) {
+    let systematic_range = if unconfirmed {
         // no black level explains one polarity: down to none, the frames as written
         (systematic_range.0.min(OFFSET_PRIOR.0), systematic_range.1)
     } else {
@@ -703,6 +704,7 @@ fn with_polarity_offsets(
     Offset {
         systematic_range,
         by_polarity,
+        unconfirmed,
         ..offset
     }
 }
@@ -1119,30 +1121,6 @@ fn std_dev(values: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Coverage draw 49's offset: fitted at 27.6 DN, the ON samples giving none; one with
-    /// both polarities, or one not fitted, is confirmed or not a fit at all.
-    #[test]
-    fn a_fitted_offset_one_polarity_does_not_give_is_unconfirmed() {
-        let fitted = Offset {
-            offset_dn: 27.6,
-            ci95: [Some(26.9), Some(28.4)],
-            systematic_range: (0.0, 60.0),
-            by_polarity: [None, Some(30.4)],
-            source: "fitted",
-        };
-        assert!(fitted.unconfirmed());
-        let both = Offset {
-            by_polarity: [Some(24.1), Some(26.0)],
-            ..fitted.clone()
-        };
-        assert!(!both.unconfirmed());
-        let given = Offset {
-            source: "given",
-            ..fitted
-        };
-        assert!(!given.unconfirmed());
-    }
 
     #[test]
     fn sigma_removes_the_estimation_noise_of_each_pixel() {

@@ -409,29 +409,58 @@ fn threshold_intervals(
         assumptions.push(note);
     }
     if !widening.fixed {
-        assumptions.extend(super::look_alikes::widen(
-            &mut state.uncertainty,
-            widening.ambiguities,
-            &state.model.params,
-        ));
-    }
-    if !widening.fixed
-        && let Some(other) = widening.other_response
-    {
-        assumptions.extend(reach_for_other_response(&mut state.uncertainty, other));
-    }
-    if !widening.fixed
-        && let Some(reach) = widening.offset_reach
-    {
-        assumptions.extend(reach_for_unconfirmed_offset(&mut state.uncertainty, reach));
-    }
-    if !widening.fixed {
-        assumptions.extend(super::method_systematic::widen(&mut state.uncertainty));
+        assumptions.extend(reach_what_the_data_leave_open(state, &widening));
     }
     assumptions.extend(super::method_systematic::widen_cutoff(
         &mut state.uncertainty,
     ));
     assumptions
+}
+
+/// The fitted thresholds' intervals reaching what the data leave open: the look-alike
+/// models' thresholds, the other log response's, an unconfirmed offset's ends, then the
+/// method systematic; the assumptions each adds.
+fn reach_what_the_data_leave_open(state: &mut State, widening: &Widening) -> Vec<String> {
+    let uncertainty = &mut state.uncertainty;
+    let mut assumptions: Vec<String> =
+        super::look_alikes::widen(uncertainty, widening.ambiguities, &state.model.params)
+            .into_iter()
+            .collect();
+    assumptions.extend(
+        widening
+            .other_response
+            .and_then(|other| reach_for_other_response(uncertainty, other)),
+    );
+    assumptions.extend(
+        widening
+            .offset_reach
+            .and_then(|reach| reach_for_unconfirmed_offset(uncertainty, reach)),
+    );
+    assumptions.extend(super::method_systematic::widen(uncertainty));
+    assumptions
+}
+
+/// Each threshold's interval (ON, OFF) reaching every one of its ratios to the value that
+/// is not 1, each on its own side; the intervals that changed, in words.
+fn reach_thresholds(
+    uncertainty: &mut BTreeMap<String, crate::fit::Uncertain>,
+    ratios: [&[f64]; 2],
+) -> Vec<String> {
+    ["ct_on", "ct_off"]
+        .into_iter()
+        .zip(ratios)
+        .filter_map(|(key, ratios)| {
+            let ratios: Vec<f64> = ratios
+                .iter()
+                .copied()
+                .filter(|r| r.is_finite() && *r > 0.0 && *r != 1.0)
+                .collect();
+            if ratios.is_empty() {
+                return None;
+            }
+            super::method_systematic::reach_ln_each(uncertainty, key, &ratios)
+        })
+        .collect()
 }
 
 /// Widens each threshold's interval on the other log response's side, in ln C in
@@ -441,14 +470,9 @@ fn reach_for_other_response(
     uncertainty: &mut BTreeMap<String, crate::fit::Uncertain>,
     other: &crate::estimate::timing::OtherResponse,
 ) -> Option<String> {
-    let widened: Vec<String> = ["ct_on", "ct_off"]
-        .into_iter()
-        .zip(other.threshold_ratios())
-        .filter(|(_, r)| r.is_finite() && *r > 0.0)
-        .filter_map(|(key, r)| super::method_systematic::reach_ln(uncertainty, key, r))
-        .collect();
+    let [on, off] = other.threshold_ratios();
+    let widened = reach_thresholds(uncertainty, [&[on], &[off]]);
     (!widened.is_empty()).then(|| {
-        let [on, off] = other.threshold_ratios();
         format!(
             "log response not determined: {} (b = {:.1} DN) explains the fit run's event timing within the pixels' noise of the response used (its scatter {:.2} times, 95 % {:.2} .. {:.2}); its thresholds, ON {on:.2} and OFF {off:.2} times the ones used, are in the intervals: {}",
             if other.response == "eps" { "a pure ln(DN + b)" } else { "v2e's lin-log" },
@@ -463,34 +487,20 @@ fn reach_for_other_response(
 
 /// Widens each threshold's interval, in ln C in quadrature on each side, to reach the
 /// thresholds the start's event timing read at the ends of the offset's range (down to no
-/// offset, the frames as written), where
-/// one polarity gave no offset (`reach`: ON, OFF, each the lower and the higher ratio to
-/// the value; [`crate::estimate::aps::ApsResult::offset_reach`]): the fit simulates the
-/// frames at the start's offset, which is then a compromise, not a measurement; returns the
-/// assumption that says so.
+/// offset, the frames as written), where one polarity gave no offset (`reach`: ON, OFF,
+/// each the lower and the higher ratio to the value;
+/// [`crate::estimate::aps::ApsResult::offset_reach`]): the fit simulates the frames at the
+/// start's offset, which is then a compromise, not a measurement; returns the assumption
+/// that says so.
 fn reach_for_unconfirmed_offset(
     uncertainty: &mut BTreeMap<String, crate::fit::Uncertain>,
     reach: [[f64; 2]; 2],
 ) -> Option<String> {
-    let widened: Vec<String> = ["ct_on", "ct_off"]
-        .into_iter()
-        .zip(reach)
-        .filter_map(|(key, ratios)| {
-            // each side reached in turn, said once: the first interval -> the last
-            let steps: Vec<String> = ratios
-                .into_iter()
-                .filter(|r| r.is_finite() && *r > 0.0 && *r != 1.0)
-                .filter_map(|r| super::method_systematic::reach_ln(uncertainty, key, r))
-                .collect();
-            let before = steps.first()?.split(" -> ").next()?;
-            let after = steps.last()?.rsplit(" -> ").next()?;
-            Some(format!("{before} -> {after}"))
-        })
-        .collect();
+    let widened = reach_thresholds(uncertainty, [&reach[0], &reach[1]]);
     (!widened.is_empty()).then(|| {
         let [[on_lo, on_hi], [off_lo, off_hi]] = reach;
         format!(
-            "frames' log offset not confirmed: one polarity of the start's event timing gives no offset within 0 .. 60 DN (something else that depends on brightness moves its samples), so the offset the frames are simulated at is a compromise; the thresholds event timing reads at the ends of the offset's range, down to no offset (the frames as written), ON {on_lo:.2} .. {on_hi:.2} and OFF {off_lo:.2} .. {off_hi:.2} times the start's, are in the intervals: {}",
+            "frames' log offset not confirmed: one polarity of the start's event timing gives no offset anywhere in its search (something else that depends on brightness moves its samples), so the offset the frames are simulated at is a compromise; the thresholds event timing reads at the ends of the offset's range, down to no offset (the frames as written), ON {on_lo:.2} .. {on_hi:.2} and OFF {off_lo:.2} .. {off_hi:.2} times the start's, are in the intervals: {}",
             widened.join("; ")
         )
     })
@@ -920,10 +930,11 @@ mod tests {
         Uncertain::with_interval(value, None, [Some(lo), Some(hi)])
     }
 
-    /// Coverage draw 49's start: ON 0.133 where event timing at the ends of the offset
-    /// prior reads 0.5 and 5.9 times that; the interval [0.089, 0.178] reaches 0.0665 and
-    /// 0.785 in quadrature in ln C (ln 2 and ln 5.9 against the interval's own half-widths)
-    /// and holds the true 0.711; OFF with no reach is unchanged.
+    /// A start like coverage draw 49's: ON 0.133 where event timing at the ends of the
+    /// offset's range reads 0.5 and 5.9 times that (the draw's own: 0.56 and 5.68); the
+    /// interval [0.089, 0.178] reaches 0.0665 and 0.785 in quadrature in ln C (ln 2 and
+    /// ln 5.9 against the interval's own half-widths) and holds the true 0.711; OFF with no
+    /// reach is unchanged.
     #[test]
     fn an_unconfirmed_offset_s_ends_are_reached() {
         let mut u = BTreeMap::from([

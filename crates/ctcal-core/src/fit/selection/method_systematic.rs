@@ -59,6 +59,20 @@ pub(super) fn reach_ln(
     })
 }
 
+/// `key`'s 95 % interval reaching each of `ratios` times its value in turn, each on its own
+/// side ([`reach_ln`]), said once: `key [lo, hi] -> [lo', hi']`.
+pub(super) fn reach_ln_each(
+    uncertainty: &mut BTreeMap<String, Uncertain>,
+    key: &str,
+    ratios: &[f64],
+) -> Option<String> {
+    reshape(uncertainty, key, |v, ends| {
+        ratios.iter().fold(ends, |ends, &ratio| {
+            crate::estimate::interval::ln_reach(v, ends, ratio)
+        })
+    })
+}
+
 /// `key`'s 95 % interval widened by `ln_sd` (a standard deviation of the parameter's
 /// logarithm) in quadrature on each side in the logarithm: a lower end at 0 stays there and
 /// an open side stays open. Returns `key [lo, hi] -> [lo', hi']`, or `None` where there is

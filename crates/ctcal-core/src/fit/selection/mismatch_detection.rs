@@ -62,7 +62,7 @@ pub fn detect(
     Some((detection, note))
 }
 
-const NO_TIMING_INTERVAL: &str = "event timing on the fit run gave no interval of the threshold spread (too few pixels with enough events against the frames, or no thresholds), so nothing bounds it from above";
+const NO_TIMING_INTERVAL: &str = "event timing on the fit run gave no interval of the threshold spread (too few pixels with enough events against the frames, a polarity whose samples are mostly noise, or thresholds that are a start value: the start's step says which), so nothing bounds it from above";
 
 const MEANING: &str = "where the final model has no threshold mismatch and event timing resolved no spread: at_most, the upper end of the 95 % interval of the frozen per-pixel threshold spread (log units) that event timing on the fit run measures (timing_ci95; null with why where it gave none); recording_evidence and evidence: the per-pixel counts' dispersion within tiles against the final model's, in standard errors (null where too few events per pixel to compare); counts_call_for_it: that evidence calls for mismatch (a spread may be present that the selection did not keep); tried_spread: the spread the fit blocks chose where the loop tried mismatch and did not keep it";
 

@@ -182,6 +182,8 @@ impl Probe<'_> {
             Limit::Never => return (Err(NEVER.into()), Some(isolated)),
         };
         let mut checked = rate;
+        // the lowest rate checked whose evidence reached the threshold, short of the margin
+        let mut reached: Option<f64> = None;
         for _ in 0..CHECKS {
             let added = match self.added(rate) {
                 Ok(a) => a,
@@ -197,11 +199,20 @@ impl Probe<'_> {
                 return (Ok(rate), Some(isolated));
             }
             checked = rate;
-            rate *= next_step(self.evidence.calls(added, 1.0, EVIDENCE_THRESHOLD));
+            let at_threshold = self.evidence.calls(added, 1.0, EVIDENCE_THRESHOLD);
+            if at_threshold && reached.is_none() {
+                reached = Some(rate);
+            }
+            rate *= next_step(at_threshold);
         }
-        let why = format!(
-            "not called for at any rate checked (up to {checked:.3} Hz): its isolated events grow more slowly than its rate (a leak's first event comes one period after the recording starts)"
-        );
+        let why = match reached {
+            Some(first) => format!(
+                "called for from {first:.3} Hz on, but never {MARGIN_Z} standard errors above the threshold at any rate checked (up to {checked:.3} Hz), so not in about 95 % of such recordings"
+            ),
+            None => format!(
+                "not called for at any rate checked (up to {checked:.3} Hz): its isolated events grow more slowly than its rate (a leak's first event comes one period after the recording starts)"
+            ),
+        };
         (Err(why), Some(isolated))
     }
 
