@@ -121,18 +121,25 @@ fn fit_interval(uncertainty: &Value, value: f64) -> Option<(Option<f64>, Option<
     Some((Some(value - Z95 * se), Some(value + Z95 * se)))
 }
 
-/// A fit's bandwidth detection limit as `[limit, open)`: absent where the fit has a cutoff
-/// (or no frames), `null` with its reason where there is no limit.
-fn cutoff_limit(output: &Value) -> Reported {
-    let Some(detection) = output.get("bandwidth_detection") else {
+/// A fit's detection limit: `object.field` as the interval `range(limit)` gives; absent
+/// where the fit wrote no `object`, `null` with its reason where there is no limit.
+fn detection_limit(
+    output: &Value,
+    (object, field): (&str, &str),
+    range: impl Fn(f64) -> (Option<f64>, Option<f64>),
+) -> Reported {
+    let Some(detection) = output.get(object) else {
         return Reported::NotReported;
     };
-    match detection["called_for_below_hz"].as_f64() {
-        Some(limit) => Reported::Interval {
-            value: limit,
-            lo: Some(limit),
-            hi: None,
-        },
+    match detection[field].as_f64() {
+        Some(limit) => {
+            let (lo, hi) = range(limit);
+            Reported::Interval {
+                value: limit,
+                lo,
+                hi,
+            }
+        }
         None => Reported::NotDeterminable {
             why: detection["why"]
                 .as_str()
@@ -142,26 +149,23 @@ fn cutoff_limit(output: &Value) -> Reported {
     }
 }
 
+/// A fit's bandwidth detection limit as `[limit, open)`: absent where the fit has a cutoff
+/// (or no frames), `null` with its reason where there is no limit.
+fn cutoff_limit(output: &Value) -> Reported {
+    detection_limit(
+        output,
+        ("bandwidth_detection", "called_for_below_hz"),
+        |limit| (Some(limit), None),
+    )
+}
+
 /// A fit's most event timing allows of a spread its model lacks, as `[0, at_most]`: absent
 /// where the model has a spread or event timing resolved one (or no frames), `null` with
 /// its reason where event timing gave no interval.
 fn mismatch_limit(output: &Value) -> Reported {
-    let Some(detection) = output.get("mismatch_detection") else {
-        return Reported::NotReported;
-    };
-    match detection["at_most"].as_f64() {
-        Some(limit) => Reported::Interval {
-            value: limit,
-            lo: Some(0.0),
-            hi: Some(limit),
-        },
-        None => Reported::NotDeterminable {
-            why: detection["why"]
-                .as_str()
-                .unwrap_or("null without a reason")
-                .to_string(),
-        },
-    }
+    detection_limit(output, ("mismatch_detection", "at_most"), |limit| {
+        (Some(0.0), Some(limit))
+    })
 }
 
 fn fit_parameter(output: &Value, key: &str) -> Reported {

@@ -362,6 +362,7 @@ impl FullPass {
                 slow,
             },
         );
+        let offset_reach = full.timing.offset_reach();
         ApsResult {
             estimate,
             interpolation_share: [
@@ -370,7 +371,7 @@ impl FullPass {
             ],
             maps: full.timing.maps,
             frame_offset_dn: (frames.offset, frames.offset_range),
-            offset_reach: [full.timing.on.offset_reach, full.timing.off.offset_reach],
+            offset_reach,
             noise_polarities: [&full.timing.on, &full.timing.off]
                 .map(|p| p.peak.is_some_and(|peak| !peak.stands_out())),
             leak_drift: full.timing.drift,

@@ -296,8 +296,12 @@ pub(super) fn assemble(
     full: &Pass,
     findings: Findings,
 ) -> CtEstimate {
-    let offset_reach = [full.timing.on.offset_reach, full.timing.off.offset_reach];
-    let [on, off] = combined_thresholds(&estimators, &findings, offset_reach, &mut assumptions);
+    let [on, off] = combined_thresholds(
+        &estimators,
+        &findings,
+        full.timing.offset_reach(),
+        &mut assumptions,
+    );
     let mut estimate = CtEstimate::from_parts("aps", &on, &off, Determinable::POSITIVE);
     estimate.intervals_used = frames.used_intervals();
     estimate.intervals_dropped = frames

@@ -204,6 +204,13 @@ pub struct TimingEstimate {
     pub lag: Lag,
 }
 
+impl TimingEstimate {
+    /// Each polarity's (ON, OFF) [`PolarityEstimate::offset_reach`].
+    pub fn offset_reach(&self) -> [[f64; 2]; 2] {
+        [self.on.offset_reach, self.off.offset_reach]
+    }
+}
+
 /// The photoreceptor lag the timing found.
 #[derive(Clone, Debug, Serialize)]
 pub struct Lag {
